@@ -121,3 +121,19 @@ def test_point_mass_pendulum_at_ninety_degrees_is_regular():
         x[model.layout.state["omega_si_s"]] = [1.0, -2.0]
         xd = model.derivative(x, p, model.loads(g_i=[-9.81, 0, 0]))
         assert np.all(np.isfinite(xd))
+
+
+def test_shift_cg_keeps_the_structure_in_place():
+    from scipy.spatial.transform import Rotation
+    model = NonRigidModel()
+    x = model.layout.zeros_state()
+    rot = Rotation.from_euler("zyx", [30, -20, 10], degrees=True)
+    q = rot.as_quat()
+    x[6:10] = [q[3], q[0], q[1], q[2]]
+    x[10:13] = [0.1, -0.4, 0.2]
+    d = np.array([-0.5, 0.02, 0.0])
+    y = model.shift_cg(x, d)
+    C = rot.as_matrix()
+    np.testing.assert_allclose(y[0:3], C @ d)
+    np.testing.assert_allclose(y[3:6], C @ np.cross(x[10:13], d))
+    np.testing.assert_array_equal(y[6:], x[6:])

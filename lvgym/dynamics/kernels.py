@@ -39,7 +39,7 @@ _S_N, _S_Y, _S_Z, _S_RHO, _S_GB, _S_TAU, _S_M, _S_L, _S_K2 = 0, 3, 6, 9, 12, 15,
 SLOSH_WORK = 20
 
 
-@nb.njit(cache=True, inline="always")
+@nb.njit(cache=True, error_model="numpy", inline="always")
 def quat_to_dcm(q0, q1, q2, q3, C):
     """Write ``C = R(q)`` (the matrix taking frame-b components to frame-i components for
     ``q = q_bi``) of the normalised quaternion into the 3x3 array ``C``."""
@@ -59,7 +59,7 @@ def quat_to_dcm(q0, q1, q2, q3, C):
     C[2, 2] = 1.0 - 2.0 * (q1 * q1 + q2 * q2)
 
 
-@nb.njit(cache=True, inline="always")
+@nb.njit(cache=True, error_model="numpy", inline="always")
 def _quat_rate(q, o, w1, w2, w3, out, oo):
     """``out[oo:oo+4] = 0.5 q (x) (0, w)`` for the quaternion ``q[o:o+4]`` and body rate w."""
     q0, q1, q2, q3 = q[o], q[o + 1], q[o + 2], q[o + 3]
@@ -69,34 +69,35 @@ def _quat_rate(q, o, w1, w2, w3, out, oo):
     out[oo + 3] = 0.5 * (q0 * w3 + q1 * w2 - q2 * w1)
 
 
-@nb.njit(cache=True, inline="always")
+@nb.njit(cache=True, error_model="numpy", inline="always")
 def _cholesky_solve(A, b, n):
     """Solve ``A x = b`` in place for the symmetric positive definite leading ``n x n`` block
-    of A (only its lower triangle is read); the solution overwrites b."""
+    of A (only its lower triangle is read); the solution overwrites b. The diagonal of A is
+    overwritten with the reciprocals of the Cholesky factor's diagonal."""
     for j in range(n):
         s = A[j, j]
         for k in range(j):
             s -= A[j, k] * A[j, k]
-        d = math.sqrt(s)
-        A[j, j] = d
+        inv = 1.0 / math.sqrt(s)
+        A[j, j] = inv
         for i in range(j + 1, n):
             s = A[i, j]
             for k in range(j):
                 s -= A[i, k] * A[j, k]
-            A[i, j] = s / d
+            A[i, j] = s * inv
     for i in range(n):
         s = b[i]
         for k in range(i):
             s -= A[i, k] * b[k]
-        b[i] = s / A[i, i]
+        b[i] = s * A[i, i]
     for i in range(n - 1, -1, -1):
         s = b[i]
         for k in range(i + 1, n):
             s -= A[k, i] * b[k]
-        b[i] = s / A[i, i]
+        b[i] = s * A[i, i]
 
 
-@nb.njit(cache=True, inline="always")
+@nb.njit(cache=True, error_model="numpy", inline="always")
 def _add_sym_outer(A, h, c, n):
     """``A += c h h^T`` on the lower triangle of the leading n x n block."""
     for i in range(n):
@@ -105,7 +106,7 @@ def _add_sym_outer(A, h, c, n):
             A[i, k] += ci * h[k]
 
 
-@nb.njit(cache=True, inline="always")
+@nb.njit(cache=True, error_model="numpy", inline="always")
 def _body_row_map(C, rho0, rho1, rho2, phi, a0, a1, a2, K, h):
     """``h = Bt^T a_b`` for a body-frame vector ``a_b`` at a node with offset rho from the CG and
     mode shape phi: ``h = [C a_b, rho x a_b, phi a_b,y, phi a_b,z]`` (the transpose of the map from
@@ -121,7 +122,7 @@ def _body_row_map(C, rho0, rho1, rho2, phi, a0, a1, a2, K, h):
         h[6 + K + k] = phi[k] * a2
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, error_model="numpy")
 def vehicle_deriv(x, p, u, n_slosh, n_modes, xdot, A, rhs, h, C, S, work):
     """Time derivative ``xdot`` of one vehicle's state ``x`` for parameters ``p`` and loads ``u``.
 
@@ -361,7 +362,7 @@ def workspace_sizes(n_slosh: int, n_modes: int) -> tuple[int, int]:
     return 6 + 2 * n_modes, max(n_slosh, 1)
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, error_model="numpy")
 def make_workspace(n_slosh, n_modes):
     """Allocate the work arrays of ``vehicle_deriv``: (A, rhs, h, C, S, work)."""
     nr = 6 + 2 * n_modes

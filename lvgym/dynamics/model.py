@@ -32,6 +32,13 @@ def _rows(a: np.ndarray, batch: int) -> np.ndarray:
     return np.require(np.broadcast_to(a, (batch, a.shape[1])), np.float64, ["C", "W"])
 
 
+def _rotate(q: np.ndarray, a: np.ndarray) -> np.ndarray:
+    """``C_ib a`` for unit scalar-first quaternions ``q`` (B, 4) and vectors ``a`` (B, 3)."""
+    s, v = q[:, :1], q[:, 1:]
+    t = 2.0 * np.cross(v, a)
+    return a + s * t + np.cross(v, t)
+
+
 def _shape_like(result: np.ndarray, template: np.ndarray) -> np.ndarray:
     return result[0] if np.ndim(template) == 1 else result
 
@@ -136,6 +143,24 @@ class NonRigidModel:
         xb = xb.copy()
         step_batch(zoh_loads, xb, pb, ub, float(t0), float(dt), int(n_steps), self.n_slosh,
                    self.n_modes, method == "rk4", self.layout.n_u)
+        return _shape_like(xb, x)
+
+    def shift_cg(self, x: np.ndarray, delta_cg_b) -> np.ndarray:
+        """State with the CG of B moved by ``delta_cg_b`` (body frame, m) within the structure.
+
+        ``r_zw_i`` and ``v_zw_i`` refer to the CG of B. When the mass model moves the CG station
+        between steps (propellant burns, a stage separates), this keeps the structure where it was:
+        ``r += C_ib d`` and ``v += C_ib (omega x d)`` (the velocity of the structure point that is the
+        new CG; the rate of the CG's motion through the structure is neglected, as the thesis does).
+        Returns a copy shaped like ``x``; ``delta_cg_b`` is (3,) or (B, 3).
+        """
+        lay = self.layout
+        xb = as_batch(x, lay.n_x, "x").copy()
+        d = np.broadcast_to(np.asarray(delta_cg_b, dtype=float), (xb.shape[0], 3))
+        q = xb[:, lay.state["q_bi"]]
+        q = q / np.linalg.norm(q, axis=1, keepdims=True)
+        xb[:, lay.state["r_zw_i"]] += _rotate(q, d)
+        xb[:, lay.state["v_zw_i"]] += _rotate(q, np.cross(xb[:, lay.state["omega_bi_b"]], d))
         return _shape_like(xb, x)
 
     # ----------------------------------------------------------------- invariants

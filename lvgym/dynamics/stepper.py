@@ -49,7 +49,7 @@ def _zoh(t, x, p, c, u):
 zoh_loads = compile_loads(_zoh)
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, error_model="numpy")
 def modal_propagator(p, n_modes, tau, E):
     """``E[k] = expm(L_k tau)`` for ``L_k = [[0, 1], [-Omega_k^2, -2 Z_k Omega_k]]``."""
     K = n_modes
@@ -76,7 +76,7 @@ def modal_propagator(p, n_modes, tau, E):
         E[k, 1, 1] = e * (c - s * a)
 
 
-@nb.njit(cache=True, inline="always")
+@nb.njit(cache=True, error_model="numpy", inline="always")
 def _apply_modal(E, n_modes, v, out):
     """Apply the modal propagator to the (eta, eta_dot) pairs of the vector v, writing into out
     (the other components are copied). v and out may be the same array."""
@@ -89,7 +89,7 @@ def _apply_modal(E, n_modes, v, out):
         out[13 + 2 * K + k] = E[km, 1, 0] * a + E[km, 1, 1] * b
 
 
-@nb.njit(cache=True, inline="always")
+@nb.njit(cache=True, error_model="numpy", inline="always")
 def _nonlinear_part(x, p, n_modes, f):
     """Subtract the free modal dynamics from the derivative f: ``f -= L x`` on the modal rows."""
     K = n_modes
@@ -101,7 +101,7 @@ def _nonlinear_part(x, p, n_modes, f):
         f[13 + 2 * K + k] += 2.0 * ze * om * x[13 + 2 * K + k] + om * om * x[13 + k]
 
 
-@nb.njit(cache=True, inline="always")
+@nb.njit(cache=True, error_model="numpy", inline="always")
 def normalise_quaternions(x, n_slosh, n_modes):
     """Scale the body and pendulum quaternions of one state to unit norm."""
     for o in range(-1, n_slosh):
@@ -111,7 +111,7 @@ def normalise_quaternions(x, n_slosh, n_modes):
             x[qo + i] /= n
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, error_model="numpy")
 def rk4_vehicle(loads_fn, t, h, x, p, c, n_slosh, n_modes, exact_modes, buf, E, ws):
     """Advance one vehicle's state x in place by one step h from time t.
 
@@ -192,14 +192,14 @@ def rk4_vehicle(loads_fn, t, h, x, p, c, n_slosh, n_modes, exact_modes, buf, E, 
     normalise_quaternions(x, N, K)
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, error_model="numpy")
 def _alloc(n_x, n_u, n_slosh, n_modes):
     A, rhs, hh, C, S, work = make_workspace(n_slosh, n_modes)
     ws = (A, rhs, hh, C, S, work, np.empty(n_u))
     return np.empty((7, n_x)), np.empty((2, max(n_modes, 1), 2, 2)), ws
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, error_model="numpy")
 def step_batch(loads_fn, x, p, c, t0, h, n_steps, n_slosh, n_modes, exact_modes, n_u):
     """Advance every row of the batch state ``x`` (B, n_x) in place by ``n_steps`` steps of ``h``
     seconds from ``t0``, with parameters ``p`` (B, n_p) held and loads of length ``n_u`` written by
@@ -214,7 +214,7 @@ def step_batch(loads_fn, x, p, c, t0, h, n_steps, n_slosh, n_modes, exact_modes,
             t += h
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, error_model="numpy")
 def deriv_batch(x, p, u, n_slosh, n_modes, out):
     """``out[b] = xdot`` of every vehicle of the batch."""
     B, n_x = x.shape
