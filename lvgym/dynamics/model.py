@@ -1,11 +1,14 @@
 """Python face of the dynamics core: one class for one vehicle or a batch, and a time integrator.
 
 >>> from lvgym.dynamics import NonRigidModel
->>> model = NonRigidModel(n_slosh=2, n_modes=1)
+>>> model = NonRigidModel(n_slosh=1, n_modes=1)
 >>> x = model.layout.zeros_state()                     # (n_x,) or (batch, n_x)
->>> p = model.params(m_b=60.0, J_b=[0.5, 300, 300])    # named, SI units
+>>> p = model.params(m_b=60.0, J_b=[0.5, 300, 300], omega_modes=[90.0],
+...                  slosh=[{"m": 5.0, "length": 0.3, "r_hinge": [-2.0, 0.0, 0.0]}])
 >>> u = model.loads(g_i=[-9.81, 0, 0])
 >>> x1 = model.step(x, p, u, dt=1e-3, n_steps=10)      # RK4, loads held over the steps
+>>> round(float(x1[3]), 6)                              # free fall: v = g t
+-0.0981
 
 Arrays with a leading batch axis go through the same compiled kernel, vehicle by vehicle.
 """

@@ -1,0 +1,24 @@
+"""The README's example and the docstring examples run."""
+
+import doctest
+import pathlib
+import re
+
+import lvgym.dynamics.model
+
+ROOT = pathlib.Path(__file__).resolve().parents[1]
+
+
+def test_readme_python_example_runs():
+    text = (ROOT / "README.md").read_text()
+    blocks = re.findall(r"```python\n(.*?)```", text, re.S)
+    assert blocks, "the README has no python example"
+    for block in blocks:
+        namespace: dict = {}
+        exec(compile(block, "README.md", "exec"), namespace)
+    assert namespace["traj"].t[-1] == 5.0
+
+
+def test_docstring_examples():
+    result = doctest.testmod(lvgym.dynamics.model)
+    assert result.attempted > 0 and result.failed == 0
