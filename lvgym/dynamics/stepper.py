@@ -77,16 +77,15 @@ def modal_propagator(p, n_modes, tau, E):
 
 
 @nb.njit(cache=True, error_model="numpy", inline="always")
-def _apply_modal(E, n_modes, v, out):
-    """Apply the modal propagator to the (eta, eta_dot) pairs of the vector v, writing into out
-    (the other components are copied). v and out may be the same array."""
+def _propagate(E, n_modes, v):
+    """Apply the modal propagator E in place to the (eta, eta_dot) pairs of the state-sized v."""
     K = n_modes
     for k in range(2 * K):
-        km = k % K if K > 0 else 0
+        km = k % K
         a = v[13 + k]
         b = v[13 + 2 * K + k]
-        out[13 + k] = E[km, 0, 0] * a + E[km, 0, 1] * b
-        out[13 + 2 * K + k] = E[km, 1, 0] * a + E[km, 1, 1] * b
+        v[13 + k] = E[km, 0, 0] * a + E[km, 0, 1] * b
+        v[13 + 2 * K + k] = E[km, 1, 0] * a + E[km, 1, 1] * b
 
 
 @nb.njit(cache=True, error_model="numpy", inline="always")
@@ -115,77 +114,64 @@ def normalise_quaternions(x, n_slosh, n_modes):
 def rk4_vehicle(loads_fn, t, h, x, p, c, n_slosh, n_modes, exact_modes, buf, E, ws):
     """Advance one vehicle's state x in place by one step h from time t.
 
-    ``buf`` is (7, n_x) scratch, ``E`` is (2, max(K, 1), 2, 2) scratch, ``ws`` the kernel workspace
-    (a tuple from ``make_workspace``) whose last entry is reused for the loads vector.
+    With ``P`` the exact free-mode propagator over h/2 (the identity for ``exact_modes=False`` or
+    no modes) and ``N(y) = f(y) - L y`` (f less the free-mode dynamics)::
+
+        k1 = N(x)                     k2 = N(P(x + h/2 k1))
+        k3 = N(P x + h/2 k2)          k4 = N(P(P x + h k3))
+        x <- P(P(x + h/6 k1) + h/3 (k2 + k3)) + h/6 k4
+
+    which is classical RK4 when P is the identity. ``buf`` is (6, n_x) scratch, ``E`` (max(K, 1),
+    2, 2) scratch, ``ws`` the kernel workspace whose last entry holds the loads vector.
     """
     N = n_slosh
     K = n_modes
     A, rhs, hh, C, S, work, u = ws
-    k1, k2, k3, k4, xs, ex, tmp = buf[0], buf[1], buf[2], buf[3], buf[4], buf[5], buf[6]
+    k1, k2, k3, k4, xs, px = buf[0], buf[1], buf[2], buf[3], buf[4], buf[5]
     n = x.size
     use_if = exact_modes and K > 0
     if use_if:
-        modal_propagator(p, K, 0.5 * h, E[0])
-        modal_propagator(p, K, h, E[1])
-    # stage 1
+        modal_propagator(p, K, 0.5 * h, E)
+
     loads_fn(t, x, p, c, u)
     vehicle_deriv(x, p, u, N, K, k1, A, rhs, hh, C, S, work)
     if use_if:
         _nonlinear_part(x, p, K, k1)
-        for i in range(n):
-            tmp[i] = x[i] + 0.5 * h * k1[i]
-        _apply_modal(E[0], K, tmp, xs)
-        for i in range(13):
-            xs[i] = tmp[i]
-        for i in range(13 + 4 * K, n):
-            xs[i] = tmp[i]
-    else:
-        for i in range(n):
-            xs[i] = x[i] + 0.5 * h * k1[i]
-    # stage 2
+    for i in range(n):
+        xs[i] = x[i] + 0.5 * h * k1[i]
+        px[i] = x[i]
+    if use_if:
+        _propagate(E, K, xs)
+        _propagate(E, K, px)
+
     loads_fn(t + 0.5 * h, xs, p, c, u)
     vehicle_deriv(xs, p, u, N, K, k2, A, rhs, hh, C, S, work)
     if use_if:
         _nonlinear_part(xs, p, K, k2)
-        # ex = E(h/2) x, shared by stages 3 and 4
-        for i in range(n):
-            ex[i] = x[i]
-        _apply_modal(E[0], K, ex, ex)
-        for i in range(n):
-            xs[i] = ex[i] + 0.5 * h * k2[i]
-    else:
-        for i in range(n):
-            xs[i] = x[i] + 0.5 * h * k2[i]
-    # stage 3
+    for i in range(n):
+        xs[i] = px[i] + 0.5 * h * k2[i]
+
     loads_fn(t + 0.5 * h, xs, p, c, u)
     vehicle_deriv(xs, p, u, N, K, k3, A, rhs, hh, C, S, work)
     if use_if:
         _nonlinear_part(xs, p, K, k3)
-        # xs = E(h) x + h E(h/2) k3 = E(h/2) (E(h/2) x + h k3)
-        for i in range(n):
-            tmp[i] = ex[i] + h * k3[i]
-        _apply_modal(E[0], K, tmp, xs)
-        for i in range(13):
-            xs[i] = tmp[i]
-        for i in range(13 + 4 * K, n):
-            xs[i] = tmp[i]
-    else:
-        for i in range(n):
-            xs[i] = x[i] + h * k3[i]
-    # stage 4
+    for i in range(n):
+        xs[i] = px[i] + h * k3[i]
+    if use_if:
+        _propagate(E, K, xs)
+
     loads_fn(t + h, xs, p, c, u)
     vehicle_deriv(xs, p, u, N, K, k4, A, rhs, hh, C, S, work)
     if use_if:
         _nonlinear_part(xs, p, K, k4)
-        # x_new = E(h/2) [E(h/2) (x + h/6 k1) + h/3 (k2 + k3)] + h/6 k4
         for i in range(n):
-            tmp[i] = x[i] + h / 6.0 * k1[i]
-        _apply_modal(E[0], K, tmp, tmp)
+            x[i] += h / 6.0 * k1[i]
+        _propagate(E, K, x)
         for i in range(n):
-            tmp[i] += h / 3.0 * (k2[i] + k3[i])
-        _apply_modal(E[0], K, tmp, tmp)
+            x[i] += h / 3.0 * (k2[i] + k3[i])
+        _propagate(E, K, x)
         for i in range(n):
-            x[i] = tmp[i] + h / 6.0 * k4[i]
+            x[i] += h / 6.0 * k4[i]
     else:
         for i in range(n):
             x[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
@@ -196,7 +182,7 @@ def rk4_vehicle(loads_fn, t, h, x, p, c, n_slosh, n_modes, exact_modes, buf, E, 
 def _alloc(n_x, n_u, n_slosh, n_modes):
     A, rhs, hh, C, S, work = make_workspace(n_slosh, n_modes)
     ws = (A, rhs, hh, C, S, work, np.empty(n_u))
-    return np.empty((7, n_x)), np.empty((2, max(n_modes, 1), 2, 2)), ws
+    return np.empty((6, n_x)), np.empty((max(n_modes, 1), 2, 2)), ws
 
 
 @nb.njit(cache=True, error_model="numpy")
