@@ -108,3 +108,12 @@ def test_bad_arguments():
         model.step(x, p, model.loads(), 0.0)
     with pytest.raises(ValueError, match="allowed"):
         integrate(model, x, p, model.loads(), (0, 1), method="LSODA")
+
+
+def test_divergence_is_reported_with_its_time():
+    model = NonRigidModel(0, 1)
+    p = model.params(m_b=1.0, J_b=[1, 1, 1], omega_modes=[2000.0])
+    x = model.layout.zeros_state()
+    x[model.layout.state["eta"]] = 1.0
+    with pytest.raises(FloatingPointError, match="not finite at t ="):
+        integrate(model, x, p, model.loads(), (0, 5), dt=0.01, method="rk4-classic")

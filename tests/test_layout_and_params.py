@@ -44,6 +44,8 @@ def test_slosh_param_slices_and_views_write_through():
 @pytest.mark.parametrize("kwargs, match", [
     ({"m_b": -1.0, "J_b": [1, 1, 1]}, "m_b = -1.0"),
     ({"m_b": 1.0, "J_b": [1, -1, 1]}, "J_b"),
+    ({"m_b": 1.0, "J_b": [1, 1, 1], "zeta_modes": [-0.1]}, "zeta_modes"),
+    ({"m_b": float("nan"), "J_b": [1, 1, 1]}, "finite"),
     ({"m_b": 1.0, "J_b": [1, 1, 1], "omega_modes": [1.0, 2.0]}, "omega_modes has 2 entries"),
 ])
 def test_bad_parameters_name_the_key(kwargs, match):

@@ -70,14 +70,11 @@ class NonRigidModel:
         """
         lay = self.layout
         p = lay.zeros_params()
-        if not np.isfinite(m_b) or m_b <= 0.0:
-            raise ValueError(f"m_b = {m_b!r}: the rigid-body mass must be finite and > 0 kg")
         p[lay.params["m_b"]] = m_b
         J = np.asarray(J_b, dtype=float)
         J = np.diag(J) if J.shape == (3,) else J
-        if J.shape != (3, 3) or not np.allclose(J, J.T) or np.any(np.linalg.eigvalsh(J) <= 0):
-            raise ValueError(f"J_b = {J_b!r}: must be a symmetric positive definite 3x3 matrix "
-                             "(or its positive diagonal) in kg m^2")
+        if J.shape != (3, 3):
+            raise ValueError(f"J_b = {J_b!r}: a 3x3 matrix or its diagonal, in kg m^2")
         p[lay.params["J_b"]] = J.ravel()
         p[lay.params["r_cg"]] = r_cg
         p[lay.params["r_gimbal"]] = r_gimbal
@@ -87,26 +84,52 @@ class NonRigidModel:
             if value.shape != (self.n_modes,):
                 raise ValueError(f"{key} has {value.size} entries: expected n_modes = {self.n_modes}")
             p[lay.params[key]] = value
-        if np.any(p[lay.params["omega_modes"]] < 0) or np.any(p[lay.params["zeta_modes"]] < 0):
-            raise ValueError("omega_modes and zeta_modes must be >= 0")
         if len(slosh) != self.n_slosh:
             raise ValueError(f"slosh has {len(slosh)} entries: expected n_slosh = {self.n_slosh}")
         for j, s in enumerate(slosh):
             unknown = set(s) - set(Layout.SLOSH_FIELDS)
             if unknown:
                 raise KeyError(f"slosh[{j}] unknown keys {sorted(unknown)}: allowed {Layout.SLOSH_FIELDS}")
-            values = {"inertia": 0.0, "zeta": 0.0, "omega": 0.0, "phi": np.zeros(self.n_modes), **s}
             for key in ("m", "length", "r_hinge"):
                 if key not in s:
                     raise KeyError(f"slosh[{j}] misses {key!r}")
-            if values["m"] < 0 or values["inertia"] < 0 or values["zeta"] < 0 or values["omega"] < 0:
-                raise ValueError(f"slosh[{j}] = {s!r}: m, inertia, zeta and omega must be >= 0")
-            if values["m"] > 0 and values["length"] <= 0 and values["inertia"] <= 0:
-                raise ValueError(f"slosh[{j}].length = {values['length']!r}: an active pendulum "
-                                 "needs a length > 0 m")
+            values = {"inertia": 0.0, "zeta": 0.0, "omega": 0.0, "phi": np.zeros(self.n_modes), **s}
             for key in Layout.SLOSH_FIELDS:
                 p[lay.slosh_param(j, key)] = values[key]
+        self.check_params(p)
         return p
+
+    def check_params(self, p: np.ndarray) -> None:
+        """Raise ``ValueError`` naming the entry, the value and what is allowed when a parameter
+        vector (one vehicle or a batch) cannot be integrated."""
+        lay = self.layout
+        pb = as_batch(p, lay.n_p, "p")
+
+        def fail(b: int, name: str, value, allowed: str):
+            where = f"vehicle {b}: " if pb.shape[0] > 1 else ""
+            value = float(value) if np.ndim(value) == 0 else value
+            raise ValueError(f"{where}{name} = {value!r}: {allowed}")
+
+        for b, row in enumerate(pb):
+            if not np.all(np.isfinite(row)):
+                fail(b, "p", row[~np.isfinite(row)].tolist(), "every parameter must be finite")
+            m_b = row[lay.params["m_b"]][0]
+            if m_b <= 0:
+                fail(b, "m_b", m_b, "the rigid-body mass must be > 0 kg")
+            J = row[lay.params["J_b"]].reshape(3, 3)
+            if not np.allclose(J, J.T) or np.any(np.linalg.eigvalsh(J) <= 0):
+                fail(b, "J_b", J.tolist(), "must be symmetric positive definite, kg m^2")
+            for key in ("omega_modes", "zeta_modes"):
+                if np.any(row[lay.params[key]] < 0):
+                    fail(b, key, row[lay.params[key]].tolist(), "must be >= 0")
+            for j in range(self.n_slosh):
+                get = {k: row[lay.slosh_param(j, k)] for k in Layout.SLOSH_FIELDS}
+                for key in ("m", "inertia", "zeta", "omega"):
+                    if get[key][0] < 0:
+                        fail(b, f"slosh[{j}].{key}", get[key][0], "must be >= 0")
+                if get["m"][0] > 0 and get["length"][0] <= 0:
+                    fail(b, f"slosh[{j}].length", get["length"][0],
+                         "an active pendulum (m > 0) needs a length > 0 m")
 
     def loads(self, *, f_b_i=(0.0, 0.0, 0.0), m_b_b=(0.0, 0.0, 0.0), thrust_e=(0.0, 0.0, 0.0),
               g_i=(0.0, 0.0, 0.0), f_eta=None) -> np.ndarray:
@@ -238,6 +261,9 @@ def integrate(model: NonRigidModel, x0: np.ndarray, p: np.ndarray | Callable[[fl
         next_record = t0 + record_dt
         for a, b in zip(grid[:-1], grid[1:]):
             x = model.step(x, p_of(a), u_of(a), b - a, 1, a, method)
+            if not np.all(np.isfinite(x)):
+                raise FloatingPointError(f"the state is not finite at t = {b:.6g} s after a step of "
+                                         f"{b - a:.3g} s: reduce dt or check the parameters")
             if b >= next_record - 1e-9 * record_dt or b == t1:
                 ts.append(b)
                 xs.append(x.copy())
