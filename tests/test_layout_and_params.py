@@ -67,3 +67,16 @@ def test_bad_slosh_entries():
     with pytest.raises(ValueError, match=r"expected \(29,\) or \(batch, 29\)"):
         NonRigidModel(2, 1).derivative(np.zeros(5), np.zeros(NonRigidModel(2, 1).layout.n_p),
                                        np.zeros(NonRigidModel(2, 1).layout.n_u))
+
+
+def test_kernel_offsets_agree_with_the_layout():
+    from lvgym.dynamics import kernels as k
+    lay = Layout(2, 3)
+    assert (k.X_R, k.X_V, k.X_Q, k.X_W, k.X_ETA) == tuple(
+        lay.state[n].start for n in ("r_zw_i", "v_zw_i", "q_bi", "omega_bi_b", "eta"))
+    assert (k.P_M, k.P_CG, k.P_J, k.P_GIM, k.P_MODES) == tuple(
+        lay.params[n].start for n in ("m_b", "r_cg", "J_b", "r_gimbal", "omega_modes"))
+    assert (k.U_F, k.U_M, k.U_T, k.U_G, k.U_ETA) == tuple(
+        lay.loads[n].start for n in ("f_b_i", "m_b_b", "thrust_e", "g_i", "f_eta"))
+    assert lay.slosh_block == 8 + 3 and lay.slosh_param(1, "phi").start == \
+        lay.params["slosh"].start + lay.slosh_block + 8

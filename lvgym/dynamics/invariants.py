@@ -12,7 +12,7 @@ from __future__ import annotations
 import numba as nb
 import numpy as np
 
-from .kernels import quat_to_dcm
+from .kernels import P_CG, P_J, P_M, P_MODES, X_ETA, X_Q, X_R, X_V, X_W, quat_to_dcm
 
 #: names of the columns written by ``energy_batch``
 ENERGY_TERMS = ("kinetic", "gravitational", "elastic", "total", "internal", "rotation", "bending",
@@ -29,33 +29,33 @@ def slosh_mass_kinematics(x, p, j, n_slosh, n_modes, C, r_out, v_out):
     K = n_modes
     Cb = C[0]
     Cs = C[1]
-    quat_to_dcm(x[6], x[7], x[8], x[9], Cb)
-    qo = 13 + 4 * K + 4 * j
+    quat_to_dcm(x[X_Q], x[X_Q + 1], x[X_Q + 2], x[X_Q + 3], Cb)
+    qo = X_ETA + 4 * K + 4 * j
     quat_to_dcm(x[qo], x[qo + 1], x[qo + 2], x[qo + 3], Cs)
-    o = 16 + 4 * K + j * (8 + K)
+    o = P_MODES + 4 * K + j * (8 + K)
     L = p[o + 1]
     py = 0.0
     pz = 0.0
     vy = 0.0
     vz = 0.0
     for k in range(K):
-        py += p[o + 8 + k] * x[13 + k]
-        pz += p[o + 8 + k] * x[13 + K + k]
-        vy += p[o + 8 + k] * x[13 + 2 * K + k]
-        vz += p[o + 8 + k] * x[13 + 3 * K + k]
-    r0 = p[o + 3] - p[1]
-    r1 = p[o + 4] - p[2] + py
-    r2 = p[o + 5] - p[3] + pz
-    w0, w1, w2 = x[10], x[11], x[12]
+        py += p[o + 8 + k] * x[X_ETA + k]
+        pz += p[o + 8 + k] * x[X_ETA + K + k]
+        vy += p[o + 8 + k] * x[X_ETA + 2 * K + k]
+        vz += p[o + 8 + k] * x[X_ETA + 3 * K + k]
+    r0 = p[o + 3] - p[P_CG]
+    r1 = p[o + 4] - p[P_CG + 1] + py
+    r2 = p[o + 5] - p[P_CG + 2] + pz
+    w0, w1, w2 = x[X_W], x[X_W + 1], x[X_W + 2]
     hb0 = w1 * r2 - w2 * r1
     hb1 = w2 * r0 - w0 * r2 + vy
     hb2 = w0 * r1 - w1 * r0 + vz
-    wo = 13 + 4 * K + 4 * n_slosh + 2 * j
+    wo = X_ETA + 4 * K + 4 * n_slosh + 2 * j
     ws1 = x[wo]
     ws2 = x[wo + 1]
     for i in range(3):
-        r_out[i] = x[i] + Cb[i, 0] * r0 + Cb[i, 1] * r1 + Cb[i, 2] * r2 - L * Cs[i, 0]
-        v_out[i] = (x[3 + i] + Cb[i, 0] * hb0 + Cb[i, 1] * hb1 + Cb[i, 2] * hb2
+        r_out[i] = x[X_R + i] + Cb[i, 0] * r0 + Cb[i, 1] * r1 + Cb[i, 2] * r2 - L * Cs[i, 0]
+        v_out[i] = (x[X_V + i] + Cb[i, 0] * hb0 + Cb[i, 1] * hb1 + Cb[i, 2] * hb2
                     + L * (ws1 * Cs[i, 2] - ws2 * Cs[i, 1]))
 
 
@@ -70,32 +70,32 @@ def energy_batch(x, p, g, n_slosh, n_modes, out):
     for b in range(B):
         xb = x[b]
         pb = p[b]
-        m = pb[0]
-        ke_t = 0.5 * m * (xb[3] ** 2 + xb[4] ** 2 + xb[5] ** 2)
-        w0, w1, w2 = xb[10], xb[11], xb[12]
-        ke_r = 0.5 * (w0 * (pb[4] * w0 + pb[5] * w1 + pb[6] * w2)
-                      + w1 * (pb[7] * w0 + pb[8] * w1 + pb[9] * w2)
-                      + w2 * (pb[10] * w0 + pb[11] * w1 + pb[12] * w2))
-        pe_g = -m * (g[b, 0] * xb[0] + g[b, 1] * xb[1] + g[b, 2] * xb[2])
+        m = pb[P_M]
+        v0, v1, v2 = xb[X_V], xb[X_V + 1], xb[X_V + 2]
+        ke_t = 0.5 * m * (v0 ** 2 + v1 ** 2 + v2 ** 2)
+        w0, w1, w2 = xb[X_W], xb[X_W + 1], xb[X_W + 2]
+        ke_r = 0.5 * (w0 * (pb[P_J] * w0 + pb[P_J + 1] * w1 + pb[P_J + 2] * w2)
+                      + w1 * (pb[P_J + 3] * w0 + pb[P_J + 4] * w1 + pb[P_J + 5] * w2)
+                      + w2 * (pb[P_J + 6] * w0 + pb[P_J + 7] * w1 + pb[P_J + 8] * w2))
+        pe_g = -m * (g[b, 0] * xb[X_R] + g[b, 1] * xb[X_R + 1] + g[b, 2] * xb[X_R + 2])
         ke_f = 0.0
         pe_f = 0.0
         for k in range(2 * K):
-            om = pb[16 + k % K]
-            ke_f += 0.5 * xb[13 + 2 * K + k] ** 2
-            pe_f += 0.5 * om * om * xb[13 + k] ** 2
+            om = pb[P_MODES + k % K]
+            ke_f += 0.5 * xb[X_ETA + 2 * K + k] ** 2
+            pe_f += 0.5 * om * om * xb[X_ETA + k] ** 2
         ke_s = 0.0
         ke_s_rel = 0.0
         for j in range(n_slosh):
-            o = 16 + 4 * K + j * (8 + K)
+            o = P_MODES + 4 * K + j * (8 + K)
             ms = pb[o]
             if ms <= 0.0:
                 continue
             slosh_mass_kinematics(xb, pb, j, n_slosh, K, C, rc, vc)
-            wo = 13 + 4 * K + 4 * n_slosh + 2 * j
+            wo = X_ETA + 4 * K + 4 * n_slosh + 2 * j
             rot = 0.5 * pb[o + 2] * (xb[wo] ** 2 + xb[wo + 1] ** 2)
             ke_s += 0.5 * ms * (vc[0] ** 2 + vc[1] ** 2 + vc[2] ** 2) + rot
-            ke_s_rel += 0.5 * ms * ((vc[0] - xb[3]) ** 2 + (vc[1] - xb[4]) ** 2
-                                    + (vc[2] - xb[5]) ** 2) + rot
+            ke_s_rel += 0.5 * ms * ((vc[0] - v0) ** 2 + (vc[1] - v1) ** 2 + (vc[2] - v2) ** 2) + rot
             pe_g -= ms * (g[b, 0] * rc[0] + g[b, 1] * rc[1] + g[b, 2] * rc[2])
         kin = ke_t + ke_r + ke_f + ke_s
         out[b, 0] = kin
@@ -117,11 +117,11 @@ def momentum_batch(x, p, n_slosh, n_modes, out):
     rc = np.empty(3)
     vc = np.empty(3)
     for b in range(B):
-        m = p[b, 0]
+        m = p[b, P_M]
         for i in range(3):
-            out[b, i] = m * x[b, 3 + i]
+            out[b, i] = m * x[b, X_V + i]
         for j in range(n_slosh):
-            ms = p[b, 16 + 4 * K + j * (8 + K)]
+            ms = p[b, P_MODES + 4 * K + j * (8 + K)]
             if ms <= 0.0:
                 continue
             slosh_mass_kinematics(x[b], p[b], j, n_slosh, K, C, rc, vc)

@@ -30,10 +30,11 @@ import math
 import numba as nb
 import numpy as np
 
-# offsets of fixed-size parts of the flat vectors (see layout.py)
-_X_R, _X_V, _X_Q, _X_W, _X_ETA = 0, 3, 6, 10, 13
-_P_M, _P_CG, _P_J, _P_GIM, _P_MODES = 0, 1, 4, 13, 16
-_U_F, _U_M, _U_T, _U_G, _U_ETA = 0, 3, 6, 9, 12
+# offsets of the fixed-size parts of the flat vectors (layout.py; tests/test_layout_and_params.py
+# checks that the two agree)
+X_R, X_V, X_Q, X_W, X_ETA = 0, 3, 6, 10, 13
+P_M, P_CG, P_J, P_GIM, P_MODES = 0, 1, 4, 13, 16
+U_F, U_M, U_T, U_G, U_ETA = 0, 3, 6, 9, 12
 # per-slosh work row: n_i(3) y_s(3) z_s(3) rho_b(3) gb_i(3) tau(2) m L k2
 _S_N, _S_Y, _S_Z, _S_RHO, _S_GB, _S_TAU, _S_M, _S_L, _S_K2 = 0, 3, 6, 9, 12, 15, 17, 18, 19
 SLOSH_WORK = 20
@@ -135,21 +136,21 @@ def vehicle_deriv(x, p, u, n_slosh, n_modes, xdot, A, rhs, h, C, S, work):
     nr = 6 + 2 * K
     Cb = C[0]
     Cs = C[1]
-    quat_to_dcm(x[_X_Q], x[_X_Q + 1], x[_X_Q + 2], x[_X_Q + 3], Cb)
-    w0, w1, w2 = x[_X_W], x[_X_W + 1], x[_X_W + 2]
-    o_eta = _X_ETA
-    o_etad = _X_ETA + 2 * K
-    o_qs = _X_ETA + 4 * K
+    quat_to_dcm(x[X_Q], x[X_Q + 1], x[X_Q + 2], x[X_Q + 3], Cb)
+    w0, w1, w2 = x[X_W], x[X_W + 1], x[X_W + 2]
+    o_eta = X_ETA
+    o_etad = X_ETA + 2 * K
+    o_qs = X_ETA + 4 * K
     o_ws = o_qs + 4 * N
-    o_om = _P_MODES
-    o_ze = _P_MODES + K
-    o_pg = _P_MODES + 2 * K
-    o_dg = _P_MODES + 3 * K
-    o_sl = _P_MODES + 4 * K
+    o_om = P_MODES
+    o_ze = P_MODES + K
+    o_pg = P_MODES + 2 * K
+    o_dg = P_MODES + 3 * K
+    o_sl = P_MODES + 4 * K
     sb = 8 + K
-    gx, gy, gz = u[_U_G], u[_U_G + 1], u[_U_G + 2]
-    m_b = p[_P_M]
-    cgx, cgy, cgz = p[_P_CG], p[_P_CG + 1], p[_P_CG + 2]
+    gx, gy, gz = u[U_G], u[U_G + 1], u[U_G + 2]
+    m_b = p[P_M]
+    cgx, cgy, cgz = p[P_CG], p[P_CG + 1], p[P_CG + 2]
 
     # ---------------------------------------------------------------- mass matrix of B and modes
     for i in range(nr):
@@ -158,7 +159,7 @@ def vehicle_deriv(x, p, u, n_slosh, n_modes, xdot, A, rhs, h, C, S, work):
     for i in range(3):
         A[i, i] = m_b
         for k in range(3):
-            A[3 + i, 3 + k] = p[_P_J + 3 * i + k]
+            A[3 + i, 3 + k] = p[P_J + 3 * i + k]
     for i in range(6, nr):
         A[i, i] = 1.0
 
@@ -173,7 +174,7 @@ def vehicle_deriv(x, p, u, n_slosh, n_modes, xdot, A, rhs, h, C, S, work):
         dy += p[o_pg + k] * x[o_eta + k]
         dz += p[o_pg + k] * x[o_eta + K + k]
     # rotate the engine-frame thrust by theta = (0, -sz, sy) (Rodrigues)
-    t0, t1, t2 = u[_U_T], u[_U_T + 1], u[_U_T + 2]
+    t0, t1, t2 = u[U_T], u[U_T + 1], u[U_T + 2]
     th1 = -sz
     th2 = sy
     ang = math.sqrt(th1 * th1 + th2 * th2)
@@ -192,27 +193,27 @@ def vehicle_deriv(x, p, u, n_slosh, n_modes, xdot, A, rhs, h, C, S, work):
         f2 = t2 * ca + c2 * sa + e2 * ed * (1.0 - ca)
     else:
         f0, f1, f2 = t0, t1, t2
-    rex = p[_P_GIM] - cgx
-    rey = p[_P_GIM + 1] - cgy + dy
-    rez = p[_P_GIM + 2] - cgz + dz
+    rex = p[P_GIM] - cgx
+    rey = p[P_GIM + 1] - cgy + dy
+    rez = p[P_GIM + 2] - cgz + dz
 
     # ---------------------------------------------------------------- right-hand side of B and modes
     for i in range(3):
-        rhs[i] = u[_U_F + i] + m_b * u[_U_G + i] + Cb[i, 0] * f0 + Cb[i, 1] * f1 + Cb[i, 2] * f2
+        rhs[i] = u[U_F + i] + m_b * u[U_G + i] + Cb[i, 0] * f0 + Cb[i, 1] * f1 + Cb[i, 2] * f2
     # Euler: m - omega x J omega + thrust moment
-    Jw0 = p[_P_J] * w0 + p[_P_J + 1] * w1 + p[_P_J + 2] * w2
-    Jw1 = p[_P_J + 3] * w0 + p[_P_J + 4] * w1 + p[_P_J + 5] * w2
-    Jw2 = p[_P_J + 6] * w0 + p[_P_J + 7] * w1 + p[_P_J + 8] * w2
-    rhs[3] = u[_U_M] - (w1 * Jw2 - w2 * Jw1) + (rey * f2 - rez * f1)
-    rhs[4] = u[_U_M + 1] - (w2 * Jw0 - w0 * Jw2) + (rez * f0 - rex * f2)
-    rhs[5] = u[_U_M + 2] - (w0 * Jw1 - w1 * Jw0) + (rex * f1 - rey * f0)
+    Jw0 = p[P_J] * w0 + p[P_J + 1] * w1 + p[P_J + 2] * w2
+    Jw1 = p[P_J + 3] * w0 + p[P_J + 4] * w1 + p[P_J + 5] * w2
+    Jw2 = p[P_J + 6] * w0 + p[P_J + 7] * w1 + p[P_J + 8] * w2
+    rhs[3] = u[U_M] - (w1 * Jw2 - w2 * Jw1) + (rey * f2 - rez * f1)
+    rhs[4] = u[U_M + 1] - (w2 * Jw0 - w0 * Jw2) + (rez * f0 - rex * f2)
+    rhs[5] = u[U_M + 2] - (w0 * Jw1 - w1 * Jw0) + (rex * f1 - rey * f0)
     for k in range(K):
         om = p[o_om + k]
         c = 2.0 * p[o_ze + k] * om
         kk = om * om
         pg = p[o_pg + k]
-        rhs[6 + k] = (u[_U_ETA + k] + pg * f1 - c * x[o_etad + k] - kk * x[o_eta + k])
-        rhs[6 + K + k] = (u[_U_ETA + K + k] + pg * f2 - c * x[o_etad + K + k]
+        rhs[6 + k] = (u[U_ETA + k] + pg * f1 - c * x[o_etad + k] - kk * x[o_eta + k])
+        rhs[6 + K + k] = (u[U_ETA + K + k] + pg * f2 - c * x[o_etad + K + k]
                           - kk * x[o_eta + K + k])
 
     # ---------------------------------------------------------------- slosh pendulums (Schur complement)
@@ -265,7 +266,7 @@ def vehicle_deriv(x, p, u, n_slosh, n_modes, xdot, A, rhs, h, C, S, work):
         cen = L * (ws1 * ws1 + ws2 * ws2)
         for i in range(3):
             beta = Cb[i, 0] * b0 + Cb[i, 1] * b1 + Cb[i, 2] * b2 + cen * Cs[i, 0]
-            S[j, _S_GB + i] = u[_U_G + i] - beta
+            S[j, _S_GB + i] = u[U_G + i] - beta
         # damper torque per unit slosh mass, s-frame (y, z): -c (w_s - omega_b components)
         cd = 2.0 * p[o + 6] * p[o + 7] * L * L
         tau1 = -cd * (ws1 - (Cs[0, 1] * wi0 + Cs[1, 1] * wi1 + Cs[2, 1] * wi2))
@@ -311,10 +312,10 @@ def vehicle_deriv(x, p, u, n_slosh, n_modes, xdot, A, rhs, h, C, S, work):
 
     # ---------------------------------------------------------------- kinematics and outputs
     for i in range(3):
-        xdot[_X_R + i] = x[_X_V + i]
-        xdot[_X_V + i] = rhs[i]
-        xdot[_X_W + i] = rhs[3 + i]
-    _quat_rate(x, _X_Q, w0, w1, w2, xdot, _X_Q)
+        xdot[X_R + i] = x[X_V + i]
+        xdot[X_V + i] = rhs[i]
+        xdot[X_W + i] = rhs[3 + i]
+    _quat_rate(x, X_Q, w0, w1, w2, xdot, X_Q)
     for k in range(2 * K):
         xdot[o_eta + k] = x[o_etad + k]
         xdot[o_etad + k] = rhs[6 + k]

@@ -24,7 +24,7 @@ import math
 import numba as nb
 import numpy as np
 
-from .kernels import make_workspace, vehicle_deriv
+from .kernels import P_MODES, X_ETA, X_Q, make_workspace, vehicle_deriv
 
 METHODS = ("rk4", "rk4-classic")
 
@@ -54,8 +54,8 @@ def modal_propagator(p, n_modes, tau, E):
     """``E[k] = expm(L_k tau)`` for ``L_k = [[0, 1], [-Omega_k^2, -2 Z_k Omega_k]]``."""
     K = n_modes
     for k in range(K):
-        om = p[16 + k]
-        ze = p[16 + K + k]
+        om = p[P_MODES + k]
+        ze = p[P_MODES + K + k]
         a = ze * om
         d2 = om * om * (1.0 - ze * ze)
         if d2 > 1e-300:
@@ -82,10 +82,10 @@ def _propagate(E, n_modes, v):
     K = n_modes
     for k in range(2 * K):
         km = k % K
-        a = v[13 + k]
-        b = v[13 + 2 * K + k]
-        v[13 + k] = E[km, 0, 0] * a + E[km, 0, 1] * b
-        v[13 + 2 * K + k] = E[km, 1, 0] * a + E[km, 1, 1] * b
+        a = v[X_ETA + k]
+        b = v[X_ETA + 2 * K + k]
+        v[X_ETA + k] = E[km, 0, 0] * a + E[km, 0, 1] * b
+        v[X_ETA + 2 * K + k] = E[km, 1, 0] * a + E[km, 1, 1] * b
 
 
 @nb.njit(cache=True, error_model="numpy", inline="always")
@@ -94,17 +94,17 @@ def _nonlinear_part(x, p, n_modes, f):
     K = n_modes
     for k in range(2 * K):
         km = k % K
-        om = p[16 + km]
-        ze = p[16 + K + km]
-        f[13 + k] -= x[13 + 2 * K + k]
-        f[13 + 2 * K + k] += 2.0 * ze * om * x[13 + 2 * K + k] + om * om * x[13 + k]
+        om = p[P_MODES + km]
+        ze = p[P_MODES + K + km]
+        f[X_ETA + k] -= x[X_ETA + 2 * K + k]
+        f[X_ETA + 2 * K + k] += 2.0 * ze * om * x[X_ETA + 2 * K + k] + om * om * x[X_ETA + k]
 
 
 @nb.njit(cache=True, error_model="numpy", inline="always")
 def normalise_quaternions(x, n_slosh, n_modes):
     """Scale the body and pendulum quaternions of one state to unit norm."""
     for o in range(-1, n_slosh):
-        qo = 6 if o < 0 else 13 + 4 * n_modes + 4 * o
+        qo = X_Q if o < 0 else X_ETA + 4 * n_modes + 4 * o
         n = math.sqrt(x[qo] ** 2 + x[qo + 1] ** 2 + x[qo + 2] ** 2 + x[qo + 3] ** 2)
         for i in range(4):
             x[qo + i] /= n
