@@ -66,7 +66,7 @@ class Oracle:
         return Y
 
     def kinematic_rate(self, x):
-        lay, K, N = self.lay, self.K, self.N
+        lay, N = self.lay, self.N
         xd = np.zeros_like(x)
         xd[lay.state["r_zw_i"]] = x[lay.state["v_zw_i"]]
         xd[lay.state["q_bi"]] = quat_rate(x[lay.state["q_bi"]], x[lay.state["omega_bi_b"]])

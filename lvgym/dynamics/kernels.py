@@ -128,7 +128,7 @@ def vehicle_deriv(x, p, u, n_slosh, n_modes, xdot, A, rhs, h, C, S, work):
     """Time derivative ``xdot`` of one vehicle's state ``x`` for parameters ``p`` and loads ``u``.
 
     Work arrays (any contents; sized by the caller, see ``make_workspace``): ``A`` (n_r, n_r),
-    ``rhs`` and ``h`` (n_r,), ``C`` (2, 3, 3), ``S`` (max(N, 1), SLOSH_WORK), ``work`` (n_r,),
+    ``rhs`` and ``h`` (n_r,), ``C`` (2, 3, 3), ``S`` (max(N, 1), SLOSH_WORK), ``work`` (max(n_r, 3),),
     with ``n_r = 6 + 2K``.
     """
     K = n_modes
@@ -148,7 +148,6 @@ def vehicle_deriv(x, p, u, n_slosh, n_modes, xdot, A, rhs, h, C, S, work):
     o_dg = P_MODES + 3 * K
     o_sl = P_MODES + 4 * K
     sb = 8 + K
-    gx, gy, gz = u[U_G], u[U_G + 1], u[U_G + 2]
     m_b = p[P_M]
     cgx, cgy, cgz = p[P_CG], p[P_CG + 1], p[P_CG + 2]
 
