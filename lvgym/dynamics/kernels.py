@@ -35,9 +35,9 @@ import numpy as np
 X_R, X_V, X_Q, X_W, X_ETA = 0, 3, 6, 10, 13
 P_M, P_CG, P_J, P_GIM, P_MODES = 0, 1, 4, 13, 16
 U_F, U_M, U_T, U_G, U_ETA = 0, 3, 6, 9, 12
-# per-slosh work row: n_i(3) y_s(3) z_s(3) rho_b(3) gb_i(3) tau(2) m L k2
-_S_N, _S_Y, _S_Z, _S_RHO, _S_GB, _S_TAU, _S_M, _S_L, _S_K2 = 0, 3, 6, 9, 12, 15, 17, 18, 19
-SLOSH_WORK = 20
+# per-slosh work row kept for the back-substitution: y_s(3) z_s(3) rho_b(3) (g - beta)_i(3) tau(2) m L k2
+_S_Y, _S_Z, _S_RHO, _S_GB, _S_TAU, _S_M, _S_L, _S_K2 = 0, 3, 6, 9, 12, 14, 15, 16
+SLOSH_WORK = 17
 
 
 @nb.njit(cache=True, error_model="numpy", inline="always")
@@ -233,7 +233,6 @@ def vehicle_deriv(x, p, u, n_slosh, n_modes, xdot, A, rhs, h, C, S, work):
         qo = o_qs + 4 * j
         quat_to_dcm(x[qo], x[qo + 1], x[qo + 2], x[qo + 3], Cs)
         for i in range(3):
-            S[j, _S_N + i] = Cs[i, 0]
             S[j, _S_Y + i] = Cs[i, 1]
             S[j, _S_Z + i] = Cs[i, 2]
         # deflected hinge offset from the CG and hinge deflection rate, body frame
