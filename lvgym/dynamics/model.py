@@ -224,9 +224,14 @@ class Trajectory:
     x: np.ndarray
 
 
+def _cuts(t0: float, t1: float, t_events: Sequence[float]) -> list[float]:
+    """Start, end and the event times between them, sorted."""
+    return sorted({t0, t1, *(float(e) for e in t_events if t0 < e < t1)})
+
+
 def _grid(t0: float, t1: float, dt: float, t_events: Sequence[float]) -> np.ndarray:
     """Step boundaries from t0 to t1 with steps of at most dt that land on every event time."""
-    cuts = sorted({t0, t1, *(float(e) for e in t_events if t0 < e < t1)})
+    cuts = _cuts(t0, t1, t_events)
     pieces = []
     for a, b in zip(cuts[:-1], cuts[1:]):
         n = max(1, int(np.ceil((b - a) / dt - 1e-9)))
@@ -272,7 +277,7 @@ def integrate(model: NonRigidModel, x0: np.ndarray, p: np.ndarray | Callable[[fl
     if method not in ADAPTIVE_METHODS:
         raise ValueError(f"method {method!r}: allowed {METHODS + ADAPTIVE_METHODS}")
     shape = np.shape(x0)
-    cuts = sorted({t0, t1, *(float(e) for e in t_events if t0 < e < t1)})
+    cuts = _cuts(t0, t1, t_events)
     n_rec = max(1, int(round((t1 - t0) / record_dt)))
     t_rec = np.linspace(t0, t1, n_rec + 1)
     y = np.array(x0, dtype=float).ravel()
