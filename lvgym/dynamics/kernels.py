@@ -356,11 +356,6 @@ def vehicle_deriv(x, p, u, n_slosh, n_modes, xdot, A, rhs, h, C, S, work):
         _quat_rate(x, qo, 0.0, x[wo], x[wo + 1], xdot, qo)
 
 
-def workspace_sizes(n_slosh: int, n_modes: int) -> tuple[int, int]:
-    """``(n_r, n_slosh_rows)`` of the work arrays of ``vehicle_deriv``."""
-    return 6 + 2 * n_modes, max(n_slosh, 1)
-
-
 @nb.njit(cache=True, error_model="numpy")
 def make_workspace(n_slosh, n_modes):
     """Allocate the work arrays of ``vehicle_deriv``: (A, rhs, h, C, S, work)."""
