@@ -1,0 +1,10 @@
+"""Environment models (thesis section 3.2): Earth, gravity, atmosphere, wind, aerodynamics.
+
+Each model is a small class with one call signature, batched over a leading axis of vehicles, whose
+arithmetic lives in numba-compiled functions over explicit parameters (so the simulator can call it
+from compiled loads functions). Models are chosen by name with :func:`make`.
+"""
+
+from .registry import make, names, register
+
+__all__ = ["make", "names", "register"]

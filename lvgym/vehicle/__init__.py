@@ -1,0 +1,5 @@
+"""Vehicle layer: configuration (YAML -> frozen dataclasses), mass model, propulsion, staging, beam modes.
+
+Imports neither the environment models nor the dynamics core: it hands plain numbers and arrays up to the
+simulator, which composes them.
+"""
