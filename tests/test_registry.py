@@ -23,7 +23,7 @@ def test_unknown_name_and_option_are_named():
         registry.make("_testkind", "nope")
     with pytest.raises(ConfigError, match=r"wind\.sclae = 2: unknown option"):
         registry.make("_testkind", {"model": "plain", "sclae": 2}, key="wind")
-    with pytest.raises(ConfigError, match=r"model = <missing>|model = None"):
+    with pytest.raises(ConfigError, match=r"_testkind\.model = <missing>: required"):
         registry.make("_testkind", {"scale": 2})
 
 

@@ -12,7 +12,7 @@ import inspect
 from collections.abc import Callable, Mapping
 from typing import Any, TypeVar
 
-from lvgym.errors import ConfigError
+from lvgym.errors import MISSING, ConfigError
 
 T = TypeVar("T")
 
@@ -50,7 +50,7 @@ def make(kind: str, spec: str | Mapping[str, Any], *, key: str | None = None, **
         name, options = spec, {}
     elif isinstance(spec, Mapping):
         if "model" not in spec:
-            raise ConfigError(f"{key}.model", None, f"required; one of {list(names(kind))}")
+            raise ConfigError(f"{key}.model", MISSING, f"required; one of {list(names(kind))}")
         options = dict(spec)
         name = options.pop("model")
     else:
