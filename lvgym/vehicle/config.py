@@ -351,7 +351,7 @@ def parse_vehicle(data: Any, source: str | None = None) -> Vehicle:
     aero = r.raw("aerodynamics", {})
     if not isinstance(aero, dict):
         raise r.error("aerodynamics", aero, "must be a mapping")
-    vehicle = Vehicle(name=r.text("name"), description=r.text("description", ""), stages=stages,
+    vehicle = Vehicle(name=r.text("name"), description=r.text("description", None) or "", stages=stages,
                       payload=payload, fairing=fairing, fairing_jettison=jettison,
                       staging=tuple(StagingStep.read(s) for s in r.children("staging")),
                       structure=StructureOptions.read(r.child("structure", None)), aerodynamics=aero,

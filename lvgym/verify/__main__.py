@@ -11,7 +11,7 @@ def main() -> int:
     start = time.perf_counter()
     for case in ALL_CASES:
         rows += case()
-    print("# lvgym dynamics core: verification against the thesis (chapter 4)\n")
+    print("# lvgym: verification against the thesis (chapter 4)\n")
     print(table(rows))
     failed = [r for r in rows if not r.passed]
     print(f"\n{len(rows) - len(failed)} of {len(rows)} rows pass or are reported "

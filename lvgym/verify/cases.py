@@ -275,5 +275,13 @@ def case_rk4_vs_dop853(dt: float = 1e-3) -> list[Check]:
     return out
 
 
+def _case_m():
+    from .mass_cases import case_m
+
+    return case_m()
+
+
+_case_m.__name__ = "case_m"
+
 ALL_CASES = (case_r1, case_r2, case_s1, case_axial_pendulum, case_tumble, case_e, case_momentum,
-             case_rk4_vs_dop853)
+             case_rk4_vs_dop853, _case_m)
