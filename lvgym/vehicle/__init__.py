@@ -3,3 +3,8 @@
 Imports neither the environment models nor the dynamics core: it hands plain numbers and arrays up to the
 simulator, which composes them.
 """
+
+from .config import Vehicle, load_vehicle, parse_vehicle
+from .massmodel import MassModel, MassProperties, MassState
+
+__all__ = ["MassModel", "MassProperties", "MassState", "Vehicle", "load_vehicle", "parse_vehicle"]
