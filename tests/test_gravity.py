@@ -55,6 +55,13 @@ def test_wgs84_normal_plus_centrifugal_is_somigliana(lat_deg):
     np.testing.assert_allclose(g / np.linalg.norm(g), down, atol=1e-12)
 
 
+def test_j2_alone_misses_somigliana_at_the_pole():
+    # why wgs84_normal carries J4-J8: J2 alone is 1.2e-5 off normal gravity at the pole (measured)
+    r = earth.geodetic_to_ecef(math.pi / 2, 0.0, 0.0)
+    g = np.linalg.norm(gravity.J2Gravity().acceleration(r))
+    assert abs(g / 9.8321849378 - 1.0) > 1e-6
+
+
 def test_point_mass_hand_number():
     # GM / a^2 = 3.986004418e14 / 6378137^2 = 9.798285479187 m/s^2 (40-digit decimal arithmetic)
     g = gravity.PointMassGravity().acceleration([0.0, -earth.WGS84_A, 0.0])
