@@ -2,9 +2,12 @@
 
 Each model is a small class with one call signature, batched over a leading axis of vehicles, whose
 arithmetic lives in numba-compiled functions over explicit parameters (so the simulator can call it
-from compiled loads functions). Models are chosen by name with :func:`make`.
+from compiled loads functions). Models are chosen by name with :func:`make`; importing this package
+registers them all.
 """
 
+from . import earth, gravity
+from .earth import LaunchSite
 from .registry import make, names, register
 
-__all__ = ["make", "names", "register"]
+__all__ = ["LaunchSite", "earth", "gravity", "make", "names", "register"]
