@@ -228,13 +228,17 @@ def modes(stations, EI, mass_per_length, *, point_masses: Sequence = (), n_modes
     if n_modes:
         T = null_space(MR.T)                     # (n_dof, n_dof - 2): M-orthogonal to both rigid modes
         Kr, Mr = T.T @ K @ T, T.T @ M @ T
-        lam, y = eigh(0.5 * (Kr + Kr.T), 0.5 * (Mr + Mr.T), subset_by_index=[0, n_modes - 1])
-        q = T @ y                                # q^T M q = 1
+        # the flexibility form M y = (1 / omega^2) K y: its largest eigenvalues are the lowest modes,
+        # found to a relative accuracy eps * omega_k^2 / omega_1^2 instead of eps * omega_max^2 / omega_k^2
+        n_r = n_dof - 2
+        mu, y = eigh(0.5 * (Mr + Mr.T), 0.5 * (Kr + Kr.T), subset_by_index=[n_r - n_modes, n_r - 1])
+        mu, y = mu[::-1], y[:, ::-1]
+        q = T @ (y / np.sqrt(np.einsum("ik,ij,jk->k", y, Mr, y)))        # q^T M q = 1
         tip = q[-2]
         big = q[np.argmax(np.abs(q[0::2]), axis=0) * 2, np.arange(n_modes)]
         sign = np.where(np.abs(tip) > 1e-9 * np.abs(big), np.sign(tip), np.sign(big))
         q = q * sign
-        omega = np.sqrt(np.clip(lam, 0.0, None))
+        omega = 1.0 / np.sqrt(mu)
     else:
         q, omega = np.zeros((n_dof, 0)), np.zeros(0)
     phi_q, dphi_q = _interpolate(x, q, query)

@@ -259,7 +259,10 @@ def point_mass_array(point_masses, lo: float, hi: float) -> np.ndarray:
         for name, v in (("mass", pm.mass), ("rotary_inertia", pm.rotary_inertia)):
             if not (math.isfinite(v) and v >= 0.0):
                 raise ConfigError(f"point_masses[{i}].{name}", v, "must be finite and >= 0")
-        station = stations_on([pm.station], lo, hi, f"point_masses[{i}].station")[0]
+        tol = 1e-9 * max(1.0, hi - lo)
+        if not (math.isfinite(pm.station) and lo - tol <= pm.station <= hi + tol):
+            raise ConfigError(f"point_masses[{i}].station", pm.station, f"must lie on the beam, in [{lo}, {hi}] m")
+        station = min(max(pm.station, lo), hi)
         rows.append((station, pm.mass, pm.rotary_inertia))
     return np.array(rows, dtype=float).reshape(-1, 3)
 
