@@ -2,6 +2,7 @@
 
 import math
 import pathlib
+import re
 
 import numpy as np
 import pytest
@@ -281,3 +282,12 @@ def test_thesis_beams_are_uniform_tubes_and_docs_are_current():
     doc = (ROOT / "docs" / "structure.md").read_text()
     for line in thesis_comparison_markdown().splitlines():
         assert line in doc, f"docs/structure.md is stale; regenerate with python -m lvgym.vehicle.beam: {line}"
+
+
+def test_docs_examples_run():
+    blocks = re.findall(r"```python\n(.*?)```", (ROOT / "docs" / "structure.md").read_text(), re.S)
+    assert blocks
+    for block in blocks:
+        namespace: dict = {}
+        exec(compile(block, "docs/structure.md", "exec"), namespace)
+    assert namespace["phi_gimbal"].shape == (2,)
