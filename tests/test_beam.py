@@ -228,7 +228,9 @@ def test_bad_beam_inputs_name_the_key(kwargs, key):
 @pytest.mark.parametrize("sections, extra, key", [
     ([Section(0.0, -4.0, EI, MPL), Section(-4.5, -10.0, EI, MPL)], {}, "sections[1].top"),
     ([Section(0.0, -4.0, EI, MPL), Section(-3.0, -10.0, EI, MPL)], {}, "sections[1].top"),
-    ([Section(0.0, -4.0, EI, MPL), Section(-4.0, -10.0, 0.0, MPL)], {}, "sections[1].EI[0]"),
+    ([Section(0.0, -4.0, EI, MPL), Section(-4.0, -10.0, 0.0, MPL)], {}, "sections[1].EI"),
+    ([Section(0.0, -4.0, EI, "heavy")], {}, "sections[0].mass_per_length"),
+    ([Section(0.0, -4.0, EI, MPL)], dict(point_masses=[(-1.0, 1.0, 0.1, 9.0)]), "point_masses[0]"),
     ([Section(1.0, -1.0, EI, MPL)], {}, "sections[].top"),
     ([Section(-1.0, 0.0, EI, MPL)], {}, "sections[0].top"),
     ([Section(-1.0, -4.0, EI, MPL)], dict(distributed_masses=[DistributedMass(-0.5, -2.0, 1.0)]),

@@ -250,20 +250,20 @@ def point_mass_array(point_masses, lo: float, hi: float) -> np.ndarray:
     """(P, 3) array of station [m], mass [kg], rotary inertia [kg m^2]."""
     rows = []
     for i, pm in enumerate(point_masses):
-        if not isinstance(pm, PointMass):
-            try:
-                pm = PointMass(*(float(v) for v in pm))
-            except (TypeError, ValueError):
-                raise ConfigError(f"point_masses[{i}]", pm,
-                                  "a PointMass or (station, mass[, rotary_inertia])") from None
-        for name, v in (("mass", pm.mass), ("rotary_inertia", pm.rotary_inertia)):
+        try:
+            fields = (pm.station, pm.mass, pm.rotary_inertia) if isinstance(pm, PointMass) else tuple(pm)
+            if len(fields) not in (2, 3):
+                raise ValueError(fields)
+            station, mass, inertia = (float(v) for v in (*fields, 0.0)[:3])
+        except (TypeError, ValueError):
+            raise ConfigError(f"point_masses[{i}]", pm, "a PointMass or (station, mass[, rotary_inertia])") from None
+        for name, v in (("mass", mass), ("rotary_inertia", inertia)):
             if not (math.isfinite(v) and v >= 0.0):
                 raise ConfigError(f"point_masses[{i}].{name}", v, "must be finite and >= 0")
         tol = 1e-9 * max(1.0, hi - lo)
-        if not (math.isfinite(pm.station) and lo - tol <= pm.station <= hi + tol):
-            raise ConfigError(f"point_masses[{i}].station", pm.station, f"must lie on the beam, in [{lo}, {hi}] m")
-        station = min(max(pm.station, lo), hi)
-        rows.append((station, pm.mass, pm.rotary_inertia))
+        if not (math.isfinite(station) and lo - tol <= station <= hi + tol):
+            raise ConfigError(f"point_masses[{i}].station", station, f"must lie on the beam, in [{lo}, {hi}] m")
+        rows.append((min(max(station, lo), hi), mass, inertia))
     return np.array(rows, dtype=float).reshape(-1, 3)
 
 
@@ -328,13 +328,15 @@ def mesh_stack(sections: Sequence[Section], point_masses: Sequence = (),
         raise ConfigError("sections[].top", hi, "stations are measured from the nose tip: <= 0 m")
     order = sorted(range(len(secs)), key=lambda i: -float(secs[i].top))
     bounds, stiff, mass = [hi], [], []
-    for n, i in enumerate(order):
+    for i in order:
         top, bottom = _span(secs[i], i, "sections", lo, hi)
         if abs(top - bounds[-1]) > 1e-6:
             raise ConfigError(f"sections[{i}].top", top, f"must equal the bottom of the section above, "
                               f"{bounds[-1]} m (sections tile the stack without gaps or overlaps)")
-        per_element([secs[i].EI], 1, f"sections[{i}].EI")
-        per_element([secs[i].mass_per_length], 1, f"sections[{i}].mass_per_length")
+        for name in ("EI", "mass_per_length"):
+            v = getattr(secs[i], name)
+            if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0.0):
+                raise ConfigError(f"sections[{i}].{name}", v, "must be a finite number > 0")
         top = bounds[-1]
         stiff.append((top, bottom, 1.0 / secs[i].EI))
         mass.append((top, bottom, secs[i].mass_per_length))
@@ -350,8 +352,11 @@ def mesh_stack(sections: Sequence[Section], point_masses: Sequence = (),
         bounds += [top, bottom]
     pm = point_mass_array(point_masses, lo, hi)
     query = stations_on(query_stations, lo, hi, "query_stations")
-    h = length / DEFAULT_ELEMENTS if element_length is None else element_length
-    if not (isinstance(h, (int, float)) and math.isfinite(h) and h > 0.0):
+    try:
+        h = length / DEFAULT_ELEMENTS if element_length is None else float(element_length)
+    except (TypeError, ValueError):
+        h = math.nan
+    if not (math.isfinite(h) and h > 0.0):
         raise ConfigError("element_length", element_length, "a finite element length > 0 m, or None")
     gap = MERGE_FRACTION * min(h, length)
     kept = [hi, lo]
