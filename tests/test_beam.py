@@ -293,3 +293,13 @@ def test_docs_examples_run():
         namespace: dict = {}
         exec(compile(block, "docs/structure.md", "exec"), namespace)
     assert namespace["phi_gimbal"].shape == (2,)
+
+
+def test_docstring_examples():
+    import doctest
+
+    import lvgym.vehicle.beam
+    import lvgym.vehicle.sections
+    for module in (lvgym.vehicle.beam, lvgym.vehicle.sections):
+        result = doctest.testmod(module)
+        assert result.attempted > 0 and result.failed == 0
