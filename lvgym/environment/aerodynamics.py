@@ -1,0 +1,460 @@
+"""Aerodynamic coefficient tables and the aerodynamic force and moment (thesis section 3.2).
+
+Two table models, chosen by name (``make("aerodynamics", ...)``):
+
+``axisymmetric``
+    The thesis's 3-DOF tables ``CA, CN, Cm`` over Mach and the *total* angle of attack
+    ``alpha_t`` in [0, 180] deg, expanded to 6-DOF by axial symmetry: the normal force lies in
+    the plane of the crossflow, whose roll orientation is ``phi_a = atan2(v, w)``.
+``tables6``
+    Full 6-DOF body-axis tables ``CA, CY, CN, Cl, Cm, Cn`` over Mach, angle of attack, sideslip and,
+    if given, altitude (Missile DATCOM style).
+
+Both carry damping derivatives (``Cmq`` = Cmq + Cmalpha_dot per rad of ``q L / (2 V)``, ``Clp``,
+and ``Cnr`` for ``tables6``; the axisymmetric model uses ``Cnr = Cmq``), a reference area ``S``
+[m^2], a reference length ``L`` [m] and the moment reference station ``x_ref`` [m] (x_b from the
+nose tip, <= 0). Conventions, with ``v_air_b = (u, v, w)`` the velocity of the vehicle relative
+to the air in body axes and ``qbar = rho V^2 / 2``:
+
+* ``alpha = atan2(w, u)``, ``beta = atan2(v, sqrt(u^2 + w^2))`` (= asin(v/V)),
+  ``alpha_t = atan2(sqrt(v^2 + w^2), u)``;
+* ``f_b = qbar S (-CA, CY, -CN)``: CA positive aft, CN positive towards -z_b at positive alpha;
+* moments about ``x_ref``: ``qbar S L (Cl, Cm, Cn)``; Cm positive nose-up (a stable vehicle has
+  dCm/dalpha < 0); the kernel moves them to the CG station ``x_cg``:
+  ``m_cg = m_ref + (x_ref - x_cg) e_x x f_b``;
+* damping about the CG: ``rho V S L^2 / 4 * (Clp p, Cmq q, Cnr r)``, tabulated values used as
+  given (they are not transferred from ``x_ref``);
+* outside the grid every axis is clamped to its end values (no extrapolation).
+
+All of it is zero, without NaN, at zero airspeed. Compiled callers use :func:`aero_loads_k` with
+``model.kernel_args() = (p, grid, dims, table)``: ``p = [kind, S, L, x_ref]``; ``grid`` the axis
+vectors (Mach, angles in rad, altitude in m) end to end; ``dims`` their lengths; ``table`` the
+coefficients, one row per grid point (C order over the axes), columns ``COLUMNS[kind]``.
+CSV formats: see ``docs/aerodynamics.md`` and :func:`read_table_csv`.
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numba as nb
+import numpy as np
+
+from lvgym.errors import MISSING, ConfigError
+
+from .registry import register
+
+KIND_AXISYMMETRIC, KIND_TABLES6 = 0.0, 1.0
+P_KIND, P_SREF, P_LREF, P_XREF = 0, 1, 2, 3
+#: coefficient columns of the table of each kind, in kernel order
+COLUMNS = {KIND_AXISYMMETRIC: ("CA", "CN", "Cm", "Cmq", "Clp"),
+           KIND_TABLES6: ("CA", "CY", "CN", "Cl", "Cm", "Cn", "Clp", "Cmq", "Cnr")}
+#: entries of the state vector written by the kernel (AeroState fields, same order)
+STATE_FIELDS = ("alpha", "beta", "alpha_total", "phi_aero", "mach", "qbar", "airspeed")
+DAMPING = ("Cmq", "Clp", "Cnr")
+
+
+# ------------------------------------------------------------------------------- kernels
+@nb.njit(cache=True)
+def interp_k(grid, dims, table, q, out):
+    """Multilinear interpolation of every column of ``table`` at the point ``q`` (one value per
+    axis), clamped to the grid; axes of length 1 are constant. Writes ``out[:table.shape[1]]``."""
+    nd = dims.shape[0]
+    idx = np.zeros(nd, np.int64)
+    wgt = np.zeros(nd)
+    stride = np.ones(nd, np.int64)
+    off = 0
+    for d in range(nd):
+        n = dims[d]
+        if n > 1:
+            x = q[d]
+            if x >= grid[off + n - 1]:
+                idx[d], wgt[d] = n - 2, 1.0
+            elif x > grid[off]:
+                i = np.searchsorted(grid[off:off + n], x, side="right") - 1
+                idx[d] = i
+                wgt[d] = (x - grid[off + i]) / (grid[off + i + 1] - grid[off + i])
+        off += n
+    for d in range(nd - 2, -1, -1):
+        stride[d] = stride[d + 1] * dims[d + 1]
+    for c in range(table.shape[1]):
+        out[c] = 0.0
+    for corner in range(1 << nd):
+        weight = 1.0
+        row = 0
+        for d in range(nd):
+            bit = (corner >> d) & 1
+            if bit == 1:
+                if dims[d] == 1:
+                    weight = 0.0
+                    break
+                weight *= wgt[d]
+            else:
+                weight *= 1.0 - wgt[d]
+            row += (idx[d] + bit) * stride[d]
+        if weight != 0.0:
+            for c in range(table.shape[1]):
+                out[c] += weight * table[row, c]
+
+
+@nb.njit(cache=True)
+def aero_loads_k(v_air_b, omega_bi_b, rho, sound, x_cg, alt, p, grid, dims, table, f_b, m_b, state):
+    """Aerodynamic force ``f_b`` [N] and moment about the CG ``m_b`` [N m] (body frame) of either
+    table kind, written into the 3-vectors ``f_b``, ``m_b``; ``state`` (7) receives alpha, beta,
+    alpha_t, phi_a [rad], Mach [-], qbar [Pa], airspeed [m/s].
+
+    ``v_air_b`` (3) [m/s] vehicle velocity relative to the air, body axes; ``omega_bi_b`` (3)
+    [rad/s]; ``rho`` [kg/m^3]; ``sound`` speed of sound [m/s]; ``x_cg`` CG station [m]; ``alt``
+    altitude [m] (only for ``tables6`` with an altitude axis; anything otherwise).
+    """
+    u, v, w = v_air_b[0], v_air_b[1], v_air_b[2]
+    vperp = math.sqrt(v * v + w * w)
+    speed = math.sqrt(u * u + vperp * vperp)
+    alpha_t = math.atan2(vperp, u)
+    mach = speed / sound if sound > 0.0 else 0.0
+    qbar = 0.5 * rho * speed * speed
+    s_ref, l_ref = p[P_SREF], p[P_LREF]
+    qs = qbar * s_ref
+    kd = 0.25 * rho * speed * s_ref * l_ref * l_ref          # damping: qbar S L * L / (2 V)
+    c = np.zeros(table.shape[1])
+    if p[P_KIND] == KIND_AXISYMMETRIC:
+        interp_k(grid, dims, table, np.array([mach, alpha_t]), c)
+        sp, cp = (v / vperp, w / vperp) if vperp > 0.0 else (0.0, 1.0)
+        f_b[0] = -qs * c[0]
+        f_b[1] = -qs * c[1] * sp
+        f_b[2] = -qs * c[1] * cp
+        m_b[0] = kd * c[4] * omega_bi_b[0]
+        m_b[1] = qs * l_ref * c[2] * cp + kd * c[3] * omega_bi_b[1]
+        m_b[2] = -qs * l_ref * c[2] * sp + kd * c[3] * omega_bi_b[2]
+    else:
+        q = np.array([mach, math.atan2(w, u), math.atan2(v, math.sqrt(u * u + w * w)), alt])
+        interp_k(grid, dims, table, q, c)
+        f_b[0] = -qs * c[0]
+        f_b[1] = qs * c[1]
+        f_b[2] = -qs * c[2]
+        m_b[0] = qs * l_ref * c[3] + kd * c[6] * omega_bi_b[0]
+        m_b[1] = qs * l_ref * c[4] + kd * c[7] * omega_bi_b[1]
+        m_b[2] = qs * l_ref * c[5] + kd * c[8] * omega_bi_b[2]
+    d = p[P_XREF] - x_cg                                     # m_cg = m_ref + d e_x x f
+    m_b[1] -= d * f_b[2]
+    m_b[2] += d * f_b[1]
+    state[0] = math.atan2(w, u)
+    state[1] = math.atan2(v, math.sqrt(u * u + w * w))
+    state[2] = alpha_t
+    state[3] = math.atan2(v, w) if vperp > 0.0 else 0.0
+    state[4] = mach
+    state[5] = qbar
+    state[6] = speed
+
+
+@nb.njit(cache=True)
+def aero_loads_batch(v_air_b, omega_bi_b, rho, sound, x_cg, alt, p, grid, dims, table, f_b, m_b, state):
+    """:func:`aero_loads_k` over a leading batch axis of every per-vehicle argument."""
+    for j in range(v_air_b.shape[0]):
+        aero_loads_k(v_air_b[j], omega_bi_b[j], rho[j], sound[j], x_cg[j], alt[j], p, grid, dims,
+                     table, f_b[j], m_b[j], state[j])
+
+
+# ------------------------------------------------------------------------------- CSV tables
+def read_table_csv(path: str | Path, axes: tuple[str, ...], required: tuple[str, ...],
+                   optional: tuple[str, ...] = (), optional_axes: tuple[str, ...] = ()
+                   ) -> tuple[list[np.ndarray], dict[str, np.ndarray]]:
+    """Read a coefficient table in long CSV format: a header line, then one row per grid point.
+
+    Lines starting with ``#`` are comments. ``axes`` (e.g. ``mach, alpha_deg``) must form a full
+    grid, every combination exactly once, in any row order; ``optional_axes`` may be absent.
+    Returns the sorted axis vectors (as written, degrees stay degrees) and each coefficient column
+    as an array of shape (len(axis_0), len(axis_1), ...). Raises ConfigError naming the file, the
+    row and column, and the value for anything malformed.
+    """
+    src = str(path)
+    try:
+        with open(path, newline="") as fh:
+            rows = [r for r in csv.reader(fh) if r and not r[0].lstrip().startswith("#")]
+    except OSError as exc:
+        raise ConfigError("table", src, f"a readable CSV file ({exc.strerror})") from None
+    if not rows:
+        raise ConfigError("header", MISSING, "a header line naming the columns", source=src)
+    header = [h.strip() for h in rows[0]]
+    allowed = axes + optional_axes + required + optional
+    for name in header:
+        if name not in allowed or header.count(name) > 1:
+            raise ConfigError(f"column {name!r}", name, f"each once, one of {list(allowed)}", source=src)
+    for name in axes + required:
+        if name not in header:
+            raise ConfigError(f"column {name!r}", MISSING, f"required; the file has {header}", source=src)
+    data = np.empty((len(rows) - 1, len(header)))
+    for i, row in enumerate(rows[1:], start=2):
+        if len(row) != len(header):
+            raise ConfigError(f"line {i}", ",".join(row), f"{len(header)} values, one per column", source=src)
+        for j, raw in enumerate(row):
+            try:
+                data[i - 2, j] = float(raw)
+            except ValueError:
+                data[i - 2, j] = math.nan
+            if not math.isfinite(data[i - 2, j]):
+                raise ConfigError(f"line {i}, column {header[j]!r}", raw.strip(), "a finite number", source=src)
+    used_axes = [a for a in axes + optional_axes if a in header]
+    grids = [np.unique(data[:, header.index(a)]) for a in used_axes]
+    shape = tuple(len(g) for g in grids)
+    index = tuple(np.searchsorted(g, data[:, header.index(a)]) for g, a in zip(grids, used_axes))
+    flat = np.ravel_multi_index(index, shape) if shape else np.zeros(0, int)
+    if len(data) != int(np.prod(shape)) or len(np.unique(flat)) != len(data):
+        raise ConfigError("rows", len(data), f"a full grid: every combination of {shape} values of "
+                          f"{used_axes} exactly once ({int(np.prod(shape))} rows)", source=src)
+    columns = {}
+    for name in required + optional:
+        if name in header:
+            col = np.empty(int(np.prod(shape)))
+            col[flat] = data[:, header.index(name)]
+            columns[name] = col.reshape(shape)
+    return grids, columns
+
+
+def _positive(key: str, value: Any, source: str | None = None) -> float:
+    try:
+        x = float(value)
+    except (TypeError, ValueError):
+        x = math.nan
+    if not (math.isfinite(x) and x > 0.0):
+        raise ConfigError(key, value, "a finite number > 0", source=source)
+    return x
+
+
+# ------------------------------------------------------------------------------- models
+@dataclass(frozen=True)
+class AeroState:
+    """Flow angles and flight condition of the loads call (arrays, () or (B,)), for recording:
+    ``alpha``, ``beta``, ``alpha_total``, ``phi_aero`` [rad], ``mach`` [-], ``qbar`` [Pa],
+    ``airspeed`` [m/s]."""
+
+    alpha: np.ndarray
+    beta: np.ndarray
+    alpha_total: np.ndarray
+    phi_aero: np.ndarray
+    mach: np.ndarray
+    qbar: np.ndarray
+    airspeed: np.ndarray
+
+
+class AeroTables:
+    """Common face of the table models: parameters for the kernel and the batched ``loads`` call.
+
+    Attributes ``params`` (``[kind, S, L, x_ref]``), ``grid``, ``dims``, ``table`` are the flat
+    arrays :func:`aero_loads_k` takes (see :meth:`kernel_args`); ``axes`` the grid vectors in SI.
+    """
+
+    kind: float
+    axis_names: tuple[str, ...]
+
+    def _setup(self, axes: list[np.ndarray], columns: Mapping[str, np.ndarray], ref_area: Any,
+               ref_length: Any, x_ref: Any, source: str | None) -> None:
+        s = _positive("ref_area", ref_area)
+        length = _positive("ref_length", ref_length)
+        try:
+            xr = float(x_ref)
+        except (TypeError, ValueError):
+            xr = math.nan
+        if not (math.isfinite(xr) and xr <= 0.0):
+            raise ConfigError("x_ref", x_ref, "a station [m] from the nose tip, finite and <= 0")
+        self.source = source
+        self.axes = [np.ascontiguousarray(a, dtype=np.float64) for a in axes]
+        self.ref_area, self.ref_length, self.x_ref = s, length, xr
+        self.params = np.array([self.kind, s, length, xr])
+        self.grid = np.concatenate(self.axes)
+        self.dims = np.array([len(a) for a in self.axes], dtype=np.int64)
+        shape = tuple(self.dims)
+        table = np.zeros((int(np.prod(shape)), len(COLUMNS[self.kind])))
+        for j, name in enumerate(COLUMNS[self.kind]):
+            col = np.asarray(columns.get(name, 0.0), dtype=np.float64)
+            table[:, j] = np.broadcast_to(col, shape).ravel()
+        if not np.all(np.isfinite(table)):
+            raise ConfigError("table", "non-finite coefficient", "finite numbers", source=source)
+        self.table = table
+
+    def kernel_args(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """``(p, grid, dims, table)`` for :func:`aero_loads_k` / :func:`aero_loads_batch`."""
+        return self.params, self.grid, self.dims, self.table
+
+    def coefficients(self, *point: float) -> dict[str, float]:
+        """Interpolated coefficients at one grid point ``(mach, angles [rad], ...)``."""
+        out = np.zeros(self.table.shape[1])
+        q = np.zeros(len(self.dims))
+        q[:len(point)] = point
+        interp_k(self.grid, self.dims, self.table, q, out)
+        return dict(zip(COLUMNS[self.kind], out.tolist()))
+
+    def loads(self, v_air_b: Any, omega_bi_b: Any, rho: Any, speed_of_sound: Any, x_cg: Any,
+              altitude: Any = 0.0) -> tuple[np.ndarray, np.ndarray, AeroState]:
+        """Aerodynamic force ``f_b`` [N] and moment about the CG ``m_b`` [N m], body frame.
+
+        ``v_air_b`` [m/s] (3,) or (B, 3): vehicle velocity relative to the air, body axes;
+        ``omega_bi_b`` [rad/s] like it; ``rho`` [kg/m^3], ``speed_of_sound`` [m/s], ``x_cg`` [m]
+        (CG station) and ``altitude`` [m] scalars or (B,). Returns ``f_b``, ``m_b`` shaped like
+        ``v_air_b`` and an :class:`AeroState`.
+        """
+        v = np.asarray(v_air_b, dtype=np.float64)
+        b = 1 if v.ndim == 1 else v.shape[0]
+
+        def rows(a: Any, width: int | None) -> np.ndarray:
+            a = np.asarray(a, dtype=np.float64)
+            shape = (b,) if width is None else (b, width)
+            return np.ascontiguousarray(np.broadcast_to(a, shape))
+
+        f = np.zeros((b, 3))
+        m = np.zeros((b, 3))
+        s = np.zeros((b, len(STATE_FIELDS)))
+        aero_loads_batch(rows(v, 3), rows(omega_bi_b, 3), rows(rho, None), rows(speed_of_sound, None),
+                         rows(x_cg, None), rows(altitude, None), *self.kernel_args(), f, m, s)
+        if v.ndim == 1:
+            return f[0], m[0], AeroState(*[s[0, k] for k in range(s.shape[1])])
+        return f, m, AeroState(*[s[:, k] for k in range(s.shape[1])])
+
+    def __repr__(self) -> str:
+        axes = ", ".join(f"{n}[{len(a)}]" for n, a in zip(self.axis_names, self.axes))
+        return (f"{type(self).__name__}({axes}, S={self.ref_area:g} m2, L={self.ref_length:g} m, "
+                f"x_ref={self.x_ref:g} m)")
+
+
+def _damping(columns: dict[str, np.ndarray], options: dict[str, Any], source: str | None) -> None:
+    for name, value in options.items():
+        if value is None:
+            continue
+        if name in columns:
+            raise ConfigError(name.lower(), value, f"given both as an option and as column {name!r} "
+                              f"of the table; give it once", source=source)
+        try:
+            x = float(value)
+        except (TypeError, ValueError):
+            x = math.nan
+        if not math.isfinite(x):
+            raise ConfigError(name.lower(), value, "a finite number [1/rad] (damping is negative)")
+        columns[name] = np.float64(x)
+
+
+@register("aerodynamics", "axisymmetric")
+class AxisymmetricAero(AeroTables):
+    """3-DOF tables ``CA, CN, Cm`` (and optionally ``Cmq``, ``Clp``) over Mach and total angle of
+    attack, expanded to 6-DOF by axial symmetry. Kernel :func:`aero_loads_k`, kind 0.
+
+    Parameters
+    ----------
+    table:
+        CSV file (columns ``mach, alpha_deg, CA, CN, Cm`` and optionally ``Cmq, Clp``; ``alpha_deg``
+        is the total angle of attack from 0 to at most 180 deg) or a mapping with the grid vectors
+        ``mach`` and ``alpha_deg`` and arrays of shape (n_mach, n_alpha) per coefficient.
+    ref_area, ref_length:
+        Reference area [m^2] and length [m] of the coefficients.
+    x_ref:
+        Moment reference station of ``Cm`` [m], <= 0.
+    cmq, clp:
+        Constant pitch (Cmq + Cmalpha_dot) and roll damping derivatives [1/rad], if the table has
+        no such column.
+    """
+
+    kind = KIND_AXISYMMETRIC
+    axis_names = ("mach", "alpha_total")
+
+    def __init__(self, table: str | Path | Mapping[str, Any], ref_area: float, ref_length: float,
+                 x_ref: float = 0.0, cmq: float | None = None, clp: float | None = None) -> None:
+        cols = COLUMNS[self.kind]
+        if isinstance(table, Mapping):
+            source = None
+            grids = [np.asarray(table["mach"], float), np.asarray(table["alpha_deg"], float)]
+            columns = {k: np.asarray(table[k], float) for k in cols if k in table}
+        else:
+            source = str(table)
+            grids, columns = read_table_csv(table, ("mach", "alpha_deg"), cols[:3], cols[3:])
+        mach, alpha_deg = grids
+        if mach[0] < 0.0 or np.any(np.diff(mach) <= 0):
+            raise ConfigError("column 'mach'", float(mach[0]), "increasing Mach numbers >= 0", source=source)
+        if alpha_deg[0] != 0.0 or alpha_deg[-1] > 180.0 or np.any(np.diff(alpha_deg) <= 0):
+            raise ConfigError("column 'alpha_deg'", [float(alpha_deg[0]), float(alpha_deg[-1])],
+                              "increasing total angles of attack from exactly 0 to at most 180 deg",
+                              source=source)
+        for name in ("CN", "Cm"):
+            bad = np.abs(columns[name][:, 0]) > 1e-9
+            if np.any(bad):
+                raise ConfigError(f"column {name!r} at alpha_deg = 0", float(columns[name][bad, 0][0]),
+                                  "0: an axisymmetric vehicle has no normal force or pitching "
+                                  "moment at zero total angle of attack", source=source)
+        _damping(columns, {"Cmq": cmq, "Clp": clp}, source)
+        self._setup([mach, np.radians(alpha_deg)], columns, ref_area, ref_length, x_ref, source)
+
+    def to_csv(self, path: str | Path, comment: str = "") -> None:
+        """Write the tables in the CSV format this class reads (``alpha_deg`` in degrees)."""
+        mach, alpha = self.axes
+        with open(path, "w", newline="") as fh:
+            for line in comment.splitlines():
+                fh.write(f"# {line}\n")
+            out = csv.writer(fh, lineterminator="\n")
+            out.writerow(("mach", "alpha_deg") + COLUMNS[self.kind])
+            for i, row in enumerate(self.table):
+                out.writerow([f"{mach[i // len(alpha)]:.6g}", f"{math.degrees(alpha[i % len(alpha)]):.6g}"]
+                             + [f"{x:.8g}" for x in row])
+
+    def to_tables6(self, alpha_deg: Any, beta_deg: Any) -> Tables6Aero:
+        """The same aerodynamics as full 6-DOF tables on the given alpha and beta grids [deg]."""
+        a, b = np.radians(np.asarray(alpha_deg, float)), np.radians(np.asarray(beta_deg, float))
+        A, B = np.meshgrid(a, b, indexing="ij")
+        u, v, w = np.cos(A) * np.cos(B), np.sin(B), np.sin(A) * np.cos(B)
+        alpha_t = np.arctan2(np.hypot(v, w), u)
+        vp = np.hypot(v, w)
+        sp, cp = np.where(vp > 0, v / np.where(vp > 0, vp, 1), 0.0), np.where(vp > 0, w / np.where(vp > 0, vp, 1), 1.0)
+        mach = self.axes[0]
+        cols: dict[str, Any] = {k: np.zeros((len(mach),) + A.shape) for k in COLUMNS[KIND_TABLES6]}
+        for i, m in enumerate(mach):
+            c = {k: np.vectorize(lambda at, m=m, k=k: self.coefficients(m, at)[k])(alpha_t)
+                 for k in COLUMNS[self.kind]}
+            cols["CA"][i], cols["CY"][i], cols["CN"][i] = c["CA"], -c["CN"] * sp, c["CN"] * cp
+            cols["Cm"][i], cols["Cn"][i] = c["Cm"] * cp, -c["Cm"] * sp
+            cols["Clp"][i], cols["Cmq"][i], cols["Cnr"][i] = c["Clp"], c["Cmq"], c["Cmq"]
+        table = {"mach": mach, "alpha_deg": np.degrees(a), "beta_deg": np.degrees(b)} | cols
+        return Tables6Aero(table, self.ref_area, self.ref_length, self.x_ref)
+
+
+@register("aerodynamics", "tables6")
+class Tables6Aero(AeroTables):
+    """Full 6-DOF body-axis tables over Mach, alpha, beta and optionally altitude. Kernel
+    :func:`aero_loads_k`, kind 1 (an absent altitude axis is one point: no dependence).
+
+    ``table`` is a CSV file with columns ``mach, alpha_deg, beta_deg`` (optionally ``alt_m``),
+    ``CA, CY, CN, Cl, Cm, Cn`` and optionally ``Clp, Cmq, Cnr``, or a mapping with the grid vectors
+    (``mach``, ``alpha_deg``, ``beta_deg``, optionally ``alt_m``) and arrays over that grid.
+    ``alpha_deg`` within [-180, 180], ``beta_deg`` within [-90, 90]. Other parameters as
+    :class:`AxisymmetricAero`, plus the constant yaw damping ``cnr`` [1/rad].
+    """
+
+    kind = KIND_TABLES6
+    axis_names = ("mach", "alpha", "beta", "altitude")
+
+    def __init__(self, table: str | Path | Mapping[str, Any], ref_area: float, ref_length: float,
+                 x_ref: float = 0.0, cmq: float | None = None, clp: float | None = None,
+                 cnr: float | None = None) -> None:
+        cols = COLUMNS[self.kind]
+        names = ("mach", "alpha_deg", "beta_deg")
+        if isinstance(table, Mapping):
+            source = None
+            grids = [np.asarray(table[k], float) for k in names + ("alt_m",) if k in table]
+            columns = {k: np.asarray(table[k], float) for k in cols if k in table}
+        else:
+            source = str(table)
+            grids, columns = read_table_csv(table, names, cols[:6], cols[6:], ("alt_m",))
+        if len(grids) == 3:
+            grids.append(np.zeros(1))
+            columns = {k: c[..., None] for k, c in columns.items()}
+        limits = {"mach": (0.0, math.inf), "alpha_deg": (-180.0, 180.0), "beta_deg": (-90.0, 90.0),
+                  "alt_m": (-math.inf, math.inf)}
+        for name, g in zip(names + ("alt_m",), grids):
+            lo, hi = limits[name]
+            if g[0] < lo or g[-1] > hi or np.any(np.diff(g) <= 0):
+                raise ConfigError(f"column {name!r}", [float(g[0]), float(g[-1])],
+                                  f"increasing values within [{lo}, {hi}]", source=source)
+        _damping(columns, {"Cmq": cmq, "Clp": clp, "Cnr": cnr}, source)
+        axes = [grids[0], np.radians(grids[1]), np.radians(grids[2]), grids[3]]
+        self._setup(axes, columns, ref_area, ref_length, x_ref, source)
