@@ -1,0 +1,169 @@
+"""Bending modes of the current stack: the mass model's parts on the free-free beam of :mod:`.beam`.
+
+The beam of the attached stages carries
+
+- stiffness from each stage's ``sections`` (``EI`` given, or a tube of ``material`` and ``wall_thickness``;
+  the sections of the attached stages must tile the stack);
+- the mass of the rigid body B, the same mass the dynamics core flies: each stage's structure mass spread
+  uniformly over the stage with a point mass at the stage end that puts its CG where the vehicle file says;
+  engines, payload and fairing as point masses with their pitch inertia; fixed liquid as a column over the
+  liquid height (with a point mass at its end that puts its CG at the fixed mass's station); a hybrid
+  grain over its length. Slosh masses are not on the beam: they are the pendulums,
+  coupled to the modes through the mode shape at their hinges.
+
+:class:`ModeSchedule` decides when the modes are recomputed: by default they are frozen at lift-off (the
+thesis's assumption) and recomputed only when a stage separates; with ``recompute_interval`` [s] (vehicle
+file, ``structure.recompute_interval``) also as propellant burns.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from lvgym.errors import ConfigError
+
+from .beam import BeamModes, stack_modes
+from .config import Vehicle
+from .massmodel import SEPARATED, MassModel, MassProperties, MassState
+from .sections import MATERIALS, DistributedMass, PointMass, Section, tube
+
+
+@dataclass(frozen=True)
+class VehicleModes:
+    """Mode data the dynamics core takes, for K modes per plane (y and z share shapes).
+
+    ``omega`` [rad/s] (K,), ``zeta`` [-] (K,), ``phi_gimbal`` [1/sqrt(kg)] and ``dphi_gimbal``
+    [1/(m sqrt(kg))] (K,), ``phi_hinge`` (N, K) at each slosh hinge, ``sensor_stations`` [m] (S,) with
+    ``phi_sensor`` and ``dphi_sensor`` (S, K); ``beam`` the full result (shapes at every node), ``t`` the
+    time [s] of the mass state they were computed for."""
+
+    t: float
+    omega: np.ndarray
+    zeta: np.ndarray
+    phi_gimbal: np.ndarray
+    dphi_gimbal: np.ndarray
+    phi_hinge: np.ndarray
+    sensor_stations: np.ndarray
+    phi_sensor: np.ndarray
+    dphi_sensor: np.ndarray
+    beam: BeamModes | None
+
+
+def _split(mass: float, top: float, bottom: float, x_cg: float) -> tuple[float, float, float]:
+    """``mass`` [kg] between stations ``top`` and ``bottom`` [m] as a uniform part [kg] plus a point mass
+    [kg] at the end station [m] on the CG's side, so that together they have their CG at ``x_cg`` (all of
+    it a point mass at ``x_cg`` when that lies outside the span)."""
+    if not bottom <= x_cg <= top:  # e.g. a shallow layer's fixed mass above its surface: all at x_cg
+        return 0.0, mass, x_cg
+    mid = 0.5 * (top + bottom)
+    end = top if x_cg > mid else bottom
+    m_end = 0.0 if end == mid else min(max(mass * (x_cg - mid) / (end - mid), 0.0), mass)
+    return mass - m_end, m_end, end
+
+
+def _structure_split(stage) -> tuple[float, float, float]:
+    return _split(stage.structure.mass, stage.top, stage.bottom, float(stage.structure.cg[0]))
+
+
+def _stiffness(vehicle: Vehicle, attached: list[int]) -> list[Section]:
+    """Beam sections of the attached stages: EI from the vehicle file, the stage's uniform structure
+    mass per length."""
+    out = []
+    for si in attached:
+        stage = vehicle.stages[si]
+        uniform = max(_structure_split(stage)[0] / stage.length, 1e-9)
+        if not stage.sections:
+            raise ConfigError(f"{stage.key}.sections", [], "bending modes need the stage's stiffness sections",
+                              vehicle.source)
+        for sec in stage.sections:
+            EI = sec.EI
+            if EI is None:
+                if sec.material not in MATERIALS:
+                    raise ConfigError(f"{sec.key}.material", sec.material, f"one of {sorted(MATERIALS)}",
+                                      vehicle.source)
+                EI = tube(MATERIALS[sec.material], sec.outer_diameter, sec.wall_thickness)[0]
+            out.append(Section(sec.top, sec.bottom, EI, uniform))
+    return out
+
+
+def stack_masses(vehicle: Vehicle, state: MassState, props: MassProperties
+                 ) -> tuple[list[PointMass], list[DistributedMass]]:
+    """Point and distributed masses of the rigid body B on the beam other than the uniform structure
+    mass, which the sections carry (see the module docstring)."""
+    points: list[PointMass] = []
+    spread: list[DistributedMass] = []
+    for si, stage in enumerate(vehicle.stages):
+        if state.phase[si] == SEPARATED:
+            continue
+        _, m_end, end = _structure_split(stage)
+        if m_end > 0.0:
+            points.append(PointMass(end, m_end))
+        points += [PointMass(float(e.part.cg[0]), e.part.mass, float(e.part.inertia[1, 1])) for e in stage.engines]
+        if stage.grain is not None and state.grain_mass[si] > 0.0:
+            g = stage.grain
+            spread.append(DistributedMass(g.top, g.bottom, float(state.grain_mass[si])))
+    for tank, tp in zip(vehicle.tanks, props.tanks):
+        if tp is not None and tp.fixed_mass > 0.0 and tp.height > 0.0:
+            top = tank.bottom + tp.height
+            m_col, m_end, end = _split(tp.fixed_mass, top, tank.bottom, tp.fixed_cg)
+            if m_col > 0.0:
+                spread.append(DistributedMass(top, tank.bottom, m_col))
+            if m_end > 0.0:
+                points.append(PointMass(end, m_end))
+    for part, on in ((vehicle.payload, True), (vehicle.fairing, state.fairing)):
+        if part is not None and on:
+            points.append(PointMass(float(part.cg[0]), part.mass, float(part.inertia[1, 1])))
+    return points, spread
+
+
+def vehicle_modes(vehicle: Vehicle, state: MassState, props: MassProperties, n_modes: int | None = None,
+                  sensor_stations=None) -> VehicleModes:
+    """First ``n_modes`` (default: the vehicle file's) bending modes of the stack in ``state``."""
+    opts = vehicle.structure
+    K = opts.n_modes if n_modes is None else int(n_modes)
+    sensors = np.asarray(opts.sensor_stations if sensor_stations is None else sensor_stations, float).reshape(-1)
+    N = props.slosh_mass.size
+    if K == 0:
+        z = np.zeros(0)
+        return VehicleModes(props.t, z, z, z, z, np.zeros((N, 0)), sensors, np.zeros((sensors.size, 0)),
+                            np.zeros((sensors.size, 0)), None)
+    attached = [si for si, ph in enumerate(state.phase) if ph != SEPARATED]
+    sections = _stiffness(vehicle, attached)
+    top, bottom = max(s.top for s in sections), min(s.bottom for s in sections)
+    hinges = np.clip(props.hinge[:, 0], bottom, top)  # inactive pendulums may sit off the stack
+    query = np.concatenate([[props.gimbal[0]], hinges, sensors])
+    points, spread = stack_masses(vehicle, state, props)
+    beam = stack_modes(sections, points, spread, n_modes=K, query_stations=query)
+    return VehicleModes(t=props.t, omega=beam.omega.copy(), zeta=np.full(K, opts.damping),
+                        phi_gimbal=beam.phi[0].copy(), dphi_gimbal=beam.dphi[0].copy(),
+                        phi_hinge=beam.phi[1:1 + N].copy(), sensor_stations=sensors,
+                        phi_sensor=beam.phi[1 + N:].copy(), dphi_sensor=beam.dphi[1 + N:].copy(), beam=beam)
+
+
+class ModeSchedule:
+    """When to recompute the modes: frozen at lift-off and recomputed at every separation (default), or
+    also every ``recompute_interval`` seconds of flight (``None``: the vehicle file's setting)."""
+
+    def __init__(self, mass_model: MassModel, n_modes: int | None = None, recompute_interval: float | None = None,
+                 sensor_stations=None):
+        self.mass_model = mass_model
+        self.n_modes = n_modes
+        self.interval = mass_model.vehicle.structure.recompute_interval if recompute_interval is None \
+            else recompute_interval
+        self.sensor_stations = sensor_stations
+        self._key: tuple | None = None
+        self._modes: VehicleModes | None = None
+
+    def modes(self, state: MassState, props: MassProperties | None = None) -> VehicleModes:
+        """The modes in force at ``state`` (computed when the schedule says so, cached otherwise)."""
+        attached = tuple(ph != SEPARATED for ph in state.phase)
+        due = self._modes is None or attached != self._key
+        if not due and self.interval is not None:
+            due = state.t - self._modes.t >= self.interval - 1e-12
+        if due:
+            props = props if props is not None else self.mass_model.properties(state)
+            self._modes = vehicle_modes(self.mass_model.vehicle, state, props, self.n_modes, self.sensor_stations)
+            self._key = attached
+        return self._modes
