@@ -125,12 +125,14 @@ def test_us76_upper_temperature_and_hydrostatics(us76):
     xi = (500.0 - 120.0) * (6356.766 + 120.0) / (6356.766 + 500.0)
     assert us76(500e3).temperature == pytest.approx(1000.0 - 640.0 * math.exp(-0.01875 * xi),
                                                     abs=1e-3)
-    # between nodes the interpolated pressure follows dp/dz = -rho g within 1 % above 120 km
+    # between nodes the interpolated pressure follows dp/dz = -rho g within 0.5 % above 120 km
+    # (0.22 % measured; below 120 km US76 itself is not hydrostatic: 1.4 % in the ussa1976 solution
+    # of its defining equations, 1.9 % in this table)
     z = np.linspace(125e3, 950e3, 60)
     s = us76(z)
     g = 9.80665 * (6356766.0 / (6356766.0 + z)) ** 2
     dlnp = (np.log(us76(z + 50.0).pressure) - np.log(us76(z - 50.0).pressure)) / 100.0
-    np.testing.assert_allclose(dlnp, -s.density * g / s.pressure, rtol=1e-2)
+    np.testing.assert_allclose(dlnp, -s.density * g / s.pressure, rtol=5e-3)
 
 
 def test_us76_upper_data_file_provenance():

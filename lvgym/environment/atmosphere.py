@@ -154,12 +154,12 @@ def table_state(p, o, alt_m, out):
         h10 = (s3 - 2.0 * s2 + s) * h
         h01 = 3.0 * s2 - 2.0 * s3
         h11 = (s3 - s2) * h
-        vals = np.empty(3)
-        for q in range(3):
-            y = o + 1 + (2 * q + 1) * n + i
-            d = y + n
-            vals[q] = h00 * p[y] + h10 * p[d] + h01 * p[y + 1] + h11 * p[d + 1]
-        lnrho, lnp, t = vals[0], vals[1], vals[2]
+        y = o + 1 + n + i                 # ln rho at node i; its slope, ln p, ... follow by n
+        lnrho = h00 * p[y] + h10 * p[y + n] + h01 * p[y + 1] + h11 * p[y + n + 1]
+        y += 2 * n
+        lnp = h00 * p[y] + h10 * p[y + n] + h01 * p[y + 1] + h11 * p[y + n + 1]
+        y += 2 * n
+        t = h00 * p[y] + h10 * p[y + n] + h01 * p[y + 1] + h11 * p[y + n + 1]
     rho = math.exp(lnrho)
     pres = math.exp(lnp)
     out[0] = rho
