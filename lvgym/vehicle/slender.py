@@ -18,7 +18,8 @@ Stratos III (``lvgym/vehicles/stratos3.yaml``):
   ``0.92 L`` (thrust structure, fins), so the default structure weighs 94.1 kg like Table 5.1's;
 - bending: one section of the same wall over the whole length (Table 6.4's beam);
 - aerodynamics: a tangent ogive of ``L / 8.2`` and Stratos III's four fins, unchanged, at the base (the
-  thesis holds the aerodynamic coefficients constant over the study).
+  thesis holds the aerodynamic coefficients constant over the study), as a mapping for the Barrowman
+  table generator (``model: barrowman``, :mod:`lvgym.environment.barrowman`).
 
 >>> from lvgym.vehicle.slender import slender_vehicle
 >>> v = slender_vehicle()
@@ -60,8 +61,7 @@ NOSE, TANK_TOP, TANK_BOTTOM, GIMBAL, ENGINE_CG = 1.0 / 8.2, 0.2, 0.8, 0.97, 0.97
 FORWARD_EQUIPMENT, AFT_EQUIPMENT = (0.15, 25.0), (0.92, 25.0)     # (fraction of L, mass [kg])
 ENGINE_MASS, ENGINE_INERTIA = 10.0, [0.112, 0.088, 0.088]         # Table 5.1 [kg], [kg m^2]
 #: Stratos III fins (lvgym/vehicles/stratos3.yaml) [m]; the trailing edge sits FIN_GAP above the base
-FINS = {"count": 4, "root_chord": 0.40, "tip_chord": 0.15, "span": 0.20, "sweep_length": 0.25,
-        "thickness": 0.006}
+FINS = {"count": 4, "root_chord": 0.50, "tip_chord": 0.20, "span": 0.25, "sweep": 0.30, "thickness": 0.006}
 FIN_GAP = 0.05
 
 
@@ -140,8 +140,9 @@ def slender_mapping(length: float = 8.5, diameter: float = 0.3, fill: float = 1.
         }],
         "staging": [{"stage": "stage1"}],
         "structure": {"n_modes": 2, "damping": 0.01},
-        "aerodynamics": {"reference_diameter": _r(D), "nose": {"shape": "ogive", "length": _r(NOSE * L)},
-                         "fins": {**FINS, "root_leading_edge_station": _r(-(L - FIN_GAP - chord))}},
+        "aerodynamics": {"model": "barrowman", "nose": {"shape": "ogive", "length": _r(NOSE * L)},
+                         "body": {"diameter": _r(D), "length": _r(L - NOSE * L)},
+                         "fins": {**FINS, "station": _r(-(L - FIN_GAP - chord))}},
     }
 
 
@@ -181,8 +182,8 @@ HEADER = """\
 #   coefficient on the slosh velocity (thesis 6.2), not a ratio;
 # - one bending section: the 2 mm aluminium tube over the whole length (Table 6.4's beam);
 # - aerodynamics: tangent ogive of L / 8.2 and Stratos III's four fins at the base (the thesis keeps
-#   the Stratos III aerodynamic coefficients for the whole study). Keys of the lead's brief for a
-#   Barrowman generator.
+#   the Stratos III aerodynamic coefficients for the whole study), in the keys of the Barrowman table
+#   generator (lvgym/environment/barrowman.py): make("aerodynamics", vehicle.aerodynamics) builds it.
 # Propellant 280.7 kg: the tank runs dry at 9.4 s at 30 kg/s, before the thesis's 12 s runs end.
 """
 
