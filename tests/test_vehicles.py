@@ -12,10 +12,15 @@ import numpy as np
 import pytest
 import yaml
 
+import lvgym.environment.barrowman  # noqa: F401  (registers the 'barrowman' aerodynamics model)
+from lvgym.environment.registry import make
 from lvgym.errors import ConfigError
+from lvgym.vehicle.beam import stack_modes
 from lvgym.vehicle.config import VEHICLE_DIR, load_vehicle
 from lvgym.vehicle.massmodel import MassModel
+from lvgym.vehicle.sections import MATERIALS, Section, tube
 from lvgym.vehicle.slender import DEFAULTS, TABLE_6_3, slender_mapping, slender_vehicle
+from lvgym.vehicle.structure import vehicle_modes
 
 SHIPPED = sorted(p.stem for p in VEHICLE_DIR.glob("*.yaml"))
 #: Table 6.10: time [s] -> vehicle mass [kg]
@@ -33,6 +38,32 @@ def test_shipped_vehicle_loads_and_has_mass(name):
 
 def test_our_vehicles_are_shipped():
     assert {"stratos3", "smile", "slender"} <= set(SHIPPED)
+
+
+def _margin(v, t: float, mach: float) -> float:
+    """Static margin [calibres] of ``v`` at time ``t`` [s] (its mass-model CG) and Mach ``mach``, from the
+    Barrowman tables its ``aerodynamics`` mapping builds (positive: CP aft of the CG)."""
+    aero = make("aerodynamics", v.aerodynamics)
+    mm = MassModel(v)
+    state, _ = mm.advance(mm.initial_state(), t)
+    return (mm.properties(state).cg[0] - aero.x_cp(mach)) / aero.diameter
+
+
+@pytest.mark.parametrize("name, t, mach, low", [
+    ("stratos3", 0.0, 0.0, 4.0), ("stratos3", 22.8, 4.0, 1.2),      # Mach from a 1-D vertical ascent
+    ("smile", 0.0, 0.0, 2.0), ("smile", 28.8, 3.1, 1.0), ("smile", 42.9, 6.0, 0.3),
+    ("slender", 0.0, 0.0, 6.0)])
+def test_statically_stable_along_the_ascent(name, t, mach, low):
+    assert _margin(load_vehicle(name), t, mach) > low
+
+
+@pytest.mark.parametrize("name", ["stratos3", "smile", "slender"])
+def test_bending_modes_of_the_loaded_stack(name):
+    v = load_vehicle(name)
+    mm = MassModel(v)
+    state = mm.initial_state()
+    modes = vehicle_modes(v, state, mm.properties(state))
+    assert modes.omega.size == 2 and 5.0 < modes.omega[0] / (2 * np.pi) < 20.0
 
 
 # ------------------------------------------------------------------------------------------ SMILE
@@ -96,6 +127,14 @@ def test_stratos3_thrust_table_peak_and_drop(stratos3):
     drops = [np.interp(x + 2.0, t, T) / np.interp(x, t, T) for x in grid]
     assert min(drops) < 0.5
     assert t[-1] == pytest.approx(38.0) and T[-1] == 0.0                   # the 38 s test burn
+
+
+def test_stratos3_bare_beam_near_33_hz(stratos3):
+    """Thesis 5.1: 33 Hz for the bare hollow beam; our bare CFRP sections give 34.1 Hz."""
+    sections = [Section(s.top, s.bottom, *tube(MATERIALS[s.material], s.outer_diameter, s.wall_thickness))
+                for s in stratos3.stages[0].sections]
+    f1 = stack_modes(sections, n_modes=1).frequency_hz[0]
+    assert f1 == pytest.approx(33.0, rel=0.05)
 
 
 def test_stratos3_geometry_fill_and_burn(stratos3):
