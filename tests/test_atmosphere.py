@@ -198,8 +198,9 @@ def test_nrlmsise00_equals_pymsis(msis):
 def test_nrlmsise00_near_us76_low(msis, us76):
     z = np.array([0.0, 5000.0, 10000.0, 20000.0, 30000.0])
     a, b = msis(z), us76(z)
-    np.testing.assert_allclose(a.density, b.density, rtol=0.15)
-    np.testing.assert_allclose(a.temperature, b.temperature, atol=25.0)
+    # measured: density within 7 %, temperature within 15 K, speed of sound within 3.3 %
+    np.testing.assert_allclose(a.density, b.density, rtol=0.10)
+    np.testing.assert_allclose(a.temperature, b.temperature, atol=20.0)
     np.testing.assert_allclose(a.speed_of_sound, b.speed_of_sound, rtol=0.05)
 
 

@@ -35,6 +35,7 @@ molar mass ``M`` of the mixture and gamma = 1.4.
 
 from __future__ import annotations
 
+import functools
 import math
 from pathlib import Path
 from typing import NamedTuple
@@ -238,6 +239,7 @@ class _Atmosphere:
         return AtmosphereState(*(out[:, k].reshape(alt.shape) for k in range(4)))
 
 
+@functools.lru_cache(maxsize=1)
 def _upper_us76_block() -> np.ndarray:
     """Table block of US76 from 86 to 1000 km (``data/us76_upper.csv``, provenance in its header)."""
     path = Path(__file__).with_name("data") / "us76_upper.csv"
@@ -260,7 +262,7 @@ class Us76Atmosphere(_Atmosphere):
     """
 
     def __init__(self) -> None:
-        self.params = np.concatenate([[float(CODE_US76)], _upper_us76_block()])
+        self.params = np.concatenate([[float(CODE_US76)], _upper_us76_block()])   # a fresh copy
 
 
 @register("atmosphere", "exponential")
