@@ -213,7 +213,7 @@ def test_bad_csv_files_name_file_column_and_value(tmp_path, edit, pattern):
 
 
 def test_bad_options(csv_path, tmp_path):
-    with pytest.raises(ConfigError, match="ref_area = -1.0"):
+    with pytest.raises(ConfigError, match="ref_area = -1.0: a reference area"):
         AxisymmetricAero(csv_path, ref_area=-1.0, ref_length=L)
     with pytest.raises(ConfigError, match="x_ref = 0.5"):
         AxisymmetricAero(csv_path, ref_area=S, ref_length=L, x_ref=0.5)

@@ -216,13 +216,30 @@ def read_table_csv(path: str | Path, axes: tuple[str, ...], required: tuple[str,
     return grids, columns
 
 
-def _positive(key: str, value: Any, source: str | None = None) -> float:
+def _from_mapping(table: Mapping[str, Any], axes: tuple[str, ...], optional_axes: tuple[str, ...],
+                  required: tuple[str, ...], optional: tuple[str, ...]
+                  ) -> tuple[list[np.ndarray], dict[str, np.ndarray]]:
+    """Grid vectors and coefficient arrays from a mapping (the in-memory form of a CSV table)."""
+    for name in axes + required:
+        if name not in table:
+            raise ConfigError(f"table.{name}", MISSING, f"required; the mapping has {sorted(table)}")
+    grids = [np.asarray(table[k], float).ravel() for k in axes + optional_axes if k in table]
+    shape = tuple(len(g) for g in grids)
+    columns = {k: np.asarray(table[k], float) for k in required + optional if k in table}
+    for name, col in columns.items():
+        if col.shape != shape:
+            raise ConfigError(f"table.{name}", col.shape, f"an array over the grid, shape {shape}")
+    return grids, columns
+
+
+def _real(key: str, value: Any, ok: Any, allowed: str) -> float:
+    """``float(value)`` if finite and ``ok(value)``, else ConfigError(key, value, allowed)."""
     try:
         x = float(value)
     except (TypeError, ValueError):
         x = math.nan
-    if not (math.isfinite(x) and x > 0.0):
-        raise ConfigError(key, value, "a finite number > 0", source=source)
+    if not (math.isfinite(x) and ok(x)):
+        raise ConfigError(key, value, allowed)
     return x
 
 
@@ -254,14 +271,9 @@ class AeroTables:
 
     def _setup(self, axes: list[np.ndarray], columns: Mapping[str, np.ndarray], ref_area: Any,
                ref_length: Any, x_ref: Any, source: str | None) -> None:
-        s = _positive("ref_area", ref_area)
-        length = _positive("ref_length", ref_length)
-        try:
-            xr = float(x_ref)
-        except (TypeError, ValueError):
-            xr = math.nan
-        if not (math.isfinite(xr) and xr <= 0.0):
-            raise ConfigError("x_ref", x_ref, "a station [m] from the nose tip, finite and <= 0")
+        s = _real("ref_area", ref_area, lambda x: x > 0.0, "a reference area [m^2] > 0")
+        length = _real("ref_length", ref_length, lambda x: x > 0.0, "a reference length [m] > 0")
+        xr = _real("x_ref", x_ref, lambda x: x <= 0.0, "a station [m] from the nose tip, <= 0")
         self.source = source
         self.axes = [np.ascontiguousarray(a, dtype=np.float64) for a in axes]
         self.ref_area, self.ref_length, self.x_ref = s, length, xr
@@ -306,9 +318,7 @@ class AeroTables:
             shape = (b,) if width is None else (b, width)
             return np.ascontiguousarray(np.broadcast_to(a, shape))
 
-        f = np.zeros((b, 3))
-        m = np.zeros((b, 3))
-        s = np.zeros((b, len(STATE_FIELDS)))
+        f, m, s = np.zeros((b, 3)), np.zeros((b, 3)), np.zeros((b, len(STATE_FIELDS)))
         aero_loads_batch(rows(v, 3), rows(omega_bi_b, 3), rows(rho, None), rows(speed_of_sound, None),
                          rows(x_cg, None), rows(altitude, None), *self.kernel_args(), f, m, s)
         if v.ndim == 1:
@@ -328,13 +338,8 @@ def _damping(columns: dict[str, np.ndarray], options: dict[str, Any], source: st
         if name in columns:
             raise ConfigError(name.lower(), value, f"given both as an option and as column {name!r} "
                               f"of the table; give it once", source=source)
-        try:
-            x = float(value)
-        except (TypeError, ValueError):
-            x = math.nan
-        if not math.isfinite(x):
-            raise ConfigError(name.lower(), value, "a finite number [1/rad] (damping is negative)")
-        columns[name] = np.float64(x)
+        columns[name] = np.float64(_real(name.lower(), value, lambda x: True,
+                                         "a finite number [1/rad] (damping is negative)"))
 
 
 @register("aerodynamics", "axisymmetric")
@@ -365,8 +370,7 @@ class AxisymmetricAero(AeroTables):
         cols = COLUMNS[self.kind]
         if isinstance(table, Mapping):
             source = None
-            grids = [np.asarray(table["mach"], float), np.asarray(table["alpha_deg"], float)]
-            columns = {k: np.asarray(table[k], float) for k in cols if k in table}
+            grids, columns = _from_mapping(table, ("mach", "alpha_deg"), (), cols[:3], cols[3:])
         else:
             source = str(table)
             grids, columns = read_table_csv(table, ("mach", "alpha_deg"), cols[:3], cols[3:])
@@ -400,21 +404,16 @@ class AxisymmetricAero(AeroTables):
 
     def to_tables6(self, alpha_deg: Any, beta_deg: Any) -> Tables6Aero:
         """The same aerodynamics as full 6-DOF tables on the given alpha and beta grids [deg]."""
-        a, b = np.radians(np.asarray(alpha_deg, float)), np.radians(np.asarray(beta_deg, float))
-        A, B = np.meshgrid(a, b, indexing="ij")
-        u, v, w = np.cos(A) * np.cos(B), np.sin(B), np.sin(A) * np.cos(B)
-        alpha_t = np.arctan2(np.hypot(v, w), u)
-        vp = np.hypot(v, w)
-        sp, cp = np.where(vp > 0, v / np.where(vp > 0, vp, 1), 0.0), np.where(vp > 0, w / np.where(vp > 0, vp, 1), 1.0)
-        mach = self.axes[0]
-        cols: dict[str, Any] = {k: np.zeros((len(mach),) + A.shape) for k in COLUMNS[KIND_TABLES6]}
-        for i, m in enumerate(mach):
-            c = {k: np.vectorize(lambda at, m=m, k=k: self.coefficients(m, at)[k])(alpha_t)
-                 for k in COLUMNS[self.kind]}
-            cols["CA"][i], cols["CY"][i], cols["CN"][i] = c["CA"], -c["CN"] * sp, c["CN"] * cp
-            cols["Cm"][i], cols["Cn"][i] = c["Cm"] * cp, -c["Cm"] * sp
-            cols["Clp"][i], cols["Cmq"][i], cols["Cnr"][i] = c["Clp"], c["Cmq"], c["Cmq"]
-        table = {"mach": mach, "alpha_deg": np.degrees(a), "beta_deg": np.degrees(b)} | cols
+        a, b = np.meshgrid(np.radians(alpha_deg), np.radians(beta_deg), indexing="ij")
+        u, v, w = np.cos(a) * np.cos(b), np.sin(b), np.sin(a) * np.cos(b)
+        alpha_t, phi = np.arctan2(np.hypot(v, w), u), np.arctan2(v, w)
+        sp, cp = np.sin(phi), np.cos(phi)
+        c = np.array([[list(self.coefficients(m, t).values()) for t in alpha_t.ravel()]
+                      for m in self.axes[0]]).reshape((len(self.axes[0]),) + a.shape + (5,))
+        cols = {"CA": c[..., 0], "CY": -c[..., 1] * sp, "CN": c[..., 1] * cp, "Cm": c[..., 2] * cp,
+                "Cn": -c[..., 2] * sp, "Cl": 0.0 * c[..., 0], "Cmq": c[..., 3], "Cnr": c[..., 3], "Clp": c[..., 4]}
+        table = {"mach": self.axes[0], "alpha_deg": np.asarray(alpha_deg, float),
+                 "beta_deg": np.asarray(beta_deg, float)} | cols
         return Tables6Aero(table, self.ref_area, self.ref_length, self.x_ref)
 
 
@@ -440,8 +439,7 @@ class Tables6Aero(AeroTables):
         names = ("mach", "alpha_deg", "beta_deg")
         if isinstance(table, Mapping):
             source = None
-            grids = [np.asarray(table[k], float) for k in names + ("alt_m",) if k in table]
-            columns = {k: np.asarray(table[k], float) for k in cols if k in table}
+            grids, columns = _from_mapping(table, names, ("alt_m",), cols[:6], cols[6:])
         else:
             source = str(table)
             grids, columns = read_table_csv(table, names, cols[:6], cols[6:], ("alt_m",))

@@ -290,10 +290,9 @@ class BarrowmanAero(AxisymmetricAero):
         ln = self.nose_length
         out = {"nose": (2.0, -(ln - nose_volume(self.nose_shape, ln, self.radius) / self.s_ref))}
         if self.tail_length > 0.0:
-            r = self.aft_diameter / self.diameter
+            r = self.aft_diameter / self.diameter          # q = fore / aft diameter in Barrowman's CP
             x_top = -(ln + self.body_length)
-            out["boat_tail"] = (2.0 * (r * r - 1.0),
-                                x_top - self.tail_length / 3.0 * (1.0 + (1.0 - r) / (1.0 - r * r)))
+            out["boat_tail"] = (2.0 * (r * r - 1.0), x_top - self.tail_length / 3.0 * (1.0 + r / (1.0 + r)))
         for i, f in enumerate(self.fins):
             out[f"fins[{i}]"] = (fin_normal_slope(f, self.radius, self.s_ref, mach)[0], f.x_cp)
         return out
