@@ -1,4 +1,4 @@
-"""Atmosphere models: US76 against the printed standard, exponential by hand, NRLMSISE-00 against pymsis."""
+"""Atmosphere models: US76 against the printed standard, exponential by hand, NRLMSISE-00 vs pymsis."""
 
 import doctest
 import math
