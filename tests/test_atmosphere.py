@@ -15,9 +15,10 @@ from lvgym.environment.registry import make
 from lvgym.errors import ConfigError
 
 # U.S. Standard Atmosphere 1976 (NOAA-S/T 76-1562, NASA-TM-X-74335), Part 4, Table I, geometric
-# altitude pages 53-67: z [m], T [K], p [mb], rho [kg/m^3], as printed (strings keep the printed
+# altitude pages 51-67: z [m], T [K], p [mb], rho [kg/m^3], as printed (strings keep the printed
 # digits; the tolerance is one unit of the last printed digit).
 US76_TABLE_I = [
+    (-2000, "301.154", "1.2778e3", "1.4782e0"),
     (0, "288.150", "1.01325e3", "1.2250e0"),
     (1000, "281.651", "8.9876e2", "1.1117e0"),
     (2000, "275.154", "7.9501e2", "1.0066e0"),
@@ -42,8 +43,8 @@ US76_TABLE_I = [
     (80000, "198.639", "1.0524e-2", "1.8458e-5"),
     (85000, "188.893", "4.4568e-3", "8.2196e-6"),
 ]
-# US76 Table III speed of sound [m/s] at 0, 1, 2, 4 km (as printed)
-US76_SOUND = [(0, "340.29"), (1000, "336.43"), (2000, "332.53"), (4000, "324.59")]
+# US76 Table III speed of sound [m/s] at -2, 0, 1, 2, 4 km (as printed)
+US76_SOUND = [(-2000, "347.89"), (0, "340.29"), (1000, "336.43"), (2000, "332.53"), (4000, "324.59")]
 # US76 Table I pressure [Pa] above 86 km, 5 significant figures (PDAS Atmosphere1976 UpperAtmosphere
 # table, p/p0 times 101325 Pa), and printed densities [kg/m^3] of the same table.
 US76_UPPER = [(86e3, 3.7338e-1, 6.958e-6), (100e3, 3.2011e-2, 5.604e-7), (150e3, 4.5422e-4, 2.076e-9),
