@@ -5,6 +5,7 @@ III's thrust table, L/D and fill (thesis 5.1, Table 5.1); the slender vehicle at
 Table 6.3 and its shipped YAML equal to ``slender_vehicle()``'s defaults.
 """
 
+import doctest
 import itertools
 import math
 
@@ -19,6 +20,7 @@ from lvgym.vehicle.beam import stack_modes
 from lvgym.vehicle.config import VEHICLE_DIR, load_vehicle
 from lvgym.vehicle.massmodel import MassModel
 from lvgym.vehicle.sections import MATERIALS, Section, tube
+import lvgym.vehicle.slender
 from lvgym.vehicle.slender import DEFAULTS, TABLE_6_3, slender_mapping, slender_vehicle
 from lvgym.vehicle.structure import vehicle_modes
 
@@ -206,3 +208,8 @@ def test_slender_errors_name_the_parameter(kwargs, key):
         slender_vehicle(**kwargs)
     assert info.value.key == key
     assert str(info.value).startswith(f"slender_vehicle: {key} = ")
+
+
+def test_slender_docstring_examples():
+    result = doctest.testmod(lvgym.vehicle.slender)
+    assert result.attempted > 0 and result.failed == 0
