@@ -6,8 +6,8 @@ from compiled loads functions). Models are chosen by name with :func:`make`; imp
 registers them all.
 """
 
-from . import earth, gravity
+from . import atmosphere, earth, gravity, wind
 from .earth import LaunchSite
 from .registry import make, names, register
 
-__all__ = ["LaunchSite", "earth", "gravity", "make", "names", "register"]
+__all__ = ["LaunchSite", "atmosphere", "earth", "gravity", "make", "names", "register", "wind"]
