@@ -197,7 +197,9 @@ class MassModel:
             used = em.consumed(state.t - state.ignition[si], t_to - state.ignition[si], throttle)
             for kind, index, frac in self._feeds[j]:
                 store = tanks if kind == "tank" else grains
-                store[index] = max(store[index] - frac * used, 0.0)
+                left = store[index] - frac * used
+                # rounding residue of an emptied store (1e-15 kg after split steps) is no propellant
+                store[index] = left if left > 1e-9 * max(store[index], 1.0) else 0.0
         return replace(state, t=t_to, tank_mass=tanks, grain_mass=grains)
 
     def _apply_events(self, state: MassState, throttle: float) -> tuple[MassState, list[str]]:

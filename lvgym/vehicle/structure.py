@@ -55,7 +55,8 @@ def _split(mass: float, top: float, bottom: float, x_cg: float) -> tuple[float, 
     """``mass`` [kg] between stations ``top`` and ``bottom`` [m] as a uniform part [kg] plus a point mass
     [kg] at the end station [m] on the CG's side, so that together they have their CG at ``x_cg`` (all of
     it a point mass at ``x_cg`` when that lies outside the span)."""
-    if not bottom <= x_cg <= top:  # e.g. a shallow layer's fixed mass above its surface: all at x_cg
+    if not bottom <= x_cg <= top or top - bottom < 1e-6:  # a shallow layer's fixed mass above its surface,
+        # or a film too thin for an element: all of it at x_cg
         return 0.0, mass, x_cg
     mid = 0.5 * (top + bottom)
     end = top if x_cg > mid else bottom
