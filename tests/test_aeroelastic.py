@@ -34,7 +34,8 @@ def test_rigid_modes_reduce_to_the_tables_cn_alpha(vehicle):
     k, n = 2, 200
     model = strip_model(vehicle, n, phi=np.zeros((k, n)), dphi=np.zeros((k, n)))
     speed, alpha, beta = 136.0, 1e-3, -2e-3
-    v = speed * np.array([math.cos(alpha) * math.cos(beta), math.sin(beta), math.sin(alpha) * math.cos(beta)])
+    v = speed * np.array([math.cos(alpha) * math.cos(beta), math.sin(beta),
+                          math.sin(alpha) * math.cos(beta)])
     f, m, f_eta = model.loads(v, np.zeros(3), 1.0, 340.0, X_REF, eta=[0.1, -0.2, 0.3, 0.4],
                               eta_dot=[1.0, 2.0, -1.0, 0.5])
     qs = 0.5 * speed ** 2 * vehicle.s_ref
@@ -124,8 +125,10 @@ def test_elastic_increment_only():
 def test_y_and_z_planes_are_symmetric():
     # a quarter turn about x_b maps (v, w) -> (-w, v), eta_z -> eta_y ... f_eta_y(v) = f_eta_z(w)
     model = hand_model()
-    _, _, fz = model.loads([100.0, 0.0, 7.0], [0.0, -0.1, 0.0], 1.0, 340.0, -2.0, eta=[0.0, 0.5], eta_dot=[0.0, 1.0])
-    _, _, fy = model.loads([100.0, 7.0, 0.0], [0.0, 0.0, 0.1], 1.0, 340.0, -2.0, eta=[0.5, 0.0], eta_dot=[1.0, 0.0])
+    _, _, fz = model.loads([100.0, 0.0, 7.0], [0.0, -0.1, 0.0], 1.0, 340.0, -2.0, eta=[0.0, 0.5],
+                           eta_dot=[0.0, 1.0])
+    _, _, fy = model.loads([100.0, 7.0, 0.0], [0.0, 0.0, 0.1], 1.0, 340.0, -2.0, eta=[0.5, 0.0],
+                           eta_dot=[1.0, 0.0])
     assert fy[0] == pytest.approx(fz[1]) and fy[1] == 0.0 and fz[0] == 0.0
 
 

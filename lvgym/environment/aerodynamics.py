@@ -1,36 +1,25 @@
 """Aerodynamic coefficient tables and the aerodynamic force and moment (thesis section 3.2).
 
-Two table models, chosen by name (``make("aerodynamics", ...)``):
+Two table models, chosen by name (``make("aerodynamics", ...)``; formats in docs/aerodynamics.md):
+``axisymmetric``, the thesis's 3-DOF tables ``CA, CN, Cm`` over Mach and the total angle of attack
+``alpha_t`` in [0, 180] deg, expanded to 6-DOF by axial symmetry (the normal force lies in the
+crossflow plane, at roll orientation ``phi_a = atan2(v, w)``), and ``tables6``, full body-axis tables
+``CA, CY, CN, Cl, Cm, Cn`` over Mach, alpha, beta and optionally altitude (Missile DATCOM style).
+Both carry damping derivatives ``Cmq`` (= Cmq + Cmalpha_dot), ``Clp`` and, for ``tables6``, ``Cnr``
+(per rad of ``omega L / (2 V)``; axisymmetric: ``Cnr = Cmq``), a reference area ``S`` [m^2], length
+``L`` [m] and moment reference station ``x_ref`` [m] (x_b from the nose tip, <= 0).
 
-``axisymmetric``
-    The thesis's 3-DOF tables ``CA, CN, Cm`` over Mach and the *total* angle of attack
-    ``alpha_t`` in [0, 180] deg, expanded to 6-DOF by axial symmetry: the normal force lies in
-    the plane of the crossflow, whose roll orientation is ``phi_a = atan2(v, w)``.
-``tables6``
-    Full 6-DOF body-axis tables ``CA, CY, CN, Cl, Cm, Cn`` over Mach, angle of attack, sideslip and,
-    if given, altitude (Missile DATCOM style).
+With ``v_air_b = (u, v, w)`` the vehicle's velocity relative to the air, body axes, and
+``qbar = rho V^2 / 2``: ``alpha = atan2(w, u)``, ``beta = atan2(v, sqrt(u^2 + w^2))``,
+``alpha_t = atan2(sqrt(v^2 + w^2), u)``; ``f_b = qbar S (-CA, CY, -CN)`` (CA positive aft, CN
+towards -z_b at positive alpha); moments ``qbar S L (Cl, Cm, Cn)`` about ``x_ref`` (Cm nose-up, a
+stable vehicle has dCm/dalpha < 0), moved to the CG station: ``m_cg = m_ref + (x_ref - x_cg) e_x x
+f_b``; damping about the CG ``rho V S L^2 / 4 (Clp p, Cmq q, Cnr r)``, used as tabulated. Axes are
+clamped at the grid ends. Everything is zero, without NaN, at zero airspeed.
 
-Both carry damping derivatives (``Cmq`` = Cmq + Cmalpha_dot per rad of ``q L / (2 V)``, ``Clp``,
-and ``Cnr`` for ``tables6``; the axisymmetric model uses ``Cnr = Cmq``), a reference area ``S``
-[m^2], a reference length ``L`` [m] and the moment reference station ``x_ref`` [m] (x_b from the
-nose tip, <= 0). Conventions, with ``v_air_b = (u, v, w)`` the velocity of the vehicle relative
-to the air in body axes and ``qbar = rho V^2 / 2``:
-
-* ``alpha = atan2(w, u)``, ``beta = atan2(v, sqrt(u^2 + w^2))`` (= asin(v/V)),
-  ``alpha_t = atan2(sqrt(v^2 + w^2), u)``;
-* ``f_b = qbar S (-CA, CY, -CN)``: CA positive aft, CN positive towards -z_b at positive alpha;
-* moments about ``x_ref``: ``qbar S L (Cl, Cm, Cn)``; Cm positive nose-up (a stable vehicle has
-  dCm/dalpha < 0); the kernel moves them to the CG station ``x_cg``:
-  ``m_cg = m_ref + (x_ref - x_cg) e_x x f_b``;
-* damping about the CG: ``rho V S L^2 / 4 * (Clp p, Cmq q, Cnr r)``, tabulated values used as
-  given (they are not transferred from ``x_ref``);
-* outside the grid every axis is clamped to its end values (no extrapolation).
-
-All of it is zero, without NaN, at zero airspeed. Compiled callers use :func:`aero_loads_k` with
-``model.kernel_args() = (p, grid, dims, table)``: ``p = [kind, S, L, x_ref]``; ``grid`` the axis
-vectors (Mach, angles in rad, altitude in m) end to end; ``dims`` their lengths; ``table`` the
-coefficients, one row per grid point (C order over the axes), columns ``COLUMNS[kind]``.
-CSV formats: see ``docs/aerodynamics.md`` and :func:`read_table_csv`.
+Compiled callers use :func:`aero_loads_k` with ``model.kernel_args() = (p, grid, dims, table)``:
+``p = [kind, S, L, x_ref]``; ``grid`` the axis vectors (Mach, angles in rad, altitude in m) end to
+end; ``dims`` their lengths; ``table`` one row per grid point (C order), columns ``COLUMNS[kind]``.
 """
 
 from __future__ import annotations
@@ -175,12 +164,13 @@ def read_table_csv(path: str | Path, axes: tuple[str, ...], required: tuple[str,
     src = str(path)
     try:
         with open(path, newline="") as fh:
-            rows = [r for r in csv.reader(fh) if r and not r[0].lstrip().startswith("#")]
+            reader = csv.reader(fh)
+            rows = [(reader.line_num, r) for r in reader if r and not r[0].lstrip().startswith("#")]
     except OSError as exc:
         raise ConfigError("table", src, f"a readable CSV file ({exc.strerror})") from None
     if not rows:
         raise ConfigError("header", MISSING, "a header line naming the columns", source=src)
-    header = [h.strip() for h in rows[0]]
+    header = [h.strip() for h in rows[0][1]]
     allowed = axes + optional_axes + required + optional
     for name in header:
         if name not in allowed or header.count(name) > 1:
@@ -189,16 +179,18 @@ def read_table_csv(path: str | Path, axes: tuple[str, ...], required: tuple[str,
         if name not in header:
             raise ConfigError(f"column {name!r}", MISSING, f"required; the file has {header}", source=src)
     data = np.empty((len(rows) - 1, len(header)))
-    for i, row in enumerate(rows[1:], start=2):
+    for n, (i, row) in enumerate(rows[1:]):
         if len(row) != len(header):
-            raise ConfigError(f"line {i}", ",".join(row), f"{len(header)} values, one per column", source=src)
+            raise ConfigError(f"line {i}", ",".join(row), f"{len(header)} values, one per column",
+                              source=src)
         for j, raw in enumerate(row):
             try:
-                data[i - 2, j] = float(raw)
+                data[n, j] = float(raw)
             except ValueError:
-                data[i - 2, j] = math.nan
-            if not math.isfinite(data[i - 2, j]):
-                raise ConfigError(f"line {i}, column {header[j]!r}", raw.strip(), "a finite number", source=src)
+                data[n, j] = math.nan
+            if not math.isfinite(data[n, j]):
+                raise ConfigError(f"line {i}, column {header[j]!r}", raw.strip(), "a finite number",
+                                  source=src)
     used_axes = [a for a in axes + optional_axes if a in header]
     grids = [np.unique(data[:, header.index(a)]) for a in used_axes]
     shape = tuple(len(g) for g in grids)
@@ -376,7 +368,8 @@ class AxisymmetricAero(AeroTables):
             grids, columns = read_table_csv(table, ("mach", "alpha_deg"), cols[:3], cols[3:])
         mach, alpha_deg = grids
         if mach[0] < 0.0 or np.any(np.diff(mach) <= 0):
-            raise ConfigError("column 'mach'", float(mach[0]), "increasing Mach numbers >= 0", source=source)
+            raise ConfigError("column 'mach'", float(mach[0]), "increasing Mach numbers >= 0",
+                              source=source)
         if alpha_deg[0] != 0.0 or alpha_deg[-1] > 180.0 or np.any(np.diff(alpha_deg) <= 0):
             raise ConfigError("column 'alpha_deg'", [float(alpha_deg[0]), float(alpha_deg[-1])],
                               "increasing total angles of attack from exactly 0 to at most 180 deg",
@@ -411,7 +404,8 @@ class AxisymmetricAero(AeroTables):
         c = np.array([[list(self.coefficients(m, t).values()) for t in alpha_t.ravel()]
                       for m in self.axes[0]]).reshape((len(self.axes[0]),) + a.shape + (5,))
         cols = {"CA": c[..., 0], "CY": -c[..., 1] * sp, "CN": c[..., 1] * cp, "Cm": c[..., 2] * cp,
-                "Cn": -c[..., 2] * sp, "Cl": 0.0 * c[..., 0], "Cmq": c[..., 3], "Cnr": c[..., 3], "Clp": c[..., 4]}
+                "Cn": -c[..., 2] * sp, "Cl": 0.0 * c[..., 0], "Cmq": c[..., 3], "Cnr": c[..., 3],
+                "Clp": c[..., 4]}
         table = {"mach": self.axes[0], "alpha_deg": np.asarray(alpha_deg, float),
                  "beta_deg": np.asarray(beta_deg, float)} | cols
         return Tables6Aero(table, self.ref_area, self.ref_length, self.x_ref)

@@ -56,7 +56,7 @@ M_WAVE_START, M_WAVE_FULL = 0.8, 1.2
 
 
 def _number(section: str, spec: Mapping[str, Any], key: str, lo: float = 0.0, *, positive: bool = True,
-            hi: float = math.inf, default: Any = MISSING) -> float:
+            hi: float = math.inf, default: Any = MISSING, allowed: str = "") -> float:
     value = spec.get(key, default)
     try:
         x = float(value)
@@ -65,7 +65,8 @@ def _number(section: str, spec: Mapping[str, Any], key: str, lo: float = 0.0, *,
     ok = math.isfinite(x) and (x > lo if positive else x >= lo) and x <= hi
     if not ok:
         rel = ">" if positive else ">="
-        raise ConfigError(f"{section}.{key}", value, f"a number [m] {rel} {lo:g}" + (f" and <= {hi:g}" if hi < math.inf else ""))
+        upper = f" and <= {hi:g}" if hi < math.inf else ""
+        raise ConfigError(f"{section}.{key}", value, allowed or f"a number [m] {rel} {lo:g}{upper}")
     return x
 
 
@@ -106,7 +107,8 @@ class FinSet:
     def x_cp(self) -> float:
         """Barrowman centre of pressure station [m]."""
         cr, ct, sw = self.root_chord, self.tip_chord, self.sweep
-        return self.station - (sw / 3.0 * (cr + 2 * ct) / (cr + ct) + (cr + ct - cr * ct / (cr + ct)) / 6.0)
+        return self.station - (sw / 3.0 * (cr + 2 * ct) / (cr + ct)
+                               + (cr + ct - cr * ct / (cr + ct)) / 6.0)
 
     @property
     def x_centroid(self) -> float:
@@ -232,17 +234,19 @@ class BarrowmanAero(AxisymmetricAero):
             self.tail_length = _number("boat_tail", bt, "length")
             self.aft_diameter = _number("boat_tail", bt, "aft_diameter")
             if abs(self.aft_diameter - self.diameter) < 1e-9 * self.diameter:
-                raise ConfigError("boat_tail.aft_diameter", bt["aft_diameter"], "differs from body.diameter "
-                                  "(leave boat_tail out for a plain cylinder)")
+                raise ConfigError("boat_tail.aft_diameter", bt["aft_diameter"],
+                                  "differs from body.diameter (leave boat_tail out for a cylinder)")
         self.length = self.nose_length + self.body_length + self.tail_length
         self.fins = self._fin_sets(fins)
         for key, value in (("roughness", roughness), ("reynolds_per_m", reynolds_per_m),
                            ("crossflow_k", crossflow_k)):
             _number("barrowman", {key: value}, key, positive=key != "roughness")
-        self.roughness, self.reynolds_per_m, self.crossflow_k = float(roughness), float(reynolds_per_m), float(crossflow_k)
+        self.roughness, self.reynolds_per_m = float(roughness), float(reynolds_per_m)
+        self.crossflow_k = float(crossflow_k)
         self.s_ref = math.pi * self.radius ** 2
-        xr = -0.5 * self.length if x_ref is None else _number("barrowman", {"x_ref": x_ref}, "x_ref",
-                                                              -math.inf, positive=False, hi=0.0)
+        xr = -0.5 * self.length if x_ref is None else _number(
+            "barrowman", {"x_ref": x_ref}, "x_ref", -math.inf, positive=False, hi=0.0,
+            allowed="a moment reference station [m] <= 0")
         self._c_sbt = (None if self.nose_shape == "cone"
                        else slender_body_wave_drag(self.nose_shape, self.nose_length, self.radius))
         grid_m = np.asarray(MACH_GRID if mach is None else mach, dtype=float)
@@ -262,14 +266,17 @@ class BarrowmanAero(AxisymmetricAero):
         out = []
         for i, spec in enumerate(specs):
             sec = f"fins[{i}]"
-            spec = _mapping(sec, spec, ("count", "root_chord", "tip_chord", "span", "sweep", "station", "thickness"))
+            spec = _mapping(sec, spec, ("count", "root_chord", "tip_chord", "span", "sweep", "station",
+                                        "thickness"))
             count = spec.get("count", MISSING)
             if not isinstance(count, (int, np.integer)) or isinstance(count, bool) or not 3 <= count <= 8:
                 raise ConfigError(f"{sec}.count", count, "an integer from 3 to 8")
             cr = _number(sec, spec, "root_chord")
             ct = _number(sec, spec, "tip_chord", positive=False, default=0.0)
             sweep = _number(sec, spec, "sweep", -math.inf, positive=False, default=cr - ct)
-            station = _number(sec, spec, "station", -self.length + cr, positive=False, hi=0.0)
+            station = _number(sec, spec, "station", -self.length + cr, positive=False, hi=0.0,
+                              allowed=f"the root leading-edge station [m], with the root chord on the "
+                                      f"body: in [{cr - self.length:g}, 0]")
             out.append(FinSet(int(count), cr, ct, _number(sec, spec, "span"), sweep, station,
                               _number(sec, spec, "thickness", positive=False, hi=cr, default=0.0)))
         return tuple(out)
@@ -278,7 +285,8 @@ class BarrowmanAero(AxisymmetricAero):
         """Body radius [m] at distance ``xi`` [m] behind the nose tip (0 beyond the ends)."""
         xi = np.asarray(xi, dtype=float)
         ln, lb = self.nose_length, self.body_length
-        r_tail = self.radius + (0.5 * self.aft_diameter - self.radius) * (xi - ln - lb) / max(self.tail_length, 1e-300)
+        slope = (0.5 * self.aft_diameter - self.radius) / max(self.tail_length, 1e-300)
+        r_tail = self.radius + slope * (xi - ln - lb)
         r = np.where(xi < ln, nose_radius(self.nose_shape, xi, ln, self.radius),
                      np.where(xi <= ln + lb, self.radius, r_tail))
         return np.where((xi < 0.0) | (xi > self.length), 0.0, r)
@@ -292,7 +300,8 @@ class BarrowmanAero(AxisymmetricAero):
         if self.tail_length > 0.0:
             r = self.aft_diameter / self.diameter          # q = fore / aft diameter in Barrowman's CP
             x_top = -(ln + self.body_length)
-            out["boat_tail"] = (2.0 * (r * r - 1.0), x_top - self.tail_length / 3.0 * (1.0 + r / (1.0 + r)))
+            out["boat_tail"] = (2.0 * (r * r - 1.0),
+                                x_top - self.tail_length / 3.0 * (1.0 + r / (1.0 + r)))
         for i, f in enumerate(self.fins):
             out[f"fins[{i}]"] = (fin_normal_slope(f, self.radius, self.s_ref, mach)[0], f.x_cp)
         return out
@@ -318,10 +327,12 @@ class BarrowmanAero(AxisymmetricAero):
         for f in self.fins:
             friction += (1.0 + 2.0 * f.thickness / f.mac) * 2.0 * f.count * f.area
             te_area += f.count * f.thickness * f.span
-            fin_wave += wave_ramp(mach, lambda m, f=f: 4.0 * (f.thickness / f.mac) ** 2 / math.sqrt(m * m - 1.0)) * f.count * f.area
+            tc2 = (f.thickness / f.mac) ** 2
+            fin_wave += wave_ramp(mach, lambda m: 4.0 * tc2 / math.sqrt(m * m - 1.0)) * f.count * f.area
         if self.nose_shape == "cone":
             phi = math.atan(self.radius / self.nose_length)
-            nose = wave_ramp(mach, lambda m: 2.1 * math.sin(phi) ** 2 + 0.5 * math.sin(phi) / math.sqrt(m * m - 1.0))
+            sp = math.sin(phi)
+            nose = wave_ramp(mach, lambda m: 2.1 * sp * sp + 0.5 * sp / math.sqrt(m * m - 1.0))
         else:
             nose = wave_ramp(mach, lambda m: self._c_sbt)
         terms = {"friction": cf * friction / self.s_ref,
@@ -374,7 +385,8 @@ class BarrowmanAero(AxisymmetricAero):
             clp = 0.0
             for f in self.fins:
                 cr, ct, s, rr = f.root_chord, f.tip_chord, f.span, self.radius
-                i_r = ((cr + 3 * ct) * s ** 3 + 4 * (cr + 2 * ct) * rr * s * s + 6 * (cr + ct) * s * rr * rr) / 12.0
+                i_r = ((cr + 3 * ct) * s ** 3 + 4 * (cr + 2 * ct) * rr * s * s
+                       + 6 * (cr + ct) * s * rr * rr) / 12.0         # int_R^R+s c(r) r^2 dr
                 single = fin_normal_slope(f, rr, self.s_ref, m)[1]
                 clp -= 2.0 * f.count * single * i_r / (f.area * self.diameter ** 2)
             out["Clp"][i] = clp
