@@ -6,8 +6,13 @@ from compiled loads functions). Models are chosen by name with :func:`make`; imp
 registers them all.
 """
 
-from . import atmosphere, earth, gravity, wind
+from . import aerodynamics, aeroelastic, atmosphere, barrowman, earth, gravity, wind
+from .aerodynamics import AeroState, AxisymmetricAero, Tables6Aero
+from .aeroelastic import StripAeroelastic
+from .barrowman import BarrowmanAero
 from .earth import LaunchSite
 from .registry import make, names, register
 
-__all__ = ["LaunchSite", "atmosphere", "earth", "gravity", "make", "names", "register", "wind"]
+__all__ = ["AeroState", "AxisymmetricAero", "BarrowmanAero", "LaunchSite", "StripAeroelastic", "Tables6Aero",
+           "aerodynamics", "aeroelastic", "atmosphere", "barrowman", "earth", "gravity", "make", "names",
+           "register", "wind"]
