@@ -65,7 +65,12 @@ def test_bending_modes_of_the_loaded_stack(name):
     mm = MassModel(v)
     state = mm.initial_state()
     modes = vehicle_modes(v, state, mm.properties(state))
-    assert modes.omega.size == 2 and 5.0 < modes.omega[0] / (2 * np.pi) < 20.0
+    f1 = modes.omega[0] / (2 * np.pi)
+    assert modes.omega.size == 2
+    if v.structure.first_mode_hz is not None:   # stratos3: calibrated to the thesis's 33 Hz
+        assert f1 == pytest.approx(v.structure.first_mode_hz, rel=1e-9)
+    else:                                       # the loaded beams of smile (9.4 Hz) and slender (11.2 Hz)
+        assert 5.0 < f1 < 20.0
 
 
 # ------------------------------------------------------------------------------------------ SMILE

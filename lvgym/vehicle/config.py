@@ -271,12 +271,17 @@ class StagingStep:
 class StructureOptions:
     """Bending model options: ``n_modes`` per plane, modal damping ratio, and when the modes are
     recomputed: ``recompute_interval`` [s] (None: frozen at lift-off, the thesis's assumption and the
-    default); ``sensor_stations`` where gyro mode slopes are wanted [m]."""
+    default); ``sensor_stations`` where gyro mode slopes are wanted [m]; ``first_mode_hz``: calibrate
+    the beam's stiffness (all sections by one factor) so that the first mode at lift-off has this
+    frequency [Hz] (a measured or finite-element value; None: the sections as given); ``aeroelastic``:
+    whether the simulator applies the strip-theory aeroelastic loads (thesis eq. 2.14-2.19)."""
 
     n_modes: int = 2
     damping: float = 0.01
     recompute_interval: float | None = None
     sensor_stations: tuple[float, ...] = ()
+    first_mode_hz: float | None = None
+    aeroelastic: bool = False
 
     @staticmethod
     def read(r: Reader | None) -> StructureOptions:
@@ -287,7 +292,9 @@ class StructureOptions:
             raise r.error("sensor_stations", sensors, "must be a list of stations <= 0")
         opts = StructureOptions(n_modes=r.integer("n_modes", 2, lo=0), damping=r.number("damping", 0.01, lo=0.0),
                                 recompute_interval=r.number("recompute_interval", None, lo=0.0, lo_open=True),
-                                sensor_stations=tuple(float(s) for s in sensors))
+                                sensor_stations=tuple(float(s) for s in sensors),
+                                first_mode_hz=r.number("first_mode_hz", None, lo=0.0, lo_open=True),
+                                aeroelastic=r.flag("aeroelastic", False))
         r.done()
         return opts
 

@@ -139,7 +139,7 @@ def slender_mapping(length: float = 8.5, diameter: float = 0.3, fill: float = 1.
                        "slosh_damping": _r(zeta)}],
         }],
         "staging": [{"stage": "stage1"}],
-        "structure": {"n_modes": 2, "damping": 0.01},
+        "structure": {"n_modes": 2, "damping": 0.01, "aeroelastic": True},
         "aerodynamics": {"model": "barrowman", "nose": {"shape": "ogive", "length": _r(NOSE * L)},
                          "body": {"diameter": _r(D), "length": _r(L - NOSE * L)},
                          "fins": {**FINS, "station": _r(-(L - FIN_GAP - chord))}},

@@ -13,7 +13,8 @@ The beam of the attached stages carries
 
 :class:`ModeSchedule` decides when the modes are recomputed: by default they are frozen at lift-off (the
 thesis's assumption) and recomputed only when a stage separates; with ``recompute_interval`` [s] (vehicle
-file, ``structure.recompute_interval``) also as propellant burns.
+file, ``structure.recompute_interval``) also as propellant burns. ``structure.first_mode_hz`` calibrates
+the stiffness to a known first frequency at lift-off (one factor on every section's EI).
 """
 
 from __future__ import annotations
@@ -119,9 +120,26 @@ def stack_masses(vehicle: Vehicle, state: MassState, props: MassProperties
     return points, spread
 
 
+def stiffness_factor(vehicle: Vehicle) -> float:
+    """Factor on every section's EI that gives the lift-off stack the vehicle file's ``first_mode_hz``
+    (1 without it). The mass-normalised shapes do not change with a common factor on EI; every
+    frequency scales with its square root."""
+    target = vehicle.structure.first_mode_hz
+    if target is None:
+        return 1.0
+    mm = MassModel(vehicle)
+    state = mm.initial_state()
+    props = mm.properties(state)
+    attached = [si for si, ph in enumerate(state.phase) if ph != SEPARATED]
+    points, spread = stack_masses(vehicle, state, props)
+    beam = stack_modes(_stiffness(vehicle, attached), points, spread, n_modes=1)
+    return float((2.0 * np.pi * target / beam.omega[0]) ** 2)
+
+
 def vehicle_modes(vehicle: Vehicle, state: MassState, props: MassProperties, n_modes: int | None = None,
-                  sensor_stations=None) -> VehicleModes:
-    """First ``n_modes`` (default: the vehicle file's) bending modes of the stack in ``state``."""
+                  sensor_stations=None, ei_factor: float | None = None) -> VehicleModes:
+    """First ``n_modes`` (default: the vehicle file's) bending modes of the stack in ``state``;
+    ``ei_factor`` multiplies every EI (default :func:`stiffness_factor`)."""
     opts = vehicle.structure
     K = opts.n_modes if n_modes is None else int(n_modes)
     sensors = np.asarray(opts.sensor_stations if sensor_stations is None else sensor_stations, float).reshape(-1)
@@ -136,6 +154,9 @@ def vehicle_modes(vehicle: Vehicle, state: MassState, props: MassProperties, n_m
     hinges = np.clip(props.hinge[:, 0], bottom, top)  # inactive pendulums may sit off the stack
     query = np.concatenate([[props.gimbal[0]], hinges, sensors])
     points, spread = stack_masses(vehicle, state, props)
+    factor = stiffness_factor(vehicle) if ei_factor is None else ei_factor
+    if factor != 1.0:
+        sections = [Section(sec.top, sec.bottom, sec.EI * factor, sec.mass_per_length) for sec in sections]
     beam = stack_modes(sections, points, spread, n_modes=K, query_stations=query)
     return VehicleModes(t=props.t, omega=beam.omega.copy(), zeta=np.full(K, opts.damping),
                         phi_gimbal=beam.phi[0].copy(), dphi_gimbal=beam.dphi[0].copy(),
@@ -154,6 +175,7 @@ class ModeSchedule:
         self.interval = mass_model.vehicle.structure.recompute_interval if recompute_interval is None \
             else recompute_interval
         self.sensor_stations = sensor_stations
+        self.ei_factor = stiffness_factor(mass_model.vehicle)
         self._key: tuple | None = None
         self._modes: VehicleModes | None = None
 
@@ -165,6 +187,7 @@ class ModeSchedule:
             due = state.t - self._modes.t >= self.interval - 1e-12
         if due:
             props = props if props is not None else self.mass_model.properties(state)
-            self._modes = vehicle_modes(self.mass_model.vehicle, state, props, self.n_modes, self.sensor_stations)
+            self._modes = vehicle_modes(self.mass_model.vehicle, state, props, self.n_modes, self.sensor_stations,
+                                        self.ei_factor)
             self._key = attached
         return self._modes
