@@ -10,9 +10,10 @@ from . import aerodynamics, aeroelastic, atmosphere, barrowman, earth, gravity, 
 from .aerodynamics import AeroState, AxisymmetricAero, Tables6Aero
 from .aeroelastic import StripAeroelastic
 from .barrowman import BarrowmanAero
+from .conditions import Environment, FlightConditions
 from .earth import LaunchSite
 from .registry import make, names, register
 
-__all__ = ["AeroState", "AxisymmetricAero", "BarrowmanAero", "LaunchSite", "StripAeroelastic", "Tables6Aero",
+__all__ = ["AeroState", "AxisymmetricAero", "BarrowmanAero", "Environment", "FlightConditions", "LaunchSite", "StripAeroelastic", "Tables6Aero",
            "aerodynamics", "aeroelastic", "atmosphere", "barrowman", "earth", "gravity", "make", "names",
            "register", "wind"]
