@@ -283,5 +283,14 @@ def _case_m():
 
 _case_m.__name__ = "case_m"
 
+
+def _case_environment():
+    from .environment_cases import case_environment
+
+    return case_environment()
+
+
+_case_environment.__name__ = "case_environment"
+
 ALL_CASES = (case_r1, case_r2, case_s1, case_axial_pendulum, case_tumble, case_e, case_momentum,
-             case_rk4_vs_dop853, _case_m)
+             case_rk4_vs_dop853, _case_m, _case_environment)
