@@ -57,3 +57,15 @@ def test_loads_are_the_aerodynamic_model_at_the_same_conditions_and_batch_equals
     for k in range(n):
         one = env.conditions(t[k], r[k], v[k], q[k], w[k], x_cg[k])
         assert np.allclose(one.f_aero_b[0], c.f_aero_b[k]) and np.allclose(one.wind_i[0], c.wind_i[k])
+
+
+def test_flat_earth_for_verification_cases():
+    """Flat, non-rotating Earth: the launch frame (x up) is inertial, altitude = pad altitude + x_i."""
+    site = LaunchSite(latitude_deg=37.1, longitude_deg=-6.7, altitude_m=10.0, azimuth_deg=0.0, flat_earth=True)
+    env = Environment(site, gravity={"model": "constant", "g_i": [-9.80665, 0.0, 0.0]})
+    r, v, q = site.initial_state()
+    assert np.allclose(q, [1.0, 0.0, 0.0, 0.0])
+    c = env.conditions(0.0, r + [1000.0, 0.0, 0.0], v + [100.0, 0.0, 0.0], q, np.zeros(3), -4.0)
+    assert c.altitude[0] == pytest.approx(1010.0)
+    assert np.allclose(c.v_air_b[0], [100.0, 0.0, 0.0]) and c.alpha_total[0] == pytest.approx(0.0)
+    assert np.allclose(c.g_i[0], [-9.80665, 0.0, 0.0])
