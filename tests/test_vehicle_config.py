@@ -78,6 +78,8 @@ def test_other_consistency_errors():
     _expect(lambda d: d["stages"][0]["tanks"][0].update(top=1.0), r"tanks\[0\]\.top = 1\.0: must be in \[-inf, 0\]")
     _expect(lambda d: d["stages"][0]["tanks"][1].update(height=11.0), r"must lie within stage 'core'")
     _expect(lambda d: d.update(staging=[]), r"staging = \[\]: one step per stage, in firing order")
+    _expect(lambda d: d.update(staging=[{"stage": "core", "ignition_delay": 2.0}]),
+            r"staging\[0\]\.ignition_delay = 2\.0: must be 0: the first stage ignites at lift-off")
     _expect(lambda d: d["stages"][0]["structure"].update(inertia=[1.0, -2.0, 3.0]), r"positive semi-definite")
     _expect(lambda d: d["stages"][0]["engines"][0].update(thrust_table=[[0, 1], [1, 1]]),
             r"give either isp .* or thrust_table")

@@ -59,6 +59,9 @@ def check_vehicle(v: Vehicle) -> None:
         if top_b > bottom_a + _TOL:
             raise ConfigError(key_b, top_b, f"tanks must not overlap: {name_b!r} (top {top_b:g}) reaches into "
                               f"{name_a!r} ({top_a:g} to {bottom_a:g}); its top must be <= {bottom_a:g}", src)
+    if v.staging and v.staging[0].ignition_delay != 0.0:
+        raise ConfigError("staging[0].ignition_delay", v.staging[0].ignition_delay,
+                          "must be 0: the first stage ignites at lift-off, t = 0", src)
     names = [st.stage for st in v.staging]
     expected = [s.name for s in v.stages]
     if names != expected:

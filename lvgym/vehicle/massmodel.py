@@ -182,9 +182,9 @@ class MassModel:
             if t_event > t1:
                 return state, events
             state, happened = self._apply_events(state, throttle)
+            if not happened:  # next_event promised an event that _apply_events does not see: a bug
+                raise RuntimeError(f"mass model stalled at t = {state.t!r} s (no event at the predicted time)")
             events += [(state.t, e) for e in happened]
-            if not happened:  # nothing to do at this time: guard against a stall
-                return state, events
 
     def _consume(self, state: MassState, t_to: float, throttle: float) -> MassState:
         if t_to <= state.t:
@@ -203,7 +203,7 @@ class MassModel:
         return replace(state, t=t_to, tank_mass=tanks, grain_mass=grains)
 
     def _apply_events(self, state: MassState, throttle: float) -> tuple[MassState, list[str]]:
-        v, t, tol = self.vehicle, state.t, 1e-9
+        v, t, tol = self.vehicle, state.t, 1e-9 * max(1.0, state.t)
         happened: list[str] = []
         engine_on = list(state.engine_on)
         for j, on in enumerate(engine_on):
