@@ -58,11 +58,17 @@ def test_hand_numbers_at_a_table_point(model):
     # fy -1156 sin30 = -578 N, fz -1156 cos30 = -1001.1345 N. Cm -0.60 -> -867 N m about the axis
     # (0, cos30, -sin30): (0, -750.8435, 433.5). CG at -1.5: d = x_ref - x_cg = 0.5,
     # my += -d fz = +500.5673, mz += d fy = -289. Damping kd = 0.25 * 1 * 170 * 0.2 * 0.25 = 2.125:
-    # p 0.1 -> -0.425, q 0.2 -> -12.75, r -0.05 -> +3.1875.
+    # p 0.1 -> Clp -2: -0.425. Cmq -30 is about x_ref; about the CG (D/L = 0.5 / 0.5 = 1) it is
+    # -30 - 4 Cm_a - 2 CN_a with the slopes at 4 deg: Cm_a = -0.60 / a4, CN_a = 0.40 / a4 -> -7.0817;
+    # q 0.2 -> -3.0097, r -0.05 -> +0.7524.
     f, m, st = model.loads(flow(170.0, 4.0, 30.0), [0.1, 0.2, -0.05], 1.0, 340.0, -1.5)
     c30 = math.sqrt(3.0) / 2.0
+    a4 = math.radians(4.0)
+    cmq = -30.0 - 4.0 * (-0.60 / a4) - 2.0 * (0.40 / a4)
     assert f == pytest.approx([-1213.8, -578.0, -1156.0 * c30], rel=1e-12)
-    assert m == pytest.approx([-0.425, -867 * c30 + 578 * c30 - 12.75, 433.5 - 289.0 + 3.1875], rel=1e-12)
+    assert m == pytest.approx([-0.425, -867 * c30 + 578 * c30 + 2.125 * cmq * 0.2,
+                               433.5 - 289.0 + 2.125 * cmq * -0.05], rel=1e-12)
+    assert cmq == pytest.approx(-7.0817, abs=1e-4)
     assert st.mach == pytest.approx(0.5) and st.qbar == pytest.approx(14450.0)
     assert st.alpha_total == pytest.approx(math.radians(4.0))
     assert st.phi_aero == pytest.approx(math.radians(30.0))
@@ -157,10 +163,13 @@ def test_tables6_from_axisymmetric_reproduces_loads_at_grid_nodes(model):
         a, b = math.radians(a_deg), math.radians(b_deg)
         v = 250.0 * np.array([math.cos(a) * math.cos(b), math.sin(b), math.sin(a) * math.cos(b)])
         w = np.array([0.1, -0.2, 0.3])
-        f6, m6, s6 = t6.loads(v, w, 0.9, 340.0, -1.4)
-        f3, m3, s3 = model.loads(v, w, 0.9, 340.0, -1.4)
-        np.testing.assert_allclose(f6, f3, rtol=1e-9, atol=1e-9)
-        np.testing.assert_allclose(m6, m3, rtol=1e-9, atol=1e-9)
+        # damping at the moment reference (tables6 uses its derivatives as tabulated, the axisymmetric
+        # model moves them to the CG) and the static moment moved to another CG
+        for rates, x_cg in ((w, X_REF), (np.zeros(3), -1.4)):
+            f6, m6, s6 = t6.loads(v, rates, 0.9, 340.0, x_cg)
+            f3, m3, s3 = model.loads(v, rates, 0.9, 340.0, x_cg)
+            np.testing.assert_allclose(f6, f3, rtol=1e-9, atol=1e-9)
+            np.testing.assert_allclose(m6, m3, rtol=1e-9, atol=1e-9)
         assert s6.alpha == pytest.approx(a) and s6.beta == pytest.approx(b)
 
 

@@ -201,3 +201,22 @@ def test_registry_and_bad_geometry():
         with pytest.raises(ConfigError, match=pattern):
             BarrowmanAero(**(GEOMETRY | change))
     assert set(NOSE_SHAPES) == {"cone", "ogive", "von_karman"}
+
+
+def test_pitch_damping_moved_to_the_cg_matches_strip_theory_about_the_cg():
+    """The generator's Cmq is strip theory about x_ref; the kernel moves it to the CG with the table's
+    static slopes. Built about the CG directly, strip theory must give the same damping (up to the
+    table's slope at its first angle, 0.25 deg, against the true CN_alpha)."""
+    from lvgym.vehicle import load_vehicle
+
+    geometry = dict(load_vehicle("stratos3").aerodynamics)
+    geometry.pop("model")
+    x_cg = -5.12
+    about_ref = BarrowmanAero(**geometry, x_ref=-4.1)
+    about_cg = BarrowmanAero(**geometry, x_ref=x_cg)
+    v = np.array([136.0, 0.0, 0.0])                     # M 0.4 at sea level, no incidence
+    for rates in ([0.0, 0.3, 0.0], [0.0, 0.0, -0.2]):
+        _, m_ref, _ = about_ref.loads(v, rates, 1.225, 340.0, x_cg)
+        _, m_cg, _ = about_cg.loads(v, rates, 1.225, 340.0, x_cg)
+        assert m_ref == pytest.approx(m_cg, rel=5e-3, abs=1e-9)   # measured: 3e-4
+        assert np.dot(m_cg, rates) < 0.0               # damping opposes the rate

@@ -5,7 +5,8 @@ Two table models, chosen by name (``make("aerodynamics", ...)``; formats in docs
 ``alpha_t`` in [0, 180] deg, expanded to 6-DOF by axial symmetry (the normal force lies in the
 crossflow plane, at roll orientation ``phi_a = atan2(v, w)``), and ``tables6``, full body-axis tables
 ``CA, CY, CN, Cl, Cm, Cn`` over Mach, alpha, beta and optionally altitude (Missile DATCOM style).
-Both carry damping derivatives ``Cmq`` (= Cmq + Cmalpha_dot), ``Clp`` and, for ``tables6``, ``Cnr``
+Both carry damping derivatives ``Cmq`` (the pitch-rate derivative; include ``Cmalpha_dot`` in it if you
+have one: the Barrowman generator does not), ``Clp`` and, for ``tables6``, ``Cnr``
 (per rad of ``omega L / (2 V)``; axisymmetric: ``Cnr = Cmq``), a reference area ``S`` [m^2], length
 ``L`` [m] and moment reference station ``x_ref`` [m] (x_b from the nose tip, <= 0).
 
@@ -14,7 +15,10 @@ With ``v_air_b = (u, v, w)`` the vehicle's velocity relative to the air, body ax
 ``alpha_t = atan2(sqrt(v^2 + w^2), u)``; ``f_b = qbar S (-CA, CY, -CN)`` (CA positive aft, CN
 towards -z_b at positive alpha); moments ``qbar S L (Cl, Cm, Cn)`` about ``x_ref`` (Cm nose-up, a
 stable vehicle has dCm/dalpha < 0), moved to the CG station: ``m_cg = m_ref + (x_ref - x_cg) e_x x
-f_b``; damping about the CG ``rho V S L^2 / 4 (Clp p, Cmq q, Cnr r)``, used as tabulated. Axes are
+f_b``; damping ``rho V S L^2 / 4 (Clp p, Cmq q, Cnr r)``. ``axisymmetric`` tables give ``Cmq`` about
+``x_ref`` and the kernel moves it to the CG with the table's own static slopes at its first non-zero angle
+(``Cmq - 4 (D/L) Cm_alpha - 2 (D/L)^2 CN_alpha``, ``D = x_ref - x_cg``, strip theory); ``tables6``
+damping derivatives are used as tabulated, so give them about the flight's mean CG. Axes are
 clamped at the grid ends. Everything is zero, without NaN, at zero airspeed.
 
 Compiled callers use :func:`aero_loads_k` with ``model.kernel_args() = (p, grid, dims, table)``:
@@ -117,9 +121,18 @@ def aero_loads_k(v_air_b, omega_bi_b, rho, sound, x_cg, alt, p, grid, dims, tabl
         f_b[0] = -qs * c[0]
         f_b[1] = -qs * c[1] * sp
         f_b[2] = -qs * c[1] * cp
+        cmq = c[3]
+        if cmq != 0.0 and dims[1] > 1:
+            # Cmq is tabulated about x_ref; about the CG it is Cmq - 4 (D/L) Cm_a - 2 (D/L)^2 CN_a with
+            # D = x_ref - x_cg and the static slopes about x_ref taken from the table's first angle
+            a1 = grid[dims[0] + 1]
+            c1 = np.zeros(table.shape[1])
+            interp_k(grid, dims, table, np.array([mach, a1]), c1)
+            dl = (p[P_XREF] - x_cg) / l_ref
+            cmq = cmq - 4.0 * dl * c1[2] / a1 - 2.0 * dl * dl * c1[1] / a1
         m_b[0] = kd * c[4] * omega_bi_b[0]
-        m_b[1] = qs * l_ref * c[2] * cp + kd * c[3] * omega_bi_b[1]
-        m_b[2] = -qs * l_ref * c[2] * sp + kd * c[3] * omega_bi_b[2]
+        m_b[1] = qs * l_ref * c[2] * cp + kd * cmq * omega_bi_b[1]
+        m_b[2] = -qs * l_ref * c[2] * sp + kd * cmq * omega_bi_b[2]
     else:
         q = np.array([mach, math.atan2(w, u), math.atan2(v, math.sqrt(u * u + w * w)), alt])
         interp_k(grid, dims, table, q, c)

@@ -18,9 +18,11 @@ climbs through, so the path length is the altitude gained) or the time (``coordi
 vehicle at ``airspeed`` and fixed ``altitude_m``, where the spatial scale lengths become the time
 constants ``L / V``). Along ``s`` each component is ``sigma(s) x(tau(s))`` with ``tau = integral of
 ds / L(s)`` and ``x`` the stationary unit-variance process of unit scale length: the first-order
-Dryden (Ornstein-Uhlenbeck) process for ``u`` (correlation ``exp(-xi / L)``) and the second-order
-Dryden process ``(1 + sqrt(3) L s) / (1 + L s)^2`` for ``v`` and ``w`` (correlation
-``(1 - xi / (2 L)) exp(-xi / L)``). With constant ``L`` this is exactly the Dryden spectrum; with a
+Dryden (Ornstein-Uhlenbeck) process (correlation ``exp(-xi / L)``) for the component along the path
+and the second-order Dryden process ``(1 + sqrt(3) L s) / (1 + L s)^2`` (correlation
+``(1 - xi / (2 L)) exp(-xi / L)``) for the two across it: ``u`` longitudinal, ``v``, ``w`` transverse
+along a horizontal path (time mode, MIL-F-8785C's assignment), ``w`` longitudinal, ``u``, ``v``
+transverse along the vertical path of an ascent (altitude mode). With constant ``L`` this is exactly the Dryden spectrum; with a
 slowly varying ``L`` it keeps the local scale length. The processes are stepped with their exact
 discretisation on a grid with ``d tau <= resolution`` (so every node has exactly the variance
 ``sigma^2``) and the run-time call interpolates linearly (losing on average a fraction
@@ -205,7 +207,12 @@ class DrydenWind(_Wind):
 
     def reset(self, rng: np.random.Generator) -> None:
         super().reset(rng)
-        self.unit = unit_dryden(self._dtau, rng.standard_normal((self.grid.size, 5)))
+        # the first-order (longitudinal) process goes to the component along the path: u along a
+        # horizontal flight path (time mode), w along the vertical path of an ascent (altitude mode)
+        order = [2, 0, 1] if self.coordinate == "altitude" else [0, 1, 2]
+        unit = unit_dryden(np.ascontiguousarray(self._dtau[:, order]), rng.standard_normal((self.grid.size, 5)))
+        self.unit = np.empty_like(unit)
+        self.unit[:, order] = unit
         uvw = self.sigma * self.unit
         psi = math.radians(self.wind_from_deg) + math.pi     # the mean wind blows towards psi
         c, s = math.cos(psi), math.sin(psi)
