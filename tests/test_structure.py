@@ -67,20 +67,21 @@ def test_schedule_frozen_by_default_or_recomputed_on_interval(verification):
     assert every.modes(mm.advance(s0, 5.0)[0]) is a
     b = every.modes(mm.advance(s0, 10.0)[0])
     assert b is not a and b.t == 10.0
+    # a new flight (time back at lift-off) gets the lift-off modes again, not the last ones
+    assert frozen.modes(s0) is first and every.modes(s0).t == 0.0
 
 
 def test_missing_sections_and_unknown_material_are_named():
     base = yaml.safe_load((VEHICLE_DIR / "thesis-verification.yaml").read_text())
     data = copy.deepcopy(base)
     data["stages"][0]["sections"][0]["material"] = "unobtainium"
-    v = parse_vehicle(data, source="x.yaml")
-    mm = MassModel(v)
-    s = mm.initial_state()
     with pytest.raises(ConfigError, match=r"x\.yaml: stages\[0\]\.sections\[0\]\.material = 'unobtainium': one of"):
-        vehicle_modes(v, s, mm.properties(s))
+        parse_vehicle(data, source="x.yaml")
     data = copy.deepcopy(base)
     data["stages"][0].pop("sections")
     v = parse_vehicle(data, source="x.yaml")
+    mm = MassModel(v)
+    s = mm.initial_state()
     with pytest.raises(ConfigError, match=r"stages\[0\]\.sections = \[\]: bending modes need"):
         vehicle_modes(v, s, mm.properties(s))
 

@@ -88,3 +88,31 @@ def test_other_consistency_errors():
 def test_unknown_vehicle_name_lists_the_shipped_ones():
     with pytest.raises(ConfigError, match=r"vehicle = 'nope': one of the shipped vehicles \[.*'thesis-verification'"):
         load_vehicle("nope")
+
+
+def test_staging_needs_separation_below_an_upper_stage():
+    data = yaml.safe_load((VEHICLE_DIR / "smile.yaml").read_text())
+    data["staging"][0].pop("separation_delay")
+    with pytest.raises(ConfigError, match=r"staging\[0\]\.separation_delay = <missing>|staging\[0\]\.separation_delay = None: required"):
+        parse_vehicle(data, source="smile.yaml")
+
+
+def test_sections_parts_and_sensors_must_lie_on_the_vehicle():
+    _expect(lambda d: d["stages"][0]["sections"][0].update(bottom=-19.5),
+            r"sections\[0\]\.bottom = -19\.5: sections must reach the bottom of stage 'core': -20")
+    _expect(lambda d: d.update(payload={"mass": 10.0, "cg": -30.0}), r"payload\.cg = -30\.0: must lie on the vehicle")
+    _expect(lambda d: d.update(structure={"sensor_stations": [-100.0]}),
+            r"structure\.sensor_stations\[0\] = -100\.0: must lie on the vehicle")
+    _expect(lambda d: d.update(structure={"sensor_stations": [False]}), r"finite stations <= 0")
+
+
+def test_thrust_table_engines_are_not_throttled_and_need_impulse():
+    def table(d, throttle=None, rows=((0.0, 0.0), (1.0, 2e6), (3.0, 0.0))):
+        e = d["stages"][0]["engines"][0]
+        e.pop("isp")
+        e["thrust_table"] = [list(r) for r in rows]
+        if throttle:
+            e["throttle"] = throttle
+
+    _expect(lambda d: table(d, [0.5, 1.0]), r"throttle = \[0\.5, 1\.0\]: a thrust-table engine cannot be throttled")
+    _expect(lambda d: table(d, rows=((0.0, 0.0), (1.0, 0.0))), r"thrust_table = .*: needs a thrust > 0")

@@ -226,7 +226,6 @@ class _Atmosphere:
     """
 
     params: np.ndarray
-    kernel = staticmethod(atmosphere_state)
 
     def __call__(self, alt_m) -> AtmosphereState:
         """State at geometric altitude(s) ``alt_m`` [m] (scalar or array of any shape)."""

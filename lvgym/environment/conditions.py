@@ -104,13 +104,13 @@ class Environment:
         atm = self.atmosphere(alt)
         rho, a = np.atleast_1d(atm.density), np.atleast_1d(atm.speed_of_sound)
         g_i = np.atleast_2d(self.gravity.acceleration(r, t_b))
-        if self.aerodynamics is None:
+        if self.aerodynamics is None:  # no loads; the flow angles as the aerodynamics kernel defines them
+            u, v_, w_ = v_air_b[:, 0], v_air_b[:, 1], v_air_b[:, 2]
             speed = np.linalg.norm(v_air_b, axis=1)
-            zeros3 = np.zeros((n, 3))
-            alpha = np.arctan2(v_air_b[:, 2], v_air_b[:, 0])
-            beta = np.arctan2(v_air_b[:, 1], np.hypot(v_air_b[:, 0], v_air_b[:, 2]))
-            alpha_total = np.arccos(np.clip(np.divide(v_air_b[:, 0], speed, out=np.ones(n), where=speed > 0), -1, 1))
-            f_b, m_b, mach, qbar = zeros3, zeros3, speed / a, 0.5 * rho * speed**2
+            alpha, beta = np.arctan2(w_, u), np.arctan2(v_, np.hypot(u, w_))
+            alpha_total = np.arctan2(np.hypot(v_, w_), u)
+            mach = np.divide(speed, a, out=np.zeros(n), where=a > 0)
+            f_b, m_b, qbar = np.zeros((n, 3)), np.zeros((n, 3)), 0.5 * rho * speed**2
         else:
             f_b, m_b, st = self.aerodynamics.loads(v_air_b, w, rho, a, x_cg, alt)
             alpha, beta, alpha_total = st.alpha, st.beta, st.alpha_total

@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
+from functools import cached_property
 from dataclasses import dataclass, fields
 from typing import Any
 
@@ -346,9 +347,9 @@ class LaunchSite:
         downrange = math.cos(self.azimuth) * n[0] + math.sin(self.azimuth) * n[1]
         return np.array([up, np.cross(downrange, up), downrange])
 
-    @property
+    @cached_property
     def params(self) -> np.ndarray:
-        """Parameter array of the compiled kernels (layout ``SITE_*``)."""
+        """Parameter array of the compiled kernels (layout ``SITE_*``), built once per site."""
         p = _round_earth_params()
         p[SITE_FLAT] = 1.0 if self.flat_earth else 0.0
         p[SITE_LAT], p[SITE_LON], p[SITE_H0] = self.latitude, self.longitude, self.altitude_m

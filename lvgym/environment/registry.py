@@ -66,7 +66,12 @@ def make(kind: str, spec: str | Mapping[str, Any], *, key: str | None = None, **
         if option not in accepted and not takes_any:
             raise ConfigError(f"{key}.{option}", options[option],
                               f"unknown option of {kind} model {name!r}; allowed: {sorted(accepted)}")
-    return cls(**options)
+    try:
+        return cls(**options)
+    except ConfigError as err:  # models name their options "<kind>.<option>": give the caller's key path
+        if key == kind or not err.key.startswith(f"{kind}."):
+            raise
+        raise ConfigError(key + err.key[len(kind):], err.value, err.allowed, err.source) from None
 
 
 def names_of_kinds() -> list[str]:

@@ -165,7 +165,6 @@ class _Wind:
     ``wind_ned(p, alt_m, t, out)`` a compiled caller uses.
     """
 
-    kernel = staticmethod(wind_ned)
     _params: np.ndarray | None = None
 
     @property
@@ -382,7 +381,7 @@ class SumWind(_Wind):
 
     ``models`` lists model names, mappings (``{"model": "gust", ...}``) or wind model objects;
     nested sums are flattened. ``reset(rng)`` gives each child its own generator from
-    ``rng.spawn``, so one child's draws do not depend on another's. Compiled callers: ``wind_ned``
+    a generator seeded from ``rng``'s stream, so one child's draws do not depend on another's. Compiled callers: ``wind_ned``
     with ``params`` (re-read after ``reset``).
     """
 
@@ -410,7 +409,8 @@ class SumWind(_Wind):
 
     def reset(self, rng: np.random.Generator) -> None:
         super().reset(rng)
-        for child, child_rng in zip(self.children, rng.spawn(len(self.children))):
+        seeds = rng.integers(0, 2**63, size=len(self.children))   # from rng's own stream: reproducible
+        for child, child_rng in zip(self.children, (np.random.default_rng(int(k)) for k in seeds)):
             child.reset(child_rng)
         self._build()
 

@@ -11,6 +11,8 @@ from typing import TYPE_CHECKING
 
 from lvgym.errors import ConfigError
 
+from .sections import MATERIALS
+
 if TYPE_CHECKING:
     from .config import Vehicle
 
@@ -54,6 +56,7 @@ def check_vehicle(v: Vehicle) -> None:
             _inside(sec.top, sec.bottom, s, f"{sec.key}.top", src)
         for e in s.engines:
             _check_mixture(s, e, src)
+    _check_parts_and_sections(v, length, src)
     ranges.sort(key=lambda r: -r[0])
     for (top_a, bottom_a, _, name_a), (top_b, _, key_b, name_b) in zip(ranges, ranges[1:]):
         if top_b > bottom_a + _TOL:
@@ -66,6 +69,47 @@ def check_vehicle(v: Vehicle) -> None:
     expected = [s.name for s in v.stages]
     if names != expected:
         raise ConfigError("staging", names, f"one step per stage, in firing order: {expected}", src)
+    for i, step in enumerate(v.staging[:-1]):
+        if step.separation_delay is None:
+            raise ConfigError(f"staging[{i}].separation_delay", None,
+                              f"required (>= 0 s): stage {v.staging[i + 1].stage!r} above ignites only after "
+                              f"{step.stage!r} separates", src)
+    for i, sensor in enumerate(v.structure.sensor_stations):
+        if not -length <= sensor <= 0.0:
+            raise ConfigError(f"structure.sensor_stations[{i}]", sensor, f"must lie on the vehicle: [{-length:g}, 0]",
+                              src)
+
+
+def _check_parts_and_sections(v, length: float, src: str | None) -> None:
+    """Rigid parts on the vehicle; stiffness sections of a stage tile it, stages with sections touch."""
+    parts = [(f"{s.key}.structure.cg", s.structure.cg) for s in v.stages]
+    parts += [(f"{e.key}.cg", e.part.cg) for s in v.stages for e in s.engines]
+    parts += [(key, part.cg) for key, part in (("payload.cg", v.payload), ("fairing.cg", v.fairing)) if part]
+    for key, cg in parts:
+        if not -length - _TOL <= cg[0] <= 0.0:
+            raise ConfigError(key, float(cg[0]), f"must lie on the vehicle: station in [{-length:g}, 0]", src)
+    for s in v.stages:
+        if not s.sections:
+            continue
+        for sec in s.sections:
+            if sec.material is not None and sec.material not in MATERIALS:
+                raise ConfigError(f"{sec.key}.material", sec.material, f"one of {sorted(MATERIALS)}", src)
+        spans = sorted(((sec.top, sec.bottom, sec.key) for sec in s.sections), reverse=True)
+        edge = s.top
+        for top, bottom, key in spans:
+            if abs(top - edge) > 1e-6:
+                raise ConfigError(f"{key}.top", top, f"sections must tile stage {s.name!r} from {s.top:g} to "
+                                  f"{s.bottom:g} without gaps or overlaps: expected {edge:g}", src)
+            edge = bottom
+        if abs(edge - s.bottom) > 1e-6:
+            raise ConfigError(f"{spans[-1][2]}.bottom", edge, f"sections must reach the bottom of stage "
+                              f"{s.name!r}: {s.bottom:g}", src)
+    with_sections = [s for s in v.stages if s.sections]
+    for lower, upper in zip(with_sections, with_sections[1:]):
+        if abs(lower.top - upper.bottom) > 1e-6:
+            raise ConfigError(f"{upper.key}.top", upper.top, f"stages with bending sections must touch: the bottom "
+                              f"of {upper.name!r} ({upper.bottom:g}) must equal the top of {lower.name!r} "
+                              f"({lower.top:g})", src)
 
 
 def _unique(names: list[str], key: str, what: str, src: str | None) -> None:
@@ -105,6 +149,11 @@ def _check_mixture(stage, engine, src: str | None) -> None:
                 continue
             raise ConfigError(f"{engine.key}.name", engine.name, f"no {role!r} tank feeds this engine", src)
         total = sum(t.share for t in tanks)
-        if abs(total - 1.0) > 1e-6:
+        grain_feeds = role == "fuel" and stage.grain is not None and stage.grain.engine == engine.name
+        if grain_feeds and total > 1.0 + 1e-6:
+            raise ConfigError(f"{tanks[0].key}.share", [t.share for t in tanks],
+                              f"the fuel tanks of engine {engine.name!r} may take at most all of the fuel flow "
+                              "(the grain burns the rest)", src)
+        if not grain_feeds and abs(total - 1.0) > 1e-6:
             raise ConfigError(f"{tanks[0].key}.share", [t.share for t in tanks],
                               f"the shares of the {role!r} tanks of engine {engine.name!r} must add up to 1", src)

@@ -109,6 +109,8 @@ class Engine:
             raise r.error("isp", isp, "give either isp (thrust equation) or thrust_table, not both or neither")
         if table is not None and (table[0, 0] < 0.0 or np.any(table[:, 1] < 0.0)):
             raise r.error("thrust_table", table.tolist(), "times and thrusts must be >= 0")
+        if table is not None and not np.any(table[:, 1] > 0.0):
+            raise r.error("thrust_table", table.tolist(), "needs a thrust > 0 somewhere (it has no impulse)")
         engine = Engine(
             name=name, part=part, gimbal=r.station("gimbal"),
             mass_flow=r.number("mass_flow", lo=0.0, lo_open=True), isp=isp, thrust_table=table,
@@ -117,6 +119,8 @@ class Engine:
             nozzle_exit_pressure=r.number("nozzle_exit_pressure", 0.0, lo=0.0),
             throttle=r.pair("throttle", [1.0, 1.0], lo=0.0, hi=2.0),
             gimbal_limit=np.radians(r.number("gimbal_limit_deg", 5.0, lo=0.0, hi=45.0)), key=r.path)
+        if table is not None and engine.throttle != (1.0, 1.0):
+            raise r.error("throttle", list(engine.throttle), "a thrust-table engine cannot be throttled: [1, 1]")
         r.done()
         return engine
 
@@ -288,8 +292,9 @@ class StructureOptions:
         if r is None:
             return StructureOptions()
         sensors = r.raw("sensor_stations", [])
-        if not isinstance(sensors, list) or not all(isinstance(s, (int, float)) and s <= 0 for s in sensors):
-            raise r.error("sensor_stations", sensors, "must be a list of stations <= 0")
+        if not isinstance(sensors, list) or not all(
+                isinstance(s, (int, float)) and not isinstance(s, bool) and -np.inf < s <= 0 for s in sensors):
+            raise r.error("sensor_stations", sensors, "must be a list of finite stations <= 0")
         opts = StructureOptions(n_modes=r.integer("n_modes", 2, lo=0), damping=r.number("damping", 0.01, lo=0.0),
                                 recompute_interval=r.number("recompute_interval", None, lo=0.0, lo_open=True),
                                 sensor_stations=tuple(float(s) for s in sensors),

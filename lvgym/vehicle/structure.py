@@ -120,14 +120,14 @@ def stack_masses(vehicle: Vehicle, state: MassState, props: MassProperties
     return points, spread
 
 
-def stiffness_factor(vehicle: Vehicle) -> float:
+def stiffness_factor(vehicle: Vehicle, cg_convention: str = "static") -> float:
     """Factor on every section's EI that gives the lift-off stack the vehicle file's ``first_mode_hz``
     (1 without it). The mass-normalised shapes do not change with a common factor on EI; every
     frequency scales with its square root."""
     target = vehicle.structure.first_mode_hz
     if target is None:
         return 1.0
-    mm = MassModel(vehicle)
+    mm = MassModel(vehicle, cg_convention)
     state = mm.initial_state()
     props = mm.properties(state)
     attached = [si for si, ph in enumerate(state.phase) if ph != SEPARATED]
@@ -175,14 +175,14 @@ class ModeSchedule:
         self.interval = mass_model.vehicle.structure.recompute_interval if recompute_interval is None \
             else recompute_interval
         self.sensor_stations = sensor_stations
-        self.ei_factor = stiffness_factor(mass_model.vehicle)
+        self.ei_factor = stiffness_factor(mass_model.vehicle, mass_model.cg_convention)
         self._key: tuple | None = None
         self._modes: VehicleModes | None = None
 
     def modes(self, state: MassState, props: MassProperties | None = None) -> VehicleModes:
         """The modes in force at ``state`` (computed when the schedule says so, cached otherwise)."""
         attached = tuple(ph != SEPARATED for ph in state.phase)
-        due = self._modes is None or attached != self._key
+        due = self._modes is None or attached != self._key or state.t < self._modes.t  # a new flight
         if not due and self.interval is not None:
             due = state.t - self._modes.t >= self.interval - 1e-12
         if due:
