@@ -339,3 +339,22 @@ def test_docs_example_runs():
     for block in blocks:
         exec(compile(block, "docs/atmosphere-and-wind.md", "exec"), namespace)
     assert namespace["w_n"].shape == (2, 3) and namespace["rho"][0] == pytest.approx(1.225, rel=1e-5)
+
+
+def test_nested_model_errors_name_the_full_key_path():
+    from lvgym.errors import ConfigError as _ConfigError
+
+    with pytest.raises(_ConfigError, match=r"^wind\.models\[0\]\.amplitude = -1: "):
+        make("wind", {"model": "sum", "models": [{"model": "gust", "amplitude": -1}]})
+
+
+def test_sum_is_reproduced_from_a_saved_generator_state():
+    wind = make("wind", {"model": "sum", "models": [{"model": "jet_stream"}, {"model": "dryden"}]})
+    rng = np.random.default_rng(5)
+    saved = rng.bit_generator.state
+    wind.reset(rng)
+    first = wind.velocity_ned(np.array([1000.0, 5000.0]), 0.0)
+    again = np.random.default_rng()
+    again.bit_generator.state = saved
+    wind.reset(again)
+    np.testing.assert_array_equal(wind.velocity_ned(np.array([1000.0, 5000.0]), 0.0), first)
