@@ -69,3 +69,21 @@ def test_flat_earth_for_verification_cases():
     assert c.altitude[0] == pytest.approx(1010.0)
     assert np.allclose(c.v_air_b[0], [100.0, 0.0, 0.0]) and c.alpha_total[0] == pytest.approx(0.0)
     assert np.allclose(c.g_i[0], [-9.80665, 0.0, 0.0])
+
+
+@pytest.mark.parametrize("axis", [1, 2])
+def test_attitude_sets_the_flow_angles_and_a_stable_vehicle_turns_back(axis):
+    """Flat Earth, climbing at 100 m/s along x_i. Turning the body +2 deg about y_b gives alpha = +2 deg;
+    about z_b it gives beta = -2 deg. Stratos III (CG ahead of CP) gets a moment turning it back."""
+    site = LaunchSite(latitude_deg=37.1, longitude_deg=-6.7, altitude_m=0.0, azimuth_deg=0.0, flat_earth=True)
+    env = Environment(site, gravity={"model": "constant"}, aerodynamics=load_vehicle("stratos3").aerodynamics)
+    half = np.radians(2.0) / 2.0
+    q = np.array([np.cos(half), 0.0, 0.0, 0.0])
+    q[1 + axis] = np.sin(half)                       # rotation of +2 deg about y_b or z_b
+    c = env.conditions(0.0, [500.0, 0.0, 0.0], [100.0, 0.0, 0.0], q, np.zeros(3), -5.1)
+    if axis == 1:
+        assert c.alpha[0] == pytest.approx(np.radians(2.0)) and abs(c.beta[0]) < 1e-12
+    else:
+        assert c.beta[0] == pytest.approx(np.radians(-2.0)) and abs(c.alpha[0]) < 1e-12
+    assert c.alpha_total[0] == pytest.approx(np.radians(2.0))
+    assert c.m_aero_b[0, axis] < 0.0
