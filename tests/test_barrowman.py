@@ -151,7 +151,7 @@ def test_tables_are_consistent_with_the_components(vehicle):
     assert isinstance(vehicle, AxisymmetricAero)
     assert np.all(np.isfinite(vehicle.table))
     m = 0.4                                               # a grid Mach number
-    h = math.radians(0.25)                                # first alpha step of the default grid
+    h = math.radians(0.05)                                # first alpha step of the default grid
     cn = vehicle.coefficients(m, h)["CN"]
     # CNa sin h cos h + Galejs K (A_plan + (n/2) A_fin) / S sin^2 h, K = 1.1, n/2 = 2; the body
     # planform area is integrated from the model's own profile (radius against distance)
@@ -161,7 +161,7 @@ def test_tables_are_consistent_with_the_components(vehicle):
     assert cn == pytest.approx(expected, rel=1e-9)
     # pitching moment: about x_ref the linear part is -CNa (x_ref - x_cp) / d per rad
     cm_lin = vehicle.coefficients(m, h)["Cm"] / h
-    assert cm_lin == pytest.approx(vehicle.cn_alpha(m) * (vehicle.x_cp(m) + 4.0) / 0.28, rel=0.03)
+    assert cm_lin == pytest.approx(vehicle.cn_alpha(m) * (vehicle.x_cp(m) + 4.0) / 0.28, rel=5e-3)
     assert vehicle.coefficients(m, 0.0)["CN"] == 0.0
     assert np.all(vehicle.table[:, 3] < 0.0) and np.all(vehicle.table[:, 4] < 0.0)   # Cmq, Clp
     # at 90 deg a finned body is still stable: Cm < 0 about the mid-length
