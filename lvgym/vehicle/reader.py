@@ -49,10 +49,6 @@ class Reader:
         """A :class:`ConfigError` for key ``name`` of this mapping."""
         return ConfigError(self.key(name), value, allowed, self.source)
 
-    def has(self, name: str) -> bool:
-        """Whether ``name`` is present (and not null)."""
-        return self.data.get(name) is not None
-
     def raw(self, name: str, default: Any = REQUIRED) -> Any:
         """The value of ``name`` unchecked; ``default`` if absent (an error if required)."""
         self._used.add(name)
