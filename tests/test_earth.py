@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from lvgym.dynamics.kernels import quat_to_dcm
+from lvgym.rotations import quat_to_dcm
 from lvgym.environment import earth
 from lvgym.environment.earth import LaunchSite
 from lvgym.errors import ConfigError

@@ -30,6 +30,8 @@ import math
 import numba as nb
 import numpy as np
 
+from lvgym.rotations import quat_to_dcm
+
 # offsets of the fixed-size parts of the flat vectors (layout.py; tests/test_layout_and_params.py
 # checks that the two agree)
 X_R, X_V, X_Q, X_W, X_ETA = 0, 3, 6, 10, 13
@@ -38,26 +40,6 @@ U_F, U_M, U_T, U_G, U_ETA = 0, 3, 6, 9, 12
 # per-slosh work row kept for the back-substitution: y_s(3) z_s(3) rho_b(3) (g - beta)_i(3) tau(2) m L k2
 _S_Y, _S_Z, _S_RHO, _S_GB, _S_TAU, _S_M, _S_L, _S_K2 = 0, 3, 6, 9, 12, 14, 15, 16
 SLOSH_WORK = 17
-
-
-@nb.njit(cache=True, error_model="numpy", inline="always")
-def quat_to_dcm(q0, q1, q2, q3, C):
-    """Write ``C = R(q)`` (the matrix taking frame-b components to frame-i components for
-    ``q = q_bi``) of the normalised quaternion into the 3x3 array ``C``."""
-    n = 1.0 / math.sqrt(q0 * q0 + q1 * q1 + q2 * q2 + q3 * q3)
-    q0 *= n
-    q1 *= n
-    q2 *= n
-    q3 *= n
-    C[0, 0] = 1.0 - 2.0 * (q2 * q2 + q3 * q3)
-    C[0, 1] = 2.0 * (q1 * q2 - q0 * q3)
-    C[0, 2] = 2.0 * (q1 * q3 + q0 * q2)
-    C[1, 0] = 2.0 * (q1 * q2 + q0 * q3)
-    C[1, 1] = 1.0 - 2.0 * (q1 * q1 + q3 * q3)
-    C[1, 2] = 2.0 * (q2 * q3 - q0 * q1)
-    C[2, 0] = 2.0 * (q1 * q3 - q0 * q2)
-    C[2, 1] = 2.0 * (q2 * q3 + q0 * q1)
-    C[2, 2] = 1.0 - 2.0 * (q1 * q1 + q2 * q2)
 
 
 @nb.njit(cache=True, error_model="numpy", inline="always")

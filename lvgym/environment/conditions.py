@@ -22,6 +22,8 @@ from typing import Any
 
 import numpy as np
 
+from lvgym.rotations import quat_to_dcm_batch
+
 from .earth import LaunchSite
 from .registry import make
 
@@ -52,15 +54,6 @@ class FlightConditions:
     f_aero_b: np.ndarray
     m_aero_b: np.ndarray
     g_i: np.ndarray
-
-
-def quat_to_dcm_ib(q_bi: np.ndarray) -> np.ndarray:
-    """``C_ib`` (B, 3, 3) from scalar-first unit quaternions ``q_bi`` (B, 4)."""
-    w, x, y, z = (q_bi[:, k] for k in range(4))
-    return np.stack([
-        np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)], -1),
-        np.stack([2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)], -1),
-        np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)], -1)], -2)
 
 
 class Environment:
@@ -99,7 +92,8 @@ class Environment:
         wind_n = np.atleast_2d(self.wind.velocity_ned(alt, t_b))
         wind_i = np.einsum("bji,bj->bi", C_ni, wind_n)
         v_rel_i = np.atleast_2d(self.site.velocity_wrt_earth(r, v)) - wind_i
-        C_ib = quat_to_dcm_ib(q / np.linalg.norm(q, axis=1, keepdims=True))
+        C_ib = np.empty((n, 3, 3))
+        quat_to_dcm_batch(np.ascontiguousarray(q), C_ib)
         v_air_b = np.einsum("bji,bj->bi", C_ib, v_rel_i)
         atm = self.atmosphere(alt)
         rho, a = np.atleast_1d(atm.density), np.atleast_1d(atm.speed_of_sound)

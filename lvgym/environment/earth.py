@@ -204,9 +204,14 @@ def ecef_to_geodetic(r_e: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 def geodetic(r_i: Any, t: Any = 0.0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Geodetic latitude, longitude [rad] and height [m] of inertial positions ``r_i`` [m],
     shape (3,) or (B, 3), at times ``t`` [s] (scalar or (B,)), on the rotating WGS84 Earth."""
+    return _geodetic_with(_round_earth_params(), r_i, t)
+
+
+def _geodetic_with(p: np.ndarray, r_i: Any, t: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Latitude, longitude [rad], height [m] of inertial positions with the site parameters ``p``."""
     rows = _rows(r_i, 3)
     out = np.empty_like(rows)
-    _geodetic_batch(rows, _times(t, rows.shape[0]), _round_earth_params(), out)
+    _geodetic_batch(rows, _times(t, rows.shape[0]), p, out)
     if np.ndim(r_i) == 1:
         return out[0, 0], out[0, 1], out[0, 2]
     return out[:, 0], out[:, 1], out[:, 2]
@@ -237,7 +242,7 @@ def C_ne(lat: Any, lon: Any) -> np.ndarray:
 
 def dcm_to_quat(C: Any) -> np.ndarray:
     """Scalar-first unit quaternion ``q_bi`` (q0 >= 0) whose rotation matrix (as built by
-    ``lvgym.dynamics.kernels.quat_to_dcm``) is ``C = C_ib`` (body -> inertial). Shepperd's method."""
+    ``lvgym.rotations.quat_to_dcm``) is ``C = C_ib`` (body -> inertial). Shepperd's method."""
     C = np.asarray(C, dtype=np.float64)
     tr = np.trace(C)
     d = np.diag(C)
@@ -401,12 +406,7 @@ class LaunchSite:
 
     def geodetic(self, r_zw_i: Any, t: Any = 0.0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Latitude, longitude [rad] and geodetic altitude [m] of inertial positions [m] at ``t``."""
-        rows = _rows(r_zw_i, 3)
-        out = np.empty_like(rows)
-        _geodetic_batch(rows, _times(t, rows.shape[0]), self.params, out)
-        if np.ndim(r_zw_i) == 1:
-            return out[0, 0], out[0, 1], out[0, 2]
-        return out[:, 0], out[:, 1], out[:, 2]
+        return _geodetic_with(self.params, r_zw_i, t)
 
     def altitude(self, r_zw_i: Any, t: Any = 0.0) -> np.ndarray:
         """Geodetic altitude [m] of inertial positions (3,) or (B, 3) [m] at ``t`` [s]."""
