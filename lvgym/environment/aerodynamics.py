@@ -57,13 +57,13 @@ DAMPING = ("Cmq", "Clp", "Cnr")
 def interp_k(grid, dims, table, q, out):
     """Multilinear interpolation of every column of ``table`` at the point ``q`` (one value per
     axis), clamped to the grid; axes of length 1 are constant. Writes ``out[:table.shape[1]]``."""
-    nd = dims.shape[0]
+    nd = dims.shape[0]                    # dims may be integers or whole floats (a packed context)
     idx = np.zeros(nd, np.int64)
     wgt = np.zeros(nd)
     stride = np.ones(nd, np.int64)
     off = 0
     for d in range(nd):
-        n = dims[d]
+        n = int(dims[d])
         if n > 1:
             x = q[d]
             if x >= grid[off + n - 1]:
@@ -74,7 +74,7 @@ def interp_k(grid, dims, table, q, out):
                 wgt[d] = (x - grid[off + i]) / (grid[off + i + 1] - grid[off + i])
         off += n
     for d in range(nd - 2, -1, -1):
-        stride[d] = stride[d + 1] * dims[d + 1]
+        stride[d] = stride[d + 1] * int(dims[d + 1])
     for c in range(table.shape[1]):
         out[c] = 0.0
     for corner in range(1 << nd):
@@ -125,7 +125,7 @@ def aero_loads_k(v_air_b, omega_bi_b, rho, sound, x_cg, alt, p, grid, dims, tabl
         if cmq != 0.0 and dims[1] > 1:
             # Cmq is tabulated about x_ref; about the CG it is Cmq - 4 (D/L) Cm_a - 2 (D/L)^2 CN_a with
             # D = x_ref - x_cg and the static slopes about x_ref taken from the table's first angle
-            a1 = grid[dims[0] + 1]
+            a1 = grid[int(dims[0]) + 1]
             c1 = np.zeros(table.shape[1])
             interp_k(grid, dims, table, np.array([mach, a1]), c1)
             dl = (p[P_XREF] - x_cg) / l_ref

@@ -1,0 +1,350 @@
+"""The simulator: a vehicle, its environment and the dynamics core, flown together over time.
+
+:class:`Simulator` composes a vehicle file (mass model, staging, bending modes, through a
+:class:`~.timeline.Timeline`), the environment models (launch site, gravity, atmosphere, wind,
+aerodynamics, through the compiled :mod:`.flight` loads) and the dynamics core, for one vehicle or a
+batch of them that may be at different times. It knows nothing of rewards or observation spaces.
+
+>>> from lvgym.simulator import Simulator
+>>> sim = Simulator("stratos3", model="rigid", t_end=5.0)
+>>> sim.reset()
+>>> events = sim.step([[0.0, 0.0]], 1.0)        # gimbal (pitch, yaw) [rad] held for 1 s
+>>> bool(sim.conditions("altitude")[0] > 10.0)
+True
+
+Stepping. :meth:`Simulator.step` advances every row by ``duration`` seconds with RK4 steps of at most
+``physics_dt`` that land on every event time (burnout, separation, ignition, tank empty) of that row.
+The mass properties, slosh and mode parameters and the thrust ``T_0`` are evaluated at the middle of
+each piece between events and held over it (second order in their slow variation; keep ``duration``
+at or below about 0.05 s). When the CG of the rigid body moves within the structure between pieces, the
+state is shifted so that the structure stays where it was (:meth:`NonRigidModel.shift_cg`).
+
+Lift-off. The vehicle starts on the pad, axis along the launch rail (``elevation_deg`` above the
+horizon towards ``site.azimuth_deg``), and is held there while the thrust cannot lift it. It then slides
+along the rail without rotating with respect to the Earth until the structure has travelled
+``rail_length`` [m]; events ``lift-off`` and ``rail exit`` mark both moments.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+from lvgym.dynamics.stepper import step_batch
+from lvgym.environment import LaunchSite, make
+from lvgym.environment.earth import WGS84_OMEGA, dcm_to_quat
+from lvgym.rotations import quat_to_dcm_batch
+from lvgym.vehicle import MassModel, Vehicle, load_vehicle
+
+from .flight import (C_AE, C_DP, C_DY, C_MIS_P, C_MIS_Y, C_T0, C_TIME0, DIAG, N_DIAG, flight_conditions_batch,
+                     flight_loads, pack_context, stack_contexts)
+from .timeline import MODELS, Timeline, build_timeline
+
+#: launch sites of the shipped vehicles (public-data.md); azimuth clockwise from north
+SITES = {
+    "andoya": LaunchSite(latitude_deg=69.2943, longitude_deg=16.0205, altitude_m=10.0, azimuth_deg=0.0),
+    "el_arenosillo": LaunchSite(latitude_deg=37.0970, longitude_deg=-6.7350, altitude_m=20.0, azimuth_deg=225.0),
+    "flat": LaunchSite(latitude_deg=0.0, longitude_deg=0.0, altitude_m=0.0, azimuth_deg=90.0, flat_earth=True),
+}
+
+
+def quat_mul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Hamilton product of scalar-first quaternions (..., 4)."""
+    a0, a1, a2, a3 = np.moveaxis(a, -1, 0)
+    b0, b1, b2, b3 = np.moveaxis(b, -1, 0)
+    return np.stack([a0 * b0 - a1 * b1 - a2 * b2 - a3 * b3, a0 * b1 + a1 * b0 + a2 * b3 - a3 * b2,
+                     a0 * b2 - a1 * b3 + a2 * b0 + a3 * b1, a0 * b3 + a1 * b2 - a2 * b1 + a3 * b0], axis=-1)
+
+
+def dcm_batch(q: np.ndarray) -> np.ndarray:
+    """``C_ib`` (B, 3, 3) of the quaternions ``q_bi`` (B, 4)."""
+    out = np.empty((q.shape[0], 3, 3))
+    quat_to_dcm_batch(np.ascontiguousarray(q, dtype=float), out)
+    return out
+
+
+class Simulator:
+    """A vehicle flown through its environment, one row per vehicle of a batch.
+
+    Parameters
+    ----------
+    vehicle: a shipped vehicle name, a YAML path or a :class:`~lvgym.vehicle.Vehicle`.
+    model: ``rigid``, ``slosh``, ``flex`` or ``nonrigid`` (see :mod:`.timeline`).
+    site: a :class:`LaunchSite` or a key of :data:`SITES` (default ``andoya``).
+    gravity, atmosphere, wind: names or mappings for :func:`lvgym.environment.make`, or models; the wind
+        may also be given per row at :meth:`reset`.
+    aerodynamics: ``"vehicle"`` (the vehicle file's ``aerodynamics`` section), a name/mapping/model, or
+        None (no aerodynamic loads).
+    t_end: mission time [s] tabulated by the timeline; physics_dt: largest RK4 step [s].
+    elevation_deg: rail elevation above the horizon [deg] (90: vertical); rail_length [m].
+    n_modes: bending modes per plane (default: the vehicle file's; modes above the Nyquist frequency of
+        the RK4 step, ``1 / (2 physics_dt)``, are decoupled, see :func:`.timeline.build_timeline`);
+        sensor_stations [m]: where the mode slopes are tabulated (an IMU); cg_convention: ``static`` or
+        ``thesis``; timeline_dt [s]; timeline: a prebuilt :class:`Timeline` to share between simulators.
+    """
+
+    def __init__(self, vehicle: str | Vehicle = "smile", model: str = "nonrigid", *, site: Any = "andoya",
+                 gravity: Any = "egm2008", atmosphere: Any = "us76", wind: Any = "none", aerodynamics: Any = "vehicle",
+                 t_end: float = 60.0, physics_dt: float = 0.01, elevation_deg: float = 90.0, rail_length: float = 0.0,
+                 n_modes: int | None = None, sensor_stations: Sequence[float] = (), cg_convention: str = "static",
+                 timeline_dt: float = 0.05, timeline: Timeline | None = None) -> None:
+        if model not in MODELS:
+            raise ValueError(f"model = {model!r}: one of {MODELS}")
+        if not 0.0 < physics_dt <= 0.1:
+            raise ValueError(f"physics_dt = {physics_dt!r}: a step in (0, 0.1] s")
+        if not 0.0 < elevation_deg <= 90.0:
+            raise ValueError(f"elevation_deg = {elevation_deg!r}: in (0, 90] deg")
+        if not rail_length >= 0.0:
+            raise ValueError(f"rail_length = {rail_length!r}: a length >= 0 m")
+        self.vehicle = vehicle if isinstance(vehicle, Vehicle) else load_vehicle(vehicle)
+        self.model = model
+        if isinstance(site, str):
+            if site not in SITES:
+                raise ValueError(f"site = {site!r}: one of {sorted(SITES)} or a LaunchSite")
+            site = SITES[site]
+        self.site: LaunchSite = site
+        self.gravity = make("gravity", gravity) if isinstance(gravity, (str, dict)) else gravity
+        self.atmosphere = make("atmosphere", atmosphere) if isinstance(atmosphere, (str, dict)) else atmosphere
+        self.wind = wind
+        if isinstance(aerodynamics, str) and aerodynamics == "vehicle":
+            aerodynamics = self.vehicle.aerodynamics or None
+        self.aerodynamics = (make("aerodynamics", aerodynamics) if isinstance(aerodynamics, (str, dict))
+                             else aerodynamics)
+        self.physics_dt = float(physics_dt)
+        self.elevation = math.radians(elevation_deg)
+        self.rail_length = float(rail_length)
+        self.mass_model = MassModel(self.vehicle, cg_convention)
+        self.timeline = timeline if timeline is not None else build_timeline(
+            self.mass_model, model, t_end, timeline_dt, n_modes, sensor_stations, 0.5 / physics_dt)
+        if timeline is not None and timeline.model != model:
+            raise ValueError(f"the timeline flies model {timeline.model!r}, not {model!r}")
+        self.dynamics = self.timeline.dynamics
+        self.layout = self.dynamics.layout
+        self._i_cg = self.layout.params["r_cg"].start
+        # launch attitude: the pad frame tilted from the vertical towards downrange (+z_b) about y_b
+        tilt = math.pi / 2 - self.elevation
+        R = np.array([[math.cos(tilt), 0.0, math.sin(tilt)], [0.0, 1.0, 0.0], [-math.sin(tilt), 0.0, math.cos(tilt)]])
+        self.C_ib0 = self.site.C_ib0 @ R
+        self.q_bi0 = dcm_to_quat(self.C_ib0)
+        self.omega_e = 0.0 if self.site.flat_earth else WGS84_OMEGA
+        self.batch = 0
+
+    # ------------------------------------------------------------------------------ set-up
+    def _wind_params(self, wind: Any, rng: np.random.Generator) -> np.ndarray:
+        model = make("wind", wind) if isinstance(wind, (str, dict)) else wind
+        model.reset(rng)
+        return model.params
+
+    def reset(self, batch: int = 1, rng: np.random.Generator | None = None, winds: Sequence[Any] | None = None,
+              misalignment: np.ndarray | None = None, param_scale: np.ndarray | None = None,
+              param_offset: np.ndarray | None = None) -> None:
+        """Put ``batch`` vehicles on the pad at t = 0.
+
+        ``winds``: one wind model (name, mapping or model) per row (default: the simulator's ``wind``),
+        each reset with ``rng``; ``misalignment`` (B, 2) [rad] fixed thrust misalignment (pitch, yaw);
+        ``param_scale`` / ``param_offset`` (B, n_p): every row flies ``timeline params * scale + offset``
+        (dispersions of mass, CG, inertia, slosh damping, bending frequencies)."""
+        rng = np.random.default_rng() if rng is None else rng
+        B = int(batch)
+        if B < 1:
+            raise ValueError(f"batch = {batch!r}: at least one vehicle")
+        winds = [self.wind] * B if winds is None else list(winds)
+        if len(winds) != B:
+            raise ValueError(f"winds has {len(winds)} entries for a batch of {B}")
+        aero = self.aerodynamics.kernel_args() if self.aerodynamics is not None else None
+        rows = [pack_context(self.site.params, self.gravity.params, self.atmosphere.params,
+                             self._wind_params(w, rng), aero) for w in winds]
+        self.c = stack_contexts(rows)
+        n_p = self.layout.n_p
+        self.scale = np.ones((B, n_p)) if param_scale is None else np.array(np.broadcast_to(param_scale, (B, n_p)))
+        self.offset = np.zeros((B, n_p)) if param_offset is None else np.array(np.broadcast_to(param_offset, (B, n_p)))
+        if misalignment is not None:
+            mis = np.broadcast_to(np.asarray(misalignment, float), (B, 2))
+            self.c[:, C_MIS_P], self.c[:, C_MIS_Y] = mis[:, 0], mis[:, 1]
+        self.batch = B
+        self.t = np.zeros(B)
+        self.p = self._params(self.t)
+        self.x = self.layout.zeros_state(B)
+        self.rail_s = np.zeros(B)                 # travel of the structure along the rail [m]
+        self.on_rail = np.ones(B, dtype=bool)
+        self.lifted = np.zeros(B, dtype=bool)
+        self.failed = np.zeros(B, dtype=bool)
+        self.gimbal = np.zeros((B, 2))
+        self.x_cg0 = self.p[:, self._i_cg].copy()
+        self._constrain(np.arange(B), from_state=False)
+        lay = self.layout.state
+        q_si = self.layout.view(self.x, "state", "q_si")
+        q_si[:] = self.x[:, None, lay["q_bi"]]
+        self.diag = np.zeros((B, N_DIAG))
+        self._update_conditions()
+
+    def _params(self, t: np.ndarray, rows: np.ndarray | None = None) -> np.ndarray:
+        rows = slice(None) if rows is None else rows
+        return self.timeline.params_at(t) * self.scale[rows] + self.offset[rows]
+
+    # ------------------------------------------------------------------------------ the rail
+    def _constrain(self, rows: np.ndarray, from_state: bool = True) -> None:
+        """Hold the rows on the rail (or the pad): position on the rail line, no motion relative to the
+        Earth across it, attitude fixed in the Earth frame. ``from_state=False``: put them at the rail's
+        start, at rest relative to the Earth."""
+        if rows.size == 0:
+            return
+        lay = self.layout.state
+        t = self.t[rows]
+        w = self.omega_e
+        ang = w * t
+        ca, sa = np.cos(ang), np.sin(ang)
+        C_ie = np.zeros((rows.size, 3, 3))
+        C_ie[:, 0, 0], C_ie[:, 0, 1], C_ie[:, 1, 0], C_ie[:, 1, 1], C_ie[:, 2, 2] = ca, -sa, sa, ca, 1.0
+        axis_e = self.C_ib0[:, 0]
+        r_pad, _, _ = self.site.initial_state(0.0)
+        x_base = -self.vehicle.length
+        # structure point at the initial CG station, at rail travel s
+        h0 = self.x_cg0[rows] - x_base
+        base_e = r_pad[None, :] + h0[:, None] * axis_e[None, :]
+        axis_i = C_ie @ axis_e
+        origin_i = np.einsum("bij,bj->bi", C_ie, base_e)
+        x = self.x[rows]
+        r, v = x[:, lay["r_zw_i"]], x[:, lay["v_zw_i"]]
+        shift = self.p[rows, self._i_cg] - self.x_cg0[rows]          # CG travel within the structure
+        if from_state:
+            s = np.maximum(np.einsum("bi,bi->b", r - origin_i, axis_i) - shift, 0.0)
+        else:
+            s, v = np.zeros(rows.size), np.cross([0.0, 0.0, w], r)
+        omega_i = np.array([0.0, 0.0, w])
+        r_new = origin_i + (s + shift)[:, None] * axis_i
+        v_earth = np.cross(omega_i[None, :], r_new)
+        v_along = np.einsum("bi,bi->b", v - np.cross(omega_i[None, :], r), axis_i)
+        v_along = np.where((s <= 0.0) & (v_along < 0.0), 0.0, v_along)
+        x[:, lay["r_zw_i"]] = r_new
+        x[:, lay["v_zw_i"]] = v_earth + v_along[:, None] * axis_i
+        q_ie = np.stack([np.cos(ang / 2), np.zeros_like(ang), np.zeros_like(ang), np.sin(ang / 2)], axis=1)
+        x[:, lay["q_bi"]] = quat_mul(q_ie, np.broadcast_to(self.q_bi0, (rows.size, 4)))
+        x[:, lay["omega_bi_b"]] = self.C_ib0.T @ omega_i
+        self.x[rows] = x
+        self.rail_s[rows] = s
+
+    # ------------------------------------------------------------------------------ stepping
+    def step(self, gimbal: Any, duration: float) -> list[list[tuple[float, str]]]:
+        """Advance every row by ``duration`` [s] with the gimbal angles ``gimbal`` (B, 2) [rad]
+        (pitch, yaw; see :mod:`.flight` for the signs) held; returns each row's events."""
+        if self.batch == 0:
+            raise RuntimeError("call reset() before step()")
+        if not duration > 0.0:
+            raise ValueError(f"duration = {duration!r}: must be > 0 s")
+        g = np.broadcast_to(np.asarray(gimbal, dtype=float), (self.batch, 2))
+        self.gimbal = np.array(g)
+        self.c[:, C_DP], self.c[:, C_DY] = g[:, 0], g[:, 1]
+        events: list[list[tuple[float, str]]] = [[] for _ in range(self.batch)]
+        t0, t1 = self.t.copy(), self.t + duration
+        ev = self.timeline.event_times
+        inside = (ev[None, :] > t0[:, None] + 1e-12) & (ev[None, :] < t1[:, None] - 1e-12)
+        plain = np.flatnonzero(~inside.any(axis=1) & ~self.failed)
+        if plain.size:
+            self._advance(plain, duration)
+        for b in np.flatnonzero(inside.any(axis=1) & ~self.failed):
+            cuts = [t0[b], *ev[inside[b]].tolist(), t1[b]]
+            for a, z in zip(cuts[:-1], cuts[1:]):
+                self._advance(np.array([b]), z - a)
+        for b in range(self.batch):
+            events[b] += [(t, e) for t, e in self.timeline.events if t0[b] < t <= t1[b] + 1e-12]
+        self.t[self.failed] = t1[self.failed]
+        for b in np.flatnonzero(self.on_rail):
+            if self.rail_s[b] > 0.0 and not self.lifted[b]:
+                self.lifted[b] = True
+                events[b].append((float(self.t[b]), "lift-off"))
+            if self.rail_s[b] >= self.rail_length and self.lifted[b]:
+                self.on_rail[b] = False
+                if self.rail_length > 0.0:
+                    events[b].append((float(self.t[b]), "rail exit"))
+        bad = ~np.all(np.isfinite(self.x), axis=1) & ~self.failed
+        self.failed |= bad
+        self._update_conditions()
+        return events
+
+    def _advance(self, rows: np.ndarray, span: float) -> None:
+        """Integrate ``rows`` by ``span`` seconds, parameters at the middle of the span."""
+        t_mid = self.t[rows] + 0.5 * span
+        p = self._params(t_mid, rows)
+        delta = np.zeros((rows.size, 3))
+        delta[:, 0] = p[:, self._i_cg] - self.p[rows, self._i_cg]
+        x = self.dynamics.shift_cg(self.x[rows], delta) if np.any(delta) else self.x[rows]
+        x = np.ascontiguousarray(x)
+        c = self.c[rows]
+        c[:, C_T0] = self.timeline.interp("thrust0", t_mid)
+        c[:, C_AE] = self.timeline.interp("exit_area", t_mid)
+        c[:, C_TIME0] = self.t[rows]
+        n = max(1, int(math.ceil(span / self.physics_dt - 1e-9)))
+        h = span / n
+        N, K, n_u = self.dynamics.n_slosh, self.dynamics.n_modes, self.layout.n_u
+        self.p[rows] = p
+        railed = self.on_rail[rows]
+        if not railed.any():
+            step_batch(flight_loads, x, p, c, 0.0, h, n, N, K, True, n_u)
+            self.x[rows] = x
+        else:
+            for k in range(n):
+                step_batch(flight_loads, x, p, c, k * h, h, 1, N, K, True, n_u)
+                self.x[rows] = x
+                self.t[rows] += h
+                self._constrain(rows[railed])
+                x = np.ascontiguousarray(self.x[rows])
+            self.t[rows] -= n * h
+        self.c[rows] = c
+        self.t[rows] += span
+
+    def _update_conditions(self) -> None:
+        flight_conditions_batch(self.t, np.ascontiguousarray(self.x), self.p, self.c, self.diag)
+
+    # ------------------------------------------------------------------------------ read-outs
+    def conditions(self, name: str) -> np.ndarray:
+        """Flight condition ``name`` (a key of :data:`.flight.DIAG`) of every row at its current time."""
+        if name not in DIAG:
+            raise KeyError(f"condition {name!r}: one of {sorted(DIAG)}")
+        out = self.diag[:, DIAG[name]]
+        return out[:, 0] if out.shape[1] == 1 else out
+
+    def state(self, name: str) -> np.ndarray:
+        """State entry ``name`` of every row (a view, see :class:`lvgym.dynamics.Layout`)."""
+        return self.layout.view(self.x, "state", name)
+
+    def slosh_angles(self) -> np.ndarray:
+        """Pendulum deflections from the body axis (B, N, 2) [rad]: the rod's angle in the x-y and x-z
+        body planes (0 at rest, hanging aft)."""
+        if self.dynamics.n_slosh == 0:
+            return np.zeros((self.batch, 0, 2))
+        q_ib = self.state("q_bi") * np.array([1.0, -1.0, -1.0, -1.0])
+        q_bs = quat_mul(q_ib[:, None, :], self.state("q_si"))
+        C = dcm_batch(q_bs.reshape(-1, 4)).reshape(self.batch, -1, 3, 3)
+        e = C[..., :, 0]                                  # rod direction in body axes
+        return np.stack([np.arctan2(e[..., 1], e[..., 0]), np.arctan2(e[..., 2], e[..., 0])], axis=-1)
+
+    def lateral_cg_offset(self) -> np.ndarray:
+        """Lateral offset of the whole vehicle's CG from the body axis (B, 2) [m] (y_b, z_b): the slosh
+        masses out of their rest position (free-free modes leave the CG of B on the axis)."""
+        if self.dynamics.n_slosh == 0:
+            return np.zeros((self.batch, 2))
+        r_j, _ = self.dynamics.slosh_kinematics(self.x, self.p)
+        C_ib = dcm_batch(self.state("q_bi"))
+        rho_b = np.einsum("bji,bnj->bni", C_ib, r_j - self.state("r_zw_i")[:, None, :])
+        m_j = self.p[:, [self.layout.slosh_param(j, "m").start for j in range(self.dynamics.n_slosh)]]
+        m_total = self.p[:, 0] + m_j.sum(axis=1)
+        return np.einsum("bn,bni->bi", m_j, rho_b[..., 1:]) / m_total[:, None]
+
+    def gyro_rates(self) -> np.ndarray:
+        """Body rates seen by a gyro at each of the timeline's sensor stations (B, S, 3) [rad/s]:
+        ``omega_bi_b`` plus the rotation rate of the deflected section, ``(0, -sum dphi eta_dot_z,
+        sum dphi eta_dot_y)`` (DESIGN.md note 6)."""
+        w = self.state("omega_bi_b")
+        S = self.timeline.sensor_stations.size
+        out = np.repeat(w[:, None, :], S, axis=1)
+        K = self.dynamics.n_modes
+        if K and S:
+            dphi = self.timeline.left("dphi_sensor", self.t)            # (B, S, K)
+            eta_dot = self.state("eta_dot")                              # (B, 2, K)
+            out[..., 1] -= np.einsum("bsk,bk->bs", dphi, eta_dot[:, 1])
+            out[..., 2] += np.einsum("bsk,bk->bs", dphi, eta_dot[:, 0])
+        return out

@@ -1,0 +1,183 @@
+"""Compiled flight loads: gravity, thrust and aerodynamics of one vehicle at every RK4 stage.
+
+The dynamics core integrates with a compiled loads function ``loads_fn(t, x, p, c, u)`` (see
+:mod:`lvgym.dynamics.stepper`). This module builds the simulator's: :func:`flight_conditions_k` evaluates
+the environment models (through their own compiled kernels) for one state and writes a vector of
+flight conditions (layout ``D_*`` below); :data:`flight_loads` turns that vector into the loads vector of
+the core. The same function fills the recorded and observed conditions, so what a policy sees is what
+the vehicle felt.
+
+``c`` is the per-vehicle *context* vector (layout ``C_*``): the commands and thrust held over a step
+and the row's start time ``c[C_TIME0]`` (the stepper's time is relative to it, so the rows of a batch
+may be at different times), followed by the parameter arrays of the launch site, gravity, atmosphere, wind and aerodynamic models,
+packed end to end with their start offsets in the header (rows of a batch may have different wind
+blocks; shorter rows are padded). :func:`pack_context` builds it.
+
+Thrust: ``T = max(T_0 - A_e p_amb, 0)`` with ``T_0`` and the total nozzle exit area ``A_e`` [m^2] from the
+mass model's timeline and ``p_amb`` the ambient pressure at the stage's altitude. Its direction in the
+undeformed engine frame (body axes) is set by the gimbal angles ``delta_p``, ``delta_y`` [rad] plus a
+fixed misalignment: ``e = (cos dp cos dy, -sin dy, sin dp cos dy)`` with ``dp = delta_p + mis_p`` and
+``dy = delta_y + mis_y``, so that a positive ``delta_p`` pitches the nose up about ``+y_b`` and a positive
+``delta_y`` yaws it about ``+z_b`` for an engine aft of the centre of gravity.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba as nb
+import numpy as np
+
+from lvgym.dynamics.stepper import compile_loads
+from lvgym.environment.aerodynamics import STATE_FIELDS, aero_loads_k
+from lvgym.environment.atmosphere import atmosphere_state
+from lvgym.environment.earth import SITE_SIZE, site_dcm_ni_k, site_geodetic_k, site_velocity_wrt_earth_k
+from lvgym.environment.gravity import gravity_k
+from lvgym.environment.wind import wind_ned
+from lvgym.rotations import quat_to_dcm
+
+# ---------------------------------------------------------------------------- context layout
+C_T0, C_AE, C_DP, C_DY, C_MIS_P, C_MIS_Y, C_AERO = 0, 1, 2, 3, 4, 5, 6
+C_SITE, C_GRAV, C_ATM, C_WIND, C_AP, C_AG, C_AD, C_AT, C_NCOL, C_END = 7, 8, 9, 10, 11, 12, 13, 14, 15, 16
+C_TIME0 = 17                      # start time of the row's step [s]: the stepper's t is relative to it
+C_HEADER = 18
+
+# ---------------------------------------------------------------------------- flight conditions layout
+DIAG_FIELDS = (
+    ("altitude", 1), ("density", 1), ("pressure", 1), ("temperature", 1), ("speed_of_sound", 1),
+    ("wind_n", 3), ("v_air_b", 3), ("alpha", 1), ("beta", 1), ("alpha_total", 1), ("phi_aero", 1),
+    ("mach", 1), ("qbar", 1), ("airspeed", 1), ("f_aero_b", 3), ("m_aero_b", 3), ("f_aero_i", 3),
+    ("g_i", 3), ("thrust", 1), ("thrust_e", 3),
+)
+DIAG: dict[str, slice] = {}
+_o = 0
+for _name, _size in DIAG_FIELDS:
+    DIAG[_name] = slice(_o, _o + _size)
+    _o += _size
+N_DIAG = _o
+(D_ALT, D_RHO, D_PRES, D_TEMP, D_SOUND) = (DIAG[k].start for k in
+                                            ("altitude", "density", "pressure", "temperature", "speed_of_sound"))
+D_WIND, D_VAIR, D_ALPHA = DIAG["wind_n"].start, DIAG["v_air_b"].start, DIAG["alpha"].start
+D_FAERO, D_MAERO, D_FAERO_I, D_G = (DIAG[k].start for k in ("f_aero_b", "m_aero_b", "f_aero_i", "g_i"))
+D_THRUST, D_THRUST_E = DIAG["thrust"].start, DIAG["thrust_e"].start
+_P_CG = 1                        # station of the CG of B in the dynamics parameter vector
+_U_F, _U_M, _U_T, _U_G = 0, 3, 6, 9     # loads layout of the dynamics core (f_b_i, m_b_b, thrust_e, g_i)
+assert len(STATE_FIELDS) == 7
+
+
+@nb.njit(cache=True, error_model="numpy")
+def flight_conditions_k(t, x, p, c, d):
+    """Flight conditions (layout ``DIAG``) of the state ``x`` at time ``t`` [s] into ``d`` (N_DIAG)."""
+    rx, ry, rz = x[0], x[1], x[2]
+    o_site, o_grav, o_atm = int(c[C_SITE]), int(c[C_GRAV]), int(c[C_ATM])
+    o_wind, o_ap, o_ag, o_ad = int(c[C_WIND]), int(c[C_AP]), int(c[C_AG]), int(c[C_AD])
+    o_at, n_col, o_end = int(c[C_AT]), int(c[C_NCOL]), int(c[C_END])
+    site = c[o_site:o_site + SITE_SIZE]
+    _, _, alt = site_geodetic_k(rx, ry, rz, t, site)
+    d[D_ALT] = alt
+    gx, gy, gz = gravity_k(rx, ry, rz, t, c[o_grav:o_atm])
+    d[D_G], d[D_G + 1], d[D_G + 2] = gx, gy, gz
+    atmosphere_state(c[o_atm:o_wind], alt, d[D_RHO:D_RHO + 4])
+    rho, pres, sound = d[D_RHO], d[D_PRES], d[D_SOUND]
+    wn = d[D_WIND:D_WIND + 3]
+    wind_ned(c[o_wind:o_ap], alt, t, wn)
+    C = np.empty((3, 3))
+    site_dcm_ni_k(rx, ry, rz, t, site, C)
+    vx, vy, vz = site_velocity_wrt_earth_k(rx, ry, rz, x[3], x[4], x[5], site)
+    vr0 = vx - (C[0, 0] * wn[0] + C[1, 0] * wn[1] + C[2, 0] * wn[2])
+    vr1 = vy - (C[0, 1] * wn[0] + C[1, 1] * wn[1] + C[2, 1] * wn[2])
+    vr2 = vz - (C[0, 2] * wn[0] + C[1, 2] * wn[1] + C[2, 2] * wn[2])
+    quat_to_dcm(x[6], x[7], x[8], x[9], C)                       # C = C_ib
+    va = d[D_VAIR:D_VAIR + 3]
+    for i in range(3):
+        va[i] = C[0, i] * vr0 + C[1, i] * vr1 + C[2, i] * vr2    # v_air_b = C_ib^T v_rel_i
+    fa = d[D_FAERO:D_FAERO + 3]
+    ma = d[D_MAERO:D_MAERO + 3]
+    st = d[D_ALPHA:D_ALPHA + 7]
+    if c[C_AERO] != 0.0:
+        table = c[o_at:o_end].reshape(((o_end - o_at) // n_col, n_col))
+        aero_loads_k(va, x[10:13], rho, sound, p[_P_CG], alt, c[o_ap:o_ag], c[o_ag:o_ad], c[o_ad:o_at],
+                     table, fa, ma, st)
+    else:                                                         # flow angles only
+        u, v, w = va[0], va[1], va[2]
+        vperp = math.sqrt(v * v + w * w)
+        speed = math.sqrt(u * u + vperp * vperp)
+        st[0] = math.atan2(w, u)
+        st[1] = math.atan2(v, math.sqrt(u * u + w * w))
+        st[2] = math.atan2(vperp, u)
+        st[3] = math.atan2(v, w) if vperp > 0.0 else 0.0
+        st[4] = speed / sound if sound > 0.0 else 0.0
+        st[5] = 0.5 * rho * speed * speed
+        st[6] = speed
+        for i in range(3):
+            fa[i] = 0.0
+            ma[i] = 0.0
+    for i in range(3):
+        d[D_FAERO_I + i] = C[i, 0] * fa[0] + C[i, 1] * fa[1] + C[i, 2] * fa[2]
+    thrust = 0.0
+    if c[C_T0] > 0.0:
+        thrust = max(c[C_T0] - c[C_AE] * pres, 0.0)
+    d[D_THRUST] = thrust
+    dp = c[C_DP] + c[C_MIS_P]
+    dy = c[C_DY] + c[C_MIS_Y]
+    d[D_THRUST_E] = thrust * math.cos(dp) * math.cos(dy)
+    d[D_THRUST_E + 1] = -thrust * math.sin(dy)
+    d[D_THRUST_E + 2] = thrust * math.sin(dp) * math.cos(dy)
+
+
+def _flight_loads(t, x, p, c, u):
+    """Loads of the dynamics core from the flight conditions: aerodynamic force (inertial) and moment
+    about the CG, thrust in the engine frame, gravity; no generalised modal forces."""
+    d = np.empty(N_DIAG)
+    flight_conditions_k(c[C_TIME0] + t, x, p, c, d)
+    for i in range(3):
+        u[_U_F + i] = d[D_FAERO_I + i]
+        u[_U_M + i] = d[D_MAERO + i]
+        u[_U_T + i] = d[D_THRUST_E + i]
+        u[_U_G + i] = d[D_G + i]
+    for i in range(12, u.size):
+        u[i] = 0.0
+
+
+flight_loads = compile_loads(_flight_loads)
+
+
+@nb.njit(cache=True)
+def flight_conditions_batch(t, x, p, c, d):
+    """:func:`flight_conditions_k` for every row: ``t`` (B,), ``x`` (B, n_x), ``p`` (B, n_p), ``c``
+    (B, n_c) into ``d`` (B, N_DIAG)."""
+    for b in range(x.shape[0]):
+        flight_conditions_k(t[b], x[b], p[b], c[b], d[b])
+
+
+def pack_context(site: np.ndarray, gravity: np.ndarray, atmosphere: np.ndarray, wind: np.ndarray,
+                 aero: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None) -> np.ndarray:
+    """Context vector of one vehicle from the models' parameter arrays (``aero`` is
+    ``model.kernel_args()`` or None for no aerodynamic loads); commands are zero."""
+    if aero is None:
+        ap, grid, dims, table = np.zeros(4), np.zeros(1), np.ones(1), np.zeros((1, 1))
+    else:
+        ap, grid, dims, table = aero
+    blocks = [np.asarray(site, float), np.asarray(gravity, float), np.asarray(atmosphere, float),
+              np.asarray(wind, float), np.asarray(ap, float), np.asarray(grid, float),
+              np.asarray(dims, float), np.ascontiguousarray(table, float).ravel()]
+    if blocks[0].size != SITE_SIZE:
+        raise ValueError(f"site parameters have {blocks[0].size} entries: expected {SITE_SIZE}")
+    header = np.zeros(C_HEADER)
+    header[C_AERO] = 0.0 if aero is None else 1.0
+    offset = C_HEADER
+    for key, block in zip((C_SITE, C_GRAV, C_ATM, C_WIND, C_AP, C_AG, C_AD, C_AT), blocks):
+        header[key] = offset
+        offset += block.size
+    header[C_END] = offset
+    header[C_NCOL] = np.shape(table)[1]
+    return np.concatenate([header, *blocks])
+
+
+def stack_contexts(rows: list[np.ndarray]) -> np.ndarray:
+    """Rows of possibly different lengths as one (B, n_c) array, zero-padded at the end."""
+    n = max(r.size for r in rows)
+    out = np.zeros((len(rows), n))
+    for b, r in enumerate(rows):
+        out[b, :r.size] = r
+    return out

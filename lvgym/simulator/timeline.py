@@ -1,0 +1,216 @@
+"""The mission timeline: the mass model and the bending modes tabulated over the flight, once per vehicle.
+
+Propellant depletion and staging do not depend on the vehicle's motion (the engines run at full
+throttle), so the dynamics parameters, the thrust and the mass properties are functions of time
+alone. :func:`build_timeline` evaluates :class:`~lvgym.vehicle.MassModel` and
+:class:`~lvgym.vehicle.structure.ModeSchedule` on a grid (every ``dt`` seconds, every breakpoint of a
+thrust table and both sides of every event) and :class:`Timeline` interpolates it linearly, so a step
+costs a table look-up instead of a mass-model evaluation and a batch of vehicles at different times
+looks up its rows in one call. Event times are stored twice (the row before and the row after), and the
+simulator lands its steps on them, so nothing is interpolated across a separation.
+
+``model`` picks which parameters the dynamics core flies (thesis section 4.4):
+
+=============  ===============================================================================
+``rigid``      the rigid-equivalent stack (slosh masses frozen at rest): same mass, CG and inertia
+``slosh``      the rigid body B and one pendulum per slosh tank
+``flex``       the rigid-equivalent stack on its bending modes (slosh masses on the beam as rigid)
+``nonrigid``   B, the pendulums and the modes, coupled (the thesis's full model)
+=============  ===============================================================================
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from lvgym.dynamics import NonRigidModel
+from lvgym.vehicle import MassModel
+from lvgym.vehicle.massmodel import BURNING, SEPARATED
+from lvgym.vehicle.structure import ModeSchedule
+
+MODELS = ("rigid", "slosh", "flex", "nonrigid")
+_TINY = 1e-9          # the row before an event is taken this fraction of the time before it
+
+
+@dataclass(frozen=True)
+class Timeline:
+    """Tabulated flight of one vehicle. Rows ``t`` (n,) [s], non-decreasing, event times twice.
+
+    ``params`` (n, n_p): dynamics parameters (:class:`~lvgym.dynamics.NonRigidModel` layout of
+    ``model``); ``hold`` (n_p,) columns that are piecewise constant (mode data); ``thrust0`` (n,) [N]
+    and ``exit_area`` (n,) [m^2]: thrust ``max(T_0 - A_e p_amb, 0)``; ``mass`` (n,) [kg], ``cg`` (n, 3)
+    [m], ``inertia`` (n, 3, 3) [kg m^2] of the whole stack; ``slosh_mass`` (n, N) [kg];
+    ``burning`` (n,) any engine burning; ``stage`` (n,) index of the lowest attached stage;
+    ``dphi_sensor`` (n, S, K) mode slopes at the sensor stations ``sensor_stations`` (S,) [m];
+    ``events`` ((time, description), ...)."""
+
+    model: str
+    dynamics: NonRigidModel
+    t: np.ndarray
+    params: np.ndarray
+    hold: np.ndarray
+    thrust0: np.ndarray
+    exit_area: np.ndarray
+    mass: np.ndarray
+    cg: np.ndarray
+    inertia: np.ndarray
+    slosh_mass: np.ndarray
+    burning: np.ndarray
+    stage: np.ndarray
+    stage_names: tuple[str, ...]
+    slosh_names: tuple[str, ...]
+    sensor_stations: np.ndarray
+    dphi_sensor: np.ndarray
+    events: tuple[tuple[float, str], ...]
+
+    @property
+    def t_end(self) -> float:
+        return float(self.t[-1])
+
+    @property
+    def event_times(self) -> np.ndarray:
+        return np.array(sorted({t for t, _ in self.events}))
+
+    def locate(self, t) -> tuple[np.ndarray, np.ndarray]:
+        """Row index ``i`` and weight ``w`` of the times ``t`` (B,): value = (1-w) row i + w row i+1.
+        A time equal to an event time takes the row after the event."""
+        t = np.atleast_1d(np.asarray(t, dtype=float))
+        i = np.clip(np.searchsorted(self.t, t, side="right") - 1, 0, len(self.t) - 2)
+        span = self.t[i + 1] - self.t[i]
+        w = np.where(span > 0.0, (t - self.t[i]) / np.where(span > 0.0, span, 1.0), 0.0)
+        return i, np.clip(w, 0.0, 1.0)
+
+    def interp(self, name: str, t) -> np.ndarray:
+        """Linear interpolation of the row quantity ``name`` at the times ``t`` (B,): shape (B, ...)."""
+        i, w = self.locate(t)
+        a = getattr(self, name)
+        w = w.reshape((-1,) + (1,) * (a.ndim - 1))
+        return (1.0 - w) * a[i] + w * a[i + 1]
+
+    def left(self, name: str, t) -> np.ndarray:
+        """The row quantity ``name`` in force at the times ``t`` (no interpolation)."""
+        i, w = self.locate(t)
+        return getattr(self, name)[np.where(w >= 1.0, i + 1, i)]
+
+    def params_at(self, t) -> np.ndarray:
+        """Dynamics parameters (B, n_p) at the times ``t`` (B,): interpolated, mode data held."""
+        i, w = self.locate(t)
+        p = (1.0 - w[:, None]) * self.params[i] + w[:, None] * self.params[i + 1]
+        held = self.params[np.where(w >= 1.0, i + 1, i)]
+        p[:, self.hold] = held[:, self.hold]
+        return p
+
+
+def _cut(modes, cutoff_hz: float):
+    """The modes with those above ``cutoff_hz`` decoupled."""
+    keep = modes.omega <= 2.0 * np.pi * cutoff_hz
+    if keep.all():
+        return modes
+    return replace(modes, phi_gimbal=modes.phi_gimbal * keep, dphi_gimbal=modes.dphi_gimbal * keep,
+                   phi_hinge=modes.phi_hinge * keep, phi_sensor=modes.phi_sensor * keep,
+                   dphi_sensor=modes.dphi_sensor * keep)
+
+
+def _grid(mm: MassModel, t_end: float, dt: float) -> tuple[list[float], list[tuple[float, str]]]:
+    """Grid times and the events of the whole flight."""
+    _, events = mm.advance(mm.initial_state(), t_end)
+    times = set(np.linspace(0.0, t_end, max(2, int(np.ceil(t_end / dt - 1e-9)) + 1)).tolist())
+    for si, em in mm.engines:
+        if em.engine.thrust_table is not None:
+            ign = 0.0 if si == 0 else None
+            if ign is None:
+                ign = next((t for t, e in events if e == f"stage {mm.vehicle.stages[si].name!r} ignition"), None)
+            if ign is not None:
+                times |= {ign + float(tau) for tau in em.engine.thrust_table[:, 0] if 0 <= ign + tau <= t_end}
+    times |= {t for t, _ in events}
+    return sorted(times), events
+
+
+def build_timeline(mass_model: MassModel, model: str, t_end: float, dt: float = 0.05,
+                   n_modes: int | None = None, sensor_stations=(), mode_cutoff_hz: float = np.inf) -> Timeline:
+    """Tabulate ``mass_model``'s vehicle from lift-off to ``t_end`` [s] for the dynamics ``model``
+    (one of ``MODELS``) every ``dt`` [s] (and at every event and thrust-table breakpoint), with
+    ``n_modes`` bending modes per plane (default: the vehicle file's; 0 for rigid and slosh) and
+    mode slopes at ``sensor_stations`` [m].
+
+    Modes above ``mode_cutoff_hz`` are decoupled (their shapes and slopes at the gimbal, hinges and
+    sensors set to zero): they stay at rest. The simulator cuts at the Nyquist frequency of its RK4
+    step, ``1 / (2 physics_dt)``: a stiff upper stage's 200 Hz mode coupled to its slosh masses makes
+    a 10 ms RK4 step diverge, and no load sampled at that step could excite it faithfully."""
+    if model not in MODELS:
+        raise ValueError(f"model = {model!r}: one of {MODELS}")
+    if not t_end > 0.0 or not dt > 0.0:
+        raise ValueError(f"t_end = {t_end!r} and dt = {dt!r} must be > 0 s")
+    mm = mass_model
+    vehicle = mm.vehicle
+    sensors = np.asarray(sensor_stations, dtype=float).reshape(-1)
+    with_modes = model in ("flex", "nonrigid")
+    K = (vehicle.structure.n_modes if n_modes is None else int(n_modes)) if with_modes else 0
+    with_slosh = model in ("slosh", "nonrigid")
+    N = mm.n_slosh if with_slosh else 0
+    dyn = NonRigidModel(N, K)
+    schedule = ModeSchedule(mm, n_modes=K, sensor_stations=sensors) if K > 0 else None
+    times, events = _grid(mm, t_end, dt)
+    event_times = {t for t, _ in events}
+    lay = dyn.layout
+    rows: dict[str, list] = {k: [] for k in ("t", "p", "T0", "Ae", "m", "cg", "J", "ms", "burn", "stage", "dphi")}
+    state = mm.initial_state()
+    for t in times:
+        samples = []
+        if t in event_times and t > 0.0:
+            pre, _ = mm.advance(state, t - _TINY * max(1.0, t))
+            samples.append((t, pre))
+        state, _ = mm.advance(state, t)
+        samples.append((t, state))
+        for tt, s in samples:
+            props = mm.properties(s)
+            on = [(si, em) for (si, em), o in zip(mm.engines, s.engine_on) if o]
+            T0 = mm.thrust(s, 1.0, 0.0)
+            Ae = sum(em.engine.nozzle_exit_area for _, em in on)
+            if with_slosh:
+                m_b, cg, J = props.m_b, props.r_cg_b, props.J_b
+            else:
+                m_b, cg, J = props.mass, props.cg, props.inertia
+            modes = schedule.modes(s, props) if schedule is not None else None
+            if modes is not None:
+                modes = _cut(modes, mode_cutoff_hz)
+            slosh = []
+            for j in range(N):
+                m_s, L = props.slosh_mass[j], props.pendulum_length[j]
+                accel = T0 / props.mass
+                slosh.append({"m": m_s, "length": L if m_s > 0 else 0.0, "r_hinge": props.hinge[j],
+                              "zeta": props.slosh_damping[j],
+                              "omega": np.sqrt(accel / L) if (m_s > 0 and L > 0) else 0.0,
+                              "phi": modes.phi_hinge[j] if modes is not None else np.zeros(0)})
+            p = dyn.params(m_b=m_b, J_b=J, r_cg=cg, r_gimbal=props.gimbal,
+                           omega_modes=modes.omega if modes is not None else (),
+                           zeta_modes=modes.zeta if modes is not None else (),
+                           phi_gimbal=modes.phi_gimbal if modes is not None else (),
+                           dphi_gimbal=modes.dphi_gimbal if modes is not None else (), slosh=slosh)
+            attached = [si for si, ph in enumerate(s.phase) if ph != SEPARATED]
+            rows["t"].append(tt)
+            rows["p"].append(p)
+            rows["T0"].append(T0)
+            rows["Ae"].append(Ae)
+            rows["m"].append(props.mass)
+            rows["cg"].append(props.cg)
+            rows["J"].append(props.inertia)
+            rows["ms"].append(props.slosh_mass)
+            rows["burn"].append(any(ph == BURNING for ph in s.phase) and T0 > 0.0)
+            rows["stage"].append(min(attached) if attached else len(s.phase) - 1)
+            rows["dphi"].append(modes.dphi_sensor if modes is not None and sensors.size
+                                else np.zeros((sensors.size, K)))
+    hold = np.zeros(lay.n_p, dtype=bool)
+    for key in ("omega_modes", "zeta_modes", "phi_gimbal", "dphi_gimbal"):
+        hold[lay.params[key]] = True
+    for j in range(N):
+        hold[lay.slosh_param(j, "phi")] = True
+    return Timeline(model=model, dynamics=dyn, t=np.array(rows["t"]), params=np.array(rows["p"]), hold=hold,
+                    thrust0=np.array(rows["T0"]), exit_area=np.array(rows["Ae"]), mass=np.array(rows["m"]),
+                    cg=np.array(rows["cg"]), inertia=np.array(rows["J"]), slosh_mass=np.array(rows["ms"]),
+                    burning=np.array(rows["burn"]), stage=np.array(rows["stage"]),
+                    stage_names=tuple(s.name for s in vehicle.stages), slosh_names=mm.slosh_names,
+                    sensor_stations=sensors, dphi_sensor=np.array(rows["dphi"]).reshape(len(rows["t"]), sensors.size, K),
+                    events=tuple((float(t), e) for t, e in events))
