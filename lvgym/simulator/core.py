@@ -39,7 +39,7 @@ from lvgym.environment.earth import WGS84_OMEGA, dcm_to_quat
 from lvgym.rotations import quat_to_dcm_batch
 from lvgym.vehicle import MassModel, Vehicle, load_vehicle
 
-from .flight import (C_AE, C_DP, C_DY, C_MIS_P, C_MIS_Y, C_T0, C_TIME0, DIAG, N_DIAG, flight_conditions_batch,
+from .flight import (C_AE, C_DP, C_DY, C_MIS_P, C_MOMENT, C_MIS_Y, C_T0, C_TIME0, DIAG, N_DIAG, flight_conditions_batch,
                      flight_loads, pack_context, stack_contexts)
 from .timeline import MODELS, Timeline, build_timeline
 
@@ -141,30 +141,14 @@ class Simulator:
     def reset(self, batch: int = 1, rng: np.random.Generator | None = None, winds: Sequence[Any] | None = None,
               misalignment: np.ndarray | None = None, param_scale: np.ndarray | None = None,
               param_offset: np.ndarray | None = None) -> None:
-        """Put ``batch`` vehicles on the pad at t = 0.
-
-        ``winds``: one wind model (name, mapping or model) per row (default: the simulator's ``wind``),
-        each reset with ``rng``; ``misalignment`` (B, 2) [rad] fixed thrust misalignment (pitch, yaw);
-        ``param_scale`` / ``param_offset`` (B, n_p): every row flies ``timeline params * scale + offset``
-        (dispersions of mass, CG, inertia, slosh damping, bending frequencies)."""
-        rng = np.random.default_rng() if rng is None else rng
+        """Put ``batch`` vehicles on the pad at t = 0 (see :meth:`reset_rows` for the options)."""
         B = int(batch)
         if B < 1:
             raise ValueError(f"batch = {batch!r}: at least one vehicle")
-        winds = [self.wind] * B if winds is None else list(winds)
-        if len(winds) != B:
-            raise ValueError(f"winds has {len(winds)} entries for a batch of {B}")
-        aero = self.aerodynamics.kernel_args() if self.aerodynamics is not None else None
-        rows = [pack_context(self.site.params, self.gravity.params, self.atmosphere.params,
-                             self._wind_params(w, rng), aero) for w in winds]
-        self.c = stack_contexts(rows)
         n_p = self.layout.n_p
-        self.scale = np.ones((B, n_p)) if param_scale is None else np.array(np.broadcast_to(param_scale, (B, n_p)))
-        self.offset = np.zeros((B, n_p)) if param_offset is None else np.array(np.broadcast_to(param_offset, (B, n_p)))
-        if misalignment is not None:
-            mis = np.broadcast_to(np.asarray(misalignment, float), (B, 2))
-            self.c[:, C_MIS_P], self.c[:, C_MIS_Y] = mis[:, 0], mis[:, 1]
         self.batch = B
+        self.c = np.zeros((B, 0))
+        self.scale, self.offset = np.ones((B, n_p)), np.zeros((B, n_p))
         self.t = np.zeros(B)
         self.p = self._params(self.t)
         self.x = self.layout.zeros_state(B)
@@ -174,11 +158,53 @@ class Simulator:
         self.failed = np.zeros(B, dtype=bool)
         self.gimbal = np.zeros((B, 2))
         self.x_cg0 = self.p[:, self._i_cg].copy()
-        self._constrain(np.arange(B), from_state=False)
-        lay = self.layout.state
-        q_si = self.layout.view(self.x, "state", "q_si")
-        q_si[:] = self.x[:, None, lay["q_bi"]]
         self.diag = np.zeros((B, N_DIAG))
+        self.reset_rows(np.arange(B), rng, winds, misalignment, param_scale, param_offset)
+
+    def reset_rows(self, rows: Any, rng: np.random.Generator | Sequence[np.random.Generator] | None = None,
+                   winds: Sequence[Any] | None = None, misalignment: np.ndarray | None = None,
+                   param_scale: np.ndarray | None = None, param_offset: np.ndarray | None = None) -> None:
+        """Put the vehicles ``rows`` back on the pad at t = 0; the others are untouched.
+
+        ``rng``: one generator, or one per row, for whatever is random (the wind models' ``reset``);
+        ``winds``: one wind model (name, mapping or model) per row (default: the simulator's ``wind``);
+        ``misalignment`` (R, 2) [rad] fixed thrust misalignment (pitch, yaw); ``param_scale`` /
+        ``param_offset`` (R, n_p): a row flies ``timeline params * scale + offset`` (dispersions of mass,
+        CG, inertia, slosh damping, bending frequencies)."""
+        if self.batch == 0:
+            raise RuntimeError("call reset() before reset_rows()")
+        rows = np.atleast_1d(np.asarray(rows, dtype=int))
+        R = rows.size
+        rngs = list(rng) if isinstance(rng, (list, tuple)) else [rng] * R
+        rngs = [np.random.default_rng() if g is None else g for g in rngs]
+        winds = [self.wind] * R if winds is None else list(winds)
+        if len(winds) != R or len(rngs) != R:
+            raise ValueError(f"{len(winds)} winds and {len(rngs)} generators for {R} rows")
+        aero = self.aerodynamics.kernel_args() if self.aerodynamics is not None else None
+        ctx = [pack_context(self.site.params, self.gravity.params, self.atmosphere.params,
+                            self._wind_params(w, g), aero) for w, g in zip(winds, rngs)]
+        width = max(r.size for r in ctx)
+        if width > self.c.shape[1]:
+            self.c = np.hstack([self.c, np.zeros((self.batch, width - self.c.shape[1]))])
+        self.c[rows] = stack_contexts(ctx + [np.zeros(self.c.shape[1])])[:R]
+        n_p = self.layout.n_p
+        self.scale[rows] = 1.0 if param_scale is None else np.broadcast_to(param_scale, (R, n_p))
+        self.offset[rows] = 0.0 if param_offset is None else np.broadcast_to(param_offset, (R, n_p))
+        if misalignment is not None:
+            mis = np.broadcast_to(np.asarray(misalignment, float), (R, 2))
+            self.c[rows, C_MIS_P], self.c[rows, C_MIS_Y] = mis[:, 0], mis[:, 1]
+        self.t[rows] = 0.0
+        self.p[rows] = self._params(self.t[rows], rows)
+        self.x[rows] = self.layout.zeros_state(R)
+        self.rail_s[rows] = 0.0
+        self.on_rail[rows] = True
+        self.lifted[rows] = False
+        self.failed[rows] = False
+        self.gimbal[rows] = 0.0
+        self.x_cg0[rows] = self.p[rows, self._i_cg]
+        self._constrain(rows, from_state=False)
+        q_si = self.layout.view(self.x, "state", "q_si")
+        q_si[rows] = self.x[rows][:, None, self.layout.state["q_bi"]]
         self._update_conditions()
 
     def _params(self, t: np.ndarray, rows: np.ndarray | None = None) -> np.ndarray:
@@ -228,9 +254,10 @@ class Simulator:
         self.rail_s[rows] = s
 
     # ------------------------------------------------------------------------------ stepping
-    def step(self, gimbal: Any, duration: float) -> list[list[tuple[float, str]]]:
+    def step(self, gimbal: Any, duration: float, moment: Any = None) -> list[list[tuple[float, str]]]:
         """Advance every row by ``duration`` [s] with the gimbal angles ``gimbal`` (B, 2) [rad]
-        (pitch, yaw; see :mod:`.flight` for the signs) held; returns each row's events."""
+        (pitch, yaw; see :mod:`.flight` for the signs) and a commanded body moment ``moment`` (B, 3)
+        [N m] (reaction control; default none) held; returns each row's events."""
         if self.batch == 0:
             raise RuntimeError("call reset() before step()")
         if not duration > 0.0:
@@ -238,6 +265,7 @@ class Simulator:
         g = np.broadcast_to(np.asarray(gimbal, dtype=float), (self.batch, 2))
         self.gimbal = np.array(g)
         self.c[:, C_DP], self.c[:, C_DY] = g[:, 0], g[:, 1]
+        self.c[:, C_MOMENT:C_MOMENT + 3] = 0.0 if moment is None else np.broadcast_to(moment, (self.batch, 3))
         events: list[list[tuple[float, str]]] = [[] for _ in range(self.batch)]
         t0, t1 = self.t.copy(), self.t + duration
         ev = self.timeline.event_times

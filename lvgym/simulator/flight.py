@@ -7,7 +7,8 @@ flight conditions (layout ``D_*`` below); :data:`flight_loads` turns that vector
 the core. The same function fills the recorded and observed conditions, so what a policy sees is what
 the vehicle felt.
 
-``c`` is the per-vehicle *context* vector (layout ``C_*``): the commands and thrust held over a step
+``c`` is the per-vehicle *context* vector (layout ``C_*``): the commands (gimbal angles, a body moment
+such as reaction-control thrusters give) and thrust held over a step
 and the row's start time ``c[C_TIME0]`` (the stepper's time is relative to it, so the rows of a batch
 may be at different times), followed by the parameter arrays of the launch site, gravity, atmosphere, wind and aerodynamic models,
 packed end to end with their start offsets in the header (rows of a batch may have different wind
@@ -40,7 +41,8 @@ from lvgym.rotations import quat_to_dcm
 C_T0, C_AE, C_DP, C_DY, C_MIS_P, C_MIS_Y, C_AERO = 0, 1, 2, 3, 4, 5, 6
 C_SITE, C_GRAV, C_ATM, C_WIND, C_AP, C_AG, C_AD, C_AT, C_NCOL, C_END = 7, 8, 9, 10, 11, 12, 13, 14, 15, 16
 C_TIME0 = 17                      # start time of the row's step [s]: the stepper's t is relative to it
-C_HEADER = 18
+C_MOMENT = 18                     # commanded body moment (3) [N m], e.g. reaction-control thrusters
+C_HEADER = 21
 
 # ---------------------------------------------------------------------------- flight conditions layout
 DIAG_FIELDS = (
@@ -132,7 +134,7 @@ def _flight_loads(t, x, p, c, u):
     flight_conditions_k(c[C_TIME0] + t, x, p, c, d)
     for i in range(3):
         u[_U_F + i] = d[D_FAERO_I + i]
-        u[_U_M + i] = d[D_MAERO + i]
+        u[_U_M + i] = d[D_MAERO + i] + c[C_MOMENT + i]
         u[_U_T + i] = d[D_THRUST_E + i]
         u[_U_G + i] = d[D_G + i]
     for i in range(12, u.size):

@@ -1,0 +1,49 @@
+"""Gymnasium environments of lvgym, registered on ``import lvgym``:
+
+- ``lvgym/SmileAscent-v0`` (:class:`~.ascent.SmileAscentEnv`): SMILE's first-stage flight, TVC;
+- ``lvgym/StratosIII-v0`` (:class:`~.ascent.StratosIIIEnv`): Stratos III through its thrust drop, roll RCS;
+- ``lvgym/SlenderAscent-v0`` (:class:`~.ascent.SlenderAscentEnv`): the parametric L/D vehicle.
+
+Each has a native batched ``VectorEnv`` as its ``vector_entry_point``
+(``gymnasium.make_vec(id, num_envs=N, vectorization_mode="vector_entry_point", **options)``) and an SB3
+``VecEnv`` adapter, :func:`make_sb3_vec_env`, over the same batched code.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from .ascent import AscentEnv, SlenderAscentEnv, SmileAscentEnv, StratosIIIEnv
+from .core import OBS_NAMES, REWARD_TERMS, AscentBatch
+from .spec import RANDOMIZE, WIND_TIERS, TaskSpec
+from .vector import AscentSB3VecEnv, AscentVectorEnv
+
+ENVS = {"lvgym/SmileAscent-v0": SmileAscentEnv, "lvgym/StratosIII-v0": StratosIIIEnv,
+        "lvgym/SlenderAscent-v0": SlenderAscentEnv}
+
+
+def smile_ascent_vector(num_envs: int = 1, **options: Any) -> AscentVectorEnv:
+    """``vector_entry_point`` of ``lvgym/SmileAscent-v0``."""
+    return AscentVectorEnv(SmileAscentEnv, num_envs, **options)
+
+
+def stratos3_vector(num_envs: int = 1, **options: Any) -> AscentVectorEnv:
+    """``vector_entry_point`` of ``lvgym/StratosIII-v0``."""
+    return AscentVectorEnv(StratosIIIEnv, num_envs, **options)
+
+
+def slender_ascent_vector(num_envs: int = 1, **options: Any) -> AscentVectorEnv:
+    """``vector_entry_point`` of ``lvgym/SlenderAscent-v0``."""
+    return AscentVectorEnv(SlenderAscentEnv, num_envs, **options)
+
+
+def make_sb3_vec_env(env_id: str, num_envs: int = 1, seed: int | None = None, **options: Any):
+    """A stable-baselines3 ``VecEnv`` of ``num_envs`` rows of ``env_id`` (batched, one simulator)."""
+    if env_id not in ENVS:
+        raise ValueError(f"env_id = {env_id!r}: one of {sorted(ENVS)}")
+    return AscentSB3VecEnv(ENVS[env_id], num_envs, seed, **options)
+
+
+__all__ = ["ENVS", "OBS_NAMES", "RANDOMIZE", "REWARD_TERMS", "WIND_TIERS", "AscentBatch", "AscentEnv",
+           "AscentSB3VecEnv", "AscentVectorEnv", "SlenderAscentEnv", "SmileAscentEnv", "StratosIIIEnv", "TaskSpec",
+           "make_sb3_vec_env", "slender_ascent_vector", "smile_ascent_vector", "stratos3_vector"]

@@ -1,0 +1,65 @@
+"""From an ascent env to a :class:`~.render.RenderFrame`: what the picture shows, read off the simulator."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from .render import HumanViewer, Renderer, RenderFrame
+
+
+def make_frame(env: Any) -> RenderFrame:
+    """A render frame of the single ascent env ``env`` (its row 0)."""
+    core = env.core
+    sim, tl = core.sim, core.timeline
+    t = float(sim.t[0])
+    length = float(core.vehicle.length)
+    stations = np.linspace(0.0, -length, 41)
+    deflection = np.zeros_like(stations)
+    K = sim.dynamics.n_modes
+    if K:
+        eta_z = sim.state("eta")[0, 1]
+        # mode shapes along the stack from the beam of the modes in force (tabulated slopes are at the IMU only):
+        # a quarter-wave sketch scaled by the IMU slope when no shapes are at hand
+        dphi = tl.left("dphi_sensor", sim.t)[0, 0] if tl.sensor_stations.size else np.zeros(K)
+        for k in range(K):
+            shape = np.cos((k + 1) * np.pi * (stations / -length))
+            deflection += shape * dphi[k] * eta_z[k] * length / ((k + 1) * np.pi)
+    C_ib = core._C_ib()[0]
+    axis_ref = core.axis_ref_i[0]
+    up = -sim.conditions("g_i")[0] / np.linalg.norm(sim.conditions("g_i")[0])
+    pitch = np.degrees(np.arccos(np.clip(C_ib[:, 0] @ up, -1.0, 1.0))) * np.sign(C_ib[:, 0] @ (axis_ref - up) + 1e-12)
+    N = sim.dynamics.n_slosh
+    if N:
+        p = sim.p[0]
+        lay = sim.layout
+        hinges = np.array([p[lay.slosh_param(j, "r_hinge")][0] for j in range(N)])
+        lengths = np.array([p[lay.slosh_param(j, "length")][0] for j in range(N)])
+        masses = np.array([p[lay.slosh_param(j, "m")][0] for j in range(N)])
+        angles = np.degrees(sim.slosh_angles()[0, :, 1])
+    else:
+        hinges = lengths = masses = angles = np.zeros(0)
+    rates = np.array(env._rates[-250:]) if env._rates else np.zeros((0, 3))
+    wind = sim.conditions("wind_n")[0]
+    return RenderFrame(t=t, length=length, diameter=float(core.vehicle.stages[0].outer_diameter),
+                       pitch_deg=float(pitch), stations=stations, deflection=deflection, slosh_stations=hinges,
+                       slosh_lengths=lengths, slosh_angles_deg=angles, slosh_masses=masses,
+                       gimbal_station=float(sim.p[0, sim.layout.params["r_gimbal"].start]),
+                       gimbal_deg=float(np.degrees(core.actuator.position[0, 0])),
+                       wind_mps=(float(np.hypot(wind[0], wind[1])), float(-wind[2])),
+                       rates_t=rates[:, 0] if rates.size else np.zeros(0),
+                       rates_degps=np.degrees(rates[:, 1:]) if rates.size else np.zeros((0, 2)),
+                       stage=tl.stage_names[int(tl.left("stage", sim.t)[0])],
+                       info=f"Mach {sim.conditions('mach')[0]:.2f}  q {sim.conditions('qbar')[0] / 1e3:.1f} kPa")
+
+
+def render_frame(env: Any, mode: str) -> np.ndarray | None:
+    """Render ``env`` in ``mode`` (``rgb_array``: an image; ``human``: a window)."""
+    frame = make_frame(env)
+    if env._renderer is None:
+        env._renderer = Renderer() if mode == "rgb_array" else HumanViewer()
+    if mode == "rgb_array":
+        return env._renderer.render_rgb(frame)
+    env._renderer.show(frame)
+    return None

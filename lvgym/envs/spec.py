@@ -1,0 +1,167 @@
+"""Task options of the ascent environments: one frozen, validated dataclass per env instance.
+
+Every keyword an env takes lands here; a bad value raises :class:`~lvgym.errors.ConfigError` naming the
+key, the value and what is allowed. Defaults of each env are set by its class (see ``ascent.py``).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+from lvgym.errors import ConfigError
+from lvgym.simulator import MODELS
+
+WIND_TIERS = ("none", "profile", "gust", "turbulence", "random")
+RANDOMIZE = ("wind", "thrust_misalignment", "mass", "slosh_damping", "bending_frequency", "sensor_noise")
+OBSERVATIONS = ("state", "sensors")
+REFERENCES = ("zero_rate", "gravity_turn")
+CONTROLS = ("tvc", "rcs")
+
+
+def wind_spec(tier: str, mission_time: float) -> Any:
+    """The wind model (a mapping for ``lvgym.environment.make``) of a wind tier.
+
+    ``profile``: a fixed 20 m/s west wind above a power-law boundary layer; ``gust``: a 15 m/s
+    1-cosine gust 200 m long at 3 km; ``turbulence``: moderate Dryden turbulence (MIL-F-8785C) over a
+    10 m/s west wind; ``random``: a random jet-stream profile plus moderate Dryden turbulence."""
+    profile = {"model": "profile", "altitude_m": [0.0, 1000.0, 10000.0, 100000.0],
+               "speed": [5.0, 12.0, 20.0, 20.0], "direction_deg": [270.0, 270.0, 270.0, 270.0]}
+    if tier == "none":
+        return "none"
+    if tier == "profile":
+        return profile
+    if tier == "gust":
+        return {"model": "gust", "amplitude": 15.0, "length": 200.0, "direction_deg": 270.0, "onset": 3000.0}
+    if tier == "turbulence":
+        return {"model": "sum", "models": [{"model": "profile", "altitude_m": [0.0, 100000.0],
+                                            "speed": [10.0, 10.0], "direction_deg": [270.0, 270.0]},
+                                           {"model": "dryden", "intensity": "moderate", "wind_from_deg": 270.0}]}
+    if tier == "random":
+        return {"model": "sum", "models": [{"model": "jet_stream"}, {"model": "dryden", "intensity": "moderate"}]}
+    raise ConfigError("wind", tier, f"one of {WIND_TIERS}")
+
+
+def _number(key: str, value: Any, lo: float, hi: float, lo_open: bool = False) -> float:
+    ok = isinstance(value, (int, float)) and not isinstance(value, bool) and (
+        (value > lo if lo_open else value >= lo) and value <= hi)
+    if not ok:
+        raise ConfigError(key, value, f"a number in {'(' if lo_open else '['}{lo}, {hi}]")
+    return float(value)
+
+
+def _choice(key: str, value: Any, allowed: tuple[str, ...]) -> str:
+    if value not in allowed:
+        raise ConfigError(key, value, f"one of {allowed}")
+    return value
+
+
+@dataclass(frozen=True)
+class TaskSpec:
+    """Options of an ascent task (units in the names; angles in degrees only where the name says so).
+
+    vehicle: shipped name or path; model: ``rigid | slosh | flex | nonrigid``; site: key of
+    ``lvgym.simulator.SITES``; elevation_deg, rail_length_m: the launcher; mission_time_s: episode length
+    (truncation); control_dt_s / physics_dt_s: policy period and largest RK4 step; controller_on_after_s:
+    the controller is off (gimbal held at zero) before this time and while no engine burns (staging coast);
+    wind: a tier of ``WIND_TIERS``; randomize: the set of ``RANDOMIZE`` names drawn from the env's generator
+    at every reset; observation: ``state`` (ideal) or ``sensors`` (IMU at ``imu_station_m``);
+    reference: ``zero_rate`` or ``gravity_turn`` (pitch kick, then the rate that keeps the flight-path
+    angle's turn); control: ``tvc`` (Box(-1, 1) per gimbal axis) or ``rcs`` (Discrete(3) roll pulses);
+    actuator: natural frequency [rad/s], damping, gimbal limit [deg] (None: the engine's), rate limit
+    [deg/s]; rcs_torque_nm: roll torque of a pulse; reward: rate_weights (roll, pitch, yaw) per rad,
+    effort_weight per rad of gimbal per second, effort_rate_weight per rad/s of gimbal rate per second,
+    failure_penalty_rad_per_s times the remaining mission time on termination; qalpha_limit_pa_deg:
+    structural limit of dynamic pressure times total angle of attack; attitude_limit_deg: largest
+    attitude error; n_modes: bending modes per plane (None: the vehicle's).
+    """
+
+    vehicle: Any
+    model: str = "nonrigid"
+    site: str = "andoya"
+    elevation_deg: float = 90.0
+    rail_length_m: float = 0.0
+    mission_time_s: float = 60.0
+    control_dt_s: float = 0.02
+    physics_dt_s: float = 0.01
+    controller_on_after_s: float = 2.0
+    wind: str = "none"
+    randomize: frozenset = field(default_factory=frozenset)
+    observation: str = "state"
+    imu_station_m: float | None = None
+    reference: str = "zero_rate"
+    kick_start_s: float = 5.0
+    kick_end_s: float = 15.0
+    kick_angle_deg: float = 5.0
+    control: str = "tvc"
+    actuator_frequency: float = 15.0
+    actuator_damping: float = 0.7
+    gimbal_limit_deg: float | None = None
+    gimbal_rate_limit_degps: float = 30.0
+    rcs_torque_nm: float = 2.0
+    rate_weights: tuple = (0.0, 1.0, 1.0)
+    effort_weight: float = 1e-3
+    effort_rate_weight: float = 1e-4
+    failure_penalty_rad_per_s: float = 0.1
+    qalpha_limit_pa_deg: float = 250e3
+    attitude_limit_deg: float = 30.0
+    n_modes: int | None = None
+    gyro_noise_radps: float = 2e-4
+    gyro_bias_radps: float = 1e-3
+    accel_noise_mps2: float = 0.05
+    attitude_noise_rad: float = 1e-3
+
+    def __post_init__(self) -> None:
+        _choice("model", self.model, MODELS)
+        _choice("wind", self.wind, WIND_TIERS)
+        _choice("observation", self.observation, OBSERVATIONS)
+        _choice("reference", self.reference, REFERENCES)
+        _choice("control", self.control, CONTROLS)
+        r = self.randomize
+        names = set(RANDOMIZE) if r is True else set() if r in (False, None) else set(r) if not isinstance(r, str) else {r}
+        bad = sorted(names - set(RANDOMIZE))
+        if bad:
+            raise ConfigError("randomize", bad[0], f"True, False or a set of {RANDOMIZE}")
+        object.__setattr__(self, "randomize", frozenset(names))
+        _number("mission_time_s", self.mission_time_s, 0.0, 3600.0, lo_open=True)
+        _number("physics_dt_s", self.physics_dt_s, 0.0, 0.05, lo_open=True)
+        _number("control_dt_s", self.control_dt_s, self.physics_dt_s, 1.0)
+        n = self.control_dt_s / self.physics_dt_s
+        if abs(n - round(n)) > 1e-6:
+            raise ConfigError("control_dt_s", self.control_dt_s,
+                              f"a whole multiple of physics_dt_s = {self.physics_dt_s}")
+        for key, lo, hi in (("elevation_deg", 1.0, 90.0), ("rail_length_m", 0.0, 1000.0),
+                            ("controller_on_after_s", 0.0, 3600.0), ("actuator_frequency", 0.1, 1000.0),
+                            ("actuator_damping", 0.05, 10.0), ("gimbal_rate_limit_degps", 0.1, 1000.0),
+                            ("rcs_torque_nm", 0.0, 1e6), ("effort_weight", 0.0, 1e6),
+                            ("effort_rate_weight", 0.0, 1e6), ("failure_penalty_rad_per_s", 0.0, 1e6),
+                            ("qalpha_limit_pa_deg", 0.0, 1e9), ("attitude_limit_deg", 0.1, 180.0),
+                            ("kick_start_s", 0.0, 3600.0), ("kick_end_s", 0.0, 3600.0),
+                            ("kick_angle_deg", -90.0, 90.0), ("gyro_noise_radps", 0.0, 1.0),
+                            ("gyro_bias_radps", 0.0, 1.0), ("accel_noise_mps2", 0.0, 100.0),
+                            ("attitude_noise_rad", 0.0, 1.0)):
+            _number(key, getattr(self, key), lo, hi)
+        if self.kick_end_s <= self.kick_start_s:
+            raise ConfigError("kick_end_s", self.kick_end_s, f"a time after kick_start_s = {self.kick_start_s}")
+        if self.gimbal_limit_deg is not None:
+            _number("gimbal_limit_deg", self.gimbal_limit_deg, 0.0, 30.0, lo_open=True)
+        w = tuple(self.rate_weights)
+        if len(w) != 3 or any(not isinstance(v, (int, float)) or v < 0 for v in w):
+            raise ConfigError("rate_weights", self.rate_weights, "three numbers >= 0 (roll, pitch, yaw) per rad")
+        object.__setattr__(self, "rate_weights", tuple(float(v) for v in w))
+        if self.n_modes is not None and (not isinstance(self.n_modes, int) or not 0 <= self.n_modes <= 10):
+            raise ConfigError("n_modes", self.n_modes, "None or an integer in [0, 10]")
+
+    @property
+    def substeps(self) -> int:
+        return int(round(self.control_dt_s / self.physics_dt_s))
+
+    @classmethod
+    def build(cls, defaults: Mapping[str, Any], overrides: Mapping[str, Any]) -> TaskSpec:
+        """Defaults of an env updated by the user's keywords (unknown keywords raise)."""
+        known = set(cls.__dataclass_fields__)
+        for key in overrides:
+            if key not in known:
+                raise ConfigError(key, overrides[key], f"unknown option; allowed: {sorted(known)}")
+        return cls(**{**defaults, **overrides})
