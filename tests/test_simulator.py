@@ -1,0 +1,141 @@
+"""The simulator: compiled loads against the environment models, the timeline against the mass model,
+events, the rail, batch against single rows."""
+
+import numpy as np
+import pytest
+
+from lvgym.environment import Environment
+from lvgym.simulator import DIAG, SITES, Simulator
+from lvgym.vehicle import MassModel
+
+
+@pytest.fixture(scope="module")
+def smile():
+    return Simulator("smile", model="nonrigid", t_end=60.0)
+
+
+def test_flight_conditions_equal_the_environment_models(smile):
+    sim = Simulator("stratos3", model="rigid", site="el_arenosillo", wind={"model": "profile",
+                    "altitude_m": [0.0, 10e3], "speed": [5.0, 30.0], "direction_deg": [270.0, 200.0]}, t_end=5.0)
+    sim.reset()
+    rng = np.random.default_rng(3)
+    x = sim.x[0].copy()
+    lay = sim.layout.state
+    x[lay["r_zw_i"]] += sim.C_ib0[:, 0] * 4000.0
+    x[lay["v_zw_i"]] += sim.C_ib0 @ np.array([600.0, 20.0, -35.0])
+    x[lay["omega_bi_b"]] = rng.normal(0.0, 0.1, 3)
+    sim.x[0] = x
+    sim.t[0] = 12.0
+    sim._update_conditions()
+    env = Environment(sim.site, gravity=sim.gravity, atmosphere=sim.atmosphere, wind=sim.wind,
+                      aerodynamics=sim.aerodynamics)
+    env.reset(np.random.default_rng(0))
+    fc = env.conditions(12.0, x[lay["r_zw_i"]], x[lay["v_zw_i"]], x[lay["q_bi"]], x[lay["omega_bi_b"]],
+                        sim.p[0, sim.layout.params["r_cg"].start])
+    for name in ("altitude", "density", "pressure", "mach", "qbar", "alpha", "beta", "alpha_total"):
+        assert sim.conditions(name)[0] == pytest.approx(getattr(fc, name)[0], rel=1e-10, abs=1e-12), name
+    for name in ("wind_n", "v_air_b", "f_aero_b", "m_aero_b", "g_i"):
+        np.testing.assert_allclose(sim.conditions(name)[0], getattr(fc, name)[0], rtol=1e-10, atol=1e-9)
+
+
+def test_thrust_includes_the_ambient_pressure(smile):
+    tl = smile.timeline
+    mm = MassModel(smile.vehicle)
+    state, _ = mm.advance(mm.initial_state(), 10.0)
+    for p_amb in (0.0, 5e4, 101325.0):
+        expected = mm.thrust(state, 1.0, p_amb)
+        got = tl.interp("thrust0", [10.0])[0] - tl.interp("exit_area", [10.0])[0] * p_amb
+        assert got == pytest.approx(expected, rel=1e-12)
+
+
+def test_timeline_matches_the_mass_model_between_rows(smile):
+    mm = MassModel(smile.vehicle)
+    for t in (0.013, 17.31, 42.99, 44.5, 50.27):
+        state, _ = mm.advance(mm.initial_state(), t)
+        props = mm.properties(state)
+        assert smile.timeline.interp("mass", [t])[0] == pytest.approx(props.mass, rel=1e-8)
+        p = smile.timeline.params_at([t])[0]
+        assert p[smile.layout.params["m_b"]][0] == pytest.approx(props.m_b, rel=1e-4)
+
+
+def test_events_are_reported_once_at_their_times(smile):
+    smile.reset()
+    seen = []
+    while smile.t[0] < 46.0:
+        for t, e in smile.step([[0.0, 0.0]], 0.03)[0]:
+            seen.append((round(t, 9), e))
+    names = [e for _, e in seen]
+    assert names[0] == "lift-off"
+    assert (43.0, "stage 'stage1' burnout") in seen
+    assert (44.0, "stage 'stage1' separation") in seen
+    assert (45.0, "stage 'stage2' ignition") in seen
+    assert len(names) == len(set(names))
+
+
+def test_rail_holds_the_attitude_until_exit():
+    sim = Simulator("stratos3", model="nonrigid", site="el_arenosillo", elevation_deg=80.0, rail_length=10.0,
+                    t_end=3.0)
+    sim.reset()
+    q0 = sim.state("q_bi")[0].copy()
+    events = []
+    while sim.on_rail[0]:
+        events += sim.step([[0.02, -0.02]], 0.01)[0]     # gimbal deflected: would turn it off the rail
+        w = sim.state("omega_bi_b")[0]
+        assert np.linalg.norm(w) < 1e-4                     # only the Earth's rate
+    names = [e for _, e in events]
+    assert names == ["lift-off", "rail exit"]
+    assert sim.rail_s[0] >= 10.0
+    assert abs(sim.state("q_bi")[0] @ q0) > 1 - 1e-9        # Earth turned less than 1e-4 rad
+    before = sim.state("omega_bi_b")[0].copy()
+    sim.step([[0.02, -0.02]], 0.2)
+    assert np.linalg.norm(sim.state("omega_bi_b")[0] - before) > 1e-3
+
+
+def test_batch_rows_at_different_times_equal_single_rows():
+    kw = dict(model="nonrigid", t_end=50.0, wind={"model": "gust", "amplitude": 10.0, "length": 100.0,
+                                                  "onset": 500.0})
+    sim = Simulator("smile", **kw)
+    sim.reset(2)
+    single = Simulator("smile", timeline=sim.timeline, **kw)
+    single.reset(1)
+    for _ in range(50):
+        sim.step([[0.01, -0.01], [0.0, 0.0]], 0.02)
+    sim.reset_rows([1])
+    for _ in range(60):
+        sim.step([[0.01, -0.01], [0.01, -0.01]], 0.02)
+        single.step([[0.01, -0.01]], 0.02)
+    assert sim.t[1] == pytest.approx(single.t[0])
+    np.testing.assert_array_equal(sim.x[1], single.x[0])
+
+
+def test_rigid_and_nonrigid_share_the_rigid_equivalent_mass(smile):
+    rigid = Simulator("smile", model="rigid", t_end=60.0)
+    t = np.array([0.0, 20.0, 50.0])
+    np.testing.assert_allclose(rigid.timeline.interp("mass", t), smile.timeline.interp("mass", t))
+    m_nr = smile.timeline.params_at(t)[:, 0] + smile.timeline.interp("slosh_mass", t).sum(axis=1)
+    np.testing.assert_allclose(rigid.timeline.params_at(t)[:, 0], m_nr, rtol=1e-12)
+
+
+def test_modes_above_the_step_nyquist_frequency_are_decoupled(smile):
+    p = smile.timeline.params_at([50.0])[0]
+    lay = smile.layout.params
+    omega, phi = p[lay["omega_modes"]], p[lay["phi_gimbal"]]
+    assert np.all(phi[omega > 2 * np.pi * 0.5 / smile.physics_dt] == 0.0)
+    assert np.all(phi[omega <= 2 * np.pi * 0.5 / smile.physics_dt] != 0.0)
+
+
+def test_bad_options_raise_with_the_key():
+    with pytest.raises(ValueError, match="model"):
+        Simulator("smile", model="elastic")
+    with pytest.raises(ValueError, match="site"):
+        Simulator("smile", site="kourou")
+    with pytest.raises(ValueError, match="elevation_deg"):
+        Simulator("smile", elevation_deg=120.0)
+
+
+def test_conditions_names_are_checked(smile):
+    smile.reset()
+    with pytest.raises(KeyError, match="one of"):
+        smile.conditions("altitud")
+    assert set(DIAG) >= {"altitude", "mach", "qbar", "alpha", "thrust"}
+    assert "flat" in SITES
