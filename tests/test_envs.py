@@ -1,0 +1,148 @@
+"""The Gymnasium envs: checkers, seeding, reward terms, vector env against single envs, robustness."""
+
+import gymnasium as gym
+import numpy as np
+import pytest
+from gymnasium.utils.env_checker import check_env as gym_check_env
+
+import lvgym  # noqa: F401  (registers the envs)
+from lvgym.envs import OBS_NAMES, REWARD_TERMS, TaskSpec
+from lvgym.errors import ConfigError
+
+ENV_IDS = ("lvgym/SmileAscent-v0", "lvgym/StratosIII-v0", "lvgym/SlenderAscent-v0")
+MODELS = ("rigid", "slosh", "flex", "nonrigid")
+
+
+@pytest.mark.parametrize("env_id", ENV_IDS)
+@pytest.mark.parametrize("model", MODELS)
+def test_gymnasium_and_sb3_checkers(env_id, model):
+    from stable_baselines3.common.env_checker import check_env as sb3_check_env
+    env = gym.make(env_id, model=model).unwrapped
+    gym_check_env(env, skip_render_check=True)
+    sb3_check_env(env, warn=False)
+    env.close()
+
+
+def _rollout(env_id, seed, n, **options):
+    env = gym.make(env_id, **options)
+    obs, _ = env.reset(seed=seed)
+    env.action_space.seed(seed)
+    out = [obs]
+    for _ in range(n):
+        obs, reward, term, trunc, info = env.step(env.action_space.sample())
+        out.append(np.append(obs, reward))
+        if term or trunc:
+            break
+    return np.concatenate(out)
+
+
+def test_same_seed_same_rollout_with_every_randomisation():
+    kw = dict(wind="random", randomize=True, observation="sensors")
+    a = _rollout("lvgym/SmileAscent-v0", 7, 100, **kw)
+    b = _rollout("lvgym/SmileAscent-v0", 7, 100, **kw)
+    c = _rollout("lvgym/SmileAscent-v0", 8, 100, **kw)
+    np.testing.assert_array_equal(a, b)
+    assert not np.array_equal(a, c)
+
+
+def test_reward_terms_add_up_and_sum_to_the_cumulative_error():
+    env = gym.make("lvgym/SmileAscent-v0", model="nonrigid", wind="gust", effort_weight=0.0,
+                   effort_rate_weight=0.0)
+    env.reset(seed=0)
+    total = 0.0
+    while True:
+        _, reward, term, trunc, info = env.step(np.array([0.3, -0.2], dtype=np.float32))
+        assert set(info["reward_terms"]) == set(REWARD_TERMS)
+        assert reward == pytest.approx(sum(info["reward_terms"].values()), abs=1e-15)
+        total += reward
+        if term or trunc:
+            break
+    if not term:
+        assert total == pytest.approx(-(info["cumulative_rate_error"][1] + info["cumulative_rate_error"][2]), rel=1e-12)
+
+
+def test_truncation_only_at_the_mission_end():
+    env = gym.make("lvgym/SlenderAscent-v0", model="rigid", mission_time_s=1.0)
+    env.reset(seed=0)
+    steps = 0
+    while True:
+        _, _, term, trunc, info = env.step(np.zeros(2, dtype=np.float32))
+        steps += 1
+        if term or trunc:
+            break
+    assert trunc and not term and steps == 50 and info["time"] == pytest.approx(1.0)
+
+
+def test_controller_is_off_during_the_staging_coast():
+    env = gym.make("lvgym/SmileAscent-v0", model="rigid").unwrapped
+    env.reset(seed=0)
+    ons = {}
+    while env.core.sim.t[0] < 45.5:
+        _, _, term, trunc, info = env.step(np.zeros(2, dtype=np.float32))
+        ons[round(info["time"], 2)] = info["controller_on"]
+        assert not term
+    assert not ons[1.0] and ons[3.0] and not ons[44.0] and ons[45.5]
+
+
+def test_vector_env_matches_single_envs_step_for_step():
+    n, seed = 3, 11
+    options = dict(model="nonrigid", wind="turbulence", randomize=True, observation="sensors")
+    venv = gym.make_vec("lvgym/SmileAscent-v0", num_envs=n, vectorization_mode="vector_entry_point", **options)
+    singles = [gym.make("lvgym/SmileAscent-v0", **options) for _ in range(n)]
+    vobs, _ = venv.reset(seed=seed)
+    sobs = [e.reset(seed=seed + i)[0] for i, e in enumerate(singles)]
+    np.testing.assert_array_equal(vobs, np.stack(sobs))
+    rng = np.random.default_rng(0)
+    for _ in range(40):
+        actions = rng.uniform(-1, 1, (n, 2)).astype(np.float32)
+        vobs, vrew, vterm, vtrunc, _ = venv.step(actions)
+        for i, e in enumerate(singles):
+            o, r, term, trunc, _ = e.step(actions[i])
+            np.testing.assert_array_equal(vobs[i], o)
+            assert vrew[i] == r and vterm[i] == term and vtrunc[i] == trunc
+
+
+def test_sb3_vec_env_runs_the_same_batch():
+    from stable_baselines3.common.vec_env import VecEnv
+    from lvgym.envs import make_sb3_vec_env
+    venv = make_sb3_vec_env("lvgym/SmileAscent-v0", num_envs=2, seed=5, model="rigid", mission_time_s=0.1)
+    assert isinstance(venv, VecEnv)
+    obs = venv.reset()
+    single = gym.make("lvgym/SmileAscent-v0", model="rigid", mission_time_s=0.1)
+    np.testing.assert_array_equal(obs[1], single.reset(seed=6)[0])
+    for k in range(5):
+        obs, reward, done, infos = venv.step(np.zeros((2, 2), dtype=np.float32))
+    assert done.all() and "terminal_observation" in infos[0] and infos[0]["TimeLimit.truncated"]
+
+
+@pytest.mark.parametrize("env_id", ENV_IDS)
+@pytest.mark.parametrize("model", MODELS)
+def test_ten_thousand_random_steps_stay_finite(env_id, model):
+    venv = gym.make_vec(env_id, num_envs=50, vectorization_mode="vector_entry_point", model=model,
+                        wind="random", randomize=True, observation="sensors")
+    venv.reset(seed=0)
+    venv.action_space.seed(0)
+    for _ in range(200):
+        obs, reward, term, trunc, info = venv.step(venv.action_space.sample())
+        assert np.all(np.isfinite(obs)) and np.all(np.isfinite(reward))
+        for reason in info["termination"][term]:
+            assert reason in ("non-finite state", "q-alpha beyond the structural limit",
+                              "attitude error beyond the limit")
+
+
+def test_bad_options_name_the_key():
+    with pytest.raises(ConfigError, match="wind"):
+        gym.make("lvgym/SmileAscent-v0", wind="hurricane")
+    with pytest.raises(ConfigError, match="randomize"):
+        gym.make("lvgym/SmileAscent-v0", randomize=["mass", "gravity"])
+    with pytest.raises(ConfigError, match="control_dt_s"):
+        gym.make("lvgym/SmileAscent-v0", control_dt_s=0.015)
+    with pytest.raises(ConfigError, match="unknown option"):
+        TaskSpec.build({"vehicle": "smile"}, {"modle": "rigid"})
+
+
+def test_observation_names_match_the_space():
+    env = gym.make("lvgym/StratosIII-v0")
+    assert env.observation_space.shape == (len(OBS_NAMES),)
+    assert env.action_space == gym.spaces.MultiDiscrete([3])
+    assert gym.make("lvgym/StratosIII-v0", control="tvc").action_space.shape == (2,)
