@@ -27,6 +27,8 @@ G0 = 9.80665
 OBS_NAMES = ("roll_rate", "pitch_rate_error", "yaw_rate_error", "pitch_attitude_error", "yaw_attitude_error",
              "alpha_or_accel_z", "beta_or_accel_y", "mach_over_10", "qbar_over_1e5", "gimbal_pitch", "gimbal_yaw",
              "time_fraction", "controller_on", "pitch_rate_reference")
+#: stations along the vehicle where the timeline also tabulates the mode shapes, for the rendered view
+RENDER_STATIONS = 21
 REWARD_TERMS = ("rate_roll", "rate_pitch", "rate_yaw", "effort", "effort_rate", "failure")
 
 
@@ -44,7 +46,9 @@ def cached_vehicle(key: Any) -> Vehicle:
 def cached_timeline(key: Any, model: str, t_end: float, physics_dt: float, n_modes: int | None,
                     imu: float) -> Timeline:
     """Timelines are shared between the envs of a process (they are read-only)."""
-    return build_timeline(MassModel(cached_vehicle(key)), model, t_end, 0.05, n_modes, [imu], 0.5 / physics_dt)
+    vehicle = cached_vehicle(key)
+    stations = [imu, *np.linspace(0.0, -vehicle.length, RENDER_STATIONS).tolist()]
+    return build_timeline(MassModel(vehicle), model, t_end, 0.05, n_modes, stations, 0.5 / physics_dt)
 
 
 class AscentBatch:

@@ -15,17 +15,11 @@ def make_frame(env: Any) -> RenderFrame:
     sim, tl = core.sim, core.timeline
     t = float(sim.t[0])
     length = float(core.vehicle.length)
-    stations = np.linspace(0.0, -length, 41)
+    stations = tl.sensor_stations[1:]                       # station 0 is the IMU
     deflection = np.zeros_like(stations)
-    K = sim.dynamics.n_modes
-    if K:
-        eta_z = sim.state("eta")[0, 1]
-        # mode shapes along the stack from the beam of the modes in force (tabulated slopes are at the IMU only):
-        # a quarter-wave sketch scaled by the IMU slope when no shapes are at hand
-        dphi = tl.left("dphi_sensor", sim.t)[0, 0] if tl.sensor_stations.size else np.zeros(K)
-        for k in range(K):
-            shape = np.cos((k + 1) * np.pi * (stations / -length))
-            deflection += shape * dphi[k] * eta_z[k] * length / ((k + 1) * np.pi)
+    if sim.dynamics.n_modes:
+        phi = tl.left("phi_sensor", sim.t)[0, 1:]           # (S, K) shapes of the modes in force
+        deflection = phi @ sim.state("eta")[0, 1]           # pitch-plane (z) deflection [m]
     C_ib = core._C_ib()[0]
     axis_ref = core.axis_ref_i[0]
     up = -sim.conditions("g_i")[0] / np.linalg.norm(sim.conditions("g_i")[0])

@@ -43,7 +43,8 @@ class Timeline:
     and ``exit_area`` (n,) [m^2]: thrust ``max(T_0 - A_e p_amb, 0)``; ``mass`` (n,) [kg], ``cg`` (n, 3)
     [m], ``inertia`` (n, 3, 3) [kg m^2] of the whole stack; ``slosh_mass`` (n, N) [kg];
     ``burning`` (n,) any engine burning; ``stage`` (n,) index of the lowest attached stage;
-    ``dphi_sensor`` (n, S, K) mode slopes at the sensor stations ``sensor_stations`` (S,) [m];
+    ``phi_sensor`` (n, S, K) mode shapes and ``dphi_sensor`` (n, S, K) slopes at the sensor stations
+    ``sensor_stations`` (S,) [m];
     ``events`` ((time, description), ...)."""
 
     model: str
@@ -62,6 +63,7 @@ class Timeline:
     stage_names: tuple[str, ...]
     slosh_names: tuple[str, ...]
     sensor_stations: np.ndarray
+    phi_sensor: np.ndarray
     dphi_sensor: np.ndarray
     events: tuple[tuple[float, str], ...]
 
@@ -155,7 +157,8 @@ def build_timeline(mass_model: MassModel, model: str, t_end: float, dt: float = 
     times, events = _grid(mm, t_end, dt)
     event_times = {t for t, _ in events}
     lay = dyn.layout
-    rows: dict[str, list] = {k: [] for k in ("t", "p", "T0", "Ae", "m", "cg", "J", "ms", "burn", "stage", "dphi")}
+    rows: dict[str, list] = {k: [] for k in ("t", "p", "T0", "Ae", "m", "cg", "J", "ms", "burn", "stage", "phi",
+                                                 "dphi")}
     state = mm.initial_state()
     for t in times:
         samples = []
@@ -200,8 +203,9 @@ def build_timeline(mass_model: MassModel, model: str, t_end: float, dt: float = 
             rows["ms"].append(props.slosh_mass)
             rows["burn"].append(any(ph == BURNING for ph in s.phase) and T0 > 0.0)
             rows["stage"].append(min(attached) if attached else len(s.phase) - 1)
-            rows["dphi"].append(modes.dphi_sensor if modes is not None and sensors.size
-                                else np.zeros((sensors.size, K)))
+            for key, name in (("phi", "phi_sensor"), ("dphi", "dphi_sensor")):
+                rows[key].append(getattr(modes, name) if modes is not None and sensors.size
+                                 else np.zeros((sensors.size, K)))
     hold = np.zeros(lay.n_p, dtype=bool)
     for key in ("omega_modes", "zeta_modes", "phi_gimbal", "dphi_gimbal"):
         hold[lay.params[key]] = True
@@ -212,5 +216,7 @@ def build_timeline(mass_model: MassModel, model: str, t_end: float, dt: float = 
                     cg=np.array(rows["cg"]), inertia=np.array(rows["J"]), slosh_mass=np.array(rows["ms"]),
                     burning=np.array(rows["burn"]), stage=np.array(rows["stage"]),
                     stage_names=tuple(s.name for s in vehicle.stages), slosh_names=mm.slosh_names,
-                    sensor_stations=sensors, dphi_sensor=np.array(rows["dphi"]).reshape(len(rows["t"]), sensors.size, K),
+                    sensor_stations=sensors,
+                    phi_sensor=np.array(rows["phi"]).reshape(len(rows["t"]), sensors.size, K),
+                    dphi_sensor=np.array(rows["dphi"]).reshape(len(rows["t"]), sensors.size, K),
                     events=tuple((float(t), e) for t, e in events))

@@ -152,7 +152,8 @@ def vehicle_modes(vehicle: Vehicle, state: MassState, props: MassProperties, n_m
     sections = _stiffness(vehicle, attached)
     top, bottom = max(s.top for s in sections), min(s.bottom for s in sections)
     hinges = np.clip(props.hinge[:, 0], bottom, top)  # inactive pendulums may sit off the stack
-    query = np.concatenate([[props.gimbal[0]], hinges, sensors])
+    # sensors on a stage that has separated read the shape at the end of the remaining stack
+    query = np.concatenate([[props.gimbal[0]], hinges, np.clip(sensors, bottom, top)])
     points, spread = stack_masses(vehicle, state, props)
     factor = stiffness_factor(vehicle) if ei_factor is None else ei_factor
     if factor != 1.0:
