@@ -146,3 +146,14 @@ def test_observation_names_match_the_space():
     assert env.observation_space.shape == (len(OBS_NAMES),)
     assert env.action_space == gym.spaces.MultiDiscrete([3])
     assert gym.make("lvgym/StratosIII-v0", control="tvc").action_space.shape == (2,)
+
+
+@pytest.mark.parametrize("env_id", ENV_IDS)
+def test_rgb_array_render_through_the_env(env_id):
+    env = gym.make(env_id, render_mode="rgb_array")
+    env.reset(seed=0)
+    for _ in range(120):
+        env.step(env.action_space.sample())
+    img = env.render()
+    assert img.dtype == np.uint8 and img.ndim == 3 and img.shape[2] == 3 and len(np.unique(img)) > 10
+    env.close()
