@@ -4,7 +4,8 @@ spaces). :class:`Simulator` steps a batch; :class:`Timeline` tabulates the mass 
 
 from .core import SITES, Simulator
 from .flight import DIAG, flight_conditions_batch, flight_loads, pack_context
+from .record import Recorder, fly, load
 from .timeline import MODELS, Timeline, build_timeline
 
-__all__ = ["DIAG", "MODELS", "SITES", "Simulator", "Timeline", "build_timeline", "flight_conditions_batch",
+__all__ = ["DIAG", "MODELS", "Recorder", "SITES", "Simulator", "fly", "load", "Timeline", "build_timeline", "flight_conditions_batch",
            "flight_loads", "pack_context"]

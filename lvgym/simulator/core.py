@@ -325,6 +325,9 @@ class Simulator:
         self.t[rows] += span
 
     def _update_conditions(self) -> None:
+        """Flight conditions of every row at its current time (thrust at that time, not mid-step)."""
+        self.c[:, C_T0] = self.timeline.interp("thrust0", self.t)
+        self.c[:, C_AE] = self.timeline.interp("exit_area", self.t)
         flight_conditions_batch(self.t, np.ascontiguousarray(self.x), self.p, self.c, self.diag)
 
     # ------------------------------------------------------------------------------ read-outs
