@@ -21,7 +21,6 @@ from .ascent import SlenderAscentEnv, _row, make_spaces
 from .core import AscentBatch
 from .spec import TaskSpec
 
-ENV_DEFAULTS: dict[str, type] = {}
 
 
 def _task(env_cls: type, options: dict[str, Any]) -> TaskSpec:
