@@ -88,6 +88,7 @@ class AscentSB3VecEnv:
                 self.task = _task(env_cls, options)
                 self.core = AscentBatch(self.task, num_envs)
                 action_space, obs_space = make_spaces(self.task)
+                self.render_mode = None                      # the batched rows do not render
                 super().__init__(num_envs, obs_space, action_space)
                 self._seed = seed
                 self._actions: np.ndarray | None = None
@@ -131,7 +132,11 @@ class AscentSB3VecEnv:
                 setattr(self, attr_name, value)
 
             def env_method(self, method_name, *args, indices=None, **kwargs):
-                raise NotImplementedError("the batched ascent VecEnv has no per-env objects")
+                """The rows share one batch: the adapter's own method, called once per index."""
+                if not callable(getattr(self, method_name, None)):
+                    raise AttributeError(f"the batched ascent VecEnv has no method {method_name!r}: its rows "
+                                         "share one AscentBatch (self.core) and have no per-env objects")
+                return [getattr(self, method_name)(*args, **kwargs) for _ in self._get_indices(indices)]
 
             def env_is_wrapped(self, wrapper_class, indices=None):
                 return [False for _ in self._get_indices(indices)]
