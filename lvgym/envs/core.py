@@ -1,7 +1,7 @@
 """The ascent task over a batch: one code path for the single env, the VectorEnv and the SB3 VecEnv.
 
 :class:`AscentBatch` owns a :class:`~lvgym.simulator.Simulator` of B rows and adds what makes it a
-task: the actuator, the sensors, the reference, the dispersions drawn at reset, the observation,
+task: the gimbal servo settings, the sensors, the reference, the dispersions drawn at reset, the observation,
 the reward terms and the termination. Every random draw of row ``b`` comes from that row's generator
 (the env's ``np_random``), so a VectorEnv of N rows and N single envs seeded alike are identical.
 """
@@ -15,11 +15,11 @@ from typing import Any
 import numpy as np
 
 from lvgym.simulator import Simulator, Timeline, build_timeline
+from lvgym.simulator.servo import Servo
 from lvgym.simulator.core import dcm_batch
 from lvgym.vehicle import MassModel, Vehicle, load_vehicle
 from lvgym.vehicle.slender import slender_vehicle
 
-from .actuator import Actuator
 from .spec import TaskSpec, wind_spec
 
 G0 = 9.80665
@@ -60,16 +60,15 @@ class AscentBatch:
         vehicle = cached_vehicle(key)
         self.imu = s.imu_station_m if s.imu_station_m is not None else -0.25 * vehicle.length
         tl = cached_timeline(key, s.model, s.mission_time_s + 1.0, s.physics_dt_s, s.n_modes, self.imu)
-        self.sim = Simulator(vehicle, s.model, site=s.site, elevation_deg=s.elevation_deg,
-                             rail_length=s.rail_length_m, physics_dt=s.physics_dt_s, timeline=tl)
-        self.vehicle, self.timeline = vehicle, tl
         limits = [math.degrees(e.gimbal_limit) for e in vehicle.stages[0].engines if e.gimbal_limit is not None]
         self.gimbal_limit = math.radians(s.gimbal_limit_deg if s.gimbal_limit_deg is not None
                                          else (min(limits) if limits else 5.0))
+        servo = Servo(s.actuator_frequency, s.actuator_damping, self.gimbal_limit, math.radians(s.gimbal_rate_limit_degps))
+        self.sim = Simulator(vehicle, s.model, site=s.site, elevation_deg=s.elevation_deg,
+                             rail_length=s.rail_length_m, physics_dt=s.physics_dt_s, timeline=tl, servo=servo)
+        self.vehicle, self.timeline = vehicle, tl
         self.B = int(batch)
         self.sim.reset(self.B)
-        self.actuator = Actuator(self.B, s.actuator_frequency, s.actuator_damping, self.gimbal_limit,
-                                 math.radians(s.gimbal_rate_limit_degps))
         self.rngs: list[np.random.Generator] = [np.random.default_rng(0) for _ in range(self.B)]
         self.gyro_bias = np.zeros((self.B, 3))
         self.axis_ref_i = np.zeros((self.B, 3))
@@ -123,7 +122,6 @@ class AscentBatch:
             self.gyro_bias[b] = bias
         self.sim.reset_rows(rows, [w[1] for w in winds], [w[0] for w in winds], np.array(mis), np.array(scales),
                             np.array(offsets))
-        self.actuator.reset(rows)
         self.axis_ref_i[rows] = self._C_ib(rows)[:, :, 0]          # the launch axis
         self.cum_error[rows] = 0.0
         self.steps[rows] = 0
@@ -196,7 +194,7 @@ class AscentBatch:
         obs[:, 5:7] = flow
         obs[:, 7] = sim.conditions("mach") / 10.0
         obs[:, 8] = sim.conditions("qbar") / 1e5
-        obs[:, 9:11] = self.actuator.position / self.gimbal_limit
+        obs[:, 9:11] = self.sim.gimbal / self.gimbal_limit
         obs[:, 11] = sim.t / s.mission_time_s
         obs[:, 12] = on
         obs[:, 13] = ref[:, 1]
@@ -217,16 +215,8 @@ class AscentBatch:
             a = np.asarray(action).reshape(self.B, -1)[:, 0]
             cmd = np.zeros((self.B, 2))
             moment[:, 0] = np.where(on, (a.astype(float) - 1.0) * s.rcs_torque_nm, 0.0)
-        h = s.physics_dt_s
-        events: list[list] = [[] for _ in range(self.B)]
-        effort = np.zeros(self.B)
-        effort_rate = np.zeros(self.B)
-        for _ in range(s.substeps):
-            gim = self.actuator.step(cmd, h)
-            for b, ev in enumerate(sim.step(gim, h, moment)):
-                events[b] += ev
-            effort += np.abs(gim).sum(axis=1) * h
-            effort_rate += np.abs(self.actuator.rate).sum(axis=1) * h
+        events = sim.step(cmd, s.control_dt_s, moment)
+        effort, effort_rate = sim.effort[:, 0], sim.effort[:, 1]
         self.steps += 1
         ref = self.reference_rates()
         if s.reference == "gravity_turn":
@@ -267,6 +257,6 @@ class AscentBatch:
                 "qbar": sim.conditions("qbar"), "mach": sim.conditions("mach"),
                 "alpha_total": sim.conditions("alpha_total"), "qalpha_pa_deg": qa, "time": sim.t.copy(),
                 "stage": self.timeline.left("stage", sim.t), "controller_on": on,
-                "slosh_angles": sim.slosh_angles(), "eta": sim.state("eta").copy(), "gimbal": self.actuator.position.copy(),
+                "slosh_angles": sim.slosh_angles(), "eta": sim.state("eta").copy(), "gimbal": self.sim.gimbal.copy(),
                 "attitude_error": att, "termination": reason, "events": events}
         return obs, reward, terminated, truncated, info

@@ -40,7 +40,7 @@ def make_frame(env: Any) -> RenderFrame:
                        pitch_deg=float(pitch), stations=stations, deflection=deflection, slosh_stations=hinges,
                        slosh_lengths=lengths, slosh_angles_deg=angles, slosh_masses=masses,
                        gimbal_station=float(sim.p[0, sim.layout.params["r_gimbal"].start]),
-                       gimbal_deg=float(np.degrees(core.actuator.position[0, 0])),
+                       gimbal_deg=float(np.degrees(core.sim.gimbal[0, 0])),
                        wind_mps=(float(np.hypot(wind[0], wind[1])), float(-wind[2])),
                        rates_t=rates[:, 0] if rates.size else np.zeros(0),
                        rates_degps=np.degrees(rates[:, 1:]) if rates.size else np.zeros((0, 2)),

@@ -12,12 +12,13 @@ batch of them that may be at different times. It knows nothing of rewards or obs
 >>> bool(sim.conditions("altitude")[0] > 10.0)
 True
 
-Stepping. :meth:`Simulator.step` advances every row by ``duration`` seconds with RK4 steps of at most
-``physics_dt`` that land on every event time (burnout, separation, ignition, tank empty) of that row.
-The mass properties, slosh and mode parameters and the thrust ``T_0`` are evaluated at the middle of
-each piece between events and held over it (second order in their slow variation; keep ``duration``
-at or below about 0.05 s). When the CG of the rigid body moves within the structure between pieces, the
-state is shifted so that the structure stays where it was (:meth:`NonRigidModel.shift_cg`).
+Stepping. :meth:`Simulator.step` advances every row by ``duration`` seconds in one compiled call
+(:mod:`.advance`): physics steps of at most ``physics_dt``, cut at every event time (burnout,
+separation, ignition, tank empty) of that row. The mass properties, slosh and mode parameters and the
+thrust ``T_0`` are evaluated at the middle of each piece and held over it. When the CG of the rigid
+body moves within the structure between pieces, the state is shifted so that the structure stays where
+it was (:meth:`NonRigidModel.shift_cg`). An optional gimbal :class:`~.servo.Servo` moves at every
+physics step. Large batches are split over threads.
 
 Lift-off. The vehicle starts on the pad, axis along the launch rail (``elevation_deg`` above the
 horizon towards ``site.azimuth_deg``), and is held there while the thrust cannot lift it. It then slides
@@ -27,21 +28,43 @@ along the rail without rotating with respect to the Earth until the structure ha
 
 from __future__ import annotations
 
+import functools
 import math
+import os
 from collections.abc import Sequence
+from concurrent.futures import ThreadPoolExecutor
 from typing import Any
 
 import numpy as np
 
-from lvgym.dynamics.stepper import step_batch
 from lvgym.environment import LaunchSite, make
 from lvgym.environment.earth import WGS84_OMEGA, dcm_to_quat
 from lvgym.rotations import quat_to_dcm_batch
 from lvgym.vehicle import MassModel, Vehicle, load_vehicle
 
-from .flight import (C_AE, C_DP, C_DY, C_MIS_P, C_MOMENT, C_MIS_Y, C_T0, C_TIME0, DIAG, N_DIAG, flight_conditions_batch,
-                     flight_loads, pack_context, stack_contexts)
+from .advance import (N_RAIL_STATE, R_AXIS, R_LENGTH, R_OMEGA, R_PAD, R_Q0, R_SIZE, R_XBASE, RS_LIFTED, RS_ON, RS_S,
+                      RS_T_EXIT, RS_T_LIFT, advance_range, conditions_range, constrain_k)
+from .flight import C_MIS_P, C_MIS_Y, C_MOMENT, DIAG, N_DIAG, flight_loads, pack_context, stack_contexts
+from .servo import DIRECT, Servo
 from .timeline import MODELS, Timeline, build_timeline
+
+_ROWS_PER_THREAD = 8          # smaller batches run on the calling thread
+
+
+def _default_threads() -> int:
+    env = os.environ.get("LVGYM_THREADS")
+    if env:
+        return max(1, int(env))
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except AttributeError:                      # not on Linux
+        return max(1, os.cpu_count() or 1)
+
+
+@functools.lru_cache(maxsize=4)
+def _pool(threads: int) -> ThreadPoolExecutor:
+    """A process-wide thread pool (the compiled step releases the GIL)."""
+    return ThreadPoolExecutor(max_workers=threads, thread_name_prefix="lvgym")
 
 #: launch sites of the shipped vehicles (public-data.md); azimuth clockwise from north
 SITES = {
@@ -90,7 +113,8 @@ class Simulator:
                  gravity: Any = "egm2008", atmosphere: Any = "us76", wind: Any = "none", aerodynamics: Any = "vehicle",
                  t_end: float = 60.0, physics_dt: float = 0.01, elevation_deg: float = 90.0, rail_length: float = 0.0,
                  n_modes: int | None = None, sensor_stations: Sequence[float] = (), cg_convention: str = "static",
-                 timeline_dt: float = 0.05, timeline: Timeline | None = None) -> None:
+                 timeline_dt: float = 0.05, timeline: Timeline | None = None, servo: Servo | None = None,
+                 threads: int | None = None) -> None:
         if model not in MODELS:
             raise ValueError(f"model = {model!r}: one of {MODELS}")
         if not 0.0 < physics_dt <= 0.1:
@@ -130,6 +154,14 @@ class Simulator:
         self.C_ib0 = self.site.C_ib0 @ R
         self.q_bi0 = dcm_to_quat(self.C_ib0)
         self.omega_e = 0.0 if self.site.flat_earth else WGS84_OMEGA
+        self.rail = self._rail_vector()
+        self.servo = servo
+        self._servo = DIRECT if servo is None else servo.params()
+        self.threads = int(threads) if threads is not None else _default_threads()
+        if self.threads < 1:
+            raise ValueError(f"threads = {threads!r}: at least 1")
+        self._event_times = np.ascontiguousarray(self.timeline.event_times, dtype=float)
+        self._event_times_all = np.array([t for t, _ in self.timeline.events], dtype=float)
         self.batch = 0
 
     # ------------------------------------------------------------------------------ set-up
@@ -152,11 +184,12 @@ class Simulator:
         self.t = np.zeros(B)
         self.p = self._params(self.t)
         self.x = self.layout.zeros_state(B)
-        self.rail_s = np.zeros(B)                 # travel of the structure along the rail [m]
-        self.on_rail = np.ones(B, dtype=bool)
-        self.lifted = np.zeros(B, dtype=bool)
+        self.rail_state = np.zeros((B, N_RAIL_STATE))
         self.failed = np.zeros(B, dtype=bool)
+        self.cmd = np.zeros((B, 2))
         self.gimbal = np.zeros((B, 2))
+        self.gimbal_rate = np.zeros((B, 2))
+        self.effort = np.zeros((B, 2))
         self.x_cg0 = self.p[:, self._i_cg].copy()
         self.diag = np.zeros((B, N_DIAG))
         self.reset_rows(np.arange(B), rng, winds, misalignment, param_scale, param_offset)
@@ -196,13 +229,13 @@ class Simulator:
         self.t[rows] = 0.0
         self.p[rows] = self._params(self.t[rows], rows)
         self.x[rows] = self.layout.zeros_state(R)
-        self.rail_s[rows] = 0.0
-        self.on_rail[rows] = True
-        self.lifted[rows] = False
+        self.rail_state[rows] = 0.0
+        self.rail_state[rows, RS_ON] = 1.0
+        self.rail_state[rows, RS_T_LIFT] = self.rail_state[rows, RS_T_EXIT] = np.nan
         self.failed[rows] = False
-        self.gimbal[rows] = 0.0
+        self.cmd[rows] = self.gimbal[rows] = self.gimbal_rate[rows] = self.effort[rows] = 0.0
         self.x_cg0[rows] = self.p[rows, self._i_cg]
-        self._constrain(rows, from_state=False)
+        self._place_on_pad(rows)
         q_si = self.layout.view(self.x, "state", "q_si")
         q_si[rows] = self.x[rows][:, None, self.layout.state["q_bi"]]
         self._update_conditions()
@@ -211,124 +244,96 @@ class Simulator:
         rows = slice(None) if rows is None else rows
         return self.timeline.params_at(t) * self.scale[rows] + self.offset[rows]
 
-    # ------------------------------------------------------------------------------ the rail
-    def _constrain(self, rows: np.ndarray, from_state: bool = True) -> None:
-        """Hold the rows on the rail (or the pad): position on the rail line, no motion relative to the
-        Earth across it, attitude fixed in the Earth frame. ``from_state=False``: put them at the rail's
-        start, at rest relative to the Earth."""
-        if rows.size == 0:
-            return
-        lay = self.layout.state
-        t = self.t[rows]
-        w = self.omega_e
-        ang = w * t
-        ca, sa = np.cos(ang), np.sin(ang)
-        C_ie = np.zeros((rows.size, 3, 3))
-        C_ie[:, 0, 0], C_ie[:, 0, 1], C_ie[:, 1, 0], C_ie[:, 1, 1], C_ie[:, 2, 2] = ca, -sa, sa, ca, 1.0
-        axis_e = self.C_ib0[:, 0]
-        r_pad, _, _ = self.site.initial_state(0.0)
-        x_base = -self.vehicle.length
-        # structure point at the initial CG station, at rail travel s
-        h0 = self.x_cg0[rows] - x_base
-        base_e = r_pad[None, :] + h0[:, None] * axis_e[None, :]
-        axis_i = C_ie @ axis_e
-        origin_i = np.einsum("bij,bj->bi", C_ie, base_e)
-        x = self.x[rows]
-        r, v = x[:, lay["r_zw_i"]], x[:, lay["v_zw_i"]]
-        shift = self.p[rows, self._i_cg] - self.x_cg0[rows]          # CG travel within the structure
-        if from_state:
-            s = np.maximum(np.einsum("bi,bi->b", r - origin_i, axis_i) - shift, 0.0)
-        else:
-            s, v = np.zeros(rows.size), np.cross([0.0, 0.0, w], r)
-        omega_i = np.array([0.0, 0.0, w])
-        r_new = origin_i + (s + shift)[:, None] * axis_i
-        v_earth = np.cross(omega_i[None, :], r_new)
-        v_along = np.einsum("bi,bi->b", v - np.cross(omega_i[None, :], r), axis_i)
-        v_along = np.where((s <= 0.0) & (v_along < 0.0), 0.0, v_along)
-        x[:, lay["r_zw_i"]] = r_new
-        x[:, lay["v_zw_i"]] = v_earth + v_along[:, None] * axis_i
-        q_ie = np.stack([np.cos(ang / 2), np.zeros_like(ang), np.zeros_like(ang), np.sin(ang / 2)], axis=1)
-        x[:, lay["q_bi"]] = quat_mul(q_ie, np.broadcast_to(self.q_bi0, (rows.size, 4)))
-        x[:, lay["omega_bi_b"]] = self.C_ib0.T @ omega_i
-        self.x[rows] = x
-        self.rail_s[rows] = s
-
     # ------------------------------------------------------------------------------ stepping
+    def _rail_vector(self) -> np.ndarray:
+        rail = np.zeros(R_SIZE)
+        rail[R_OMEGA], rail[R_XBASE], rail[R_LENGTH] = self.omega_e, -self.vehicle.length, self.rail_length
+        rail[R_PAD:R_PAD + 3] = self.site.initial_state(0.0)[0]
+        rail[R_AXIS:R_AXIS + 3] = self.C_ib0[:, 0]
+        rail[R_Q0:R_Q0 + 4] = self.q_bi0
+        return rail
+
+    def _place_on_pad(self, rows: np.ndarray) -> None:
+        """Put ``rows`` at the rail's start at t = 0, at rest relative to the Earth."""
+        lay = self.layout.state
+        rail = self.rail
+        h0 = self.x_cg0[rows] - rail[R_XBASE]
+        r = rail[R_PAD:R_PAD + 3][None, :] + h0[:, None] * rail[R_AXIS:R_AXIS + 3][None, :]
+        self.x[rows, lay["r_zw_i"]] = r
+        self.x[rows, lay["v_zw_i"]] = np.cross([0.0, 0.0, self.omega_e], r)
+        for b in rows:
+            constrain_k(self.x[b], 0.0, rail, self.x_cg0[b], self.p[b, self._i_cg], self.rail_state[b])
+
+    def _chunks(self) -> list[tuple[int, int]]:
+        """Row ranges run on separate threads (one range for small batches)."""
+        k = max(1, min(self.threads, self.batch // _ROWS_PER_THREAD))
+        edges = np.linspace(0, self.batch, k + 1).astype(int)
+        return [(int(a), int(z)) for a, z in zip(edges[:-1], edges[1:]) if z > a]
+
+    def _run(self, fn, *args) -> None:
+        chunks = self._chunks()
+        if len(chunks) == 1:
+            fn(0, self.batch, *args)
+            return
+        list(_pool(self.threads).map(lambda ch: fn(ch[0], ch[1], *args), chunks))
+
     def step(self, gimbal: Any, duration: float, moment: Any = None) -> list[list[tuple[float, str]]]:
-        """Advance every row by ``duration`` [s] with the gimbal angles ``gimbal`` (B, 2) [rad]
+        """Advance every row by ``duration`` [s] with the gimbal command ``gimbal`` (B, 2) [rad]
         (pitch, yaw; see :mod:`.flight` for the signs) and a commanded body moment ``moment`` (B, 3)
-        [N m] (reaction control; default none) held; returns each row's events."""
+        [N m] (reaction control; default none) held; returns each row's events.
+
+        Without a servo the gimbal takes the command at once; with one (``servo=``) it moves towards
+        it at every physics step. ``self.effort`` (B, 2) then holds the integrals of |gimbal| [rad s]
+        and |gimbal rate| [rad] (both axes summed) over the period."""
         if self.batch == 0:
             raise RuntimeError("call reset() before step()")
         if not duration > 0.0:
             raise ValueError(f"duration = {duration!r}: must be > 0 s")
-        g = np.broadcast_to(np.asarray(gimbal, dtype=float), (self.batch, 2))
-        self.gimbal = np.array(g)
-        self.c[:, C_DP], self.c[:, C_DY] = g[:, 0], g[:, 1]
-        self.c[:, C_MOMENT:C_MOMENT + 3] = 0.0 if moment is None else np.broadcast_to(moment, (self.batch, 3))
-        events: list[list[tuple[float, str]]] = [[] for _ in range(self.batch)]
-        t0, t1 = self.t.copy(), self.t + duration
-        ev = self.timeline.event_times
-        inside = (ev[None, :] > t0[:, None] + 1e-12) & (ev[None, :] < t1[:, None] - 1e-12)
-        plain = np.flatnonzero(~inside.any(axis=1) & ~self.failed)
-        if plain.size:
-            self._advance(plain, duration)
-        for b in np.flatnonzero(inside.any(axis=1) & ~self.failed):
-            cuts = [t0[b], *ev[inside[b]].tolist(), t1[b]]
-            for a, z in zip(cuts[:-1], cuts[1:]):
-                self._advance(np.array([b]), z - a)
-        for b in range(self.batch):
-            events[b] += [(t, e) for t, e in self.timeline.events if t0[b] < t <= t1[b] + 1e-12]
-        self.t[self.failed] = t1[self.failed]
-        for b in np.flatnonzero(self.on_rail):
-            if self.rail_s[b] > 0.0 and not self.lifted[b]:
-                self.lifted[b] = True
-                events[b].append((float(self.t[b]), "lift-off"))
-            if self.rail_s[b] >= self.rail_length and self.lifted[b]:
-                self.on_rail[b] = False
-                if self.rail_length > 0.0:
-                    events[b].append((float(self.t[b]), "rail exit"))
-        bad = ~np.all(np.isfinite(self.x), axis=1) & ~self.failed
-        self.failed |= bad
-        self._update_conditions()
+        B = self.batch
+        self.cmd[:] = np.broadcast_to(np.asarray(gimbal, dtype=float), (B, 2))
+        self.c[:, C_MOMENT:C_MOMENT + 3] = 0.0 if moment is None else np.broadcast_to(moment, (B, 3))
+        t0 = self.t.copy()
+        rs = self.rail_state
+        lifted0, on0 = rs[:, RS_LIFTED].copy(), rs[:, RS_ON].copy()
+        tl = self.timeline
+        self._run(advance_range, flight_loads, self.x, self.p, self.c, self.t, self.scale, self.offset,
+                  self.x_cg0, self.failed, self.rail, rs, self._servo, self.cmd, self.gimbal, self.gimbal_rate,
+                  self.effort, tl.t, tl.params, tl.hold, tl.thrust0, tl.exit_area, self._event_times,
+                  float(duration), self.physics_dt, self.dynamics.n_slosh, self.dynamics.n_modes,
+                  self.layout.n_u, self._i_cg, self.diag)
+        events: list[list[tuple[float, str]]] = [[] for _ in range(B)]
+        ev_t = self._event_times_all
+        hit = (ev_t[None, :] > t0[:, None]) & (ev_t[None, :] <= self.t[:, None] + 1e-12)
+        new_lift = rs[:, RS_LIFTED] > lifted0
+        new_exit = (rs[:, RS_ON] < on0) & (self.rail_length > 0.0)
+        for b in np.flatnonzero(hit.any(axis=1) | new_lift | new_exit):
+            evs = [self.timeline.events[i] for i in np.flatnonzero(hit[b])]
+            if new_lift[b]:
+                evs.append((float(rs[b, RS_T_LIFT]), "lift-off"))
+            if new_exit[b]:
+                evs.append((float(rs[b, RS_T_EXIT]), "rail exit"))
+            events[b] = sorted(evs, key=lambda e: e[0])
         return events
 
-    def _advance(self, rows: np.ndarray, span: float) -> None:
-        """Integrate ``rows`` by ``span`` seconds, parameters at the middle of the span."""
-        t_mid = self.t[rows] + 0.5 * span
-        p = self._params(t_mid, rows)
-        delta = np.zeros((rows.size, 3))
-        delta[:, 0] = p[:, self._i_cg] - self.p[rows, self._i_cg]
-        x = self.dynamics.shift_cg(self.x[rows], delta) if np.any(delta) else self.x[rows]
-        x = np.ascontiguousarray(x)
-        c = self.c[rows]
-        c[:, C_T0] = self.timeline.interp("thrust0", t_mid)
-        c[:, C_AE] = self.timeline.interp("exit_area", t_mid)
-        c[:, C_TIME0] = self.t[rows]
-        n = max(1, int(math.ceil(span / self.physics_dt - 1e-9)))
-        h = span / n
-        N, K, n_u = self.dynamics.n_slosh, self.dynamics.n_modes, self.layout.n_u
-        self.p[rows] = p
-        railed = self.on_rail[rows]
-        if not railed.any():
-            step_batch(flight_loads, x, p, c, 0.0, h, n, N, K, True, n_u)
-            self.x[rows] = x
-        else:
-            for k in range(n):
-                step_batch(flight_loads, x, p, c, k * h, h, 1, N, K, True, n_u)
-                self.x[rows] = x
-                self.t[rows] += h
-                self._constrain(rows[railed])
-                x = np.ascontiguousarray(self.x[rows])
-            self.t[rows] -= n * h
-        self.c[rows] = c
-        self.t[rows] += span
-
     def _update_conditions(self) -> None:
-        """Flight conditions of every row at its current time (thrust at that time, not mid-step)."""
-        self.c[:, C_T0] = self.timeline.interp("thrust0", self.t)
-        self.c[:, C_AE] = self.timeline.interp("exit_area", self.t)
-        flight_conditions_batch(self.t, np.ascontiguousarray(self.x), self.p, self.c, self.diag)
+        """Flight conditions of every row at its current time (thrust at that time)."""
+        tl = self.timeline
+        self._run(conditions_range, self.t, self.x, self.p, self.c, tl.t, tl.thrust0, tl.exit_area, self.diag)
+
+    @property
+    def on_rail(self) -> np.ndarray:
+        """Whether each row is still held on the pad or rail."""
+        return self.rail_state[:, RS_ON] != 0.0
+
+    @property
+    def lifted(self) -> np.ndarray:
+        """Whether each row has lifted off."""
+        return self.rail_state[:, RS_LIFTED] != 0.0
+
+    @property
+    def rail_s(self) -> np.ndarray:
+        """Travel of the structure along the rail [m] (frozen at rail exit)."""
+        return self.rail_state[:, RS_S]
 
     # ------------------------------------------------------------------------------ read-outs
     def conditions(self, name: str) -> np.ndarray:
