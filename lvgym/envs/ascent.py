@@ -87,8 +87,7 @@ class AscentEnv(gym.Env):
 
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
         super().reset(seed=seed)
-        self.core.reset_rows(np.array([0]), [self.np_random])
-        obs = self.core.observe(self.core.controller_on(), self.core.reference_rates())[0]
+        obs = self.core.reset_rows(np.array([0]), [self.np_random])[0]
         self._rates = []
         return obs, {"time": 0.0, "cumulative_rate_error": np.zeros(3)}
 

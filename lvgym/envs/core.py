@@ -16,13 +16,14 @@ import numpy as np
 
 from lvgym.simulator import Simulator, Timeline, build_timeline
 from lvgym.simulator.servo import Servo
-from lvgym.simulator.core import dcm_batch
 from lvgym.vehicle import MassModel, Vehicle, load_vehicle
 from lvgym.vehicle.slender import slender_vehicle
 
+from .signals import (G0, N_TASK, REASONS, T_ATT, T_DT, T_EFFORT, T_EFFORT_RATE, T_GIMBAL, T_GTURN, T_KICK0, T_KICK1,
+                      T_KICK_ANGLE, T_MISSION, T_N_STEPS, T_ON_AFTER, T_PENALTY, T_QALPHA, T_SENSORS, T_W_ROLL, T_W_YAW,
+                      reset_signals, step_signals)
 from .spec import TaskSpec, wind_spec
 
-G0 = 9.80665
 #: observation entries (same for ``state`` and ``sensors``; see the env docstrings)
 OBS_NAMES = ("roll_rate", "pitch_rate_error", "yaw_rate_error", "pitch_attitude_error", "yaw_attitude_error",
              "alpha_or_accel_z", "beta_or_accel_y", "mach_over_10", "qbar_over_1e5", "gimbal_pitch", "gimbal_yaw",
@@ -30,6 +31,7 @@ OBS_NAMES = ("roll_rate", "pitch_rate_error", "yaw_rate_error", "pitch_attitude_
 #: stations along the vehicle where the timeline also tabulates the mode shapes, for the rendered view
 RENDER_STATIONS = 21
 REWARD_TERMS = ("rate_roll", "rate_pitch", "rate_yaw", "effort", "effort_rate", "failure")
+_REASONS = np.array(REASONS, dtype=object)
 
 
 @functools.lru_cache(maxsize=32)
@@ -73,13 +75,17 @@ class AscentBatch:
         self.gyro_bias = np.zeros((self.B, 3))
         self.axis_ref_i = np.zeros((self.B, 3))
         self.cum_error = np.zeros((self.B, 3))
-        self.steps = np.zeros(self.B, dtype=int)
-        self.last_cmd = np.zeros((self.B, 2))
+        self.steps = np.zeros(self.B, dtype=np.int64)
+        self.on = np.zeros(self.B, dtype=bool)
+        self.obs = np.zeros((self.B, len(OBS_NAMES)), dtype=np.float32)
+        self.att = np.zeros((self.B, 2))
         lay = self.sim.layout
         self._i_mb, self._i_J = lay.params["m_b"], lay.params["J_b"]
         self._i_cg, self._i_om = lay.params["r_cg"], lay.params["omega_modes"]
         self._i_zeta = [lay.slosh_param(j, "zeta") for j in range(self.sim.dynamics.n_slosh)]
         self.n_steps = int(round(s.mission_time_s / s.control_dt_s))
+        self._tp = self._task_vector()
+        self._burning = tl.burning.astype(float)
 
     # ------------------------------------------------------------------------------ reset
     def _dispersions(self, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -105,9 +111,10 @@ class AscentBatch:
             mis = np.radians(np.clip(rng.normal(0.0, 0.05, 2), -0.15, 0.15))
         return scale, offset, mis
 
-    def reset_rows(self, rows: np.ndarray, rngs: list[np.random.Generator]) -> None:
-        """New episodes for ``rows``, drawing from ``rngs`` (one generator per row, kept for the episode)."""
-        rows = np.atleast_1d(rows)
+    def reset_rows(self, rows: np.ndarray, rngs: list[np.random.Generator]) -> np.ndarray:
+        """New episodes for ``rows``, drawing from ``rngs`` (one generator per row, kept for the episode);
+        returns their first observations."""
+        rows = np.atleast_1d(np.asarray(rows, dtype=np.int64))
         s = self.spec
         winds, scales, offsets, mis = [], [], [], []
         for b, g in zip(rows, rngs):
@@ -120,143 +127,98 @@ class AscentBatch:
             mis.append(m)
             bias = g.normal(0.0, s.gyro_bias_radps, 3) if "sensor_noise" in s.randomize else np.zeros(3)
             self.gyro_bias[b] = bias
-        self.sim.reset_rows(rows, [w[1] for w in winds], [w[0] for w in winds], np.array(mis), np.array(scales),
-                            np.array(offsets))
-        self.axis_ref_i[rows] = self._C_ib(rows)[:, :, 0]          # the launch axis
+        sim = self.sim
+        sim.reset_rows(rows, [w[1] for w in winds], [w[0] for w in winds], np.array(mis), np.array(scales),
+                       np.array(offsets))
         self.cum_error[rows] = 0.0
         self.steps[rows] = 0
-        self.last_cmd[rows] = 0.0
+        tl = self.timeline
+        reset_signals(rows, self._tp, sim.t, sim.x, sim.diag, sim.gimbal, self.axis_ref_i, self.gyro_bias, tl.t,
+                      self._burning, tl.mass, tl.dphi_sensor, sim.dynamics.n_modes, self.on, self.obs, self.att)
+        self._add_noise(rows)
+        return self.obs[rows].copy()
 
-    def _C_ib(self, rows: Any = slice(None)) -> np.ndarray:
-        return dcm_batch(self.sim.state("q_bi")[rows])
+    def _task_vector(self) -> np.ndarray:
+        s = self.spec
+        tp = np.zeros(N_TASK)
+        tp[T_ON_AFTER], tp[T_DT], tp[T_MISSION] = s.controller_on_after_s, s.control_dt_s, s.mission_time_s
+        tp[T_W_ROLL:T_W_YAW + 1] = s.rate_weights
+        tp[T_EFFORT], tp[T_EFFORT_RATE] = s.effort_weight, s.effort_rate_weight
+        tp[T_PENALTY], tp[T_QALPHA], tp[T_ATT] = s.failure_penalty_rad_per_s, s.qalpha_limit_pa_deg, s.attitude_limit_deg
+        tp[T_GIMBAL] = self.gimbal_limit
+        tp[T_GTURN] = 1.0 if s.reference == "gravity_turn" else 0.0
+        tp[T_KICK0], tp[T_KICK1], tp[T_KICK_ANGLE] = s.kick_start_s, s.kick_end_s, math.radians(s.kick_angle_deg)
+        tp[T_SENSORS] = 1.0 if s.observation == "sensors" else 0.0
+        tp[T_N_STEPS] = self.n_steps
+        return tp
+
+    def _add_noise(self, rows: np.ndarray) -> None:
+        """Sensor noise on the observation of ``rows`` (gyro, attitude, accelerometers), each row from its
+        own generator, when ``sensor_noise`` is randomised with the ``sensors`` observation."""
+        s = self.spec
+        if s.observation != "sensors" or "sensor_noise" not in s.randomize:
+            return
+        for b in rows:
+            if self.sim.failed[b]:
+                continue
+            g = self.rngs[b]
+            self.obs[b, 0:3] += g.normal(0.0, s.gyro_noise_radps, 3)
+            self.obs[b, 3:5] += g.normal(0.0, s.attitude_noise_rad, 2)
+            self.obs[b, 5:7] += g.normal(0.0, s.accel_noise_mps2, 2) / G0
 
     # ------------------------------------------------------------------------------ task signals
     def controller_on(self) -> np.ndarray:
-        """Whether the controller acts: after ``controller_on_after_s`` and while an engine burns."""
-        burning = self.timeline.left("burning", self.sim.t).astype(bool)
-        return (self.sim.t >= self.spec.controller_on_after_s - 1e-9) & burning
-
-    def reference_rates(self) -> np.ndarray:
-        """Reference body rates (B, 3) [rad/s]: zero, or the gravity-turn pitch program (a kick of
-        ``kick_angle_deg`` between ``kick_start_s`` and ``kick_end_s`` towards downrange, then the rate at
-        which gravity turns the velocity, ``-g sin(theta) / V`` with theta the velocity's angle from the
-        vertical; negative pitch rate turns the nose downrange)."""
-        ref = np.zeros((self.B, 3))
-        s = self.spec
-        if s.reference == "gravity_turn":
-            t = self.sim.t
-            kick = (t >= s.kick_start_s) & (t < s.kick_end_s)
-            ref[kick, 1] = -math.radians(s.kick_angle_deg) / (s.kick_end_s - s.kick_start_s)
-            after = t >= s.kick_end_s
-            if after.any():
-                v = self.sim.state("v_zw_i")
-                g = self.sim.conditions("g_i")
-                gn = np.linalg.norm(g, axis=1)
-                up = -g / gn[:, None]
-                speed = np.maximum(np.linalg.norm(v, axis=1), 1.0)
-                cos_th = np.clip(np.einsum("bi,bi->b", v, up) / speed, -1.0, 1.0)
-                ref[after, 1] = -(gn * np.sqrt(1.0 - cos_th**2) / speed)[after]
-        return ref
+        """Whether the controller acts now: after ``controller_on_after_s`` and while an engine burns."""
+        return self.on.copy()
 
     def attitude_error(self) -> np.ndarray:
         """Pitch and yaw attitude error (B, 2) [rad]: the body axis against the reference axis (the
         launch axis, fixed in inertial space; turned by the pitch program when there is one), body y, z."""
-        C_ib = self._C_ib()
-        x_b_i = C_ib[:, :, 0]
-        e_i = np.cross(x_b_i, self.axis_ref_i)
-        e_b = np.einsum("bji,bj->bi", C_ib, e_i)
-        return -e_b[:, 1:]
-
-    def observe(self, on: np.ndarray, ref: np.ndarray) -> np.ndarray:
-        """Observation (B, 14) float32, entries ``OBS_NAMES``."""
-        s, sim = self.spec, self.sim
-        if s.observation == "state":
-            w = sim.state("omega_bi_b").copy()
-            att = self.attitude_error()
-            flow = np.stack([sim.conditions("alpha"), sim.conditions("beta")], axis=1)
-        else:
-            w = sim.gyro_rates()[:, 0, :] + self.gyro_bias
-            att = self.attitude_error()
-            if "sensor_noise" in s.randomize:
-                w += np.stack([g.normal(0.0, s.gyro_noise_radps, 3) for g in self.rngs])
-                att = att + np.stack([g.normal(0.0, s.attitude_noise_rad, 2) for g in self.rngs])
-            f = sim.conditions("f_aero_b") + sim.conditions("thrust_e")
-            m = self.timeline.interp("mass", sim.t)
-            acc = f[:, [2, 1]] / m[:, None]
-            if "sensor_noise" in s.randomize:
-                acc = acc + np.stack([g.normal(0.0, s.accel_noise_mps2, 2) for g in self.rngs])
-            flow = acc / G0
-        obs = np.empty((self.B, len(OBS_NAMES)), dtype=np.float32)
-        obs[:, 0] = w[:, 0]
-        obs[:, 1] = w[:, 1] - ref[:, 1]
-        obs[:, 2] = w[:, 2] - ref[:, 2]
-        obs[:, 3:5] = att
-        obs[:, 5:7] = flow
-        obs[:, 7] = sim.conditions("mach") / 10.0
-        obs[:, 8] = sim.conditions("qbar") / 1e5
-        obs[:, 9:11] = self.sim.gimbal / self.gimbal_limit
-        obs[:, 11] = sim.t / s.mission_time_s
-        obs[:, 12] = on
-        obs[:, 13] = ref[:, 1]
-        return obs
+        return self.att.copy()
 
     # ------------------------------------------------------------------------------ step
-    def step(self, action: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
+    def step(self, action: np.ndarray, skip: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
         """Advance every row by one control period with ``action`` (B, 2) in [-1, 1] (``tvc``) or (B, 1)
         in {0, 1, 2} (``rcs``: negative, no, positive roll pulse). Returns observation, reward,
-        terminated, truncated and a dict of per-row arrays (``info``)."""
-        s, sim = self.spec, self.sim
-        on = self.controller_on()
-        moment = np.zeros((self.B, 3))
+        terminated, truncated and a dict of per-row arrays (``info``). Rows ``skip`` (about to be reset by
+        the caller) draw no sensor noise, so their generators stay as a single env's would.
+
+        The signals (:mod:`.signals`): reference pitch rate ``r`` (zero, or the gravity-turn programme);
+        rate error ``e = |omega - (0, r, 0)|`` (zero once the state is non-finite), integrated into
+        ``info["cumulative_rate_error"]``; reward terms ``-w_axis e_axis dt``, ``-effort_weight int
+        |gimbal| dt``, ``-effort_rate_weight int |gimbal rate| dt`` and, on termination,
+        ``-failure_penalty_rad_per_s * remaining time``; termination on a non-finite state, q-alpha above
+        the limit or attitude error above the limit."""
+        s, sim, B = self.spec, self.sim, self.B
+        on = self.on.copy()
+        moment = None
         if s.control == "tvc":
-            a = np.clip(np.asarray(action, dtype=float).reshape(self.B, 2), -1.0, 1.0)
-            cmd = np.where(on[:, None], a * self.gimbal_limit, 0.0)
+            a = np.asarray(action, dtype=float).reshape(B, 2)
+            cmd = np.where(on[:, None], np.clip(a, -1.0, 1.0) * self.gimbal_limit, 0.0)
         else:
-            a = np.asarray(action).reshape(self.B, -1)[:, 0]
-            cmd = np.zeros((self.B, 2))
-            moment[:, 0] = np.where(on, (a.astype(float) - 1.0) * s.rcs_torque_nm, 0.0)
+            a = np.asarray(action).reshape(B, -1)[:, 0].astype(float)
+            cmd = np.zeros((B, 2))
+            moment = np.zeros((B, 3))
+            moment[:, 0] = np.where(on, (a - 1.0) * s.rcs_torque_nm, 0.0)
         events = sim.step(cmd, s.control_dt_s, moment)
-        effort, effort_rate = sim.effort[:, 0], sim.effort[:, 1]
         self.steps += 1
-        ref = self.reference_rates()
-        if s.reference == "gravity_turn":
-            C_ib = self._C_ib()
-            turn = C_ib @ np.array([0.0, 1.0, 0.0])           # pitch axis in inertial
-            ang = ref[:, 1] * s.control_dt_s
-            k = turn
-            v = self.axis_ref_i
-            self.axis_ref_i = (v * np.cos(ang)[:, None] + np.cross(k, v) * np.sin(ang)[:, None]
-                               + k * np.einsum("bi,bi->b", k, v)[:, None] * (1 - np.cos(ang))[:, None])
-        w = sim.state("omega_bi_b")
-        failed = sim.failed.copy()
-        err = np.abs(np.where(failed[:, None], 0.0, w - ref))
-        self.cum_error += err * s.control_dt_s
-        terms = {
-            "rate_roll": -s.rate_weights[0] * err[:, 0] * s.control_dt_s,
-            "rate_pitch": -s.rate_weights[1] * err[:, 1] * s.control_dt_s,
-            "rate_yaw": -s.rate_weights[2] * err[:, 2] * s.control_dt_s,
-            "effort": -s.effort_weight * effort,
-            "effort_rate": -s.effort_rate_weight * effort_rate,
-        }
-        qa = sim.conditions("qbar") * np.degrees(sim.conditions("alpha_total"))
-        att = self.attitude_error()
-        att_deg = np.degrees(np.linalg.norm(att, axis=1))
-        reason = np.full(self.B, "", dtype=object)
-        reason[att_deg > s.attitude_limit_deg] = "attitude error beyond the limit"
-        reason[qa > s.qalpha_limit_pa_deg] = "q-alpha beyond the structural limit"
-        reason[failed] = "non-finite state"
-        terminated = reason != ""
-        truncated = ~terminated & (self.steps >= self.n_steps)
-        remaining = np.maximum(s.mission_time_s - sim.t, 0.0)
-        terms["failure"] = np.where(terminated, -s.failure_penalty_rad_per_s * remaining, 0.0)
-        reward = sum(terms.values())
-        obs = self.observe(self.controller_on(), ref)
-        if failed.any():
-            obs[failed] = 0.0
-        info = {"reward_terms": terms, "cumulative_rate_error": self.cum_error.copy(),
-                "qbar": sim.conditions("qbar"), "mach": sim.conditions("mach"),
-                "alpha_total": sim.conditions("alpha_total"), "qalpha_pa_deg": qa, "time": sim.t.copy(),
-                "stage": self.timeline.left("stage", sim.t), "controller_on": on,
-                "slosh_angles": sim.slosh_angles(), "eta": sim.state("eta").copy(), "gimbal": self.sim.gimbal.copy(),
-                "attitude_error": att, "termination": reason, "events": events}
-        return obs, reward, terminated, truncated, info
+        tl = self.timeline
+        terms, reward = np.empty((B, len(REWARD_TERMS))), np.empty(B)
+        reason, truncated, qalpha = np.empty(B, dtype=np.int64), np.empty(B, dtype=bool), np.empty(B)
+        step_signals(self._tp, sim.t, sim.x, sim.diag, sim.failed, sim.effort, sim.gimbal, self.steps,
+                     self.axis_ref_i, self.cum_error, self.gyro_bias, tl.t, self._burning, tl.mass, tl.dphi_sensor,
+                     sim.dynamics.n_modes, self.on, self.obs, self.att, terms, reward, reason, truncated, qalpha)
+        self._add_noise(np.arange(B) if skip is None else np.setdiff1d(np.arange(B), skip))
+        terminated = reason != 0
+        i_stage = self._stage_index(sim.t)
+        info = {"reward_terms": dict(zip(REWARD_TERMS, terms.T)), "cumulative_rate_error": self.cum_error.copy(),
+                "qbar": sim.conditions("qbar").copy(), "mach": sim.conditions("mach").copy(),
+                "alpha_total": sim.conditions("alpha_total").copy(), "qalpha_pa_deg": qalpha, "time": sim.t.copy(),
+                "stage": tl.stage[i_stage], "controller_on": on, "slosh_angles": sim.slosh_angles(),
+                "eta": sim.state("eta").copy(), "gimbal": sim.gimbal.copy(), "attitude_error": self.att.copy(),
+                "termination": _REASONS[reason], "events": events}
+        return self.obs.copy(), reward, terminated, truncated, info
+
+    def _stage_index(self, t: np.ndarray) -> np.ndarray:
+        i, w = self.timeline.locate(t)
+        return np.where(w >= 1.0, i + 1, i)

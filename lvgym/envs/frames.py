@@ -6,6 +6,8 @@ from typing import Any
 
 import numpy as np
 
+from lvgym.simulator.core import dcm_batch
+
 from .render import HumanViewer, Renderer, RenderFrame
 
 
@@ -20,10 +22,10 @@ def make_frame(env: Any) -> RenderFrame:
     if sim.dynamics.n_modes:
         phi = tl.left("phi_sensor", sim.t)[0, 1:]           # (S, K) shapes of the modes in force
         deflection = phi @ sim.state("eta")[0, 1]           # pitch-plane (z) deflection [m]
-    C_ib = core._C_ib()[0]
-    axis_ref = core.axis_ref_i[0]
+    C_ib = dcm_batch(sim.state("q_bi")[:1])[0]
     up = -sim.conditions("g_i")[0] / np.linalg.norm(sim.conditions("g_i")[0])
-    pitch = np.degrees(np.arccos(np.clip(C_ib[:, 0] @ up, -1.0, 1.0))) * np.sign(C_ib[:, 0] @ (axis_ref - up) + 1e-12)
+    # the body axis' angle from the local vertical, signed as a rotation about the body pitch axis y_b
+    pitch = np.degrees(np.arctan2(np.cross(up, C_ib[:, 0]) @ C_ib[:, 1], up @ C_ib[:, 0]))
     N = sim.dynamics.n_slosh
     if N:
         p = sim.p[0]

@@ -56,19 +56,16 @@ class AscentVectorEnv(VectorEnv):
         else:
             seeds = list(seed)
         self._rngs = [gym.utils.seeding.np_random(s)[0] for s in seeds]
-        self.core.reset_rows(np.arange(self.num_envs), self._rngs)
+        obs = self.core.reset_rows(np.arange(self.num_envs), self._rngs)
         self._needs_reset[:] = False
-        obs = self.core.observe(self.core.controller_on(), self.core.reference_rates())
         return obs, {}
 
     def step(self, actions):
         actions = np.asarray(actions)
-        obs, reward, terminated, truncated, info = self.core.step(actions.reshape(self.num_envs, -1))
         redo = np.flatnonzero(self._needs_reset)
+        obs, reward, terminated, truncated, info = self.core.step(actions.reshape(self.num_envs, -1), skip=redo)
         if redo.size:
-            self.core.reset_rows(redo, [self._rngs[b] for b in redo])
-            fresh = self.core.observe(self.core.controller_on(), self.core.reference_rates())
-            obs[redo] = fresh[redo]
+            obs[redo] = self.core.reset_rows(redo, [self._rngs[b] for b in redo])
             reward[redo] = 0.0
             terminated[redo] = False
             truncated[redo] = False
@@ -98,8 +95,7 @@ class AscentSB3VecEnv:
                 if self._seed is not None:
                     self._rngs = [gym.utils.seeding.np_random(self._seed + i)[0] for i in range(self.num_envs)]
                     self._seed = None
-                self.core.reset_rows(np.arange(self.num_envs), self._rngs)
-                return self.core.observe(self.core.controller_on(), self.core.reference_rates())
+                return self.core.reset_rows(np.arange(self.num_envs), self._rngs)
 
             def step_async(self, actions) -> None:
                 self._actions = np.asarray(actions)
@@ -113,9 +109,7 @@ class AscentSB3VecEnv:
                     infos[b]["TimeLimit.truncated"] = bool(truncated[b] and not terminated[b])
                 if done.any():
                     rows = np.flatnonzero(done)
-                    self.core.reset_rows(rows, [self._rngs[b] for b in rows])
-                    fresh = self.core.observe(self.core.controller_on(), self.core.reference_rates())
-                    obs[rows] = fresh[rows]
+                    obs[rows] = self.core.reset_rows(rows, [self._rngs[b] for b in rows])
                 return obs, reward.astype(np.float32), done, infos
 
             def seed(self, seed: int | None = None):

@@ -23,7 +23,7 @@ import math
 import numba as nb
 import numpy as np
 
-from lvgym.dynamics.kernels import X_Q, X_R, X_V, X_W
+from lvgym.dynamics.kernels import X_ETA, X_Q, X_R, X_V, X_W
 from lvgym.dynamics.stepper import _alloc, rk4_vehicle
 from lvgym.rotations import quat_to_dcm
 
@@ -203,3 +203,23 @@ def conditions_range(lo, hi, t, x, p, c, tl_t, tl_T0, tl_Ae, diag):
         c[b, C_T0] = interp_k(tl_t, tl_T0, t[b])
         c[b, C_AE] = interp_k(tl_t, tl_Ae, t[b])
         flight_conditions_k(t[b], x[b], p[b], c[b], diag[b])
+
+
+@nb.njit(cache=True, nogil=True)
+def slosh_angles_k(x, n_slosh, n_modes, out):
+    """Pendulum deflections from the body axis (B, N, 2) [rad]: the rod's angle in the x-y and x-z
+    body planes (0 at rest, hanging aft)."""
+    C = np.empty((3, 3))
+    S = np.empty((3, 3))
+    for b in range(x.shape[0]):
+        xb = x[b]
+        quat_to_dcm(xb[X_Q], xb[X_Q + 1], xb[X_Q + 2], xb[X_Q + 3], C)
+        for j in range(n_slosh):
+            o = X_ETA + 4 * n_modes + 4 * j
+            quat_to_dcm(xb[o], xb[o + 1], xb[o + 2], xb[o + 3], S)
+            # rod direction in body axes: C_ib^T C_is e_x
+            e0 = C[0, 0] * S[0, 0] + C[1, 0] * S[1, 0] + C[2, 0] * S[2, 0]
+            e1 = C[0, 1] * S[0, 0] + C[1, 1] * S[1, 0] + C[2, 1] * S[2, 0]
+            e2 = C[0, 2] * S[0, 0] + C[1, 2] * S[1, 0] + C[2, 2] * S[2, 0]
+            out[b, j, 0] = math.atan2(e1, e0)
+            out[b, j, 1] = math.atan2(e2, e0)
