@@ -95,6 +95,42 @@ def interp_k(grid, dims, table, q, out):
                 out[c] += weight * table[row, c]
 
 
+@nb.njit(cache=True, inline="always")
+def _axis_k(grid, off, n, x):
+    """Index ``i``, next index and weight of ``x`` on the axis ``grid[off:off+n]`` (clamped)."""
+    if n <= 1 or x <= grid[off]:
+        return 0, min(1, n - 1), 0.0
+    if x >= grid[off + n - 1]:
+        return n - 2, n - 1, 1.0
+    i = np.searchsorted(grid[off:off + n], x, side="right") - 1
+    return i, i + 1, (x - grid[off + i]) / (grid[off + i + 1] - grid[off + i])
+
+
+@nb.njit(cache=True)
+def _axisymmetric_k(grid, dims, table, mach, alpha_t, x_ref, x_cg, l_ref):
+    """``CA, CN, Cm, Cmq, Clp`` of an axisymmetric table at (Mach, total angle of attack), with Cmq
+    moved from ``x_ref`` to the CG (see the module docstring); bilinear, without allocation (the same
+    values as :func:`interp_k`)."""
+    nm, na = int(dims[0]), int(dims[1])
+    i0, i1, wm = _axis_k(grid, 0, nm, mach)
+    j0, j1, wa = _axis_k(grid, nm, na, alpha_t)
+    w00, w01, w10, w11 = (1.0 - wm) * (1.0 - wa), (1.0 - wm) * wa, wm * (1.0 - wa), wm * wa
+    r00, r01, r10, r11 = i0 * na + j0, i0 * na + j1, i1 * na + j0, i1 * na + j1
+    ca = w00 * table[r00, 0] + w01 * table[r01, 0] + w10 * table[r10, 0] + w11 * table[r11, 0]
+    cn = w00 * table[r00, 1] + w01 * table[r01, 1] + w10 * table[r10, 1] + w11 * table[r11, 1]
+    cm = w00 * table[r00, 2] + w01 * table[r01, 2] + w10 * table[r10, 2] + w11 * table[r11, 2]
+    cmq = w00 * table[r00, 3] + w01 * table[r01, 3] + w10 * table[r10, 3] + w11 * table[r11, 3]
+    clp = w00 * table[r00, 4] + w01 * table[r01, 4] + w10 * table[r10, 4] + w11 * table[r11, 4]
+    if cmq != 0.0 and na > 1:
+        # static slopes about x_ref from the table's first nonzero angle, at this Mach
+        a1 = grid[nm + 1]
+        cn1 = (1.0 - wm) * table[i0 * na + 1, 1] + wm * table[i1 * na + 1, 1]
+        cm1 = (1.0 - wm) * table[i0 * na + 1, 2] + wm * table[i1 * na + 1, 2]
+        dl = (x_ref - x_cg) / l_ref
+        cmq = cmq - 4.0 * dl * cm1 / a1 - 2.0 * dl * dl * cn1 / a1
+    return ca, cn, cm, cmq, clp
+
+
 @nb.njit(cache=True)
 def aero_loads_k(v_air_b, omega_bi_b, rho, sound, x_cg, alt, p, grid, dims, table, f_b, m_b, state):
     """Aerodynamic force ``f_b`` [N] and moment about the CG ``m_b`` [N m] (body frame) of either
@@ -114,26 +150,17 @@ def aero_loads_k(v_air_b, omega_bi_b, rho, sound, x_cg, alt, p, grid, dims, tabl
     s_ref, l_ref = p[P_SREF], p[P_LREF]
     qs = qbar * s_ref
     kd = 0.25 * rho * speed * s_ref * l_ref * l_ref          # damping: qbar S L * L / (2 V)
-    c = np.zeros(table.shape[1])
     if p[P_KIND] == KIND_AXISYMMETRIC:
-        interp_k(grid, dims, table, np.array([mach, alpha_t]), c)
+        ca, cn, cm, cmq, clp = _axisymmetric_k(grid, dims, table, mach, alpha_t, p[P_XREF], x_cg, l_ref)
         sp, cp = (v / vperp, w / vperp) if vperp > 0.0 else (0.0, 1.0)
-        f_b[0] = -qs * c[0]
-        f_b[1] = -qs * c[1] * sp
-        f_b[2] = -qs * c[1] * cp
-        cmq = c[3]
-        if cmq != 0.0 and dims[1] > 1:
-            # Cmq is tabulated about x_ref; about the CG it is Cmq - 4 (D/L) Cm_a - 2 (D/L)^2 CN_a with
-            # D = x_ref - x_cg and the static slopes about x_ref taken from the table's first angle
-            a1 = grid[int(dims[0]) + 1]
-            c1 = np.zeros(table.shape[1])
-            interp_k(grid, dims, table, np.array([mach, a1]), c1)
-            dl = (p[P_XREF] - x_cg) / l_ref
-            cmq = cmq - 4.0 * dl * c1[2] / a1 - 2.0 * dl * dl * c1[1] / a1
-        m_b[0] = kd * c[4] * omega_bi_b[0]
-        m_b[1] = qs * l_ref * c[2] * cp + kd * cmq * omega_bi_b[1]
-        m_b[2] = -qs * l_ref * c[2] * sp + kd * cmq * omega_bi_b[2]
+        f_b[0] = -qs * ca
+        f_b[1] = -qs * cn * sp
+        f_b[2] = -qs * cn * cp
+        m_b[0] = kd * clp * omega_bi_b[0]
+        m_b[1] = qs * l_ref * cm * cp + kd * cmq * omega_bi_b[1]
+        m_b[2] = -qs * l_ref * cm * sp + kd * cmq * omega_bi_b[2]
     else:
+        c = np.zeros(table.shape[1])
         q = np.array([mach, math.atan2(w, u), math.atan2(v, math.sqrt(u * u + w * w)), alt])
         interp_k(grid, dims, table, q, c)
         f_b[0] = -qs * c[0]

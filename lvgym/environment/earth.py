@@ -118,6 +118,13 @@ def site_dcm_ni_k(x, y, z, t, p, C):
     """Write ``C_ni`` (inertial -> local NED under the inertial point (x, y, z) [m] at ``t`` [s])
     into ``C``. Flat Earth: the pad's NED frame for every point."""
     lat, lon, _ = site_geodetic_k(x, y, z, t, p)
+    site_dcm_ni_latlon_k(lat, lon, t, p, C)
+
+
+@nb.njit(cache=True)
+def site_dcm_ni_latlon_k(lat, lon, t, p, C):
+    """:func:`site_dcm_ni_k` from the point's geodetic latitude and longitude [rad] (as
+    :func:`site_geodetic_k` returns them), for callers that already have them."""
     C_ne = np.empty((3, 3))
     dcm_ne_k(lat, lon, C_ne)
     C_ei = np.empty((3, 3))

@@ -36,12 +36,35 @@ P_KIND, P_OMEGA = 0, 1          # all models: kind, Earth rotation rate [rad/s]
 P_G = 2                         # constant: g_i[3] [m/s^2]
 P_GM, P_RADIUS = 2, 3           # point mass (GM only), J2 and harmonics [m^3/s^2], [m]
 P_J2 = 4                        # J2: J2 [-]
-P_DEGREE, P_ORDER, P_COEF = 4, 5, 6   # harmonics: N, M, then C[K], S[K], K = (N+1)(N+2)/2, at n(n+1)/2+m
+P_DEGREE, P_ORDER, P_COEF = 4, 5, 6   # harmonics: N, M, then C[K], S[K], K = (N+1)(N+2)/2, at n(n+1)/2+m,
+F_A, F_B, F_FZ, F_F0, F_FA, F_FB = range(6)   # then harmonic_factors(N): six (N+2, N+2) blocks
 
 DATA_FILE = Path(__file__).with_name("data") / "egm2008_n4.csv"
 
 
 # ------------------------------------------------------------------------------- kernels
+def harmonic_factors(N: int) -> np.ndarray:
+    """Recursion and gradient factors of the fully normalised harmonics up to degree N, as six
+    (N+2, N+2) blocks end to end (``F_*`` order): the column recursion ``a``, ``b`` and the gradient
+    factors ``fz``, ``f0`` (m = 0), ``fa``, ``fb``, so the kernel takes no square root."""
+    n2 = N + 2
+    F = np.zeros((6, n2, n2))
+    for m in range(n2):
+        for n in range(m + 1, n2):
+            F[F_A, n, m] = math.sqrt((2.0 * n + 1.0) * (2.0 * n - 1.0) / ((n - m) * (n + m)))
+            if n > m + 1:
+                F[F_B, n, m] = math.sqrt((2.0 * n + 1.0) * (n + m - 1.0) * (n - m - 1.0)
+                                         / ((n - m) * (n + m) * (2.0 * n - 3.0)))
+    for n in range(N + 1):
+        for m in range(n + 1):
+            F[F_FZ, n, m] = math.sqrt((2.0 * n + 1.0) * (n + m + 1.0) * (n - m + 1.0) / (2.0 * n + 3.0))
+            F[F_F0, n, m] = math.sqrt((2.0 * n + 1.0) * (n + 1.0) * (n + 2.0) / (2.0 * (2.0 * n + 3.0)))
+            F[F_FA, n, m] = math.sqrt((2.0 * n + 1.0) * (n + m + 1.0) * (n + m + 2.0) / (2.0 * n + 3.0))
+            F[F_FB, n, m] = math.sqrt((2.0 if m == 1 else 1.0) * (2.0 * n + 1.0) * (n - m + 1.0)
+                                      * (n - m + 2.0) / (2.0 * n + 3.0))
+    return F.ravel()
+
+
 @nb.njit(cache=True)
 def harmonics_k(x, y, z, p):
     """Acceleration (3) [m/s^2] and potential energy [J/kg] of the spherical-harmonic field with
@@ -49,24 +72,25 @@ def harmonics_k(x, y, z, p):
     gm, R = p[P_GM], p[P_RADIUS]
     N, M = int(p[P_DEGREE]), int(p[P_ORDER])
     K = (N + 1) * (N + 2) // 2
+    n2 = N + 2
+    F = p[P_COEF + 2 * K:P_COEF + 2 * K + 6 * n2 * n2].reshape((6, n2, n2))
     r2 = x * x + y * y + z * z
     rho = R / r2
     x0, y0, z0, rr = x * rho, y * rho, z * rho, R * rho
-    V = np.zeros((N + 2, N + 2))
-    W = np.zeros((N + 2, N + 2))
+    V = np.zeros((n2, n2))
+    W = np.zeros((n2, n2))
     V[0, 0] = R / math.sqrt(r2)
     for m in range(min(M + 1, N + 1) + 1):
         if m > 0:                                      # sectoral: V_mm from V_m-1,m-1
             f = math.sqrt(3.0) if m == 1 else math.sqrt((2.0 * m + 1.0) / (2.0 * m))
             V[m, m] = f * (x0 * V[m - 1, m - 1] - y0 * W[m - 1, m - 1])
             W[m, m] = f * (x0 * W[m - 1, m - 1] + y0 * V[m - 1, m - 1])
-        for n in range(m + 1, N + 2):                  # along the column m
-            a = math.sqrt((2.0 * n + 1.0) * (2.0 * n - 1.0) / ((n - m) * (n + m)))
+        for n in range(m + 1, n2):                     # along the column m
+            a = F[F_A, n, m]
             V[n, m] = a * z0 * V[n - 1, m]
             W[n, m] = a * z0 * W[n - 1, m]
             if n > m + 1:
-                b = math.sqrt((2.0 * n + 1.0) * (n + m - 1.0) * (n - m - 1.0)
-                              / ((n - m) * (n + m) * (2.0 * n - 3.0)))
+                b = F[F_B, n, m]
                 V[n, m] -= b * rr * V[n - 2, m]
                 W[n, m] -= b * rr * W[n - 2, m]
     ax = ay = az = u = 0.0
@@ -76,16 +100,13 @@ def harmonics_k(x, y, z, p):
             if C == 0.0 and S == 0.0:
                 continue
             u += C * V[n, m] + S * W[n, m]
-            fz = math.sqrt((2.0 * n + 1.0) * (n + m + 1.0) * (n - m + 1.0) / (2.0 * n + 3.0))
-            az -= fz * (C * V[n + 1, m] + S * W[n + 1, m])
+            az -= F[F_FZ, n, m] * (C * V[n + 1, m] + S * W[n + 1, m])
             if m == 0:
-                f0 = math.sqrt((2.0 * n + 1.0) * (n + 1.0) * (n + 2.0) / (2.0 * (2.0 * n + 3.0)))
+                f0 = F[F_F0, n, m]
                 ax -= f0 * C * V[n + 1, 1]
                 ay -= f0 * C * W[n + 1, 1]
             else:
-                fa = math.sqrt((2.0 * n + 1.0) * (n + m + 1.0) * (n + m + 2.0) / (2.0 * n + 3.0))
-                fb = math.sqrt((2.0 if m == 1 else 1.0) * (2.0 * n + 1.0) * (n - m + 1.0)
-                               * (n - m + 2.0) / (2.0 * n + 3.0))
+                fa, fb = F[F_FA, n, m], F[F_FB, n, m]
                 ax += 0.5 * (fa * (-C * V[n + 1, m + 1] - S * W[n + 1, m + 1])
                              + fb * (C * V[n + 1, m - 1] + S * W[n + 1, m - 1]))
                 ay += 0.5 * (fa * (-C * W[n + 1, m + 1] + S * V[n + 1, m + 1])
@@ -259,7 +280,7 @@ class HarmonicGravity(GravityModel):
         self.C, self.S = np.tril(C), np.tril(S)
         n_idx, m_idx = np.tril_indices(N + 1)
         self.params = np.concatenate([[KIND_HARMONICS, omega, gm, radius, N, M],
-                                      self.C[n_idx, m_idx], self.S[n_idx, m_idx]])
+                                      self.C[n_idx, m_idx], self.S[n_idx, m_idx], harmonic_factors(N)])
 
 
 def load_egm2008(path: Path = DATA_FILE) -> tuple[np.ndarray, np.ndarray, float, float]:

@@ -32,7 +32,7 @@ import numpy as np
 from lvgym.dynamics.stepper import compile_loads
 from lvgym.environment.aerodynamics import STATE_FIELDS, aero_loads_k
 from lvgym.environment.atmosphere import atmosphere_state
-from lvgym.environment.earth import SITE_SIZE, site_dcm_ni_k, site_geodetic_k, site_velocity_wrt_earth_k
+from lvgym.environment.earth import SITE_SIZE, site_dcm_ni_latlon_k, site_geodetic_k, site_velocity_wrt_earth_k
 from lvgym.environment.gravity import gravity_k
 from lvgym.environment.wind import wind_ned
 from lvgym.rotations import quat_to_dcm
@@ -75,7 +75,7 @@ def flight_conditions_k(t, x, p, c, d):
     o_wind, o_ap, o_ag, o_ad = int(c[C_WIND]), int(c[C_AP]), int(c[C_AG]), int(c[C_AD])
     o_at, n_col, o_end = int(c[C_AT]), int(c[C_NCOL]), int(c[C_END])
     site = c[o_site:o_site + SITE_SIZE]
-    _, _, alt = site_geodetic_k(rx, ry, rz, t, site)
+    lat, lon, alt = site_geodetic_k(rx, ry, rz, t, site)
     d[D_ALT] = alt
     gx, gy, gz = gravity_k(rx, ry, rz, t, c[o_grav:o_atm])
     d[D_G], d[D_G + 1], d[D_G + 2] = gx, gy, gz
@@ -84,7 +84,7 @@ def flight_conditions_k(t, x, p, c, d):
     wn = d[D_WIND:D_WIND + 3]
     wind_ned(c[o_wind:o_ap], alt, t, wn)
     C = np.empty((3, 3))
-    site_dcm_ni_k(rx, ry, rz, t, site, C)
+    site_dcm_ni_latlon_k(lat, lon, t, site, C)
     vx, vy, vz = site_velocity_wrt_earth_k(rx, ry, rz, x[3], x[4], x[5], site)
     vr0 = vx - (C[0, 0] * wn[0] + C[1, 0] * wn[1] + C[2, 0] * wn[2])
     vr1 = vy - (C[0, 1] * wn[0] + C[1, 1] * wn[1] + C[2, 1] * wn[2])
