@@ -1,0 +1,121 @@
+"""The compiled task signals and step against independent numpy formulas and hand numbers.
+
+The env's observation, reference and reward come from one compiled call (lvgym.envs.signals), the
+gimbal servo and the rail from the simulator's compiled step (lvgym.simulator.advance); these tests
+recompute them here from the simulator's state with plain numpy.
+"""
+
+import math
+
+import gymnasium as gym
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation
+
+import lvgym  # noqa: F401  (registers the envs)
+from lvgym.simulator import Simulator
+from lvgym.simulator.core import dcm_batch
+from lvgym.simulator.servo import Servo, servo_step_k
+
+G0 = 9.80665
+
+
+def _reference_pitch_rate(core, t, v, g, spec):
+    if spec.kick_start_s <= t < spec.kick_end_s:
+        return -math.radians(spec.kick_angle_deg) / (spec.kick_end_s - spec.kick_start_s)
+    if t < spec.kick_end_s:
+        return 0.0
+    up = -g / np.linalg.norm(g)
+    speed = max(np.linalg.norm(v), 1.0)
+    cos_th = np.clip(v @ up / speed, -1.0, 1.0)
+    return -np.linalg.norm(g) * math.sqrt(1.0 - cos_th**2) / speed
+
+
+@pytest.mark.parametrize("observation", ["state", "sensors"])
+def test_observation_and_reference_equal_numpy_formulas(observation):
+    env = gym.make("lvgym/SmileAscent-v0", model="nonrigid", wind="gust", reference="gravity_turn",
+                   observation=observation, randomize=["wind", "mass", "thrust_misalignment"])
+    env.reset(seed=3)
+    core = env.unwrapped.core
+    sim, spec = core.sim, core.spec
+    rng = np.random.default_rng(0)
+    checked = 0
+    for k in range(700):
+        axis_before = core.axis_ref_i[0].copy()
+        obs, _, term, trunc, info = env.step(rng.uniform(-0.3, 0.3, 2).astype(np.float32))
+        assert not term and not trunc
+        if k % 70 != 69:
+            continue
+        t = float(sim.t[0])
+        x_b = sim.state("v_zw_i")[0]
+        ref = _reference_pitch_rate(core, t, x_b, sim.conditions("g_i")[0], spec)
+        C = dcm_batch(sim.state("q_bi")[:1])[0]
+        # the reference axis turned by ref * dt about the body pitch axis
+        turn = Rotation.from_rotvec(ref * spec.control_dt_s * C[:, 1])
+        np.testing.assert_allclose(core.axis_ref_i[0], turn.apply(axis_before), atol=1e-12)
+        e_b = C.T @ np.cross(C[:, 0], core.axis_ref_i[0])
+        w = sim.state("omega_bi_b")[0].copy()
+        if observation == "sensors":
+            dphi = core.timeline.left("dphi_sensor", sim.t)[0, 0]            # IMU slopes (K,)
+            eta_dot = sim.state("eta_dot")[0]                              # (2, K): y, z planes
+            w += np.array([0.0, -dphi @ eta_dot[1], dphi @ eta_dot[0]])
+            f = sim.conditions("f_aero_b")[0] + sim.conditions("thrust_e")[0]
+            m = core.timeline.interp("mass", sim.t)[0]
+            flow = f[[2, 1]] / m / G0
+        else:
+            flow = [sim.conditions("alpha")[0], sim.conditions("beta")[0]]
+        on = float(t >= spec.controller_on_after_s and bool(core.timeline.left("burning", sim.t)[0]))
+        expected = np.concatenate([[w[0], w[1] - ref, w[2]], -e_b[1:], flow,
+                                   [sim.conditions("mach")[0] / 10, sim.conditions("qbar")[0] / 1e5],
+                                   sim.gimbal[0] / core.gimbal_limit, [t / spec.mission_time_s, on, ref]])
+        np.testing.assert_allclose(obs, expected.astype(np.float32), rtol=2e-6, atol=1e-7)
+        assert info["attitude_error"] == pytest.approx(-e_b[1:], abs=1e-12)
+        checked += 1
+    assert checked == 10
+
+
+def test_servo_hand_numbers():
+    s = Servo(frequency=15.0, damping=0.7, limit=math.radians(5.0), rate_limit=math.radians(30.0)).params()
+    pos, rate = np.zeros(2), np.zeros(2)
+    cmd = np.array([math.radians(0.1), -math.radians(0.1)])
+    servo_step_k(s, cmd, pos, rate, 0.01)
+    # semi-implicit Euler from rest: rate = h w^2 c, position = h rate
+    np.testing.assert_allclose(rate, 0.01 * 225.0 * cmd)
+    np.testing.assert_allclose(pos, 0.01 * 0.01 * 225.0 * cmd)
+    # a large command is clipped to the 5 deg limit; the rate saturates at 30 deg/s on the way, then the
+    # position stops at 5 deg (rate zeroed there)
+    pos[:], rate[:] = 0.0, 0.0
+    big = np.array([1.0, -1.0])
+    servo_step_k(s, big, pos, rate, 0.01)
+    np.testing.assert_allclose(np.abs(rate), 0.01 * 225.0 * math.radians(5.0))
+    peak = 0.0
+    for _ in range(100):
+        servo_step_k(s, big, pos, rate, 0.01)
+        peak = max(peak, np.abs(rate).max())
+    assert peak == pytest.approx(math.radians(30.0), rel=1e-12)
+    np.testing.assert_allclose(pos, [math.radians(5.0), -math.radians(5.0)])
+    np.testing.assert_allclose(rate, 0.0)
+    # no servo: the position is the command
+    direct = np.zeros(5)
+    servo_step_k(direct, cmd, pos, rate, 0.01)
+    np.testing.assert_array_equal(pos, cmd)
+
+
+def test_servo_rejects_bad_values():
+    with pytest.raises(ValueError, match="servo.damping"):
+        Servo(damping=-0.1)
+
+
+def test_rail_exit_is_found_at_the_physics_step():
+    """Travel along the rail is checked after every RK4 step, not only at the end of a step() call."""
+    sim = Simulator("stratos3", model="rigid", site="el_arenosillo", elevation_deg=85.0, rail_length=10.0,
+                    t_end=3.0, physics_dt=0.01)
+    sim.reset()
+    exit_t = None
+    while exit_t is None:
+        for t, e in sim.step([[0.0, 0.0]], 0.1)[0]:            # 10 physics steps per call
+            if e == "rail exit":
+                exit_t = t
+    speed = np.linalg.norm(sim.state("v_zw_i")[0] - np.cross([0, 0, sim.omega_e], sim.state("r_zw_i")[0]))
+    assert 10.0 <= sim.rail_s[0] < 10.0 + 0.01 * speed         # within one physics step of travel
+    assert abs(exit_t / 0.01 - round(exit_t / 0.01)) < 1e-6      # on a physics step, inside the call
