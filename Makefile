@@ -22,6 +22,7 @@ test: $(STAMP)
 
 bench: $(STAMP)
 	$(PY) -m lvgym.bench
+	$(PY) -m lvgym.bench_envs
 
 clean:
 	rm -rf $(VENV) .pytest_cache

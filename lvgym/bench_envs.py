@@ -1,0 +1,93 @@
+"""Speed of the ascent envs: env steps per second (``python -m lvgym.bench_envs``).
+
+``lvgym/SmileAscent-v0`` rigid and non-rigid at the defaults (50 Hz control over 100 Hz RK4: two RK4
+steps, nine evaluations of the flight loads, the servo, the task signals per env step), with zero
+actions from mid-flight states (the first 2 s on the pad and before the controller acts are skipped
+by a warm-up). Three ways: one env through ``gymnasium.make`` (with its wrappers), the native
+``VectorEnv`` of N rows (``gymnasium.make_vec``; rows split over the threads of the simulator), and the
+SB3 ``VecEnv`` adapter (which builds one info dict per row, as SB3 requires).
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import platform
+import time
+
+import gymnasium as gym
+import numpy as np
+
+import lvgym  # noqa: F401  (registers the envs)
+from lvgym.envs import make_sb3_vec_env
+
+ENV_ID = "lvgym/SmileAscent-v0"
+
+
+def _timed(step, n_min: int, min_time: float) -> float:
+    """Steps per second of ``step()`` over at least ``n_min`` calls and ``min_time`` seconds."""
+    n, start = 0, time.perf_counter()
+    while n < n_min or time.perf_counter() - start < min_time:
+        step()
+        n += 1
+    return n / (time.perf_counter() - start)
+
+
+def single(model: str, min_time: float) -> float:
+    env = gym.make(ENV_ID, model=model)
+    env.reset(seed=0)
+    a = np.zeros(2, dtype=np.float32)
+    for _ in range(250):                                   # 5 s: off the pad, controller on
+        env.step(a)
+
+    def step():
+        _, _, term, trunc, _ = env.step(a)
+        if term or trunc:
+            env.reset()
+    return _timed(step, 200, min_time)
+
+
+def vector(model: str, n: int, min_time: float) -> float:
+    env = gym.make_vec(ENV_ID, num_envs=n, vectorization_mode="vector_entry_point", model=model)
+    env.reset(seed=0)
+    a = np.zeros((n, 2), dtype=np.float32)
+    for _ in range(250):
+        env.step(a)
+    return n * _timed(lambda: env.step(a), 20, min_time)
+
+
+def sb3(model: str, n: int, min_time: float) -> float:
+    env = make_sb3_vec_env(ENV_ID, num_envs=n, seed=0, model=model)
+    env.reset()
+    a = np.zeros((n, 2), dtype=np.float32)
+    for _ in range(250):
+        env.step(a)
+    return n * _timed(lambda: env.step(a), 20, min_time)
+
+
+def run(min_time: float = 2.0, batch: int = 1024) -> list[tuple[str, str, float]]:
+    rows = []
+    for model in ("rigid", "nonrigid"):
+        rows.append((model, "single env (gymnasium.make)", single(model, min_time)))
+        rows.append((model, f"VectorEnv, {batch} rows", vector(model, batch, min_time)))
+        rows.append((model, f"SB3 VecEnv, {batch} rows", sb3(model, batch, min_time)))
+    return rows
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--min-time", type=float, default=2.0, help="seconds per measurement")
+    parser.add_argument("--batch", type=int, default=1024, help="rows of the batched envs")
+    args = parser.parse_args()
+    rows = run(args.min_time, args.batch)
+    from lvgym.simulator.core import _default_threads
+    print(f"# {ENV_ID} env steps per second ({platform.processor() or platform.machine()}, "
+          f"{os.cpu_count()} cores, {_default_threads()} simulator threads)\n")
+    print("| model | how | env-steps/s |")
+    print("|---|---|---|")
+    for model, how, rate in rows:
+        print(f"| {model} | {how} | {rate:,.0f} |")
+
+
+if __name__ == "__main__":
+    main()
