@@ -1,5 +1,23 @@
-"""The frozen benchmark protocol: named suites of conditions with fixed seeds, metrics, and the runner."""
+"""The frozen benchmark protocol: named suites of conditions with fixed seeds, metrics, and the runner.
 
+- :mod:`.policy`: the :class:`Policy` interface (``name``, ``reset()``, ``act(observation, info)``);
+- :mod:`.suites`: :data:`SUITES` (conditions and seed sets, :data:`PROTOCOL_VERSION`);
+- :mod:`.metrics`: per-episode metrics, per-suite mean / std / CVaR10 / failure rate, degradation;
+- :mod:`.runner`: :func:`run_episode` and :func:`evaluate` (serial, local process pool or Ray);
+- :mod:`.results`: atomic CSV / JSON / Markdown / PNG result files;
+- :mod:`.sb3`: a saved stable-baselines3 model as a policy.
+"""
+
+from .metrics import (CVAR_LEVEL, SUMMARY_METRICS, Trajectory, TrajectoryBuilder, cvar, degradation, episode_metrics,
+                      summarize)
 from .policy import Policy, ZeroPolicy
+from .results import atomic_write, atomic_write_text, markdown_table, write_results
+from .runner import EXECUTORS, ZERO, PolicySpec, build_policy, evaluate, make_tasks, run_episode
+from .suites import (DEFAULT_SUITE, PROTOCOL_VERSION, SEED_SETS, SUITES, TEST_SEED0, VALIDATION_SEED0, Condition,
+                     Suite, get_suite)
 
-__all__ = ["Policy", "ZeroPolicy"]
+__all__ = ["CVAR_LEVEL", "Condition", "DEFAULT_SUITE", "EXECUTORS", "PROTOCOL_VERSION", "Policy", "PolicySpec",
+           "SEED_SETS", "SUITES", "SUMMARY_METRICS", "Suite", "TEST_SEED0", "Trajectory", "TrajectoryBuilder",
+           "VALIDATION_SEED0", "ZERO", "ZeroPolicy", "atomic_write", "atomic_write_text", "build_policy", "cvar",
+           "degradation", "episode_metrics", "evaluate", "get_suite", "make_tasks", "markdown_table", "run_episode",
+           "summarize", "write_results"]

@@ -1,0 +1,159 @@
+"""Compare TVC policies on the frozen benchmark protocol (``lvgym.benchmark``).
+
+    python evaluate.py                                   # the default comparison (see DEFAULT_*)
+    python evaluate.py --policies zero pid gs-pid runs/ppo_smile.zip --suites smile-windy --episodes 50
+    python evaluate.py --executor ray --workers 32       # Ray (pip install 'lvgym[ray]'); joins a running
+                                                         # cluster if ray.init() was called, else starts one
+
+Policies are names of :data:`POLICIES` (``zero``, ``pid``, ``gs-pid``) or paths of saved
+stable-baselines3 models (``.zip``; an optional ``<stem>_vecnormalize.pkl`` next to it normalises the
+observations). Suites are names of ``lvgym.benchmark.SUITES``. Episodes run on a local process pool
+by default; the Markdown table is printed, and CSV, JSON, the table and PNG plots go to ``--out``
+(each file written atomically: an interrupted run leaves no half-written file). ``--seed-set
+validation`` evaluates on the training seeds; reported numbers use the ``test`` seeds (the default).
+"""
+
+from __future__ import annotations
+
+import argparse
+import datetime as dt
+import signal
+import sys
+import time
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+from typing import Any
+
+from lvgym.benchmark import (EXECUTORS, PROTOCOL_VERSION, SEED_SETS, SUITES, ZERO, PolicySpec, degradation,
+                             evaluate, get_suite, markdown_table, summarize, write_results)
+
+#: policy names -> how a worker builds them (factories are imported lazily, in the workers)
+POLICIES: dict[str, PolicySpec] = {
+    "zero": ZERO,
+    "pid": PolicySpec("pid", "baselines_pid.pid:PIDPolicy"),
+    "gs-pid": PolicySpec("gs-pid", "baselines_pid.pid:smile_scheduled_pid"),
+}
+DEFAULT_POLICIES = ["zero", "pid", "gs-pid"]
+DEFAULT_SUITES = ["smile-windy"]
+#: episodes per condition and policy of the default run (2 x 3 x 30 = 180 episodes of 60 s, ~1.5 min on 2 cores)
+DEFAULT_EPISODES = 30
+
+
+@dataclass
+class Args:
+    """Command-line arguments (``python evaluate.py --help``)."""
+
+    policies: list[str] = field(default_factory=lambda: list(DEFAULT_POLICIES))
+    """policy names (zero, pid, gs-pid) or paths of stable-baselines3 .zip models"""
+    suites: list[str] = field(default_factory=lambda: list(DEFAULT_SUITES))
+    """suite names of the protocol"""
+    episodes: int = DEFAULT_EPISODES
+    """episodes (seeds) per condition and policy"""
+    executor: str = "local"
+    """local (process pool), serial or ray"""
+    workers: int | None = None
+    """parallel workers (default: the CPUs available)"""
+    out: str = "results"
+    """folder of the result files"""
+    seed_set: str = "test"
+    """test (reported numbers) or validation (training and tuning)"""
+    mission_time_s: float | None = None
+    """shorten every episode to this many seconds (smoke tests; results are marked '+override')"""
+    plots: bool = True
+    """write PNG plots"""
+    progress: bool = True
+    """show a progress bar"""
+
+
+def parse_args(argv: list[str] | None = None) -> Args:
+    """Parse the command line into :class:`Args`."""
+    d = Args()
+    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0], formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--policies", nargs="+", default=d.policies, metavar="POLICY",
+                   help=f"names {sorted(POLICIES)} or SB3 .zip paths (default: {' '.join(d.policies)})")
+    p.add_argument("--suites", nargs="+", default=d.suites, metavar="SUITE",
+                   help=f"of {sorted(SUITES)} (default: {' '.join(d.suites)})")
+    p.add_argument("--episodes", type=int, default=d.episodes, help=f"per condition and policy (default {d.episodes})")
+    p.add_argument("--executor", choices=EXECUTORS, default=d.executor, help="default: local process pool")
+    p.add_argument("--workers", type=int, default=d.workers, help="default: the CPUs available")
+    p.add_argument("--out", default=d.out, help=f"results folder (default {d.out}/)")
+    p.add_argument("--seed-set", choices=SEED_SETS, default=d.seed_set, help="default: test")
+    p.add_argument("--mission-time-s", type=float, default=None, help="shorten episodes (smoke tests only)")
+    p.add_argument("--no-plots", dest="plots", action="store_false", help="skip the PNG plots")
+    p.add_argument("--no-progress", dest="progress", action="store_false", help="hide the progress bar")
+    ns = p.parse_args(argv)
+    if ns.episodes < 1:
+        p.error(f"--episodes {ns.episodes}: at least 1")
+    if ns.workers is not None and ns.workers < 1:
+        p.error(f"--workers {ns.workers}: at least 1")
+    return Args(**vars(ns))
+
+
+def resolve_policy(name: str) -> PolicySpec:
+    """The :class:`PolicySpec` of a registered name or of a saved SB3 model path. Checks here, in the
+    main process, that the factory imports, so a missing package fails before any episode runs."""
+    if name in POLICIES:
+        spec = POLICIES[name]
+        try:
+            spec.resolve()
+        except ImportError as exc:
+            raise SystemExit(f"evaluate.py: policy {name!r} needs {spec.factory} (the "
+                             f"{spec.factory.split('.')[0].split(':')[0]} package), which is not available: {exc}")
+        return spec
+    path = Path(name)
+    if path.suffix == ".zip" or path.exists():
+        if not path.is_file():
+            raise SystemExit(f"evaluate.py: policy {name!r}: no such file")
+        return PolicySpec(path.stem, "lvgym.benchmark.sb3:SB3Policy", (("path", str(path.resolve())),))
+    raise SystemExit(f"evaluate.py: policy {name!r}: one of {sorted(POLICIES)} or a path to an SB3 .zip model")
+
+
+def _unique(specs: list[PolicySpec]) -> list[PolicySpec]:
+    """Distinct labels: a repeated one gets ``-2``, ``-3``, ..."""
+    seen: dict[str, int] = {}
+    out = []
+    for s in specs:
+        seen[s.name] = seen.get(s.name, 0) + 1
+        out.append(s if seen[s.name] == 1 else PolicySpec(f"{s.name}-{seen[s.name]}", s.factory, s.kwargs))
+    return out
+
+
+def _terminate(signum: int, frame: Any) -> None:
+    raise SystemExit(128 + signum)
+
+
+def main(argv: list[str] | None = None) -> dict[str, Any]:
+    """Run the comparison, print the Markdown table, write the result files; returns the results."""
+    args = parse_args(argv)
+    signal.signal(signal.SIGTERM, _terminate)        # clean up temporary files on kill (SIGTERM)
+    policies = _unique([resolve_policy(n) for n in args.policies])
+    try:
+        suites = [get_suite(n) for n in args.suites]
+    except ValueError as exc:
+        raise SystemExit(f"evaluate.py: {exc}")
+    if args.mission_time_s is not None:
+        suites = [s.with_options(mission_time_s=float(args.mission_time_s)) for s in suites]
+    t0 = time.perf_counter()
+    records = evaluate(policies, suites, args.episodes, args.seed_set, args.executor, args.workers, args.progress)
+    wall = time.perf_counter() - t0
+    summary = summarize(records)
+    deg = degradation(summary)
+    meta = {
+        "protocol": PROTOCOL_VERSION, "seed_set": args.seed_set, "episodes": args.episodes, "args": asdict(args),
+        "suites": {s.name: {"version": s.version, "description": s.description, "overrides": dict(s.overrides),
+                            "first_seed": s.seeds(args.seed_set, args.episodes)[0],
+                            "last_seed": s.seeds(args.seed_set, args.episodes)[-1],
+                            "conditions": [c.to_dict() for c in s.conditions]} for s in suites},
+        "policies": [{"name": p.name, "factory": p.factory, "kwargs": dict(p.kwargs)} for p in policies],
+        "wall_time_s": round(wall, 3), "created_utc": dt.datetime.now(dt.timezone.utc).isoformat(timespec="seconds"),
+    }
+    table = markdown_table(summary, deg, meta)
+    paths = write_results(args.out, records, summary, deg, meta, plots=args.plots)
+    print(table)
+    print(f"{len(records)} episodes in {wall:.1f} s ({args.executor}); results in {Path(args.out)}/: "
+          f"{', '.join(sorted(paths))}", file=sys.stderr)
+    return {"records": records, "summary": summary, "degradation": deg, "meta": meta, "table": table}
+
+
+if __name__ == "__main__":
+    main()

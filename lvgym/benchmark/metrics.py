@@ -1,0 +1,209 @@
+"""Metrics of the benchmark: per episode from a trajectory, per suite from the episode records.
+
+Per episode (:func:`episode_metrics`; ``e`` is the absolute body-rate error ``|omega - omega_ref|`` at
+the end of each control step, ``dt`` the control period; integrals are sums ``sum_k x_k dt``):
+
+=========================  ========  ===========================================================
+rate_error_rad             rad       cumulative pitch + yaw rate error ``int (e_pitch + e_yaw) dt``
+                                     (the thesis's criterion; the headline metric)
+rate_error_{roll,pitch,    rad       the same per axis
+yaw}_rad
+max_rate_radps             rad/s     largest pitch or yaw rate error of the episode
+max_rate_{pitch,yaw}_radps rad/s     per axis
+effort_rad_s               rad s     control effort ``int (|gimbal_pitch| + |gimbal_yaw|) dt``
+                                     (actuator positions, not commands)
+max_alpha_rad              rad       largest total angle of attack while the dynamic pressure is at
+                                     least ``ALPHA_MIN_QBAR_PA`` = 5 kPa (at lift-off a slow vehicle
+                                     in wind sees tens of degrees that no controller can change)
+max_qalpha_pa_deg          Pa deg    largest dynamic pressure times total angle of attack
+episode_return             -         sum of the env's rewards
+duration_s                 s         flight time when the episode ended
+failed, failure_reason     -         terminated before the mission end, and the env's reason
+=========================  ========  ===========================================================
+
+A failed episode's integrals stop at the failure: read them with its failure rate (the env's reward
+charges the remaining time instead). NaN samples (a non-finite state) are ignored by the maxima (0.0 without any sample).
+
+Per suite, for each (suite, condition, policy) (:func:`summarize`): ``mean``, ``std`` (sample standard
+deviation, ``ddof = 1``; 0 for one episode), ``cvar10`` (conditional value at risk at 10 %: the mean of
+the worst ``ceil(0.1 n)`` episodes, at least one; worst is the largest value, the smallest for
+``episode_return``), ``failure_rate`` (failed episodes over episodes) and ``n``.
+
+Degradation (:func:`degradation`), per policy, for each condition against the ``rigid`` condition of its
+group (same env, wind, randomisation and seeds; only the flight model differs):
+``ratio = mean_model / mean_rigid`` and ``diff = mean_model - mean_rigid`` of ``rate_error_rad``
+(ratio 1.0 and diff 0 mean the policy does not notice slosh and bending), also for ``cvar10``, and
+``failure_rate_diff``.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+#: metrics summarised per suite (all "lower is better" except those in :data:`HIGHER_IS_BETTER`)
+SUMMARY_METRICS = ("rate_error_rad", "rate_error_pitch_rad", "rate_error_yaw_rad", "max_rate_radps", "effort_rad_s",
+                   "max_alpha_rad", "max_qalpha_pa_deg", "episode_return")
+HIGHER_IS_BETTER = frozenset({"episode_return"})
+CVAR_LEVEL = 0.10
+#: dynamic pressure [Pa] from which the angle of attack counts in ``max_alpha_rad``
+ALPHA_MIN_QBAR_PA = 5e3
+#: keys that identify a summary row
+GROUP_KEYS = ("suite", "condition", "policy")
+
+
+@dataclass
+class Trajectory:
+    """What one episode leaves, per control step ``k = 1 .. N`` (after the step).
+
+    dt_s: control period [s]; rate_error_radps (N, 3): ``|omega - omega_ref|`` roll, pitch, yaw [rad/s];
+    gimbal_rad (N, 2): actuator pitch, yaw [rad]; alpha_total_rad (N,) [rad]; qalpha_pa_deg (N,) [Pa deg];
+    reward (N,); time_s (N,) [s]; qbar_pa (N,) [Pa]; termination: the env's reason ("" if none)."""
+
+    dt_s: float
+    rate_error_radps: np.ndarray
+    gimbal_rad: np.ndarray
+    alpha_total_rad: np.ndarray
+    qalpha_pa_deg: np.ndarray
+    reward: np.ndarray
+    time_s: np.ndarray
+    qbar_pa: np.ndarray
+    termination: str = ""
+
+
+@dataclass
+class TrajectoryBuilder:
+    """Collects a :class:`Trajectory` from the ``info`` dicts of ``env.step`` (lvgym envs).
+
+    The rate error of step ``k`` is recovered from ``info["cumulative_rate_error"]`` as
+    ``(c_k - c_{k-1}) / dt``, so its sum times ``dt`` is the env's own cumulative rate error."""
+
+    dt_s: float
+    _prev: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    _rows: list[tuple[Any, ...]] = field(default_factory=list)
+    termination: str = ""
+
+    def add(self, reward: float, info: dict[str, Any]) -> None:
+        """Record one step's reward and info."""
+        cum = np.asarray(info["cumulative_rate_error"], dtype=float)
+        rate = (cum - self._prev) / self.dt_s
+        self._prev = cum.copy()
+        self._rows.append((rate, np.asarray(info["gimbal"], dtype=float), float(info["alpha_total"]),
+                           float(info["qalpha_pa_deg"]), float(reward), float(info["time"]), float(info["qbar"])))
+        if info.get("termination"):
+            self.termination = str(info["termination"])
+
+    def build(self) -> Trajectory:
+        """The trajectory so far."""
+        n = len(self._rows)
+        cols = list(zip(*self._rows)) if n else [[]] * 7
+        return Trajectory(self.dt_s, np.reshape(np.array(cols[0], dtype=float), (n, 3)),
+                          np.reshape(np.array(cols[1], dtype=float), (n, 2)), np.array(cols[2], dtype=float),
+                          np.array(cols[3], dtype=float), np.array(cols[4], dtype=float),
+                          np.array(cols[5], dtype=float), np.array(cols[6], dtype=float), self.termination)
+
+
+def _nanmax(x: np.ndarray) -> float:
+    """Largest value ignoring NaN; 0.0 when there is none (an episode that never reached the samples)."""
+    x = np.asarray(x, dtype=float)
+    return float(np.nanmax(x)) if x.size and not np.all(np.isnan(x)) else 0.0
+
+
+def episode_metrics(traj: Trajectory) -> dict[str, Any]:
+    """The per-episode metrics of ``traj`` (see the module docstring; SI units, radians)."""
+    dt = float(traj.dt_s)
+    e = np.abs(np.nan_to_num(np.asarray(traj.rate_error_radps, dtype=float), nan=0.0))
+    g = np.abs(np.nan_to_num(np.asarray(traj.gimbal_rad, dtype=float), nan=0.0))
+    integral = e.sum(axis=0) * dt if len(e) else np.zeros(3)
+    peak = e.max(axis=0) if len(e) else np.zeros(3)
+    return {
+        "rate_error_rad": float(integral[1] + integral[2]),
+        "rate_error_roll_rad": float(integral[0]),
+        "rate_error_pitch_rad": float(integral[1]),
+        "rate_error_yaw_rad": float(integral[2]),
+        "max_rate_radps": float(max(peak[1], peak[2])),
+        "max_rate_pitch_radps": float(peak[1]),
+        "max_rate_yaw_radps": float(peak[2]),
+        "effort_rad_s": float(g.sum() * dt),
+        "max_alpha_rad": _nanmax(np.where(np.asarray(traj.qbar_pa) >= ALPHA_MIN_QBAR_PA, traj.alpha_total_rad, np.nan)),
+        "max_qalpha_pa_deg": _nanmax(traj.qalpha_pa_deg),
+        "episode_return": float(np.sum(traj.reward)),
+        "duration_s": float(traj.time_s[-1]) if len(traj.time_s) else 0.0,
+        "failed": bool(traj.termination),
+        "failure_reason": str(traj.termination),
+    }
+
+
+def cvar(values: Sequence[float], level: float = CVAR_LEVEL, higher_is_worse: bool = True) -> float:
+    """Conditional value at risk: the mean of the worst ``ceil(level * n)`` values (at least one).
+    Worst is the largest when ``higher_is_worse``, else the smallest. NaN for no values."""
+    x = np.sort(np.asarray(values, dtype=float))
+    if x.size == 0:
+        return math.nan
+    k = max(1, math.ceil(level * x.size - 1e-9))
+    return float(np.mean(x[-k:] if higher_is_worse else x[:k]))
+
+
+def _std(x: np.ndarray) -> float:
+    return float(np.std(x, ddof=1)) if x.size > 1 else 0.0
+
+
+def summarize(records: Iterable[dict[str, Any]], metrics: Sequence[str] = SUMMARY_METRICS) -> list[dict[str, Any]]:
+    """One row per (suite, condition, policy), in order of first appearance: ``n``, ``failure_rate``,
+    the failure reasons with their counts, and ``<metric>_mean``, ``_std``, ``_cvar10`` of every metric."""
+    groups: dict[tuple[Any, ...], list[dict[str, Any]]] = {}
+    for r in records:
+        groups.setdefault(tuple(r[k] for k in GROUP_KEYS), []).append(r)
+    rows = []
+    for key, recs in groups.items():
+        first = recs[0]
+        row: dict[str, Any] = dict(zip(GROUP_KEYS, key))
+        for k in ("group", "model", "wind"):
+            if k in first:
+                row[k] = first[k]
+        row["n"] = len(recs)
+        failed = [bool(r["failed"]) for r in recs]
+        row["failure_rate"] = float(np.mean(failed))
+        reasons: dict[str, int] = {}
+        for r in recs:
+            if r["failed"]:
+                reasons[r["failure_reason"]] = reasons.get(r["failure_reason"], 0) + 1
+        row["failure_reasons"] = "; ".join(f"{k}: {v}" for k, v in sorted(reasons.items()))
+        for m in metrics:
+            x = np.array([r[m] for r in recs], dtype=float)
+            row[f"{m}_mean"] = float(np.mean(x))
+            row[f"{m}_std"] = _std(x)
+            row[f"{m}_cvar10"] = cvar(x, CVAR_LEVEL, m not in HIGHER_IS_BETTER)
+        rows.append(row)
+    return rows
+
+
+def degradation(summary: Iterable[dict[str, Any]], metric: str = "rate_error_rad",
+                reference_model: str = "rigid") -> list[dict[str, Any]]:
+    """Per (suite, group, policy), every non-reference condition against the reference (``rigid``) one:
+    ``ratio = mean / mean_rigid``, ``diff = mean - mean_rigid`` (units of ``metric``), the same for the
+    CVaR10, and ``failure_rate_diff``. A zero reference mean gives a ratio of ``inf`` (or NaN for 0/0)."""
+    rows = list(summary)
+    ref = {(r["suite"], r.get("group", r["suite"]), r["policy"]): r for r in rows if r.get("model") == reference_model}
+    out = []
+    for r in rows:
+        key = (r["suite"], r.get("group", r["suite"]), r["policy"])
+        if r.get("model") == reference_model or key not in ref:
+            continue
+        base = ref[key]
+        d: dict[str, Any] = {"suite": r["suite"], "group": key[1], "policy": r["policy"], "metric": metric,
+                             "reference": base["condition"], "condition": r["condition"], "model": r["model"]}
+        for stat in ("mean", "cvar10"):
+            a, b = float(r[f"{metric}_{stat}"]), float(base[f"{metric}_{stat}"])
+            d[f"{reference_model}_{stat}"] = b
+            d[f"{stat}"] = a
+            d[f"{stat}_diff"] = a - b
+            with np.errstate(divide="ignore", invalid="ignore"):
+                d[f"{stat}_ratio"] = float(np.float64(a) / np.float64(b))
+        d["failure_rate_diff"] = float(r["failure_rate"] - base["failure_rate"])
+        out.append(d)
+    return out

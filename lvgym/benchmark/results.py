@@ -1,0 +1,253 @@
+"""Result files of an evaluation: CSV, JSON, a Markdown table and PNG plots, each written atomically.
+
+Every file is first written to a hidden temporary file in the same folder (``.<name>.<pid>.tmp``),
+flushed and fsync'ed, then renamed over its final name with ``os.replace`` (atomic on POSIX and
+Windows within one file system). An evaluation that is interrupted therefore leaves each result file
+either complete (new or old) or absent, never half-written; an exception while writing removes the
+temporary file, and temporaries left by killed processes are removed by the next write to the folder.
+
+Files (:func:`write_results`): ``episodes.csv`` (one row per episode, SI units and radians),
+``summary.csv`` (per suite, condition and policy), ``degradation.csv``, ``table.md`` (what
+:func:`markdown_table` prints), ``results.json`` (all of it with the run's metadata; written last),
+``rate_error.png`` and ``degradation.png``.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import csv
+import io
+import json
+import math
+import os
+import re
+from collections.abc import Callable, Iterator, Mapping, Sequence
+from pathlib import Path
+from typing import IO, Any
+
+import numpy as np
+
+_TMP = re.compile(r"^\..+\.(\d+)\.tmp$")
+
+
+def _pid_alive(pid: int) -> bool:
+    if pid == os.getpid():
+        return True
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    return True
+
+
+def remove_stale_temporaries(folder: str | os.PathLike[str]) -> list[Path]:
+    """Delete ``.<name>.<pid>.tmp`` files in ``folder`` whose writing process is gone; returns them."""
+    removed = []
+    folder = Path(folder)
+    if not folder.is_dir():
+        return removed
+    for p in folder.iterdir():
+        m = _TMP.match(p.name)
+        if m and not _pid_alive(int(m.group(1))):
+            with contextlib.suppress(FileNotFoundError):
+                p.unlink()
+                removed.append(p)
+    return removed
+
+
+@contextlib.contextmanager
+def atomic_path(path: str | os.PathLike[str]) -> Iterator[Path]:
+    """Yield a temporary path next to ``path``; on a clean exit it replaces ``path`` (``os.replace``),
+    on an exception it is deleted and ``path`` is left as it was."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    try:
+        yield tmp
+        with open(tmp, "rb+") as f:
+            os.fsync(f.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        with contextlib.suppress(FileNotFoundError):
+            tmp.unlink()
+        raise
+
+
+def atomic_write(path: str | os.PathLike[str], write: Callable[[IO[Any]], None], binary: bool = False) -> Path:
+    """Open a temporary file next to ``path``, call ``write(file)``, then atomically move it to ``path``."""
+    with atomic_path(path) as tmp:
+        with open(tmp, "wb" if binary else "w", newline="" if not binary else None,
+                  **({} if binary else {"encoding": "utf-8"})) as f:
+            write(f)
+    return Path(path)
+
+
+def atomic_write_text(path: str | os.PathLike[str], text: str) -> Path:
+    """Write ``text`` (UTF-8) to ``path`` atomically."""
+    return atomic_write(path, lambda f: f.write(text))
+
+
+# ---------------------------------------------------------------------------------------------- formats
+def _plain(value: Any) -> Any:
+    """JSON-safe value: numpy scalars to Python, NaN and infinities to None."""
+    if isinstance(value, np.generic):
+        value = value.item()
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    if isinstance(value, Mapping):
+        return {str(k): _plain(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_plain(v) for v in value]
+    return value
+
+
+def csv_text(rows: Sequence[Mapping[str, Any]]) -> str:
+    """Rows as CSV (columns in order of first appearance; floats in shortest round-trip form)."""
+    columns: list[str] = []
+    for r in rows:
+        columns += [k for k in r if k not in columns]
+    buf = io.StringIO()
+    w = csv.DictWriter(buf, fieldnames=columns, lineterminator="\n")
+    w.writeheader()
+    for r in rows:
+        w.writerow({k: (v.item() if isinstance(v, np.generic) else v) for k, v in r.items()})
+    return buf.getvalue()
+
+
+def json_text(obj: Any) -> str:
+    """``obj`` as indented JSON (NaN and infinities as null)."""
+    return json.dumps(_plain(obj), indent=1, sort_keys=False) + "\n"
+
+
+def _pct(x: float) -> str:
+    return f"{100.0 * x:.0f} %"
+
+
+def markdown_table(summary: Sequence[Mapping[str, Any]], degradation: Sequence[Mapping[str, Any]],
+                   meta: Mapping[str, Any] | None = None) -> str:
+    """The comparison as Markdown: per suite one table (condition x policy) and one of the degradation.
+
+    Columns: cumulative pitch + yaw rate error [rad] (mean +- std, CVaR10), mean of the maximum rate
+    error [deg/s], control effort [deg s], maximum angle of attack [deg] (q >= 5 kPa) and q-alpha
+    [kPa deg], failure rate; degradation: rate error of the non-rigid condition over the rigid one."""
+    meta = dict(meta or {})
+    out: list[str] = []
+    suites = list(dict.fromkeys(r["suite"] for r in summary))
+    for suite in suites:
+        rows = [r for r in summary if r["suite"] == suite]
+        info = meta.get("suites", {}).get(suite, {}) if isinstance(meta.get("suites"), Mapping) else {}
+        head = f"### {suite}"
+        if info:
+            head += (f" (protocol {info.get('version', '?')}, {meta.get('seed_set', '?')} seeds "
+                     f"{info.get('first_seed', '?')}-{info.get('last_seed', '?')}, {rows[0]['n']} episodes each)")
+        out += [head, "", "| condition | policy | rate error [rad] | CVaR10 [rad] | max rate [deg/s] | effort [deg s] "
+                "| max alpha [deg] | max q-alpha [kPa deg] | failures |",
+                "|---|---|---:|---:|---:|---:|---:|---:|---:|"]
+        for r in rows:
+            d = math.degrees
+            fail = _pct(r["failure_rate"]) + (f" ({r['failure_reasons']})" if r.get("failure_reasons") else "")
+            out.append(f"| {r['condition'].split('/')[-1]} | {r['policy']} "
+                       f"| {r['rate_error_rad_mean']:.4f} ± {r['rate_error_rad_std']:.4f} "
+                       f"| {r['rate_error_rad_cvar10']:.4f} | {d(r['max_rate_radps_mean']):.3f} "
+                       f"| {d(r['effort_rad_s_mean']):.2f} | {d(r['max_alpha_rad_mean']):.2f} "
+                       f"| {r['max_qalpha_pa_deg_mean'] / 1e3:.2f} | {fail} |")
+        deg = [g for g in degradation if g["suite"] == suite]
+        if deg:
+            out += ["", f"Rigid-to-non-rigid degradation of the rate error ({suite}): ratio = non-rigid / rigid, "
+                    "diff = non-rigid - rigid", "",
+                    "| policy | condition | rigid [rad] | non-rigid [rad] | ratio | diff [rad] | CVaR10 ratio "
+                    "| failure rate diff |", "|---|---|---:|---:|---:|---:|---:|---:|"]
+            for g in deg:
+                out.append(f"| {g['policy']} | {g['condition'].split('/')[-1]} | {g['rigid_mean']:.4f} "
+                           f"| {g['mean']:.4f} | {g['mean_ratio']:.3f} | {g['mean_diff']:+.4f} "
+                           f"| {g['cvar10_ratio']:.3f} | {100.0 * g['failure_rate_diff']:+.0f} pp |")
+        out.append("")
+    return "\n".join(out)
+
+
+# ---------------------------------------------------------------------------------------------- plots
+def _figure(width: float, height: float) -> Any:
+    """A matplotlib Figure on the Agg canvas (no pyplot, no global backend change)."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(width, height), dpi=110)
+    FigureCanvasAgg(fig)
+    return fig
+
+
+def plot_rate_error(records: Sequence[Mapping[str, Any]], write_to: IO[bytes]) -> None:
+    """Box plots of the cumulative rate error [rad] per suite: one box per condition and policy."""
+    suites = list(dict.fromkeys(r["suite"] for r in records))
+    fig = _figure(max(5.0, 4.2 * len(suites)), 4.0)
+    for k, suite in enumerate(suites):
+        ax = fig.add_subplot(1, len(suites), k + 1)
+        recs = [r for r in records if r["suite"] == suite]
+        conds = list(dict.fromkeys(r["condition"] for r in recs))
+        pols = list(dict.fromkeys(r["policy"] for r in recs))
+        width = 0.8 / len(pols)
+        for j, pol in enumerate(pols):
+            data = [[r["rate_error_rad"] for r in recs if r["condition"] == c and r["policy"] == pol] for c in conds]
+            pos = [i + (j - (len(pols) - 1) / 2) * width for i in range(len(conds))]
+            bp = ax.boxplot(data, positions=pos, widths=width * 0.9, patch_artist=True, manage_ticks=False)
+            for box in bp["boxes"]:
+                box.set_facecolor(f"C{j}")
+                box.set_alpha(0.6)
+            ax.plot([], [], "s", color=f"C{j}", label=pol)
+        ax.set_xticks(range(len(conds)), [c.split("/")[-1] for c in conds])
+        ax.set_title(suite)
+        ax.set_ylabel("cumulative pitch + yaw rate error [rad]")
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(write_to, format="png")
+
+
+def plot_degradation(degradation: Sequence[Mapping[str, Any]], write_to: IO[bytes]) -> None:
+    """Bars of the rigid-to-non-rigid ratio of the mean rate error per suite and policy (1 = no change)."""
+    fig = _figure(6.0, 3.8)
+    ax = fig.add_subplot(1, 1, 1)
+    labels = list(dict.fromkeys(f"{g['suite']}\n{g['condition'].split('/')[-1]}" for g in degradation))
+    pols = list(dict.fromkeys(g["policy"] for g in degradation))
+    width = 0.8 / max(1, len(pols))
+    for j, pol in enumerate(pols):
+        xs, ys = [], []
+        for g in degradation:
+            if g["policy"] == pol:
+                xs.append(labels.index(f"{g['suite']}\n{g['condition'].split('/')[-1]}") + (j - (len(pols) - 1) / 2) * width)
+                ys.append(g["mean_ratio"] if math.isfinite(g["mean_ratio"]) else np.nan)
+        ax.bar(xs, ys, width * 0.9, color=f"C{j}", label=pol)
+    ax.axhline(1.0, color="k", lw=0.8)
+    ax.set_xticks(range(len(labels)), labels, fontsize=8)
+    ax.set_ylabel("rate error, non-rigid / rigid")
+    ax.grid(alpha=0.3, axis="y")
+    if pols:
+        ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(write_to, format="png")
+
+
+# ---------------------------------------------------------------------------------------------- all files
+def write_results(out: str | os.PathLike[str], records: Sequence[Mapping[str, Any]],
+                  summary: Sequence[Mapping[str, Any]], degradation: Sequence[Mapping[str, Any]],
+                  meta: Mapping[str, Any], plots: bool = True) -> dict[str, Path]:
+    """Write every result file into ``out`` (created if missing), each atomically; ``results.json``
+    last. Returns the paths by name."""
+    folder = Path(out)
+    folder.mkdir(parents=True, exist_ok=True)
+    remove_stale_temporaries(folder)
+    paths: dict[str, Path] = {}
+    paths["episodes.csv"] = atomic_write_text(folder / "episodes.csv", csv_text(records))
+    paths["summary.csv"] = atomic_write_text(folder / "summary.csv", csv_text(summary))
+    paths["degradation.csv"] = atomic_write_text(folder / "degradation.csv", csv_text(degradation))
+    paths["table.md"] = atomic_write_text(folder / "table.md", markdown_table(summary, degradation, meta))
+    if plots:
+        paths["rate_error.png"] = atomic_write(folder / "rate_error.png", lambda f: plot_rate_error(records, f), True)
+        if degradation:
+            paths["degradation.png"] = atomic_write(folder / "degradation.png",
+                                                    lambda f: plot_degradation(degradation, f), True)
+    paths["results.json"] = atomic_write_text(folder / "results.json", json_text(
+        {"meta": meta, "summary": summary, "degradation": degradation, "episodes": records}))
+    return paths

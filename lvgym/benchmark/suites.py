@@ -1,0 +1,153 @@
+"""The frozen evaluation protocol: named suites of conditions and the seed sets they are run on.
+
+A *condition* is one env configuration (env id, flight model, wind tier, randomisation and a few fixed
+options); a *suite* is a list of conditions that share a seed set. Episode ``i`` of a suite is reset
+with the same seed under every condition and for every policy (common random numbers), so the rigid and
+the non-rigid episode of a seed fly the same wind and dispersions and the comparison is paired.
+
+Seeds: **validation** seeds ``0 .. 9_999`` are for training, tuning and model selection; **test**
+seeds ``10_000 ..`` are for reported numbers only. Episode ``i`` uses ``VALIDATION_SEED0 + i`` or
+``TEST_SEED0 + i``.
+
+The protocol is versioned: :data:`PROTOCOL_VERSION` is written into every result record. A change of a
+suite's conditions, of a seed set or of a metric's definition is a new version (``v1``, ...) and leaves
+the old suites untouched under their old names; results of different versions are not comparable.
+
+=================  =====================  ==========================================================
+suite              env                    conditions (each flown ``rigid`` and ``nonrigid``)
+=================  =====================  ==========================================================
+smile-calm         SmileAscent-v0         no wind; thrust misalignment and mass dispersed
+smile-windy        SmileAscent-v0         moderate Dryden turbulence over a 10 m/s wind (drawn per
+                                          seed); thrust misalignment dispersed. The default suite.
+smile-dispersed    SmileAscent-v0         random jet stream + turbulence, every randomisation (mass,
+                                          slosh damping, bending frequency, sensor noise), IMU sensors
+slender-ld30       SlenderAscent-v0       L/D = 30 (8.5 m x 0.2833 m); turbulence drawn per seed,
+                                          thrust misalignment and bending frequency dispersed
+=================  =====================  ==========================================================
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field, replace
+from typing import Any
+
+PROTOCOL_VERSION = "v0"
+#: first validation seed; validation seeds are ``VALIDATION_SEED0 + i`` for ``i < N_VALIDATION_SEEDS``
+VALIDATION_SEED0 = 0
+N_VALIDATION_SEEDS = 10_000
+#: first test seed; test seeds are ``TEST_SEED0 + i`` (disjoint from the validation seeds)
+TEST_SEED0 = 10_000
+N_TEST_SEEDS = 10_000
+SEED_SETS = ("test", "validation")
+DEFAULT_SUITE = "smile-windy"
+
+
+def _freeze(options: Mapping[str, Any]) -> tuple[tuple[str, Any], ...]:
+    """Options as a sorted tuple of pairs (hashable; lists become tuples)."""
+    return tuple(sorted((k, tuple(v) if isinstance(v, list) else v) for k, v in options.items()))
+
+
+@dataclass(frozen=True)
+class Condition:
+    """One env configuration of a suite.
+
+    env_id: a registered lvgym env id; model: ``rigid | slosh | flex | nonrigid``; wind: a wind tier
+    (``lvgym.envs.WIND_TIERS``); randomize: names of ``lvgym.envs.RANDOMIZE`` drawn per seed (a sorted
+    tuple, or ``()``); options: further env keywords as sorted ``(key, value)`` pairs (e.g.
+    ``("mission_time_s", 3.0)``). ``name`` labels the condition in result tables; conditions of a suite
+    that differ only in ``model`` share a ``group`` (the pairing of the rigid-to-non-rigid degradation).
+    """
+
+    name: str
+    env_id: str
+    model: str = "nonrigid"
+    wind: str = "none"
+    randomize: tuple[str, ...] = ()
+    options: tuple[tuple[str, Any], ...] = ()
+    group: str = ""
+
+    def env_kwargs(self) -> dict[str, Any]:
+        """Keywords of ``gymnasium.make(self.env_id, **kwargs)``."""
+        return {"model": self.model, "wind": self.wind, "randomize": list(self.randomize), **dict(self.options)}
+
+    def make_env(self) -> Any:
+        """A fresh env of this condition (``gymnasium.make``; imports ``lvgym`` to register the ids)."""
+        import gymnasium
+
+        import lvgym  # noqa: F401  (registers the env ids)
+
+        return gymnasium.make(self.env_id, **self.env_kwargs())
+
+    def with_options(self, **options: Any) -> Condition:
+        """This condition with env keywords added or replaced (e.g. a short ``mission_time_s`` for tests)."""
+        return replace(self, options=_freeze({**dict(self.options), **options}))
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-friendly description."""
+        return {"name": self.name, "env_id": self.env_id, "model": self.model, "wind": self.wind,
+                "randomize": list(self.randomize), "options": dict(self.options), "group": self.group}
+
+
+@dataclass(frozen=True)
+class Suite:
+    """A named list of conditions evaluated on a common seed set."""
+
+    name: str
+    description: str
+    conditions: tuple[Condition, ...]
+    version: str = PROTOCOL_VERSION
+    overrides: tuple[tuple[str, Any], ...] = field(default=())
+
+    def seeds(self, seed_set: str, n: int) -> list[int]:
+        """The first ``n`` seeds of ``seed_set`` (``"test"`` or ``"validation"``)."""
+        if seed_set not in SEED_SETS:
+            raise ValueError(f"seed_set = {seed_set!r}: one of {SEED_SETS}")
+        limit = N_TEST_SEEDS if seed_set == "test" else N_VALIDATION_SEEDS
+        if not 1 <= int(n) <= limit:
+            raise ValueError(f"episodes = {n!r}: 1 .. {limit} per condition for the {seed_set} seed set")
+        base = TEST_SEED0 if seed_set == "test" else VALIDATION_SEED0
+        return [base + i for i in range(int(n))]
+
+    def with_options(self, **options: Any) -> Suite:
+        """This suite with env keywords overridden in every condition. The overrides are recorded
+        (``overrides``) and the version gets a ``+override`` suffix: such results are not protocol numbers."""
+        if not options:
+            return self
+        conds = tuple(c.with_options(**options) for c in self.conditions)
+        return replace(self, conditions=conds, version=f"{PROTOCOL_VERSION}+override",
+                       overrides=_freeze({**dict(self.overrides), **options}))
+
+
+def _pair(suite: str, env_id: str, wind: str, randomize: tuple[str, ...], models: tuple[str, ...] = ("rigid", "nonrigid"),
+          **options: Any) -> tuple[Condition, ...]:
+    """The conditions of one group: the same env flown with each flight model."""
+    return tuple(Condition(name=f"{suite}/{m}", env_id=env_id, model=m, wind=wind, randomize=tuple(sorted(randomize)),
+                           options=_freeze(options), group=suite) for m in models)
+
+
+SMILE, SLENDER = "lvgym/SmileAscent-v0", "lvgym/SlenderAscent-v0"
+
+#: the frozen suites of protocol v0 (do not edit: add new suites or a new protocol version instead)
+SUITES: dict[str, Suite] = {s.name: s for s in (
+    Suite("smile-calm", "SMILE, 60 s, no wind; thrust misalignment and mass dispersed",
+          _pair("smile-calm", SMILE, "none", ("thrust_misalignment", "mass"))),
+    Suite("smile-windy", "SMILE, 60 s, moderate Dryden turbulence over a 10 m/s wind drawn per seed; "
+          "thrust misalignment dispersed",
+          _pair("smile-windy", SMILE, "turbulence", ("wind", "thrust_misalignment"))),
+    Suite("smile-dispersed", "SMILE, 60 s, random jet stream and turbulence, every randomisation, IMU sensors",
+          _pair("smile-dispersed", SMILE, "random", ("wind", "thrust_misalignment", "mass", "slosh_damping",
+                                                     "bending_frequency", "sensor_noise"), observation="sensors")),
+    Suite("slender-ld30", "Slender vehicle L/D = 30 (8.5 m x 0.2833 m), 10 s, turbulence drawn per seed; "
+          "thrust misalignment and bending frequency dispersed",
+          _pair("slender-ld30", SLENDER, "turbulence", ("wind", "thrust_misalignment", "bending_frequency"),
+                length=8.5, diameter=0.2833)),
+)}
+
+
+def get_suite(name: str) -> Suite:
+    """The suite called ``name``; a ``ValueError`` lists the known names otherwise."""
+    try:
+        return SUITES[name]
+    except KeyError:
+        raise ValueError(f"suite = {name!r}: one of {sorted(SUITES)}") from None
