@@ -119,3 +119,21 @@ def test_rail_exit_is_found_at_the_physics_step():
     speed = np.linalg.norm(sim.state("v_zw_i")[0] - np.cross([0, 0, sim.omega_e], sim.state("r_zw_i")[0]))
     assert 10.0 <= sim.rail_s[0] < 10.0 + 0.01 * speed         # within one physics step of travel
     assert abs(exit_t / 0.01 - round(exit_t / 0.01)) < 1e-6      # on a physics step, inside the call
+
+
+def test_batched_row_infos_equal_single_row_infos():
+    from lvgym.envs.ascent import _row, _rows
+    from lvgym.envs import smile_ascent_vector
+    env = smile_ascent_vector(num_envs=3, model="nonrigid", wind="gust")
+    env.reset(seed=1)
+    for _ in range(120):
+        _, _, _, _, info = env.step(np.full((3, 2), 0.1, dtype=np.float32))
+    rows = _rows(info, 3)
+    for b in range(3):
+        one = _row(info, b)
+        assert rows[b].keys() == one.keys()
+        for key, value in one.items():
+            if isinstance(value, np.ndarray):
+                np.testing.assert_array_equal(rows[b][key], value)
+            else:
+                assert rows[b][key] == value, key

@@ -17,7 +17,7 @@ import numpy as np
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
-from .ascent import SlenderAscentEnv, _row, make_spaces
+from .ascent import SlenderAscentEnv, _rows, make_spaces
 from .core import AscentBatch
 from .spec import TaskSpec
 
@@ -103,7 +103,7 @@ class AscentSB3VecEnv:
             def step_wait(self):
                 obs, reward, terminated, truncated, info = self.core.step(self._actions.reshape(self.num_envs, -1))
                 done = terminated | truncated
-                infos = [_row(info, b) for b in range(self.num_envs)]
+                infos = _rows(info, self.num_envs)
                 for b in np.flatnonzero(done):
                     infos[b]["terminal_observation"] = obs[b].copy()
                     infos[b]["TimeLimit.truncated"] = bool(truncated[b] and not terminated[b])
