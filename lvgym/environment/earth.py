@@ -124,19 +124,19 @@ def site_dcm_ni_k(x, y, z, t, p, C):
 @nb.njit(cache=True)
 def site_dcm_ni_latlon_k(lat, lon, t, p, C):
     """:func:`site_dcm_ni_k` from the point's geodetic latitude and longitude [rad] (as
-    :func:`site_geodetic_k` returns them), for callers that already have them."""
-    C_ne = np.empty((3, 3))
-    dcm_ne_k(lat, lon, C_ne)
-    C_ei = np.empty((3, 3))
-    if p[SITE_FLAT] != 0.0:              # "inertial" is the launch frame: C_ei = C_el = C_le^T
-        for j in range(3):
-            for k in range(3):
-                C_ei[j, k] = p[SITE_C_LE + 3 * k + j]
-    else:
-        dcm_ei_k(t, p[SITE_OMEGA], C_ei)
+    :func:`site_geodetic_k` returns them), for callers that already have them. No allocation."""
+    dcm_ne_k(lat, lon, C)                            # C = C_ne, then C_ne C_ei row by row
+    flat = p[SITE_FLAT] != 0.0
+    c, s = math.cos(p[SITE_OMEGA] * t), math.sin(p[SITE_OMEGA] * t)
     for j in range(3):
-        for k in range(3):
-            C[j, k] = C_ne[j, 0] * C_ei[0, k] + C_ne[j, 1] * C_ei[1, k] + C_ne[j, 2] * C_ei[2, k]
+        r0, r1, r2 = C[j, 0], C[j, 1], C[j, 2]
+        if flat:                                     # "inertial" is the launch frame: C_ei = C_le^T
+            for k in range(3):
+                C[j, k] = r0 * p[SITE_C_LE + 3 * k] + r1 * p[SITE_C_LE + 3 * k + 1] + r2 * p[SITE_C_LE + 3 * k + 2]
+        else:                                        # C_ei = [[c, s, 0], [-s, c, 0], [0, 0, 1]]
+            C[j, 0] = r0 * c - r1 * s
+            C[j, 1] = r0 * s + r1 * c
+            C[j, 2] = r2
 
 
 @nb.njit(cache=True)

@@ -10,7 +10,8 @@ the vehicle felt.
 ``c`` is the per-vehicle *context* vector (layout ``C_*``): the commands (gimbal angles, a body moment
 such as reaction-control thrusters give) and thrust held over a step
 and the row's start time ``c[C_TIME0]`` (the stepper's time is relative to it, so the rows of a batch
-may be at different times), followed by the parameter arrays of the launch site, gravity, atmosphere, wind and aerodynamic models,
+may be at different times), a scratch block the compiled functions write into (so that an evaluation
+allocates nothing; each row is only ever evaluated by one thread at a time), followed by the parameter arrays of the launch site, gravity, atmosphere, wind and aerodynamic models,
 packed end to end with their start offsets in the header (rows of a batch may have different wind
 blocks; shorter rows are padded). :func:`pack_context` builds it.
 
@@ -42,7 +43,7 @@ C_T0, C_AE, C_DP, C_DY, C_MIS_P, C_MIS_Y, C_AERO = 0, 1, 2, 3, 4, 5, 6
 C_SITE, C_GRAV, C_ATM, C_WIND, C_AP, C_AG, C_AD, C_AT, C_NCOL, C_END = 7, 8, 9, 10, 11, 12, 13, 14, 15, 16
 C_TIME0 = 17                      # start time of the row's step [s]: the stepper's t is relative to it
 C_MOMENT = 18                     # commanded body moment (3) [N m], e.g. reaction-control thrusters
-C_HEADER = 21
+C_SCRATCH = 21                    # scratch of the compiled functions (flight conditions, a 3x3 matrix)
 
 # ---------------------------------------------------------------------------- flight conditions layout
 DIAG_FIELDS = (
@@ -57,6 +58,8 @@ for _name, _size in DIAG_FIELDS:
     DIAG[_name] = slice(_o, _o + _size)
     _o += _size
 N_DIAG = _o
+C_SCRATCH_M = C_SCRATCH + N_DIAG
+C_HEADER = C_SCRATCH_M + 9
 (D_ALT, D_RHO, D_PRES, D_TEMP, D_SOUND) = (DIAG[k].start for k in
                                             ("altitude", "density", "pressure", "temperature", "speed_of_sound"))
 D_WIND, D_VAIR, D_ALPHA = DIAG["wind_n"].start, DIAG["v_air_b"].start, DIAG["alpha"].start
@@ -83,7 +86,7 @@ def flight_conditions_k(t, x, p, c, d):
     rho, pres, sound = d[D_RHO], d[D_PRES], d[D_SOUND]
     wn = d[D_WIND:D_WIND + 3]
     wind_ned(c[o_wind:o_ap], alt, t, wn)
-    C = np.empty((3, 3))
+    C = c[C_SCRATCH_M:C_SCRATCH_M + 9].reshape((3, 3))
     site_dcm_ni_latlon_k(lat, lon, t, site, C)
     vx, vy, vz = site_velocity_wrt_earth_k(rx, ry, rz, x[3], x[4], x[5], site)
     vr0 = vx - (C[0, 0] * wn[0] + C[1, 0] * wn[1] + C[2, 0] * wn[2])
@@ -130,7 +133,7 @@ def flight_conditions_k(t, x, p, c, d):
 def _flight_loads(t, x, p, c, u):
     """Loads of the dynamics core from the flight conditions: aerodynamic force (inertial) and moment
     about the CG, thrust in the engine frame, gravity; no generalised modal forces."""
-    d = np.empty(N_DIAG)
+    d = c[C_SCRATCH:C_SCRATCH + N_DIAG]
     flight_conditions_k(c[C_TIME0] + t, x, p, c, d)
     for i in range(3):
         u[_U_F + i] = d[D_FAERO_I + i]
