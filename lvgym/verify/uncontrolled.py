@@ -143,7 +143,12 @@ def run_stratos3(model: str, drop_thrust_n: float | None = None, thesis_slosh: b
                  dt: float = 0.05) -> dict[str, np.ndarray]:
     """Stratos III uncontrolled for 30 s, one batch row per wind of :func:`stratos3_winds`."""
     winds = list(stratos3_winds().values())
-    sim = Simulator(_stratos3_vehicle(drop_thrust_n), model=model, t_end=STRATOS3_T_END, **STRATOS3)
+    vehicle = _stratos3_vehicle(drop_thrust_n)
+    try:
+        sim = Simulator(vehicle, model=model, t_end=STRATOS3_T_END, **STRATOS3)
+    finally:
+        if vehicle != "stratos3":
+            Path(vehicle).unlink(missing_ok=True)
     scale, offset = _thesis_slosh(sim) if thesis_slosh and sim.dynamics.n_slosh else (None, None)
     sim.reset(batch=len(winds), rng=np.random.default_rng(0), winds=winds, param_scale=scale, param_offset=offset)
     return fly(sim, STRATOS3_T_END, dt)
