@@ -151,8 +151,9 @@ class StratosIIIEnv(AscentEnv):
     30 s from El Arenosillo, 85 deg elevation off a 10 m rail. Roll control with reaction-control pulses:
     ``MultiDiscrete([3])`` (0: negative, 1: none, 2: positive roll torque of ``rcs_torque_nm`` = 2 N m,
     an assumption: the thesis gives no thruster size), bang-bang as in thesis 5.3; ``control="tvc"`` gives
-    the hypothetical TVC instead. Reward weights all three rates (roll, pitch, yaw). The nonrigid model
-    shows the slosh-driven departure at the thrust drop (22-23 s) that the rigid model does not."""
+    the hypothetical TVC instead. Reward weights all three rates (roll, pitch, yaw). As shipped, the
+    thrust after the drop stays above the drag and the N2O slosh mass is about 3 kg, so the nonrigid
+    model does not depart at the drop as the thesis's did (docs/uncontrolled.md)."""
 
     DEFAULTS = {"vehicle": "stratos3", "site": "el_arenosillo", "elevation_deg": 85.0, "rail_length_m": 10.0,
                 "mission_time_s": 30.0, "control": "rcs", "rate_weights": (1.0, 1.0, 1.0),

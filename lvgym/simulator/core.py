@@ -373,9 +373,14 @@ class Simulator:
 
     def slosh_angles(self) -> np.ndarray:
         """Pendulum deflections from the body axis (B, N, 2) [rad]: the rod's angle in the x-y and x-z
-        body planes (0 at rest, hanging aft)."""
-        out = np.zeros((self.batch, self.dynamics.n_slosh, 2))
-        slosh_angles_k(self.x, self.dynamics.n_slosh, self.dynamics.n_modes, out)
+        body planes (0 at rest, hanging aft); NaN for a pendulum without mass (an empty or dropped
+        tank, whose frozen state means nothing)."""
+        N = self.dynamics.n_slosh
+        out = np.zeros((self.batch, N, 2))
+        slosh_angles_k(self.x, N, self.dynamics.n_modes, out)
+        if N:
+            m_j = self.p[:, [self.layout.slosh_param(j, "m").start for j in range(N)]]
+            out[m_j <= 0.0] = np.nan
         return out
 
     def lateral_cg_offset(self) -> np.ndarray:
