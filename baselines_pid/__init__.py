@@ -1,4 +1,14 @@
-"""PID and gain-scheduled PID TVC baselines: arrive with the issue "PID and gain-scheduled PID".
+"""PID and gain-scheduled PID TVC baselines (thesis 6.3) and a bang-bang roll controller (thesis 5.3).
 
-Nothing is importable here yet; the package exists so the project layout is fixed from the start.
+Every controller implements the benchmark's policy interface (:class:`lvgym.benchmark.Policy`):
+``reset()`` and ``act(observation, info) -> action``. ``python -m baselines_pid.tune --vehicle smile``
+regenerates a gain schedule from the rigid linearisation; ``python -m baselines_pid.study`` runs the
+thesis's control study (docs/control-study.md).
 """
+
+from .bangbang import BangBangRollPolicy
+from .pid import (DiscretePID, GainSchedule, GainScheduledPIDPolicy, PIDPolicy, smile_scheduled_pid,
+                  smile_single_pid)
+
+__all__ = ["BangBangRollPolicy", "DiscretePID", "GainSchedule", "GainScheduledPIDPolicy", "PIDPolicy",
+           "smile_scheduled_pid", "smile_single_pid"]
