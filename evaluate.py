@@ -68,7 +68,8 @@ class Args:
 def parse_args(argv: list[str] | None = None) -> Args:
     """Parse the command line into :class:`Args`."""
     d = Args()
-    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0], formatter_class=argparse.RawDescriptionHelpFormatter)
+    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0],
+                                formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--policies", nargs="+", default=d.policies, metavar="POLICY",
                    help=f"names {sorted(POLICIES)} or SB3 .zip paths (default: {' '.join(d.policies)})")
     p.add_argument("--suites", nargs="+", default=d.suites, metavar="SUITE",

@@ -22,7 +22,8 @@ failed, failure_reason     -         terminated before the mission end, and the 
 =========================  ========  ===========================================================
 
 A failed episode's integrals stop at the failure: read them with its failure rate (the env's reward
-charges the remaining time instead). NaN samples (a non-finite state) are ignored by the maxima (0.0 without any sample).
+charges the remaining time instead). NaN samples (a non-finite state) are ignored by the maxima (0.0
+without any sample).
 
 Per suite, for each (suite, condition, policy) (:func:`summarize`): ``mean``, ``std`` (sample standard
 deviation, ``ddof = 1``; 0 for one episode), ``cvar10`` (conditional value at risk at 10 %: the mean of

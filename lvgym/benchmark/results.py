@@ -216,7 +216,8 @@ def plot_degradation(degradation: Sequence[Mapping[str, Any]], write_to: IO[byte
         xs, ys = [], []
         for g in degradation:
             if g["policy"] == pol:
-                xs.append(labels.index(f"{g['suite']}\n{g['condition'].split('/')[-1]}") + (j - (len(pols) - 1) / 2) * width)
+                label = f"{g['suite']}\n{g['condition'].split('/')[-1]}"
+                xs.append(labels.index(label) + (j - (len(pols) - 1) / 2) * width)
                 ys.append(g["mean_ratio"] if math.isfinite(g["mean_ratio"]) else np.nan)
         ax.bar(xs, ys, width * 0.9, color=f"C{j}", label=pol)
     ax.axhline(1.0, color="k", lw=0.8)

@@ -15,7 +15,7 @@ import inspect
 import os
 import sys
 from collections.abc import Callable, Sequence
-from concurrent.futures import FIRST_EXCEPTION, ProcessPoolExecutor, wait
+from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass
 from typing import Any
 
@@ -176,24 +176,36 @@ def _run_serial(tasks: Sequence[Task], bar: Any) -> list[dict[str, Any]]:
     return out
 
 
+def _exit_with_parent(parent: int) -> None:
+    """Worker initializer: a daemon thread ends the worker once its parent is gone (a killed evaluation
+    leaves no workers behind; a pool's workers otherwise wait for work forever)."""
+    import threading
+    import time
+
+    def watch() -> None:
+        while os.getppid() == parent:
+            time.sleep(0.5)
+        os._exit(1)
+
+    threading.Thread(target=watch, name="exit-with-parent", daemon=True).start()
+
+
 def _run_local(tasks: Sequence[Task], bar: Any, workers: int) -> list[dict[str, Any]]:
     import multiprocessing as mp
 
     results: list[dict[str, Any] | None] = [None] * len(tasks)
     # spawn: workers do not inherit the parent's threads (numba, BLAS) or open files
-    with ProcessPoolExecutor(max_workers=workers, mp_context=mp.get_context("spawn")) as pool:
+    with ProcessPoolExecutor(max_workers=workers, mp_context=mp.get_context("spawn"),
+                             initializer=_exit_with_parent, initargs=(os.getpid(),)) as pool:
         futures = {pool.submit(run_task, t): i for i, t in enumerate(tasks)}
-        pending = set(futures)
         try:
-            while pending:
-                done, pending = wait(pending, return_when=FIRST_EXCEPTION)
-                for f in done:
-                    i = futures[f]
-                    exc = f.exception()
-                    if exc is not None:
-                        raise RuntimeError(f"episode failed: {_describe(tasks[i])}: {exc}") from exc
-                    results[i] = f.result()
-                    bar.update(1)
+            for f in as_completed(futures):
+                i = futures[f]
+                exc = f.exception()
+                if exc is not None:
+                    raise RuntimeError(f"episode failed: {_describe(tasks[i])}: {exc}") from exc
+                results[i] = f.result()
+                bar.update(1)
         except BaseException:
             pool.shutdown(wait=True, cancel_futures=True)
             raise
@@ -214,7 +226,7 @@ def _run_ray(tasks: Sequence[Task], bar: Any, workers: int) -> list[dict[str, An
         index = {r: i for i, r in enumerate(refs)}
         pending = list(refs)
         while pending:
-            done, pending = ray.wait(pending, num_returns=1)
+            done, pending = ray.wait(pending, num_returns=len(pending), timeout=0.2)
             for ref in done:
                 try:
                     ray.get(ref)

@@ -119,8 +119,8 @@ class Suite:
                        overrides=_freeze({**dict(self.overrides), **options}))
 
 
-def _pair(suite: str, env_id: str, wind: str, randomize: tuple[str, ...], models: tuple[str, ...] = ("rigid", "nonrigid"),
-          **options: Any) -> tuple[Condition, ...]:
+def _pair(suite: str, env_id: str, wind: str, randomize: tuple[str, ...],
+          models: tuple[str, ...] = ("rigid", "nonrigid"), **options: Any) -> tuple[Condition, ...]:
     """The conditions of one group: the same env flown with each flight model."""
     return tuple(Condition(name=f"{suite}/{m}", env_id=env_id, model=m, wind=wind, randomize=tuple(sorted(randomize)),
                            options=_freeze(options), group=suite) for m in models)

@@ -1,0 +1,344 @@
+"""The benchmark protocol (lvgym.benchmark) and evaluate.py: metrics by hand, determinism of the table
+across runs and executors, atomic result files (an interrupted write or a killed run leaves no
+half-written file), Ray, the SB3 adapter and the command line end to end on a tiny case."""
+
+from __future__ import annotations
+
+import csv
+import importlib.util
+import io
+import json
+import math
+import re
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from lvgym.benchmark import (SUITES, ZERO, PolicySpec, Trajectory, TrajectoryBuilder, cvar, degradation,
+                             episode_metrics, evaluate, get_suite, markdown_table, run_episode, summarize,
+                             write_results)
+from lvgym.benchmark import results as results_mod
+from lvgym.benchmark.results import atomic_write, csv_text
+from lvgym.benchmark.suites import TEST_SEED0, VALIDATION_SEED0
+
+ROOT = Path(__file__).resolve().parents[1]
+SHORT = 3.0   # s: mission time of the short episodes used here
+
+
+def short_suite(name: str = "smile-windy"):
+    return get_suite(name).with_options(mission_time_s=SHORT)
+
+
+# ---------------------------------------------------------------------------------------------- metrics
+def hand_trajectory(termination: str = "q-alpha beyond the structural limit") -> Trajectory:
+    return Trajectory(
+        dt_s=0.5,
+        rate_error_radps=np.array([[0.1, 0.2, 0.0], [0.0, -0.4, 0.1], [0.3, 0.0, 0.2], [0.0, 0.2, 0.0]]),
+        gimbal_rad=np.array([[0.01, -0.02], [0.0, 0.0], [0.03, 0.01], [-0.01, 0.0]]),
+        alpha_total_rad=np.array([0.5, 0.1, 0.05, 0.02]),
+        qalpha_pa_deg=np.array([10.0, 200.0, np.nan, 50.0]),
+        reward=np.array([-1.0, -2.0, -0.5, 0.0]),
+        time_s=np.array([0.5, 1.0, 1.5, 2.0]),
+        qbar_pa=np.array([100.0, 6000.0, 20000.0, 4000.0]),
+        termination=termination)
+
+
+def test_episode_metrics_by_hand():
+    m = episode_metrics(hand_trajectory())
+    # pitch |e| = 0.2, 0.4, 0, 0.2 -> 0.8 * 0.5 s; yaw 0, 0.1, 0.2, 0 -> 0.3 * 0.5; roll 0.4 * 0.5
+    assert m["rate_error_pitch_rad"] == pytest.approx(0.4)
+    assert m["rate_error_yaw_rad"] == pytest.approx(0.15)
+    assert m["rate_error_roll_rad"] == pytest.approx(0.2)
+    assert m["rate_error_rad"] == pytest.approx(0.55)
+    assert m["max_rate_pitch_radps"] == pytest.approx(0.4)
+    assert m["max_rate_yaw_radps"] == pytest.approx(0.2)
+    assert m["max_rate_radps"] == pytest.approx(0.4)
+    # |gimbal| sums 0.03 + 0 + 0.04 + 0.01 = 0.08 -> 0.04 rad s
+    assert m["effort_rad_s"] == pytest.approx(0.04)
+    # alpha counts where qbar >= 5 kPa (steps 2 and 3): 0.1; the 0.5 rad at 100 Pa does not
+    assert m["max_alpha_rad"] == pytest.approx(0.1)
+    assert m["max_qalpha_pa_deg"] == pytest.approx(200.0)      # the NaN sample is ignored
+    assert m["episode_return"] == pytest.approx(-3.5)
+    assert m["duration_s"] == 2.0
+    assert m["failed"] is True and m["failure_reason"] == "q-alpha beyond the structural limit"
+    ok = episode_metrics(hand_trajectory(termination=""))
+    assert ok["failed"] is False and ok["failure_reason"] == ""
+
+
+def test_trajectory_builder_recovers_rates_from_the_cumulative_error():
+    b = TrajectoryBuilder(dt_s=0.5)
+    cum = np.zeros(3)
+    for k, e in enumerate([[0.1, 0.2, 0.0], [0.0, 0.4, 0.1]]):
+        cum = cum + np.array(e) * 0.5
+        b.add(-1.0, {"cumulative_rate_error": cum.copy(), "gimbal": np.array([0.01, 0.0]), "alpha_total": 0.1,
+                     "qalpha_pa_deg": 5.0, "time": 0.5 * (k + 1), "qbar": 1e4,
+                     "termination": "" if k == 0 else "attitude error beyond the limit"})
+    t = b.build()
+    np.testing.assert_allclose(t.rate_error_radps, [[0.1, 0.2, 0.0], [0.0, 0.4, 0.1]])
+    m = episode_metrics(t)
+    assert m["rate_error_rad"] == pytest.approx(cum[1] + cum[2])
+    assert m["failure_reason"] == "attitude error beyond the limit"
+
+
+def test_cvar_is_the_mean_of_the_worst_tenth():
+    x = np.arange(1.0, 21.0)                      # 20 values: the worst 2 are 19 and 20
+    assert cvar(x) == pytest.approx(19.5)
+    assert cvar(x, higher_is_worse=False) == pytest.approx(1.5)
+    assert cvar([3.0, 1.0, 2.0]) == 3.0           # fewer than 10: the single worst
+    assert cvar(np.arange(11.0)) == pytest.approx(9.5)   # 11 values: ceil(1.1) = 2
+    assert math.isnan(cvar([]))
+
+
+def _rec(cond: str, model: str, value: float, failed: bool = False) -> dict:
+    m = episode_metrics(hand_trajectory(""))
+    m.update(rate_error_rad=value, failed=failed, failure_reason="x" if failed else "")
+    return {"suite": "s", "condition": cond, "group": "s", "model": model, "wind": "none", "policy": "p", **m}
+
+
+def test_summary_and_degradation_by_hand():
+    recs = [_rec("s/rigid", "rigid", v) for v in (1.0, 2.0, 3.0)]
+    recs += [_rec("s/nonrigid", "nonrigid", v, failed=(v == 6.0)) for v in (2.0, 4.0, 6.0)]
+    rigid, nonrigid = summarize(recs)
+    assert rigid["n"] == 3 and rigid["rate_error_rad_mean"] == 2.0 and rigid["rate_error_rad_std"] == 1.0
+    assert rigid["rate_error_rad_cvar10"] == 3.0 and rigid["failure_rate"] == 0.0
+    assert nonrigid["failure_rate"] == pytest.approx(1 / 3) and nonrigid["failure_reasons"] == "x: 1"
+    (d,) = degradation([rigid, nonrigid])
+    assert d["policy"] == "p" and d["condition"] == "s/nonrigid" and d["reference"] == "s/rigid"
+    assert d["mean_ratio"] == 2.0 and d["mean_diff"] == 2.0
+    assert d["cvar10_ratio"] == 2.0 and d["failure_rate_diff"] == pytest.approx(1 / 3)
+    table = markdown_table([rigid, nonrigid], [d])
+    assert "| rigid | p | 2.0000 ± 1.0000 | 3.0000 |" in table
+    assert "| p | nonrigid | 2.0000 | 4.0000 | 2.000 | +2.0000 | 2.000 | +33 pp |" in table
+
+
+# ---------------------------------------------------------------------------------------------- suites
+def test_suites_are_frozen_and_seed_sets_disjoint():
+    assert {"smile-calm", "smile-windy", "smile-dispersed", "slender-ld30"} <= set(SUITES)
+    s = get_suite("smile-windy")
+    assert s.seeds("test", 3) == [TEST_SEED0, TEST_SEED0 + 1, TEST_SEED0 + 2]
+    assert s.seeds("validation", 2) == [VALIDATION_SEED0, VALIDATION_SEED0 + 1]
+    assert not set(s.seeds("test", 10_000)) & set(s.seeds("validation", 10_000))
+    for suite in SUITES.values():
+        assert suite.version == "v0" and {c.model for c in suite.conditions} == {"rigid", "nonrigid"}
+    short = short_suite()
+    assert short.version == "v0+override" and dict(short.overrides) == {"mission_time_s": SHORT}
+    assert get_suite("smile-windy").version == "v0"            # the frozen suite is untouched
+    with pytest.raises(ValueError, match="smile-windy"):
+        get_suite("no-such-suite")
+
+
+@pytest.mark.parametrize("name", sorted(SUITES))
+def test_every_condition_makes_its_env(name):
+    for cond in get_suite(name).with_options(mission_time_s=0.1).conditions:
+        env = cond.make_env()
+        env.reset(seed=1)
+        env.step(env.action_space.sample())
+        env.close()
+
+
+# ---------------------------------------------------------------------------------------------- determinism
+def test_run_episode_does_not_depend_on_what_ran_before():
+    cond = short_suite().conditions[1]
+    a = run_episode(ZERO, cond, 10_000)
+    b = run_episode(ZERO, cond, 10_001)
+    assert a != b                                           # the seed draws the wind
+    assert run_episode(ZERO, cond, 10_000) == a
+
+
+def test_same_seeds_give_the_same_table_whatever_the_executor():
+    suite = short_suite()
+    runs = [evaluate([ZERO], [suite], 2, executor=ex, workers=2, progress=False)
+            for ex in ("serial", "serial", "local")]
+    tables, csvs = [], []
+    for recs in runs:
+        s = summarize(recs)
+        tables.append(markdown_table(s, degradation(s)))
+        csvs.append(csv_text(recs))
+    assert tables[0] == tables[1] == tables[2]
+    assert csvs[0] == csvs[1] == csvs[2]
+    assert [r["seed"] for r in runs[0]] == [10_000, 10_001] * 2
+    other = evaluate([ZERO], [suite], 2, seed_set="validation", executor="serial", progress=False)
+    assert csv_text(other) != csvs[0]
+
+
+@pytest.mark.skipif(importlib.util.find_spec("ray") is None, reason="ray is not installed (optional extra)")
+def test_ray_executor_gives_the_serial_records():
+    suite = short_suite()
+    serial = evaluate([ZERO], [suite], 1, executor="serial", progress=False)
+    ray = evaluate([ZERO], [suite], 1, executor="ray", workers=2, progress=False)
+    # Ray workers run BLAS on one thread (OMP_NUM_THREADS=1): the modal analysis of the non-rigid
+    # timeline then differs in the last bits, so floats agree to 1e-9, not bit for bit
+    assert [r.keys() for r in ray] == [r.keys() for r in serial]
+    for r, s in zip(ray, serial):
+        assert r == {k: pytest.approx(v, rel=1e-9) if isinstance(v, float) else v for k, v in s.items()}
+    table = [markdown_table(summarize(x), degradation(summarize(x))) for x in (serial, ray)]
+    assert table[0] == table[1]
+
+
+# ---------------------------------------------------------------------------------------------- result files
+def _complete(folder: Path) -> None:
+    """Every file in ``folder`` is a finished result file and no temporary is left."""
+    names = sorted(p.name for p in folder.iterdir())
+    assert not [n for n in names if n.startswith(".")], names
+    for p in folder.iterdir():
+        if p.suffix == ".json":
+            json.loads(p.read_text())
+        elif p.suffix == ".csv":
+            rows = list(csv.reader(io.StringIO(p.read_text())))
+            assert all(len(r) == len(rows[0]) for r in rows)
+        elif p.suffix == ".png":
+            data = p.read_bytes()
+            assert data[:8] == b"\x89PNG\r\n\x1a\n" and data[-8:-4] == b"IEND"
+
+
+def test_an_interrupted_write_leaves_no_partial_file(tmp_path, monkeypatch):
+    recs = [_rec("s/rigid", "rigid", v) for v in (1.0, 2.0)] + [_rec("s/nonrigid", "nonrigid", 3.0)]
+    s = summarize(recs)
+    first = write_results(tmp_path, recs, s, degradation(s), {"run": 1})
+    before = {n: p.read_bytes() for n, p in first.items()}
+
+    def broken_plot(records, f):                    # writes half a PNG, then fails
+        f.write(b"\x89PNG\r\n\x1a\n" + b"\0" * 100)
+        raise KeyboardInterrupt("killed while writing")
+
+    monkeypatch.setattr(results_mod, "plot_rate_error", broken_plot)
+    with pytest.raises(KeyboardInterrupt):
+        write_results(tmp_path, recs[:2], s[:1], [], {"run": 2})
+    _complete(tmp_path)
+    assert (tmp_path / "rate_error.png").read_bytes() == before["rate_error.png"]
+    assert (tmp_path / "results.json").read_bytes() == before["results.json"]   # written last: never reached
+
+    with pytest.raises(RuntimeError):
+        atomic_write(tmp_path / "new.csv", lambda f: (f.write("a,b\n1,"), (_ for _ in ()).throw(RuntimeError())))
+    assert not (tmp_path / "new.csv").exists()
+    _complete(tmp_path)
+
+
+def test_temporaries_of_dead_writers_are_removed(tmp_path):
+    dead = subprocess.Popen([sys.executable, "-c", "pass"])
+    dead.wait()
+    stale = tmp_path / f".episodes.csv.{dead.pid}.tmp"
+    stale.write_text("half")
+    recs = [_rec("s/rigid", "rigid", 1.0)]
+    write_results(tmp_path, recs, summarize(recs), [], {}, plots=False)
+    assert not stale.exists()
+    _complete(tmp_path)
+
+
+def _evaluate_cmd(out: Path, *extra: str) -> list[str]:
+    return [sys.executable, str(ROOT / "evaluate.py"), "--out", str(out), "--mission-time-s", str(SHORT), *extra]
+
+
+def _children(pid: int) -> list[int]:
+    """Processes whose parent is ``pid`` (Linux /proc)."""
+    out = []
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            fields = stat.read_text().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        if int(fields[1]) == pid:
+            out.append(int(stat.parent.name))
+    return out
+
+
+def _alive(pid: int) -> bool:
+    try:
+        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+    except OSError:
+        return False
+    return state != "Z"
+
+
+@pytest.mark.parametrize("sig, executor", [(signal.SIGKILL, "local"), (signal.SIGTERM, "serial")])
+def test_a_killed_evaluation_leaves_no_result_file(tmp_path, sig, executor):
+    out = tmp_path / "results"
+    proc = subprocess.Popen(_evaluate_cmd(out, "--policies", "zero", "--episodes", "500", "--executor", executor,
+                                          "--workers", "2"),
+                            cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    seen = b""
+    deadline = time.time() + 60
+    while not re.search(rb" [1-9]\d*/1000 ", seen) and time.time() < deadline:   # episodes are finishing
+        seen += proc.stderr.read1(1024)
+    assert proc.poll() is None, seen.decode(errors="replace")
+    workers = _children(proc.pid) if Path("/proc").is_dir() else []
+    proc.send_signal(sig)
+    proc.communicate(timeout=30)
+    assert proc.returncode != 0
+    assert not out.exists() or not any(out.iterdir())
+    deadline = time.time() + 10                      # pool workers follow their killed parent
+    while any(_alive(w) for w in workers) and time.time() < deadline:
+        time.sleep(0.2)
+    assert not [w for w in workers if _alive(w)]
+
+
+# ---------------------------------------------------------------------------------------------- policies, CLI
+@pytest.fixture(scope="module")
+def tiny_sb3(tmp_path_factory):
+    """An untrained PPO saved with a VecNormalize pickle next to it."""
+    import gymnasium
+    from stable_baselines3 import PPO
+    from stable_baselines3.common.vec_env import DummyVecEnv, VecNormalize
+
+    folder = tmp_path_factory.mktemp("sb3")
+    venv = VecNormalize(DummyVecEnv([lambda: gymnasium.make("lvgym/SmileAscent-v0", model="rigid",
+                                                            mission_time_s=0.2)]))
+    model = PPO("MlpPolicy", venv, n_steps=8, batch_size=8, policy_kwargs={"net_arch": [8]}, device="cpu", seed=0)
+    model.save(folder / "tiny.zip")
+    venv.save(str(folder / "tiny_vecnormalize.pkl"))
+    return folder / "tiny.zip"
+
+
+def test_sb3_model_acts_as_a_policy(tiny_sb3):
+    from lvgym.benchmark.sb3 import SB3Policy
+
+    p = SB3Policy(str(tiny_sb3))
+    assert p.name == "tiny" and p.normalizer is not None
+    p.reset()
+    a = p.act(np.zeros(14, dtype=np.float32), {})
+    assert a.shape == (2,) and np.all(np.abs(a) <= 1.0)
+    spec = PolicySpec("tiny", "lvgym.benchmark.sb3:SB3Policy", (("path", str(tiny_sb3)),))
+    r = run_episode(spec, short_suite().conditions[0], 10_000)
+    assert r["policy"] == "tiny" and r["duration_s"] == pytest.approx(SHORT)
+
+
+def _evaluate_module(monkeypatch):
+    spec = importlib.util.spec_from_file_location("evaluate_under_test", ROOT / "evaluate.py")
+    mod = importlib.util.module_from_spec(spec)
+    monkeypatch.setitem(sys.modules, spec.name, mod)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+def test_registry_names_what_is_missing(monkeypatch):
+    ev = _evaluate_module(monkeypatch)
+    monkeypatch.setitem(ev.POLICIES, "ghost", PolicySpec("ghost", "no_such_baselines.pid:GhostPID"))
+    with pytest.raises(SystemExit, match="no_such_baselines"):
+        ev.resolve_policy("ghost")
+    with pytest.raises(SystemExit, match="zero"):
+        ev.resolve_policy("not-a-policy")
+    assert ev.resolve_policy("zero") == ZERO
+    args = ev.parse_args([])
+    assert args.policies == ["zero", "pid", "gs-pid"] and args.suites == ["smile-windy"] and args.executor == "local"
+
+
+def test_cli_end_to_end(tmp_path, tiny_sb3):
+    out = tmp_path / "res"
+    proc = subprocess.run(_evaluate_cmd(out, "--policies", "zero", str(tiny_sb3), "--episodes", "2", "--workers", "2"),
+                          cwd=ROOT, capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0, proc.stderr
+    assert "| rigid | zero |" in proc.stdout and "| nonrigid | tiny |" in proc.stdout
+    assert "episodes" in proc.stderr                                  # the progress bar
+    assert {"episodes.csv", "summary.csv", "degradation.csv", "table.md", "results.json", "rate_error.png",
+            "degradation.png"} <= {p.name for p in out.iterdir()}
+    _complete(out)
+    rows = list(csv.DictReader(io.StringIO((out / "episodes.csv").read_text())))
+    assert len(rows) == 2 * 2 * 2 and {r["policy"] for r in rows} == {"zero", "tiny"}
+    data = json.loads((out / "results.json").read_text())
+    assert data["meta"]["suites"]["smile-windy"]["version"] == "v0+override"
+    assert (out / "table.md").read_text() in proc.stdout
