@@ -1,0 +1,127 @@
+"""Map a picklable function over tasks: serially, on a local process pool or on Ray, with a progress bar.
+
+``lvgym.benchmark.runner`` has the same three executors, but bound to benchmark episodes (its
+``run_task``); this is the generic form the studies need: any module-level function, any picklable
+tasks, and a callback per finished task (the studies write their cache there, so an interrupted study
+keeps every run that finished). Results come back in the order of the tasks whatever the executor.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+from collections.abc import Callable, Sequence
+from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+from typing import Any, TypeVar
+
+__all__ = ["EXECUTORS", "default_workers", "run_map"]
+
+EXECUTORS = ("local", "serial", "ray")
+T = TypeVar("T")
+R = TypeVar("R")
+
+
+def default_workers() -> int:
+    """CPUs this process may run on."""
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except AttributeError:                        # not on Linux
+        return max(1, os.cpu_count() or 1)
+
+
+def _exit_with_parent(parent: int) -> None:
+    """Worker initializer: end the worker once its parent is gone (an interrupted study leaves no workers)."""
+    import threading
+    import time
+
+    def watch() -> None:
+        while os.getppid() == parent:
+            time.sleep(0.5)
+        os._exit(1)
+
+    threading.Thread(target=watch, name="exit-with-parent", daemon=True).start()
+
+
+def _serial(fn: Callable[[T], R], tasks: Sequence[T], done: Callable[[int, R], None]) -> None:
+    for i, t in enumerate(tasks):
+        done(i, fn(t))
+
+
+def _local(fn: Callable[[T], R], tasks: Sequence[T], done: Callable[[int, R], None], workers: int) -> None:
+    import multiprocessing as mp
+
+    # spawn: workers inherit neither the parent's threads (numba, BLAS) nor its open files
+    with ProcessPoolExecutor(max_workers=workers, mp_context=mp.get_context("spawn"),
+                             initializer=_exit_with_parent, initargs=(os.getpid(),)) as pool:
+        futures = {pool.submit(fn, t): i for i, t in enumerate(tasks)}
+        pending = set(futures)
+        try:
+            while pending:
+                finished, pending = wait(pending, return_when=FIRST_COMPLETED)
+                for f in finished:
+                    done(futures[f], f.result())
+        except BaseException:
+            pool.shutdown(wait=True, cancel_futures=True)
+            raise
+
+
+def _ray(fn: Callable[[T], R], tasks: Sequence[T], done: Callable[[int, R], None], workers: int) -> None:
+    try:
+        import ray
+    except ImportError as exc:
+        raise ImportError("executor 'ray' needs Ray: pip install 'lvgym[ray]' (or pip install ray)") from exc
+    started = not ray.is_initialized()
+    if started:
+        ray.init(num_cpus=workers, include_dashboard=False, log_to_driver=False, configure_logging=False)
+    try:
+        remote = ray.remote(num_cpus=1)(fn)
+        refs = [remote.remote(t) for t in tasks]
+        index = {r: i for i, r in enumerate(refs)}
+        pending = list(refs)
+        try:
+            while pending:
+                finished, pending = ray.wait(pending, num_returns=1)
+                for ref in finished:
+                    done(index[ref], ray.get(ref))
+        except BaseException:
+            for p in pending:
+                ray.cancel(p, force=True)
+            raise
+    finally:
+        if started:
+            ray.shutdown()
+
+
+def run_map(fn: Callable[[T], R], tasks: Sequence[T], executor: str = "local", workers: int | None = None,
+            progress: bool = True, on_result: Callable[[int, R], None] | None = None,
+            desc: str = "runs") -> list[R]:
+    """``[fn(t) for t in tasks]`` computed by ``executor``, in the order of ``tasks``.
+
+    executor: ``local`` (a spawn process pool of ``workers`` processes, default the CPUs available; one
+    worker runs serially), ``serial`` (this process) or ``ray`` (Ray tasks; starts a local Ray with
+    ``workers`` CPUs unless ``ray.init`` was called already, e.g. to join a cluster). ``fn`` must be a
+    module-level function and the tasks picklable. ``on_result(i, result)`` is called in this process as
+    each task finishes. An exception in a task stops the map and is raised here."""
+    if executor not in EXECUTORS:
+        raise ValueError(f"executor = {executor!r}: one of {EXECUTORS}")
+    results: list[Any] = [None] * len(tasks)
+    if not tasks:
+        return []
+    n = max(1, min(int(workers) if workers else default_workers(), len(tasks)))
+    from tqdm.auto import tqdm
+
+    with tqdm(total=len(tasks), desc=desc, unit="run", disable=not progress, file=sys.stderr,
+              dynamic_ncols=True) as bar:
+        def done(i: int, r: R) -> None:
+            results[i] = r
+            if on_result is not None:
+                on_result(i, r)
+            bar.update(1)
+
+        if executor == "serial" or (executor == "local" and n == 1):
+            _serial(fn, tasks, done)
+        elif executor == "local":
+            _local(fn, tasks, done, n)
+        else:
+            _ray(fn, tasks, done, n)
+    return results
