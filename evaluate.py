@@ -2,8 +2,8 @@
 
     python evaluate.py                                   # the default comparison (see DEFAULT_*)
     python evaluate.py --policies zero pid gs-pid runs/ppo_smile.zip --suites smile-windy --episodes 50
-    python evaluate.py --executor ray --workers 32       # Ray (pip install 'lvgym[ray]'); joins a running
-                                                         # cluster if ray.init() was called, else starts one
+    python evaluate.py --executor ray --workers 4        # Ray (pip install 'lvgym[ray]'): a local Ray
+    RAY_ADDRESS=auto python evaluate.py --executor ray    # ... or the running cluster (``ray start``)
 
 Policies are names of :data:`POLICIES` (``zero``, ``pid``, ``gs-pid``) or paths of saved
 stable-baselines3 models (``.zip``; an optional ``<stem>_vecnormalize.pkl`` next to it normalises the
@@ -35,8 +35,9 @@ POLICIES: dict[str, PolicySpec] = {
 }
 DEFAULT_POLICIES = ["zero", "pid", "gs-pid"]
 DEFAULT_SUITES = ["smile-windy"]
-#: episodes per condition and policy of the default run (2 x 3 x 30 = 180 episodes of 60 s, ~1.5 min on 2 cores)
-DEFAULT_EPISODES = 30
+#: episodes per condition and policy of the default run (2 conditions x 3 policies x 50 = 300 episodes of 60 s:
+#: about 75 s on 2 free cores)
+DEFAULT_EPISODES = 50
 
 
 @dataclass

@@ -179,7 +179,8 @@ def _figure(width: float, height: float) -> Any:
 
 
 def plot_rate_error(records: Sequence[Mapping[str, Any]], write_to: IO[bytes]) -> None:
-    """Box plots of the cumulative rate error [rad] per suite: one box per condition and policy."""
+    """Box plots of the cumulative rate error [rad] per suite: one box per condition and policy; failed
+    episodes (their error integrated up to the failure) marked with red crosses."""
     suites = list(dict.fromkeys(r["suite"] for r in records))
     fig = _figure(max(5.0, 4.2 * len(suites)), 4.0)
     for k, suite in enumerate(suites):
@@ -196,6 +197,9 @@ def plot_rate_error(records: Sequence[Mapping[str, Any]], write_to: IO[bytes]) -
                 box.set_facecolor(f"C{j}")
                 box.set_alpha(0.6)
             ax.plot([], [], "s", color=f"C{j}", label=pol)
+            for x, c in zip(pos, conds):             # failed episodes as red crosses
+                ys = [r["rate_error_rad"] for r in recs if r["condition"] == c and r["policy"] == pol and r["failed"]]
+                ax.plot([x] * len(ys), ys, "x", color="red", ms=6)
         ax.set_xticks(range(len(conds)), [c.split("/")[-1] for c in conds])
         ax.set_title(suite)
         ax.set_ylabel("cumulative pitch + yaw rate error [rad]")

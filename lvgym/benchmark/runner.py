@@ -218,7 +218,9 @@ def _run_ray(tasks: Sequence[Task], bar: Any, workers: int) -> list[dict[str, An
     except ImportError as exc:
         raise ImportError("executor 'ray' needs Ray: pip install 'lvgym[ray]' (or pip install ray)") from exc
     started = not ray.is_initialized()
-    if started:
+    if started and os.environ.get("RAY_ADDRESS"):     # join the cluster named by RAY_ADDRESS
+        ray.init(log_to_driver=False, configure_logging=False)
+    elif started:                                     # a local Ray of `workers` CPUs, for this run
         ray.init(num_cpus=workers, include_dashboard=False, log_to_driver=False, configure_logging=False)
     try:
         remote = ray.remote(num_cpus=1)(run_task)
@@ -247,8 +249,10 @@ def evaluate(policies: Sequence[PolicySpec], suites: Sequence[Suite], episodes: 
     the episode records in the order of :func:`make_tasks` (whatever the executor and worker count).
 
     executor: ``local`` (a process pool of ``workers`` processes, default: the CPUs available),
-    ``serial`` (this process) or ``ray`` (Ray tasks; starts a local Ray with ``workers`` CPUs unless
-    ``ray.init`` was called already, e.g. to join a cluster)."""
+    ``serial`` (this process) or ``ray`` (one Ray task per episode: on the Ray already initialised in this
+    process, else on the cluster at ``$RAY_ADDRESS``, else on a local Ray of ``workers`` CPUs started and
+    stopped here). Ray workers import ``lvgym`` and the policy factories, so install the project on
+    every node."""
     if executor not in EXECUTORS:
         raise ValueError(f"executor = {executor!r}: one of {EXECUTORS}")
     tasks = make_tasks(policies, suites, episodes, seed_set)
