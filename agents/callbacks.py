@@ -1,0 +1,336 @@
+"""Training callbacks: crash-safe checkpoints with validation on the benchmark protocol, and a progress bar.
+
+A checkpoint ``checkpoints/step_<N>`` (N = env steps, 12 digits) is::
+
+    step_<N>.zip, step_<N>_vecnormalize.pkl     model (weights, optimiser) and normalisation statistics
+    step_<N>_rng.pkl                            torch, numpy and random generator states
+    step_<N>_replay_buffer.pkl                  SAC / TD3 replay buffer (kept for the latest checkpoint only)
+    step_<N>.json                               state: algo, steps, evaluation history, best so far
+
+each file written atomically and the JSON last: a checkpoint exists once its JSON does, so a run killed at
+any moment resumes from a complete checkpoint (files of a half-written one are removed on resume).
+Checkpoints are taken at rollout boundaries (after a PPO update, before the next rollout), so the weights,
+the optimiser, the step counter and the statistics agree. Validation (when due) runs at a checkpoint, on
+the checkpointed model, with the protocol's validation seeds; its result is part of the checkpoint's JSON,
+so the evaluation history and the best model are restored with it. ``best_model.*`` and ``final_model.*``
+next to ``checkpoints/`` are copies in the :mod:`agents.policy` layout (loadable by ``evaluate.py``).
+"""
+
+from __future__ import annotations
+
+import json
+import pickle
+import random
+import re
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from stable_baselines3.common.callbacks import BaseCallback
+
+from lvgym.benchmark.metrics import TrajectoryBuilder, episode_metrics, summarize
+from lvgym.benchmark.policy import Policy
+from lvgym.benchmark.results import atomic_path, atomic_write_text, json_text, remove_stale_temporaries
+from lvgym.benchmark.suites import Suite, get_suite
+
+from .policy import SB3Policy, copy_policy, policy_files
+
+_STEM = re.compile(r"^step_(\d{12})$")
+RNG_SUFFIX = "_rng.pkl"
+BUFFER_SUFFIX = "_replay_buffer.pkl"
+
+
+def checkpoint_stem(folder: Path, step: int) -> Path:
+    return folder / f"step_{int(step):012d}"
+
+
+def list_checkpoints(folder: str | Path) -> list[tuple[int, Path]]:
+    """Complete checkpoints (their JSON exists) of ``folder``, oldest first: ``(step, stem)``."""
+    folder = Path(folder)
+    out = []
+    if folder.is_dir():
+        for p in folder.glob("step_*.json"):
+            m = _STEM.match(p.stem)
+            if m and p.with_suffix(".zip").is_file():
+                out.append((int(m.group(1)), p.with_suffix("")))
+    return sorted(out)
+
+
+def latest_checkpoint(folder: str | Path) -> tuple[Path, dict[str, Any]] | None:
+    """``(zip path, state)`` of the newest complete checkpoint of ``folder``, or None."""
+    ckpts = list_checkpoints(folder)
+    if not ckpts:
+        return None
+    stem = ckpts[-1][1]
+    return policy_files(stem)[0], json.loads(policy_files(stem)[2].read_text(encoding="utf-8"))
+
+
+def clean_incomplete(folder: str | Path) -> list[Path]:
+    """Remove the files of checkpoints whose JSON was never written (a run killed while saving) and
+    stale temporaries; returns what was removed."""
+    folder = Path(folder)
+    removed = remove_stale_temporaries(folder)
+    complete = {stem.name for _, stem in list_checkpoints(folder)}
+    for p in sorted(folder.glob("step_*")) if folder.is_dir() else []:
+        stem = p.name[:len("step_") + 12]
+        if _STEM.match(stem) and stem not in complete:
+            p.unlink()
+            removed.append(p)
+    return removed
+
+
+def save_rng(path: Path) -> None:
+    import torch
+
+    state = {"torch": torch.get_rng_state(), "numpy": np.random.get_state(), "random": random.getstate()}
+    with atomic_path(path) as tmp, open(tmp, "wb") as f:
+        pickle.dump(state, f)
+
+
+def load_rng(path: Path) -> bool:
+    """Restore the generator states saved by :func:`save_rng`; False when there is no file."""
+    import torch
+
+    if not path.is_file():
+        return False
+    with open(path, "rb") as f:
+        state = pickle.load(f)
+    torch.set_rng_state(state["torch"])
+    np.random.set_state(state["numpy"])
+    random.setstate(state["random"])
+    return True
+
+
+# ------------------------------------------------------------------------------------------ validation
+class ValidationEvaluator:
+    """Episodes of a policy on every condition of a protocol suite, reset with the suite's validation
+    seeds (``lvgym.benchmark``: same conditions, seeds, trajectory and metrics as ``evaluate.py``).
+    ``overrides``: env keywords for every condition (e.g. ``mission_time_s`` in tests; the suite is then
+    marked ``+override``)."""
+
+    def __init__(self, suite: str | Suite, episodes: int, overrides: dict[str, Any] | None = None) -> None:
+        s = get_suite(suite) if isinstance(suite, str) else suite
+        self.suite = s.with_options(**overrides) if overrides else s
+        self.seeds = self.suite.seeds("validation", int(episodes))
+        self._envs: dict[Any, Any] = {}
+
+    def episode(self, policy: Policy, condition: Any, seed: int) -> dict[str, Any]:
+        """One episode's record (as ``lvgym.benchmark.runner.run_episode`` returns it)."""
+        if condition not in self._envs:
+            self._envs[condition] = condition.make_env()
+        env = self._envs[condition]
+        obs, info = env.reset(seed=int(seed))
+        policy.reset()
+        traj = TrajectoryBuilder(float(env.unwrapped.task.control_dt_s))
+        while True:
+            obs, reward, terminated, truncated, info = env.step(policy.act(obs, info))
+            traj.add(reward, info)
+            if terminated or truncated:
+                break
+        return {"suite": self.suite.name, "condition": condition.name, "group": condition.group,
+                "policy": policy.name, "model": condition.model, "seed": int(seed), **episode_metrics(traj.build())}
+
+    def evaluate(self, policy: Policy) -> dict[str, Any]:
+        """Per-condition means and failure rates, and the selection ``score``: ``[failure rate, rate
+        error]`` averaged over the conditions, compared lexicographically (lower is better; a failed
+        episode's rate error stops at the failure, so failures must count first)."""
+        records = [self.episode(policy, c, s) for c in self.suite.conditions for s in self.seeds]
+        rows = summarize(records, ("rate_error_rad", "max_rate_radps", "effort_rad_s", "episode_return"))
+        conds: dict[str, dict[str, float]] = {}
+        for r in rows:
+            conds[r["condition"]] = {k: float(r[k]) for k in r if isinstance(r[k], (int, float))
+                                     and not isinstance(r[k], bool) and k != "n"}
+        fail = float(np.mean([c["failure_rate"] for c in conds.values()]))
+        err = float(np.mean([c["rate_error_rad_mean"] for c in conds.values()]))
+        return {"suite": self.suite.name, "version": self.suite.version, "seed_set": "validation",
+                "episodes": len(self.seeds), "conditions": conds, "failure_rate": fail, "rate_error_rad": err,
+                "score": [fail, err]}
+
+    def close(self) -> None:
+        for env in self._envs.values():
+            env.close()
+        self._envs.clear()
+
+
+# ------------------------------------------------------------------------------------------ checkpoints
+class CheckpointCallback(BaseCallback):
+    """Checkpoint every ``save_freq`` env steps (at the first rollout boundary past it) and at the end;
+    validate with ``evaluator`` at the checkpoints at least ``eval_freq`` steps after the last validation
+    (and at the end; ``eval_freq <= 0`` or no evaluator: never). Keeps the newest ``keep`` checkpoints and
+    the best one. ``meta``: written into every JSON (algo, env id and kwargs, ...). ``state``: the JSON of
+    the checkpoint a resumed run starts from (restores the evaluation history and the best)."""
+
+    def __init__(self, run_dir: str | Path, save_freq: int, meta: dict[str, Any], vecnormalize: Any = None,
+                 evaluator: ValidationEvaluator | None = None, eval_freq: int = 0, keep: int = 3,
+                 state: dict[str, Any] | None = None, verbose: int = 0) -> None:
+        super().__init__(verbose)
+        self.run_dir = Path(run_dir)
+        self.folder = self.run_dir / "checkpoints"
+        self.save_freq = max(1, int(save_freq))
+        self.meta = dict(meta)
+        self.vecnormalize = vecnormalize
+        self.evaluator = evaluator
+        self.eval_freq = int(eval_freq)
+        self.keep = max(1, int(keep))
+        state = state or {}
+        self.evaluations: list[dict[str, Any]] = list(state.get("evaluations", []))
+        self.best: dict[str, Any] | None = state.get("best")
+        self.last_save = int(state.get("num_timesteps", -1))
+        self.last_eval = int(self.evaluations[-1]["num_timesteps"]) if self.evaluations else 0
+
+    def _init_callback(self) -> None:
+        self.folder.mkdir(parents=True, exist_ok=True)
+        if self.last_save < 0:
+            self.last_save = self.num_timesteps
+        if self.best is not None:                   # a resumed run: best_model.* as of its checkpoint
+            self._copy_best()
+
+    def _on_step(self) -> bool:
+        return True
+
+    def _on_rollout_start(self) -> None:
+        if self.num_timesteps - self.last_save >= self.save_freq:
+            due = self.evaluator is not None and self.eval_freq > 0 and \
+                self.num_timesteps - self.last_eval >= self.eval_freq
+            self.save(evaluate=due)
+
+    def _on_training_end(self) -> None:
+        if self.num_timesteps != self.last_save or not list_checkpoints(self.folder):
+            self.save(evaluate=self.evaluator is not None and self.eval_freq > 0)
+        last = list_checkpoints(self.folder)
+        if last:
+            copy_policy(last[-1][1], self.run_dir / "final_model")
+
+    def save(self, evaluate: bool = False) -> Path:
+        """Write a checkpoint of the model now (and validate it first if ``evaluate``)."""
+        step = int(self.num_timesteps)
+        stem = checkpoint_stem(self.folder, step)
+        zip_path, norm_path, json_path = policy_files(stem)
+        with atomic_path(zip_path) as tmp:
+            self.model.save(tmp)
+        if self.vecnormalize is not None:
+            with atomic_path(norm_path) as tmp:
+                self.vecnormalize.save(tmp)
+        save_rng(stem.with_name(stem.name + RNG_SUFFIX))
+        if hasattr(self.model, "save_replay_buffer") and self.model.replay_buffer is not None:
+            with atomic_path(stem.with_name(stem.name + BUFFER_SUFFIX)) as tmp:
+                with open(tmp, "wb") as f:
+                    pickle.dump(self.model.replay_buffer, f, protocol=pickle.HIGHEST_PROTOCOL)
+        new_best = False
+        if evaluate:
+            result = self._validate(step)
+            self.evaluations.append(result)
+            self.last_eval = step
+            if self.best is None or result["score"] < self.best["score"]:
+                self.best, new_best = {"num_timesteps": step, "score": result["score"], "stem": stem.name}, True
+        state = {**self.meta, "num_timesteps": step, "saved_utc": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
+                 "evaluations": self.evaluations, "best": self.best}
+        atomic_write_text(json_path, json_text(state))            # the commit: the checkpoint now exists
+        self.last_save = step
+        if evaluate:
+            atomic_write_text(self.run_dir / "evaluations.json", json_text(self.evaluations))
+        if new_best:
+            self._copy_best()
+        self._prune()
+        if self.verbose:
+            print(f"checkpoint {stem.name}" + (f" (validation score {self.evaluations[-1]['score']})"
+                                               if evaluate else ""), file=sys.stderr)
+        return zip_path
+
+    def _validate(self, step: int) -> dict[str, Any]:
+        assert self.evaluator is not None
+        t0 = time.perf_counter()
+        policy = SB3Policy.from_model(self.model, self.vecnormalize, name=f"step_{step}")
+        result = {"num_timesteps": step, **self.evaluator.evaluate(policy),
+                  "wall_s": round(time.perf_counter() - t0, 3)}
+        self.logger.record("eval/failure_rate", result["failure_rate"])
+        self.logger.record("eval/rate_error_rad", result["rate_error_rad"])
+        for name, c in result["conditions"].items():
+            tag = name.split("/")[-1]
+            self.logger.record(f"eval/{tag}/rate_error_rad", c["rate_error_rad_mean"])
+            self.logger.record(f"eval/{tag}/failure_rate", c["failure_rate"])
+            self.logger.record(f"eval/{tag}/episode_return", c["episode_return_mean"])
+        return result
+
+    def _copy_best(self) -> None:
+        if self.best is None:
+            return
+        stem = self.folder / self.best["stem"]
+        if policy_files(stem)[2].is_file():
+            copy_policy(stem, self.run_dir / "best_model", {"validation_score": self.best["score"]})
+
+    def _prune(self) -> None:
+        ckpts = list_checkpoints(self.folder)
+        keep = {stem.name for _, stem in ckpts[-self.keep:]}
+        if self.best is not None:
+            keep.add(self.best["stem"])
+        latest = ckpts[-1][1].name if ckpts else ""
+        for _, stem in ckpts:
+            if stem.name != latest:
+                stem.with_name(stem.name + BUFFER_SUFFIX).unlink(missing_ok=True)
+            if stem.name in keep:
+                continue
+            policy_files(stem)[2].unlink(missing_ok=True)          # the JSON first: no half checkpoint
+            for suffix in (".zip", "_vecnormalize.pkl", RNG_SUFFIX, BUFFER_SUFFIX):
+                stem.with_name(stem.name + suffix).unlink(missing_ok=True)
+
+
+def load_replay_buffer(model: Any, stem: Path) -> bool:
+    """Put a checkpoint's replay buffer (SAC / TD3) back into ``model``; False when it has none."""
+    path = stem.with_name(stem.name + BUFFER_SUFFIX)
+    if not path.is_file() or not hasattr(model, "replay_buffer"):
+        return False
+    with open(path, "rb") as f:
+        model.replay_buffer = pickle.load(f)
+    return True
+
+
+# ------------------------------------------------------------------------------------------ progress
+class ProgressBarCallback(BaseCallback):
+    """A tqdm bar of env steps towards the run's target (continuing from the resumed step), with the
+    steps per second and the mean return of the last episodes (SB3's own bar needs ``rich``)."""
+
+    def __init__(self, enabled: bool = True, refresh_s: float = 0.5) -> None:
+        super().__init__()
+        self.enabled = enabled
+        self.refresh_s = refresh_s
+        self.bar: Any = None
+        self._last = 0.0
+
+    def _on_training_start(self) -> None:
+        from tqdm.auto import tqdm
+
+        self.bar = tqdm(total=int(self.model._total_timesteps), initial=int(self.model.num_timesteps),
+                        unit="step", unit_scale=True, dynamic_ncols=True, disable=not self.enabled,
+                        file=sys.stderr, desc="training")
+
+    def _on_step(self) -> bool:
+        now = time.monotonic()
+        if self.bar is not None and now - self._last >= self.refresh_s:
+            self._last = now
+            self.bar.update(int(self.model.num_timesteps) - self.bar.n)
+            buf = self.model.ep_info_buffer
+            if buf:
+                self.bar.set_postfix(ep_return=f"{np.mean([e['r'] for e in buf]):.3g}", refresh=False)
+        return True
+
+    def _on_training_end(self) -> None:
+        if self.bar is not None:
+            self.bar.update(int(self.model.num_timesteps) - self.bar.n)
+            self.bar.close()
+
+
+def evaluate_saved(path: str | Path, suite: str = "smile-windy", episodes: int = 10,
+                   overrides: dict[str, Any] | None = None) -> dict[str, Any]:
+    """Validation of a saved policy (a ``.zip`` or a run folder) as the training run does it."""
+    ev = ValidationEvaluator(suite, episodes, overrides)
+    try:
+        return ev.evaluate(SB3Policy(path))
+    finally:
+        ev.close()
+
+
+__all__ = ["CheckpointCallback", "ProgressBarCallback", "ValidationEvaluator", "checkpoint_stem", "clean_incomplete",
+           "evaluate_saved", "latest_checkpoint", "list_checkpoints", "load_replay_buffer", "load_rng", "save_rng"]

@@ -1,0 +1,203 @@
+"""A trained stable-baselines3 model as a benchmark :class:`~lvgym.benchmark.policy.Policy`, and the files
+a saved policy is made of.
+
+A saved policy is three files with one stem::
+
+    <stem>.zip                  the SB3 model (``model.save``)
+    <stem>_vecnormalize.pkl     the VecNormalize statistics (``VecNormalize.save``), if training normalised
+    <stem>.json                 {"algo": "PPO", "env_id": ..., "env_kwargs": {...}, "num_timesteps": ...}
+
+the layout ``lvgym.benchmark.sb3.SB3Policy`` (used by ``evaluate.py``) reads too. :class:`SB3Policy`
+accepts such a ``.zip``, its stem, or a run folder of ``train.py`` (``runs/<name>``: its best model by
+validation, else its final model, else its last checkpoint).
+
+    python -m agents.policy export runs/ppo-smile agents/trained/ppo_smile_ascent   # copy a run's policy
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import pickle
+import shutil
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from lvgym.benchmark.results import atomic_path, atomic_write_text
+
+ALGO_NAMES = {"ppo": "PPO", "sac": "SAC", "td3": "TD3"}
+VECNORM_SUFFIX = "_vecnormalize.pkl"
+
+
+def policy_files(stem: str | Path) -> tuple[Path, Path, Path]:
+    """``(<stem>.zip, <stem>_vecnormalize.pkl, <stem>.json)`` of a stem (with or without ``.zip``)."""
+    s = Path(stem)
+    if s.suffix == ".zip":
+        s = s.with_suffix("")
+    return s.with_name(s.name + ".zip"), s.with_name(s.name + VECNORM_SUFFIX), s.with_name(s.name + ".json")
+
+
+def save_policy(model: Any, vecnormalize: Any, stem: str | Path, meta: dict[str, Any]) -> Path:
+    """Write the three files of ``stem``, each atomically, the JSON last (its presence means the others
+    are complete). ``meta`` must hold ``algo``; returns the ``.zip`` path."""
+    if "algo" not in meta:
+        raise ValueError("save_policy: meta needs 'algo' (e.g. 'PPO')")
+    zip_path, norm_path, json_path = policy_files(stem)
+    with atomic_path(zip_path) as tmp:
+        model.save(tmp)
+    if vecnormalize is not None:
+        with atomic_path(norm_path) as tmp:
+            vecnormalize.save(tmp)
+    atomic_write_text(json_path, json.dumps({**meta, "algo": str(meta["algo"]).upper()}, indent=1, sort_keys=True))
+    return zip_path
+
+
+def copy_policy(src_stem: str | Path, dst_stem: str | Path, extra: dict[str, Any] | None = None) -> Path:
+    """Copy a saved policy's files to another stem (atomically, the JSON last)."""
+    src, dst = policy_files(src_stem), policy_files(dst_stem)
+    for s, d in zip(src[:2], dst[:2]):
+        if s.is_file():
+            with atomic_path(d) as tmp:
+                shutil.copyfile(s, tmp)
+        elif d.is_file():
+            d.unlink()
+    meta = json.loads(src[2].read_text(encoding="utf-8")) if src[2].is_file() else {}
+    atomic_write_text(dst[2], json.dumps({**meta, **(extra or {})}, indent=1, sort_keys=True))
+    return dst[0]
+
+
+def resolve_model_path(path: str | Path) -> Path:
+    """The ``.zip`` of a saved policy: ``path`` itself, ``path + '.zip'``, or in a run folder its best
+    model, its final model or its latest checkpoint (``FileNotFoundError`` otherwise)."""
+    p = Path(path)
+    if p.is_dir():
+        from agents.callbacks import latest_checkpoint
+
+        for stem in ("best_model", "final_model"):
+            if (p / f"{stem}.zip").is_file() and (p / f"{stem}.json").is_file():
+                return p / f"{stem}.zip"
+        ckpt = latest_checkpoint(p / "checkpoints")
+        if ckpt is not None:
+            return ckpt[0]
+        raise FileNotFoundError(f"{str(p)!r}: a run folder without best_model.zip, final_model.zip or checkpoints")
+    if p.is_file():
+        return p
+    if p.with_name(p.name + ".zip").is_file():
+        return p.with_name(p.name + ".zip")
+    raise FileNotFoundError(f"{str(p)!r}: no such SB3 model (.zip) or run folder")
+
+
+def read_meta(zip_path: str | Path) -> dict[str, Any]:
+    """The sidecar JSON of a saved policy (``{}`` when it has none)."""
+    side = policy_files(zip_path)[2]
+    return json.loads(side.read_text(encoding="utf-8")) if side.is_file() else {}
+
+
+def load_model(zip_path: str | Path, algo: str | None = None) -> Any:
+    """The SB3 model at ``zip_path`` on the CPU: class from ``algo``, else from the sidecar JSON, else
+    guessed by :func:`lvgym.benchmark.sb3.load_model` (policies saved by other tools)."""
+    import stable_baselines3 as sb3
+
+    algo = algo or read_meta(zip_path).get("algo")
+    if algo is None:
+        from lvgym.benchmark.sb3 import load_model as guess
+
+        return guess(zip_path)
+    name = ALGO_NAMES.get(str(algo).lower(), str(algo).upper())
+    cls = getattr(sb3, name, None)
+    if cls is None:
+        raise ValueError(f"{str(zip_path)!r}: algo = {algo!r}: one of {sorted(ALGO_NAMES.values())}")
+    return cls.load(str(zip_path), device="cpu")
+
+
+def load_vecnormalize(zip_path: str | Path) -> Any:
+    """The VecNormalize statistics saved next to ``zip_path`` (frozen: ``training = False``), or None."""
+    norm = policy_files(zip_path)[1]
+    if not norm.is_file():
+        return None
+    with open(norm, "rb") as f:
+        vn = pickle.load(f)
+    vn.training = False
+    vn.norm_reward = False
+    return vn
+
+
+class SB3Policy:
+    """A trained SB3 model behind the benchmark's Policy interface: ``act`` normalises the observation
+    with the training run's frozen VecNormalize statistics and returns ``model.predict(...,
+    deterministic=True)`` (actions inside the action space). ``name`` defaults to the file stem (the run
+    name for a run folder)."""
+
+    def __init__(self, path: str | Path, name: str | None = None, deterministic: bool = True) -> None:
+        zip_path = resolve_model_path(path)
+        self.path = str(zip_path)
+        self.meta = read_meta(zip_path)
+        self.model = load_model(zip_path)
+        self.normalizer = load_vecnormalize(zip_path)
+        self.deterministic = bool(deterministic)
+        p = Path(path)
+        self.name = name or (p.resolve().name if p.is_dir() else zip_path.stem)
+
+    @classmethod
+    def from_model(cls, model: Any, normalizer: Any = None, name: str = "agent",
+                   deterministic: bool = True) -> SB3Policy:
+        """A live model (and a VecNormalize whose statistics it was trained with) as a policy. The
+        statistics are copied and frozen: later training does not change this policy."""
+        self = cls.__new__(cls)
+        self.path, self.meta, self.model, self.name = "", {}, model, name
+        self.deterministic = bool(deterministic)
+        self.normalizer = None
+        if normalizer is not None:
+            import copy
+
+            self.normalizer = copy.copy(normalizer)
+            self.normalizer.obs_rms = copy.deepcopy(normalizer.obs_rms)
+            self.normalizer.training = False
+        return self
+
+    def reset(self) -> None:
+        """Nothing to reset (feed-forward networks)."""
+
+    def act(self, observation: np.ndarray, info: dict[str, Any]) -> np.ndarray:
+        """The action for one observation of the env's observation space."""
+        obs = np.asarray(observation, dtype=np.float32)
+        expected = self.model.observation_space.shape
+        if obs.shape != expected:
+            raise ValueError(f"policy {self.name!r}: observation of shape {obs.shape}, trained on {expected}")
+        if self.normalizer is not None and getattr(self.normalizer, "norm_obs", True):
+            obs = np.asarray(self.normalizer.normalize_obs(obs), dtype=np.float32)
+        action, _ = self.model.predict(obs, deterministic=self.deterministic)
+        return np.asarray(action)
+
+
+def load_policy(path: str | Path, name: str | None = None) -> SB3Policy:
+    """``SB3Policy(path, name)``: a factory for ``lvgym.benchmark.PolicySpec("...", "agents.policy:load_policy",
+    (("path", ...),))``."""
+    return SB3Policy(path, name)
+
+
+def _export(args: argparse.Namespace) -> None:
+    src = resolve_model_path(args.run)
+    dst = copy_policy(src, args.stem, {"exported_from": str(src)})
+    print(f"{src} -> {dst}")
+
+
+def main(argv: list[str] | None = None) -> None:
+    """``python -m agents.policy export RUN STEM``: copy a run's policy (best, else final, else latest)."""
+    p = argparse.ArgumentParser(prog="python -m agents.policy", description=main.__doc__)
+    sub = p.add_subparsers(dest="cmd", required=True)
+    e = sub.add_parser("export", help="copy a run's policy to STEM.zip, STEM_vecnormalize.pkl, STEM.json")
+    e.add_argument("run", help="run folder (runs/<name>) or a .zip")
+    e.add_argument("stem", help="destination without suffix, e.g. agents/trained/ppo_smile_ascent")
+    args = p.parse_args(argv)
+    _export(args)
+
+
+if __name__ == "__main__":
+    main()
+
+
+__all__ = ["SB3Policy", "copy_policy", "load_model", "load_policy", "load_vecnormalize", "policy_files",
+           "read_meta", "resolve_model_path", "save_policy"]

@@ -1,0 +1,372 @@
+"""Train a TVC policy with stable-baselines3 (PPO, SAC or TD3) on the batched lvgym envs.
+
+    python train.py                                            # PPO on SmileAscent-v0, agents/hyperparams/ppo.yaml
+    python train.py --algo sac --model rigid --wind random --randomize all --total-timesteps 2e6 --name sac-rigid
+    python train.py --hp algo.n_steps=128 policy.net_arch=[32,32] --env-kwargs mission_time_s=20
+    python train.py --resume runs/sac-rigid                    # continue a stopped or killed run
+
+A run lives in ``runs/<name>/``: ``config.yaml`` (every argument, the resolved hyperparameters and env
+keywords, lvgym version, git commit), ``segments.jsonl`` (one line per start or resume), ``tb/``
+(TensorBoard: ``tensorboard --logdir runs``), ``progress_<step>.csv``, ``checkpoints/`` (model,
+VecNormalize statistics, generator states, replay buffer; see ``agents/callbacks.py``),
+``evaluations.json`` (validation on the benchmark protocol's validation seeds), ``best_model.*`` and
+``final_model.*`` (load with ``agents.policy.SB3Policy`` or pass the ``.zip`` to ``evaluate.py``).
+``--resume`` restarts from the newest complete checkpoint with the run's own configuration, the same
+target step count, the normalisation statistics and the step counter (``reset_num_timesteps=False``).
+"""
+
+from __future__ import annotations
+
+import argparse
+import datetime as dt
+import json
+import os
+import platform
+import signal
+import subprocess
+import sys
+import time
+from dataclasses import asdict, dataclass, field, fields
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+ROOT = Path(__file__).resolve().parent
+DEFAULT_EVAL_SUITES = {"lvgym/SmileAscent-v0": "smile-windy", "lvgym/SlenderAscent-v0": "slender-ld30"}
+RESUME_OVERRIDABLE = ("resume", "progress", "torch_threads", "verbose", "total_timesteps")
+
+
+@dataclass
+class Args:
+    """Command-line arguments (``python train.py --help``)."""
+
+    env_id: str = "lvgym/SmileAscent-v0"
+    """registered lvgym env id"""
+    model: str = "nonrigid"
+    """flight model: rigid, slosh, flex or nonrigid"""
+    wind: str = "turbulence"
+    """wind tier: none, profile, gust, turbulence or random"""
+    randomize: list[str] = field(default_factory=lambda: ["wind", "thrust_misalignment"])
+    """names drawn per episode (lvgym.envs.RANDOMIZE), or 'all' / 'none'"""
+    observation: str = "state"
+    """state (ideal) or sensors (IMU)"""
+    env_kwargs: list[str] = field(default_factory=list)
+    """further env keywords KEY=VALUE (values in YAML), e.g. mission_time_s=20"""
+    algo: str = "ppo"
+    """ppo, sac or td3"""
+    total_timesteps: int | None = None
+    """env steps of the whole run (default: n_timesteps of the hyperparameter file)"""
+    seed: int = 0
+    """seed of the networks and generators; env row i starts with seed + i (validation seeds)"""
+    n_envs: int | None = None
+    """rows of the batched VecEnv (default: the hyperparameter file's)"""
+    hp: list[str] = field(default_factory=list)
+    """hyperparameter overrides KEY=VALUE with dotted keys, e.g. algo.n_steps=128 policy.net_arch=[32,32]"""
+    hyperparams: str | None = None
+    """hyperparameter YAML file (default agents/hyperparams/<algo>.yaml)"""
+    runs_dir: str = "runs"
+    """folder of the run folders"""
+    name: str | None = None
+    """run name (default <algo>-<env>-<model>-s<seed>-<time>)"""
+    checkpoint_freq: int = 200_000
+    """env steps between checkpoints"""
+    keep_checkpoints: int = 3
+    """newest checkpoints kept (plus the best)"""
+    eval_freq: int = 1_000_000
+    """env steps between validations (at checkpoints; 0: none); also at the end"""
+    eval_episodes: int = 10
+    """validation seeds per condition of the eval suite"""
+    eval_suite: str | None = None
+    """protocol suite of the validation (default: smile-windy or slender-ld30 by env; 'none': no validation)"""
+    eval_mission_time_s: float | None = None
+    """shorten validation episodes (smoke tests only)"""
+    torch_threads: int = 1
+    """torch CPU threads (the env rows are one batched simulator on one core)"""
+    progress: bool = True
+    """show a progress bar"""
+    verbose: int = 0
+    """SB3 verbosity (1: tables on stdout)"""
+    resume: str | None = None
+    """continue the run in this folder from its newest checkpoint"""
+
+
+def _number(text: str) -> int:
+    value = float(text)
+    if value != int(value):
+        raise argparse.ArgumentTypeError(f"{text!r}: a whole number of steps")
+    return int(value)
+
+
+def build_parser(suppress: bool = False) -> argparse.ArgumentParser:
+    """The argparse parser of :class:`Args` (``suppress``: omit the arguments not given)."""
+    d = Args()
+    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0], formatter_class=argparse.RawDescriptionHelpFormatter,
+                                argument_default=argparse.SUPPRESS if suppress else None)
+    doc = {f.name: "" for f in fields(Args)}
+    import ast
+    import inspect
+
+    body = ast.parse(inspect.getsource(Args)).body[0].body
+    for a, b in zip(body, body[1:]):
+        if isinstance(a, ast.AnnAssign) and isinstance(b, ast.Expr) and isinstance(b.value, ast.Constant):
+            doc[a.target.id] = str(b.value.value)
+    for f in fields(Args):
+        flag, default = "--" + f.name.replace("_", "-"), getattr(d, f.name)
+        kw: dict[str, Any] = {"help": f"{doc[f.name]} (default: {default})"}
+        if not suppress:
+            kw["default"] = default
+        if f.name == "progress":
+            p.add_argument("--no-progress", dest="progress", action="store_false", help="hide the progress bar")
+            continue
+        if isinstance(default, list):
+            kw["nargs"] = "*"
+        elif f.name in ("total_timesteps", "checkpoint_freq", "eval_freq"):
+            kw["type"] = _number
+        elif f.name in ("seed", "n_envs", "keep_checkpoints", "eval_episodes", "torch_threads", "verbose"):
+            kw["type"] = int
+        elif f.name == "eval_mission_time_s":
+            kw["type"] = float
+        if f.name == "algo":
+            kw["choices"] = ("ppo", "sac", "td3")
+        p.add_argument(flag, **kw)
+    return p
+
+
+def parse_args(argv: list[str] | None = None) -> tuple[Args, set[str]]:
+    """The arguments and the names given on the command line."""
+    given = set(vars(build_parser(suppress=True).parse_args(argv)))
+    return Args(**vars(build_parser().parse_args(argv))), given
+
+
+# ------------------------------------------------------------------------------------------ helpers
+def env_kwargs_of(args: Args) -> dict[str, Any]:
+    """The env keywords of a run: model, wind, randomisation, observation and the ``--env-kwargs``."""
+    r: Any = list(args.randomize)
+    if r in (["all"], ["true"], ["True"]):
+        r = True
+    elif r in ([], ["none"], ["false"], ["False"]):
+        r = False
+    out: dict[str, Any] = {"model": args.model, "wind": args.wind, "randomize": r, "observation": args.observation}
+    for item in args.env_kwargs:
+        key, sep, text = item.partition("=")
+        if not sep:
+            raise SystemExit(f"train.py: --env-kwargs {item!r}: KEY=VALUE")
+        out[key.strip()] = yaml.safe_load(text)
+    return out
+
+
+def provenance() -> dict[str, Any]:
+    """Versions, git commit and whether the work tree had changes."""
+    import gymnasium
+    import stable_baselines3
+    import torch
+
+    import lvgym
+
+    def git(*cmd: str) -> str:
+        try:
+            return subprocess.run(["git", *cmd], cwd=ROOT, capture_output=True, text=True, timeout=10).stdout.strip()
+        except (OSError, subprocess.SubprocessError):
+            return ""
+
+    try:
+        from importlib.metadata import version
+
+        lv = version("lvgym")
+    except Exception:  # noqa: BLE001
+        lv = getattr(lvgym, "__version__", "unknown")
+    return {"lvgym_version": lv, "git_commit": git("rev-parse", "HEAD") or None,
+            "git_dirty": bool(git("status", "--porcelain", "--untracked-files=no")),
+            "stable_baselines3": stable_baselines3.__version__, "torch": torch.__version__,
+            "gymnasium": gymnasium.__version__, "python": platform.python_version(),
+            "host": platform.node(), "command": [sys.executable, *sys.argv]}
+
+
+def training_seed(seed: int, step: int, n_envs: int) -> int:
+    """Seed of env row 0 for a run segment starting at ``step`` (rows get ``+ i``): ``seed`` at the
+    start, a fresh draw on resume; always a validation seed (the test seeds stay unseen)."""
+    from lvgym.benchmark.suites import TEST_SEED0
+
+    if step == 0:
+        if not 0 <= seed <= TEST_SEED0 - n_envs:
+            raise SystemExit(f"train.py: --seed {seed} with {n_envs} envs: rows seed .. seed + n_envs - 1 must "
+                             f"be validation seeds (0 .. {TEST_SEED0 - 1}); the test seeds are for reported numbers")
+        return seed
+    import numpy as np
+
+    return int(np.random.SeedSequence([seed, step]).generate_state(1)[0]) % (TEST_SEED0 - n_envs)
+
+
+def make_venv(env_id: str, n_envs: int, seed: int, env_kwargs: dict[str, Any], norm: Any, gamma: float,
+              stats: Path | None) -> Any:
+    """Batched SB3 VecEnv -> VecMonitor (episode returns) -> VecNormalize (new, or loaded from ``stats``)."""
+    from stable_baselines3.common.vec_env import VecMonitor, VecNormalize
+
+    import lvgym  # noqa: F401
+    from lvgym.envs import make_sb3_vec_env
+
+    venv = VecMonitor(make_sb3_vec_env(env_id, num_envs=n_envs, seed=seed, **env_kwargs))
+    if stats is not None and stats.is_file():
+        return VecNormalize.load(str(stats), venv)
+    if norm.norm_obs or norm.norm_reward:
+        return VecNormalize(venv, norm_obs=norm.norm_obs, norm_reward=norm.norm_reward, clip_obs=norm.clip_obs,
+                            clip_reward=norm.clip_reward, epsilon=norm.epsilon, gamma=gamma)
+    return venv
+
+
+def make_logger(run_dir: Path, start: int, verbose: int) -> Any:
+    from stable_baselines3.common.logger import CSVOutputFormat, HumanOutputFormat, Logger, TensorBoardOutputFormat
+
+    formats: list[Any] = [TensorBoardOutputFormat(str(run_dir / "tb")),
+                          CSVOutputFormat(str(run_dir / f"progress_{start:012d}.csv"))]
+    if verbose:
+        formats.append(HumanOutputFormat(sys.stdout))
+    return Logger(str(run_dir), formats)
+
+
+def _plain(x: Any) -> Any:
+    if isinstance(x, dict):
+        return {k: _plain(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [_plain(v) for v in x]
+    if isinstance(x, str):
+        return str(x)
+    return x
+
+
+def _write_yaml(path: Path, data: dict[str, Any]) -> None:
+    from lvgym.benchmark.results import atomic_write_text
+
+    atomic_write_text(path, yaml.safe_dump(_plain(data), sort_keys=False, width=120))
+
+
+def _terminate(signum: int, frame: Any) -> None:
+    raise SystemExit(128 + signum)
+
+
+# ------------------------------------------------------------------------------------------ main
+def prepare(args: Args, given: set[str]) -> tuple[Args, dict[str, Any], Path, bool]:
+    """The run's arguments, its ``config.yaml`` content, its folder and whether it resumes."""
+    from agents.config import build_config, load_config, parse_overrides
+
+    if args.resume:
+        run_dir = Path(args.resume)
+        cfg_path = run_dir / "config.yaml"
+        if not cfg_path.is_file():
+            raise SystemExit(f"train.py: --resume {args.resume}: no config.yaml there (not a run folder)")
+        extra = sorted(given - set(RESUME_OVERRIDABLE))
+        if extra:
+            raise SystemExit(f"train.py: --resume takes the run's own config.yaml; only {list(RESUME_OVERRIDABLE)} "
+                             f"may be given with it, not {['--' + e.replace('_', '-') for e in extra]}")
+        config = yaml.safe_load(cfg_path.read_text(encoding="utf-8"))
+        stored = Args(**{**config["args"], **{k: getattr(args, k) for k in given if k != "resume"}, "resume": None})
+        if "total_timesteps" in given:
+            config["total_timesteps"] = int(args.total_timesteps)
+            _write_yaml(cfg_path, config)
+        build_config(stored.algo, stored.env_id, config["hyperparams"], str(cfg_path))  # still valid?
+        return stored, config, run_dir, True
+    overrides = parse_overrides(args.hp)
+    if args.n_envs is not None:
+        overrides["n_envs"] = args.n_envs
+    cfg = load_config(args.algo, args.env_id, overrides, args.hyperparams)
+    env_kwargs = env_kwargs_of(args)
+    suite = args.eval_suite or DEFAULT_EVAL_SUITES.get(args.env_id, "none")
+    name = args.name or (f"{args.algo}-{args.env_id.split('/')[-1].split('-')[0].lower()}-{args.model}-s{args.seed}-"
+                         f"{dt.datetime.now().strftime('%Y%m%d-%H%M%S')}")
+    run_dir = Path(args.runs_dir) / name
+    if (run_dir / "config.yaml").exists():
+        raise SystemExit(f"train.py: {run_dir} exists; continue it with --resume {run_dir} or choose another --name")
+    config = {"name": name, "args": asdict(args), "algo": args.algo, "env_id": args.env_id, "env_kwargs": env_kwargs,
+              "total_timesteps": int(args.total_timesteps or cfg.n_timesteps), "seed": args.seed,
+              "eval_suite": suite, "hyperparams": cfg.to_dict(), "hyperparams_source": cfg.source,
+              "created_utc": dt.datetime.now(dt.timezone.utc).isoformat(timespec="seconds"), **provenance()}
+    run_dir.mkdir(parents=True, exist_ok=True)
+    _write_yaml(run_dir / "config.yaml", config)
+    return args, config, run_dir, False
+
+
+def train(argv: list[str] | None = None) -> Path:
+    """Run (or resume) a training run; returns its folder."""
+    import stable_baselines3 as sb3
+    import torch
+
+    from agents.callbacks import (CheckpointCallback, ProgressBarCallback, ValidationEvaluator, clean_incomplete,
+                                  latest_checkpoint, load_replay_buffer, load_rng)
+    from agents.config import build_config
+    from agents.policy import ALGO_NAMES, policy_files
+
+    args, given = parse_args(argv)
+    args, config, run_dir, resumed = prepare(args, given)
+    torch.set_num_threads(max(1, args.torch_threads))
+    cfg = build_config(config["algo"], config["env_id"], config["hyperparams"], str(run_dir / "config.yaml"))
+    target = int(config["total_timesteps"])
+    ckpt_dir = run_dir / "checkpoints"
+    state: dict[str, Any] | None = None
+    stem: Path | None = None
+    if resumed:
+        clean_incomplete(ckpt_dir)
+        latest = latest_checkpoint(ckpt_dir)
+        if latest is not None:
+            stem, state = latest[0].with_suffix(""), latest[1]
+    start = int(state["num_timesteps"]) if state else 0
+    seed = training_seed(int(config["seed"]), start, cfg.n_envs)
+    venv = make_venv(config["env_id"], cfg.n_envs, seed, config["env_kwargs"], cfg.normalize, cfg.hyper.gamma,
+                     policy_files(stem)[1] if stem is not None else None)
+    cls = getattr(sb3, ALGO_NAMES[config["algo"]])
+    if stem is not None:
+        model = cls.load(str(policy_files(stem)[0]), env=venv, device="cpu")
+        load_rng(stem.with_name(stem.name + "_rng.pkl"))
+        load_replay_buffer(model, stem)
+        venv.seed(seed)                                      # fresh episodes for the new segment
+    else:
+        kw = cfg.sb3_kwargs()
+        noise, sigma = kw.pop("action_noise_spec", ("none", 0.0))
+        if noise != "none":
+            import numpy as np
+            from stable_baselines3.common.noise import NormalActionNoise, OrnsteinUhlenbeckActionNoise
+
+            n = venv.action_space.shape[0]
+            kw["action_noise"] = (NormalActionNoise if noise == "normal" else OrnsteinUhlenbeckActionNoise)(
+                np.zeros(n), sigma * np.ones(n))
+        model = cls("MlpPolicy", venv, seed=int(config["seed"]), device="cpu", verbose=0, **kw)
+    model.set_logger(make_logger(run_dir, start, args.verbose))
+    with open(run_dir / "segments.jsonl", "a", encoding="utf-8") as f:
+        f.write(json.dumps({"start_step": start, "env_seed": seed, "target": target, "resumed": resumed,
+                            "started_utc": dt.datetime.now(dt.timezone.utc).isoformat(timespec="seconds"),
+                            "pid": os.getpid(), **provenance()}) + "\n")
+    suite = config.get("eval_suite", "none")
+    evaluator = None
+    if suite != "none" and args.eval_freq > 0:
+        over = {"mission_time_s": args.eval_mission_time_s} if args.eval_mission_time_s else None
+        evaluator = ValidationEvaluator(suite, args.eval_episodes, over)
+    meta = {"algo": ALGO_NAMES[config["algo"]], "env_id": config["env_id"], "env_kwargs": config["env_kwargs"],
+            "run": config["name"], "seed": config["seed"], "target_timesteps": target,
+            "git_commit": config.get("git_commit"), "lvgym_version": config.get("lvgym_version")}
+    checkpoint = CheckpointCallback(run_dir, args.checkpoint_freq, meta, venv if hasattr(venv, "obs_rms") else None,
+                                    evaluator, args.eval_freq, args.keep_checkpoints, state, verbose=args.verbose)
+    remaining = target - start
+    t0 = time.perf_counter()
+    if remaining > 0:
+        model.learn(total_timesteps=remaining, callback=[checkpoint, ProgressBarCallback(args.progress)],
+                    reset_num_timesteps=not resumed or stem is None, log_interval=1, progress_bar=False)
+    elif not (run_dir / "final_model.json").is_file():
+        checkpoint.init_callback(model)
+        checkpoint.on_training_end()
+    wall = time.perf_counter() - t0
+    done = int(model.num_timesteps) - start
+    print(f"{run_dir}: {model.num_timesteps} / {target} steps ({done / max(wall, 1e-9):.0f} steps/s this segment)",
+          file=sys.stderr)
+    if evaluator is not None:
+        evaluator.close()
+    venv.close()
+    return run_dir
+
+
+def main(argv: list[str] | None = None) -> None:
+    signal.signal(signal.SIGTERM, _terminate)
+    train(argv)
+
+
+if __name__ == "__main__":
+    main()
