@@ -19,9 +19,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from lvgym.benchmark import (SUITES, ZERO, PolicySpec, Trajectory, TrajectoryBuilder, cvar, degradation,
-                             episode_metrics, evaluate, get_suite, markdown_table, run_episode, summarize,
-                             write_results)
+from lvgym.benchmark import (SUITES, ZERO, PolicySpec, Trajectory, TrajectoryBuilder, ZeroPolicy, cvar,
+                             degradation, episode_metrics, evaluate, get_suite, markdown_table, play_episode,
+                             run_episode, summarize, write_results)
 from lvgym.benchmark import results as results_mod
 from lvgym.benchmark.results import atomic_write, csv_text
 from lvgym.benchmark.suites import TEST_SEED0, VALIDATION_SEED0
@@ -148,6 +148,8 @@ def test_run_episode_does_not_depend_on_what_ran_before():
     b = run_episode(ZERO, cond, 10_001)
     assert a != b                                           # the seed draws the wind
     assert run_episode(ZERO, cond, 10_000) == a
+    fresh = play_episode(ZeroPolicy(), cond.make_env(), 10_000)    # a new env: the same episode
+    assert fresh == {k: a[k] for k in fresh}
 
 
 def test_same_seeds_give_the_same_table_whatever_the_executor():

@@ -12,12 +12,13 @@ from .metrics import (CVAR_LEVEL, SUMMARY_METRICS, Trajectory, TrajectoryBuilder
                       summarize)
 from .policy import Policy, ZeroPolicy
 from .results import atomic_write, atomic_write_text, markdown_table, write_results
-from .runner import EXECUTORS, ZERO, PolicySpec, build_policy, evaluate, make_tasks, run_episode
+from .runner import EXECUTORS, ZERO, PolicySpec, build_policy, evaluate, make_tasks, play_episode, run_episode
 from .suites import (DEFAULT_SUITE, PROTOCOL_VERSION, SEED_SETS, SUITES, TEST_SEED0, VALIDATION_SEED0, Condition,
                      Suite, get_suite)
 
 __all__ = ["CVAR_LEVEL", "Condition", "DEFAULT_SUITE", "EXECUTORS", "PROTOCOL_VERSION", "Policy", "PolicySpec",
            "SEED_SETS", "SUITES", "SUMMARY_METRICS", "Suite", "TEST_SEED0", "Trajectory", "TrajectoryBuilder",
            "VALIDATION_SEED0", "ZERO", "ZeroPolicy", "atomic_write", "atomic_write_text", "build_policy", "cvar",
-           "degradation", "episode_metrics", "evaluate", "get_suite", "make_tasks", "markdown_table", "run_episode",
+           "degradation", "episode_metrics", "evaluate", "get_suite", "make_tasks", "markdown_table", "play_episode",
+           "run_episode",
            "summarize", "write_results"]

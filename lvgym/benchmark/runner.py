@@ -88,15 +88,10 @@ def _env(condition: Condition) -> Any:
     return _ENVS[condition]
 
 
-def run_episode(policy_spec: PolicySpec, condition: Condition, seed: int) -> dict[str, Any]:
-    """One episode of ``policy_spec`` on ``condition``, reset with ``seed``; returns the record: the
-    policy and condition labels, the seed and :func:`~.metrics.episode_metrics`. A function of its
-    arguments only (envs and policies are cached per process, and reset every episode)."""
-    env = _env(condition)
-    key = (policy_spec, condition)
-    if key not in _POLICIES:
-        _POLICIES[key] = build_policy(policy_spec, env)
-    policy = _POLICIES[key]
+def play_episode(policy: Policy, env: Any, seed: int) -> dict[str, Any]:
+    """Fly one episode of a policy object on an lvgym env reset with ``seed``; returns
+    :func:`~.metrics.episode_metrics`. In-process (e.g. a validation callback during training:
+    ``play_episode(policy, condition.make_env(), seed)`` over ``suite.seeds("validation", n)``)."""
     obs, info = env.reset(seed=int(seed))
     policy.reset()
     traj = TrajectoryBuilder(float(env.unwrapped.task.control_dt_s))
@@ -106,9 +101,20 @@ def run_episode(policy_spec: PolicySpec, condition: Condition, seed: int) -> dic
         traj.add(reward, info)
         if terminated or truncated:
             break
+    return episode_metrics(traj.build())
+
+
+def run_episode(policy_spec: PolicySpec, condition: Condition, seed: int) -> dict[str, Any]:
+    """One episode of ``policy_spec`` on ``condition``, reset with ``seed``; returns the record: the
+    policy and condition labels, the seed and :func:`~.metrics.episode_metrics`. A function of its
+    arguments only (envs and policies are cached per process, and reset every episode)."""
+    env = _env(condition)
+    key = (policy_spec, condition)
+    if key not in _POLICIES:
+        _POLICIES[key] = build_policy(policy_spec, env)
     return {"policy": policy_spec.name, "condition": condition.name, "group": condition.group,
             "env_id": condition.env_id, "model": condition.model, "wind": condition.wind, "seed": int(seed),
-            **episode_metrics(traj.build())}
+            **play_episode(_POLICIES[key], env, seed)}
 
 
 @dataclass(frozen=True)
@@ -266,4 +272,4 @@ def evaluate(policies: Sequence[PolicySpec], suites: Sequence[Suite], episodes: 
 
 
 __all__ = ["EXECUTORS", "PROTOCOL_VERSION", "PolicySpec", "Task", "ZERO", "build_policy", "default_workers",
-           "evaluate", "make_tasks", "run_episode", "run_task", "zero_policy"]
+           "evaluate", "make_tasks", "play_episode", "run_episode", "run_task", "zero_policy"]
