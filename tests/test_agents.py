@@ -1,0 +1,216 @@
+"""Learning agents (issue 7): hyperparameter files, training runs that save, resume (also after a kill)
+and reload into the Policy interface, determinism on CPU, and the shipped checkpoint (skipped until one
+exists). Runs are tiny: a few hundred env steps of 2 s episodes with 8-unit networks."""
+
+from __future__ import annotations
+
+import importlib.util
+import json
+import os
+import pickle
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import gymnasium
+import numpy as np
+import pytest
+import torch
+
+import lvgym  # noqa: F401
+from agents.callbacks import latest_checkpoint, list_checkpoints
+from agents.config import ALGOS, load_config, read_entries
+from agents.policy import SB3Policy, load_model
+from lvgym.benchmark.policy import Policy
+from lvgym.errors import ConfigError
+
+ROOT = Path(__file__).resolve().parents[1]
+SHIPPED = ROOT / "agents" / "trained" / "ppo_smile_ascent.zip"
+ENV_KW = ["mission_time_s=2", "controller_on_after_s=0.2"]
+TINY = {"ppo": ["algo.n_steps=32", "algo.batch_size=64", "algo.n_epochs=2", "policy.net_arch=[8,8]"],
+        "sac": ["algo.learning_starts=64", "algo.buffer_size=2000", "algo.batch_size=32", "policy.net_arch=[8,8]"],
+        "td3": ["algo.learning_starts=64", "algo.buffer_size=2000", "algo.batch_size=32", "policy.net_arch=[8,8]"]}
+
+
+def _train_module():
+    spec = importlib.util.spec_from_file_location("lvgym_train_script", ROOT / "train.py")
+    mod = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = mod
+    spec.loader.exec_module(mod)
+    return mod
+
+
+TRAIN = _train_module()
+
+
+def _argv(tmp: Path, name: str, algo: str = "ppo", steps: int = 384, seed: int = 0, extra: tuple = ()) -> list[str]:
+    return ["--algo", algo, "--name", name, "--runs-dir", str(tmp), "--total-timesteps", str(steps),
+            "--seed", str(seed), "--n-envs", "4", "--hp", *TINY[algo], "--env-kwargs", *ENV_KW,
+            "--checkpoint-freq", "128", "--eval-freq", "256", "--eval-episodes", "1", "--eval-mission-time-s", "0.5",
+            "--no-progress", *extra]
+
+
+def _vecnorm(stem: Path):
+    with open(stem.with_name(stem.name + "_vecnormalize.pkl"), "rb") as f:
+        return pickle.load(f)
+
+
+def _params(zip_path: Path) -> dict[str, torch.Tensor]:
+    return {k: v.clone() for k, v in load_model(zip_path).policy.state_dict().items()}
+
+
+# ------------------------------------------------------------------------------------------ config
+def test_every_hyperparameter_entry_loads():
+    for algo in ALGOS:
+        entries, _ = read_entries(algo)
+        for env_id in entries:
+            cfg = load_config(algo, env_id)
+            assert cfg.algo == algo and cfg.n_envs >= 1
+    ppo = load_config("ppo", "lvgym/SmileAscent-v0")
+    assert 16 <= ppo.n_envs <= 64 and 0.99 <= ppo.hyper.gamma <= 0.995 and ppo.policy.net_arch == (64, 64)
+
+
+@pytest.mark.parametrize("algo, overrides, key, text", [
+    ("ppo", {"algo.n_stepz": 64}, "algo.n_stepz", "unknown key"),
+    ("ppo", {"algo.gamma": 1.5}, "algo.gamma", "[0.0, 1.0]"),
+    ("ppo", {"policy.net_arch": [0, 8]}, "policy.net_arch", "layer widths"),
+    ("ppo", {"policy.activation": "swish"}, "policy.activation", "one of"),
+    ("ppo", {"algo.batch_size": 10**6}, "algo.batch_size", "n_envs * algo.n_steps"),
+    ("ppo", {"n_envs": 0}, "n_envs", "[1, 4096]"),
+    ("ppo", {"learning_rate": 1e-3}, "learning_rate", "allowed: ['n_envs'"),
+    ("td3", {"algo.ent_coef": 0.1}, "algo.ent_coef", "not a TD3 key"),
+    ("sac", {"algo.ent_coef": "often"}, "algo.ent_coef", "a number"),
+])
+def test_config_errors_name_key_value_and_allowed(algo, overrides, key, text):
+    with pytest.raises(ConfigError) as err:
+        load_config(algo, "lvgym/SmileAscent-v0", overrides)
+    msg = str(err.value)
+    assert err.value.key == key and repr(next(iter(overrides.values()))) in msg and text in msg
+    assert f"{algo}.yaml" in msg
+
+
+def test_yaml_file_errors_name_the_file(tmp_path):
+    bad = tmp_path / "ppo.yaml"
+    bad.write_text("lvgym/SmileAscent-v0:\n  normalize: {norm_obs: yes please}\n")
+    with pytest.raises(ConfigError, match=r"ppo.yaml: normalize.norm_obs = 'yes please': true or false"):
+        load_config("ppo", "lvgym/SmileAscent-v0", path=bad)
+
+
+# ------------------------------------------------------------------------------------------ training
+def test_train_saves_resumes_and_reloads_as_a_policy(tmp_path):
+    run = TRAIN.train(_argv(tmp_path, "r1", steps=384))
+    config = (run / "config.yaml").read_text()
+    for key in ("git_commit:", "lvgym_version:", "hyperparams:", "env_kwargs:", "mission_time_s: 2"):
+        assert key in config
+    assert list((run / "tb").glob("events.out.tfevents.*"))
+    zip0, state0 = latest_checkpoint(run / "checkpoints")
+    s0 = state0["num_timesteps"]
+    assert s0 >= 384 and state0["algo"] == "PPO" and state0["evaluations"]
+    assert load_model(zip0).num_timesteps == s0
+    count0 = _vecnorm(zip0.with_suffix("")).obs_rms.count
+
+    TRAIN.train(["--resume", str(run), "--total-timesteps", "768", "--no-progress"])
+    segments = [json.loads(x) for x in (run / "segments.jsonl").read_text().splitlines()]
+    assert [s["start_step"] for s in segments] == [0, s0] and segments[1]["resumed"]
+    zip1, state1 = latest_checkpoint(run / "checkpoints")
+    s1 = state1["num_timesteps"]
+    assert s1 >= 768 and load_model(zip1).num_timesteps == s1
+    # the statistics went on from the checkpoint's (a fresh VecNormalize would count only the new steps)
+    assert _vecnorm(zip1.with_suffix("")).obs_rms.count >= count0 + (s1 - s0)
+    # the evaluation history continued: earlier records kept, no step evaluated twice
+    steps = [e["num_timesteps"] for e in state1["evaluations"]]
+    assert steps[:len(state0["evaluations"])] == [e["num_timesteps"] for e in state0["evaluations"]]
+    assert steps == sorted(set(steps))
+    assert json.loads((run / "final_model.json").read_text())["num_timesteps"] == s1
+
+    env = gymnasium.make("lvgym/SmileAscent-v0", mission_time_s=0.5)
+    for source in (run, run / "final_model.zip", run / "best_model.zip"):
+        policy = SB3Policy(source)
+        assert isinstance(policy, Policy)
+        obs, info = env.reset(seed=0)
+        policy.reset()
+        for _ in range(5):
+            action = policy.act(obs, info)
+            assert action.shape == (2,) and np.all(np.abs(action) <= 1.0)
+            obs, _, terminated, truncated, info = env.step(action)
+    # evaluate.py's loader (lvgym.benchmark.sb3) reads the same files and acts the same
+    from lvgym.benchmark.sb3 import SB3Policy as BenchmarkSB3Policy
+
+    obs, info = env.reset(seed=3)
+    ours, theirs = SB3Policy(run / "final_model.zip"), BenchmarkSB3Policy(str(run / "final_model.zip"))
+    np.testing.assert_array_equal(ours.act(obs, info), theirs.act(obs, info))
+
+
+def test_a_killed_run_resumes_from_its_last_complete_checkpoint(tmp_path):
+    argv = _argv(tmp_path, "killed", steps=10**7, extra=("--eval-freq", "0"))
+    proc = subprocess.Popen([sys.executable, str(ROOT / "train.py"), *argv], cwd=ROOT, stdout=subprocess.DEVNULL,
+                            stderr=subprocess.DEVNULL, start_new_session=True)
+    folder = tmp_path / "killed" / "checkpoints"
+    try:
+        deadline = time.monotonic() + 60
+        while len(list_checkpoints(folder)) < 2 and time.monotonic() < deadline and proc.poll() is None:
+            time.sleep(0.05)
+    finally:
+        os.kill(proc.pid, signal.SIGKILL)
+        proc.wait()
+    assert len(list_checkpoints(folder)) >= 2, "the run wrote no checkpoints before the deadline"
+    last = list_checkpoints(folder)[-1][0]
+    orphan = folder / f"step_{last + 10**6:012d}.zip"          # a checkpoint cut off before its JSON
+    orphan.write_bytes(b"partial")
+    TRAIN.train(["--resume", str(tmp_path / "killed"), "--total-timesteps", str(last + 128), "--no-progress"])
+    assert not orphan.exists()
+    segments = [json.loads(x) for x in (tmp_path / "killed" / "segments.jsonl").read_text().splitlines()]
+    assert segments[-1]["start_step"] == last
+    assert list_checkpoints(folder)[-1][0] >= last + 128
+
+
+def test_same_seed_same_training_result(tmp_path):
+    runs = [TRAIN.train(_argv(tmp_path, name, steps=256, seed=seed, extra=("--eval-freq", "0")))
+            for name, seed in (("a", 5), ("b", 5), ("c", 6))]
+    params = [_params(r / "final_model.zip") for r in runs]
+    assert params[0].keys() == params[1].keys()
+    for k in params[0]:
+        assert torch.equal(params[0][k], params[1][k]), k
+    assert any(not torch.equal(params[0][k], params[2][k]) for k in params[0])
+    norms = [_vecnorm(r / "final_model") for r in runs[:2]]
+    np.testing.assert_array_equal(norms[0].obs_rms.mean, norms[1].obs_rms.mean)
+    np.testing.assert_array_equal(norms[0].ret_rms.var, norms[1].ret_rms.var)
+
+
+@pytest.mark.parametrize("algo", ["sac", "td3"])
+def test_off_policy_runs_resume_with_their_replay_buffer(tmp_path, algo):
+    run = TRAIN.train(_argv(tmp_path, algo, algo=algo, steps=256, extra=("--eval-freq", "0")))
+    stem = list_checkpoints(run / "checkpoints")[-1][1]
+    with open(stem.with_name(stem.name + "_replay_buffer.pkl"), "rb") as f:
+        buffer = pickle.load(f)
+    assert buffer.size() * 4 == 256        # 4 rows: every transition of the run is in the buffer
+    TRAIN.train(["--resume", str(run), "--total-timesteps", "384", "--no-progress"])
+    stem = list_checkpoints(run / "checkpoints")[-1][1]
+    with open(stem.with_name(stem.name + "_replay_buffer.pkl"), "rb") as f:
+        assert pickle.load(f).size() * 4 == 384
+    assert SB3Policy(run).act(np.zeros(14, dtype=np.float32), {}).shape == (2,)
+
+
+def test_resume_refuses_arguments_that_would_change_the_run(tmp_path):
+    run = TRAIN.train(_argv(tmp_path, "r", steps=128, extra=("--eval-freq", "0")))
+    with pytest.raises(SystemExit, match="--seed"):
+        TRAIN.train(["--resume", str(run), "--seed", "3"])
+    with pytest.raises(SystemExit, match="exists"):
+        TRAIN.train(_argv(tmp_path, "r", steps=128))
+
+
+@pytest.mark.skipif(not SHIPPED.is_file(), reason=f"no shipped checkpoint yet ({SHIPPED.relative_to(ROOT)})")
+def test_shipped_checkpoint_loads_and_acts():
+    policy = SB3Policy(SHIPPED)
+    assert policy.meta.get("env_id") == "lvgym/SmileAscent-v0" and policy.normalizer is not None
+    env = gymnasium.make("lvgym/SmileAscent-v0", mission_time_s=1.0)
+    obs, info = env.reset(seed=0)
+    policy.reset()
+    for _ in range(50):
+        action = policy.act(obs, info)
+        assert action.shape == (2,) and np.all(np.isfinite(action)) and np.all(np.abs(action) <= 1.0)
+        obs, _, terminated, truncated, info = env.step(action)
+        if terminated or truncated:
+            break
