@@ -47,6 +47,9 @@ import numpy as np
 G0 = 9.80665                  # [m/s^2] standard gravity (thrust-to-weight)
 RESPONSES = ("flex_total", "flex_max", "cg_total", "cg_max", "defl_total", "defl_max")
 FACTORS = ("length", "diameter", "fill", "mass_flow", "slosh_damping")
+#: the keys of a :func:`run_case` record, in order
+RECORD = (*FACTORS, "ld", "mass0", "tw0", "f1_hz", "f2_hz", "phi1_max", "slosh_mass0", "t_burnout", "alpha_max_deg",
+          "departed", *RESPONSES, "wall_s")
 #: the env tier ``profile`` (lvgym/envs/spec.py), repeated so the study does not depend on the envs layer
 PROFILE_WIND: dict[str, Any] = {"model": "profile", "altitude_m": [0.0, 1000.0, 10000.0, 100000.0],
                                 "speed": [5.0, 12.0, 20.0, 20.0], "direction_deg": [270.0, 270.0, 270.0, 270.0]}
@@ -54,7 +57,8 @@ DEPARTED_DEG = 20.0           # a run whose total angle of attack exceeds this [
 QBAR_MIN = 5000.0             # ... while the dynamic pressure is above this [Pa] departed
 AERO_MODES = ("reference", "own", "tables")
 
-__all__ = ["AERO_MODES", "DEPARTED_DEG", "QBAR_MIN", "FACTORS", "G0", "PROFILE_WIND", "RESPONSES", "RunSetup", "deflection",
+__all__ = ["AERO_MODES", "DEPARTED_DEG", "QBAR_MIN", "FACTORS", "G0", "PROFILE_WIND", "RECORD", "RESPONSES",
+           "RunSetup", "deflection",
            "responses", "run_case"]
 
 

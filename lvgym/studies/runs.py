@@ -16,7 +16,7 @@ import pandas as pd
 
 from .cache import RunCache, run_key
 from .executor import run_map
-from .responses import FACTORS, RunSetup, run_case
+from .responses import FACTORS, RECORD, RunSetup, run_case
 
 __all__ = ["StudyRun", "case", "run_cases"]
 
@@ -57,5 +57,6 @@ def run_cases(cases: Sequence[dict[str, Any]], cache_dir: str | os.PathLike[str]
     rows = []
     for c, r, k in zip(cases, records, keys):
         labels = {n: v for n, v in c.items() if n not in (*FACTORS, "setup")}
-        rows.append({**labels, **(r or {}), "key": k})
+        r = r or {}
+        rows.append({**labels, **{n: r.get(n) for n in RECORD}, "key": k})
     return StudyRun(pd.DataFrame(rows), ran=len(todo), cached=len(cases) - len(todo))
