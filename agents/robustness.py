@@ -1,0 +1,84 @@
+"""The robustness experiment: policies trained on the rigid model against policies trained on the
+non-rigid model (slosh and bending), both evaluated on the rigid and the non-rigid conditions of the
+benchmark suites. The protocol's degradation table (non-rigid over rigid rate error, per policy) then
+shows what a rigid-trained policy loses on the flexible, sloshing vehicle, and what non-rigid training buys.
+
+    python -m agents.robustness --dry-run                 # print the commands
+    python -m agents.robustness                           # train 2 models x 3 seeds, then evaluate
+    python -m agents.robustness --seeds 0 --total-timesteps 2e6 --episodes 10   # a smaller version
+
+Every step is restartable: a run with ``final_model.json`` is done and skipped, a run folder without it
+is continued with ``train.py --resume``, so the command can simply be run again after an interruption.
+Each run's policy (best by validation) is exported as ``<runs-dir>/robustness-policies/<run>.zip`` (so
+that ``evaluate.py`` labels it by run), then ``evaluate.py`` runs on the test seeds.
+"""
+
+from __future__ import annotations
+
+import argparse
+import shlex
+import subprocess
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+MODELS = ("rigid", "nonrigid")
+
+
+def run_name(algo: str, model: str, seed: int) -> str:
+    return f"robust-{algo}-{model}-s{seed}"
+
+
+def train_command(args: argparse.Namespace, model: str, seed: int) -> list[str]:
+    """The train.py command of one run (``--resume`` if its folder exists)."""
+    folder = Path(args.runs_dir) / run_name(args.algo, model, seed)
+    if (folder / "config.yaml").is_file():
+        return [sys.executable, str(ROOT / "train.py"), "--resume", str(folder)]
+    cmd = [sys.executable, str(ROOT / "train.py"), "--algo", args.algo, "--model", model, "--seed", str(seed),
+           "--wind", args.wind, "--randomize", *args.randomize, "--name", folder.name, "--runs-dir", args.runs_dir]
+    if args.total_timesteps:
+        cmd += ["--total-timesteps", str(int(float(args.total_timesteps)))]
+    return cmd
+
+
+def commands(args: argparse.Namespace) -> list[list[str]]:
+    """Every command of the experiment, in order (training runs already finished are left out)."""
+    out: list[list[str]] = []
+    exported: list[str] = []
+    for model in MODELS:
+        for seed in args.seeds:
+            name = run_name(args.algo, model, seed)
+            folder = Path(args.runs_dir) / name
+            if not (folder / "final_model.json").is_file():
+                out.append(train_command(args, model, seed))
+            stem = Path(args.runs_dir) / "robustness-policies" / name
+            out.append([sys.executable, "-m", "agents.policy", "export", str(folder), str(stem)])
+            exported.append(str(stem) + ".zip")
+    out.append([sys.executable, str(ROOT / "evaluate.py"), "--policies", *args.baselines, *exported,
+                "--suites", *args.suites, "--episodes", str(args.episodes), "--out", args.out])
+    return out
+
+
+def main(argv: list[str] | None = None) -> None:
+    p = argparse.ArgumentParser(prog="python -m agents.robustness", description=__doc__.split("\n\n")[0])
+    p.add_argument("--algo", default="ppo", choices=("ppo", "sac", "td3"))
+    p.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2])
+    p.add_argument("--total-timesteps", default=None, help="per run (default: the hyperparameter file's)")
+    p.add_argument("--wind", default="turbulence", help="training wind tier (default turbulence)")
+    p.add_argument("--randomize", nargs="+", default=["wind", "thrust_misalignment", "mass"],
+                   help="training randomisation (default: wind thrust_misalignment mass)")
+    p.add_argument("--suites", nargs="+", default=["smile-calm", "smile-windy", "smile-dispersed"])
+    p.add_argument("--baselines", nargs="*", default=["pid", "gs-pid"], help="evaluate.py policy names beside the agents")
+    p.add_argument("--episodes", type=int, default=50, help="test seeds per condition and policy")
+    p.add_argument("--runs-dir", default="runs")
+    p.add_argument("--out", default="results/robustness")
+    p.add_argument("--dry-run", action="store_true", help="print the commands only")
+    args = p.parse_args(argv)
+    for cmd in commands(args):
+        print("+ " + shlex.join(cmd), flush=True)
+        if not args.dry_run:
+            subprocess.run(cmd, cwd=ROOT, check=True)
+
+
+if __name__ == "__main__":
+    main()
