@@ -306,11 +306,17 @@ class ProgressBarCallback(BaseCallback):
                         unit="step", unit_scale=True, dynamic_ncols=True, disable=not self.enabled,
                         file=sys.stderr, desc="training")
 
+    def _advance(self) -> None:
+        n = int(self.model.num_timesteps)
+        if self.bar.total is not None and n > self.bar.total:     # the last rollout overshoots the target
+            self.bar.total = n
+        self.bar.update(n - self.bar.n)
+
     def _on_step(self) -> bool:
         now = time.monotonic()
         if self.bar is not None and now - self._last >= self.refresh_s:
             self._last = now
-            self.bar.update(int(self.model.num_timesteps) - self.bar.n)
+            self._advance()
             buf = self.model.ep_info_buffer
             if buf:
                 self.bar.set_postfix(ep_return=f"{np.mean([e['r'] for e in buf]):.3g}", refresh=False)
@@ -318,7 +324,7 @@ class ProgressBarCallback(BaseCallback):
 
     def _on_training_end(self) -> None:
         if self.bar is not None:
-            self.bar.update(int(self.model.num_timesteps) - self.bar.n)
+            self._advance()
             self.bar.close()
 
 
