@@ -1,4 +1,10 @@
-"""Learned TVC policies (stable-baselines3): arrives with the issue "Learned TVC policies".
+"""Learned TVC policies with stable-baselines3 (PPO, SAC, TD3) on the batched lvgym envs.
 
-Nothing is importable here yet; the package exists so the project layout is fixed from the start.
+- :mod:`agents.config`: per-env hyperparameters (``agents/hyperparams/<algo>.yaml``) as validated dataclasses;
+- :mod:`agents.callbacks`: crash-safe checkpoints, validation on the protocol's validation seeds, progress;
+- :mod:`agents.policy`: :class:`~agents.policy.SB3Policy`, a trained model behind the benchmark Policy interface;
+- :mod:`agents.robustness`: the rigid-trained vs nonrigid-trained experiment.
+
+Training itself is ``train.py`` at the repository root (``docs/training.md``). Nothing in ``lvgym`` imports this
+package; importing it does not import stable-baselines3 (the submodules do).
 """
