@@ -30,8 +30,9 @@ from typing import Any
 import numpy as np
 from stable_baselines3.common.callbacks import BaseCallback
 
-from lvgym.benchmark.metrics import TrajectoryBuilder, episode_metrics, summarize
+from lvgym.benchmark.metrics import summarize
 from lvgym.benchmark.policy import Policy
+from lvgym.benchmark.runner import play_episode
 from lvgym.benchmark.results import atomic_path, atomic_write_text, json_text, remove_stale_temporaries
 from lvgym.benchmark.suites import Suite, get_suite
 
@@ -117,20 +118,13 @@ class ValidationEvaluator:
         self._envs: dict[Any, Any] = {}
 
     def episode(self, policy: Policy, condition: Any, seed: int) -> dict[str, Any]:
-        """One episode's record (as ``lvgym.benchmark.runner.run_episode`` returns it)."""
+        """One episode's record (as ``lvgym.benchmark.runner.run_episode`` returns it), flown by the
+        protocol's :func:`~lvgym.benchmark.runner.play_episode`."""
         if condition not in self._envs:
             self._envs[condition] = condition.make_env()
-        env = self._envs[condition]
-        obs, info = env.reset(seed=int(seed))
-        policy.reset()
-        traj = TrajectoryBuilder(float(env.unwrapped.task.control_dt_s))
-        while True:
-            obs, reward, terminated, truncated, info = env.step(policy.act(obs, info))
-            traj.add(reward, info)
-            if terminated or truncated:
-                break
         return {"suite": self.suite.name, "condition": condition.name, "group": condition.group,
-                "policy": policy.name, "model": condition.model, "seed": int(seed), **episode_metrics(traj.build())}
+                "policy": policy.name, "model": condition.model, "seed": int(seed),
+                **play_episode(policy, self._envs[condition], seed)}
 
     def evaluate(self, policy: Policy) -> dict[str, Any]:
         """Per-condition means and failure rates, and the selection ``score``: ``[failure rate, rate
