@@ -15,6 +15,9 @@ $(STAMP): pyproject.toml
 	touch $(STAMP)
 
 run: $(STAMP)
+	$(PY) evaluate.py
+
+verify: $(STAMP)
 	$(PY) -m lvgym.verify
 
 test: $(STAMP)

@@ -5,7 +5,8 @@
     python evaluate.py --executor ray --workers 4        # Ray (pip install 'lvgym[ray]'): a local Ray
     RAY_ADDRESS=auto python evaluate.py --executor ray    # ... or the running cluster (``ray start``)
 
-Policies are names of :data:`POLICIES` (``zero``, ``pid``, ``gs-pid``) or paths of saved
+Policies are names of :data:`POLICIES` (``zero``, ``pid``, ``gs-pid``: our rigid tuning; ``pid-thesis``,
+``gs-pid-thesis``: the thesis's gains and Table 6.10) or paths of saved
 stable-baselines3 models (``.zip``; an optional ``<stem>_vecnormalize.pkl`` next to it normalises the
 observations). Suites are names of ``lvgym.benchmark.SUITES``. Episodes run on a local process pool
 by default; the Markdown table is printed, and CSV, JSON, the table and PNG plots go to ``--out``
@@ -30,8 +31,13 @@ from lvgym.benchmark import (EXECUTORS, PROTOCOL_VERSION, SEED_SETS, SUITES, ZER
 #: policy names -> how a worker builds them (factories are imported lazily, in the workers)
 POLICIES: dict[str, PolicySpec] = {
     "zero": ZERO,
-    "pid": PolicySpec("pid", "baselines_pid.pid:PIDPolicy"),
-    "gs-pid": PolicySpec("gs-pid", "baselines_pid.pid:smile_scheduled_pid"),
+    # our tuning on the rigid linearisation (baselines_pid.tune): one gain set, and the schedule on mass
+    "pid": PolicySpec("pid", "baselines_pid.pid:smile_tuned_pid"),
+    "gs-pid": PolicySpec("gs-pid", "baselines_pid.pid:smile_scheduled_pid", (("name", "gs-pid"), ("schedule", "smile"))),
+    # the thesis's gains (6.3.1) and its Table 6.10 schedule, as published
+    "pid-thesis": PolicySpec("pid-thesis", "baselines_pid.pid:smile_single_pid"),
+    "gs-pid-thesis": PolicySpec("gs-pid-thesis", "baselines_pid.pid:smile_scheduled_pid",
+                                (("name", "gs-pid-thesis"), ("schedule", "smile_thesis"))),
 }
 DEFAULT_POLICIES = ["zero", "pid", "gs-pid"]
 DEFAULT_SUITES = ["smile-windy"]
@@ -104,9 +110,11 @@ def resolve_policy(name: str) -> PolicySpec:
         return spec
     path = Path(name)
     if path.suffix == ".zip" or path.exists():
-        if not path.is_file():
+        if not path.exists():
             raise SystemExit(f"evaluate.py: policy {name!r}: no such file")
-        return PolicySpec(path.stem, "lvgym.benchmark.sb3:SB3Policy", (("path", str(path.resolve())),))
+        if path.is_dir():                       # a training run folder: its best (or final) model
+            return PolicySpec(path.name, "agents.policy:load_policy", (("path", str(path.resolve())),))
+        return PolicySpec(path.stem, "agents.policy:load_policy", (("path", str(path.resolve())),))
     raise SystemExit(f"evaluate.py: policy {name!r}: one of {sorted(POLICIES)} or a path to an SB3 .zip model")
 
 

@@ -7,8 +7,7 @@ A saved policy is three files with one stem::
     <stem>_vecnormalize.pkl     the VecNormalize statistics (``VecNormalize.save``), if training normalised
     <stem>.json                 {"algo": "PPO", "env_id": ..., "env_kwargs": {...}, "num_timesteps": ...}
 
-the layout ``lvgym.benchmark.sb3.SB3Policy`` (used by ``evaluate.py``) reads too. :class:`SB3Policy`
-accepts such a ``.zip``, its stem, or a run folder of ``train.py`` (``runs/<name>``: its best model by
+``evaluate.py`` loads saved models through :func:`load_policy`. :class:`SB3Policy` accepts such a ``.zip``, its stem, or a run folder of ``train.py`` (``runs/<name>``: its best model by
 validation, else its final model, else its last checkpoint).
 
     python -m agents.policy export runs/ppo-smile agents/trained/ppo_smile_ascent   # copy a run's policy
@@ -20,6 +19,7 @@ import argparse
 import json
 import pickle
 import shutil
+import zipfile
 from pathlib import Path
 from typing import Any
 
@@ -89,6 +89,55 @@ def resolve_model_path(path: str | Path) -> Path:
     raise FileNotFoundError(f"{str(p)!r}: no such SB3 model (.zip) or run folder")
 
 
+ALGOS = ("PPO", "SAC", "TD3", "A2C", "DDPG")
+
+
+def _sidecar_algo(path: Path) -> str | None:
+    side = path.with_suffix(".json")
+    if side.is_file():
+        algo = json.loads(side.read_text(encoding="utf-8")).get("algo")
+        return str(algo).upper() if algo else None
+    return None
+
+
+def _guess_algo(path: Path) -> str | None:
+    """The algorithm suggested by the policy class module stored in the zip's ``data``."""
+    try:
+        with zipfile.ZipFile(path) as z:
+            data = json.loads(z.read("data"))
+        module = str(data.get("policy_class", {}).get("__module__", ""))
+    except (KeyError, ValueError, zipfile.BadZipFile, AttributeError):
+        return None
+    for key, algo in (("sac", "SAC"), ("td3", "TD3"), ("ddpg", "DDPG"), ("common.policies", "PPO")):
+        if key in module:
+            return algo
+    return None
+
+
+def guess_and_load(path: str | Path) -> Any:
+    """The SB3 model at ``path`` when no sidecar names its algorithm: the algorithm suggested by the
+    policy class stored in the zip first, then every algorithm of ``ALGOS`` in turn."""
+    import stable_baselines3 as sb3
+
+    path = Path(path)
+    if not path.is_file():
+        raise FileNotFoundError(f"policy {str(path)!r}: no such SB3 model file")
+    first = _sidecar_algo(path) or _guess_algo(path)
+    order = [first] + [a for a in ALGOS if a != first] if first else list(ALGOS)
+    errors = []
+    for algo in order:
+        cls = getattr(sb3, algo, None)
+        if cls is None:
+            errors.append(f"{algo}: not in stable_baselines3")
+            continue
+        try:
+            return cls.load(str(path), device="cpu")
+        except Exception as exc:  # noqa: BLE001 (a wrong algorithm fails in many ways)
+            errors.append(f"{algo}: {type(exc).__name__}: {exc}")
+    raise ValueError(f"policy {str(path)!r}: no SB3 algorithm loads it ({'; '.join(errors)}); "
+                     f"add a sidecar {path.with_suffix('.json').name} with {{\"algo\": \"PPO\"}}")
+
+
 def read_meta(zip_path: str | Path) -> dict[str, Any]:
     """The sidecar JSON of a saved policy (``{}`` when it has none)."""
     side = policy_files(zip_path)[2]
@@ -97,14 +146,12 @@ def read_meta(zip_path: str | Path) -> dict[str, Any]:
 
 def load_model(zip_path: str | Path, algo: str | None = None) -> Any:
     """The SB3 model at ``zip_path`` on the CPU: class from ``algo``, else from the sidecar JSON, else
-    guessed by :func:`lvgym.benchmark.sb3.load_model` (policies saved by other tools)."""
+    guessed by :func:`guess_and_load` (policies saved by other tools)."""
     import stable_baselines3 as sb3
 
     algo = algo or read_meta(zip_path).get("algo")
     if algo is None:
-        from lvgym.benchmark.sb3 import load_model as guess
-
-        return guess(zip_path)
+        return guess_and_load(zip_path)
     name = ALGO_NAMES.get(str(algo).lower(), str(algo).upper())
     cls = getattr(sb3, name, None)
     if cls is None:

@@ -258,3 +258,13 @@ def smile_single_pid(**kw: Any) -> PIDPolicy:
 def smile_scheduled_pid(schedule: str = "smile_thesis", **kw: Any) -> GainScheduledPIDPolicy:
     """Gain-scheduled PID on SMILE: ``smile_thesis`` (Table 6.10, on mass) or ``smile`` (our tuning)."""
     return GainScheduledPIDPolicy(schedule, vehicle="smile", name=kw.pop("name", f"gs-pid-{schedule}"), **kw)
+
+
+def smile_tuned_pid(schedule: str = "smile", t_design: float = 28.8, **kw: Any) -> PIDPolicy:
+    """One gain set from our rigid tuning: the row of ``schedules/<schedule>.yaml`` nearest ``t_design``
+    [s] (28.8 s, the thesis's design point), held over the flight."""
+    ours = GainSchedule.load(schedule)
+    rows = ours.meta["rows"]
+    i = int(np.argmin(np.abs(np.array([r["time_s"] for r in rows]) - t_design)))
+    return PIDPolicy(*ours.gains(ours.points[i]), name=kw.pop("name", "pid"), **kw)
+

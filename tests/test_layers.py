@@ -15,13 +15,16 @@ import pytest
 
 import lvgym
 
-ABOVE_ALL = ("gymnasium", "stable_baselines3", "torch", "lvgym.envs", "lvgym.simulator", "lvgym.benchmark")
+ON_TOP = ("agents", "baselines_pid")           # controllers and agents sit on top of lvgym
+ABOVE_ALL = ("gymnasium", "stable_baselines3", "torch", "lvgym.envs", "lvgym.simulator", "lvgym.benchmark") + ON_TOP
 
 FORBIDDEN = {
     "lvgym.dynamics": ABOVE_ALL + ("lvgym.environment", "lvgym.vehicle"),
     "lvgym.environment": ABOVE_ALL + ("lvgym.dynamics", "lvgym.vehicle"),
     "lvgym.vehicle": ABOVE_ALL + ("lvgym.dynamics", "lvgym.environment"),
-    "lvgym.simulator": ("gymnasium", "stable_baselines3", "torch", "lvgym.envs", "lvgym.benchmark"),
+    "lvgym.simulator": ("gymnasium", "stable_baselines3", "torch", "lvgym.envs", "lvgym.benchmark") + ON_TOP,
+    "lvgym.envs": ("stable_baselines3.common.policies", "torch", "lvgym.benchmark") + ON_TOP,
+    "lvgym.benchmark": ("torch",) + ON_TOP,
 }
 ROOT = Path(lvgym.__file__).parent
 

@@ -5,7 +5,6 @@
 - :mod:`.metrics`: per-episode metrics, per-suite mean / std / CVaR10 / failure rate, degradation;
 - :mod:`.runner`: :func:`run_episode` and :func:`evaluate` (serial, local process pool or Ray);
 - :mod:`.results`: atomic CSV / JSON / Markdown / PNG result files;
-- :mod:`.sb3`: a saved stable-baselines3 model as a policy.
 """
 
 from .metrics import (CVAR_LEVEL, SUMMARY_METRICS, Trajectory, TrajectoryBuilder, cvar, degradation, episode_metrics,
