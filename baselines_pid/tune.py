@@ -95,7 +95,8 @@ def schedule(vehicle: str = "smile", times=None, bandwidth: float = 75.0, pm_deg
              n: float = 500.0, ki_ratio: float = 3.0, log=print) -> dict[str, Any]:
     """Tune at each time and return the schedule document (variable: vehicle mass)."""
     times = VEHICLE_TIMES.get(vehicle, VEHICLE_TIMES["smile"]) if times is None else times
-    rows = []
+    rows: list[dict[str, Any]] = []
+    skipped: list[dict[str, Any]] = []
     for t in times:
         op = operating_point(vehicle, t, "rigid")
         tl = op.sim.timeline
@@ -104,7 +105,14 @@ def schedule(vehicle: str = "smile", times=None, bandwidth: float = 75.0, pm_deg
             continue
         mass = float(tl.interp("mass", [t])[0])
         rigid = linearize(op=op)
-        res = tune(rigid, bandwidth, pm_deg, dt, n, ki_ratio)
+        try:
+            res = tune(rigid, bandwidth, pm_deg, dt, n, ki_ratio)
+        except RuntimeError as exc:               # e.g. an aerodynamically unstable vehicle beyond a Mach
+            unstable = np.linalg.eigvals(rigid.A).real.max()
+            log(f"t = {t:g} s: skipped, {exc} (fastest open-loop pole of the rigid plant {unstable:+.3g} 1/s)")
+            skipped.append({"time_s": float(t), "reason": str(exc),
+                            "max_open_loop_pole_real_per_s": round(float(unstable), 5)})
+            continue
         gains = res["gains"]
         nonrigid = linearize(op=operating_point(vehicle, t, "nonrigid"))
         mr, mn = loop_margins(rigid, gains, dt), loop_margins(nonrigid, gains, dt)
@@ -120,7 +128,7 @@ def schedule(vehicle: str = "smile", times=None, bandwidth: float = 75.0, pm_deg
     return {"vehicle": vehicle, "source": "python -m baselines_pid.tune (rigid linearisation, discrete loop)",
             "variable": "mass", "target": {"bandwidth_radps": bandwidth, "phase_margin_deg": pm_deg,
                                            "control_dt_s": dt, "ki_ratio": ki_ratio},
-            "rows": rows}
+            "rows": rows, "skipped": skipped}
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -135,6 +143,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--ki-ratio", type=float, default=3.0, help="crossover over integral zero")
     a = ap.parse_args(argv)
     doc = schedule(a.vehicle, a.times, a.bandwidth, a.phase_margin, a.dt or None, a.n, a.ki_ratio)
+    if len(doc["rows"]) < 1:
+        print(f"no flight time of {a.vehicle} could be tuned; nothing written", file=sys.stderr)
+        return 1
     out = Path(a.out) if a.out else SCHEDULES / f"{a.vehicle}.yaml"
     out.parent.mkdir(parents=True, exist_ok=True)
     with open(out, "w") as f:
