@@ -139,3 +139,51 @@ def test_conditions_names_are_checked(smile):
         smile.conditions("altitud")
     assert set(DIAG) >= {"altitude", "mach", "qbar", "alpha", "thrust"}
     assert "flat" in SITES
+
+
+def _smile_mapping():
+    from pathlib import Path
+
+    import yaml
+
+    import lvgym.vehicle.config as cfg
+
+    return yaml.safe_load((Path(cfg.VEHICLE_DIR) / "smile.yaml").read_text())
+
+
+def test_aerodynamics_of_the_stack_in_flight_after_separation():
+    """A stage's own aerodynamics is in force once it is the lowest attached stage: SMILE with the
+    finless upper stack after stage 1 separates at 44 s."""
+    from lvgym.vehicle.config import parse_vehicle
+
+    data = _smile_mapping()
+    data["stages"][1]["aerodynamics"] = {"model": "barrowman", "nose": {"shape": "ogive", "length": 1.8},
+                                         "body": {"diameter": 1.1, "length": 5.3}}
+    sim = Simulator(parse_vehicle(data), model="rigid", t_end=46.0,
+                    wind={"model": "profile", "altitude_m": [0.0, 1e5], "speed": [5.0, 5.0],
+                          "direction_deg": [90.0, 90.0]})
+    sim.reset()
+    lift_off, upper = sim.stage_aerodynamics[0], sim.stage_aerodynamics[1]
+    assert upper is not lift_off and sim.stage_aerodynamics[2] is upper       # stage 3 inherits
+    for t_stop, model in ((43.5, lift_off), (45.5, upper)):
+        while sim.t[0] < t_stop - 1e-9:
+            sim.step([[0.0, 0.0]], 0.05)
+        f, m, _ = model.loads(sim.conditions("v_air_b")[0], sim.state("omega_bi_b")[0], sim.conditions("density")[0],
+                              sim.conditions("speed_of_sound")[0], sim.p[0, sim._i_cg])
+        np.testing.assert_allclose(sim.conditions("f_aero_b")[0], f, rtol=1e-12, atol=1e-9)
+        np.testing.assert_allclose(sim.conditions("m_aero_b")[0], m, rtol=1e-12, atol=1e-9)
+    # the finless upper stack is statically unstable (positive Cm at positive alpha), the lift-off stack stable
+    assert lift_off.coefficients(5.8, np.radians(2.0))["Cm"] < 0.0 < upper.coefficients(5.8, np.radians(2.0))["Cm"]
+    # the shipped smile keeps the lift-off stack's aerodynamics all flight (as the thesis)
+    shipped = Simulator("smile", model="rigid", t_end=2.0)
+    assert all(m is shipped.aerodynamics for m in shipped.stage_aerodynamics)
+
+
+def test_stage_aerodynamics_must_be_a_mapping():
+    from lvgym.errors import ConfigError
+    from lvgym.vehicle.config import parse_vehicle
+
+    data = _smile_mapping()
+    data["stages"][1]["aerodynamics"] = [1, 2]
+    with pytest.raises(ConfigError, match="aerodynamics"):
+        parse_vehicle(data)

@@ -27,7 +27,7 @@ from lvgym.dynamics.kernels import X_ETA, X_Q, X_R, X_V, X_W
 from lvgym.dynamics.stepper import _alloc, rk4_vehicle
 from lvgym.rotations import quat_to_dcm
 
-from .flight import C_AE, C_DP, C_DY, C_T0, C_TIME0, flight_conditions_k
+from .flight import C_AE, C_DP, C_DY, C_T0, C_TIME0, flight_conditions_k, select_aero_k
 from .servo import servo_step_k
 
 # rail parameter vector (one per simulator)
@@ -67,6 +67,14 @@ def interp_k(tl_t, values, t):
     """Linear interpolation of a timeline column ``values`` at time ``t``."""
     i, w = locate_k(tl_t, t)
     return (1.0 - w) * values[i] + w * values[i + 1]
+
+
+@nb.njit(cache=True, nogil=True)
+def held_k(tl_t, values, t):
+    """The value of a piecewise-constant timeline column ``values`` in force at time ``t`` (the row
+    after an event at an event time)."""
+    i, w = locate_k(tl_t, t)
+    return values[i + 1] if w >= 1.0 else values[i]
 
 
 @nb.njit(cache=True, nogil=True)
@@ -125,7 +133,7 @@ def constrain_k(x, t, rail, x_cg0, x_cg, rs):
 
 @nb.njit(cache=True, nogil=True)
 def advance_range(lo, hi, loads_fn, x, p, c, t, scale, offset, x_cg0, failed, rail, rail_state, servo, cmd,
-                  gimbal, gimbal_rate, effort, tl_t, tl_p, hold, tl_T0, tl_Ae, ev_t, duration, physics_dt,
+                  gimbal, gimbal_rate, effort, tl_t, tl_p, hold, tl_T0, tl_Ae, tl_stage, ev_t, duration, physics_dt,
                   n_slosh, n_modes, n_u, i_cg, diag):
     """Advance rows ``lo:hi`` by ``duration`` [s] (see the module docstring).
 
@@ -134,7 +142,8 @@ def advance_range(lo, hi, loads_fn, x, p, c, t, scale, offset, x_cg0, failed, ra
     (B,) bool; ``rail`` (R_SIZE,); ``rail_state`` (B, N_RAIL_STATE); ``servo`` (N_SERVO,); ``cmd``
     (B, 2) gimbal command [rad]; ``gimbal``, ``gimbal_rate`` (B, 2) servo state [rad, rad/s];
     ``effort`` (B, 2) receives the integrals of |gimbal| [rad s] and |gimbal rate| [rad] over the
-    period; timeline columns ``tl_*`` and event times ``ev_t``; ``i_cg``: index of the CG station in
+    period; timeline columns ``tl_*`` (``tl_stage``: the lowest attached stage, which picks the
+    aerodynamic block) and event times ``ev_t``; ``i_cg``: index of the CG station in
     ``p``; ``diag`` (B, N_DIAG) receives the flight conditions at the end."""
     n_x = x.shape[1]
     n_p = p.shape[1]
@@ -171,6 +180,7 @@ def advance_range(lo, hi, loads_fn, x, p, c, t, scale, offset, x_cg0, failed, ra
                 cb[C_T0] = interp_k(tl_t, tl_T0, tm)
                 cb[C_AE] = interp_k(tl_t, tl_Ae, tm)
                 cb[C_TIME0] = ta
+                select_aero_k(cb, held_k(tl_t, tl_stage, tm))
                 rk4_vehicle(loads_fn, 0.0, te - ta, xb, pb, cb, n_slosh, n_modes, True, buf, E, ws)
                 ta = te
                 if rs[RS_ON] != 0.0:
@@ -193,15 +203,18 @@ def advance_range(lo, hi, loads_fn, x, p, c, t, scale, offset, x_cg0, failed, ra
                 break
         cb[C_T0] = interp_k(tl_t, tl_T0, t[b])
         cb[C_AE] = interp_k(tl_t, tl_Ae, t[b])
+        select_aero_k(cb, held_k(tl_t, tl_stage, t[b]))
         flight_conditions_k(t[b], xb, pb, cb, diag[b])
 
 
 @nb.njit(cache=True, nogil=True)
-def conditions_range(lo, hi, t, x, p, c, tl_t, tl_T0, tl_Ae, diag):
-    """Flight conditions of rows ``lo:hi`` at their current times, thrust at those times."""
+def conditions_range(lo, hi, t, x, p, c, tl_t, tl_T0, tl_Ae, tl_stage, diag):
+    """Flight conditions of rows ``lo:hi`` at their current times, thrust and aerodynamics at those
+    times."""
     for b in range(lo, hi):
         c[b, C_T0] = interp_k(tl_t, tl_T0, t[b])
         c[b, C_AE] = interp_k(tl_t, tl_Ae, t[b])
+        select_aero_k(c[b], held_k(tl_t, tl_stage, t[b]))
         flight_conditions_k(t[b], x[b], p[b], c[b], diag[b])
 
 

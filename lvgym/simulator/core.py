@@ -157,10 +157,17 @@ class Simulator:
         self.gravity = make("gravity", gravity) if isinstance(gravity, (str, dict)) else gravity
         self.atmosphere = make("atmosphere", atmosphere) if isinstance(atmosphere, (str, dict)) else atmosphere
         self.wind = wind
-        if isinstance(aerodynamics, str) and aerodynamics == "vehicle":
+        from_vehicle = isinstance(aerodynamics, str) and aerodynamics == "vehicle"
+        if from_vehicle:
             aerodynamics = self.vehicle.aerodynamics or None
         self.aerodynamics = (make("aerodynamics", aerodynamics) if isinstance(aerodynamics, (str, dict))
                              else aerodynamics)
+        # per stage (the lowest attached one): the stage's own ``aerodynamics`` from the vehicle file
+        # when there is one, else the stack's before it
+        self.stage_aerodynamics = [self.aerodynamics]
+        for stage in self.vehicle.stages[1:]:
+            own = stage.aerodynamics if from_vehicle and self.aerodynamics is not None else None
+            self.stage_aerodynamics.append(make("aerodynamics", own) if own else self.stage_aerodynamics[-1])
         self.physics_dt = float(physics_dt)
         self.elevation = math.radians(elevation_deg)
         self.rail_length = float(rail_length)
@@ -185,6 +192,7 @@ class Simulator:
         if self.threads < 1:
             raise ValueError(f"threads = {threads!r}: at least 1")
         self._event_times = np.ascontiguousarray(self.timeline.event_times, dtype=float)
+        self._stage_column = np.ascontiguousarray(self.timeline.stage, dtype=float)
         self._event_times_all = np.array([t for t, _ in self.timeline.events], dtype=float)
         self.batch = 0
 
@@ -237,7 +245,11 @@ class Simulator:
         winds = [self.wind] * R if winds is None else list(winds)
         if len(winds) != R or len(rngs) != R:
             raise ValueError(f"{len(winds)} winds and {len(rngs)} generators for {R} rows")
-        aero = self.aerodynamics.kernel_args() if self.aerodynamics is not None else None
+        if self.aerodynamics is None:
+            aero = None
+        else:
+            args = {id(m): m.kernel_args() for m in self.stage_aerodynamics}
+            aero = [args[id(m)] for m in self.stage_aerodynamics]
         ctx = [pack_context(self.site.params, self.gravity.params, self.atmosphere.params,
                             self._wind_params(w, g), aero) for w, g in zip(winds, rngs)]
         width = max(r.size for r in ctx)
@@ -322,7 +334,7 @@ class Simulator:
         tl = self.timeline
         self._run(_ADVANCE, flight_loads, self.x, self.p, self.c, self.t, self.scale, self.offset,
                   self.x_cg0, self.failed, self.rail, rs, self._servo, self.cmd, self.gimbal, self.gimbal_rate,
-                  self.effort, tl.t, tl.params, tl.hold, tl.thrust0, tl.exit_area, self._event_times,
+                  self.effort, tl.t, tl.params, tl.hold, tl.thrust0, tl.exit_area, self._stage_column, self._event_times,
                   float(duration), self.physics_dt, self.dynamics.n_slosh, self.dynamics.n_modes,
                   self.layout.n_u, self._i_cg, self.diag)
         events: list[list[tuple[float, str]]] = [[] for _ in range(B)]
@@ -342,7 +354,8 @@ class Simulator:
     def _update_conditions(self) -> None:
         """Flight conditions of every row at its current time (thrust at that time)."""
         tl = self.timeline
-        self._run(_CONDITIONS, self.t, self.x, self.p, self.c, tl.t, tl.thrust0, tl.exit_area, self.diag)
+        self._run(_CONDITIONS, self.t, self.x, self.p, self.c, tl.t, tl.thrust0, tl.exit_area, self._stage_column,
+                  self.diag)
 
     @property
     def on_rail(self) -> np.ndarray:

@@ -10,7 +10,8 @@ the vehicle felt.
 ``c`` is the per-vehicle *context* vector (layout ``C_*``): the commands (gimbal angles, a body moment
 such as reaction-control thrusters give) and thrust held over a step
 and the row's start time ``c[C_TIME0]`` (the stepper's time is relative to it, so the rows of a batch
-may be at different times), a scratch block the compiled functions write into (so that an evaluation
+may be at different times), the aerodynamic block in force (``C_AP`` .. ``C_END``, chosen per stage from a
+table of contents by :func:`select_aero_k`), a scratch block the compiled functions write into (so that an evaluation
 allocates nothing; each row is only ever evaluated by one thread at a time), followed by the parameter arrays of the launch site, gravity, atmosphere, wind and aerodynamic models,
 packed end to end with their start offsets in the header (rows of a batch may have different wind
 blocks; shorter rows are padded). :func:`pack_context` builds it.
@@ -26,6 +27,7 @@ fixed misalignment: ``e = (cos dp cos dy, -sin dy, sin dp cos dy)`` with ``dp = 
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numba as nb
 import numpy as np
@@ -43,7 +45,12 @@ C_T0, C_AE, C_DP, C_DY, C_MIS_P, C_MIS_Y, C_AERO = 0, 1, 2, 3, 4, 5, 6
 C_SITE, C_GRAV, C_ATM, C_WIND, C_AP, C_AG, C_AD, C_AT, C_NCOL, C_END = 7, 8, 9, 10, 11, 12, 13, 14, 15, 16
 C_TIME0 = 17                      # start time of the row's step [s]: the stepper's t is relative to it
 C_MOMENT = 18                     # commanded body moment (3) [N m], e.g. reaction-control thrusters
-C_SCRATCH = 21                    # scratch of the compiled functions (flight conditions, a 3x3 matrix)
+C_WEND = 21                       # end of the wind block
+C_STAGE = 22                      # the stage whose aerodynamic block is in force (C_AP .. C_END)
+C_NBLOCK = 23                     # rows of the aerodynamic table of contents (one per stage)
+C_TOC = 24                        # offset of that table: per stage (o_ap, o_ag, o_ad, o_at, n_col, o_end)
+C_SCRATCH = 25                    # scratch of the compiled functions (flight conditions, a 3x3 matrix)
+_TOC_KEYS = (C_AP, C_AG, C_AD, C_AT, C_NCOL, C_END)
 
 # ---------------------------------------------------------------------------- flight conditions layout
 DIAG_FIELDS = (
@@ -85,7 +92,7 @@ def flight_conditions_k(t, x, p, c, d):
     atmosphere_state(c[o_atm:o_wind], alt, d[D_RHO:D_RHO + 4])
     rho, pres, sound = d[D_RHO], d[D_PRES], d[D_SOUND]
     wn = d[D_WIND:D_WIND + 3]
-    wind_ned(c[o_wind:o_ap], alt, t, wn)
+    wind_ned(c[o_wind:int(c[C_WEND])], alt, t, wn)
     C = c[C_SCRATCH_M:C_SCRATCH_M + 9].reshape((3, 3))
     site_dcm_ni_latlon_k(lat, lon, t, site, C)
     vx, vy, vz = site_velocity_wrt_earth_k(rx, ry, rz, x[3], x[4], x[5], site)
@@ -155,27 +162,58 @@ def flight_conditions_batch(t, x, p, c, d):
         flight_conditions_k(t[b], x[b], p[b], c[b], d[b])
 
 
+@nb.njit(cache=True, nogil=True)
+def select_aero_k(c, stage):
+    """Put the aerodynamic block of ``stage`` (the lowest attached stage) in force in the context ``c``
+    (stages beyond the table of contents take its last row)."""
+    s = min(max(int(stage), 0), int(c[C_NBLOCK]) - 1)
+    if int(c[C_STAGE]) == s:
+        return
+    o = int(c[C_TOC]) + 6 * s
+    c[C_AP], c[C_AG], c[C_AD], c[C_AT], c[C_NCOL], c[C_END] = c[o], c[o + 1], c[o + 2], c[o + 3], c[o + 4], c[o + 5]
+    c[C_STAGE] = s
+
+
 def pack_context(site: np.ndarray, gravity: np.ndarray, atmosphere: np.ndarray, wind: np.ndarray,
-                 aero: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None) -> np.ndarray:
-    """Context vector of one vehicle from the models' parameter arrays (``aero`` is
-    ``model.kernel_args()`` or None for no aerodynamic loads); commands are zero."""
-    if aero is None:
-        ap, grid, dims, table = np.zeros(4), np.zeros(1), np.ones(1), np.zeros((1, 1))
-    else:
-        ap, grid, dims, table = aero
+                 aero: Any) -> np.ndarray:
+    """Context vector of one vehicle from the models' parameter arrays; commands are zero.
+
+    ``aero``: None (no aerodynamic loads), one model's ``kernel_args()``, or a list of them, one per
+    stage: entry ``s`` is in force while stage ``s`` is the lowest attached one (the same tuple object
+    given for several stages is packed once). Stage 0's block is in force at first."""
+    per_stage = [None] if aero is None else (list(aero) if isinstance(aero, list) else [aero])
     blocks = [np.asarray(site, float), np.asarray(gravity, float), np.asarray(atmosphere, float),
-              np.asarray(wind, float), np.asarray(ap, float), np.asarray(grid, float),
-              np.asarray(dims, float), np.ascontiguousarray(table, float).ravel()]
+              np.asarray(wind, float)]
     if blocks[0].size != SITE_SIZE:
         raise ValueError(f"site parameters have {blocks[0].size} entries: expected {SITE_SIZE}")
     header = np.zeros(C_HEADER)
     header[C_AERO] = 0.0 if aero is None else 1.0
     offset = C_HEADER
-    for key, block in zip((C_SITE, C_GRAV, C_ATM, C_WIND, C_AP, C_AG, C_AD, C_AT), blocks):
+    for key, block in zip((C_SITE, C_GRAV, C_ATM, C_WIND), blocks):
         header[key] = offset
         offset += block.size
-    header[C_END] = offset
-    header[C_NCOL] = np.shape(table)[1]
+    header[C_WEND] = offset
+    packed: dict[int, list[float]] = {}
+    toc = []
+    for args in per_stage:
+        if id(args) not in packed:
+            ap, grid, dims, table = ((np.zeros(4), np.zeros(1), np.ones(1), np.zeros((1, 1))) if args is None
+                                     else args)
+            parts = [np.asarray(ap, float), np.asarray(grid, float), np.asarray(dims, float),
+                     np.ascontiguousarray(table, float).ravel()]
+            starts = []
+            for part in parts:
+                starts.append(offset)
+                blocks.append(part)
+                offset += part.size
+            packed[id(args)] = [*starts, float(np.shape(table)[1]), offset]
+        toc.append(packed[id(args)])
+    header[C_NBLOCK] = len(toc)
+    header[C_TOC] = offset
+    blocks.append(np.asarray(toc, float).ravel())
+    for key, value in zip(_TOC_KEYS, toc[0]):
+        header[key] = value
+    header[C_STAGE] = 0.0
     return np.concatenate([header, *blocks])
 
 

@@ -213,7 +213,9 @@ class Grain:
 class Stage:
     """One stage: its structure, engines, tanks, optional hybrid grain and stiffness sections.
 
-    ``top`` station of the stage's top [m]; ``length`` [m]; ``outer_diameter`` [m]."""
+    ``top`` station of the stage's top [m]; ``length`` [m]; ``outer_diameter`` [m]; ``aerodynamics``: the
+    raw mapping of the stack's aerodynamics once this stage is the lowest attached one (empty: the
+    stack's before it; the first stage's is the vehicle's top-level ``aerodynamics``)."""
 
     name: str
     top: float
@@ -225,6 +227,7 @@ class Stage:
     grain: Grain | None
     sections: tuple[Section, ...]
     key: str
+    aerodynamics: dict[str, Any] = field(default_factory=dict)
 
     @property
     def bottom(self) -> float:
@@ -242,11 +245,16 @@ class Stage:
         for sr in r.children("sections", []):
             sections.append(Section.read(sr, diameter))
             sr.done()
+        aero = r.raw("aerodynamics", {})
+        if not isinstance(aero, dict):
+            raise r.error("aerodynamics", aero, "must be a mapping (the stack's aerodynamics once this stage is "
+                          "the lowest attached one)")
         stage = Stage(name=name, top=r.number("top", hi=0.0), length=r.number("length", lo=0.0, lo_open=True),
                       outer_diameter=diameter, structure=structure,
                       engines=tuple(Engine.read(e) for e in r.children("engines", [])),
                       tanks=tuple(Tank.read(t) for t in r.children("tanks", [])),
-                      grain=Grain.read(grain_r) if grain_r else None, sections=tuple(sections), key=r.path)
+                      grain=Grain.read(grain_r) if grain_r else None, sections=tuple(sections), key=r.path,
+                      aerodynamics=aero)
         r.done()
         return stage
 
