@@ -6,7 +6,7 @@
     RAY_ADDRESS=auto python evaluate.py --executor ray    # ... or the running cluster (``ray start``)
 
 Policies are names of :data:`POLICIES` (``zero``, ``pid``, ``gs-pid``: our rigid tuning; ``pid-thesis``,
-``gs-pid-thesis``: the thesis's gains and Table 6.10) or paths of saved
+``gs-pid-thesis``: the thesis's gains and Table 6.10; ``ppo``: the shipped learned policy) or paths of saved
 stable-baselines3 models (``.zip``; an optional ``<stem>_vecnormalize.pkl`` next to it normalises the
 observations). Suites are names of ``lvgym.benchmark.SUITES``. Episodes run on a local process pool
 by default; the Markdown table is printed, and CSV, JSON, the table and PNG plots go to ``--out``
@@ -38,11 +38,13 @@ POLICIES: dict[str, PolicySpec] = {
     "pid-thesis": PolicySpec("pid-thesis", "baselines_pid.pid:smile_single_pid"),
     "gs-pid-thesis": PolicySpec("gs-pid-thesis", "baselines_pid.pid:smile_scheduled_pid",
                                 (("name", "gs-pid-thesis"), ("schedule", "smile_thesis"))),
+    # the shipped learned policy (agents/trained/ppo_smile_ascent, docs/training.md)
+    "ppo": PolicySpec("ppo", "agents.policy:shipped_policy"),
 }
-DEFAULT_POLICIES = ["zero", "pid", "gs-pid"]
+DEFAULT_POLICIES = ["zero", "pid", "gs-pid", "ppo"]
 DEFAULT_SUITES = ["smile-windy"]
-#: episodes per condition and policy of the default run (2 conditions x 3 policies x 50 = 300 episodes of 60 s:
-#: about 75 s on 2 free cores)
+#: episodes per condition and policy of the default run (2 conditions x 4 policies x 50 = 400 episodes of 60 s:
+#: about 100 s on 2 free cores with the four default policies)
 DEFAULT_EPISODES = 50
 
 

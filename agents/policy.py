@@ -219,6 +219,18 @@ class SB3Policy:
         return np.asarray(action)
 
 
+#: the policy shipped for ``lvgym/SmileAscent-v0`` (its sidecar JSON holds the training set-up; the command
+#: that reproduces it is in docs/training.md)
+SHIPPED = Path(__file__).resolve().parent / "trained" / "ppo_smile_ascent.zip"
+
+
+def shipped_policy(name: str = "ppo") -> SB3Policy:
+    """The shipped PPO policy of ``lvgym/SmileAscent-v0`` (``agents/trained/ppo_smile_ascent``)."""
+    if not SHIPPED.is_file():
+        raise FileNotFoundError(f"the shipped policy {str(SHIPPED)!r} is missing (see docs/training.md)")
+    return SB3Policy(SHIPPED, name)
+
+
 def load_policy(path: str | Path, name: str | None = None) -> SB3Policy:
     """``SB3Policy(path, name)``: a factory for ``lvgym.benchmark.PolicySpec("...", "agents.policy:load_policy",
     (("path", ...),))``."""

@@ -196,10 +196,13 @@ def test_resume_refuses_arguments_that_would_change_the_run(tmp_path):
         TRAIN.train(_argv(tmp_path, "r", steps=128))
 
 
-@pytest.mark.skipif(not SHIPPED.is_file(), reason=f"no shipped checkpoint yet ({SHIPPED.relative_to(ROOT)})")
 def test_shipped_checkpoint_loads_and_acts():
-    policy = SB3Policy(SHIPPED)
-    assert policy.meta.get("env_id") == "lvgym/SmileAscent-v0" and policy.normalizer is not None
+    from agents.policy import shipped_policy
+
+    assert SHIPPED.is_file(), f"the shipped checkpoint {SHIPPED.relative_to(ROOT)} is missing"
+    policy = shipped_policy()
+    assert policy.name == "ppo" and policy.meta.get("env_id") == "lvgym/SmileAscent-v0"
+    assert policy.meta["env_kwargs"]["model"] == "nonrigid" and policy.normalizer is not None
     env = gymnasium.make("lvgym/SmileAscent-v0", mission_time_s=1.0)
     obs, info = env.reset(seed=0)
     policy.reset()
