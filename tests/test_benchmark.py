@@ -326,7 +326,7 @@ def test_registry_names_what_is_missing(monkeypatch):
         ev.resolve_policy("not-a-policy")
     assert ev.resolve_policy("zero") == ZERO
     args = ev.parse_args([])
-    assert args.policies == ["zero", "pid", "gs-pid"] and args.suites == ["smile-windy"] and args.executor == "local"
+    assert args.policies == ["zero", "pid", "gs-pid", "ppo"] and args.suites == ["smile-windy"] and args.executor == "local"
 
 
 def test_cli_end_to_end(tmp_path, tiny_sb3):
