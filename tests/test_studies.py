@@ -12,7 +12,7 @@ from lvgym.studies import RunSetup, doe_study, ld_sweep_study, responses, tw_swe
 from lvgym.studies.__main__ import main
 from lvgym.studies.cache import RunCache, run_key
 from lvgym.studies.doe import anova, design
-from lvgym.studies.executor import run_map
+from lvgym.parallel import run_map
 from lvgym.studies.responses import deflection
 from lvgym.studies.runs import case, run_cases
 

@@ -12,18 +12,16 @@ from __future__ import annotations
 
 import importlib
 import inspect
-import os
-import sys
 from collections.abc import Callable, Sequence
-from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass
 from typing import Any
+
+from lvgym.parallel import EXECUTORS, default_workers, run_map
 
 from .metrics import TrajectoryBuilder, episode_metrics
 from .policy import Policy, ZeroPolicy
 from .suites import PROTOCOL_VERSION, Condition, Suite
 
-EXECUTORS = ("local", "serial", "ray")
 
 
 @dataclass(frozen=True)
@@ -153,100 +151,8 @@ def make_tasks(policies: Sequence[PolicySpec], suites: Sequence[Suite], episodes
     return tasks
 
 
-def default_workers() -> int:
-    """CPUs this process may run on."""
-    try:
-        return max(1, len(os.sched_getaffinity(0)))
-    except AttributeError:
-        return max(1, os.cpu_count() or 1)
-
-
-def _progress(total: int, enabled: bool) -> Any:
-    from tqdm.auto import tqdm
-
-    return tqdm(total=total, desc="episodes", unit="ep", disable=not enabled, file=sys.stderr, dynamic_ncols=True)
-
-
 def _describe(task: Task) -> str:
     return f"policy {task.policy.name!r} on {task.condition.name!r} seed {task.seed}"
-
-
-def _run_serial(tasks: Sequence[Task], bar: Any) -> list[dict[str, Any]]:
-    out = []
-    for t in tasks:
-        try:
-            out.append(run_task(t))
-        except Exception as exc:
-            raise RuntimeError(f"episode failed: {_describe(t)}: {exc}") from exc
-        bar.update(1)
-    return out
-
-
-def _exit_with_parent(parent: int) -> None:
-    """Worker initializer: a daemon thread ends the worker once its parent is gone (a killed evaluation
-    leaves no workers behind; a pool's workers otherwise wait for work forever)."""
-    import threading
-    import time
-
-    def watch() -> None:
-        while os.getppid() == parent:
-            time.sleep(0.5)
-        os._exit(1)
-
-    threading.Thread(target=watch, name="exit-with-parent", daemon=True).start()
-
-
-def _run_local(tasks: Sequence[Task], bar: Any, workers: int) -> list[dict[str, Any]]:
-    import multiprocessing as mp
-
-    results: list[dict[str, Any] | None] = [None] * len(tasks)
-    # spawn: workers do not inherit the parent's threads (numba, BLAS) or open files
-    with ProcessPoolExecutor(max_workers=workers, mp_context=mp.get_context("spawn"),
-                             initializer=_exit_with_parent, initargs=(os.getpid(),)) as pool:
-        futures = {pool.submit(run_task, t): i for i, t in enumerate(tasks)}
-        try:
-            for f in as_completed(futures):
-                i = futures[f]
-                exc = f.exception()
-                if exc is not None:
-                    raise RuntimeError(f"episode failed: {_describe(tasks[i])}: {exc}") from exc
-                results[i] = f.result()
-                bar.update(1)
-        except BaseException:
-            pool.shutdown(wait=True, cancel_futures=True)
-            raise
-    return [r for r in results if r is not None]
-
-
-def _run_ray(tasks: Sequence[Task], bar: Any, workers: int) -> list[dict[str, Any]]:
-    try:
-        import ray
-    except ImportError as exc:
-        raise ImportError("executor 'ray' needs Ray: pip install 'lvgym[ray]' (or pip install ray)") from exc
-    started = not ray.is_initialized()
-    if started and os.environ.get("RAY_ADDRESS"):     # join the cluster named by RAY_ADDRESS
-        ray.init(log_to_driver=False, configure_logging=False)
-    elif started:                                     # a local Ray of `workers` CPUs, for this run
-        ray.init(num_cpus=workers, include_dashboard=False, log_to_driver=False, configure_logging=False)
-    try:
-        remote = ray.remote(num_cpus=1)(run_task)
-        refs = [remote.remote(t) for t in tasks]
-        index = {r: i for i, r in enumerate(refs)}
-        pending = list(refs)
-        while pending:
-            done, pending = ray.wait(pending, num_returns=len(pending), timeout=0.2)
-            for ref in done:
-                try:
-                    ray.get(ref)
-                except Exception as exc:
-                    for p in pending:
-                        ray.cancel(p, force=True)
-                    raise RuntimeError(f"episode failed: {_describe(tasks[index[ref]])}: {exc}") from exc
-            bar.update(len(done))
-        return list(ray.get(refs))
-    finally:
-        if started:
-            ray.shutdown()
 
 
 def evaluate(policies: Sequence[PolicySpec], suites: Sequence[Suite], episodes: int, seed_set: str = "test",
@@ -262,13 +168,7 @@ def evaluate(policies: Sequence[PolicySpec], suites: Sequence[Suite], episodes: 
     if executor not in EXECUTORS:
         raise ValueError(f"executor = {executor!r}: one of {EXECUTORS}")
     tasks = make_tasks(policies, suites, episodes, seed_set)
-    n = max(1, min(int(workers) if workers else default_workers(), len(tasks)))
-    with _progress(len(tasks), progress) as bar:
-        if executor == "serial" or (executor == "local" and n == 1):
-            return _run_serial(tasks, bar)
-        if executor == "local":
-            return _run_local(tasks, bar, n)
-        return _run_ray(tasks, bar, n)
+    return run_map(run_task, tasks, executor, workers, progress, desc="episodes", unit="ep", describe=_describe)
 
 
 __all__ = ["EXECUTORS", "PROTOCOL_VERSION", "PolicySpec", "Task", "ZERO", "build_policy", "default_workers",

@@ -15,7 +15,7 @@ from __future__ import annotations
 import argparse
 import sys
 
-from .executor import EXECUTORS
+from lvgym.parallel import EXECUTORS
 from .responses import AERO_MODES, RunSetup
 from .study import doe_study, ld_sweep_study, tw_sweep_study
 

@@ -15,7 +15,7 @@ from typing import Any
 import pandas as pd
 
 from .cache import RunCache, run_key
-from .executor import run_map
+from lvgym.parallel import run_map
 from .responses import FACTORS, RECORD, RunSetup, run_case
 
 __all__ = ["StudyRun", "case", "run_cases"]

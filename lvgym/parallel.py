@@ -1,9 +1,10 @@
 """Map a picklable function over tasks: serially, on a local process pool or on Ray, with a progress bar.
 
-``lvgym.benchmark.runner`` has the same three executors, but bound to benchmark episodes (its
-``run_task``); this is the generic form the studies need: any module-level function, any picklable
-tasks, and a callback per finished task (the studies write their cache there, so an interrupted study
-keeps every run that finished). Results come back in the order of the tasks whatever the executor.
+The one executor of the benchmark's episodes (:func:`lvgym.benchmark.evaluate`) and of the studies' runs
+(:mod:`lvgym.studies`): any module-level function, any picklable tasks, and a callback per finished task
+(the studies write their cache there, so an interrupted study keeps every run that finished). Results
+come back in the order of the tasks whatever the executor. Pool workers are spawned (they inherit no
+numba or BLAS threads) and exit when their parent dies, so a killed run leaves no workers behind.
 """
 
 from __future__ import annotations
@@ -30,7 +31,8 @@ def default_workers() -> int:
 
 
 def _exit_with_parent(parent: int) -> None:
-    """Worker initializer: end the worker once its parent is gone (an interrupted study leaves no workers)."""
+    """Worker initializer: a daemon thread ends the worker once its parent is gone (a pool's workers
+    otherwise wait for work forever)."""
     import threading
     import time
 
@@ -42,9 +44,21 @@ def _exit_with_parent(parent: int) -> None:
     threading.Thread(target=watch, name="exit-with-parent", daemon=True).start()
 
 
+class _TaskError(Exception):
+    """The exception of task ``index``, raised from it (``__cause__``)."""
+
+    def __init__(self, index: int) -> None:
+        super().__init__(index)
+        self.index = index
+
+
 def _serial(fn: Callable[[T], R], tasks: Sequence[T], done: Callable[[int, R], None]) -> None:
     for i, t in enumerate(tasks):
-        done(i, fn(t))
+        try:
+            r = fn(t)
+        except Exception as exc:
+            raise _TaskError(i) from exc
+        done(i, r)
 
 
 def _local(fn: Callable[[T], R], tasks: Sequence[T], done: Callable[[int, R], None], workers: int) -> None:
@@ -59,7 +73,11 @@ def _local(fn: Callable[[T], R], tasks: Sequence[T], done: Callable[[int, R], No
             while pending:
                 finished, pending = wait(pending, return_when=FIRST_COMPLETED)
                 for f in finished:
-                    done(futures[f], f.result())
+                    try:
+                        r = f.result()
+                    except Exception as exc:
+                        raise _TaskError(futures[f]) from exc
+                    done(futures[f], r)
         except BaseException:
             pool.shutdown(wait=True, cancel_futures=True)
             raise
@@ -71,7 +89,9 @@ def _ray(fn: Callable[[T], R], tasks: Sequence[T], done: Callable[[int, R], None
     except ImportError as exc:
         raise ImportError("executor 'ray' needs Ray: pip install 'lvgym[ray]' (or pip install ray)") from exc
     started = not ray.is_initialized()
-    if started:
+    if started and os.environ.get("RAY_ADDRESS"):     # join the cluster named by RAY_ADDRESS
+        ray.init(log_to_driver=False, configure_logging=False)
+    elif started:                                     # a local Ray of `workers` CPUs, for this map
         ray.init(num_cpus=workers, include_dashboard=False, log_to_driver=False, configure_logging=False)
     try:
         remote = ray.remote(num_cpus=1)(fn)
@@ -82,7 +102,11 @@ def _ray(fn: Callable[[T], R], tasks: Sequence[T], done: Callable[[int, R], None
             while pending:
                 finished, pending = ray.wait(pending, num_returns=1)
                 for ref in finished:
-                    done(index[ref], ray.get(ref))
+                    try:
+                        r = ray.get(ref)
+                    except Exception as exc:
+                        raise _TaskError(index[ref]) from exc
+                    done(index[ref], r)
         except BaseException:
             for p in pending:
                 ray.cancel(p, force=True)
@@ -94,14 +118,15 @@ def _ray(fn: Callable[[T], R], tasks: Sequence[T], done: Callable[[int, R], None
 
 def run_map(fn: Callable[[T], R], tasks: Sequence[T], executor: str = "local", workers: int | None = None,
             progress: bool = True, on_result: Callable[[int, R], None] | None = None,
-            desc: str = "runs") -> list[R]:
+            desc: str = "runs", unit: str = "run", describe: Callable[[T], str] | None = None) -> list[R]:
     """``[fn(t) for t in tasks]`` computed by ``executor``, in the order of ``tasks``.
 
     executor: ``local`` (a spawn process pool of ``workers`` processes, default the CPUs available; one
     worker runs serially), ``serial`` (this process) or ``ray`` (Ray tasks; starts a local Ray with
-    ``workers`` CPUs unless ``ray.init`` was called already, e.g. to join a cluster). ``fn`` must be a
-    module-level function and the tasks picklable. ``on_result(i, result)`` is called in this process as
-    each task finishes. An exception in a task stops the map and is raised here."""
+    ``workers`` CPUs unless ``ray.init`` was called already or ``$RAY_ADDRESS`` names a cluster to join).
+    ``fn`` must be a module-level function and the tasks picklable. ``on_result(i, result)`` is called in
+    this process as each task finishes. An exception in a task stops the map and is raised here, as a
+    ``RuntimeError`` naming the task by ``describe(task)`` when ``describe`` is given."""
     if executor not in EXECUTORS:
         raise ValueError(f"executor = {executor!r}: one of {EXECUTORS}")
     results: list[Any] = [None] * len(tasks)
@@ -110,7 +135,7 @@ def run_map(fn: Callable[[T], R], tasks: Sequence[T], executor: str = "local", w
     n = max(1, min(int(workers) if workers else default_workers(), len(tasks)))
     from tqdm.auto import tqdm
 
-    with tqdm(total=len(tasks), desc=desc, unit="run", disable=not progress, file=sys.stderr,
+    with tqdm(total=len(tasks), desc=desc, unit=unit, disable=not progress, file=sys.stderr,
               dynamic_ncols=True) as bar:
         def done(i: int, r: R) -> None:
             results[i] = r
@@ -118,10 +143,15 @@ def run_map(fn: Callable[[T], R], tasks: Sequence[T], executor: str = "local", w
                 on_result(i, r)
             bar.update(1)
 
-        if executor == "serial" or (executor == "local" and n == 1):
-            _serial(fn, tasks, done)
-        elif executor == "local":
-            _local(fn, tasks, done, n)
-        else:
-            _ray(fn, tasks, done, n)
+        try:
+            if executor == "serial" or (executor == "local" and n == 1):
+                _serial(fn, tasks, done)
+            elif executor == "local":
+                _local(fn, tasks, done, n)
+            else:
+                _ray(fn, tasks, done, n)
+        except _TaskError as exc:
+            if describe is None:
+                raise exc.__cause__ from None
+            raise RuntimeError(f"task failed: {describe(tasks[exc.index])}: {exc.__cause__}") from exc.__cause__
     return results
