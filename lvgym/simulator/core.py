@@ -39,6 +39,7 @@ import numpy as np
 
 from lvgym.environment import LaunchSite, make
 from lvgym.environment.earth import WGS84_OMEGA, dcm_to_quat
+from lvgym.parallel import default_workers
 from lvgym.rotations import quat_to_dcm_batch
 from lvgym.vehicle import MassModel, Vehicle, load_vehicle
 
@@ -52,13 +53,9 @@ _ROWS_PER_THREAD = 8          # smaller batches run on the calling thread
 
 
 def _default_threads() -> int:
+    """``$LVGYM_THREADS``, else the CPUs this process may run on."""
     env = os.environ.get("LVGYM_THREADS")
-    if env:
-        return max(1, int(env))
-    try:
-        return max(1, len(os.sched_getaffinity(0)))
-    except AttributeError:                      # not on Linux
-        return max(1, os.cpu_count() or 1)
+    return max(1, int(env)) if env else default_workers()
 
 
 class _Kernel:
