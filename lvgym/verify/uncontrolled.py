@@ -48,6 +48,7 @@ JET = {"model": "jet_stream", "surface_speed": [5.0, 5.0], "shear_exponent": [0.
        "boundary_layer_m": [500.0, 500.0], "peak_altitude_m": [10500.0, 10500.0], "peak_speed": [50.0, 50.0],
        "width_m": [2000.0, 2000.0], "direction_deg": [270.0, 270.0], "veer_deg": [0.0, 0.0]}
 THESIS_SLOSH_KG, THESIS_PENDULUM_M = 15.0, 0.152   # thesis Figure 5.6; L = 0.28 m / 1.84119
+THESIS_DROP_S = 20.0             # [s] the thesis's model: its fuel empties "at around 20 seconds" (5.2)
 
 
 def stratos3_winds() -> dict[str, Any]:
@@ -61,16 +62,33 @@ def smile_winds() -> dict[str, Any]:
     return {"none": "none", "jet stream": JET, "gust at 9 km": MAXQ_GUST}
 
 
-def _stratos3_vehicle(drop_thrust_n: float | None) -> str:
-    """``stratos3``, or a temporary copy whose thrust after 23 s ramps from ``drop_thrust_n`` [N] to 0."""
-    if drop_thrust_n is None:
+def thesis_thrust_table(table: list[list[float]]) -> list[list[float]]:
+    """The thesis's Stratos III thrust law (5.2) on ``table`` ([time s, thrust N] rows): unchanged up to
+    :data:`THESIS_DROP_S`, where "the thrust is quickly decreased to approximately half of its original
+    value and decreasing to zero in approximately 10 seconds" (0.5 s to half, then linear to 0)."""
+    t0, t_half, t_zero = THESIS_DROP_S, THESIS_DROP_S + 0.5, THESIS_DROP_S + 10.0
+    f0 = float(np.interp(t0, [r[0] for r in table], [r[1] for r in table]))
+    return [list(r) for r in table if r[0] < t0] + [[t0, f0], [t_half, 0.5 * f0], [t_zero, 0.0]]
+
+
+def _stratos3_vehicle(drop_thrust_n: float | None, thesis_thrust: bool = False) -> str:
+    """``stratos3``, or a temporary copy with another thrust law after the drop: a ramp from
+    ``drop_thrust_n`` [N] at 23 s to 0 at the table's end (same mass flow, so the propellant lasts to
+    the end), or the thesis's law (:func:`thesis_thrust_table`, mass flow raised so the N2O empties
+    just before the shorter table ends, as in the shipped file)."""
+    if drop_thrust_n is None and not thesis_thrust:
         return "stratos3"
     data = yaml.safe_load((VEHICLE_DIR / "stratos3.yaml").read_text(encoding="utf-8"))
-    table = data["stages"][0]["engines"][0]["thrust_table"]
+    engine = data["stages"][0]["engines"][0]
+    table = engine["thrust_table"]
     t_last = table[-1][0]
-    for row in table:
-        if row[0] >= THRUST_DROP[1]:
-            row[1] = drop_thrust_n * (t_last - row[0]) / (t_last - THRUST_DROP[1])
+    if thesis_thrust:
+        engine["thrust_table"] = thesis_thrust_table(table)
+        engine["mass_flow"] = engine["mass_flow"] * t_last / engine["thrust_table"][-1][0]
+    else:
+        for row in table:
+            if row[0] >= THRUST_DROP[1]:
+                row[1] = drop_thrust_n * (t_last - row[0]) / (t_last - THRUST_DROP[1])
     fh = tempfile.NamedTemporaryFile("w", suffix=".yaml", prefix="stratos3_drop_", delete=False)
     with fh:
         yaml.safe_dump(data, fh)
@@ -140,10 +158,11 @@ def peak_time(h: dict[str, np.ndarray], t0: float, t1: float) -> np.ndarray:
 
 
 def run_stratos3(model: str, drop_thrust_n: float | None = None, thesis_slosh: bool = False,
-                 dt: float = 0.05) -> dict[str, np.ndarray]:
-    """Stratos III uncontrolled for 30 s, one batch row per wind of :func:`stratos3_winds`."""
+                 dt: float = 0.05, thesis_thrust: bool = False) -> dict[str, np.ndarray]:
+    """Stratos III uncontrolled for 30 s, one batch row per wind of :func:`stratos3_winds`; the
+    what-ifs of :func:`_stratos3_vehicle` and :func:`_thesis_slosh` on request."""
     winds = list(stratos3_winds().values())
-    vehicle = _stratos3_vehicle(drop_thrust_n)
+    vehicle = _stratos3_vehicle(drop_thrust_n, thesis_thrust)
     try:
         sim = Simulator(vehicle, model=model, t_end=STRATOS3_T_END, **STRATOS3)
     finally:
@@ -164,22 +183,29 @@ def run_smile(model: str, winds: dict[str, Any] | None = None, gimbal_sine: tupl
 
 
 def stratos3_summary(dt: float = 0.05) -> list[dict[str, Any]]:
-    """One line per (set-up, wind): peak transverse rates [deg/s] before (15-22 s) and after (22-30 s)
-    the thrust drop, rigid and non-rigid, peak slosh angle [deg] and the specific force after the drop."""
+    """One line per (set-up, wind): peak transverse rates [deg/s] before (15 s to the drop) and after
+    (the drop to 30 s) the thrust drop, rigid and non-rigid, peak slosh angle [deg], the smallest
+    specific force after the drop [m/s^2] and when it first turns negative [s] (NaN: never)."""
     rows = []
-    for name, drop, thesis in (("nominal", None, False), ("thesis slosh size", None, True),
-                               ("thrust < drag after 23 s", 2000.0, False), ("both", 2000.0, True)):
-        hr, hn = run_stratos3("rigid", drop, thesis, dt), run_stratos3("nonrigid", drop, thesis, dt)
+    setups = (("nominal", None, False, False), ("thesis slosh size", None, True, False),
+              ("thesis thrust law", None, False, True), ("thesis thrust law and slosh size", None, True, True),
+              ("thrust < drag after 23 s", 2000.0, False, False), ("thrust < drag and thesis slosh size", 2000.0, True, False))
+    for name, drop, slosh, law in setups:
+        hr, hn = run_stratos3("rigid", drop, slosh, dt, law), run_stratos3("nonrigid", drop, slosh, dt, law)
         wr, wn = transverse_rate(hr), transverse_rate(hn)
+        t_drop = THESIS_DROP_S if law else THRUST_DROP[0]
         for b, wind in enumerate(stratos3_winds()):
-            rows.append({"setup": name, "wind": wind,
-                         "rigid_15_22_degps": DEG * window_max(hr, wr, 15, 22)[b],
-                         "rigid_22_30_degps": DEG * window_max(hr, wr, 22, 30.01)[b],
-                         "nonrigid_15_22_degps": DEG * window_max(hn, wn, 15, 22)[b],
-                         "nonrigid_22_30_degps": DEG * window_max(hn, wn, 22, 30.01)[b],
-                         "slosh_15_22_deg": DEG * window_max(hn, hn["slosh"], 15, 22)[b],
-                         "slosh_22_30_deg": DEG * window_max(hn, hn["slosh"], 22, 30.01)[b],
-                         "ax_min_22_30_mps2": float(hn["ax"][hn["t"] >= 22, b].min())})
+            after = hn["t"] >= t_drop
+            negative = hn["t"][after][hn["ax"][after, b] < 0.0]
+            rows.append({"setup": name, "wind": wind, "t_drop_s": t_drop,
+                         "rigid_before_degps": DEG * window_max(hr, wr, 15, t_drop)[b],
+                         "rigid_after_degps": DEG * window_max(hr, wr, t_drop, 30.01)[b],
+                         "nonrigid_before_degps": DEG * window_max(hn, wn, 15, t_drop)[b],
+                         "nonrigid_after_degps": DEG * window_max(hn, wn, t_drop, 30.01)[b],
+                         "slosh_before_deg": DEG * window_max(hn, hn["slosh"], 15, t_drop)[b],
+                         "slosh_after_deg": DEG * window_max(hn, hn["slosh"], t_drop, 30.01)[b],
+                         "ax_min_after_mps2": float(hn["ax"][after, b].min()),
+                         "t_ax_negative_s": float(negative[0]) if negative.size else math.nan})
     return rows
 
 
@@ -202,6 +228,45 @@ def smile_summary(dt: float = 0.05) -> list[dict[str, Any]]:
                      "rigid_45_60_degps": DEG * window_max(hr, wr, 45, 60.01)[b],
                      "nonrigid_45_60_degps": DEG * window_max(hn, wn, 45, 60.01)[b],
                      "t_peak_rigid_s": float(tp_r[b]), "t_peak_nonrigid_s": float(tp_n[b])})
+    return rows
+
+
+def smile_suite_departures(suite: str = "smile-windy", n: int = 50) -> list[dict[str, Any]]:
+    """SMILE uncontrolled (gimbal at zero) on ``n`` test seeds of a benchmark suite, per condition:
+    failures, their reasons and end times [s], and over all episodes up to burnout (43 s) the median
+    time [s] of the largest q-alpha and of the largest pitch-yaw rate, against the median time of
+    maximum dynamic pressure [s]."""
+    from lvgym.benchmark.suites import get_suite
+
+    s = get_suite(suite)
+    rows = []
+    for cond in s.conditions:
+        env = cond.make_env()
+        ends, reasons, t_qa, t_rate, t_q = [], [], [], [], []
+        for seed in s.seeds("test", n):
+            env.reset(seed=seed)
+            best = {"qa": (-1.0, 0.0), "rate": (-1.0, 0.0), "q": (-1.0, 0.0)}
+            while True:
+                _, _, term, trunc, info = env.step(np.zeros(2, np.float32))
+                t = float(info["time"])
+                omega = env.unwrapped.core.sim.state("omega_bi_b")[0]
+                for key, v in (("qa", info["qalpha_pa_deg"]), ("rate", math.hypot(omega[1], omega[2])),
+                               ("q", info["qbar"])):
+                    if v > best[key][0] and (key == "q" or t <= SMILE_EVENTS["burnout"]):
+                        best[key] = (float(v), t)
+                if term or trunc:
+                    break
+            if info["termination"]:
+                ends.append(t)
+                reasons.append(info["termination"])
+            t_qa.append(best["qa"][1])
+            t_rate.append(best["rate"][1])
+            t_q.append(best["q"][1])
+        env.close()
+        rows.append({"condition": cond.name, "episodes": n, "failed": len(ends),
+                     "reasons": "; ".join(sorted(set(reasons))), "end_s": ", ".join(f"{t:.1f}" for t in sorted(ends)),
+                     "t_max_q_s": float(np.median(t_q)), "t_peak_qalpha_s": float(np.median(t_qa)),
+                     "t_peak_rate_s": float(np.median(t_rate))})
     return rows
 
 
@@ -307,6 +372,8 @@ def main() -> None:
     print(_table(stratos3_summary()))
     print("\nSMILE, uncontrolled (thesis 6.3.1)")
     print(_table(smile_summary()))
+    print("\nSMILE uncontrolled on smile-windy's 50 test seeds")
+    print(_table(smile_suite_departures()))
     print("\nSMILE staging coast: pendulum divergence against an inverted pendulum")
     print(_table(coast_growth()))
     print("\nSMILE with a 0.1 deg, 1 Hz pitch gimbal sine, no wind: peak rate [deg/s]")
