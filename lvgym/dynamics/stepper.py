@@ -110,7 +110,7 @@ def normalise_quaternions(x, n_slosh, n_modes):
             x[qo + i] /= n
 
 
-@nb.njit(cache=True, error_model="numpy")
+@nb.njit(cache=True, error_model="numpy", inline="always")
 def rk4_vehicle(loads_fn, t, h, x, p, c, n_slosh, n_modes, exact_modes, buf, E, ws):
     """Advance one vehicle's state x in place by one step h from time t.
 

@@ -35,158 +35,20 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-import numba as nb
 import numpy as np
 
 from lvgym.errors import MISSING, ConfigError
 
+from .aerokernels import (KIND_AXISYMMETRIC, KIND_TABLES6, P_KIND, P_LREF, P_SREF, P_XREF,  # noqa: F401 (re-exported)
+                          aero_loads_at, aero_loads_batch, aero_loads_k, interp_at, interp_k)
 from .registry import register
 
-KIND_AXISYMMETRIC, KIND_TABLES6 = 0.0, 1.0
-P_KIND, P_SREF, P_LREF, P_XREF = 0, 1, 2, 3
 #: coefficient columns of the table of each kind, in kernel order
 COLUMNS = {KIND_AXISYMMETRIC: ("CA", "CN", "Cm", "Cmq", "Clp"),
            KIND_TABLES6: ("CA", "CY", "CN", "Cl", "Cm", "Cn", "Clp", "Cmq", "Cnr")}
 #: entries of the state vector written by the kernel (AeroState fields, same order)
 STATE_FIELDS = ("alpha", "beta", "alpha_total", "phi_aero", "mach", "qbar", "airspeed")
 DAMPING = ("Cmq", "Clp", "Cnr")
-
-
-# ------------------------------------------------------------------------------- kernels
-@nb.njit(cache=True)
-def interp_k(grid, dims, table, q, out):
-    """Multilinear interpolation of every column of ``table`` at the point ``q`` (one value per
-    axis), clamped to the grid; axes of length 1 are constant. Writes ``out[:table.shape[1]]``."""
-    nd = dims.shape[0]                    # dims may be integers or whole floats (a packed context)
-    idx = np.zeros(nd, np.int64)
-    wgt = np.zeros(nd)
-    stride = np.ones(nd, np.int64)
-    off = 0
-    for d in range(nd):
-        n = int(dims[d])
-        if n > 1:
-            x = q[d]
-            if x >= grid[off + n - 1]:
-                idx[d], wgt[d] = n - 2, 1.0
-            elif x > grid[off]:
-                i = np.searchsorted(grid[off:off + n], x, side="right") - 1
-                idx[d] = i
-                wgt[d] = (x - grid[off + i]) / (grid[off + i + 1] - grid[off + i])
-        off += n
-    for d in range(nd - 2, -1, -1):
-        stride[d] = stride[d + 1] * int(dims[d + 1])
-    for c in range(table.shape[1]):
-        out[c] = 0.0
-    for corner in range(1 << nd):
-        weight = 1.0
-        row = 0
-        for d in range(nd):
-            bit = (corner >> d) & 1
-            if bit == 1:
-                if dims[d] == 1:
-                    weight = 0.0
-                    break
-                weight *= wgt[d]
-            else:
-                weight *= 1.0 - wgt[d]
-            row += (idx[d] + bit) * stride[d]
-        if weight != 0.0:
-            for c in range(table.shape[1]):
-                out[c] += weight * table[row, c]
-
-
-@nb.njit(cache=True, inline="always")
-def _axis_k(grid, off, n, x):
-    """Index ``i``, next index and weight of ``x`` on the axis ``grid[off:off+n]`` (clamped)."""
-    if n <= 1 or x <= grid[off]:
-        return 0, min(1, n - 1), 0.0
-    if x >= grid[off + n - 1]:
-        return n - 2, n - 1, 1.0
-    i = np.searchsorted(grid[off:off + n], x, side="right") - 1
-    return i, i + 1, (x - grid[off + i]) / (grid[off + i + 1] - grid[off + i])
-
-
-@nb.njit(cache=True)
-def _axisymmetric_k(grid, dims, table, mach, alpha_t, x_ref, x_cg, l_ref):
-    """``CA, CN, Cm, Cmq, Clp`` of an axisymmetric table at (Mach, total angle of attack), with Cmq
-    moved from ``x_ref`` to the CG (see the module docstring); bilinear, without allocation (the same
-    values as :func:`interp_k`)."""
-    nm, na = int(dims[0]), int(dims[1])
-    i0, i1, wm = _axis_k(grid, 0, nm, mach)
-    j0, j1, wa = _axis_k(grid, nm, na, alpha_t)
-    w00, w01, w10, w11 = (1.0 - wm) * (1.0 - wa), (1.0 - wm) * wa, wm * (1.0 - wa), wm * wa
-    r00, r01, r10, r11 = i0 * na + j0, i0 * na + j1, i1 * na + j0, i1 * na + j1
-    ca = w00 * table[r00, 0] + w01 * table[r01, 0] + w10 * table[r10, 0] + w11 * table[r11, 0]
-    cn = w00 * table[r00, 1] + w01 * table[r01, 1] + w10 * table[r10, 1] + w11 * table[r11, 1]
-    cm = w00 * table[r00, 2] + w01 * table[r01, 2] + w10 * table[r10, 2] + w11 * table[r11, 2]
-    cmq = w00 * table[r00, 3] + w01 * table[r01, 3] + w10 * table[r10, 3] + w11 * table[r11, 3]
-    clp = w00 * table[r00, 4] + w01 * table[r01, 4] + w10 * table[r10, 4] + w11 * table[r11, 4]
-    if cmq != 0.0 and na > 1:
-        # static slopes about x_ref from the table's first nonzero angle, at this Mach
-        a1 = grid[nm + 1]
-        cn1 = (1.0 - wm) * table[i0 * na + 1, 1] + wm * table[i1 * na + 1, 1]
-        cm1 = (1.0 - wm) * table[i0 * na + 1, 2] + wm * table[i1 * na + 1, 2]
-        dl = (x_ref - x_cg) / l_ref
-        cmq = cmq - 4.0 * dl * cm1 / a1 - 2.0 * dl * dl * cn1 / a1
-    return ca, cn, cm, cmq, clp
-
-
-@nb.njit(cache=True)
-def aero_loads_k(v_air_b, omega_bi_b, rho, sound, x_cg, alt, p, grid, dims, table, f_b, m_b, state):
-    """Aerodynamic force ``f_b`` [N] and moment about the CG ``m_b`` [N m] (body frame) of either
-    table kind, written into the 3-vectors ``f_b``, ``m_b``; ``state`` (7) receives alpha, beta,
-    alpha_t, phi_a [rad], Mach [-], qbar [Pa], airspeed [m/s].
-
-    ``v_air_b`` (3) [m/s] vehicle velocity relative to the air, body axes; ``omega_bi_b`` (3)
-    [rad/s]; ``rho`` [kg/m^3]; ``sound`` speed of sound [m/s]; ``x_cg`` CG station [m]; ``alt``
-    altitude [m] (only for ``tables6`` with an altitude axis; anything otherwise).
-    """
-    u, v, w = v_air_b[0], v_air_b[1], v_air_b[2]
-    vperp = math.sqrt(v * v + w * w)
-    speed = math.sqrt(u * u + vperp * vperp)
-    alpha_t = math.atan2(vperp, u)
-    mach = speed / sound if sound > 0.0 else 0.0
-    qbar = 0.5 * rho * speed * speed
-    s_ref, l_ref = p[P_SREF], p[P_LREF]
-    qs = qbar * s_ref
-    kd = 0.25 * rho * speed * s_ref * l_ref * l_ref          # damping: qbar S L * L / (2 V)
-    if p[P_KIND] == KIND_AXISYMMETRIC:
-        ca, cn, cm, cmq, clp = _axisymmetric_k(grid, dims, table, mach, alpha_t, p[P_XREF], x_cg, l_ref)
-        sp, cp = (v / vperp, w / vperp) if vperp > 0.0 else (0.0, 1.0)
-        f_b[0] = -qs * ca
-        f_b[1] = -qs * cn * sp
-        f_b[2] = -qs * cn * cp
-        m_b[0] = kd * clp * omega_bi_b[0]
-        m_b[1] = qs * l_ref * cm * cp + kd * cmq * omega_bi_b[1]
-        m_b[2] = -qs * l_ref * cm * sp + kd * cmq * omega_bi_b[2]
-    else:
-        c = np.zeros(table.shape[1])
-        q = np.array([mach, math.atan2(w, u), math.atan2(v, math.sqrt(u * u + w * w)), alt])
-        interp_k(grid, dims, table, q, c)
-        f_b[0] = -qs * c[0]
-        f_b[1] = qs * c[1]
-        f_b[2] = -qs * c[2]
-        m_b[0] = qs * l_ref * c[3] + kd * c[6] * omega_bi_b[0]
-        m_b[1] = qs * l_ref * c[4] + kd * c[7] * omega_bi_b[1]
-        m_b[2] = qs * l_ref * c[5] + kd * c[8] * omega_bi_b[2]
-    d = p[P_XREF] - x_cg                                     # m_cg = m_ref + d e_x x f
-    m_b[1] -= d * f_b[2]
-    m_b[2] += d * f_b[1]
-    state[0] = math.atan2(w, u)
-    state[1] = math.atan2(v, math.sqrt(u * u + w * w))
-    state[2] = alpha_t
-    state[3] = math.atan2(v, w) if vperp > 0.0 else 0.0
-    state[4] = mach
-    state[5] = qbar
-    state[6] = speed
-
-
-@nb.njit(cache=True)
-def aero_loads_batch(v_air_b, omega_bi_b, rho, sound, x_cg, alt, p, grid, dims, table, f_b, m_b, state):
-    """:func:`aero_loads_k` over a leading batch axis of every per-vehicle argument."""
-    for j in range(v_air_b.shape[0]):
-        aero_loads_k(v_air_b[j], omega_bi_b[j], rho[j], sound[j], x_cg[j], alt[j], p, grid, dims,
-                     table, f_b[j], m_b[j], state[j])
 
 
 # ------------------------------------------------------------------------------- CSV tables

@@ -46,6 +46,7 @@ import numpy as np
 from lvgym.errors import ConfigError
 
 from .registry import register
+from .search import search_right_k
 
 __all__ = [
     "AtmosphereState", "Us76Atmosphere", "ExponentialAtmosphere", "Nrlmsise00Atmosphere",
@@ -91,14 +92,8 @@ US76_TB, US76_PB = _us76_bases()
 
 
 @nb.njit(cache=True)
-def us76_lower(alt_m, out):
-    """US76 below 86 km: the seven layers in closed form (eqs. 18, 33a, 33b, 42, 50).
-
-    ``alt_m`` is the geometric altitude [m]; below 0 the first layer is extended (the standard
-    covers -5 km), above 86 km the seventh. Writes density [kg/m^3], pressure [Pa], temperature
-    (molecular-scale temperature, equal to the kinetic temperature below 80 km) [K] and speed of
-    sound [m/s] into ``out[0:4]``.
-    """
+def us76_lower_at(alt_m, out, oo):
+    """:func:`us76_lower` into ``out[oo:oo + 4]``."""
     h = R0_GEOPOT * alt_m / (R0_GEOPOT + alt_m)
     b = 0
     while b < 6 and h >= US76_HB[b + 1]:
@@ -111,10 +106,32 @@ def us76_lower(alt_m, out):
         p = US76_PB[b] * math.exp(-G0 * M0 * dh / (R_STAR * tb))
     else:
         p = US76_PB[b] * (tb / t) ** (G0 * M0 / (R_STAR * lapse))
-    out[0] = p * M0 / (R_STAR * t)
-    out[1] = p
-    out[2] = t
-    out[3] = math.sqrt(GAMMA * R_STAR * t / M0)
+    out[oo] = p * M0 / (R_STAR * t)
+    out[oo + 1] = p
+    out[oo + 2] = t
+    out[oo + 3] = math.sqrt(GAMMA * R_STAR * t / M0)
+
+
+@nb.njit(cache=True)
+def us76_lower(alt_m, out):
+    """US76 below 86 km: the seven layers in closed form (eqs. 18, 33a, 33b, 42, 50).
+
+    ``alt_m`` is the geometric altitude [m]; below 0 the first layer is extended (the standard
+    covers -5 km), above 86 km the seventh. Writes density [kg/m^3], pressure [Pa], temperature
+    (molecular-scale temperature, equal to the kinetic temperature below 80 km) [K] and speed of
+    sound [m/s] into ``out[0:4]``.
+    """
+    us76_lower_at(alt_m, out, 0)
+
+
+@nb.njit(cache=True)
+def exponential_state_at(p, o, alt_m, out, oo):
+    """:func:`exponential_state` with the parameters at ``p[o:]``, into ``out[oo:oo + 4]``."""
+    rho = p[o + 1] * math.exp(-alt_m / p[o + 2])
+    out[oo] = rho
+    out[oo + 1] = rho * R_AIR * p[o + 3]
+    out[oo + 2] = p[o + 3]
+    out[oo + 3] = math.sqrt(GAMMA * R_AIR * p[o + 3])
 
 
 @nb.njit(cache=True)
@@ -124,31 +141,24 @@ def exponential_state(p, alt_m, out):
     ``p[1:4] = rho0 [kg/m^3], H [m], T0 [K]``; ``R = 287.05287 J/(kg K)``, speed of sound
     ``sqrt(1.4 R T0)``. Writes ``out[0:4]`` as :func:`us76_lower`.
     """
-    rho = p[1] * math.exp(-alt_m / p[2])
-    out[0] = rho
-    out[1] = rho * R_AIR * p[3]
-    out[2] = p[3]
-    out[3] = math.sqrt(GAMMA * R_AIR * p[3])
+    exponential_state_at(p, 0, alt_m, out, 0)
 
 
 @nb.njit(cache=True)
-def table_state(p, o, alt_m, out):
-    """Cubic Hermite interpolation of the table block at ``p[o:]`` (layout in the module docstring).
-
-    Writes density [kg/m^3], pressure [Pa], temperature [K] and ``sqrt(1.4 p / rho)`` [m/s].
-    """
+def table_state_at(p, o, alt_m, out, oo):
+    """:func:`table_state` into ``out[oo:oo + 4]`` (no array view)."""
     n = int(p[o])
-    z = p[o + 1:o + 1 + n]
-    if alt_m <= z[0] or alt_m >= z[n - 1]:
-        k = 0 if alt_m <= z[0] else n - 1
-        dz = alt_m - z[k]
+    z = o + 1                             # the nodes are p[z:z + n]
+    if alt_m <= p[z] or alt_m >= p[z + n - 1]:
+        k = 0 if alt_m <= p[z] else n - 1
+        dz = alt_m - p[z + k]
         lnrho = p[o + 1 + n + k] + p[o + 1 + 2 * n + k] * dz
         lnp = p[o + 1 + 3 * n + k] + p[o + 1 + 4 * n + k] * dz
         t = p[o + 1 + 5 * n + k]
     else:
-        i = np.searchsorted(z, alt_m, side="right") - 1
-        h = z[i + 1] - z[i]
-        s = (alt_m - z[i]) / h
+        i = search_right_k(p, z, z + n, alt_m) - z - 1
+        h = p[z + i + 1] - p[z + i]
+        s = (alt_m - p[z + i]) / h
         s2 = s * s
         s3 = s2 * s
         h00 = 2.0 * s3 - 3.0 * s2 + 1.0
@@ -163,26 +173,42 @@ def table_state(p, o, alt_m, out):
         t = h00 * p[y] + h10 * p[y + n] + h01 * p[y + 1] + h11 * p[y + n + 1]
     rho = math.exp(lnrho)
     pres = math.exp(lnp)
-    out[0] = rho
-    out[1] = pres
-    out[2] = t
-    out[3] = math.sqrt(GAMMA * pres / rho)
+    out[oo] = rho
+    out[oo + 1] = pres
+    out[oo + 2] = t
+    out[oo + 3] = math.sqrt(GAMMA * pres / rho)
+
+
+@nb.njit(cache=True)
+def table_state(p, o, alt_m, out):
+    """Cubic Hermite interpolation of the table block at ``p[o:]`` (layout in the module docstring).
+
+    Writes density [kg/m^3], pressure [Pa], temperature [K] and ``sqrt(1.4 p / rho)`` [m/s].
+    """
+    table_state_at(p, o, alt_m, out, 0)
+
+
+@nb.njit(cache=True, inline="always")
+def atmosphere_state_at(p, o, alt_m, out, oo):
+    """:func:`atmosphere_state` with the model's parameters at ``p[o:]`` (a packed array), into
+    ``out[oo:oo + 4]``: no array view, no allocation."""
+    code = int(p[o])
+    if code == CODE_US76:
+        if alt_m < US76_Z_TOP:
+            us76_lower_at(alt_m, out, oo)
+        else:
+            table_state_at(p, o + 1, alt_m, out, oo)
+    elif code == CODE_EXPONENTIAL:
+        exponential_state_at(p, o, alt_m, out, oo)
+    else:
+        table_state_at(p, o + 1, alt_m, out, oo)
 
 
 @nb.njit(cache=True)
 def atmosphere_state(p, alt_m, out):
     """Density [kg/m^3], pressure [Pa], temperature [K] and speed of sound [m/s] at geometric
     altitude ``alt_m`` [m] into ``out[0:4]``, for any model's parameter array ``p``."""
-    code = int(p[0])
-    if code == CODE_US76:
-        if alt_m < US76_Z_TOP:
-            us76_lower(alt_m, out)
-        else:
-            table_state(p, 1, alt_m, out)
-    elif code == CODE_EXPONENTIAL:
-        exponential_state(p, alt_m, out)
-    else:
-        table_state(p, 1, alt_m, out)
+    atmosphere_state_at(p, 0, alt_m, out, 0)
 
 
 @nb.njit(cache=True)

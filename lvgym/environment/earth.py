@@ -103,14 +103,20 @@ def dcm_ne_k(lat, lon, C):
 
 
 @nb.njit(cache=True)
+def site_geodetic_at(x, y, z, t, p, o):
+    """:func:`site_geodetic_k` with the site parameters at ``p[o:]`` (a packed array; no view)."""
+    if p[o + SITE_FLAT] != 0.0:
+        return p[o + SITE_LAT], p[o + SITE_LON], p[o + SITE_H0] + x
+    c, s = math.cos(p[o + SITE_OMEGA] * t), math.sin(p[o + SITE_OMEGA] * t)
+    return ecef_to_geodetic_k(c * x + s * y, -s * x + c * y, z, p[o + SITE_A], p[o + SITE_E2])
+
+
+@nb.njit(cache=True)
 def site_geodetic_k(x, y, z, t, p):
     """Geodetic latitude, longitude [rad] and altitude [m] of the inertial point (x, y, z) [m] at
     time ``t`` [s], for the site parameters ``p``. Flat Earth: the pad's latitude and longitude
     and ``h_pad + x``."""
-    if p[SITE_FLAT] != 0.0:
-        return p[SITE_LAT], p[SITE_LON], p[SITE_H0] + x
-    c, s = math.cos(p[SITE_OMEGA] * t), math.sin(p[SITE_OMEGA] * t)
-    return ecef_to_geodetic_k(c * x + s * y, -s * x + c * y, z, p[SITE_A], p[SITE_E2])
+    return site_geodetic_at(x, y, z, t, p, 0)
 
 
 @nb.njit(cache=True)
@@ -122,17 +128,17 @@ def site_dcm_ni_k(x, y, z, t, p, C):
 
 
 @nb.njit(cache=True)
-def site_dcm_ni_latlon_k(lat, lon, t, p, C):
-    """:func:`site_dcm_ni_k` from the point's geodetic latitude and longitude [rad] (as
-    :func:`site_geodetic_k` returns them), for callers that already have them. No allocation."""
+def site_dcm_ni_latlon_at(lat, lon, t, p, o, C):
+    """:func:`site_dcm_ni_latlon_k` with the site parameters at ``p[o:]`` (a packed array)."""
     dcm_ne_k(lat, lon, C)                            # C = C_ne, then C_ne C_ei row by row
-    flat = p[SITE_FLAT] != 0.0
-    c, s = math.cos(p[SITE_OMEGA] * t), math.sin(p[SITE_OMEGA] * t)
+    flat = p[o + SITE_FLAT] != 0.0
+    c, s = math.cos(p[o + SITE_OMEGA] * t), math.sin(p[o + SITE_OMEGA] * t)
+    le = o + SITE_C_LE
     for j in range(3):
         r0, r1, r2 = C[j, 0], C[j, 1], C[j, 2]
         if flat:                                     # "inertial" is the launch frame: C_ei = C_le^T
             for k in range(3):
-                C[j, k] = r0 * p[SITE_C_LE + 3 * k] + r1 * p[SITE_C_LE + 3 * k + 1] + r2 * p[SITE_C_LE + 3 * k + 2]
+                C[j, k] = r0 * p[le + 3 * k] + r1 * p[le + 3 * k + 1] + r2 * p[le + 3 * k + 2]
         else:                                        # C_ei = [[c, s, 0], [-s, c, 0], [0, 0, 1]]
             C[j, 0] = r0 * c - r1 * s
             C[j, 1] = r0 * s + r1 * c
@@ -140,13 +146,26 @@ def site_dcm_ni_latlon_k(lat, lon, t, p, C):
 
 
 @nb.njit(cache=True)
+def site_dcm_ni_latlon_k(lat, lon, t, p, C):
+    """:func:`site_dcm_ni_k` from the point's geodetic latitude and longitude [rad] (as
+    :func:`site_geodetic_k` returns them), for callers that already have them. No allocation."""
+    site_dcm_ni_latlon_at(lat, lon, t, p, 0, C)
+
+
+@nb.njit(cache=True)
+def site_velocity_wrt_earth_at(x, y, z, vx, vy, vz, p, o):
+    """:func:`site_velocity_wrt_earth_k` with the site parameters at ``p[o:]``."""
+    if p[o + SITE_FLAT] != 0.0:
+        return vx, vy, vz
+    w = p[o + SITE_OMEGA]
+    return vx + w * y, vy - w * x, vz
+
+
+@nb.njit(cache=True)
 def site_velocity_wrt_earth_k(x, y, z, vx, vy, vz, p):
     """Velocity relative to the rotating Earth, ``v_i - omega_ie_i x r_i`` [m/s], in inertial
     components, of the inertial position (x, y, z) [m] and velocity (vx, vy, vz) [m/s]."""
-    if p[SITE_FLAT] != 0.0:
-        return vx, vy, vz
-    w = p[SITE_OMEGA]
-    return vx + w * y, vy - w * x, vz
+    return site_velocity_wrt_earth_at(x, y, z, vx, vy, vz, p, 0)
 
 
 @nb.njit(cache=True)

@@ -65,54 +65,72 @@ def harmonic_factors(N: int) -> np.ndarray:
     return F.ravel()
 
 
+def harmonics_work(p: np.ndarray) -> int:
+    """Scratch entries :func:`harmonics_at` needs for the harmonics parameters ``p`` (0 otherwise)."""
+    return 2 * (int(p[P_DEGREE]) + 2) ** 2 if p[P_KIND] == KIND_HARMONICS else 0
+
+
+@nb.njit(cache=True)
+def harmonics_at(x, y, z, p, o, w, ow):
+    """:func:`harmonics_k` with the parameters at ``p[o:]`` and the solid harmonics ``V``, ``W``
+    ((N+2, N+2) each, row major) in the scratch ``w[ow:ow + harmonics_work]`` (any contents)."""
+    gm, R = p[o + P_GM], p[o + P_RADIUS]
+    N, M = int(p[o + P_DEGREE]), int(p[o + P_ORDER])
+    K = (N + 1) * (N + 2) // 2
+    n2 = N + 2
+    oc = o + P_COEF                                    # C at oc, S at oc + K, F at oc + 2K
+    of = oc + 2 * K
+    ov, ow_ = ow, ow + n2 * n2                         # V[n, m] = w[ov + n n2 + m], W likewise
+    r2 = x * x + y * y + z * z
+    rho = R / r2
+    x0, y0, z0, rr = x * rho, y * rho, z * rho, R * rho
+    w[ov] = R / math.sqrt(r2)
+    w[ow_] = 0.0
+    for m in range(min(M + 1, N + 1) + 1):
+        if m > 0:                                      # sectoral: V_mm from V_m-1,m-1
+            f = math.sqrt(3.0) if m == 1 else math.sqrt((2.0 * m + 1.0) / (2.0 * m))
+            d, e = (m - 1) * n2 + m - 1, m * n2 + m
+            w[ov + e] = f * (x0 * w[ov + d] - y0 * w[ow_ + d])
+            w[ow_ + e] = f * (x0 * w[ow_ + d] + y0 * w[ov + d])
+        for n in range(m + 1, n2):                     # along the column m
+            a = p[of + (F_A * n2 + n) * n2 + m]
+            e = n * n2 + m
+            w[ov + e] = a * z0 * w[ov + e - n2]
+            w[ow_ + e] = a * z0 * w[ow_ + e - n2]
+            if n > m + 1:
+                b = p[of + (F_B * n2 + n) * n2 + m]
+                w[ov + e] -= b * rr * w[ov + e - 2 * n2]
+                w[ow_ + e] -= b * rr * w[ow_ + e - 2 * n2]
+    ax = ay = az = u = 0.0
+    for n in range(N + 1):
+        for m in range(min(n, M) + 1):
+            C, S = p[oc + n * (n + 1) // 2 + m], p[oc + K + n * (n + 1) // 2 + m]
+            if C == 0.0 and S == 0.0:
+                continue
+            e = n * n2 + m                             # (n, m); (n + 1, m) is e + n2
+            u += C * w[ov + e] + S * w[ow_ + e]
+            az -= p[of + F_FZ * n2 * n2 + e] * (C * w[ov + e + n2] + S * w[ow_ + e + n2])
+            if m == 0:
+                f0 = p[of + F_F0 * n2 * n2 + e]
+                ax -= f0 * C * w[ov + (n + 1) * n2 + 1]
+                ay -= f0 * C * w[ow_ + (n + 1) * n2 + 1]
+            else:
+                fa, fb = p[of + F_FA * n2 * n2 + e], p[of + F_FB * n2 * n2 + e]
+                up, dn = e + n2 + 1, e + n2 - 1
+                ax += 0.5 * (fa * (-C * w[ov + up] - S * w[ow_ + up])
+                             + fb * (C * w[ov + dn] + S * w[ow_ + dn]))
+                ay += 0.5 * (fa * (-C * w[ow_ + up] + S * w[ov + up])
+                             + fb * (-C * w[ow_ + dn] + S * w[ov + dn]))
+    s = gm / (R * R)
+    return s * ax, s * ay, s * az, -gm / R * u
+
+
 @nb.njit(cache=True)
 def harmonics_k(x, y, z, p):
     """Acceleration (3) [m/s^2] and potential energy [J/kg] of the spherical-harmonic field with
     parameters ``p`` (layout ``P_*``) at the body-fixed point (x, y, z) [m], as a 4-tuple."""
-    gm, R = p[P_GM], p[P_RADIUS]
-    N, M = int(p[P_DEGREE]), int(p[P_ORDER])
-    K = (N + 1) * (N + 2) // 2
-    n2 = N + 2
-    F = p[P_COEF + 2 * K:P_COEF + 2 * K + 6 * n2 * n2].reshape((6, n2, n2))
-    r2 = x * x + y * y + z * z
-    rho = R / r2
-    x0, y0, z0, rr = x * rho, y * rho, z * rho, R * rho
-    V = np.zeros((n2, n2))
-    W = np.zeros((n2, n2))
-    V[0, 0] = R / math.sqrt(r2)
-    for m in range(min(M + 1, N + 1) + 1):
-        if m > 0:                                      # sectoral: V_mm from V_m-1,m-1
-            f = math.sqrt(3.0) if m == 1 else math.sqrt((2.0 * m + 1.0) / (2.0 * m))
-            V[m, m] = f * (x0 * V[m - 1, m - 1] - y0 * W[m - 1, m - 1])
-            W[m, m] = f * (x0 * W[m - 1, m - 1] + y0 * V[m - 1, m - 1])
-        for n in range(m + 1, n2):                     # along the column m
-            a = F[F_A, n, m]
-            V[n, m] = a * z0 * V[n - 1, m]
-            W[n, m] = a * z0 * W[n - 1, m]
-            if n > m + 1:
-                b = F[F_B, n, m]
-                V[n, m] -= b * rr * V[n - 2, m]
-                W[n, m] -= b * rr * W[n - 2, m]
-    ax = ay = az = u = 0.0
-    for n in range(N + 1):
-        for m in range(min(n, M) + 1):
-            C, S = p[P_COEF + n * (n + 1) // 2 + m], p[P_COEF + K + n * (n + 1) // 2 + m]
-            if C == 0.0 and S == 0.0:
-                continue
-            u += C * V[n, m] + S * W[n, m]
-            az -= F[F_FZ, n, m] * (C * V[n + 1, m] + S * W[n + 1, m])
-            if m == 0:
-                f0 = F[F_F0, n, m]
-                ax -= f0 * C * V[n + 1, 1]
-                ay -= f0 * C * W[n + 1, 1]
-            else:
-                fa, fb = F[F_FA, n, m], F[F_FB, n, m]
-                ax += 0.5 * (fa * (-C * V[n + 1, m + 1] - S * W[n + 1, m + 1])
-                             + fb * (C * V[n + 1, m - 1] + S * W[n + 1, m - 1]))
-                ay += 0.5 * (fa * (-C * W[n + 1, m + 1] + S * V[n + 1, m + 1])
-                             + fb * (-C * W[n + 1, m - 1] + S * V[n + 1, m - 1]))
-    s = gm / (R * R)
-    return s * ax, s * ay, s * az, -gm / R * u
+    n2 = int(p[P_DEGREE]) + 2
+    return harmonics_at(x, y, z, p, 0, np.empty(2 * n2 * n2), 0)
 
 
 @nb.njit(cache=True)
@@ -129,23 +147,42 @@ def j2_k(x, y, z, gm, a, j2):
     return h * x, h * y, c * z * (1.0 - k * (zz - 3.0)), u
 
 
+@nb.njit(cache=True, inline="always")
+def gravity_field_at(x, y, z, t, p, o, w, ow):
+    """:func:`gravity_field_k` with the model's parameters at ``p[o:]`` and, for harmonics, the
+    scratch ``w[ow:]`` of :func:`harmonics_work` entries (``ow < 0``: allocated here)."""
+    kind = p[o + P_KIND]
+    if kind == KIND_CONSTANT:
+        g = o + P_G
+        return p[g], p[g + 1], p[g + 2], -(p[g] * x + p[g + 1] * y + p[g + 2] * z)
+    if kind == KIND_POINT_MASS:
+        r2 = x * x + y * y + z * z
+        r = math.sqrt(r2)
+        c = -p[o + P_GM] / (r2 * r)
+        return c * x, c * y, c * z, -p[o + P_GM] / r
+    if kind == KIND_J2:                                # zonal: no rotation to the Earth frame needed
+        return j2_k(x, y, z, p[o + P_GM], p[o + P_RADIUS], p[o + P_J2])
+    c, s = math.cos(p[o + P_OMEGA] * t), math.sin(p[o + P_OMEGA] * t)
+    if ow < 0:
+        n2 = int(p[o + P_DEGREE]) + 2
+        w, ow = np.empty(2 * n2 * n2), 0
+    ge0, ge1, gz, u = harmonics_at(c * x + s * y, -s * x + c * y, z, p, o, w, ow)   # r_e = C_ei(t) r_i
+    return c * ge0 - s * ge1, s * ge0 + c * ge1, gz, u                            # g_i = C_ei^T g_e
+
+
 @nb.njit(cache=True)
 def gravity_field_k(x, y, z, t, p):
     """``(gx, gy, gz, U)``: inertial acceleration [m/s^2] and potential energy [J/kg] at the
     inertial point (x, y, z) [m] and time ``t`` [s] for any model's parameter array ``p``."""
-    kind = p[P_KIND]
-    if kind == KIND_CONSTANT:
-        return p[P_G], p[P_G + 1], p[P_G + 2], -(p[P_G] * x + p[P_G + 1] * y + p[P_G + 2] * z)
-    if kind == KIND_POINT_MASS:
-        r2 = x * x + y * y + z * z
-        r = math.sqrt(r2)
-        c = -p[P_GM] / (r2 * r)
-        return c * x, c * y, c * z, -p[P_GM] / r
-    if kind == KIND_J2:                                # zonal: no rotation to the Earth frame needed
-        return j2_k(x, y, z, p[P_GM], p[P_RADIUS], p[P_J2])
-    c, s = math.cos(p[P_OMEGA] * t), math.sin(p[P_OMEGA] * t)
-    ge0, ge1, gz, u = harmonics_k(c * x + s * y, -s * x + c * y, z, p)   # r_e = C_ei(t) r_i
-    return c * ge0 - s * ge1, s * ge0 + c * ge1, gz, u                  # g_i = C_ei^T g_e
+    return gravity_field_at(x, y, z, t, p, 0, p, -1)
+
+
+@nb.njit(cache=True, inline="always")
+def gravity_at(x, y, z, t, p, o, w, ow):
+    """:func:`gravity_k` with the parameters at ``p[o:]`` and scratch ``w[ow:]`` (see
+    :func:`gravity_field_at`): what the simulator's loads call, allocating nothing."""
+    gx, gy, gz, _ = gravity_field_at(x, y, z, t, p, o, w, ow)
+    return gx, gy, gz
 
 
 @nb.njit(cache=True)

@@ -45,6 +45,7 @@ import yaml
 from lvgym.errors import MISSING, ConfigError
 
 from .registry import make, register
+from .search import search_right_k
 
 __all__ = [
     "NoWind", "ProfileWind", "GustWind", "JetStreamWind", "SumWind", "wind_ned", "wind_ned_batch",
@@ -56,24 +57,47 @@ CODE_NONE, CODE_GRID, CODE_GUST, CODE_SUM = 0, 1, 2, 3
 
 
 @nb.njit(cache=True)
+def wind_grid_at(p, o, alt_m, t, out, oo):
+    """:func:`wind_grid_ned` with the parameters at ``p[o:]``, adding to ``out[oo:oo + 3]``."""
+    x = alt_m if p[o + 1] == 0.0 else t
+    n = int(p[o + 3])
+    s = o + 4                                 # the grid coordinates are p[s:s + n]
+    if x < p[s] or x > p[s + n - 1] or n == 1:
+        if p[o + 2] != 0.0:
+            return
+        k = 0 if x <= p[s] else n - 1
+        for c in range(3):
+            out[oo + c] += p[s + (c + 1) * n + k]
+        return
+    i = min(search_right_k(p, s, s + n, x) - s - 1, n - 2)
+    f = (x - p[s + i]) / (p[s + i + 1] - p[s + i])
+    for c in range(3):
+        j = s + (c + 1) * n + i
+        out[oo + c] += (1.0 - f) * p[j] + f * p[j + 1]
+
+
+@nb.njit(cache=True)
 def wind_grid_ned(p, alt_m, t, out):
     """Add the linearly interpolated grid wind [m/s] of ``p`` (layout in the module docstring) to
     ``out[0:3]``; the grid coordinate is ``alt_m`` [m] or ``t`` [s]."""
-    x = alt_m if p[1] == 0.0 else t
-    n = int(p[3])
-    s = p[4:4 + n]
-    if x < s[0] or x > s[n - 1] or n == 1:
-        if p[2] != 0.0:
-            return
-        k = 0 if x <= s[0] else n - 1
-        for c in range(3):
-            out[c] += p[4 + (c + 1) * n + k]
+    wind_grid_at(p, 0, alt_m, t, out, 0)
+
+
+@nb.njit(cache=True)
+def wind_gust_at(p, o, alt_m, t, out, oo):
+    """:func:`wind_gust_ned` with the parameters at ``p[o:]``, adding to ``out[oo:oo + 3]``."""
+    x = alt_m - p[o + 6] if p[o + 7] == 0.0 else p[o + 8] * (t - p[o + 6])
+    dm = p[o + 2]
+    if x <= 0.0:
         return
-    i = min(np.searchsorted(s, x, side="right") - 1, n - 2)
-    f = (x - s[i]) / (s[i + 1] - s[i])
+    if x <= dm or (p[o + 9] != 0.0 and x <= 2.0 * dm):
+        f = 0.5 * (1.0 - math.cos(math.pi * x / dm))
+    elif p[o + 9] != 0.0:
+        return
+    else:
+        f = 1.0
     for c in range(3):
-        j = 4 + (c + 1) * n + i
-        out[c] += (1.0 - f) * p[j] + f * p[j + 1]
+        out[oo + c] += p[o + 1] * f * p[o + 3 + c]
 
 
 @nb.njit(cache=True)
@@ -84,41 +108,37 @@ def wind_gust_ned(p, alt_m, t, out):
     cosine continued back to 0 at ``2 dm`` and 0 after (bump); ``x`` is the distance into the gust:
     ``alt_m - onset`` or ``speed (t - onset)``.
     """
-    x = alt_m - p[6] if p[7] == 0.0 else p[8] * (t - p[6])
-    dm = p[2]
-    if x <= 0.0:
-        return
-    if x <= dm or (p[9] != 0.0 and x <= 2.0 * dm):
-        f = 0.5 * (1.0 - math.cos(math.pi * x / dm))
-    elif p[9] != 0.0:
-        return
-    else:
-        f = 1.0
-    for c in range(3):
-        out[c] += p[1] * f * p[3 + c]
+    wind_gust_at(p, 0, alt_m, t, out, 0)
 
 
-@nb.njit(cache=True)
-def _leaf(p, alt_m, t, out):
-    code = int(p[0])
+@nb.njit(cache=True, inline="always")
+def _leaf(p, o, alt_m, t, out, oo):
+    code = int(p[o])
     if code == CODE_GRID:
-        wind_grid_ned(p, alt_m, t, out)
+        wind_grid_at(p, o, alt_m, t, out, oo)
     elif code == CODE_GUST:
-        wind_gust_ned(p, alt_m, t, out)
+        wind_gust_at(p, o, alt_m, t, out, oo)
+
+
+@nb.njit(cache=True, inline="always")
+def wind_ned_at(p, o, alt_m, t, out, oo):
+    """:func:`wind_ned` with the model's parameters at ``p[o:]`` (a packed array; child offsets of a
+    sum are relative to ``o``), into ``out[oo:oo + 3]``: no array view, no allocation."""
+    out[oo] = 0.0
+    out[oo + 1] = 0.0
+    out[oo + 2] = 0.0
+    if int(p[o]) == CODE_SUM:
+        for i in range(int(p[o + 1])):
+            _leaf(p, o + int(p[o + 2 + 2 * i]), alt_m, t, out, oo)
+    else:
+        _leaf(p, o, alt_m, t, out, oo)
 
 
 @nb.njit(cache=True)
 def wind_ned(p, alt_m, t, out):
     """Wind velocity [m/s] in NED at altitude ``alt_m`` [m] and time ``t`` [s] into ``out[0:3]``
     (overwritten), for any model's parameter array ``p``."""
-    out[0] = 0.0
-    out[1] = 0.0
-    out[2] = 0.0
-    if int(p[0]) == CODE_SUM:
-        for i in range(int(p[1])):
-            _leaf(p[int(p[2 + 2 * i]):int(p[3 + 2 * i])], alt_m, t, out)
-    else:
-        _leaf(p, alt_m, t, out)
+    wind_ned_at(p, 0, alt_m, t, out, 0)
 
 
 @nb.njit(cache=True)

@@ -39,7 +39,7 @@ N_RAIL_STATE = 5
 _EPS = 1e-12
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, inline="always")
 def locate_k(tl_t, t):
     """Row ``i`` and weight ``w`` of time ``t`` in the timeline rows ``tl_t`` (an event time takes the
     row after the event), as :meth:`.timeline.Timeline.locate`."""
@@ -51,7 +51,7 @@ def locate_k(tl_t, t):
     return i, min(max(w, 0.0), 1.0)
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, inline="always")
 def params_k(tl_t, tl_p, hold, scale, offset, t, out):
     """Dynamics parameters at time ``t`` into ``out``: interpolated, held columns from the row in
     force, then ``* scale + offset``."""
@@ -62,14 +62,14 @@ def params_k(tl_t, tl_p, hold, scale, offset, t, out):
         out[k] = v * scale[k] + offset[k]
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, inline="always")
 def interp_k(tl_t, values, t):
     """Linear interpolation of a timeline column ``values`` at time ``t``."""
     i, w = locate_k(tl_t, t)
     return (1.0 - w) * values[i] + w * values[i + 1]
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, inline="always")
 def held_k(tl_t, values, t):
     """The value of a piecewise-constant timeline column ``values`` in force at time ``t`` (the row
     after an event at an event time)."""
@@ -77,7 +77,7 @@ def held_k(tl_t, values, t):
     return values[i + 1] if w >= 1.0 else values[i]
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, inline="always")
 def shift_cg_k(x, d, C):
     """Move the reference point of ``r_zw_i``, ``v_zw_i`` by ``d`` [m] along ``x_b`` (the CG's travel
     within the structure): ``r += C_ib d``, ``v += C_ib (omega x d)``; ``C`` is 3x3 scratch."""

@@ -33,11 +33,12 @@ import numba as nb
 import numpy as np
 
 from lvgym.dynamics.stepper import compile_loads
-from lvgym.environment.aerodynamics import STATE_FIELDS, aero_loads_k
-from lvgym.environment.atmosphere import atmosphere_state
-from lvgym.environment.earth import SITE_SIZE, site_dcm_ni_latlon_k, site_geodetic_k, site_velocity_wrt_earth_k
-from lvgym.environment.gravity import gravity_k
-from lvgym.environment.wind import wind_ned
+from lvgym.environment.aerodynamics import STATE_FIELDS
+from lvgym.environment.aerokernels import aero_loads_at
+from lvgym.environment.atmosphere import atmosphere_state_at
+from lvgym.environment.earth import SITE_SIZE, site_dcm_ni_latlon_at, site_geodetic_at, site_velocity_wrt_earth_at
+from lvgym.environment.gravity import gravity_at, harmonics_work
+from lvgym.environment.wind import wind_ned_at
 from lvgym.rotations import quat_to_dcm
 
 # ---------------------------------------------------------------------------- context layout
@@ -49,7 +50,8 @@ C_WEND = 21                       # end of the wind block
 C_STAGE = 22                      # the stage whose aerodynamic block is in force (C_AP .. C_END)
 C_NBLOCK = 23                     # rows of the aerodynamic table of contents (one per stage)
 C_TOC = 24                        # offset of that table: per stage (o_ap, o_ag, o_ad, o_at, n_col, o_end)
-C_SCRATCH = 25                    # scratch of the compiled functions (flight conditions, a 3x3 matrix)
+C_GWORK = 25                      # offset of the gravity kernel's scratch block (spherical harmonics)
+C_SCRATCH = 26                    # scratch of the compiled functions (flight conditions, a 3x3 matrix)
 _TOC_KEYS = (C_AP, C_AG, C_AD, C_AT, C_NCOL, C_END)
 
 # ---------------------------------------------------------------------------- flight conditions layout
@@ -77,76 +79,81 @@ _U_F, _U_M, _U_T, _U_G = 0, 3, 6, 9     # loads layout of the dynamics core (f_b
 assert len(STATE_FIELDS) == 7
 
 
-@nb.njit(cache=True, error_model="numpy")
-def flight_conditions_k(t, x, p, c, d):
-    """Flight conditions (layout ``DIAG``) of the state ``x`` at time ``t`` [s] into ``d`` (N_DIAG)."""
+@nb.njit(cache=True, error_model="numpy", inline="always")
+def flight_conditions_at(t, x, p, c, d, od, full):
+    """Flight conditions (layout ``DIAG``) of the state ``x`` at time ``t`` [s] into ``d[od:od +
+    N_DIAG]`` (``d`` may be ``c``: its scratch). The models are read in place from the packed context:
+    no array view, no allocation. ``full=False`` (the loads at an RK4 stage) skips the flow angles
+    alpha, beta and phi_aero, which no load depends on (they are left as they were)."""
     rx, ry, rz = x[0], x[1], x[2]
     o_site, o_grav, o_atm = int(c[C_SITE]), int(c[C_GRAV]), int(c[C_ATM])
     o_wind, o_ap, o_ag, o_ad = int(c[C_WIND]), int(c[C_AP]), int(c[C_AG]), int(c[C_AD])
-    o_at, n_col, o_end = int(c[C_AT]), int(c[C_NCOL]), int(c[C_END])
-    site = c[o_site:o_site + SITE_SIZE]
-    lat, lon, alt = site_geodetic_k(rx, ry, rz, t, site)
-    d[D_ALT] = alt
-    gx, gy, gz = gravity_k(rx, ry, rz, t, c[o_grav:o_atm])
-    d[D_G], d[D_G + 1], d[D_G + 2] = gx, gy, gz
-    atmosphere_state(c[o_atm:o_wind], alt, d[D_RHO:D_RHO + 4])
-    rho, pres, sound = d[D_RHO], d[D_PRES], d[D_SOUND]
-    wn = d[D_WIND:D_WIND + 3]
-    wind_ned(c[o_wind:int(c[C_WEND])], alt, t, wn)
+    o_at, n_col = int(c[C_AT]), int(c[C_NCOL])
+    lat, lon, alt = site_geodetic_at(rx, ry, rz, t, c, o_site)
+    d[od + D_ALT] = alt
+    gx, gy, gz = gravity_at(rx, ry, rz, t, c, o_grav, c, int(c[C_GWORK]))
+    d[od + D_G], d[od + D_G + 1], d[od + D_G + 2] = gx, gy, gz
+    atmosphere_state_at(c, o_atm, alt, d, od + D_RHO)
+    rho, pres, sound = d[od + D_RHO], d[od + D_PRES], d[od + D_SOUND]
+    w = od + D_WIND
+    wind_ned_at(c, o_wind, alt, t, d, w)
+    wn0, wn1, wn2 = d[w], d[w + 1], d[w + 2]
     C = c[C_SCRATCH_M:C_SCRATCH_M + 9].reshape((3, 3))
-    site_dcm_ni_latlon_k(lat, lon, t, site, C)
-    vx, vy, vz = site_velocity_wrt_earth_k(rx, ry, rz, x[3], x[4], x[5], site)
-    vr0 = vx - (C[0, 0] * wn[0] + C[1, 0] * wn[1] + C[2, 0] * wn[2])
-    vr1 = vy - (C[0, 1] * wn[0] + C[1, 1] * wn[1] + C[2, 1] * wn[2])
-    vr2 = vz - (C[0, 2] * wn[0] + C[1, 2] * wn[1] + C[2, 2] * wn[2])
+    site_dcm_ni_latlon_at(lat, lon, t, c, o_site, C)
+    vx, vy, vz = site_velocity_wrt_earth_at(rx, ry, rz, x[3], x[4], x[5], c, o_site)
+    vr0 = vx - (C[0, 0] * wn0 + C[1, 0] * wn1 + C[2, 0] * wn2)
+    vr1 = vy - (C[0, 1] * wn0 + C[1, 1] * wn1 + C[2, 1] * wn2)
+    vr2 = vz - (C[0, 2] * wn0 + C[1, 2] * wn1 + C[2, 2] * wn2)
     quat_to_dcm(x[6], x[7], x[8], x[9], C)                       # C = C_ib
-    va = d[D_VAIR:D_VAIR + 3]
+    va = od + D_VAIR
     for i in range(3):
-        va[i] = C[0, i] * vr0 + C[1, i] * vr1 + C[2, i] * vr2    # v_air_b = C_ib^T v_rel_i
-    fa = d[D_FAERO:D_FAERO + 3]
-    ma = d[D_MAERO:D_MAERO + 3]
-    st = d[D_ALPHA:D_ALPHA + 7]
+        d[va + i] = C[0, i] * vr0 + C[1, i] * vr1 + C[2, i] * vr2    # v_air_b = C_ib^T v_rel_i
+    u, v, w = d[va], d[va + 1], d[va + 2]
+    fa, ma, st = od + D_FAERO, od + D_MAERO, od + D_ALPHA
     if c[C_AERO] != 0.0:
-        table = c[o_at:o_end].reshape(((o_end - o_at) // n_col, n_col))
-        aero_loads_k(va, x[10:13], rho, sound, p[_P_CG], alt, c[o_ap:o_ag], c[o_ag:o_ad], c[o_ad:o_at],
-                     table, fa, ma, st)
+        aero_loads_at(u, v, w, x[10], x[11], x[12], rho, sound, p[_P_CG], alt, c, o_ap, c, o_ag, c, o_ad,
+                      o_at - o_ad, c, o_at, n_col, d, fa, ma, st, full)
     else:                                                         # flow angles only
-        u, v, w = va[0], va[1], va[2]
         vperp = math.sqrt(v * v + w * w)
         speed = math.sqrt(u * u + vperp * vperp)
-        st[0] = math.atan2(w, u)
-        st[1] = math.atan2(v, math.sqrt(u * u + w * w))
-        st[2] = math.atan2(vperp, u)
-        st[3] = math.atan2(v, w) if vperp > 0.0 else 0.0
-        st[4] = speed / sound if sound > 0.0 else 0.0
-        st[5] = 0.5 * rho * speed * speed
-        st[6] = speed
+        d[st] = math.atan2(w, u)
+        d[st + 1] = math.atan2(v, math.sqrt(u * u + w * w))
+        d[st + 2] = math.atan2(vperp, u)
+        d[st + 3] = math.atan2(v, w) if vperp > 0.0 else 0.0
+        d[st + 4] = speed / sound if sound > 0.0 else 0.0
+        d[st + 5] = 0.5 * rho * speed * speed
+        d[st + 6] = speed
         for i in range(3):
-            fa[i] = 0.0
-            ma[i] = 0.0
+            d[fa + i] = 0.0
+            d[ma + i] = 0.0
     for i in range(3):
-        d[D_FAERO_I + i] = C[i, 0] * fa[0] + C[i, 1] * fa[1] + C[i, 2] * fa[2]
+        d[od + D_FAERO_I + i] = C[i, 0] * d[fa] + C[i, 1] * d[fa + 1] + C[i, 2] * d[fa + 2]
     thrust = 0.0
     if c[C_T0] > 0.0:
         thrust = max(c[C_T0] - c[C_AE] * pres, 0.0)
-    d[D_THRUST] = thrust
+    d[od + D_THRUST] = thrust
     dp = c[C_DP] + c[C_MIS_P]
     dy = c[C_DY] + c[C_MIS_Y]
-    d[D_THRUST_E] = thrust * math.cos(dp) * math.cos(dy)
-    d[D_THRUST_E + 1] = -thrust * math.sin(dy)
-    d[D_THRUST_E + 2] = thrust * math.sin(dp) * math.cos(dy)
+    d[od + D_THRUST_E] = thrust * math.cos(dp) * math.cos(dy)
+    d[od + D_THRUST_E + 1] = -thrust * math.sin(dy)
+    d[od + D_THRUST_E + 2] = thrust * math.sin(dp) * math.cos(dy)
+
+
+@nb.njit(cache=True, error_model="numpy")
+def flight_conditions_k(t, x, p, c, d):
+    """Flight conditions (layout ``DIAG``) of the state ``x`` at time ``t`` [s] into ``d`` (N_DIAG)."""
+    flight_conditions_at(t, x, p, c, d, 0, True)
 
 
 def _flight_loads(t, x, p, c, u):
     """Loads of the dynamics core from the flight conditions: aerodynamic force (inertial) and moment
     about the CG, thrust in the engine frame, gravity; no generalised modal forces."""
-    d = c[C_SCRATCH:C_SCRATCH + N_DIAG]
-    flight_conditions_k(c[C_TIME0] + t, x, p, c, d)
+    flight_conditions_at(c[C_TIME0] + t, x, p, c, c, C_SCRATCH, False)
     for i in range(3):
-        u[_U_F + i] = d[D_FAERO_I + i]
-        u[_U_M + i] = d[D_MAERO + i] + c[C_MOMENT + i]
-        u[_U_T + i] = d[D_THRUST_E + i]
-        u[_U_G + i] = d[D_G + i]
+        u[_U_F + i] = c[C_SCRATCH + D_FAERO_I + i]
+        u[_U_M + i] = c[C_SCRATCH + D_MAERO + i] + c[C_MOMENT + i]
+        u[_U_T + i] = c[C_SCRATCH + D_THRUST_E + i]
+        u[_U_G + i] = c[C_SCRATCH + D_G + i]
     for i in range(12, u.size):
         u[i] = 0.0
 
@@ -162,7 +169,7 @@ def flight_conditions_batch(t, x, p, c, d):
         flight_conditions_k(t[b], x[b], p[b], c[b], d[b])
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, inline="always")
 def select_aero_k(c, stage):
     """Put the aerodynamic block of ``stage`` (the lowest attached stage) in force in the context ``c``
     (stages beyond the table of contents take its last row)."""
@@ -211,6 +218,9 @@ def pack_context(site: np.ndarray, gravity: np.ndarray, atmosphere: np.ndarray, 
     header[C_NBLOCK] = len(toc)
     header[C_TOC] = offset
     blocks.append(np.asarray(toc, float).ravel())
+    offset += blocks[-1].size
+    header[C_GWORK] = offset
+    blocks.append(np.zeros(harmonics_work(blocks[1])))
     for key, value in zip(_TOC_KEYS, toc[0]):
         header[key] = value
     header[C_STAGE] = 0.0

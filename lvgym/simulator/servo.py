@@ -51,7 +51,7 @@ def _clip(v, lo, hi):
     return min(max(v, lo), hi)
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, inline="always")
 def servo_step_k(s, cmd, pos, rate, h):
     """Advance the two axes ``pos``, ``rate`` (2) in place by ``h`` [s] towards ``cmd`` (2) [rad]
     with servo parameters ``s`` (layout ``S_*``); with ``s[S_ON] == 0`` the position is the command
