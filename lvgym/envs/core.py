@@ -15,13 +15,14 @@ from typing import Any
 import numpy as np
 
 from lvgym.simulator import Simulator, Timeline, build_timeline
+from lvgym.simulator.core import _Kernel
 from lvgym.simulator.servo import Servo
 from lvgym.vehicle import MassModel, Vehicle, load_vehicle
 from lvgym.vehicle.slender import slender_vehicle
 
 from .signals import (G0, N_TASK, REASONS, T_ATT, T_DT, T_EFFORT, T_EFFORT_RATE, T_GIMBAL, T_GTURN, T_KICK0, T_KICK1,
                       T_KICK_ANGLE, T_MISSION, T_N_STEPS, T_ON_AFTER, T_PENALTY, T_QALPHA, T_SENSORS, T_W_ROLL, T_W_YAW,
-                      reset_signals, step_signals)
+                      reset_signals, step_signals_range)
 from .spec import TaskSpec, wind_spec
 
 #: observation entries (same for ``state`` and ``sensors``; see the env docstrings)
@@ -32,6 +33,7 @@ OBS_NAMES = ("roll_rate", "pitch_rate_error", "yaw_rate_error", "pitch_attitude_
 RENDER_STATIONS = 21
 REWARD_TERMS = ("rate_roll", "rate_pitch", "rate_yaw", "effort", "effort_rate", "failure")
 _REASONS = np.array(REASONS, dtype=object)
+_SIGNALS = _Kernel(step_signals_range)      # row ranges on the simulator's threads
 
 
 @functools.lru_cache(maxsize=32)
@@ -86,6 +88,7 @@ class AscentBatch:
         self.n_steps = int(round(s.mission_time_s / s.control_dt_s))
         self._tp = self._task_vector()
         self._burning = tl.burning.astype(float)
+        self._noisy = s.observation == "sensors" and "sensor_noise" in s.randomize
 
     # ------------------------------------------------------------------------------ reset
     def _dispersions(self, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -155,9 +158,9 @@ class AscentBatch:
     def _add_noise(self, rows: np.ndarray) -> None:
         """Sensor noise on the observation of ``rows`` (gyro, attitude, accelerometers), each row from its
         own generator, when ``sensor_noise`` is randomised with the ``sensors`` observation."""
-        s = self.spec
-        if s.observation != "sensors" or "sensor_noise" not in s.randomize:
+        if not self._noisy:
             return
+        s = self.spec
         for b in rows:
             if self.sim.failed[b]:
                 continue
@@ -205,10 +208,11 @@ class AscentBatch:
         tl = self.timeline
         terms, reward = np.empty((B, len(REWARD_TERMS))), np.empty(B)
         reason, truncated, qalpha = np.empty(B, dtype=np.int64), np.empty(B, dtype=bool), np.empty(B)
-        step_signals(self._tp, sim.t, sim.x, sim.diag, sim.failed, sim.effort, sim.gimbal, self.steps,
-                     self.axis_ref_i, self.cum_error, self.gyro_bias, tl.t, self._burning, tl.mass, tl.dphi_sensor,
-                     sim.dynamics.n_modes, self.on, self.obs, self.att, terms, reward, reason, truncated, qalpha)
-        self._add_noise(np.arange(B) if skip is None else np.setdiff1d(np.arange(B), skip))
+        sim._run(_SIGNALS, self._tp, sim.t, sim.x, sim.diag, sim.failed, sim.effort, sim.gimbal, self.steps,
+                 self.axis_ref_i, self.cum_error, self.gyro_bias, tl.t, self._burning, tl.mass, tl.dphi_sensor,
+                 sim.dynamics.n_modes, self.on, self.obs, self.att, terms, reward, reason, truncated, qalpha)
+        if self._noisy:
+            self._add_noise(np.arange(B) if skip is None else np.setdiff1d(np.arange(B), skip))
         terminated = reason != 0
         i_stage = self._stage_index(sim.t)
         info = {"reward_terms": dict(zip(REWARD_TERMS, terms.T)), "cumulative_rate_error": self.cum_error.copy(),

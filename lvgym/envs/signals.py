@@ -121,19 +121,18 @@ def reset_signals(rows, tp, t, x, diag, gimbal, axis_ref, bias, tl_t, tl_burning
 
 
 @nb.njit(cache=True, nogil=True)
-def step_signals(tp, t, x, diag, failed, effort, gimbal, steps, axis_ref, cum_error, bias, tl_t, tl_burning,
-                 tl_mass, tl_dphi, n_modes, on, obs, att, terms, reward, reason, truncated, qalpha):
-    """Signals of every row after a control step (``steps`` already counts it).
+def step_signals_range(lo, hi, tp, t, x, diag, failed, effort, gimbal, steps, axis_ref, cum_error, bias, tl_t,
+                       tl_burning, tl_mass, tl_dphi, n_modes, on, obs, att, terms, reward, reason, truncated, qalpha):
+    """Signals of rows ``lo:hi`` after a control step (``steps`` already counts it).
 
     Updates ``axis_ref`` (B, 3) (turned by the reference pitch rate about the body pitch axis),
     ``cum_error`` (B, 3) [rad] and ``on`` (B,) (the controller flag for the next step); writes the
     observation ``obs`` (B, 14) without noise, attitude error ``att`` (B, 2) [rad], reward ``terms``
     (B, 6) in the order of :data:`~.core.REWARD_TERMS` and their sum ``reward``, the termination code
     ``reason`` (index into :data:`REASONS`), ``truncated`` and q-alpha [Pa deg]."""
-    B = x.shape[0]
     dt = tp[T_DT]
     C = np.empty((3, 3))
-    for b in range(B):
+    for b in range(lo, hi):
         xb, db, a = x[b], diag[b], axis_ref[b]
         quat_to_dcm(xb[X_Q], xb[X_Q + 1], xb[X_Q + 2], xb[X_Q + 3], C)
         ref_pitch = reference_pitch_rate_k(tp, t[b], xb, db)
@@ -177,3 +176,12 @@ def step_signals(tp, t, x, diag, failed, effort, gimbal, steps, axis_ref, cum_er
         if failed[b]:
             for i in range(obs.shape[1]):
                 obs[b, i] = 0.0
+
+
+@nb.njit(cache=True, nogil=True)
+def step_signals(tp, t, x, diag, failed, effort, gimbal, steps, axis_ref, cum_error, bias, tl_t, tl_burning,
+                 tl_mass, tl_dphi, n_modes, on, obs, att, terms, reward, reason, truncated, qalpha):
+    """:func:`step_signals_range` over every row (the batch wrapper runs row ranges on the simulator's
+    threads)."""
+    step_signals_range(0, x.shape[0], tp, t, x, diag, failed, effort, gimbal, steps, axis_ref, cum_error, bias, tl_t,
+                       tl_burning, tl_mass, tl_dphi, n_modes, on, obs, att, terms, reward, reason, truncated, qalpha)

@@ -222,9 +222,15 @@ def conditions_range(lo, hi, t, x, p, c, tl_t, tl_T0, tl_Ae, tl_stage, diag):
 def slosh_angles_k(x, n_slosh, n_modes, out):
     """Pendulum deflections from the body axis (B, N, 2) [rad]: the rod's angle in the x-y and x-z
     body planes (0 at rest, hanging aft)."""
+    slosh_angles_range(0, x.shape[0], x, n_slosh, n_modes, out)
+
+
+@nb.njit(cache=True, nogil=True)
+def slosh_angles_range(lo, hi, x, n_slosh, n_modes, out):
+    """:func:`slosh_angles_k` of rows ``lo:hi``."""
     C = np.empty((3, 3))
     S = np.empty((3, 3))
-    for b in range(x.shape[0]):
+    for b in range(lo, hi):
         xb = x[b]
         quat_to_dcm(xb[X_Q], xb[X_Q + 1], xb[X_Q + 2], xb[X_Q + 3], C)
         for j in range(n_slosh):

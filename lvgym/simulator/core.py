@@ -44,7 +44,7 @@ from lvgym.rotations import quat_to_dcm_batch
 from lvgym.vehicle import MassModel, Vehicle, load_vehicle
 
 from .advance import (N_RAIL_STATE, R_AXIS, R_LENGTH, R_OMEGA, R_PAD, R_Q0, R_SIZE, R_XBASE, RS_LIFTED, RS_ON, RS_S,
-                      RS_T_EXIT, RS_T_LIFT, advance_range, conditions_range, constrain_k, slosh_angles_k)
+                      RS_T_EXIT, RS_T_LIFT, advance_range, conditions_range, constrain_k, slosh_angles_range)
 from .flight import C_MIS_P, C_MIS_Y, C_MOMENT, DIAG, N_DIAG, flight_loads, pack_context, stack_contexts
 from .servo import DIRECT, Servo
 from .timeline import MODELS, Timeline, build_timeline
@@ -79,7 +79,7 @@ class _Kernel:
         self.entry(*args)
 
 
-_ADVANCE, _CONDITIONS = _Kernel(advance_range), _Kernel(conditions_range)
+_ADVANCE, _CONDITIONS, _SLOSH = _Kernel(advance_range), _Kernel(conditions_range), _Kernel(slosh_angles_range)
 
 
 @functools.lru_cache(maxsize=4)
@@ -387,8 +387,8 @@ class Simulator:
         tank, whose frozen state means nothing)."""
         N = self.dynamics.n_slosh
         out = np.zeros((self.batch, N, 2))
-        slosh_angles_k(self.x, N, self.dynamics.n_modes, out)
         if N:
+            self._run(_SLOSH, self.x, N, self.dynamics.n_modes, out)
             m_j = self.p[:, [self.layout.slosh_param(j, "m").start for j in range(N)]]
             out[m_j <= 0.0] = np.nan
         return out
