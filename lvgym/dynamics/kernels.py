@@ -81,12 +81,22 @@ def _cholesky_solve(A, b, n):
 
 
 @nb.njit(cache=True, error_model="numpy", inline="always")
-def _add_sym_outer(A, h, c, n):
-    """``A += c h h^T`` on the lower triangle of the leading n x n block."""
+def _scaled_row(G, q, c, n):
+    """Rank-one term ``q`` of :func:`_add_sym_outers`: ``G[1 + 2q] = c G[2 + 2q]`` (first n entries)."""
     for i in range(n):
-        ci = c * h[i]
-        for k in range(i + 1):
-            A[i, k] += ci * h[k]
+        G[1 + 2 * q, i] = c * G[2 + 2 * q, i]
+
+
+@nb.njit(cache=True, error_model="numpy", inline="always")
+def _add_sym_outers(A, G, nq, n):
+    """``A += sum_q c_q h_q h_q^T`` on the lower triangle of the leading n x n block, with ``c_q h_q``
+    and ``h_q`` in the rows ``1 + 2q`` and ``2 + 2q`` of ``G``; each entry is summed in a register in
+    the order of q (the same sums as nq successive rank-one updates)."""
+    for i in range(n):
+        for q in range(nq):
+            ci = G[1 + 2 * q, i]
+            for k in range(i + 1):
+                A[i, k] += ci * G[2 + 2 * q, k]
 
 
 @nb.njit(cache=True, error_model="numpy", inline="always")
@@ -110,8 +120,8 @@ def vehicle_deriv(x, p, u, n_slosh, n_modes, xdot, A, rhs, h, C, S, work):
     """Time derivative ``xdot`` of one vehicle's state ``x`` for parameters ``p`` and loads ``u``.
 
     Work arrays (any contents; sized by the caller, see ``make_workspace``): ``A`` (n_r, n_r),
-    ``rhs`` and ``h`` (n_r,), ``C`` (2, 3, 3), ``S`` (max(N, 1), SLOSH_WORK), ``work`` (max(n_r, 3),),
-    with ``n_r = 6 + 2K``.
+    ``rhs`` and ``h`` (n_r,), ``C`` (2, 3, 3), ``S`` (max(N, 1), SLOSH_WORK), ``work`` (1 + 8N,
+    max(n_r, 3)), with ``n_r = 6 + 2K``.
     """
     K = n_modes
     N = n_slosh
@@ -202,6 +212,7 @@ def vehicle_deriv(x, p, u, n_slosh, n_modes, xdot, A, rhs, h, C, S, work):
     wi0 = Cb[0, 0] * w0 + Cb[0, 1] * w1 + Cb[0, 2] * w2
     wi1 = Cb[1, 0] * w0 + Cb[1, 1] * w1 + Cb[1, 2] * w2
     wi2 = Cb[2, 0] * w0 + Cb[2, 1] * w1 + Cb[2, 2] * w2
+    nq = 0                                  # rank-one terms of A_r collected in work
     for j in range(N):
         o = o_sl + j * sb
         m = p[o]
@@ -265,17 +276,21 @@ def vehicle_deriv(x, p, u, n_slosh, n_modes, xdot, A, rhs, h, C, S, work):
         nb1 = Cb[0, 1] * Cs[0, 0] + Cb[1, 1] * Cs[1, 0] + Cb[2, 1] * Cs[2, 0]
         nb2 = Cb[0, 2] * Cs[0, 0] + Cb[1, 2] * Cs[1, 0] + Cb[2, 2] * Cs[2, 0]
         phi = p[o + 8:o + 8 + K]
-        _body_row_map(Cb, r0, r1, r2, phi, nb0, nb1, nb2, K, h)
-        _add_sym_outer(A, h, m * s, nr)
+        # the rank-one terms c h h^T of A_r are collected (rows c h and h of work) and summed after
+        # the loop, entry by entry in the same order: no load and store of A per pendulum
+        _body_row_map(Cb, r0, r1, r2, phi, nb0, nb1, nb2, K, work[2 + 2 * nq])
+        _scaled_row(work, nq, m * s, nr)
+        nq += 1
         if s < 1.0:
             for r in range(3):
                 _body_row_map(Cb, r0, r1, r2, phi, 1.0 if r == 0 else 0.0,
-                              1.0 if r == 1 else 0.0, 1.0 if r == 2 else 0.0, K, h)
-                _add_sym_outer(A, h, m * (1.0 - s), nr)
+                              1.0 if r == 1 else 0.0, 1.0 if r == 2 else 0.0, K, work[2 + 2 * nq])
+                _scaled_row(work, nq, m * (1.0 - s), nr)
+                nq += 1
         # z = Q (g - beta) - lam (tau1 z_s - tau2 y_s), then rhs += m Bt^T C^T z
         gb0, gb1, gb2 = S[j, _S_GB], S[j, _S_GB + 1], S[j, _S_GB + 2]
         nd = Cs[0, 0] * gb0 + Cs[1, 0] * gb1 + Cs[2, 0] * gb2
-        z = work
+        z = work[0]
         for i in range(3):
             z[i] = ((1.0 - s) * S[j, _S_GB + i] + s * nd * Cs[i, 0]
                     - lam * (tau1 * Cs[i, 2] - tau2 * Cs[i, 1]))
@@ -287,6 +302,7 @@ def vehicle_deriv(x, p, u, n_slosh, n_modes, xdot, A, rhs, h, C, S, work):
             rhs[i] += m * h[i]
 
     # ---------------------------------------------------------------- solve the reduced system
+    _add_sym_outers(A, work, nq, nr)
     _cholesky_solve(A, rhs, nr)
     # rhs now holds [v_dot_i, omega_dot_b, eta_ddot]
 
@@ -343,4 +359,4 @@ def make_workspace(n_slosh, n_modes):
     """Allocate the work arrays of ``vehicle_deriv``: (A, rhs, h, C, S, work)."""
     nr = 6 + 2 * n_modes
     return (np.empty((nr, nr)), np.empty(nr), np.empty(nr), np.empty((2, 3, 3)),
-            np.zeros((max(n_slosh, 1), SLOSH_WORK)), np.empty(max(nr, 3)))
+            np.zeros((max(n_slosh, 1), SLOSH_WORK)), np.empty((1 + 8 * n_slosh, max(nr, 3))))
