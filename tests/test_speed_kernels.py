@@ -161,7 +161,9 @@ def test_wind_in_place(spec):
 
 def _smile_aero(kind):
     model = make("aerodynamics", load_vehicle("smile").aerodynamics)
-    return model if kind == "axisymmetric" else model.to_tables6(np.arange(-20.0, 20.1, 4.0), np.arange(-12.0, 12.1, 4.0))
+    if kind == "axisymmetric":
+        return model
+    return model.to_tables6(np.arange(-20.0, 20.1, 4.0), np.arange(-12.0, 12.1, 4.0))
 
 
 @pytest.mark.parametrize("kind", ["axisymmetric", "tables6"])

@@ -23,6 +23,9 @@ import math
 
 import numba as nb
 import numpy as np
+from numba.core import cgutils, types
+from numba.extending import intrinsic
+from numba.np.arrayobj import make_array
 
 from .kernels import P_MODES, X_ETA, X_Q, make_workspace, vehicle_deriv
 
@@ -32,6 +35,33 @@ METHODS = ("rk4", "rk4-classic")
 _vec = nb.types.float64[::1]
 #: signature of a loads function ``loads_fn(t, x, p, c, u) -> None``
 LOADS_SIGNATURE = nb.types.void(nb.types.float64, _vec, _vec, _vec, _vec)
+
+
+@intrinsic
+def unowned(typingctx, a):
+    """A view of the array ``a`` that holds no reference to its memory (a null meminfo).
+
+    Numba increments and decrements the reference count of every array view it makes and of every
+    array argument of a compiled function it calls, with atomic instructions on the owner's counter;
+    rows of one batch share that counter, so the threads that step row ranges contend for it. Passing
+    unowned views of the rows to the per-stage functions (the loads, the derivative) makes those
+    updates no-ops. The caller must keep ``a``'s owner alive while the view is in use."""
+    if not isinstance(a, types.Array):
+        return None
+
+    def codegen(context, builder, sig, args):
+        src = make_array(a)(context, builder, value=args[0])
+        dst = make_array(a)(context, builder)
+        dst.meminfo = cgutils.get_null_value(dst.meminfo.type)
+        dst.parent = cgutils.get_null_value(dst.parent.type)
+        dst.nitems = src.nitems
+        dst.itemsize = src.itemsize
+        dst.data = src.data
+        dst.shape = src.shape
+        dst.strides = src.strides
+        return dst._getvalue()
+
+    return a(a), codegen
 
 
 def compile_loads(fn):

@@ -102,7 +102,7 @@ def dcm_ne_k(lat, lon, C):
     C[2, 0], C[2, 1], C[2, 2] = -cl * co, -cl * so, -sl
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, inline="always")
 def site_geodetic_at(x, y, z, t, p, o):
     """:func:`site_geodetic_k` with the site parameters at ``p[o:]`` (a packed array; no view)."""
     if p[o + SITE_FLAT] != 0.0:
@@ -127,7 +127,7 @@ def site_dcm_ni_k(x, y, z, t, p, C):
     site_dcm_ni_latlon_k(lat, lon, t, p, C)
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, inline="always")
 def site_dcm_ni_latlon_at(lat, lon, t, p, o, C):
     """:func:`site_dcm_ni_latlon_k` with the site parameters at ``p[o:]`` (a packed array)."""
     dcm_ne_k(lat, lon, C)                            # C = C_ne, then C_ne C_ei row by row
@@ -152,7 +152,7 @@ def site_dcm_ni_latlon_k(lat, lon, t, p, C):
     site_dcm_ni_latlon_at(lat, lon, t, p, 0, C)
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, inline="always")
 def site_velocity_wrt_earth_at(x, y, z, vx, vy, vz, p, o):
     """:func:`site_velocity_wrt_earth_k` with the site parameters at ``p[o:]``."""
     if p[o + SITE_FLAT] != 0.0:

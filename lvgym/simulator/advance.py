@@ -24,7 +24,7 @@ import numba as nb
 import numpy as np
 
 from lvgym.dynamics.kernels import X_ETA, X_Q, X_R, X_V, X_W
-from lvgym.dynamics.stepper import _alloc, rk4_vehicle
+from lvgym.dynamics.stepper import _alloc, rk4_vehicle, unowned
 from lvgym.rotations import quat_to_dcm
 
 from .flight import C_AE, C_DP, C_DY, C_T0, C_TIME0, flight_conditions_k, select_aero_k
@@ -153,7 +153,8 @@ def advance_range(lo, hi, loads_fn, x, p, c, t, scale, offset, x_cg0, failed, ra
     n = max(1, int(math.ceil(duration / physics_dt - 1e-9)))
     h = duration / n
     for b in range(lo, hi):
-        xb, pb, cb, rs = x[b], p[b], c[b], rail_state[b]
+        # rows of the caller's arrays, passed on without reference counting (see unowned)
+        xb, pb, cb, rs = unowned(x[b]), unowned(p[b]), unowned(c[b]), rail_state[b]
         effort[b, 0] = 0.0
         effort[b, 1] = 0.0
         if failed[b]:

@@ -68,7 +68,8 @@ for _name, _size in DIAG_FIELDS:
     _o += _size
 N_DIAG = _o
 C_SCRATCH_M = C_SCRATCH + N_DIAG
-C_HEADER = C_SCRATCH_M + 9
+C_TRIG = C_SCRATCH_M + 9          # cache: the angles dp, dy and cos dp, sin dp, cos dy, sin dy of the thrust
+C_HEADER = C_TRIG + 6
 (D_ALT, D_RHO, D_PRES, D_TEMP, D_SOUND) = (DIAG[k].start for k in
                                             ("altitude", "density", "pressure", "temperature", "speed_of_sound"))
 D_WIND, D_VAIR, D_ALPHA = DIAG["wind_n"].start, DIAG["v_air_b"].start, DIAG["alpha"].start
@@ -134,9 +135,13 @@ def flight_conditions_at(t, x, p, c, d, od, full):
     d[od + D_THRUST] = thrust
     dp = c[C_DP] + c[C_MIS_P]
     dy = c[C_DY] + c[C_MIS_Y]
-    d[od + D_THRUST_E] = thrust * math.cos(dp) * math.cos(dy)
-    d[od + D_THRUST_E + 1] = -thrust * math.sin(dy)
-    d[od + D_THRUST_E + 2] = thrust * math.sin(dp) * math.cos(dy)
+    if dp != c[C_TRIG] or dy != c[C_TRIG + 1]:              # the gimbal is held over an RK4 step
+        c[C_TRIG], c[C_TRIG + 1] = dp, dy
+        c[C_TRIG + 2], c[C_TRIG + 3] = math.cos(dp), math.sin(dp)
+        c[C_TRIG + 4], c[C_TRIG + 5] = math.cos(dy), math.sin(dy)
+    d[od + D_THRUST_E] = thrust * c[C_TRIG + 2] * c[C_TRIG + 4]
+    d[od + D_THRUST_E + 1] = -thrust * c[C_TRIG + 5]
+    d[od + D_THRUST_E + 2] = thrust * c[C_TRIG + 3] * c[C_TRIG + 4]
 
 
 @nb.njit(cache=True, error_model="numpy")
@@ -194,6 +199,7 @@ def pack_context(site: np.ndarray, gravity: np.ndarray, atmosphere: np.ndarray, 
     if blocks[0].size != SITE_SIZE:
         raise ValueError(f"site parameters have {blocks[0].size} entries: expected {SITE_SIZE}")
     header = np.zeros(C_HEADER)
+    header[C_TRIG:C_TRIG + 2] = np.nan                         # the thrust angles' cache is empty
     header[C_AERO] = 0.0 if aero is None else 1.0
     offset = C_HEADER
     for key, block in zip((C_SITE, C_GRAV, C_ATM, C_WIND), blocks):
