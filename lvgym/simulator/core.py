@@ -298,10 +298,15 @@ class Simulator:
             constrain_k(self.x[b], 0.0, rail, self.x_cg0[b], self.p[b, self._i_cg], self.rail_state[b])
 
     def _chunks(self) -> list[tuple[int, int]]:
-        """Row ranges run on separate threads (one range for small batches)."""
-        k = max(1, min(self.threads, self.batch // _ROWS_PER_THREAD))
-        edges = np.linspace(0, self.batch, k + 1).astype(int)
-        return [(int(a), int(z)) for a, z in zip(edges[:-1], edges[1:]) if z > a]
+        """Row ranges run on separate threads (one range for small batches); kept until the batch
+        size or the thread count changes (several compiled kernels run per step)."""
+        key = (self.batch, self.threads)
+        if getattr(self, "_chunk_key", None) != key:
+            k = max(1, min(self.threads, self.batch // _ROWS_PER_THREAD))
+            edges = np.linspace(0, self.batch, k + 1).astype(int)
+            self._chunk_list = [(int(a), int(z)) for a, z in zip(edges[:-1], edges[1:]) if z > a]
+            self._chunk_key = key
+        return self._chunk_list
 
     def _run(self, fn, *args) -> None:
         chunks = self._chunks()
