@@ -157,3 +157,28 @@ def test_rgb_array_render_through_the_env(env_id):
     img = env.render()
     assert img.dtype == np.uint8 and img.ndim == 3 and img.shape[2] == 3 and len(np.unique(img)) > 10
     env.close()
+
+
+def _fly_zero(env) -> dict:
+    env.reset(seed=10000)
+    while True:
+        _, _, term, trunc, info = env.step(np.zeros(2, dtype=np.float32))
+        if term or trunc:
+            return info
+
+
+def test_slender_aerodynamics_frozen_at_mach_2_by_default():
+    """SlenderAscent-v0 holds the thesis's constant coefficients (its tables frozen at Mach 2): with the
+    gimbal at zero in turbulence the vehicle flies the 10 s; with the full Mach tables (``aero_mach=None``)
+    its fins lose lift above Mach 3 and q-alpha passes the limit before 7.5 s (docs/vehicles.md)."""
+    env = gym.make("lvgym/SlenderAscent-v0", model="rigid", wind="turbulence", randomize=["wind"])
+    assert env.unwrapped.core.sim.vehicle.aerodynamics["mach"] == [2.0]
+    info = _fly_zero(env)
+    assert info["termination"] == "" and info["time"] == pytest.approx(10.0)
+    assert info["mach"] > 5.0                                  # 5.96: the task's fast, high-q part is flown
+    full = gym.make("lvgym/SlenderAscent-v0", model="rigid", wind="turbulence", randomize=["wind"], aero_mach=None)
+    assert "mach" not in full.unwrapped.core.sim.vehicle.aerodynamics
+    info = _fly_zero(full)
+    assert info["termination"] == "q-alpha beyond the structural limit" and info["time"] < 7.5
+    with pytest.raises(ConfigError, match="aero_mach"):
+        gym.make("lvgym/SlenderAscent-v0", aero_mach=40.0)

@@ -45,6 +45,9 @@ from gymnasium import spaces
 from .core import OBS_NAMES, AscentBatch
 from .spec import TaskSpec
 
+#: Mach number at which SlenderAscent-v0 freezes the vehicle's aerodynamic tables by default [-]
+DEFAULT_AERO_MACH = 2.0
+
 
 def _row(info: dict[str, Any], b: int) -> dict[str, Any]:
     """The info of row ``b`` of a batch info dict (scalars as Python floats)."""
@@ -166,20 +169,36 @@ class SlenderAscentEnv(AscentEnv):
     ``length`` [m] and ``diameter`` [m] set L/D (defaults 8.5 m, 0.3 m); ``diameter`` may be a pair
     ``(low, high)``: each reset then draws one of 4 diameters evenly spaced in that range from the env's
     generator (vehicles and their timelines are cached). This is where bending matters: the first mode
-    drops towards the control bandwidth as L/D grows. Other options as SmileAscent-v0."""
+    drops towards the control bandwidth as L/D grows.
+
+    ``aero_mach`` [-]: the vehicle's Barrowman tables are frozen at this Mach number (default 2.0), as the
+    thesis's chapter-6 studies held the aerodynamic coefficients constant and as ``lvgym.studies`` does;
+    ``None`` flies the full Mach-dependent tables. With the full tables the vehicle (Mach 5.7 and 1 MPa
+    by 7.5 s, its fins losing lift above Mach 3) is statically unstable above Mach 3.85, with an
+    open-loop pole near +21 1/s at 8 s, beyond what the 15 rad/s actuator can stabilise: every policy
+    then fails on q-alpha between 5 and 7.5 s. Other options as SmileAscent-v0.
+
+    Version history: v0 (2026-11): first release; before the first tagged release the default
+    ``aero_mach`` became 2.0 (it flew the full tables, which no policy survives)."""
 
     DEFAULTS = {"site": "andoya", "mission_time_s": 10.0, "rate_weights": (0.0, 1.0, 1.0)}
+    DEFAULT_AERO_MACH = DEFAULT_AERO_MACH
 
     def __init__(self, render_mode: str | None = None, length: float = 8.5, diameter: Any = 0.3,
-                 **options: Any) -> None:
+                 aero_mach: float | None = DEFAULT_AERO_MACH, **options: Any) -> None:
         d = np.atleast_1d(np.asarray(diameter, dtype=float))
         if d.size not in (1, 2) or np.any(d <= 0):
             raise ValueError(f"diameter = {diameter!r}: a diameter [m] > 0 or a (low, high) pair")
         self.diameters = tuple(np.linspace(d[0], d[-1], 4 if d.size == 2 else 1).tolist())
         self.length = float(length)
+        self.aero_mach = None if aero_mach is None else float(aero_mach)
         self._cores: dict[float, AscentBatch] = {}
-        super().__init__(render_mode, vehicle=("slender", self.length, self.diameters[0]), **options)
+        super().__init__(render_mode, vehicle=self._key(self.diameters[0]), **options)
         self._cores[self.diameters[0]] = self.core
+
+    def _key(self, diameter: float) -> tuple:
+        """The vehicle key of :func:`~.core.cached_vehicle` for one diameter [m]."""
+        return ("slender", self.length, diameter, self.aero_mach)
 
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
         gym.Env.reset(self, seed=seed)
@@ -187,7 +206,7 @@ class SlenderAscentEnv(AscentEnv):
             dia = self.diameters[int(self.np_random.integers(len(self.diameters)))]
             if dia not in self._cores:
                 task = TaskSpec.build(self.DEFAULTS, {**{k: getattr(self.task, k) for k in TaskSpec.__dataclass_fields__},
-                                                      "vehicle": ("slender", self.length, dia)})
+                                                      "vehicle": self._key(dia)})
                 self._cores[dia] = AscentBatch(task, 1)
             self.core = self._cores[dia]
         return super().reset(seed=None, options=options)

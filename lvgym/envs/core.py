@@ -38,12 +38,13 @@ _SIGNALS = _Kernel(step_signals_range)      # row ranges on the simulator's thre
 
 @functools.lru_cache(maxsize=32)
 def cached_vehicle(key: Any) -> Vehicle:
-    """A shipped vehicle by name or path, or ``("slender", length, diameter)`` for the parametric one."""
-    if isinstance(key, tuple) and len(key) == 3 and key[0] == "slender":
-        return slender_vehicle(length=float(key[1]), diameter=float(key[2]))
+    """A shipped vehicle by name or path, or ``("slender", length, diameter[, aero_mach])`` for the
+    parametric one (``aero_mach``: Mach number its aerodynamic tables are frozen at, None: full tables)."""
+    if isinstance(key, tuple) and len(key) in (3, 4) and key[0] == "slender":
+        return slender_vehicle(length=float(key[1]), diameter=float(key[2]), aero_mach=key[3] if len(key) == 4 else None)
     if isinstance(key, str):
         return load_vehicle(key)
-    raise ValueError(f"vehicle = {key!r}: a shipped name, a YAML path or ('slender', length, diameter)")
+    raise ValueError(f"vehicle = {key!r}: a shipped name, a YAML path or ('slender', length, diameter[, aero_mach])")
 
 
 @functools.lru_cache(maxsize=32)

@@ -30,7 +30,9 @@ def _task(env_cls: type, options: dict[str, Any]) -> TaskSpec:
         if np.size(diameter) != 1:
             raise ValueError("diameter ranges are drawn per episode by the single SlenderAscent env only; "
                              "a vector env flies one geometry (make one vector env per diameter)")
-        options["vehicle"] = ("slender", float(length), float(np.ravel(diameter)[0]))
+        aero_mach = options.pop("aero_mach", SlenderAscentEnv.DEFAULT_AERO_MACH)
+        options["vehicle"] = ("slender", float(length), float(np.ravel(diameter)[0]),
+                              None if aero_mach is None else float(aero_mach))
     return TaskSpec.build(env_cls.DEFAULTS, options)
 
 

@@ -82,7 +82,8 @@ def _r(x: float) -> float:
 
 def slender_mapping(length: float = 8.5, diameter: float = 0.3, fill: float = 1.0, mass_flow: float = 30.0,
                     slosh_damping: float = 0.5, *, wall_thickness: float = 0.002, material: str = "al_ansys",
-                    density: float = 800.0, isp: float = 220.0, name: str = "slender") -> dict[str, Any]:
+                    density: float = 800.0, isp: float = 220.0, name: str = "slender",
+                    aero_mach: float | None = None) -> dict[str, Any]:
     """The vehicle-file mapping of the slender vehicle (see the module docstring).
 
     Parameters
@@ -97,6 +98,8 @@ def slender_mapping(length: float = 8.5, diameter: float = 0.3, fill: float = 1.
     density : propellant density [kg/m^3], in (0, 3000].
     isp : momentum specific impulse of the thrust equation [s], in (0, 1000].
     name : vehicle name.
+    aero_mach : if given, the Barrowman tables are frozen at this Mach number [-], in [0, 25] (the
+        thesis's constant coefficients; ``SlenderAscent-v0`` uses 2.0); None: the full Mach tables.
     """
     L = _number("length", length, 3.0, 30.0, False)
     t = _number("wall_thickness", wall_thickness, 0.0, 0.05, True)
@@ -110,6 +113,7 @@ def slender_mapping(length: float = 8.5, diameter: float = 0.3, fill: float = 1.
     isp_s = _number("isp", isp, 0.0, 1000.0, True)
     if material not in MATERIALS:
         raise ConfigError("material", material, f"one of {sorted(MATERIALS)}", SOURCE)
+    frozen = {} if aero_mach is None else {"mach": [_number("aero_mach", aero_mach, 0.0, 25.0, False)]}
     if not isinstance(name, str) or not name:
         raise ConfigError("name", name, "must be a non-empty string", SOURCE)
 
@@ -142,7 +146,7 @@ def slender_mapping(length: float = 8.5, diameter: float = 0.3, fill: float = 1.
         "structure": {"n_modes": 2, "damping": 0.01, "aeroelastic": True},
         "aerodynamics": {"model": "barrowman", "nose": {"shape": "ogive", "length": _r(NOSE * L)},
                          "body": {"diameter": _r(D), "length": _r(L - NOSE * L)},
-                         "fins": {**FINS, "station": _r(-(L - FIN_GAP - chord))}},
+                         "fins": {**FINS, "station": _r(-(L - FIN_GAP - chord))}, **frozen},
     }
 
 
@@ -152,12 +156,12 @@ def slender_vehicle(length: float = 8.5, diameter: float = 0.3, fill: float = 1.
 
     ``length`` [m], ``diameter`` [m], ``fill`` [-], ``mass_flow`` [kg/s], ``slosh_damping`` [-] are
     the factors of Table 6.3; ``options`` are the keyword options of :func:`slender_mapping`
-    (``wall_thickness``, ``material``, ``density``, ``isp``, ``name``). A parameter out of range raises
-    :class:`~lvgym.errors.ConfigError` naming it."""
-    unknown = sorted(set(options) - {"wall_thickness", "material", "density", "isp", "name"})
+    (``wall_thickness``, ``material``, ``density``, ``isp``, ``name``, ``aero_mach``). A parameter out of
+    range raises :class:`~lvgym.errors.ConfigError` naming it."""
+    unknown = sorted(set(options) - {"wall_thickness", "material", "density", "isp", "name", "aero_mach"})
     if unknown:
         raise ConfigError(unknown[0], options[unknown[0]],
-                          "unknown option; allowed: wall_thickness, material, density, isp, name", SOURCE)
+                          "unknown option; allowed: wall_thickness, material, density, isp, name, aero_mach", SOURCE)
     mapping = slender_mapping(length, diameter, fill, mass_flow, slosh_damping, **options)
     return parse_vehicle(mapping, source=SOURCE)
 
