@@ -127,8 +127,9 @@ def test_smile_slosh_modes_stable_at_max_q_even_undamped():
 def test_smile_uncontrolled_departs_in_random_winds_both_models():
     """smile-dispersed (random jet stream, turbulence, dispersions), gimbal at zero, 20 test seeds:
     the aerodynamically stable SMILE leaves the attitude limit in both models, three times each
-    between 19 and 31 s around maximum dynamic pressure (26 s), as thesis 6.3.1 found (a controller
-    is needed; README: on smile-windy the PID baselines have no failure)."""
+    between 19 and 31 s around maximum dynamic pressure (26 s): a controller is needed, as thesis
+    6.3.1 concluded. The error builds up from lift-off (weathercocking at low speed), not at max q
+    (docs/uncontrolled.md figure)."""
     rows = {r["condition"].split("/")[1]: r for r in U.smile_suite_departures("smile-dispersed", 20)}
     for model in ("rigid", "nonrigid"):
         r = rows[model]

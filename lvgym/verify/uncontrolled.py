@@ -231,11 +231,13 @@ def smile_summary(dt: float = 0.05) -> list[dict[str, Any]]:
     return rows
 
 
-def smile_suite_departures(suite: str = "smile-windy", n: int = 50) -> list[dict[str, Any]]:
+def smile_suite_departures(suite: str = "smile-windy", n: int = 50, histories: dict | None = None
+                           ) -> list[dict[str, Any]]:
     """SMILE uncontrolled (gimbal at zero) on ``n`` test seeds of a benchmark suite, per condition:
     failures, their reasons and end times [s], and over all episodes up to burnout (43 s) the median
     time [s] of the largest q-alpha and of the largest pitch-yaw rate, against the median time of
-    maximum dynamic pressure [s]."""
+    maximum dynamic pressure [s]. ``histories``, if given, receives per condition name a list of
+    ``(t [s], attitude error [deg], failed)`` per episode, every 0.1 s."""
     from lvgym.benchmark.suites import get_suite
 
     s = get_suite(suite)
@@ -246,9 +248,12 @@ def smile_suite_departures(suite: str = "smile-windy", n: int = 50) -> list[dict
         for seed in s.seeds("test", n):
             env.reset(seed=seed)
             best = {"qa": (-1.0, 0.0), "rate": (-1.0, 0.0), "q": (-1.0, 0.0)}
+            trace: list[tuple[float, float]] = []
             while True:
                 _, _, term, trunc, info = env.step(np.zeros(2, np.float32))
                 t = float(info["time"])
+                if len(trace) < round(10.0 * t):
+                    trace.append((t, DEG * math.hypot(*info["attitude_error"])))
                 omega = env.unwrapped.core.sim.state("omega_bi_b")[0]
                 for key, v in (("qa", info["qalpha_pa_deg"]), ("rate", math.hypot(omega[1], omega[2])),
                                ("q", info["qbar"])):
@@ -262,6 +267,9 @@ def smile_suite_departures(suite: str = "smile-windy", n: int = 50) -> list[dict
             t_qa.append(best["qa"][1])
             t_rate.append(best["rate"][1])
             t_q.append(best["q"][1])
+            if histories is not None:
+                tr = np.asarray(trace)
+                histories.setdefault(cond.name, []).append((tr[:, 0], tr[:, 1], bool(info["termination"])))
         env.close()
         rows.append({"condition": cond.name, "episodes": n, "failed": len(ends),
                      "reasons": "; ".join(sorted(set(reasons))), "end_s": ", ".join(f"{t:.1f}" for t in sorted(ends)),
@@ -342,9 +350,36 @@ def _figure(title: str, hr: dict, hn: dict, row: int, marks: dict[str, float], n
     return path
 
 
+def suite_figure(histories: dict, t_max_q: float, limit_deg: float, path: Path) -> Path:
+    """Attitude error against time of every episode of :func:`smile_suite_departures`, one panel per
+    condition; failed episodes in red, the attitude limit and maximum dynamic pressure marked."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(11.0, 4.5), layout="constrained")
+    FigureCanvasAgg(fig)
+    axes = fig.subplots(1, len(histories), sharey=True)
+    for ax, (name, runs) in zip(np.atleast_1d(axes), histories.items()):
+        for t, att, failed in runs:
+            ax.plot(t, att, color="C3" if failed else "0.7", linewidth=1.2 if failed else 0.6, zorder=3 if failed else 2)
+        n_fail = sum(r[2] for r in runs)
+        ax.set_title(f"{name}, gimbal at zero: {n_fail} of {len(runs)} beyond {limit_deg:g} deg", fontsize="medium")
+        ax.axhline(limit_deg, color="k", linestyle="--", linewidth=0.8)
+        ax.axvline(t_max_q, color="C1", linestyle=":", linewidth=1.0)
+        ax.annotate("max q", (t_max_q, 0.97), xycoords=("data", "axes fraction"), rotation=90, va="top", ha="right",
+                    fontsize="small", color="C1")
+        ax.set_xlabel("t [s]")
+        ax.grid(True, alpha=0.3)
+    np.atleast_1d(axes)[0].set_ylabel("attitude error [deg]")
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, format="png", dpi=90)
+    return path
+
+
 def figures(out_dir: Path = FIGURES) -> list[Path]:
     """Write ``uncontrolled_stratos3.png`` (profile wind; nominal, and the thrust-below-drag what-if
-    with the thesis's slosh size dashed) and ``uncontrolled_smile.png`` (jet-stream row)."""
+    with the thesis's slosh size dashed), ``uncontrolled_smile.png`` (jet-stream row) and
+    ``uncontrolled_smile_dispersed.png`` (smile-dispersed's 50 test seeds)."""
     hr, hn = run_stratos3("rigid"), run_stratos3("nonrigid")
     hr2, hn2 = run_stratos3("rigid", 2000.0, True), run_stratos3("nonrigid", 2000.0, True)
     p1 = _figure("Stratos III uncontrolled, profile wind (thesis 5.2)", hr, hn, 0,
@@ -356,7 +391,10 @@ def figures(out_dir: Path = FIGURES) -> list[Path]:
     names = Simulator("smile", model="nonrigid", t_end=1.0).timeline.slosh_names
     p2 = _figure("SMILE uncontrolled, jet stream 50 m/s at 10.5 km (thesis 6.3.1)", sr, sn, 1,
                  {"max q": tq, **SMILE_EVENTS}, names, out_dir / "uncontrolled_smile.png")
-    return [p1, p2]
+    hist: dict = {}
+    rows = smile_suite_departures("smile-dispersed", 50, hist)
+    p3 = suite_figure(hist, rows[0]["t_max_q_s"], 30.0, out_dir / "uncontrolled_smile_dispersed.png")
+    return [p1, p2, p3]
 
 
 def _table(rows: list[dict[str, Any]]) -> str:
@@ -372,8 +410,9 @@ def main() -> None:
     print(_table(stratos3_summary()))
     print("\nSMILE, uncontrolled (thesis 6.3.1)")
     print(_table(smile_summary()))
-    print("\nSMILE uncontrolled on smile-windy's 50 test seeds")
-    print(_table(smile_suite_departures()))
+    for suite in ("smile-windy", "smile-dispersed"):
+        print(f"\nSMILE uncontrolled on {suite}'s 50 test seeds")
+        print(_table(smile_suite_departures(suite)))
     print("\nSMILE staging coast: pendulum divergence against an inverted pendulum")
     print(_table(coast_growth()))
     print("\nSMILE with a 0.1 deg, 1 Hz pitch gimbal sine, no wind: peak rate [deg/s]")
