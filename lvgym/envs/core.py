@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 
 from lvgym.simulator import Simulator, Timeline, build_timeline
-from lvgym.simulator.core import _Kernel
+from lvgym.simulator.core import Kernel
 from lvgym.simulator.servo import Servo
 from lvgym.vehicle import MassModel, Vehicle, load_vehicle
 from lvgym.vehicle.slender import slender_vehicle
@@ -33,7 +33,7 @@ OBS_NAMES = ("roll_rate", "pitch_rate_error", "yaw_rate_error", "pitch_attitude_
 RENDER_STATIONS = 21
 REWARD_TERMS = ("rate_roll", "rate_pitch", "rate_yaw", "effort", "effort_rate", "failure")
 _REASONS = np.array(REASONS, dtype=object)
-_SIGNALS = _Kernel(step_signals_range)      # row ranges on the simulator's threads
+_SIGNALS = Kernel(step_signals_range)      # row ranges on the simulator's threads
 
 
 @functools.lru_cache(maxsize=32)
@@ -209,9 +209,9 @@ class AscentBatch:
         tl = self.timeline
         terms, reward = np.empty((B, len(REWARD_TERMS))), np.empty(B)
         reason, truncated, qalpha = np.empty(B, dtype=np.int64), np.empty(B, dtype=bool), np.empty(B)
-        sim._run(_SIGNALS, self._tp, sim.t, sim.x, sim.diag, sim.failed, sim.effort, sim.gimbal, self.steps,
-                 self.axis_ref_i, self.cum_error, self.gyro_bias, tl.t, self._burning, tl.mass, tl.dphi_sensor,
-                 sim.dynamics.n_modes, self.on, self.obs, self.att, terms, reward, reason, truncated, qalpha)
+        sim.run_rows(_SIGNALS, self._tp, sim.t, sim.x, sim.diag, sim.failed, sim.effort, sim.gimbal, self.steps,
+                     self.axis_ref_i, self.cum_error, self.gyro_bias, tl.t, self._burning, tl.mass, tl.dphi_sensor,
+                     sim.dynamics.n_modes, self.on, self.obs, self.att, terms, reward, reason, truncated, qalpha)
         if self._noisy:
             self._add_noise(np.arange(B) if skip is None else np.setdiff1d(np.arange(B), skip))
         terminated = reason != 0

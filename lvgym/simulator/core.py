@@ -58,7 +58,7 @@ def _default_threads() -> int:
     return max(1, int(env)) if env else default_workers()
 
 
-class _Kernel:
+class Kernel:
     """A compiled function called through its compiled entry point after the first call.
 
     Numba's dispatcher resolves the types of every argument on every call; for the loads function
@@ -79,7 +79,7 @@ class _Kernel:
         self.entry(*args)
 
 
-_ADVANCE, _CONDITIONS, _SLOSH = _Kernel(advance_range), _Kernel(conditions_range), _Kernel(slosh_angles_range)
+_ADVANCE, _CONDITIONS, _SLOSH = Kernel(advance_range), Kernel(conditions_range), Kernel(slosh_angles_range)
 
 
 @functools.lru_cache(maxsize=4)
@@ -308,7 +308,10 @@ class Simulator:
             self._chunk_key = key
         return self._chunk_list
 
-    def _run(self, fn, *args) -> None:
+    def run_rows(self, fn: Kernel, *args: Any) -> None:
+        """Call ``fn(lo, hi, *args)`` over the row ranges of the batch, on the simulator's threads when
+        it has more than one range; ``fn`` is a :class:`Kernel` of a compiled ``nogil`` function that
+        touches only rows ``lo:hi`` of its batch arrays."""
         chunks = self._chunks()
         if len(chunks) == 1:
             fn(0, self.batch, *args)
@@ -334,7 +337,7 @@ class Simulator:
         rs = self.rail_state
         lifted0, on0 = rs[:, RS_LIFTED].copy(), rs[:, RS_ON].copy()
         tl = self.timeline
-        self._run(_ADVANCE, flight_loads, self.x, self.p, self.c, self.t, self.scale, self.offset,
+        self.run_rows(_ADVANCE, flight_loads, self.x, self.p, self.c, self.t, self.scale, self.offset,
                   self.x_cg0, self.failed, self.rail, rs, self._servo, self.cmd, self.gimbal, self.gimbal_rate,
                   self.effort, tl.t, tl.params, tl.hold, tl.thrust0, tl.exit_area, self._stage_column, self._event_times,
                   float(duration), self.physics_dt, self.dynamics.n_slosh, self.dynamics.n_modes,
@@ -356,7 +359,7 @@ class Simulator:
     def _update_conditions(self) -> None:
         """Flight conditions of every row at its current time (thrust at that time)."""
         tl = self.timeline
-        self._run(_CONDITIONS, self.t, self.x, self.p, self.c, tl.t, tl.thrust0, tl.exit_area, self._stage_column,
+        self.run_rows(_CONDITIONS, self.t, self.x, self.p, self.c, tl.t, tl.thrust0, tl.exit_area, self._stage_column,
                   self.diag)
 
     @property
@@ -393,7 +396,7 @@ class Simulator:
         N = self.dynamics.n_slosh
         out = np.zeros((self.batch, N, 2))
         if N:
-            self._run(_SLOSH, self.x, N, self.dynamics.n_modes, out)
+            self.run_rows(_SLOSH, self.x, N, self.dynamics.n_modes, out)
             m_j = self.p[:, [self.layout.slosh_param(j, "m").start for j in range(N)]]
             out[m_j <= 0.0] = np.nan
         return out
