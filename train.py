@@ -81,6 +81,9 @@ class Args:
     """protocol suite of the validation (default: smile-windy or slender-ld30 by env; 'none': no validation)"""
     eval_mission_time_s: float | None = None
     """shorten validation episodes (smoke tests only)"""
+    eval_select: str = "trained"
+    """conditions whose validation picks the best model: 'trained' (those of the training --model; all if
+    the suite has none) or 'all' (every condition of the suite, which lets the other model into selection)"""
     torch_threads: int = 1
     """torch CPU threads (the env rows are one batched simulator on one core)"""
     progress: bool = True
@@ -129,6 +132,8 @@ def build_parser(suppress: bool = False) -> argparse.ArgumentParser:
             kw["type"] = float
         if f.name == "algo":
             kw["choices"] = ("ppo", "sac", "td3")
+        if f.name == "eval_select":
+            kw["choices"] = ("trained", "all")
         p.add_argument(flag, **kw)
     return p
 
@@ -279,7 +284,8 @@ def prepare(args: Args, given: set[str]) -> tuple[Args, dict[str, Any], Path, bo
         raise SystemExit(f"train.py: {run_dir} exists; continue it with --resume {run_dir} or choose another --name")
     config = {"name": name, "args": asdict(args), "algo": args.algo, "env_id": args.env_id, "env_kwargs": env_kwargs,
               "total_timesteps": int(args.total_timesteps or cfg.n_timesteps), "seed": args.seed,
-              "eval_suite": suite, "hyperparams": cfg.to_dict(), "hyperparams_source": cfg.source,
+              "eval_suite": suite, "eval_select": args.eval_select, "hyperparams": cfg.to_dict(),
+              "hyperparams_source": cfg.source,
               "created_utc": dt.datetime.now(dt.timezone.utc).isoformat(timespec="seconds"), **provenance()}
     run_dir.mkdir(parents=True, exist_ok=True)
     _write_yaml(run_dir / "config.yaml", config)
@@ -339,7 +345,10 @@ def train(argv: list[str] | None = None) -> Path:
     evaluator = None
     if suite != "none" and args.eval_freq > 0:
         over = {"mission_time_s": args.eval_mission_time_s} if args.eval_mission_time_s else None
-        evaluator = ValidationEvaluator(suite, args.eval_episodes, over)
+        # runs made before eval_select existed selected on every condition
+        select = config.get("eval_select", "all")
+        evaluator = ValidationEvaluator(suite, args.eval_episodes, over,
+                                        select_on=config["env_kwargs"].get("model") if select == "trained" else None)
     meta = {"algo": ALGO_NAMES[config["algo"]], "env_id": config["env_id"], "env_kwargs": config["env_kwargs"],
             "run": config["name"], "seed": config["seed"], "target_timesteps": target,
             "git_commit": config.get("git_commit"), "lvgym_version": config.get("lvgym_version")}

@@ -109,12 +109,17 @@ class ValidationEvaluator:
     """Episodes of a policy on every condition of a protocol suite, reset with the suite's validation
     seeds (``lvgym.benchmark``: same conditions, seeds, trajectory and metrics as ``evaluate.py``).
     ``overrides``: env keywords for every condition (e.g. ``mission_time_s`` in tests; the suite is then
-    marked ``+override``)."""
+    marked ``+override``). ``select_on``: the flight model (``rigid``, ``nonrigid``, ...) whose conditions
+    make the selection score; None, or a model the suite does not fly: all conditions. A policy trained on
+    one model and selected on every condition has seen the others through model selection."""
 
-    def __init__(self, suite: str | Suite, episodes: int, overrides: dict[str, Any] | None = None) -> None:
+    def __init__(self, suite: str | Suite, episodes: int, overrides: dict[str, Any] | None = None,
+                 select_on: str | None = None) -> None:
         s = get_suite(suite) if isinstance(suite, str) else suite
         self.suite = s.with_options(**overrides) if overrides else s
         self.seeds = self.suite.seeds("validation", int(episodes))
+        chosen = [c.name for c in self.suite.conditions if c.model == select_on]
+        self.selected = chosen or [c.name for c in self.suite.conditions]
         self._envs: dict[Any, Any] = {}
 
     def episode(self, policy: Policy, condition: Any, seed: int) -> dict[str, Any]:
@@ -128,19 +133,20 @@ class ValidationEvaluator:
 
     def evaluate(self, policy: Policy) -> dict[str, Any]:
         """Per-condition means and failure rates, and the selection ``score``: ``[failure rate, rate
-        error]`` averaged over the conditions, compared lexicographically (lower is better; a failed
-        episode's rate error stops at the failure, so failures must count first)."""
+        error]`` averaged over the selected conditions (``selected_on``), compared lexicographically (lower
+        is better; a failed episode's rate error stops at the failure, so failures must count first)."""
         records = [self.episode(policy, c, s) for c in self.suite.conditions for s in self.seeds]
         rows = summarize(records, ("rate_error_rad", "max_rate_radps", "effort_rad_s", "episode_return"))
         conds: dict[str, dict[str, float]] = {}
         for r in rows:
             conds[r["condition"]] = {k: float(r[k]) for k in r if isinstance(r[k], (int, float))
                                      and not isinstance(r[k], bool) and k != "n"}
-        fail = float(np.mean([c["failure_rate"] for c in conds.values()]))
-        err = float(np.mean([c["rate_error_rad_mean"] for c in conds.values()]))
+        sel = [conds[name] for name in self.selected]
+        fail = float(np.mean([c["failure_rate"] for c in sel]))
+        err = float(np.mean([c["rate_error_rad_mean"] for c in sel]))
         return {"suite": self.suite.name, "version": self.suite.version, "seed_set": "validation",
-                "episodes": len(self.seeds), "conditions": conds, "failure_rate": fail, "rate_error_rad": err,
-                "score": [fail, err]}
+                "episodes": len(self.seeds), "conditions": conds, "selected_on": list(self.selected),
+                "failure_rate": fail, "rate_error_rad": err, "score": [fail, err]}
 
     def close(self) -> None:
         for env in self._envs.values():

@@ -108,6 +108,12 @@ def test_train_saves_resumes_and_reloads_as_a_policy(tmp_path):
     zip0, state0 = latest_checkpoint(run / "checkpoints")
     s0 = state0["num_timesteps"]
     assert s0 >= 384 and state0["algo"] == "PPO" and state0["evaluations"]
+    # the best model is selected on the training model's condition only (default --eval-select trained)
+    assert "eval_select: trained" in config
+    for e in state0["evaluations"]:
+        (name,) = e["selected_on"]
+        assert name.endswith("/nonrigid")
+        assert e["score"] == [e["conditions"][name]["failure_rate"], e["conditions"][name]["rate_error_rad_mean"]]
     assert load_model(zip0).num_timesteps == s0
     count0 = _vecnorm(zip0.with_suffix("")).obs_rms.count
 
@@ -212,3 +218,11 @@ def test_shipped_checkpoint_loads_and_acts():
         obs, _, terminated, truncated, info = env.step(action)
         if terminated or truncated:
             break
+
+
+def test_validation_selects_on_the_training_model_or_on_every_condition():
+    from agents.callbacks import ValidationEvaluator
+
+    names = {m: ValidationEvaluator("smile-windy", 1, select_on=m).selected for m in ("rigid", "nonrigid", "flex", None)}
+    assert names["rigid"] == ["smile-windy/rigid"] and names["nonrigid"] == ["smile-windy/nonrigid"]
+    assert names["flex"] == names[None] == ["smile-windy/rigid", "smile-windy/nonrigid"]   # not flown: all
