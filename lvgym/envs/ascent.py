@@ -182,7 +182,6 @@ class SlenderAscentEnv(AscentEnv):
     ``aero_mach`` became 2.0 (it flew the full tables, which no policy survives)."""
 
     DEFAULTS = {"site": "andoya", "mission_time_s": 10.0, "rate_weights": (0.0, 1.0, 1.0)}
-    DEFAULT_AERO_MACH = DEFAULT_AERO_MACH
 
     def __init__(self, render_mode: str | None = None, length: float = 8.5, diameter: Any = 0.3,
                  aero_mach: float | None = DEFAULT_AERO_MACH, **options: Any) -> None:

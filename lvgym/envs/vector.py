@@ -17,7 +17,7 @@ import numpy as np
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
-from .ascent import SlenderAscentEnv, _rows, make_spaces
+from .ascent import DEFAULT_AERO_MACH, SlenderAscentEnv, _rows, make_spaces
 from .core import AscentBatch
 from .spec import TaskSpec
 
@@ -30,7 +30,7 @@ def _task(env_cls: type, options: dict[str, Any]) -> TaskSpec:
         if np.size(diameter) != 1:
             raise ValueError("diameter ranges are drawn per episode by the single SlenderAscent env only; "
                              "a vector env flies one geometry (make one vector env per diameter)")
-        aero_mach = options.pop("aero_mach", SlenderAscentEnv.DEFAULT_AERO_MACH)
+        aero_mach = options.pop("aero_mach", DEFAULT_AERO_MACH)
         options["vehicle"] = ("slender", float(length), float(np.ravel(diameter)[0]),
                               None if aero_mach is None else float(aero_mach))
     return TaskSpec.build(env_cls.DEFAULTS, options)
