@@ -38,7 +38,7 @@ def vehicle(n_slosh: int, n_modes: int, batch: int, seed: int = 0):
     qs = lay.view(x, "state", "q_si")
     qs[..., 1:] = 0.02 * rng.normal(size=(batch, n_slosh, 3))
     qs /= np.linalg.norm(qs, axis=-1, keepdims=True)
-    u = model.loads(thrust_e=(60_000.0, 300.0, -200.0), g_i=(-9.81, 0, 0), m_b_b=(5.0, 0, 0))
+    u = model.loads(thrust_b=(60_000.0, 300.0, -200.0), g_i=(-9.81, 0, 0), m_b_b=(5.0, 0, 0))
     return model, x, np.repeat(p[None], batch, 0), np.repeat(u[None], batch, 0)
 
 

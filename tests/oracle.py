@@ -108,7 +108,7 @@ class Oracle:
         phi_g = p[lay.params["phi_gimbal"]]
         dphi_g = p[lay.params["dphi_gimbal"]]
         s_y, s_z = dphi_g @ eta[:K], dphi_g @ eta[K:]
-        f_t = Rotation.from_rotvec([0.0, -s_z, s_y]).apply(ld["thrust_e"])
+        f_t = Rotation.from_rotvec([0.0, -s_z, s_y]).apply(ld["thrust_b"])
         Psi_g = np.zeros((3, 2 * K))
         Psi_g[1, :K] = phi_g
         Psi_g[2, K:] = phi_g

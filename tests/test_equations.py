@@ -77,7 +77,7 @@ def test_thrust_at_gimbal_with_flex_tilt_hand_numbers():
     x = model.layout.zeros_state()
     x[model.layout.state["eta"]] = [0.1, 0.0]  # y-plane mode deflected
     thrust = 1000.0
-    xd = model.derivative(x, p, model.loads(thrust_e=[thrust, 0, 0]))
+    xd = model.derivative(x, p, model.loads(thrust_b=[thrust, 0, 0]))
     slope = -0.05 * 0.1
     f_b = thrust * np.array([np.cos(slope), np.sin(slope), 0.0])
     np.testing.assert_allclose(xd[3:6], f_b / 100.0)

@@ -47,7 +47,7 @@ def test_integrating_factor_equals_classic_without_modes():
                                                     {"m": 2.0, "length": 0.7, "r_hinge": [-1, 0, 0]}])
     x = model.layout.zeros_state()
     x[model.layout.state["omega_si_s"]] = [0.3, 0.1, -0.2, 0.4]
-    u = model.loads(thrust_e=[300, 5, 0], g_i=[-9.8, 0, 0])
+    u = model.loads(thrust_b=[300, 5, 0], g_i=[-9.8, 0, 0])
     np.testing.assert_array_equal(model.step(x, p, u, 1e-3, 50),
                                   model.step(x, p, u, 1e-3, 50, method="rk4-classic"))
 

@@ -77,6 +77,6 @@ def test_kernel_offsets_agree_with_the_layout():
     assert (k.P_M, k.P_CG, k.P_J, k.P_GIM, k.P_MODES) == tuple(
         lay.params[n].start for n in ("m_b", "r_cg", "J_b", "r_gimbal", "omega_modes"))
     assert (k.U_F, k.U_M, k.U_T, k.U_G, k.U_ETA) == tuple(
-        lay.loads[n].start for n in ("f_b_i", "m_b_b", "thrust_e", "g_i", "f_eta"))
+        lay.loads[n].start for n in ("f_b_i", "m_b_b", "thrust_b", "g_i", "f_eta"))
     assert lay.slosh_block == 8 + 3 and lay.slosh_param(1, "phi").start == \
         lay.params["slosh"].start + lay.slosh_block + 8

@@ -59,7 +59,7 @@ def test_observation_and_reference_equal_numpy_formulas(observation):
             dphi = core.timeline.left("dphi_sensor", sim.t)[0, 0]            # IMU slopes (K,)
             eta_dot = sim.state("eta_dot")[0]                              # (2, K): y, z planes
             w += np.array([0.0, -dphi @ eta_dot[1], dphi @ eta_dot[0]])
-            f = sim.conditions("f_aero_b")[0] + sim.conditions("thrust_e")[0]
+            f = sim.conditions("f_aero_b")[0] + sim.conditions("thrust_b")[0]
             m = core.timeline.interp("mass", sim.t)[0]
             flow = f[[2, 1]] / m / G0
         else:

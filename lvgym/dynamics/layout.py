@@ -11,57 +11,9 @@ Conventions (see DESIGN.md): SI units, radians; quaternions are Hamilton, scalar
 ``C_ib = R(q_bi)`` (``v_i = C_ib @ v_b``). Stations are body-frame coordinates measured from the
 nose tip, ``+x_b`` forward, so stations along the vehicle are zero or negative.
 
-State ``x`` (length ``13 + 4K + 6N``):
-
-==================  =====  ==============================================================
-name                size   meaning
-==================  =====  ==============================================================
-``r_zw_i``          3      position of the rigid-body CG z from the inertial origin w [m]
-``v_zw_i``          3      its inertial velocity [m/s]
-``q_bi``            4      body attitude quaternion (scalar first)
-``omega_bi_b``      3      body angular velocity, body frame [rad/s]
-``eta``             2K     modal coordinates, first the K modes of the y plane, then z [sqrt(kg) m]
-``eta_dot``         2K     their rates
-``q_si``            4N     attitude of each pendulum frame s_j (rod along ``+x_s``; the mass
-                           hangs at ``-L x_s`` from the hinge)
-``omega_si_s``      2N     pendulum angular velocity, y_s and z_s components; the component
-                           along the rod is zero by construction (a point mass has no spin)
-==================  =====  ==============================================================
-
-Parameters ``p`` (length ``16 + 4K + N (8 + K)``):
-
-==================  =====  ==============================================================
-``m_b``             1      mass of the rigid body B (everything except the slosh masses) [kg]
-``r_cg``            3      station of the CG of B [m]
-``J_b``             9      inertia of B about its CG, body axes, row major [kg m^2]
-``r_gimbal``        3      station of the engine gimbal (thrust application node) [m]
-``omega_modes``     K      bending natural frequencies Omega [rad/s]
-``zeta_modes``      K      bending damping ratios Z [-]
-``phi_gimbal``      K      mass-normalised mode shape at the gimbal node [1/sqrt(kg)]
-``dphi_gimbal``     K      mode slope d(phi)/dx at the gimbal node [1/(m sqrt(kg))]
-per slosh j:
-``m``               1      slosh mass (0: the pendulum is inactive and its state frozen) [kg]
-``length``          1      pendulum length L, hinge to mass [m]
-``inertia``         1      transverse inertia of the slosh body about the mass (0: point mass)
-                           [kg m^2]
-``r_hinge``         3      station of the undeflected hinge [m]
-``zeta``            1      slosh damping ratio [-]
-``omega``           1      slosh natural frequency used by the damper, sqrt(a / L) [rad/s]
-``phi``             K      mode shape at the hinge node [1/sqrt(kg)]
-==================  =====  ==============================================================
-
-Loads ``u`` (length ``12 + 2K``), held constant over one integration stage:
-
-==================  =====  ==============================================================
-``f_b_i``           3      external force on B at its CG other than gravity and thrust
-                           (aerodynamics, support), inertial frame [N]
-``m_b_b``           3      external moment on B about its CG, body frame [N m]
-``thrust_e``        3      thrust force in the undeformed engine frame (body axes); the core
-                           tilts it by the mode slope at the gimbal and applies it at the
-                           deflected gimbal node (thesis eq. 2.20-2.22) [N]
-``g_i``             3      gravitational acceleration on B and on every slosh mass [m/s^2]
-``f_eta``           2K     further generalised forces on the modes (aeroelastic) [sqrt(kg) m/s^2]
-==================  =====  ==============================================================
+The tables below are generated from the descriptions in this module (:data:`STATE`, :data:`PARAMS`,
+:data:`SLOSH`, :data:`LOADS`), which are the only place any offset is defined: the compiled kernels read
+their offsets from them (``at(X.eta_dot, K, N)``, see :mod:`lvgym.packing`).
 """
 
 from __future__ import annotations
@@ -70,32 +22,90 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-__all__ = ["Layout"]
+from lvgym.packing import Linear, LinearField, Packed
 
+__all__ = ["LOADS", "Layout", "P", "PARAMS", "SLOSH", "SLOSH_FIELDS", "SPEEDS", "STATE", "S", "U", "V", "X"]
 
-def _build(entries: list[tuple[str, int]]) -> tuple[dict[str, slice], int]:
-    slices: dict[str, slice] = {}
-    offset = 0
-    for name, size in entries:
-        slices[name] = slice(offset, offset + size)
-        offset += size
-    return slices, offset
+# ---------------------------------------------------------------------------- the one description
+#: state x (K modes per plane, N pendulums)
+STATE = Linear("dynamics state", [
+    LinearField("r_zw_i", 3, unit="m", doc="position of the rigid-body CG z from the inertial origin w"),
+    LinearField("v_zw_i", 3, unit="m/s", doc="its inertial velocity"),
+    LinearField("q_bi", 4, unit="-", doc="body attitude quaternion (scalar first)"),
+    LinearField("omega_bi_b", 3, unit="rad/s", doc="body angular velocity, body frame"),
+    LinearField("eta", per_mode=2, unit="sqrt(kg) m", doc="modal coordinates: the K modes of the y plane, then z",
+                shape=lambda K, N: (2, K)),
+    LinearField("eta_dot", per_mode=2, unit="sqrt(kg) m/s", doc="their rates", shape=lambda K, N: (2, K)),
+    LinearField("q_si", per_slosh=4, unit="-", doc="attitude of each pendulum frame s_j (scalar first)",
+                shape=lambda K, N: (N, 4)),
+    LinearField("omega_si_s", per_slosh=2, unit="rad/s", doc="pendulum angular velocity, y_s and z_s components",
+                shape=lambda K, N: (N, 2)),
+])
+#: parameters of one pendulum j, a block of the ``slosh`` parameter (sizes in K only)
+SLOSH = Linear("slosh parameters", [
+    LinearField("m", 1, unit="kg", doc="slosh mass (0: the pendulum is inactive and its state frozen)"),
+    LinearField("length", 1, unit="m", doc="pendulum length L, hinge to mass"),
+    LinearField("inertia", 1, unit="kg m^2", doc="transverse inertia of the slosh body about the mass"),
+    LinearField("r_hinge", 3, unit="m", doc="station of the undeflected hinge"),
+    LinearField("zeta", 1, unit="-", doc="slosh damping ratio"),
+    LinearField("omega", 1, unit="rad/s", doc="slosh natural frequency used by the damper"),
+    LinearField("phi", per_mode=1, unit="1/sqrt(kg)", doc="mode shape at the hinge node"),
+])
+#: parameters p
+PARAMS = Linear("dynamics parameters", [
+    LinearField("m_b", 1, unit="kg", doc="mass of the rigid body B"),
+    LinearField("r_cg", 3, unit="m", doc="station of the CG of B"),
+    LinearField("J_b", 9, unit="kg m^2", doc="inertia of B about its CG, body axes, row major",
+                shape=lambda K, N: (3, 3)),
+    LinearField("r_gimbal", 3, unit="m", doc="station of the engine gimbal"),
+    LinearField("omega_modes", per_mode=1, unit="rad/s", doc="bending natural frequencies"),
+    LinearField("zeta_modes", per_mode=1, unit="-", doc="bending damping ratios"),
+    LinearField("phi_gimbal", per_mode=1, unit="1/sqrt(kg)", doc="mode shape at the gimbal node"),
+    LinearField("dphi_gimbal", per_mode=1, unit="1/(m sqrt(kg))", doc="mode slope at the gimbal node"),
+    LinearField("slosh", per_slosh=SLOSH.size_form[0], per_both=SLOSH.size_form[1], unit="-",
+                doc="per pendulum, the block SLOSH"),
+])
+#: loads u, held over one integration stage
+LOADS = Linear("dynamics loads", [
+    LinearField("f_b_i", 3, unit="N", doc="external force on B at its CG other than gravity and thrust, inertial"),
+    LinearField("m_b_b", 3, unit="N m", doc="external moment on B about its CG, body frame"),
+    LinearField("thrust_b", 3, unit="N", doc="thrust in the undeformed engine frame (body axes)"),
+    LinearField("g_i", 3, unit="m/s^2", doc="gravitational acceleration"),
+    LinearField("f_eta", per_mode=2, unit="sqrt(kg) m/s^2", doc="further generalised forces on the modes",
+                shape=lambda K, N: (2, K)),
+])
+#: independent speeds of B and the modes, the unknowns of the reduced system ``A_r u_dot = b``
+SPEEDS = Linear("rigid and elastic speeds", [
+    LinearField("v_zw_i", 3, unit="m/s", doc="inertial velocity of the CG of B"),
+    LinearField("omega_bi_b", 3, unit="rad/s", doc="body rate"),
+    LinearField("eta_dot", per_mode=2, unit="sqrt(kg) m/s", doc="modal rates, y plane then z"),
+], pad=False)
+
+#: offset forms for compiled code: ``at(X.eta_dot, K, N)``, ``at(P.slosh, K, N) + j * at(SLOSH_BLOCK, K, N)
+#: + at(S.phi, K, N)``; the fields that depend on neither K nor N are also plain integers in ``*.fixed``
+X, P, U, S, V = STATE.at, PARAMS.at, LOADS.at, SLOSH.at, SPEEDS.at
+#: size form of one pendulum's parameter block
+SLOSH_BLOCK = SLOSH.size_form
+#: names of one pendulum's parameters, in order
+SLOSH_FIELDS = SLOSH.names
 
 
 @dataclass(frozen=True)
 class Layout:
-    """Index map of state, parameter and load vectors for N slosh pendulums and K modes per plane."""
+    """Index map of state, parameter and load vectors for N slosh pendulums and K modes per plane
+    (the :class:`~lvgym.packing.Packed` layouts of :data:`STATE`, :data:`PARAMS` and :data:`LOADS`)."""
 
     n_slosh: int
     n_modes: int
     state: dict[str, slice] = field(init=False, repr=False)
     params: dict[str, slice] = field(init=False, repr=False)
     loads: dict[str, slice] = field(init=False, repr=False)
+    packed: dict[str, Packed] = field(init=False, repr=False, compare=False)
     n_x: int = field(init=False)
     n_p: int = field(init=False)
     n_u: int = field(init=False)
 
-    SLOSH_FIELDS = ("m", "length", "inertia", "r_hinge", "zeta", "omega", "phi")
+    SLOSH_FIELDS = SLOSH_FIELDS
 
     def __post_init__(self) -> None:
         for key in ("n_slosh", "n_modes"):
@@ -103,47 +113,37 @@ class Layout:
             if not isinstance(value, (int, np.integer)) or value < 0:
                 raise ValueError(f"Layout.{key} = {value!r}: must be an integer >= 0")
         n, k = int(self.n_slosh), int(self.n_modes)
-        state, n_x = _build(
-            [("r_zw_i", 3), ("v_zw_i", 3), ("q_bi", 4), ("omega_bi_b", 3), ("eta", 2 * k),
-             ("eta_dot", 2 * k), ("q_si", 4 * n), ("omega_si_s", 2 * n)]
-        )
-        params, n_p = _build(
-            [("m_b", 1), ("r_cg", 3), ("J_b", 9), ("r_gimbal", 3), ("omega_modes", k),
-             ("zeta_modes", k), ("phi_gimbal", k), ("dphi_gimbal", k), ("slosh", n * (8 + k))]
-        )
-        loads, n_u = _build([("f_b_i", 3), ("m_b_b", 3), ("thrust_e", 3), ("g_i", 3), ("f_eta", 2 * k)])
-        for name, value in (("state", state), ("params", params), ("loads", loads), ("n_x", n_x),
-                            ("n_p", n_p), ("n_u", n_u)):
-            object.__setattr__(self, name, value)
+        packed = {kind: lin.resolve(k, n) for kind, lin in (("state", STATE), ("params", PARAMS),
+                                                              ("loads", LOADS), ("slosh", SLOSH))}
+        object.__setattr__(self, "packed", packed)
+        for kind in ("state", "params", "loads"):
+            object.__setattr__(self, kind, {name: packed[kind].slice(name) for name in packed[kind].names})
+        for name, kind in (("n_x", "state"), ("n_p", "params"), ("n_u", "loads")):
+            object.__setattr__(self, name, packed[kind].size)
 
     # ------------------------------------------------------------------ slosh parameter blocks
     @property
     def slosh_block(self) -> int:
         """Number of parameters per slosh pendulum."""
-        return 8 + self.n_modes
+        return self.packed["slosh"].size
 
     def slosh_param(self, j: int, name: str) -> slice:
         """Slice of parameter ``name`` (one of ``SLOSH_FIELDS``) of pendulum ``j`` in ``p``."""
         if not 0 <= j < self.n_slosh:
             raise IndexError(f"slosh index {j} outside 0..{self.n_slosh - 1}")
-        sizes = {"m": 1, "length": 1, "inertia": 1, "r_hinge": 3, "zeta": 1, "omega": 1,
-                 "phi": self.n_modes}
-        if name not in sizes:
-            raise KeyError(f"slosh parameter {name!r}: allowed {self.SLOSH_FIELDS}")
-        offset = self.params["slosh"].start + j * self.slosh_block
-        for key in self.SLOSH_FIELDS:
-            if key == name:
-                return slice(offset, offset + sizes[key])
-            offset += sizes[key]
-        raise AssertionError("unreachable")
+        if name not in SLOSH_FIELDS:
+            raise KeyError(f"slosh parameter {name!r}: allowed {SLOSH_FIELDS}")
+        sub = self.packed["slosh"].slice(name)
+        start = self.params["slosh"].start + j * self.slosh_block
+        return slice(start + sub.start, start + sub.stop)
 
     # ------------------------------------------------------------------ allocation helpers
     def zeros_state(self, batch: int | None = None) -> np.ndarray:
         """A state at rest: identity attitudes, everything else zero."""
         x = np.zeros(self.n_x if batch is None else (batch, self.n_x))
         x[..., self.state["q_bi"].start] = 1.0
-        q_si = self.state["q_si"]
-        x[..., q_si.start:q_si.stop:4] = 1.0
+        q_si = self.view(x, "state", "q_si")
+        q_si[..., 0] = 1.0
         return x
 
     def zeros_params(self, batch: int | None = None) -> np.ndarray:
@@ -158,14 +158,19 @@ class Layout:
         Multi-entry quantities keep their natural shape: ``q_si`` is ``(..., N, 4)``,
         ``omega_si_s`` ``(..., N, 2)``, ``J_b`` ``(..., 3, 3)``, ``eta`` ``(..., 2, K)`` (plane, mode).
         """
-        table = {"state": self.state, "params": self.params, "loads": self.loads}.get(kind)
-        if table is None:
+        if kind not in ("state", "params", "loads"):
             raise KeyError(f"kind {kind!r}: allowed 'state', 'params', 'loads'")
-        if name not in table:
-            raise KeyError(f"{kind} has no {name!r}: allowed {sorted(table)}")
-        part = array[..., table[name]]
-        shapes = {"q_si": (self.n_slosh, 4), "omega_si_s": (self.n_slosh, 2), "J_b": (3, 3),
-                  "eta": (2, self.n_modes), "eta_dot": (2, self.n_modes), "f_eta": (2, self.n_modes)}
-        if name in shapes:
-            part = part.reshape(part.shape[:-1] + shapes[name])
-        return part
+        layout = self.packed[kind]
+        if name not in layout:
+            raise KeyError(f"{kind} has no {name!r}: allowed {sorted(layout.names)}")
+        return layout.view(array, name)
+
+
+def _doc() -> str:
+    parts = [("State ``x``", STATE), ("Parameters ``p``", PARAMS), ("Per slosh pendulum ``j`` (block ``slosh``)", SLOSH),
+             ("Loads ``u``, held constant over one integration stage", LOADS),
+             ("Independent speeds of the reduced system", SPEEDS)]
+    return "\n\n".join(f"{title} (length ``{lin.table_size()}``):\n\n{lin.table()}" for title, lin in parts)
+
+
+__doc__ = (__doc__ or "") + "\n" + _doc()

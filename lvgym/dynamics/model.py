@@ -131,12 +131,12 @@ class NonRigidModel:
                     fail(b, f"slosh[{j}].length", get["length"][0],
                          "an active pendulum (m > 0) needs a length > 0 m")
 
-    def loads(self, *, f_b_i=(0.0, 0.0, 0.0), m_b_b=(0.0, 0.0, 0.0), thrust_e=(0.0, 0.0, 0.0),
+    def loads(self, *, f_b_i=(0.0, 0.0, 0.0), m_b_b=(0.0, 0.0, 0.0), thrust_b=(0.0, 0.0, 0.0),
               g_i=(0.0, 0.0, 0.0), f_eta=None) -> np.ndarray:
         """Loads vector from named values (see ``layout.py``)."""
         lay = self.layout
         u = lay.zeros_loads()
-        for key, value in (("f_b_i", f_b_i), ("m_b_b", m_b_b), ("thrust_e", thrust_e), ("g_i", g_i)):
+        for key, value in (("f_b_i", f_b_i), ("m_b_b", m_b_b), ("thrust_b", thrust_b), ("g_i", g_i)):
             u[lay.loads[key]] = value
         if f_eta is not None:
             u[lay.loads["f_eta"]] = np.asarray(f_eta, dtype=float).ravel()

@@ -245,7 +245,7 @@ def ascent_model():
     x[lay.state["eta"]] = 0.0
     x[lay.state["eta_dot"]] = 0.0
     total = CASE_E["m_b"] + sum(CASE_E["m_slosh"])
-    return model, x, p, model.loads(thrust_e=(3 * G0 * total, 0.0, 0.0), g_i=g)
+    return model, x, p, model.loads(thrust_b=(3 * G0 * total, 0.0, 0.0), g_i=g)
 
 
 def case_rk4_vs_dop853(dt: float = 1e-3) -> list[Check]:
