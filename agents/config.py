@@ -26,7 +26,7 @@ from typing import Any
 
 import yaml
 
-from lvgym.errors import ConfigError
+from lvgym.errors import ConfigError, check_bool, check_choice, check_number
 
 HYPERPARAMS_DIR = Path(__file__).resolve().parent / "hyperparams"
 ALGOS = ("ppo", "sac", "td3")
@@ -38,23 +38,7 @@ ACTION_NOISES = ("none", "normal", "ornstein_uhlenbeck")
 # ------------------------------------------------------------------------------------------ validation
 def _num(key: str, value: Any, lo: float, hi: float, integer: bool = False, lo_open: bool = False,
          src: str | None = None) -> Any:
-    ok_type = isinstance(value, int) if integer else isinstance(value, (int, float))
-    if not ok_type or isinstance(value, bool) or not ((value > lo if lo_open else value >= lo) and value <= hi):
-        kind = "an integer" if integer else "a number"
-        raise ConfigError(key, value, f"{kind} in {'(' if lo_open else '['}{lo}, {hi}]", src)
-    return int(value) if integer else float(value)
-
-
-def _bool(key: str, value: Any, src: str | None) -> bool:
-    if not isinstance(value, bool):
-        raise ConfigError(key, value, "true or false", src)
-    return value
-
-
-def _choice(key: str, value: Any, allowed: tuple[str, ...], src: str | None) -> str:
-    if value not in allowed:
-        raise ConfigError(key, value, f"one of {allowed}", src)
-    return str(value)
+    return check_number(key, value, lo, hi, integer=integer, lo_open=lo_open, source=src)
 
 
 def _layers(key: str, value: Any, src: str | None) -> tuple[int, ...]:
@@ -85,8 +69,8 @@ class NormalizeConfig:
     epsilon: float = 1e-8
 
     def validate(self, src: str | None = None) -> NormalizeConfig:
-        _bool("normalize.norm_obs", self.norm_obs, src)
-        _bool("normalize.norm_reward", self.norm_reward, src)
+        check_bool("normalize.norm_obs", self.norm_obs, src)
+        check_bool("normalize.norm_reward", self.norm_reward, src)
         _num("normalize.clip_obs", self.clip_obs, 0.0, 1e6, lo_open=True, src=src)
         _num("normalize.clip_reward", self.clip_reward, 0.0, 1e6, lo_open=True, src=src)
         _num("normalize.epsilon", self.epsilon, 0.0, 1.0, lo_open=True, src=src)
@@ -108,9 +92,9 @@ class PolicyConfig:
         object.__setattr__(self, "net_arch", _layers("policy.net_arch", self.net_arch, src))
         if self.qf_arch is not None:
             object.__setattr__(self, "qf_arch", _layers("policy.qf_arch", self.qf_arch, src))
-        _choice("policy.activation", self.activation, ACTIVATIONS, src)
+        check_choice("policy.activation", self.activation, ACTIVATIONS, src)
         _num("policy.log_std_init", self.log_std_init, -10.0, 5.0, src=src)
-        _bool("policy.ortho_init", self.ortho_init, src)
+        check_bool("policy.ortho_init", self.ortho_init, src)
         return self
 
     def sb3_kwargs(self, algo: str) -> dict[str, Any]:
@@ -146,7 +130,7 @@ class PPOConfig:
     def validate(self, src: str | None = None) -> PPOConfig:
         p = "algo."
         _num(p + "learning_rate", self.learning_rate, 0.0, 1.0, lo_open=True, src=src)
-        _choice(p + "lr_schedule", self.lr_schedule, LR_SCHEDULES, src)
+        check_choice(p + "lr_schedule", self.lr_schedule, LR_SCHEDULES, src)
         _num(p + "n_steps", self.n_steps, 2, 1_000_000, integer=True, src=src)
         _num(p + "batch_size", self.batch_size, 2, 10_000_000, integer=True, src=src)
         _num(p + "n_epochs", self.n_epochs, 1, 1000, integer=True, src=src)
@@ -158,7 +142,7 @@ class PPOConfig:
         _num(p + "max_grad_norm", self.max_grad_norm, 0.0, 1e6, lo_open=True, src=src)
         if self.target_kl is not None:
             _num(p + "target_kl", self.target_kl, 0.0, 10.0, lo_open=True, src=src)
-        _bool(p + "use_sde", self.use_sde, src)
+        check_bool(p + "use_sde", self.use_sde, src)
         return self
 
 
@@ -189,7 +173,7 @@ class OffPolicyConfig:
     def validate(self, src: str | None = None) -> OffPolicyConfig:
         p = "algo."
         _num(p + "learning_rate", self.learning_rate, 0.0, 1.0, lo_open=True, src=src)
-        _choice(p + "lr_schedule", self.lr_schedule, LR_SCHEDULES, src)
+        check_choice(p + "lr_schedule", self.lr_schedule, LR_SCHEDULES, src)
         _num(p + "buffer_size", self.buffer_size, 1, 100_000_000, integer=True, src=src)
         _num(p + "learning_starts", self.learning_starts, 0, 100_000_000, integer=True, src=src)
         _num(p + "batch_size", self.batch_size, 1, 1_000_000, integer=True, src=src)
@@ -197,12 +181,12 @@ class OffPolicyConfig:
         _num(p + "gamma", self.gamma, 0.0, 1.0, src=src)
         _num(p + "train_freq", self.train_freq, 1, 1_000_000, integer=True, src=src)
         _num(p + "gradient_steps", self.gradient_steps, -1, 1_000_000, integer=True, src=src)
-        _choice(p + "action_noise", self.action_noise, ACTION_NOISES, src)
+        check_choice(p + "action_noise", self.action_noise, ACTION_NOISES, src)
         _num(p + "action_noise_sigma", self.action_noise_sigma, 0.0, 10.0, src=src)
         e = self.ent_coef
         if not (isinstance(e, str) and (e == "auto" or e.startswith("auto_"))):
             _num(p + "ent_coef", e, 0.0, 100.0, src=src)
-        _bool(p + "use_sde", self.use_sde, src)
+        check_bool(p + "use_sde", self.use_sde, src)
         _num(p + "policy_delay", self.policy_delay, 1, 1000, integer=True, src=src)
         _num(p + "target_policy_noise", self.target_policy_noise, 0.0, 10.0, src=src)
         _num(p + "target_noise_clip", self.target_noise_clip, 0.0, 10.0, src=src)
@@ -300,7 +284,7 @@ def parse_overrides(items: list[str] | tuple[str, ...]) -> dict[str, Any]:
 
 def read_entries(algo: str, path: str | Path | None = None) -> tuple[dict[str, Any], str]:
     """The raw YAML mapping of ``algo``'s file and the file's name."""
-    _choice("algo", algo, ALGOS, None)
+    check_choice("algo", algo, ALGOS, None)
     p = Path(path) if path is not None else HYPERPARAMS_DIR / f"{algo}.yaml"
     src = str(p)
     if not p.is_file():
@@ -314,7 +298,7 @@ def read_entries(algo: str, path: str | Path | None = None) -> tuple[dict[str, A
 def build_config(algo: str, env_id: str, entry: Mapping[str, Any], source: str = "",
                  overrides: Mapping[str, Any] | None = None) -> AgentConfig:
     """Validate one entry (a plain mapping, e.g. from YAML or a run's ``config.yaml``) with dotted overrides."""
-    _choice("algo", algo, ALGOS, None)
+    check_choice("algo", algo, ALGOS, None)
     src = source or None
     raw = copy.deepcopy(dict(entry))
     for key, value in (overrides or {}).items():

@@ -36,7 +36,9 @@ import numpy as np
 
 import lvgym  # noqa: F401  (registers the envs)
 from lvgym.simulator import flight_loads
-from lvgym.simulator.flight import C_DP, C_TIME0, DIAG, flight_conditions_batch
+from lvgym.rotations import quat_mul
+from lvgym.simulator import CONDITIONS, CONTEXT
+from lvgym.simulator.flight import flight_conditions_batch
 
 ENV_IDS = {"smile": "lvgym/SmileAscent-v0", "stratos3": "lvgym/StratosIII-v0", "slender": "lvgym/SlenderAscent-v0"}
 
@@ -61,24 +63,16 @@ def operating_point(vehicle: str = "smile", t: float = 28.8, model: str = "rigid
         opts.setdefault("control", "tvc")
     env = gym.make(env_id, **opts)
     env.reset(seed=0)
-    core = env.unwrapped.core
-    sim = core.sim
+    sim = env.unwrapped.sim                          # its rows are the env's state
     if t > 0:
         sim.step(np.zeros((1, 2)), float(t))
     return OperatingPoint(float(sim.t[0]), sim.x[0].copy(), sim.p[0].copy(), sim.c[0].copy(), sim, opts)
 
 
-def _qmul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    a0, a1, a2, a3 = a
-    b0, b1, b2, b3 = b
-    return np.array([a0 * b0 - a1 * b1 - a2 * b2 - a3 * b3, a0 * b1 + a1 * b0 + a2 * b3 - a3 * b2,
-                     a0 * b2 - a1 * b3 + a2 * b0 + a3 * b1, a0 * b3 + a1 * b2 - a2 * b1 + a3 * b0])
-
-
 def _rot(q: np.ndarray, theta: np.ndarray) -> np.ndarray:
     """``q (1, theta/2)`` normalised: q turned by the small rotation ``theta`` about its own axes."""
     dq = np.concatenate([[1.0], 0.5 * np.asarray(theta, float)])
-    out = _qmul(q, dq)
+    out = quat_mul(q, dq)
     return out / np.linalg.norm(out)
 
 
@@ -134,8 +128,8 @@ class _Coords:
         lay, K = self.layout, self.K
         x = self.state(d)
         c = self.op.c.copy()
-        c[C_DP] += gimbal
-        c[C_TIME0] = self.op.t
+        c[CONTEXT.offset("gimbal")] += gimbal                # the pitch entry
+        c[CONTEXT.index("time0")] = self.op.t
         u = np.zeros(lay.n_u)
         flight_loads(0.0, x, self.op.p.copy(), c, u)
         f = self.dyn.derivative(x, self.op.p, u)
@@ -189,15 +183,16 @@ def aero_slopes(op: OperatingPoint, dw: float = 0.1) -> tuple[float, float, floa
         d = np.zeros(9 + 4 * co.K + 4 * len(co.active))
         d[2] = s
         x = co.state(d)[None]
-        diag = np.zeros((1, max(v.stop for v in DIAG.values())))
-        flight_conditions_batch(np.array([op.t]), x, op.p[None], op.c[None], diag)
-        out.append(diag[0])
+        cond = CONDITIONS.zeros(1)
+        flight_conditions_batch(np.array([op.t]), x, op.p[None], op.c[None], cond)
+        out.append(cond[0])
     (a, b) = out
-    V = 0.5 * (a[DIAG["airspeed"]][0] + b[DIAG["airspeed"]][0])
+    get = CONDITIONS.view
+    V = 0.5 * (get(a, "airspeed")[0] + get(b, "airspeed")[0])
     dalpha = 2 * dw / V
-    n_alpha = -(a[DIAG["f_aero_b"]][2] - b[DIAG["f_aero_b"]][2]) / dalpha
-    m_alpha = (a[DIAG["m_aero_b"]][1] - b[DIAG["m_aero_b"]][1]) / dalpha
-    axial = -0.5 * (a[DIAG["f_aero_b"]][0] + b[DIAG["f_aero_b"]][0])
+    n_alpha = -(get(a, "f_aero_b")[2] - get(b, "f_aero_b")[2]) / dalpha
+    m_alpha = (get(a, "m_aero_b")[1] - get(b, "m_aero_b")[1]) / dalpha
+    axial = -0.5 * (get(a, "f_aero_b")[0] + get(b, "f_aero_b")[0])
     return n_alpha, m_alpha, V, axial
 
 

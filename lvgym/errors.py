@@ -44,3 +44,29 @@ class _Missing:
 
 #: marker for a required key that is absent
 MISSING = _Missing()
+
+
+# ---------------------------------------------------------------------------- validators
+def check_number(key: str, value: Any, lo: float, hi: float, *, integer: bool = False, lo_open: bool = False,
+                 source: str | None = None) -> Any:
+    """``value`` as a float (an int with ``integer``) when it is a number (not a bool) in ``[lo, hi]``
+    (``(lo, hi]`` with ``lo_open``); else a :class:`ConfigError` naming ``key``."""
+    ok_type = isinstance(value, int) if integer else isinstance(value, (int, float))
+    if not ok_type or isinstance(value, bool) or not ((value > lo if lo_open else value >= lo) and value <= hi):
+        kind = "an integer" if integer else "a number"
+        raise ConfigError(key, value, f"{kind} in {'(' if lo_open else '['}{lo}, {hi}]", source)
+    return int(value) if integer else float(value)
+
+
+def check_choice(key: str, value: Any, allowed: tuple[str, ...], source: str | None = None) -> str:
+    """``value`` when it is one of ``allowed``; else a :class:`ConfigError` naming ``key``."""
+    if value not in allowed:
+        raise ConfigError(key, value, f"one of {allowed}", source)
+    return str(value)
+
+
+def check_bool(key: str, value: Any, source: str | None = None) -> bool:
+    """``value`` when it is a bool; else a :class:`ConfigError` naming ``key``."""
+    if not isinstance(value, bool):
+        raise ConfigError(key, value, "true or false", source)
+    return value

@@ -51,10 +51,16 @@ class Field:
     unit: str = "-"
     doc: str = ""
     shape: tuple[int, ...] | None = None
+    #: the entries' own layout (a block written by another module's kernel); its names are reachable
+    #: from the parent layout, which then owns them too
+    sub: Packed | None = None
 
     def __post_init__(self) -> None:
         if not self.name.isidentifier() or self.name.startswith("_"):
             raise ValueError(f"field name {self.name!r}: a Python identifier not starting with '_'")
+        if self.sub is not None and self.sub.size != self.size:
+            raise ValueError(f"field {self.name!r}: size {self.size} but its layout {self.sub.title!r} has "
+                             f"{self.sub.size} entries")
         if not isinstance(self.size, (int, np.integer)) or self.size < 0:
             raise ValueError(f"field {self.name!r}: size = {self.size!r} must be an integer >= 0")
         if self.shape is not None and int(np.prod(self.shape)) != self.size:
@@ -73,8 +79,9 @@ def _fields(entries: Iterable[Field | tuple]) -> tuple[Field, ...]:
 class Packed:
     """Fields packed end to end in one vector of :attr:`size` entries (see the module docstring).
 
-    ``title`` names the vector in errors and tables; ``interface=True`` marks a layout that users
-    or saved models depend on (never padded)."""
+    ``title`` names the vector in errors and tables; ``interface=True`` marks a layout that users,
+    saved models or another module's kernel depend on (never padded). A field with a ``sub`` layout
+    makes that layout's entries reachable by their own names (``CONDITIONS.offset("density")``)."""
 
     def __init__(self, title: str, fields: Sequence[Field | tuple], *, interface: bool = False,
                  pad: bool | None = None) -> None:
@@ -82,54 +89,68 @@ class Packed:
         self.fields = _fields(fields)
         self.interface = bool(interface)
         self.padded = (PADDING if pad is None else bool(pad)) and not self.interface
-        self._field = {f.name: f for f in self.fields}
-        offsets: dict[str, int] = {}
+        entries: dict[str, tuple[int, Field]] = {}
         o = 0
         for f in self.fields:
             o += 1 if self.padded else 0
-            offsets[f.name] = o
+            entries[f.name] = (o, f)
+            if f.sub is not None:
+                for name in f.sub.names:
+                    if name in entries or name in (g.name for g in self.fields):
+                        raise ValueError(f"{title}: entry {name!r} of {f.sub.title!r} clashes with another entry")
+                    entries[name] = (o + f.sub.offset(name), f.sub.field(name))
             o += f.size
         self.size = o
-        self._offset = offsets
-        self.at = namedtuple(_tuple_name(title), [f.name for f in self.fields])(*offsets.values())
+        self._entries = entries
+        self.at = namedtuple(_tuple_name(title), list(entries))(*(e[0] for e in entries.values()))
 
     # ------------------------------------------------------------------ look-up
     def __len__(self) -> int:
         return self.size
 
     def __contains__(self, name: object) -> bool:
-        return name in self._field
+        return name in self._entries
 
     def __repr__(self) -> str:
         return f"Packed({self.title!r}, {len(self.fields)} fields, size {self.size})"
 
     @property
     def names(self) -> tuple[str, ...]:
-        return tuple(f.name for f in self.fields)
+        """Every entry's name: the fields and the entries of their ``sub`` layouts."""
+        return tuple(self._entries)
+
+    def leaves(self) -> list[tuple[int, Field]]:
+        """``(offset, field)`` of every field, a field with a ``sub`` layout replaced by its entries."""
+        out = []
+        for f in self.fields:
+            o = self._entries[f.name][0]
+            out += [(o + so, sf) for so, sf in f.sub.leaves()] if f.sub is not None else [(o, f)]
+        return out
 
     def field(self, name: str) -> Field:
         """The :class:`Field` ``name`` (a ``KeyError`` lists the names)."""
         try:
-            return self._field[name]
+            return self._entries[name][1]
         except KeyError:
-            raise KeyError(f"{self.title} has no entry {name!r}: one of {list(self._field)}") from None
+            raise KeyError(f"{self.title} has no entry {name!r}: one of {list(self._entries)}") from None
 
     def offset(self, name: str) -> int:
         """Index of the first entry of ``name``."""
         self.field(name)
-        return self._offset[name]
+        return self._entries[name][0]
 
     def slice(self, name: str) -> slice:
         """Slice of ``name``'s entries."""
         f = self.field(name)
-        return slice(self._offset[name], self._offset[name] + f.size)
+        o = self._entries[name][0]
+        return slice(o, o + f.size)
 
     def index(self, name: str) -> int:
         """Index of the single entry ``name`` (a ``ValueError`` for a multi-entry field)."""
         f = self.field(name)
         if f.size != 1:
             raise ValueError(f"{self.title}: {name!r} has {f.size} entries; use slice({name!r})")
-        return self._offset[name]
+        return self._entries[name][0]
 
     # ------------------------------------------------------------------ arrays
     def zeros(self, batch: int | None = None, dtype: Any = np.float64) -> np.ndarray:
@@ -158,10 +179,9 @@ class Packed:
     def table(self, columns: Sequence[str] = ("index", "name", "unit", "meaning"),
               names: Iterable[str] | None = None) -> str:
         """A reStructuredText simple table of the layout (or of the fields ``names``)."""
-        pick = self.fields if names is None else [self.field(n) for n in names]
+        pick = self.leaves() if names is None else [(self.offset(n), self.field(n)) for n in names]
         rows = []
-        for f in pick:
-            o = self._offset[f.name]
+        for o, f in pick:
             index = str(o) if f.size == 1 else f"{o}-{o + f.size - 1}" if f.size else "-"
             cells = {"index": index, "name": f"``{f.name}``", "size": str(f.size), "unit": f.unit,
                      "meaning": f.doc}

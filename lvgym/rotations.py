@@ -9,6 +9,7 @@ from __future__ import annotations
 import math
 
 import numba as nb
+import numpy as np
 
 
 @nb.njit(cache=True, error_model="numpy", inline="always")
@@ -36,3 +37,11 @@ def quat_to_dcm_batch(q, C):
     """:func:`quat_to_dcm` over a batch: ``q`` (B, 4) scalar-first, ``C`` (B, 3, 3) written."""
     for j in range(q.shape[0]):
         quat_to_dcm(q[j, 0], q[j, 1], q[j, 2], q[j, 3], C[j])
+
+
+def quat_mul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Hamilton product ``a (x) b`` of scalar-first quaternions (..., 4) (``q_ac = q_ab (x) q_bc``)."""
+    a0, a1, a2, a3 = np.moveaxis(np.asarray(a, dtype=float), -1, 0)
+    b0, b1, b2, b3 = np.moveaxis(np.asarray(b, dtype=float), -1, 0)
+    return np.stack([a0 * b0 - a1 * b1 - a2 * b2 - a3 * b3, a0 * b1 + a1 * b0 + a2 * b3 - a3 * b2,
+                     a0 * b2 - a1 * b3 + a2 * b0 + a3 * b1, a0 * b3 + a1 * b2 - a2 * b1 + a3 * b0], axis=-1)

@@ -39,7 +39,7 @@ import numpy as np
 
 from lvgym.errors import MISSING, ConfigError
 
-from .aerokernels import (KIND_AXISYMMETRIC, KIND_TABLES6, P_KIND, P_LREF, P_SREF, P_XREF,  # noqa: F401 (re-exported)
+from .aerokernels import (FLOW, KIND_AXISYMMETRIC, KIND_TABLES6, P_KIND, P_LREF, P_SREF, P_XREF,  # noqa: F401
                           aero_loads_at, aero_loads_batch, aero_loads_k, interp_at, interp_k)
 from .registry import register
 
@@ -47,7 +47,7 @@ from .registry import register
 COLUMNS = {KIND_AXISYMMETRIC: ("CA", "CN", "Cm", "Cmq", "Clp"),
            KIND_TABLES6: ("CA", "CY", "CN", "Cl", "Cm", "Cn", "Clp", "Cmq", "Cnr")}
 #: entries of the state vector written by the kernel (AeroState fields, same order)
-STATE_FIELDS = ("alpha", "beta", "alpha_total", "phi_aero", "mach", "qbar", "airspeed")
+STATE_FIELDS = FLOW.names
 DAMPING = ("Cmq", "Clp", "Cnr")
 
 

@@ -13,7 +13,21 @@ import math
 import numba as nb
 import numpy as np
 
+from lvgym.packing import Field, Packed
+
 from .search import search_right_k
+
+#: the flow state the aerodynamic kernels write, in this order (an interface: ``AeroState``)
+FLOW = Packed("flow state", [
+    Field("alpha", 1, "rad", "angle of attack atan2(w, u)"),
+    Field("beta", 1, "rad", "sideslip atan2(v, sqrt(u^2 + w^2))"),
+    Field("alpha_total", 1, "rad", "total angle of attack atan2(sqrt(v^2 + w^2), u)"),
+    Field("phi_aero", 1, "rad", "aerodynamic roll angle atan2(v, w)"),
+    Field("mach", 1, "-", "Mach number"),
+    Field("qbar", 1, "Pa", "dynamic pressure"),
+    Field("airspeed", 1, "m/s", "speed relative to the air"),
+], interface=True)
+_FL = FLOW.at
 
 KIND_AXISYMMETRIC, KIND_TABLES6 = 0.0, 1.0
 P_KIND, P_SREF, P_LREF, P_XREF = 0, 1, 2, 3
@@ -146,13 +160,13 @@ def aero_loads_at(u, v, w, p0, p1, p2, rho, sound, x_cg, alt, p, op, grid, og, d
     out[om + 1] -= d * out[of + 2]
     out[om + 2] += d * out[of + 1]
     if full:
-        out[os] = math.atan2(w, u)
-        out[os + 1] = math.atan2(v, math.sqrt(u * u + w * w))
-        out[os + 3] = math.atan2(v, w) if vperp > 0.0 else 0.0
-    out[os + 2] = alpha_t
-    out[os + 4] = mach
-    out[os + 5] = qbar
-    out[os + 6] = speed
+        out[os + _FL.alpha] = math.atan2(w, u)
+        out[os + _FL.beta] = math.atan2(v, math.sqrt(u * u + w * w))
+        out[os + _FL.phi_aero] = math.atan2(v, w) if vperp > 0.0 else 0.0
+    out[os + _FL.alpha_total] = alpha_t
+    out[os + _FL.mach] = mach
+    out[os + _FL.qbar] = qbar
+    out[os + _FL.airspeed] = speed
 
 
 @nb.njit(cache=True)

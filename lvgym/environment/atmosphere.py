@@ -44,6 +44,7 @@ import numba as nb
 import numpy as np
 
 from lvgym.errors import ConfigError
+from lvgym.packing import Field, Packed
 
 from .registry import register
 from .search import search_right_k
@@ -60,6 +61,11 @@ CODE_US76, CODE_EXPONENTIAL, CODE_TABLE = 0, 1, 2
 
 # US76 defining constants (NOAA-S/T 76-1562, Part 1, Tables 2 and 4)
 G0 = 9.80665                     # m/s^2, and m^2/(s^2 m') for geopotential metres
+#: what every atmosphere kernel writes, in this order (an interface: callers read (B, 4) arrays)
+AIR = Packed("air state", [Field("density", 1, "kg/m^3", "air density"), Field("pressure", 1, "Pa", "ambient pressure"),
+                           Field("temperature", 1, "K", "air temperature"),
+                           Field("speed_of_sound", 1, "m/s", "speed of sound")], interface=True)
+_AIR = AIR.at
 R_STAR = 8314.32                 # N m/(kmol K), gas constant of US76
 M0 = 28.9644                     # kg/kmol, sea-level mean molar mass
 R_AIR = R_STAR / M0              # 287.05287 J/(kg K)
@@ -106,10 +112,10 @@ def us76_lower_at(alt_m, out, oo):
         p = US76_PB[b] * math.exp(-G0 * M0 * dh / (R_STAR * tb))
     else:
         p = US76_PB[b] * (tb / t) ** (G0 * M0 / (R_STAR * lapse))
-    out[oo] = p * M0 / (R_STAR * t)
-    out[oo + 1] = p
-    out[oo + 2] = t
-    out[oo + 3] = math.sqrt(GAMMA * R_STAR * t / M0)
+    out[oo + _AIR.density] = p * M0 / (R_STAR * t)
+    out[oo + _AIR.pressure] = p
+    out[oo + _AIR.temperature] = t
+    out[oo + _AIR.speed_of_sound] = math.sqrt(GAMMA * R_STAR * t / M0)
 
 
 @nb.njit(cache=True)
@@ -128,10 +134,10 @@ def us76_lower(alt_m, out):
 def exponential_state_at(p, o, alt_m, out, oo):
     """:func:`exponential_state` with the parameters at ``p[o:]``, into ``out[oo:oo + 4]``."""
     rho = p[o + 1] * math.exp(-alt_m / p[o + 2])
-    out[oo] = rho
-    out[oo + 1] = rho * R_AIR * p[o + 3]
-    out[oo + 2] = p[o + 3]
-    out[oo + 3] = math.sqrt(GAMMA * R_AIR * p[o + 3])
+    out[oo + _AIR.density] = rho
+    out[oo + _AIR.pressure] = rho * R_AIR * p[o + 3]
+    out[oo + _AIR.temperature] = p[o + 3]
+    out[oo + _AIR.speed_of_sound] = math.sqrt(GAMMA * R_AIR * p[o + 3])
 
 
 @nb.njit(cache=True)
@@ -173,10 +179,10 @@ def table_state_at(p, o, alt_m, out, oo):
         t = h00 * p[y] + h10 * p[y + n] + h01 * p[y + 1] + h11 * p[y + n + 1]
     rho = math.exp(lnrho)
     pres = math.exp(lnp)
-    out[oo] = rho
-    out[oo + 1] = pres
-    out[oo + 2] = t
-    out[oo + 3] = math.sqrt(GAMMA * pres / rho)
+    out[oo + _AIR.density] = rho
+    out[oo + _AIR.pressure] = pres
+    out[oo + _AIR.temperature] = t
+    out[oo + _AIR.speed_of_sound] = math.sqrt(GAMMA * pres / rho)
 
 
 @nb.njit(cache=True)

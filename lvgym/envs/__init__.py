@@ -4,9 +4,11 @@
 - ``lvgym/StratosIII-v0`` (:class:`~.ascent.StratosIIIEnv`): Stratos III through its thrust drop, roll RCS;
 - ``lvgym/SlenderAscent-v0`` (:class:`~.ascent.SlenderAscentEnv`): the parametric L/D vehicle.
 
-Each has a native batched ``VectorEnv`` as its ``vector_entry_point``
+Each is a thin adapter over the functional env :class:`~.functional.AscentFuncEnv` (explicit state and
+parameters, batched over rows); each has a native batched ``VectorEnv`` as its ``vector_entry_point``
 (``gymnasium.make_vec(id, num_envs=N, vectorization_mode="vector_entry_point", **options)``) and an SB3
-``VecEnv`` adapter, :func:`make_sb3_vec_env`, over the same batched code.
+``VecEnv`` adapter, :func:`make_sb3_vec_env`, over the same batched code. ``env.unwrapped.get_state()``
+and ``set_state(state)`` capture and restore an episode (:mod:`.snapshot`).
 """
 
 from __future__ import annotations
@@ -14,9 +16,11 @@ from __future__ import annotations
 from typing import Any
 
 from .ascent import AscentEnv, SlenderAscentEnv, SmileAscentEnv, StratosIIIEnv
-from .core import OBS_NAMES, REWARD_TERMS, AscentBatch
+from .functional import AscentFuncEnv, AscentParams, AscentState
+from .layouts import OBS_SENSORS, OBS_STATE, OBSERVATIONS, REWARD_TERMS, TASK
+from .snapshot import EpisodeState
 from .spec import RANDOMIZE, WIND_TIERS, TaskSpec
-from .vector import AscentSB3VecEnv, AscentVectorEnv
+from .vector import AscentVectorEnv
 
 ENVS = {"lvgym/SmileAscent-v0": SmileAscentEnv, "lvgym/StratosIII-v0": StratosIIIEnv,
         "lvgym/SlenderAscent-v0": SlenderAscentEnv}
@@ -38,12 +42,22 @@ def slender_ascent_vector(num_envs: int = 1, **options: Any) -> AscentVectorEnv:
 
 
 def make_sb3_vec_env(env_id: str, num_envs: int = 1, seed: int | None = None, **options: Any):
-    """A stable-baselines3 ``VecEnv`` of ``num_envs`` rows of ``env_id`` (batched, one simulator)."""
+    """A stable-baselines3 ``VecEnv`` of ``num_envs`` rows of ``env_id`` (batched, one simulator;
+    :class:`~.sb3.AscentSB3VecEnv`, imported here so that ``import lvgym`` does not import SB3)."""
     if env_id not in ENVS:
         raise ValueError(f"env_id = {env_id!r}: one of {sorted(ENVS)}")
+    from .sb3 import AscentSB3VecEnv
     return AscentSB3VecEnv(ENVS[env_id], num_envs, seed, **options)
 
 
-__all__ = ["ENVS", "OBS_NAMES", "RANDOMIZE", "REWARD_TERMS", "WIND_TIERS", "AscentBatch", "AscentEnv",
-           "AscentSB3VecEnv", "AscentVectorEnv", "SlenderAscentEnv", "SmileAscentEnv", "StratosIIIEnv", "TaskSpec",
-           "make_sb3_vec_env", "slender_ascent_vector", "smile_ascent_vector", "stratos3_vector"]
+def __getattr__(name: str) -> Any:
+    if name == "AscentSB3VecEnv":                    # lazily: importing it imports stable-baselines3
+        from .sb3 import AscentSB3VecEnv
+        return AscentSB3VecEnv
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+__all__ = ["ENVS", "OBSERVATIONS", "OBS_SENSORS", "OBS_STATE", "RANDOMIZE", "REWARD_TERMS", "TASK", "WIND_TIERS",
+           "AscentEnv", "AscentFuncEnv", "AscentParams", "AscentSB3VecEnv", "AscentState", "AscentVectorEnv",
+           "EpisodeState", "SlenderAscentEnv", "SmileAscentEnv", "StratosIIIEnv", "TaskSpec", "make_sb3_vec_env",
+           "slender_ascent_vector", "smile_ascent_vector", "stratos3_vector"]

@@ -1,31 +1,26 @@
 """Gymnasium environments of thrust-vector (and roll) control in ascent.
 
-Physics lives in the simulator; :class:`~.core.AscentBatch` shapes the task; these classes only adapt
-one row of it to ``gymnasium.Env``. Options are keywords (see :class:`~.spec.TaskSpec`), e.g.
+Physics lives in the simulator; :class:`~.functional.AscentFuncEnv` is the task as pure functions of an
+explicit state; these classes only adapt one row of it to ``gymnasium.Env`` (the state is
+``env.unwrapped.state``; :meth:`AscentEnv.get_state` and :meth:`AscentEnv.set_state` capture and restore
+it whole, see :mod:`.snapshot`). Options are keywords (see :class:`~.spec.TaskSpec`), e.g.
 ``gymnasium.make("lvgym/SmileAscent-v0", model="rigid", wind="turbulence", randomize=True)``.
 
-Observation (``Box(-inf, inf, (14,), float32)``), for ``observation="state"`` (ideal) and ``"sensors"``:
+Observation (``Box(-inf, inf, (14,), float32)``), for ``observation="state"`` (the ideal state, a research
+option) and ``"sensors"`` (what a flight computer has: a gyro at the IMU station that sees the bending slope
+rate, with bias and noise when ``sensor_noise`` is randomised, a noisy attitude, accelerometers); the table is
+:data:`lvgym.envs.layouts.OBSERVATIONS` (``env.unwrapped.observation_layout`` names the entries)::
 
-===  ==========================  ===========================================================================
-0    roll rate [rad/s]           true body rate; ``sensors``: gyro at the IMU station (sees the bending
-                                 slope rate), with bias and noise when ``sensor_noise`` is randomised
-1    pitch rate error [rad/s]    rate minus the reference rate
-2    yaw rate error [rad/s]
-3-4  pitch, yaw attitude error   body axis against the reference axis [rad] (``sensors``: with noise)
-5-6  alpha, beta [rad]           ``sensors``: lateral specific force z, y over g0 (accelerometers)
-7    Mach / 10
-8    dynamic pressure / 1e5 Pa
-9-10 gimbal pitch, yaw           actuator position over the gimbal limit
-11   time / mission time
-12   controller on (0 or 1)      off before ``controller_on_after_s`` and during staging coasts
-13   reference pitch rate [rad/s]
-===  ==========================  ===========================================================================
+%(observation)s
 
 Reward: ``-sum_axis w_axis |rate - reference| dt`` (terms ``rate_roll``, ``rate_pitch``, ``rate_yaw``; so the
 episode's sum is minus the weighted cumulative rate error in rad) ``- effort_weight * int |gimbal| dt``
 (``effort``) ``- effort_rate_weight * int |gimbal rate| dt`` (``effort_rate``) and, on termination,
 ``- failure_penalty_rad_per_s * remaining time`` (``failure``). ``info["reward_terms"]`` holds each term;
-they add up to the reward.
+they add up to the reward. ``info["rate_error"]`` holds the step's ``|rate - reference|`` [rad/s] (roll,
+pitch, yaw), ``info["cumulative_rate_error"]`` its integral [rad], ``info["mass"]`` the stack's mass [kg].
+
+Actions: a ``Box`` action outside [-1, 1] is clipped (Gymnasium's convention).
 
 Termination: a non-finite state (``info["termination"] == "non-finite state"``, never an exception),
 dynamic pressure times total angle of attack above ``qalpha_limit_pa_deg``, attitude error above
@@ -36,14 +31,18 @@ Version history: v0 (2026-11): first release.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import Any
 
 import gymnasium as gym
 import numpy as np
-from gymnasium import spaces
 
-from .core import OBS_NAMES, AscentBatch
+from .functional import AscentFuncEnv, AscentState
+from .layouts import observation_table
+from .snapshot import EpisodeState, rng_state, set_rng_state
 from .spec import TaskSpec
+
+__doc__ = __doc__ % {"observation": "\n".join("    " + line for line in observation_table().splitlines())}
 
 #: Mach number at which SlenderAscent-v0 freezes the vehicle's aerodynamic tables by default [-]
 DEFAULT_AERO_MACH = 2.0
@@ -81,45 +80,109 @@ def _rows(info: dict[str, Any], batch: int) -> list[dict[str, Any]]:
     return [dict(zip(keys, vals)) for vals in zip(*columns.values())] if keys else [{} for _ in range(batch)]
 
 
-def make_spaces(task: TaskSpec) -> tuple[spaces.Space, spaces.Box]:
-    """Action and observation spaces of one env of ``task``."""
-    if task.control == "tvc":
-        action = spaces.Box(-1.0, 1.0, (2,), np.float32)
-    else:
-        action = spaces.MultiDiscrete([3])
-    return action, spaces.Box(-np.inf, np.inf, (len(OBS_NAMES),), np.float32)
-
-
 class AscentEnv(gym.Env):
-    """Base of the ascent envs: one row of an :class:`AscentBatch`. Subclasses set ``DEFAULTS``."""
+    """Base of the ascent envs: one row of an :class:`~.functional.AscentFuncEnv`. Subclasses set
+    ``DEFAULTS``. ``vehicles``: several vehicles (keys of :func:`~.functional.cached_vehicle`) of which
+    each reset draws one from the env's generator (the episode's *variant*, part of its state)."""
 
     metadata = {"render_modes": ["human", "rgb_array"], "render_fps": 25}
     DEFAULTS: dict[str, Any] = {}
 
-    def __init__(self, render_mode: str | None = None, **options: Any) -> None:
+    def __init__(self, render_mode: str | None = None, *, vehicles: Sequence[Any] | None = None,
+                 **options: Any) -> None:
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(f"render_mode = {render_mode!r}: one of {self.metadata['render_modes']} or None")
         self.render_mode = render_mode
-        self.task = TaskSpec.build(self.DEFAULTS, options)
-        self.core = AscentBatch(self.task, 1)
-        self.action_space, self.observation_space = make_spaces(self.task)
+        if vehicles is None:
+            self.specs = (TaskSpec.build(self.DEFAULTS, options),)
+        else:
+            self.specs = tuple(TaskSpec.build(self.DEFAULTS, {**options, "vehicle": v}) for v in vehicles)
+        self._funcs: dict[int, AscentFuncEnv] = {}
+        self._select(0)
+        self.action_space, self.observation_space = self.func.action_space, self.func.observation_space
+        self.state: AscentState | None = None
         self._renderer: Any = None
         self._rates: list[tuple[float, float, float]] = []
 
+    def _select(self, variant: int) -> None:
+        """Fly variant ``variant`` (its functional env is built on first use and kept)."""
+        if variant not in self._funcs:
+            self._funcs[variant] = AscentFuncEnv(self.specs[variant])
+        self.variant, self.func = variant, self._funcs[variant]
+        self.task = self.func.spec
+
+    def _bind(self) -> None:
+        """Point the simulator's read-outs (``env.unwrapped.sim.x``, ``.conditions(...)``) at the state."""
+        self.func.sim.data = self.state.sim
+
+    # ------------------------------------------------------------------------------ facts of the task
+    @property
+    def sim(self):
+        """The :class:`~lvgym.simulator.Simulator` of the current variant (its ``data`` is this env's rows)."""
+        return self.func.sim
+
+    @property
+    def timeline(self):
+        return self.func.timeline
+
+    @property
+    def vehicle(self):
+        return self.func.vehicle
+
+    @property
+    def observation_layout(self):
+        """The :class:`~lvgym.packing.Packed` layout of the observation (names, indices, units)."""
+        return self.func.observation_layout
+
+    @property
+    def gimbal_limit(self) -> float:
+        """Gimbal limit [rad]: a TVC action of 1 commands this angle."""
+        return self.func.gimbal_limit
+
+    # ------------------------------------------------------------------------------ Gymnasium
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
         super().reset(seed=seed)
-        obs = self.core.reset_rows(np.array([0]), [self.np_random])[0]
+        if len(self.specs) > 1:
+            self._select(int(self.np_random.integers(len(self.specs))))
+        self.state = self.func.initial([self.np_random])
+        self._bind()
         self._rates = []
-        return obs, {"time": 0.0, "cumulative_rate_error": np.zeros(3)}
+        info = _row(self.func.state_info(self.state), 0)
+        return self.state.task.obs[0].copy(), info
 
     def step(self, action):
-        obs, reward, terminated, truncated, info = self.core.step(np.asarray(action)[None])
-        row = _row(info, 0)
-        w = self.core.sim.state("omega_bi_b")[0]
+        if self.state is None:
+            raise RuntimeError("call reset() before step()")
+        func = self.func
+        self.state = func.transition(self.state, np.asarray(action)[None], [self.np_random], inplace=True)
+        ts = self.state.task
+        row = _row(func.transition_info(None, action, self.state), 0)
+        w = self.state.sim.x[0, self.sim.layout.state["omega_bi_b"]]
         self._rates.append((row["time"], float(w[1]), float(w[2])))
         if self.render_mode == "human":
             self.render()
-        return obs[0], float(reward[0]), bool(terminated[0]), bool(truncated[0]), row
+        return ts.obs[0].copy(), float(ts.reward[0]), bool(ts.reason[0] != 0), bool(ts.truncated[0]), row
+
+    # ------------------------------------------------------------------------------ state as data
+    def get_state(self) -> EpisodeState:
+        """The episode's whole state (a copy; see :mod:`.snapshot`)."""
+        if self.state is None:
+            raise RuntimeError("call reset() before get_state()")
+        return EpisodeState(self.task, self.func.take(self.state), [rng_state(self.np_random)],
+                            {"variant": [self.variant], "rates": [list(self._rates)]})
+
+    def set_state(self, state: EpisodeState) -> None:
+        """Continue from ``state`` (from :meth:`get_state` of an env with the same options, or one row of
+        a vector env's); the snapshot itself is not changed and can be restored again."""
+        variant = int(state.extra.get("variant", [0])[0])
+        if not 0 <= variant < len(self.specs):
+            raise ValueError(f"the state flies vehicle variant {variant}; this env has {len(self.specs)}")
+        state.check(self.specs[variant], 1)
+        self._select(variant)
+        self.state = self.func.take(state.state)
+        set_rng_state(self.np_random, state.rng[0])
+        self._rates = list(state.extra.get("rates", [[]])[0])
+        self._bind()
 
     def render(self):
         if self.render_mode is None:
@@ -191,21 +254,10 @@ class SlenderAscentEnv(AscentEnv):
         self.diameters = tuple(np.linspace(d[0], d[-1], 4 if d.size == 2 else 1).tolist())
         self.length = float(length)
         self.aero_mach = None if aero_mach is None else float(aero_mach)
-        self._cores: dict[float, AscentBatch] = {}
-        super().__init__(render_mode, vehicle=self._key(self.diameters[0]), **options)
-        self._cores[self.diameters[0]] = self.core
+        super().__init__(render_mode, vehicles=[slender_key(self.length, dia, self.aero_mach) for dia in self.diameters],
+                         **options)
 
-    def _key(self, diameter: float) -> tuple:
-        """The vehicle key of :func:`~.core.cached_vehicle` for one diameter [m]."""
-        return ("slender", self.length, diameter, self.aero_mach)
 
-    def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
-        gym.Env.reset(self, seed=seed)
-        if len(self.diameters) > 1:
-            dia = self.diameters[int(self.np_random.integers(len(self.diameters)))]
-            if dia not in self._cores:
-                task = TaskSpec.build(self.DEFAULTS, {**{k: getattr(self.task, k) for k in TaskSpec.__dataclass_fields__},
-                                                      "vehicle": self._key(dia)})
-                self._cores[dia] = AscentBatch(task, 1)
-            self.core = self._cores[dia]
-        return super().reset(seed=None, options=options)
+def slender_key(length: float, diameter: float, aero_mach: float | None) -> tuple:
+    """The vehicle key of :func:`~.functional.cached_vehicle` of one slender vehicle [m, m, -]."""
+    return ("slender", float(length), float(diameter), aero_mach)

@@ -13,10 +13,9 @@ from .render import HumanViewer, Renderer, RenderFrame
 
 def make_frame(env: Any) -> RenderFrame:
     """A render frame of the single ascent env ``env`` (its row 0)."""
-    core = env.core
-    sim, tl = core.sim, core.timeline
+    sim, tl = env.sim, env.timeline
     t = float(sim.t[0])
-    length = float(core.vehicle.length)
+    length = float(env.vehicle.length)
     stations = tl.sensor_stations[1:]                       # station 0 is the IMU
     deflection = np.zeros_like(stations)
     if sim.dynamics.n_modes:
@@ -38,11 +37,11 @@ def make_frame(env: Any) -> RenderFrame:
         hinges = lengths = masses = angles = np.zeros(0)
     rates = np.array(env._rates[-250:]) if env._rates else np.zeros((0, 3))
     wind = sim.conditions("wind_n")[0]
-    return RenderFrame(t=t, length=length, diameter=float(core.vehicle.stages[0].outer_diameter),
+    return RenderFrame(t=t, length=length, diameter=float(env.vehicle.stages[0].outer_diameter),
                        pitch_deg=float(pitch), stations=stations, deflection=deflection, slosh_stations=hinges,
                        slosh_lengths=lengths, slosh_angles_deg=angles, slosh_masses=masses,
                        gimbal_station=float(sim.p[0, sim.layout.params["r_gimbal"].start]),
-                       gimbal_deg=float(np.degrees(core.sim.gimbal[0, 0])),
+                       gimbal_deg=float(np.degrees(sim.gimbal[0, 0])),
                        wind_mps=(float(np.hypot(wind[0], wind[1])), float(-wind[2])),
                        rates_t=rates[:, 0] if rates.size else np.zeros(0),
                        rates_degps=np.degrees(rates[:, 1:]) if rates.size else np.zeros((0, 2)),

@@ -1,59 +1,66 @@
 """Compiled task signals of the ascent envs: reference, errors, reward terms, termination, observation.
 
-One call per control step evaluates, for every row of a batch, what :class:`~.core.AscentBatch` needs
-after the simulator has advanced: the reference rates (zero, or the gravity-turn pitch program), the
-reference axis turned by them, the rate errors and their integral, the reward terms, the q-alpha and
-attitude checks, and the noise-free observation. Sensor noise is added afterwards from each row's own
-generator. The formulas are those documented on :class:`~.core.AscentBatch`; this module only runs
-them without Python overhead (a single env pays one call instead of a hundred numpy calls).
+One call per control step evaluates, for every row of a batch, what the task needs after the simulator
+has advanced: the reference rates (zero, or the gravity-turn pitch program), the reference axis turned
+by them, the rate errors and their integral, the reward terms, the q-alpha and attitude checks, and the
+noise-free observation. Sensor noise is added afterwards from each row's own generator
+(:mod:`.functional`). The functions take a few named blocks: the task parameters ``task`` (layout
+:data:`.layouts.TASK`), the simulator's :data:`~lvgym.simulator.advance.StepSetup`, its rows
+(:class:`~lvgym.simulator.SimData`), the task's rows (:data:`TaskData`) and the timeline's
+:class:`~lvgym.simulator.Tables`; every offset comes from a layout.
 """
 
 from __future__ import annotations
 
 import math
+from collections import namedtuple
 
 import numba as nb
 import numpy as np
 
-from lvgym.dynamics.kernels import X_ETA, X_Q, X_V, X_W
+from lvgym.dynamics.layout import STATE, X
+from lvgym.packing import at
 from lvgym.rotations import quat_to_dcm
-from lvgym.simulator.advance import locate_k
-from lvgym.simulator.flight import DIAG
+from lvgym.simulator.layouts import A, D
+from lvgym.simulator.timeline import locate_k
 
-# task parameter vector
-(T_ON_AFTER, T_DT, T_MISSION, T_W_ROLL, T_W_PITCH, T_W_YAW, T_EFFORT, T_EFFORT_RATE, T_PENALTY, T_QALPHA, T_ATT,
- T_GIMBAL, T_GTURN, T_KICK0, T_KICK1, T_KICK_ANGLE, T_SENSORS, T_N_STEPS) = range(18)
-N_TASK = 18
-#: termination codes (the order is the precedence: a later one overrides an earlier one)
-REASONS = ("", "attitude error beyond the limit", "q-alpha beyond the structural limit", "non-finite state")
-G0 = 9.80665
+from .layouts import G0, RW, OS, O, T
 
-_ALPHA, _BETA, _AT = DIAG["alpha"].start, DIAG["beta"].start, DIAG["alpha_total"].start
-_MACH, _QBAR, _G = DIAG["mach"].start, DIAG["qbar"].start, DIAG["g_i"].start
-_FA, _TE = DIAG["f_aero_b"].start, DIAG["thrust_e"].start
+#: the task's rows (B leading): ``steps`` (B,) int64 control steps flown; ``on`` (B,) bool the controller
+#: acts at the next step; ``on_step`` (B,) bool it acted during the last step; ``axis_ref_i`` (B, 3) the
+#: reference axis, inertial; ``cum_error`` (B, 3) [rad] integrated |rate errors| (roll, pitch, yaw);
+#: ``rate_error`` (B, 3) [rad/s] |rate - reference| after the last step; ``gyro_bias`` (B, 3) [rad/s];
+#: ``obs`` (B, n_obs) float32 the observation (with its noise: what the flight computer sampled); ``att``
+#: (B, 2) [rad] attitude error; ``terms`` (B, n_terms) the last step's reward terms (layout REWARD);
+#: ``reward`` (B,); ``reason`` (B,) int64 termination code (index of REASONS); ``truncated`` (B,) bool;
+#: ``qalpha`` (B,) [Pa deg]; ``mass`` (B,) [kg] the whole stack's mass at the row's time
+TaskData = namedtuple("TaskData", ["steps", "on", "on_step", "axis_ref_i", "cum_error", "rate_error", "gyro_bias",
+                                   "obs", "att", "terms", "reward", "reason", "truncated", "qalpha", "mass"])
+XF = STATE.fixed
 
 
 @nb.njit(cache=True, nogil=True)
-def controller_on_k(tp, tl_t, tl_burning, t):
-    """Whether the controller acts at time ``t``: after ``T_ON_AFTER`` and while an engine burns."""
+def controller_on_k(task, tl_t, tl_burning, t):
+    """Whether the controller acts at time ``t``: after ``on_after`` and while an engine burns."""
     i, w = locate_k(tl_t, t)
-    return t >= tp[T_ON_AFTER] - 1e-9 and tl_burning[i + 1 if w >= 1.0 else i] != 0.0
+    return t >= task[T.on_after] - 1e-9 and tl_burning[i + 1 if w >= 1.0 else i] != 0.0
 
 
 @nb.njit(cache=True, nogil=True)
-def reference_pitch_rate_k(tp, t, x, d):
-    """Reference pitch rate [rad/s]: zero, or the gravity-turn programme (a kick of ``T_KICK_ANGLE``
-    between ``T_KICK0`` and ``T_KICK1``, then ``-g sin(theta) / V`` with theta the velocity's angle
+def reference_pitch_rate_k(task, t, x, cond):
+    """Reference pitch rate [rad/s]: zero, or the gravity-turn programme (a kick of ``kick_angle``
+    between ``kick_start`` and ``kick_end``, then ``-g sin(theta) / V`` with theta the velocity's angle
     from the local vertical; negative turns the nose downrange)."""
-    if tp[T_GTURN] == 0.0:
+    if task[T.gravity_turn] == 0.0:
         return 0.0
-    if tp[T_KICK0] <= t < tp[T_KICK1]:
-        return -tp[T_KICK_ANGLE] / (tp[T_KICK1] - tp[T_KICK0])
-    if t < tp[T_KICK1]:
+    if task[T.kick_start] <= t < task[T.kick_end]:
+        return -task[T.kick_angle] / (task[T.kick_end] - task[T.kick_start])
+    if t < task[T.kick_end]:
         return 0.0
-    gx, gy, gz = d[_G], d[_G + 1], d[_G + 2]
+    gx, gy, gz = cond[D.g_i], cond[D.g_i + 1], cond[D.g_i + 2]
     gn = math.sqrt(gx * gx + gy * gy + gz * gz)
-    vx, vy, vz = x[X_V], x[X_V + 1], x[X_V + 2]
+    ov = XF.v_zw_i
+    vx, vy, vz = x[ov], x[ov + 1], x[ov + 2]
     speed = max(math.sqrt(vx * vx + vy * vy + vz * vz), 1.0)
     cos_th = min(max(-(vx * gx + vy * gy + vz * gz) / (gn * speed), -1.0), 1.0)
     return -gn * math.sqrt(1.0 - cos_th * cos_th) / speed
@@ -70,72 +77,86 @@ def attitude_error_k(C, a, out):
 
 
 @nb.njit(cache=True, nogil=True)
-def observe_k(tp, t, x, d, C, a, gimbal, on, ref_pitch, bias, dphi, mass, n_modes, obs, att):
-    """Noise-free observation (14) of one row into ``obs`` and its attitude error into ``att``.
-    ``dphi`` (K,): mode slopes at the IMU (sensors only); ``mass`` [kg] of the whole stack."""
+def observe_k(task, t, x, cond, act, C, a, on, ref_pitch, bias, dphi, mass, n_slosh, n_modes, obs, att):
+    """Noise-free observation of one row into ``obs`` (layout OBS_STATE or OBS_SENSORS) and its
+    attitude error into ``att``. ``dphi`` (K,): mode slopes at the IMU (sensors only); ``mass`` [kg] of
+    the whole stack."""
     attitude_error_k(C, a, att)
-    w0, w1, w2 = x[X_W], x[X_W + 1], x[X_W + 2]
-    if tp[T_SENSORS] != 0.0:
+    ow = XF.omega_bi_b
+    w0, w1, w2 = x[ow], x[ow + 1], x[ow + 2]
+    if task[T.sensors] != 0.0:
         K = n_modes
+        o_etad = at(X.eta_dot, n_modes, n_slosh)          # y-plane modes, then the K z-plane ones
         for k in range(K):                   # the gyro sees the slope rate of the deflected section
-            w1 -= dphi[k] * x[X_ETA + 2 * K + K + k]
-            w2 += dphi[k] * x[X_ETA + 2 * K + k]
+            w1 -= dphi[k] * x[o_etad + K + k]
+            w2 += dphi[k] * x[o_etad + k]
         w0 += bias[0]
         w1 += bias[1]
         w2 += bias[2]
-        obs[5] = (d[_FA + 2] + d[_TE + 2]) / mass / G0
-        obs[6] = (d[_FA + 1] + d[_TE + 1]) / mass / G0
+        obs[OS.accel_z] = (cond[D.f_aero_b + 2] + cond[D.thrust_b + 2]) / mass / G0
+        obs[OS.accel_y] = (cond[D.f_aero_b + 1] + cond[D.thrust_b + 1]) / mass / G0
     else:
-        obs[5] = d[_ALPHA]
-        obs[6] = d[_BETA]
-    obs[0] = w0
-    obs[1] = w1 - ref_pitch
-    obs[2] = w2
-    obs[3] = att[0]
-    obs[4] = att[1]
-    obs[7] = d[_MACH] / 10.0
-    obs[8] = d[_QBAR] / 1e5
-    obs[9] = gimbal[0] / tp[T_GIMBAL]
-    obs[10] = gimbal[1] / tp[T_GIMBAL]
-    obs[11] = t / tp[T_MISSION]
-    obs[12] = 1.0 if on else 0.0
-    obs[13] = ref_pitch
+        obs[O.alpha] = cond[D.alpha]
+        obs[O.beta] = cond[D.beta]
+    obs[O.roll_rate] = w0
+    obs[O.pitch_rate_error] = w1 - ref_pitch
+    obs[O.yaw_rate_error] = w2
+    obs[O.pitch_attitude_error] = att[0]
+    obs[O.yaw_attitude_error] = att[1]
+    obs[O.mach_over_10] = cond[D.mach] / 10.0
+    obs[O.qbar_over_1e5] = cond[D.qbar] / 1e5
+    obs[O.gimbal_pitch] = act[A.gimbal] / task[T.gimbal_limit]
+    obs[O.gimbal_yaw] = act[A.gimbal + 1] / task[T.gimbal_limit]
+    obs[O.time_fraction] = t / task[T.mission]
+    obs[O.controller_on] = 1.0 if on else 0.0
+    obs[O.pitch_rate_reference] = ref_pitch
+
+
+@nb.njit(cache=True, nogil=True, inline="always")
+def _imu_and_mass_k(tables, t):
+    """Row of the timeline in force at ``t`` (for the mode slopes at the IMU) and the stack's mass [kg]."""
+    i, w = locate_k(tables.t, t)
+    j = i + 1 if w >= 1.0 else i
+    return j, (1.0 - w) * tables.mass[i] + w * tables.mass[i + 1]
 
 
 @nb.njit(cache=True, nogil=True)
-def reset_signals(rows, tp, t, x, diag, gimbal, axis_ref, bias, tl_t, tl_burning, tl_mass, tl_dphi, n_modes, on,
-                  obs, att):
-    """Reference axis (the launch axis), controller flag and observation of freshly reset ``rows``."""
+def reset_signals(rows, task, setup, sim, ts, tables):
+    """Reference axis (the launch axis), controller flag, mass and observation of freshly reset
+    ``rows`` of the task rows ``ts`` (a :data:`TaskData`) over the simulator rows ``sim``."""
     C = np.empty((3, 3))
+    oq = XF.q_bi
     for b in rows:
-        xb = x[b]
-        quat_to_dcm(xb[X_Q], xb[X_Q + 1], xb[X_Q + 2], xb[X_Q + 3], C)
+        xb = sim.x[b]
+        t = sim.t[b]
+        quat_to_dcm(xb[oq], xb[oq + 1], xb[oq + 2], xb[oq + 3], C)
         for i in range(3):
-            axis_ref[b, i] = C[i, 0]
-        on[b] = controller_on_k(tp, tl_t, tl_burning, t[b])
-        i, w = locate_k(tl_t, t[b])
-        j = i + 1 if w >= 1.0 else i
-        observe_k(tp, t[b], xb, diag[b], C, axis_ref[b], gimbal[b], on[b],
-                  reference_pitch_rate_k(tp, t[b], xb, diag[b]), bias[b], tl_dphi[j, 0],
-                  (1.0 - w) * tl_mass[i] + w * tl_mass[i + 1], n_modes, obs[b], att[b])
+            ts.axis_ref_i[b, i] = C[i, 0]
+        ts.on[b] = controller_on_k(task, tables.t, tables.burning, t)
+        ts.on_step[b] = ts.on[b]
+        j, mass = _imu_and_mass_k(tables, t)
+        ts.mass[b] = mass
+        observe_k(task, t, xb, sim.conditions[b], sim.actuator[b], C, ts.axis_ref_i[b], ts.on[b],
+                  reference_pitch_rate_k(task, t, xb, sim.conditions[b]), ts.gyro_bias[b], tables.dphi_sensor[j, 0],
+                  mass, setup.n_slosh, setup.n_modes, ts.obs[b], ts.att[b])
 
 
 @nb.njit(cache=True, nogil=True)
-def step_signals_range(lo, hi, tp, t, x, diag, failed, effort, gimbal, steps, axis_ref, cum_error, bias, tl_t,
-                       tl_burning, tl_mass, tl_dphi, n_modes, on, obs, att, terms, reward, reason, truncated, qalpha):
-    """Signals of rows ``lo:hi`` after a control step (``steps`` already counts it).
+def step_signals_range(lo, hi, task, setup, sim, ts, tables):
+    """Signals of rows ``lo:hi`` after a control step (``ts.steps`` already counts it).
 
-    Updates ``axis_ref`` (B, 3) (turned by the reference pitch rate about the body pitch axis),
-    ``cum_error`` (B, 3) [rad] and ``on`` (B,) (the controller flag for the next step); writes the
-    observation ``obs`` (B, 14) without noise, attitude error ``att`` (B, 2) [rad], reward ``terms``
-    (B, 6) in the order of :data:`~.core.REWARD_TERMS` and their sum ``reward``, the termination code
-    ``reason`` (index into :data:`REASONS`), ``truncated`` and q-alpha [Pa deg]."""
-    dt = tp[T_DT]
+    Turns ``axis_ref_i`` by the reference pitch rate about the body pitch axis; writes the rate errors
+    and adds them to ``cum_error`` [rad]; keeps the controller flag of the step flown in ``on_step`` and
+    sets ``on`` for the next one; writes the observation without noise, the attitude error, the reward
+    terms (layout REWARD) and their sum, the termination code, ``truncated``, q-alpha [Pa deg] and the
+    mass."""
+    dt = task[T.dt]
     C = np.empty((3, 3))
+    oq, ow = XF.q_bi, XF.omega_bi_b
     for b in range(lo, hi):
-        xb, db, a = x[b], diag[b], axis_ref[b]
-        quat_to_dcm(xb[X_Q], xb[X_Q + 1], xb[X_Q + 2], xb[X_Q + 3], C)
-        ref_pitch = reference_pitch_rate_k(tp, t[b], xb, db)
+        xb, cond, a, t = sim.x[b], sim.conditions[b], ts.axis_ref_i[b], sim.t[b]
+        quat_to_dcm(xb[oq], xb[oq + 1], xb[oq + 2], xb[oq + 3], C)
+        ref_pitch = reference_pitch_rate_k(task, t, xb, cond)
         if ref_pitch != 0.0:                  # Rodrigues: turn a about the body pitch axis k
             ang = ref_pitch * dt
             k0, k1, k2 = C[0, 1], C[1, 1], C[2, 1]
@@ -146,42 +167,39 @@ def step_signals_range(lo, hi, tp, t, x, diag, failed, effort, gimbal, steps, ax
             a[1] = a[1] * ca + c1 * sa + k1 * kv * (1.0 - ca)
             a[2] = a[2] * ca + c2 * sa + k2 * kv * (1.0 - ca)
         e0, e1, e2 = 0.0, 0.0, 0.0
-        if not failed[b]:
-            e0, e1, e2 = abs(xb[X_W]), abs(xb[X_W + 1] - ref_pitch), abs(xb[X_W + 2])
-        cum_error[b, 0] += e0 * dt
-        cum_error[b, 1] += e1 * dt
-        cum_error[b, 2] += e2 * dt
-        terms[b, 0] = -tp[T_W_ROLL] * e0 * dt
-        terms[b, 1] = -tp[T_W_PITCH] * e1 * dt
-        terms[b, 2] = -tp[T_W_YAW] * e2 * dt
-        terms[b, 3] = -tp[T_EFFORT] * effort[b, 0]
-        terms[b, 4] = -tp[T_EFFORT_RATE] * effort[b, 1]
-        on[b] = controller_on_k(tp, tl_t, tl_burning, t[b])
-        i, w = locate_k(tl_t, t[b])
-        j = i + 1 if w >= 1.0 else i
-        observe_k(tp, t[b], xb, db, C, a, gimbal[b], on[b], ref_pitch, bias[b], tl_dphi[j, 0],
-                  (1.0 - w) * tl_mass[i] + w * tl_mass[i + 1], n_modes, obs[b], att[b])
-        qalpha[b] = db[_QBAR] * math.degrees(db[_AT])
+        failed = sim.failed[b]
+        if not failed:
+            e0, e1, e2 = abs(xb[ow]), abs(xb[ow + 1] - ref_pitch), abs(xb[ow + 2])
+        ts.rate_error[b, 0], ts.rate_error[b, 1], ts.rate_error[b, 2] = e0, e1, e2
+        ts.cum_error[b, 0] += e0 * dt
+        ts.cum_error[b, 1] += e1 * dt
+        ts.cum_error[b, 2] += e2 * dt
+        terms, act = ts.terms[b], sim.actuator[b]
+        terms[RW.rate_roll] = -task[T.rate_weights] * e0 * dt
+        terms[RW.rate_pitch] = -task[T.rate_weights + 1] * e1 * dt
+        terms[RW.rate_yaw] = -task[T.rate_weights + 2] * e2 * dt
+        terms[RW.effort] = -task[T.effort_weight] * act[A.effort]
+        terms[RW.effort_rate] = -task[T.effort_rate_weight] * act[A.effort_rate]
+        ts.on_step[b] = ts.on[b]
+        ts.on[b] = controller_on_k(task, tables.t, tables.burning, t)
+        j, mass = _imu_and_mass_k(tables, t)
+        ts.mass[b] = mass
+        observe_k(task, t, xb, cond, act, C, a, ts.on[b], ref_pitch, ts.gyro_bias[b], tables.dphi_sensor[j, 0], mass,
+                  setup.n_slosh, setup.n_modes, ts.obs[b], ts.att[b])
+        qalpha = cond[D.qbar] * math.degrees(cond[D.alpha_total])
+        ts.qalpha[b] = qalpha
         code = 0
-        if math.degrees(math.sqrt(att[b, 0] ** 2 + att[b, 1] ** 2)) > tp[T_ATT]:
+        if math.degrees(math.sqrt(ts.att[b, 0] ** 2 + ts.att[b, 1] ** 2)) > task[T.attitude_limit]:
             code = 1
-        if qalpha[b] > tp[T_QALPHA]:
+        if qalpha > task[T.qalpha_limit]:
             code = 2
-        if failed[b]:
+        if failed:
             code = 3
-        reason[b] = code
-        truncated[b] = code == 0 and steps[b] >= tp[T_N_STEPS]
-        terms[b, 5] = -tp[T_PENALTY] * max(tp[T_MISSION] - t[b], 0.0) if code != 0 else 0.0
-        reward[b] = terms[b, 0] + terms[b, 1] + terms[b, 2] + terms[b, 3] + terms[b, 4] + terms[b, 5]
-        if failed[b]:
-            for i in range(obs.shape[1]):
-                obs[b, i] = 0.0
-
-
-@nb.njit(cache=True, nogil=True)
-def step_signals(tp, t, x, diag, failed, effort, gimbal, steps, axis_ref, cum_error, bias, tl_t, tl_burning,
-                 tl_mass, tl_dphi, n_modes, on, obs, att, terms, reward, reason, truncated, qalpha):
-    """:func:`step_signals_range` over every row (the batch wrapper runs row ranges on the simulator's
-    threads)."""
-    step_signals_range(0, x.shape[0], tp, t, x, diag, failed, effort, gimbal, steps, axis_ref, cum_error, bias, tl_t,
-                       tl_burning, tl_mass, tl_dphi, n_modes, on, obs, att, terms, reward, reason, truncated, qalpha)
+        ts.reason[b] = code
+        ts.truncated[b] = code == 0 and ts.steps[b] >= task[T.n_steps]
+        terms[RW.failure] = -task[T.failure_penalty] * max(task[T.mission] - t, 0.0) if code != 0 else 0.0
+        ts.reward[b] = (terms[RW.rate_roll] + terms[RW.rate_pitch] + terms[RW.rate_yaw] + terms[RW.effort]
+                        + terms[RW.effort_rate] + terms[RW.failure])
+        if failed:
+            for i in range(ts.obs.shape[1]):
+                ts.obs[b, i] = 0.0

@@ -10,7 +10,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
-from lvgym.errors import ConfigError
+from lvgym.errors import ConfigError, check_choice, check_number
 from lvgym.simulator import MODELS
 
 WIND_TIERS = ("none", "profile", "gust", "turbulence", "random")
@@ -43,20 +43,6 @@ def wind_spec(tier: str, mission_time: float) -> Any:
     raise ConfigError("wind", tier, f"one of {WIND_TIERS}")
 
 
-def _number(key: str, value: Any, lo: float, hi: float, lo_open: bool = False) -> float:
-    ok = isinstance(value, (int, float)) and not isinstance(value, bool) and (
-        (value > lo if lo_open else value >= lo) and value <= hi)
-    if not ok:
-        raise ConfigError(key, value, f"a number in {'(' if lo_open else '['}{lo}, {hi}]")
-    return float(value)
-
-
-def _choice(key: str, value: Any, allowed: tuple[str, ...]) -> str:
-    if value not in allowed:
-        raise ConfigError(key, value, f"one of {allowed}")
-    return value
-
-
 @dataclass(frozen=True)
 class TaskSpec:
     """Options of an ascent task (units in the names; angles in degrees only where the name says so).
@@ -68,7 +54,7 @@ class TaskSpec:
     wind: a tier of ``WIND_TIERS``; randomize: the set of ``RANDOMIZE`` names drawn from the env's generator
     at every reset; observation: ``state`` (ideal) or ``sensors`` (IMU at ``imu_station_m``);
     reference: ``zero_rate`` or ``gravity_turn`` (pitch kick, then the rate that keeps the flight-path
-    angle's turn); control: ``tvc`` (Box(-1, 1) per gimbal axis) or ``rcs`` (Discrete(3) roll pulses);
+    angle's turn); control: ``tvc`` (Box(-1, 1) per gimbal axis) or ``rcs`` (MultiDiscrete([3]) roll pulses);
     actuator: natural frequency [rad/s], damping, gimbal limit [deg] (None: the engine's), rate limit
     [deg/s]; rcs_torque_nm: roll torque of a pulse; reward: rate_weights (roll, pitch, yaw) per rad,
     effort_weight per rad of gimbal per second, effort_rate_weight per rad/s of gimbal rate per second,
@@ -113,20 +99,20 @@ class TaskSpec:
     attitude_noise_rad: float = 1e-3
 
     def __post_init__(self) -> None:
-        _choice("model", self.model, MODELS)
-        _choice("wind", self.wind, WIND_TIERS)
-        _choice("observation", self.observation, OBSERVATIONS)
-        _choice("reference", self.reference, REFERENCES)
-        _choice("control", self.control, CONTROLS)
+        check_choice("model", self.model, MODELS)
+        check_choice("wind", self.wind, WIND_TIERS)
+        check_choice("observation", self.observation, OBSERVATIONS)
+        check_choice("reference", self.reference, REFERENCES)
+        check_choice("control", self.control, CONTROLS)
         r = self.randomize
         names = set(RANDOMIZE) if r is True else set() if r in (False, None) else set(r) if not isinstance(r, str) else {r}
         bad = sorted(names - set(RANDOMIZE))
         if bad:
             raise ConfigError("randomize", bad[0], f"True, False or a set of {RANDOMIZE}")
         object.__setattr__(self, "randomize", frozenset(names))
-        _number("mission_time_s", self.mission_time_s, 0.0, 3600.0, lo_open=True)
-        _number("physics_dt_s", self.physics_dt_s, 0.0, 0.05, lo_open=True)
-        _number("control_dt_s", self.control_dt_s, self.physics_dt_s, 1.0)
+        check_number("mission_time_s", self.mission_time_s, 0.0, 3600.0, lo_open=True)
+        check_number("physics_dt_s", self.physics_dt_s, 0.0, 0.05, lo_open=True)
+        check_number("control_dt_s", self.control_dt_s, self.physics_dt_s, 1.0)
         n = self.control_dt_s / self.physics_dt_s
         if abs(n - round(n)) > 1e-6:
             raise ConfigError("control_dt_s", self.control_dt_s,
@@ -141,11 +127,11 @@ class TaskSpec:
                             ("kick_angle_deg", -90.0, 90.0), ("gyro_noise_radps", 0.0, 1.0),
                             ("gyro_bias_radps", 0.0, 1.0), ("accel_noise_mps2", 0.0, 100.0),
                             ("attitude_noise_rad", 0.0, 1.0)):
-            _number(key, getattr(self, key), lo, hi)
+            check_number(key, getattr(self, key), lo, hi)
         if self.kick_end_s <= self.kick_start_s:
             raise ConfigError("kick_end_s", self.kick_end_s, f"a time after kick_start_s = {self.kick_start_s}")
         if self.gimbal_limit_deg is not None:
-            _number("gimbal_limit_deg", self.gimbal_limit_deg, 0.0, 30.0, lo_open=True)
+            check_number("gimbal_limit_deg", self.gimbal_limit_deg, 0.0, 30.0, lo_open=True)
         w = tuple(self.rate_weights)
         if len(w) != 3 or any(not isinstance(v, (int, float)) or v < 0 for v in w):
             raise ConfigError("rate_weights", self.rate_weights, "three numbers >= 0 (roll, pitch, yaw) per rad")

@@ -1,11 +1,10 @@
-"""Batched environments over one :class:`~.core.AscentBatch`: a Gymnasium ``VectorEnv`` and an SB3 ``VecEnv``.
+"""Batched environments over one :class:`~.functional.AscentFuncEnv`: a Gymnasium ``VectorEnv``.
 
-Both run the same batched code as the single env (one simulator, one compiled kernel over all rows);
-row ``i`` seeded with ``seed + i`` is step for step the single env seeded with ``seed + i``.
+It runs the same batched code as the single env (one simulator, one compiled kernel over all rows); row
+``i`` seeded with ``seed + i`` is step for step the single env seeded with ``seed + i``.
 :class:`AscentVectorEnv` autoresets on the next step (Gymnasium's default ``NEXT_STEP`` mode: the step
-after an episode's end resets that row, ignores its action and returns reward 0);
-:class:`AscentSB3VecEnv` follows stable-baselines3 (reset at once, the last observation in
-``infos[i]["terminal_observation"]``).
+after an episode's end resets that row, ignores its action and returns reward 0). The stable-baselines3
+``VecEnv`` over the same code is :class:`lvgym.envs.sb3.AscentSB3VecEnv`.
 """
 
 from __future__ import annotations
@@ -17,13 +16,14 @@ import numpy as np
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
-from .ascent import DEFAULT_AERO_MACH, SlenderAscentEnv, _rows, make_spaces
-from .core import AscentBatch
+from .ascent import DEFAULT_AERO_MACH, SlenderAscentEnv, slender_key
+from .functional import AscentFuncEnv, AscentState
+from .snapshot import EpisodeState, rng_state, set_rng_state
 from .spec import TaskSpec
 
 
-
-def _task(env_cls: type, options: dict[str, Any]) -> TaskSpec:
+def batch_task(env_cls: type, options: dict[str, Any]) -> TaskSpec:
+    """The task of ``num_envs`` rows of ``env_cls`` with ``options`` (one vehicle for all rows)."""
     options = dict(options)
     if env_cls is SlenderAscentEnv:
         length, diameter = options.pop("length", 8.5), options.pop("diameter", 0.3)
@@ -31,9 +31,16 @@ def _task(env_cls: type, options: dict[str, Any]) -> TaskSpec:
             raise ValueError("diameter ranges are drawn per episode by the single SlenderAscent env only; "
                              "a vector env flies one geometry (make one vector env per diameter)")
         aero_mach = options.pop("aero_mach", DEFAULT_AERO_MACH)
-        options["vehicle"] = ("slender", float(length), float(np.ravel(diameter)[0]),
-                              None if aero_mach is None else float(aero_mach))
+        options["vehicle"] = slender_key(length, float(np.ravel(diameter)[0]),
+                                         None if aero_mach is None else float(aero_mach))
     return TaskSpec.build(env_cls.DEFAULTS, options)
+
+
+def _select(rows: Any, n: int) -> np.ndarray:
+    idx = np.arange(n) if rows is None else np.atleast_1d(np.asarray(rows, dtype=np.int64))
+    if idx.size and (idx.min() < 0 or idx.max() >= n):
+        raise IndexError(f"rows {idx.tolist()} of a vector env of {n} rows")
+    return idx
 
 
 class AscentVectorEnv(VectorEnv):
@@ -43,14 +50,20 @@ class AscentVectorEnv(VectorEnv):
 
     def __init__(self, env_cls: type, num_envs: int = 1, **options: Any) -> None:
         options.pop("render_mode", None)
-        self.task = _task(env_cls, options)
+        self.task = batch_task(env_cls, options)
         self.num_envs = int(num_envs)
-        self.core = AscentBatch(self.task, self.num_envs)
-        self.single_action_space, self.single_observation_space = make_spaces(self.task)
+        self.func = AscentFuncEnv(self.task)
+        self.single_action_space, self.single_observation_space = self.func.action_space, self.func.observation_space
         self.action_space = batch_space(self.single_action_space, self.num_envs)
         self.observation_space = batch_space(self.single_observation_space, self.num_envs)
-        self._rngs = [np.random.default_rng() for _ in range(self.num_envs)]
+        self.state: AscentState | None = None
+        self._rngs: list[np.random.Generator] = []
         self._needs_reset = np.zeros(self.num_envs, dtype=bool)
+
+    @property
+    def sim(self):
+        """The :class:`~lvgym.simulator.Simulator` (its ``data`` is this env's rows)."""
+        return self.func.sim
 
     def reset(self, *, seed: int | list[int | None] | None = None, options: dict[str, Any] | None = None):
         if seed is None or isinstance(seed, int):
@@ -58,83 +71,51 @@ class AscentVectorEnv(VectorEnv):
         else:
             seeds = list(seed)
         self._rngs = [gym.utils.seeding.np_random(s)[0] for s in seeds]
-        obs = self.core.reset_rows(np.arange(self.num_envs), self._rngs)
+        self.state = self.func.initial(self._rngs)
+        self.func.sim.data = self.state.sim
         self._needs_reset[:] = False
-        return obs, {}
+        return self.func.observation(self.state), self.func.state_info(self.state)
 
     def step(self, actions):
+        if self.state is None:
+            raise RuntimeError("call reset() before step()")
+        func = self.func
         actions = np.asarray(actions)
         redo = np.flatnonzero(self._needs_reset)
-        obs, reward, terminated, truncated, info = self.core.step(actions.reshape(self.num_envs, -1), skip=redo)
+        rngs = [None if r else g for g, r in zip(self._rngs, self._needs_reset)]
+        self.state = func.transition(self.state, actions.reshape(self.num_envs, -1), rngs, inplace=True)
+        info = func.transition_info(None, actions, self.state)
+        reward = func.reward(None, actions, self.state)
+        terminated, truncated = func.terminal(self.state), func.truncation(self.state)
         if redo.size:
-            obs[redo] = self.core.reset_rows(redo, [self._rngs[b] for b in redo])
+            self.state = func.reset(self.state, redo, [self._rngs[b] for b in redo])
             reward[redo] = 0.0
             terminated[redo] = False
             truncated[redo] = False
+        self.func.sim.data = self.state.sim
         self._needs_reset = terminated | truncated
-        return obs, reward, terminated, truncated, info
+        return func.observation(self.state), reward, terminated, truncated, info
 
+    # ------------------------------------------------------------------------------ state as data
+    def get_state(self, rows: Any = None) -> EpisodeState:
+        """The whole state of the rows ``rows`` (default all), one :class:`~.snapshot.EpisodeState`
+        (``.row(i)`` is row i alone, which a single env of the same options restores)."""
+        if self.state is None:
+            raise RuntimeError("call reset() before get_state()")
+        idx = _select(rows, self.num_envs)
+        return EpisodeState(self.task, self.func.take(self.state, idx), [rng_state(self._rngs[b]) for b in idx],
+                            {"needs_reset": [bool(self._needs_reset[b]) for b in idx], "variant": [0] * idx.size,
+                             "rates": [[] for _ in idx]})
 
-class AscentSB3VecEnv:
-    """A stable-baselines3 ``VecEnv`` over an :class:`AscentBatch` (built lazily so that importing lvgym
-    does not import stable-baselines3)."""
-
-    def __new__(cls, env_cls: type, num_envs: int = 1, seed: int | None = None, **options: Any):
-        from stable_baselines3.common.vec_env.base_vec_env import VecEnv
-
-        class _Adapter(VecEnv):
-            def __init__(self) -> None:
-                self.task = _task(env_cls, options)
-                self.core = AscentBatch(self.task, num_envs)
-                action_space, obs_space = make_spaces(self.task)
-                self.render_mode = None                      # the batched rows do not render
-                super().__init__(num_envs, obs_space, action_space)
-                self._seed = seed
-                self._actions: np.ndarray | None = None
-                self._rngs = [np.random.default_rng(None if seed is None else seed + i) for i in range(num_envs)]
-
-            def reset(self):
-                if self._seed is not None:
-                    self._rngs = [gym.utils.seeding.np_random(self._seed + i)[0] for i in range(self.num_envs)]
-                    self._seed = None
-                return self.core.reset_rows(np.arange(self.num_envs), self._rngs)
-
-            def step_async(self, actions) -> None:
-                self._actions = np.asarray(actions)
-
-            def step_wait(self):
-                obs, reward, terminated, truncated, info = self.core.step(self._actions.reshape(self.num_envs, -1))
-                done = terminated | truncated
-                infos = _rows(info, self.num_envs)
-                for b in np.flatnonzero(done):
-                    infos[b]["terminal_observation"] = obs[b].copy()
-                    infos[b]["TimeLimit.truncated"] = bool(truncated[b] and not terminated[b])
-                if done.any():
-                    rows = np.flatnonzero(done)
-                    obs[rows] = self.core.reset_rows(rows, [self._rngs[b] for b in rows])
-                return obs, reward.astype(np.float32), done, infos
-
-            def seed(self, seed: int | None = None):
-                self._seed = seed
-                return [None if seed is None else seed + i for i in range(self.num_envs)]
-
-            def close(self) -> None:
-                pass
-
-            def get_attr(self, attr_name, indices=None):
-                return [getattr(self, attr_name) for _ in self._get_indices(indices)]
-
-            def set_attr(self, attr_name, value, indices=None) -> None:
-                setattr(self, attr_name, value)
-
-            def env_method(self, method_name, *args, indices=None, **kwargs):
-                """The rows share one batch: the adapter's own method, called once per index."""
-                if not callable(getattr(self, method_name, None)):
-                    raise AttributeError(f"the batched ascent VecEnv has no method {method_name!r}: its rows "
-                                         "share one AscentBatch (self.core) and have no per-env objects")
-                return [getattr(self, method_name)(*args, **kwargs) for _ in self._get_indices(indices)]
-
-            def env_is_wrapped(self, wrapper_class, indices=None):
-                return [False for _ in self._get_indices(indices)]
-
-        return _Adapter()
+    def set_state(self, state: EpisodeState, rows: Any = None) -> None:
+        """Continue the rows ``rows`` (default all) from ``state`` (the same number of rows; from
+        :meth:`get_state`, or single envs' states of the same options)."""
+        if self.state is None:
+            raise RuntimeError("call reset() before set_state()")
+        idx = _select(rows, self.num_envs)
+        state.check(self.task, idx.size)
+        self.state = self.func.put(self.state, idx, state.state)
+        for i, b in enumerate(idx):
+            set_rng_state(self._rngs[b], state.rng[i])
+            self._needs_reset[b] = bool(state.extra.get("needs_reset", [False] * idx.size)[i])
+        self.func.sim.data = self.state.sim

@@ -20,6 +20,12 @@ body moves within the structure between pieces, the state is shifted so that the
 it was (:meth:`NonRigidModel.shift_cg`). An optional gimbal :class:`~.servo.Servo` moves at every
 physics step. Large batches are split over threads.
 
+State as data. Everything that changes during a flight is in :attr:`Simulator.data`, a
+:class:`~.data.SimData` (one row per vehicle); the simulator itself holds only constants. Every method
+that changes or reads rows also takes an explicit ``data=`` (the functional env passes its own), and
+:meth:`Simulator.get_rows` / :meth:`Simulator.set_rows` copy rows out and back: a restored row flies on
+bit for bit as the original would have.
+
 Lift-off. The vehicle starts on the pad, axis along the launch rail (``elevation_deg`` above the
 horizon towards ``site.azimuth_deg``), and is held there while the thrust cannot lift it. It then slides
 along the rail without rotating with respect to the Earth until the structure has travelled
@@ -43,9 +49,11 @@ from lvgym.parallel import default_workers
 from lvgym.rotations import quat_to_dcm_batch
 from lvgym.vehicle import MassModel, Vehicle, load_vehicle
 
-from .advance import (N_RAIL_STATE, R_AXIS, R_LENGTH, R_OMEGA, R_PAD, R_Q0, R_SIZE, R_XBASE, RS_LIFTED, RS_ON, RS_S,
-                      RS_T_EXIT, RS_T_LIFT, advance_range, conditions_range, constrain_k, slosh_angles_range)
-from .flight import C_MIS_P, C_MIS_Y, C_MOMENT, DIAG, N_DIAG, flight_loads, pack_context, stack_contexts
+from . import data as simdata
+from .advance import StepSetup, advance_range, conditions_rows, constrain_k, slosh_angles_range
+from .data import SimData
+from .flight import flight_loads, pack_context, stack_contexts
+from .layouts import ACTUATOR, CONDITIONS, CONTEXT, RAIL, RAIL_STATE
 from .servo import DIRECT, Servo
 from .timeline import MODELS, Timeline, build_timeline
 
@@ -79,7 +87,7 @@ class Kernel:
         self.entry(*args)
 
 
-_ADVANCE, _CONDITIONS, _SLOSH = Kernel(advance_range), Kernel(conditions_range), Kernel(slosh_angles_range)
+_ADVANCE, _SLOSH = Kernel(advance_range), Kernel(slosh_angles_range)
 
 
 @functools.lru_cache(maxsize=4)
@@ -93,14 +101,6 @@ SITES = {
     "el_arenosillo": LaunchSite(latitude_deg=37.0970, longitude_deg=-6.7350, altitude_m=20.0, azimuth_deg=225.0),
     "flat": LaunchSite(latitude_deg=0.0, longitude_deg=0.0, altitude_m=0.0, azimuth_deg=90.0, flat_earth=True),
 }
-
-
-def quat_mul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Hamilton product of scalar-first quaternions (..., 4)."""
-    a0, a1, a2, a3 = np.moveaxis(a, -1, 0)
-    b0, b1, b2, b3 = np.moveaxis(b, -1, 0)
-    return np.stack([a0 * b0 - a1 * b1 - a2 * b2 - a3 * b3, a0 * b1 + a1 * b0 + a2 * b3 - a3 * b2,
-                     a0 * b2 - a1 * b3 + a2 * b0 + a3 * b1, a0 * b3 + a1 * b2 - a2 * b1 + a3 * b0], axis=-1)
 
 
 def dcm_batch(q: np.ndarray) -> np.ndarray:
@@ -184,14 +184,38 @@ class Simulator:
         self.omega_e = 0.0 if self.site.flat_earth else WGS84_OMEGA
         self.rail = self._rail_vector()
         self.servo = servo
-        self._servo = DIRECT if servo is None else servo.params()
         self.threads = int(threads) if threads is not None else _default_threads()
         if self.threads < 1:
             raise ValueError(f"threads = {threads!r}: at least 1")
-        self._event_times = np.ascontiguousarray(self.timeline.event_times, dtype=float)
-        self._stage_column = np.ascontiguousarray(self.timeline.stage, dtype=float)
+        self.tables = self.timeline.tables
+        self.setup = StepSetup(rail=self.rail, servo=DIRECT if servo is None else servo.params(),
+                               physics_dt=self.physics_dt, n_slosh=self.dynamics.n_slosh,
+                               n_modes=self.dynamics.n_modes, n_u=self.layout.n_u)
         self._event_times_all = np.array([t for t, _ in self.timeline.events], dtype=float)
-        self.batch = 0
+        self.data: SimData = self.new_data(0)
+
+    # ------------------------------------------------------------------------------ the rows
+    def new_data(self, batch: int) -> SimData:
+        """Zeroed rows for ``batch`` vehicles (call :meth:`reset_rows` on them before flying)."""
+        return simdata.allocate(batch, self.layout.n_x, self.layout.n_p)
+
+    @property
+    def batch(self) -> int:
+        """Rows of :attr:`data`."""
+        return int(self.data.t.size)
+
+    def get_rows(self, rows: Any = None, data: SimData | None = None) -> SimData:
+        """A copy of the rows ``rows`` (default all) of ``data`` (default :attr:`data`)."""
+        return simdata.take(self.data if data is None else data, rows)
+
+    def set_rows(self, rows: Any, src: SimData, data: SimData | None = None) -> SimData:
+        """Write the rows of ``src`` (from :meth:`get_rows`) into the rows ``rows`` of ``data`` (default
+        :attr:`data`); returns the updated value (a new one when the context had to widen)."""
+        own = data is None
+        out = simdata.put(self.data if own else data, rows, src)
+        if own:
+            self.data = out
+        return out
 
     # ------------------------------------------------------------------------------ set-up
     def _wind_params(self, wind: Any, rng: np.random.Generator) -> np.ndarray:
@@ -206,35 +230,25 @@ class Simulator:
         B = int(batch)
         if B < 1:
             raise ValueError(f"batch = {batch!r}: at least one vehicle")
-        n_p = self.layout.n_p
-        self.batch = B
-        self.c = np.zeros((B, 0))
-        self.scale, self.offset = np.ones((B, n_p)), np.zeros((B, n_p))
-        self.t = np.zeros(B)
-        self.p = self._params(self.t)
-        self.x = self.layout.zeros_state(B)
-        self.rail_state = np.zeros((B, N_RAIL_STATE))
-        self.failed = np.zeros(B, dtype=bool)
-        self.cmd = np.zeros((B, 2))
-        self.gimbal = np.zeros((B, 2))
-        self.gimbal_rate = np.zeros((B, 2))
-        self.effort = np.zeros((B, 2))
-        self.x_cg0 = self.p[:, self._i_cg].copy()
-        self.diag = np.zeros((B, N_DIAG))
-        self.reset_rows(np.arange(B), rng, winds, misalignment, param_scale, param_offset)
+        self.data = self.reset_rows(np.arange(B), rng, winds, misalignment, param_scale, param_offset,
+                                    data=self.new_data(B))
 
     def reset_rows(self, rows: Any, rng: np.random.Generator | Sequence[np.random.Generator] | None = None,
                    winds: Sequence[Any] | None = None, misalignment: np.ndarray | None = None,
-                   param_scale: np.ndarray | None = None, param_offset: np.ndarray | None = None) -> None:
+                   param_scale: np.ndarray | None = None, param_offset: np.ndarray | None = None,
+                   data: SimData | None = None) -> SimData:
         """Put the vehicles ``rows`` back on the pad at t = 0; the others are untouched.
 
         ``rng``: one generator, or one per row, for whatever is random (the wind models' ``reset``);
         ``winds``: one wind model (name, mapping or model) per row (default: the simulator's ``wind``);
         ``misalignment`` (R, 2) [rad] fixed thrust misalignment (pitch, yaw); ``param_scale`` /
         ``param_offset`` (R, n_p): a row flies ``timeline params * scale + offset`` (dispersions of mass,
-        CG, inertia, slosh damping, bending frequencies)."""
-        if self.batch == 0:
+        CG, inertia, slosh damping, bending frequencies). ``data``: the rows to reset (default
+        :attr:`data`, which is then updated); returns them (a new value when the context widened)."""
+        own = data is None
+        if own and self.batch == 0:
             raise RuntimeError("call reset() before reset_rows()")
+        d = self.data if own else data
         rows = np.atleast_1d(np.asarray(rows, dtype=int))
         R = rows.size
         rngs = list(rng) if isinstance(rng, (list, tuple)) else [rng] * R
@@ -249,155 +263,160 @@ class Simulator:
             aero = [args[id(m)] for m in self.stage_aerodynamics]
         ctx = [pack_context(self.site.params, self.gravity.params, self.atmosphere.params,
                             self._wind_params(w, g), aero) for w, g in zip(winds, rngs)]
-        width = max(r.size for r in ctx)
-        if width > self.c.shape[1]:
-            self.c = np.hstack([self.c, np.zeros((self.batch, width - self.c.shape[1]))])
-        self.c[rows] = stack_contexts(ctx + [np.zeros(self.c.shape[1])])[:R]
+        d = simdata.widen(d, max(r.size for r in ctx))
+        d.ctx[rows] = stack_contexts(ctx + [np.zeros(d.ctx.shape[1])])[:R]
         n_p = self.layout.n_p
-        self.scale[rows] = 1.0 if param_scale is None else np.broadcast_to(param_scale, (R, n_p))
-        self.offset[rows] = 0.0 if param_offset is None else np.broadcast_to(param_offset, (R, n_p))
+        d.scale[rows] = 1.0 if param_scale is None else np.broadcast_to(param_scale, (R, n_p))
+        d.offset[rows] = 0.0 if param_offset is None else np.broadcast_to(param_offset, (R, n_p))
         if misalignment is not None:
-            mis = np.broadcast_to(np.asarray(misalignment, float), (R, 2))
-            self.c[rows, C_MIS_P], self.c[rows, C_MIS_Y] = mis[:, 0], mis[:, 1]
-        self.t[rows] = 0.0
-        self.p[rows] = self._params(self.t[rows], rows)
-        self.x[rows] = self.layout.zeros_state(R)
-        self.rail_state[rows] = 0.0
-        self.rail_state[rows, RS_ON] = 1.0
-        self.rail_state[rows, RS_T_LIFT] = self.rail_state[rows, RS_T_EXIT] = np.nan
-        self.failed[rows] = False
-        self.cmd[rows] = self.gimbal[rows] = self.gimbal_rate[rows] = self.effort[rows] = 0.0
-        self.x_cg0[rows] = self.p[rows, self._i_cg]
-        self._place_on_pad(rows)
-        q_si = self.layout.view(self.x, "state", "q_si")
-        q_si[rows] = self.x[rows][:, None, self.layout.state["q_bi"]]
-        self._update_conditions()
+            CONTEXT.view(d.ctx[:, :CONTEXT.size], "misalignment")[rows] = np.broadcast_to(
+                np.asarray(misalignment, float), (R, 2))
+        d.t[rows] = 0.0
+        d.p[rows] = self.timeline.params_at(d.t[rows], d.scale[rows], d.offset[rows])
+        d.x[rows] = self.layout.zeros_state(R)
+        d.rail_state[rows] = RAIL_STATE.pack({"on": 1.0, "t_lift": np.nan, "t_exit": np.nan})
+        d.failed[rows] = False
+        d.actuator[rows] = 0.0
+        d.x_cg0[rows] = d.p[rows, self._i_cg]
+        self._place_on_pad(rows, d)
+        q_si = self.layout.view(d.x, "state", "q_si")
+        q_si[rows] = d.x[rows][:, None, self.layout.state["q_bi"]]
+        conditions_rows(rows.astype(np.int64), d, self.tables)
+        if own:
+            self.data = d
+        return d
 
-    def _params(self, t: np.ndarray, rows: np.ndarray | None = None) -> np.ndarray:
-        rows = slice(None) if rows is None else rows
-        return self.timeline.params_at(t) * self.scale[rows] + self.offset[rows]
-
-    # ------------------------------------------------------------------------------ stepping
     def _rail_vector(self) -> np.ndarray:
-        rail = np.zeros(R_SIZE)
-        rail[R_OMEGA], rail[R_XBASE], rail[R_LENGTH] = self.omega_e, -self.vehicle.length, self.rail_length
-        rail[R_PAD:R_PAD + 3] = self.site.initial_state(0.0)[0]
-        rail[R_AXIS:R_AXIS + 3] = self.C_ib0[:, 0]
-        rail[R_Q0:R_Q0 + 4] = self.q_bi0
-        return rail
+        return RAIL.pack({"omega_e": self.omega_e, "x_base": -self.vehicle.length, "length": self.rail_length,
+                          "r_pad_e": self.site.initial_state(0.0)[0], "axis_e": self.C_ib0[:, 0],
+                          "q_bi0": self.q_bi0})
 
-    def _place_on_pad(self, rows: np.ndarray) -> None:
+    def _place_on_pad(self, rows: np.ndarray, d: SimData) -> None:
         """Put ``rows`` at the rail's start at t = 0, at rest relative to the Earth."""
         lay = self.layout.state
-        rail = self.rail
-        h0 = self.x_cg0[rows] - rail[R_XBASE]
-        r = rail[R_PAD:R_PAD + 3][None, :] + h0[:, None] * rail[R_AXIS:R_AXIS + 3][None, :]
-        self.x[rows, lay["r_zw_i"]] = r
-        self.x[rows, lay["v_zw_i"]] = np.cross([0.0, 0.0, self.omega_e], r)
+        rail = RAIL.view
+        h0 = d.x_cg0[rows] - rail(self.rail, "x_base")
+        r = rail(self.rail, "r_pad_e")[None, :] + h0[:, None] * rail(self.rail, "axis_e")[None, :]
+        d.x[rows, lay["r_zw_i"]] = r
+        d.x[rows, lay["v_zw_i"]] = np.cross([0.0, 0.0, self.omega_e], r)
         for b in rows:
-            constrain_k(self.x[b], 0.0, rail, self.x_cg0[b], self.p[b, self._i_cg], self.rail_state[b])
+            constrain_k(d.x[b], 0.0, self.rail, d.x_cg0[b], d.p[b, self._i_cg], d.rail_state[b])
 
-    def _chunks(self) -> list[tuple[int, int]]:
+    # ------------------------------------------------------------------------------ stepping
+    def _chunks(self, batch: int) -> list[tuple[int, int]]:
         """Row ranges run on separate threads (one range for small batches); kept until the batch
         size or the thread count changes (several compiled kernels run per step)."""
-        key = (self.batch, self.threads)
+        key = (batch, self.threads)
         if getattr(self, "_chunk_key", None) != key:
-            k = max(1, min(self.threads, self.batch // _ROWS_PER_THREAD))
-            edges = np.linspace(0, self.batch, k + 1).astype(int)
+            k = max(1, min(self.threads, batch // _ROWS_PER_THREAD))
+            edges = np.linspace(0, batch, k + 1).astype(int)
             self._chunk_list = [(int(a), int(z)) for a, z in zip(edges[:-1], edges[1:]) if z > a]
             self._chunk_key = key
         return self._chunk_list
 
-    def run_rows(self, fn: Kernel, *args: Any) -> None:
-        """Call ``fn(lo, hi, *args)`` over the row ranges of the batch, on the simulator's threads when
-        it has more than one range; ``fn`` is a :class:`Kernel` of a compiled ``nogil`` function that
-        touches only rows ``lo:hi`` of its batch arrays."""
-        chunks = self._chunks()
+    def run_rows(self, fn: Kernel, batch: int, *args: Any) -> None:
+        """Call ``fn(lo, hi, *args)`` over the row ranges of a batch of ``batch`` rows, on the
+        simulator's threads when it has more than one range; ``fn`` is a :class:`Kernel` of a compiled
+        ``nogil`` function that touches only rows ``lo:hi`` of its batch arrays."""
+        chunks = self._chunks(batch)
         if len(chunks) == 1:
-            fn(0, self.batch, *args)
+            fn(0, batch, *args)
             return
         list(_pool(self.threads).map(lambda ch: fn(ch[0], ch[1], *args), chunks))
 
-    def step(self, gimbal: Any, duration: float, moment: Any = None) -> list[list[tuple[float, str]]]:
+    def step(self, gimbal: Any, duration: float, moment: Any = None,
+             data: SimData | None = None) -> list[list[tuple[float, str]]]:
         """Advance every row by ``duration`` [s] with the gimbal command ``gimbal`` (B, 2) [rad]
         (pitch, yaw; see :mod:`.flight` for the signs) and a commanded body moment ``moment`` (B, 3)
-        [N m] (reaction control; default none) held; returns each row's events.
+        [N m] (reaction control; default none) held; returns each row's events. ``data``: the rows
+        (default :attr:`data`), changed in place.
 
         Without a servo the gimbal takes the command at once; with one (``servo=``) it moves towards
-        it at every physics step. ``self.effort`` (B, 2) then holds the integrals of |gimbal| [rad s]
-        and |gimbal rate| [rad] (both axes summed) over the period."""
-        if self.batch == 0:
+        it at every physics step. The actuator rows then hold the integrals of |gimbal| [rad s] and
+        |gimbal rate| [rad] (both axes summed) over the period (:attr:`effort`)."""
+        d = self.data if data is None else data
+        B = int(d.t.size)
+        if B == 0:
             raise RuntimeError("call reset() before step()")
         if not duration > 0.0:
             raise ValueError(f"duration = {duration!r}: must be > 0 s")
-        B = self.batch
-        self.cmd[:] = np.broadcast_to(np.asarray(gimbal, dtype=float), (B, 2))
-        self.c[:, C_MOMENT:C_MOMENT + 3] = 0.0 if moment is None else np.broadcast_to(moment, (B, 3))
-        t0 = self.t.copy()
-        rs = self.rail_state
-        lifted0, on0 = rs[:, RS_LIFTED].copy(), rs[:, RS_ON].copy()
-        tl = self.timeline
-        self.run_rows(_ADVANCE, flight_loads, self.x, self.p, self.c, self.t, self.scale, self.offset,
-                  self.x_cg0, self.failed, self.rail, rs, self._servo, self.cmd, self.gimbal, self.gimbal_rate,
-                  self.effort, tl.t, tl.params, tl.hold, tl.thrust0, tl.exit_area, self._stage_column, self._event_times,
-                  float(duration), self.physics_dt, self.dynamics.n_slosh, self.dynamics.n_modes,
-                  self.layout.n_u, self._i_cg, self.diag)
+        ACTUATOR.view(d.actuator, "command")[:] = np.broadcast_to(np.asarray(gimbal, dtype=float), (B, 2))
+        CONTEXT.view(d.ctx[:, :CONTEXT.size], "moment_b")[:] = 0.0 if moment is None else np.broadcast_to(moment, (B, 3))
+        t0 = d.t.copy()
+        rs = d.rail_state
+        i_on, i_lifted = RAIL_STATE.index("on"), RAIL_STATE.index("lifted")
+        lifted0, on0 = rs[:, i_lifted].copy(), rs[:, i_on].copy()
+        self.run_rows(_ADVANCE, B, flight_loads, d, self.tables, self.setup, float(duration))
         events: list[list[tuple[float, str]]] = [[] for _ in range(B)]
         ev_t = self._event_times_all
-        hit = (ev_t[None, :] > t0[:, None]) & (ev_t[None, :] <= self.t[:, None] + 1e-12)
-        new_lift = rs[:, RS_LIFTED] > lifted0
-        new_exit = (rs[:, RS_ON] < on0) & (self.rail_length > 0.0)
+        hit = (ev_t[None, :] > t0[:, None]) & (ev_t[None, :] <= d.t[:, None] + 1e-12)
+        new_lift = rs[:, i_lifted] > lifted0
+        new_exit = (rs[:, i_on] < on0) & (self.rail_length > 0.0)
         for b in np.flatnonzero(hit.any(axis=1) | new_lift | new_exit):
             evs = [self.timeline.events[i] for i in np.flatnonzero(hit[b])]
             if new_lift[b]:
-                evs.append((float(rs[b, RS_T_LIFT]), "lift-off"))
+                evs.append((float(rs[b, RAIL_STATE.index("t_lift")]), "lift-off"))
             if new_exit[b]:
-                evs.append((float(rs[b, RS_T_EXIT]), "rail exit"))
+                evs.append((float(rs[b, RAIL_STATE.index("t_exit")]), "rail exit"))
             events[b] = sorted(evs, key=lambda e: e[0])
         return events
 
-    def _update_conditions(self) -> None:
-        """Flight conditions of every row at its current time (thrust at that time)."""
-        tl = self.timeline
-        self.run_rows(_CONDITIONS, self.t, self.x, self.p, self.c, tl.t, tl.thrust0, tl.exit_area, self._stage_column,
-                  self.diag)
+    # ------------------------------------------------------------------------------ read-outs
+    # the arrays of :attr:`data` (views: writing them writes the rows)
+    t = property(lambda self: self.data.t, doc="time of each row [s] (B,)")
+    x = property(lambda self: self.data.x, doc="dynamics state (B, n_x)")
+    p = property(lambda self: self.data.p, doc="dynamics parameters in force (B, n_p)")
+    c = property(lambda self: self.data.ctx, doc="context (B, n_ctx), layout CONTEXT then the models' blocks")
+    failed = property(lambda self: self.data.failed, doc="rows whose state turned non-finite (B,)")
+    gimbal = property(lambda self: ACTUATOR.view(self.data.actuator, "gimbal"), doc="gimbal angles (B, 2) [rad]")
+    gimbal_rate = property(lambda self: ACTUATOR.view(self.data.actuator, "gimbal_rate"),
+                           doc="gimbal rates (B, 2) [rad/s]")
+    cmd = property(lambda self: ACTUATOR.view(self.data.actuator, "command"), doc="gimbal command (B, 2) [rad]")
+
+    @property
+    def effort(self) -> np.ndarray:
+        """Integrals of |gimbal| [rad s] and |gimbal rate| [rad] over the last period (B, 2)."""
+        a = self.data.actuator
+        return np.stack([a[:, ACTUATOR.index("effort")], a[:, ACTUATOR.index("effort_rate")]], axis=1)
 
     @property
     def on_rail(self) -> np.ndarray:
         """Whether each row is still held on the pad or rail."""
-        return self.rail_state[:, RS_ON] != 0.0
+        return self.data.rail_state[:, RAIL_STATE.index("on")] != 0.0
 
     @property
     def lifted(self) -> np.ndarray:
         """Whether each row has lifted off."""
-        return self.rail_state[:, RS_LIFTED] != 0.0
+        return self.data.rail_state[:, RAIL_STATE.index("lifted")] != 0.0
 
     @property
     def rail_s(self) -> np.ndarray:
         """Travel of the structure along the rail [m] (frozen at rail exit)."""
-        return self.rail_state[:, RS_S]
+        return self.data.rail_state[:, RAIL_STATE.index("s")]
 
-    # ------------------------------------------------------------------------------ read-outs
-    def conditions(self, name: str) -> np.ndarray:
-        """Flight condition ``name`` (a key of :data:`.flight.DIAG`) of every row at its current time."""
-        if name not in DIAG:
-            raise KeyError(f"condition {name!r}: one of {sorted(DIAG)}")
-        out = self.diag[:, DIAG[name]]
+    def conditions(self, name: str, data: SimData | None = None) -> np.ndarray:
+        """Flight condition ``name`` (an entry of :data:`.layouts.CONDITIONS`) of every row at its
+        current time (a view)."""
+        d = self.data if data is None else data
+        if name not in CONDITIONS:
+            raise KeyError(f"condition {name!r}: one of {sorted(CONDITIONS.names)}")
+        out = CONDITIONS.view(d.conditions, name)
         return out[:, 0] if out.shape[1] == 1 else out
 
-    def state(self, name: str) -> np.ndarray:
+    def state(self, name: str, data: SimData | None = None) -> np.ndarray:
         """State entry ``name`` of every row (a view, see :class:`lvgym.dynamics.Layout`)."""
-        return self.layout.view(self.x, "state", name)
+        return self.layout.view(self.data.x if data is None else data.x, "state", name)
 
-    def slosh_angles(self) -> np.ndarray:
+    def slosh_angles(self, data: SimData | None = None) -> np.ndarray:
         """Pendulum deflections from the body axis (B, N, 2) [rad]: the rod's angle in the x-y and x-z
         body planes (0 at rest, hanging aft); NaN for a pendulum without mass (an empty or dropped
         tank, whose frozen state means nothing)."""
-        N = self.dynamics.n_slosh
-        out = np.zeros((self.batch, N, 2))
+        d = self.data if data is None else data
+        N, B = self.dynamics.n_slosh, int(d.t.size)
+        out = np.zeros((B, N, 2))
         if N:
-            self.run_rows(_SLOSH, self.x, N, self.dynamics.n_modes, out)
-            m_j = self.p[:, [self.layout.slosh_param(j, "m").start for j in range(N)]]
+            self.run_rows(_SLOSH, B, d.x, N, self.dynamics.n_modes, out)
+            m_j = d.p[:, [self.layout.slosh_param(j, "m").start for j in range(N)]]
             out[m_j <= 0.0] = np.nan
         return out
 
@@ -410,20 +429,5 @@ class Simulator:
         C_ib = dcm_batch(self.state("q_bi"))
         rho_b = np.einsum("bji,bnj->bni", C_ib, r_j - self.state("r_zw_i")[:, None, :])
         m_j = self.p[:, [self.layout.slosh_param(j, "m").start for j in range(self.dynamics.n_slosh)]]
-        m_total = self.p[:, 0] + m_j.sum(axis=1)
+        m_total = self.p[:, self.layout.params["m_b"].start] + m_j.sum(axis=1)
         return np.einsum("bn,bni->bi", m_j, rho_b[..., 1:]) / m_total[:, None]
-
-    def gyro_rates(self) -> np.ndarray:
-        """Body rates seen by a gyro at each of the timeline's sensor stations (B, S, 3) [rad/s]:
-        ``omega_bi_b`` plus the rotation rate of the deflected section, ``(0, -sum dphi eta_dot_z,
-        sum dphi eta_dot_y)`` (DESIGN.md note 6)."""
-        w = self.state("omega_bi_b")
-        S = self.timeline.sensor_stations.size
-        out = np.repeat(w[:, None, :], S, axis=1)
-        K = self.dynamics.n_modes
-        if K and S:
-            dphi = self.timeline.left("dphi_sensor", self.t)            # (B, S, K)
-            eta_dot = self.state("eta_dot")                              # (B, 2, K)
-            out[..., 1] -= np.einsum("bsk,bk->bs", dphi, eta_dot[:, 1])
-            out[..., 2] += np.einsum("bsk,bk->bs", dphi, eta_dot[:, 0])
-        return out

@@ -5,7 +5,8 @@ damping ``z``; the command is clipped to the position limit ``limit`` [rad], the
 ``rate_limit`` [rad/s], the position to ``limit`` (and the rate is zeroed when the position saturates
 against it). Integrated with semi-implicit Euler at the simulator's physics step (``w h = 0.15`` at
 the defaults 15 rad/s and 10 ms). The simulator integrates it inside its compiled step
-(:mod:`.advance`), so the gimbal moves between the RK4 steps of one control period.
+(:mod:`.advance`), so the gimbal moves between the RK4 steps of one control period. The parameters
+have the layout :data:`.layouts.SERVO`, a row's command and servo state :data:`.layouts.ACTUATOR`.
 """
 
 from __future__ import annotations
@@ -16,9 +17,7 @@ from dataclasses import dataclass
 import numba as nb
 import numpy as np
 
-# parameter vector of the compiled servo
-S_ON, S_W, S_Z, S_LIMIT, S_RATE = 0, 1, 2, 3, 4
-N_SERVO = 5
+from .layouts import SERVO, SV, A
 
 
 @dataclass(frozen=True)
@@ -38,12 +37,13 @@ class Servo:
                 raise ValueError(f"servo.{key} = {v!r}: a finite number > {lo:g}")
 
     def params(self) -> np.ndarray:
-        """Parameter vector of the compiled servo (layout ``S_*``)."""
-        return np.array([1.0, self.frequency, self.damping, self.limit, self.rate_limit])
+        """Parameter vector of the compiled servo (layout :data:`.layouts.SERVO`)."""
+        return SERVO.pack({"on": 1.0, "frequency": self.frequency, "damping": self.damping, "limit": self.limit,
+                           "rate_limit": self.rate_limit})
 
 
 #: no servo: the gimbal takes the commanded angle at once
-DIRECT = np.zeros(N_SERVO)
+DIRECT = SERVO.zeros()
 
 
 @nb.njit(cache=True, nogil=True, inline="always")
@@ -52,22 +52,23 @@ def _clip(v, lo, hi):
 
 
 @nb.njit(cache=True, nogil=True, inline="always")
-def servo_step_k(s, cmd, pos, rate, h):
-    """Advance the two axes ``pos``, ``rate`` (2) in place by ``h`` [s] towards ``cmd`` (2) [rad]
-    with servo parameters ``s`` (layout ``S_*``); with ``s[S_ON] == 0`` the position is the command
-    and the rate is zero."""
-    if s[S_ON] == 0.0:
+def servo_step_k(s, act, h):
+    """Advance the two axes of the actuator row ``act`` (layout ``ACTUATOR``: gimbal and gimbal rate)
+    in place by ``h`` [s] towards its command [rad] with servo parameters ``s`` (layout ``SERVO``);
+    with ``s[SV.on] == 0`` the gimbal is the command and the rate is zero."""
+    if s[SV.on] == 0.0:
         for i in range(2):
-            pos[i] = cmd[i]
-            rate[i] = 0.0
+            act[A.gimbal + i] = act[A.command + i]
+            act[A.gimbal_rate + i] = 0.0
         return
-    w, z, lim, rl = s[S_W], s[S_Z], s[S_LIMIT], s[S_RATE]
+    w, z, lim, rl = s[SV.frequency], s[SV.damping], s[SV.limit], s[SV.rate_limit]
     for i in range(2):
-        c = _clip(cmd[i], -lim, lim)
-        acc = w * w * (c - pos[i]) - 2.0 * z * w * rate[i]
-        r = _clip(rate[i] + h * acc, -rl, rl)
-        p = pos[i] + h * r
+        c = _clip(act[A.command + i], -lim, lim)
+        pos, rate = act[A.gimbal + i], act[A.gimbal_rate + i]
+        acc = w * w * (c - pos) - 2.0 * z * w * rate
+        r = _clip(rate + h * acc, -rl, rl)
+        p = pos + h * r
         if abs(p) >= lim and (r > 0.0) == (p > 0.0) and r != 0.0:
             r = 0.0
-        pos[i] = _clip(p, -lim, lim)
-        rate[i] = r
+        act[A.gimbal + i] = _clip(p, -lim, lim)
+        act[A.gimbal_rate + i] = r

@@ -21,8 +21,11 @@ simulator lands its steps on them, so nothing is interpolated across a separatio
 
 from __future__ import annotations
 
+import functools
+from collections import namedtuple
 from dataclasses import dataclass, replace
 
+import numba as nb
 import numpy as np
 
 from lvgym.dynamics import NonRigidModel
@@ -77,32 +80,118 @@ class Timeline:
 
     def locate(self, t) -> tuple[np.ndarray, np.ndarray]:
         """Row index ``i`` and weight ``w`` of the times ``t`` (B,): value = (1-w) row i + w row i+1.
-        A time equal to an event time takes the row after the event."""
+        A time equal to an event time takes the row after the event (:func:`locate_k`)."""
         t = np.atleast_1d(np.asarray(t, dtype=float))
-        i = np.clip(np.searchsorted(self.t, t, side="right") - 1, 0, len(self.t) - 2)
-        span = self.t[i + 1] - self.t[i]
-        w = np.where(span > 0.0, (t - self.t[i]) / np.where(span > 0.0, span, 1.0), 0.0)
-        return i, np.clip(w, 0.0, 1.0)
+        i, w = np.empty(t.size, dtype=np.int64), np.empty(t.size)
+        locate_rows(self.t, t, i, w)
+        return i, w
 
     def interp(self, name: str, t) -> np.ndarray:
-        """Linear interpolation of the row quantity ``name`` at the times ``t`` (B,): shape (B, ...)."""
-        i, w = self.locate(t)
+        """Linear interpolation of the row quantity ``name`` at the times ``t`` (B,): shape (B, ...)
+        (:func:`interp_k`)."""
         a = getattr(self, name)
-        w = w.reshape((-1,) + (1,) * (a.ndim - 1))
-        return (1.0 - w) * a[i] + w * a[i + 1]
+        t = np.atleast_1d(np.asarray(t, dtype=float))
+        out = np.empty((t.size, int(np.prod(a.shape[1:], dtype=int))))
+        interp_rows(self.t, np.ascontiguousarray(a, dtype=float).reshape(a.shape[0], -1), t, out)
+        return out.reshape((t.size,) + a.shape[1:])
 
     def left(self, name: str, t) -> np.ndarray:
-        """The row quantity ``name`` in force at the times ``t`` (no interpolation)."""
+        """The row quantity ``name`` in force at the times ``t`` (no interpolation; the row after an
+        event at an event time, :func:`held_k`)."""
         i, w = self.locate(t)
         return getattr(self, name)[np.where(w >= 1.0, i + 1, i)]
 
-    def params_at(self, t) -> np.ndarray:
-        """Dynamics parameters (B, n_p) at the times ``t`` (B,): interpolated, mode data held."""
-        i, w = self.locate(t)
-        p = (1.0 - w[:, None]) * self.params[i] + w[:, None] * self.params[i + 1]
-        held = self.params[np.where(w >= 1.0, i + 1, i)]
-        p[:, self.hold] = held[:, self.hold]
-        return p
+    def params_at(self, t, scale: np.ndarray | None = None, offset: np.ndarray | None = None) -> np.ndarray:
+        """Dynamics parameters (B, n_p) at the times ``t`` (B,): interpolated, mode data held, then
+        ``* scale + offset`` (B, n_p) when given (:func:`params_k`, as the simulator's step)."""
+        t = np.atleast_1d(np.asarray(t, dtype=float))
+        n_p = self.params.shape[1]
+        scale = np.ones((t.size, n_p)) if scale is None else np.ascontiguousarray(scale, dtype=float)
+        offset = np.zeros((t.size, n_p)) if offset is None else np.ascontiguousarray(offset, dtype=float)
+        out = np.empty((t.size, n_p))
+        params_rows(self.t, self.params, self.hold, scale, offset, t, out)
+        return out
+
+    @functools.cached_property
+    def tables(self) -> Tables:
+        """The columns the compiled step and the task signals read (:class:`Tables`)."""
+        return Tables(t=np.ascontiguousarray(self.t, dtype=float), params=np.ascontiguousarray(self.params),
+                      hold=np.ascontiguousarray(self.hold), thrust0=np.ascontiguousarray(self.thrust0, dtype=float),
+                      exit_area=np.ascontiguousarray(self.exit_area, dtype=float),
+                      stage=np.ascontiguousarray(self.stage, dtype=float),
+                      burning=np.ascontiguousarray(self.burning, dtype=float),
+                      mass=np.ascontiguousarray(self.mass, dtype=float),
+                      dphi_sensor=np.ascontiguousarray(self.dphi_sensor, dtype=float),
+                      event_times=np.ascontiguousarray(self.event_times, dtype=float))
+
+
+#: the timeline's columns as compiled code reads them: ``t`` (n,) [s] rows; ``params`` (n, n_p);
+#: ``hold`` (n_p,) bool; ``thrust0`` (n,) [N]; ``exit_area`` (n,) [m^2]; ``stage`` (n,) lowest attached
+#: stage; ``burning`` (n,) 1 while an engine burns; ``mass`` (n,) [kg]; ``dphi_sensor`` (n, S, K)
+#: [1/(m sqrt(kg))]; ``event_times`` (E,) [s], each once
+Tables = namedtuple("Tables", ["t", "params", "hold", "thrust0", "exit_area", "stage", "burning", "mass",
+                               "dphi_sensor", "event_times"])
+
+
+# ---------------------------------------------------------------------------- compiled look-ups (the only ones)
+@nb.njit(cache=True, nogil=True, inline="always")
+def locate_k(tl_t, t):
+    """Row ``i`` and weight ``w`` of time ``t`` in the timeline rows ``tl_t``: value = (1-w) row i + w
+    row i+1; a time equal to an event time (stored twice) takes the row after the event."""
+    n = tl_t.size
+    i = np.searchsorted(tl_t, t, side="right") - 1
+    i = min(max(i, 0), n - 2)
+    span = tl_t[i + 1] - tl_t[i]
+    w = (t - tl_t[i]) / span if span > 0.0 else 0.0
+    return i, min(max(w, 0.0), 1.0)
+
+
+@nb.njit(cache=True, nogil=True, inline="always")
+def params_k(tl_t, tl_p, hold, scale, offset, t, out):
+    """Dynamics parameters at time ``t`` into ``out``: interpolated, held columns from the row in
+    force, then ``* scale + offset``."""
+    i, w = locate_k(tl_t, t)
+    j = i + 1 if w >= 1.0 else i
+    for k in range(out.size):
+        v = tl_p[j, k] if hold[k] else (1.0 - w) * tl_p[i, k] + w * tl_p[i + 1, k]
+        out[k] = v * scale[k] + offset[k]
+
+
+@nb.njit(cache=True, nogil=True, inline="always")
+def interp_k(tl_t, values, t):
+    """Linear interpolation of a timeline column ``values`` at time ``t``."""
+    i, w = locate_k(tl_t, t)
+    return (1.0 - w) * values[i] + w * values[i + 1]
+
+
+@nb.njit(cache=True, nogil=True, inline="always")
+def held_k(tl_t, values, t):
+    """The value of a piecewise-constant timeline column ``values`` in force at time ``t`` (the row
+    after an event at an event time)."""
+    i, w = locate_k(tl_t, t)
+    return values[i + 1] if w >= 1.0 else values[i]
+
+
+@nb.njit(cache=True)
+def locate_rows(tl_t, t, i_out, w_out):
+    """:func:`locate_k` of every time ``t`` (B,)."""
+    for b in range(t.size):
+        i_out[b], w_out[b] = locate_k(tl_t, t[b])
+
+
+@nb.njit(cache=True)
+def interp_rows(tl_t, values, t, out):
+    """:func:`interp_k` of every column of ``values`` (n, m) at every time ``t`` (B,) into ``out`` (B, m)."""
+    for b in range(t.size):
+        for k in range(values.shape[1]):
+            out[b, k] = interp_k(tl_t, values[:, k], t[b])
+
+
+@nb.njit(cache=True)
+def params_rows(tl_t, tl_p, hold, scale, offset, t, out):
+    """:func:`params_k` at every time ``t`` (B,) with the rows' ``scale``, ``offset`` (B, n_p)."""
+    for b in range(t.size):
+        params_k(tl_t, tl_p, hold, scale[b], offset[b], t[b], out[b])
 
 
 def _cut(modes, cutoff_hz: float):

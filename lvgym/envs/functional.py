@@ -1,0 +1,316 @@
+"""The ascent task as a functional env: pure functions of an explicit state and explicit parameters.
+
+After Gymnasium's ``gymnasium.experimental.functional.FuncEnv`` (and brax, gymnax): :class:`AscentFuncEnv`
+holds only constants (the vehicle, its timeline, the simulator's models, the task's options); an
+episode's whole state is one :data:`AscentState` value, batched over rows::
+
+    func = AscentFuncEnv(TaskSpec.build(SmileAscentEnv.DEFAULTS, {"model": "rigid"}))
+    rngs = [np.random.default_rng(s) for s in range(8)]
+    state = func.initial(rngs)                               # 8 episodes on the pad
+    state = func.transition(state, np.zeros((8, 2)), rngs)   # a new state; the old one is unchanged
+    obs, reward, done = func.observation(state), func.reward(None, None, state), func.terminal(state)
+
+``transition(..., inplace=True)`` reuses the input state's arrays for the output (as JAX's buffer
+donation); the Gymnasium adapters (:mod:`.ascent`, :mod:`.vector`) step that way, so they copy nothing.
+A transition records its outputs (reward terms, termination, the observation with its sensor noise, the
+events) in the new state, so :meth:`reward`, :meth:`terminal` and :meth:`transition_info` read the new
+state only. ``rng``: one ``numpy.random.Generator`` per row (the Gymnasium envs' ``np_random``), or None
+for a row that draws nothing; every random draw of a row comes from its generator.
+
+Per row and reset (:meth:`AscentFuncEnv.reset`), in this order: the dispersions of ``randomize``
+(:meth:`AscentFuncEnv.dispersions`), the gyro bias (``sensor_noise``), the wind realisation (``wind``; a
+fixed generator otherwise), the first observation's noise; per step: the observation's noise
+(:data:`.layouts.SENSOR_NOISE`). So N rows and N single envs seeded alike are identical.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+from collections import namedtuple
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+from gymnasium import spaces
+from gymnasium.experimental.functional import FuncEnv
+
+from lvgym.simulator import SimData, Simulator, Timeline, build_timeline
+from lvgym.simulator import data as simdata
+from lvgym.simulator.core import Kernel
+from lvgym.simulator.layouts import ACTUATOR
+from lvgym.simulator.servo import Servo
+from lvgym.vehicle import MassModel, Vehicle, load_vehicle
+from lvgym.vehicle.slender import slender_vehicle
+
+from .layouts import OBSERVATIONS, REASONS, REWARD, REWARD_TERMS, SENSOR_NOISE, TASK
+from .signals import TaskData, reset_signals, step_signals_range
+from .spec import TaskSpec, wind_spec
+
+__all__ = ["AscentFuncEnv", "AscentParams", "AscentState", "RENDER_STATIONS", "cached_timeline", "cached_vehicle"]
+
+#: an episode's (or a batch of episodes') whole state: the simulator's rows (:class:`~lvgym.simulator.SimData`),
+#: the task's rows (:data:`~.signals.TaskData`) and the events of the last step (one list per row)
+AscentState = namedtuple("AscentState", ["sim", "task", "events"])
+#: the explicit parameters: ``task`` (layout :data:`.layouts.TASK`), the timeline's
+#: :class:`~lvgym.simulator.Tables` and the simulator's step set-up
+AscentParams = namedtuple("AscentParams", ["task", "tables", "setup"])
+#: stations along the vehicle where the timeline also tabulates the mode shapes, for the rendered view
+RENDER_STATIONS = 21
+_REASONS = np.array(REASONS, dtype=object)
+_SIGNALS = Kernel(step_signals_range)      # row ranges on the simulator's threads
+
+
+@functools.lru_cache(maxsize=32)
+def cached_vehicle(key: Any) -> Vehicle:
+    """A shipped vehicle by name or path, or ``("slender", length, diameter[, aero_mach])`` for the
+    parametric one (``aero_mach``: Mach number its aerodynamic tables are frozen at, None: full tables)."""
+    if isinstance(key, tuple) and len(key) in (3, 4) and key[0] == "slender":
+        return slender_vehicle(length=float(key[1]), diameter=float(key[2]), aero_mach=key[3] if len(key) == 4 else None)
+    if isinstance(key, str):
+        return load_vehicle(key)
+    raise ValueError(f"vehicle = {key!r}: a shipped name, a YAML path or ('slender', length, diameter[, aero_mach])")
+
+
+@functools.lru_cache(maxsize=32)
+def cached_timeline(key: Any, model: str, t_end: float, physics_dt: float, n_modes: int | None,
+                    imu: float) -> Timeline:
+    """Timelines are shared between the envs of a process (they are read-only)."""
+    vehicle = cached_vehicle(key)
+    stations = [imu, *np.linspace(0.0, -vehicle.length, RENDER_STATIONS).tolist()]
+    return build_timeline(MassModel(vehicle), model, t_end, 0.05, n_modes, stations, 0.5 / physics_dt)
+
+
+def _rows(rows: Any) -> np.ndarray:
+    return np.atleast_1d(np.asarray(rows, dtype=np.int64))
+
+
+class AscentFuncEnv(FuncEnv):
+    """The ascent task of one :class:`~.spec.TaskSpec` as pure functions of an explicit state (see the
+    module docstring). Attributes: ``spec``, ``vehicle``, ``timeline``, ``sim`` (the
+    :class:`~lvgym.simulator.Simulator` whose constants it flies; its own ``data`` is unused unless an
+    adapter binds it), ``gimbal_limit`` [rad], ``imu`` station [m], ``n_steps``, ``observation_layout``
+    (:data:`.layouts.OBSERVATIONS` of the observation mode), ``action_space``, ``observation_space``
+    (of one row)."""
+
+    def __init__(self, spec: TaskSpec) -> None:
+        self.spec = s = spec
+        key = tuple(s.vehicle) if isinstance(s.vehicle, (list, tuple)) else str(s.vehicle)
+        self.vehicle = vehicle = cached_vehicle(key)
+        self.imu = s.imu_station_m if s.imu_station_m is not None else -0.25 * vehicle.length
+        self.timeline = tl = cached_timeline(key, s.model, s.mission_time_s + 1.0, s.physics_dt_s, s.n_modes, self.imu)
+        limits = [math.degrees(e.gimbal_limit) for e in vehicle.stages[0].engines if e.gimbal_limit is not None]
+        self.gimbal_limit = math.radians(s.gimbal_limit_deg if s.gimbal_limit_deg is not None
+                                         else (min(limits) if limits else 5.0))
+        servo = Servo(s.actuator_frequency, s.actuator_damping, self.gimbal_limit, math.radians(s.gimbal_rate_limit_degps))
+        self.sim = Simulator(vehicle, s.model, site=s.site, elevation_deg=s.elevation_deg,
+                             rail_length=s.rail_length_m, physics_dt=s.physics_dt_s, timeline=tl, servo=servo)
+        self.n_steps = int(round(s.mission_time_s / s.control_dt_s))
+        self.observation_layout = OBSERVATIONS[s.observation]
+        self.action_space = (spaces.Box(-1.0, 1.0, (2,), np.float32) if s.control == "tvc" else spaces.MultiDiscrete([3]))
+        self.observation_space = spaces.Box(-np.inf, np.inf, (self.observation_layout.size,), np.float32)
+        self._noisy = s.observation == "sensors" and "sensor_noise" in s.randomize
+        self._noise = [(getattr(s, key), self.observation_layout.slice(names[0]).start, len(names), per)
+                       for key, names, per in SENSOR_NOISE if names[0] in self.observation_layout]
+        lay = self.sim.layout
+        self._i_mb, self._i_J = lay.params["m_b"], lay.params["J_b"]
+        self._i_cg, self._i_om = lay.params["r_cg"], lay.params["omega_modes"]
+        self._i_zeta = [lay.slosh_param(j, "zeta") for j in range(self.sim.dynamics.n_slosh)]
+        super().__init__()
+
+    # ------------------------------------------------------------------------------ parameters
+    def get_default_params(self, **kwargs: Any) -> AscentParams:
+        """The parameters of ``spec``: the task vector (layout TASK), the timeline's tables, the step
+        set-up of the simulator."""
+        s = self.spec
+        task = TASK.pack({"on_after": s.controller_on_after_s, "dt": s.control_dt_s, "mission": s.mission_time_s,
+                          "rate_weights": s.rate_weights, "effort_weight": s.effort_weight,
+                          "effort_rate_weight": s.effort_rate_weight, "failure_penalty": s.failure_penalty_rad_per_s,
+                          "qalpha_limit": s.qalpha_limit_pa_deg, "attitude_limit": s.attitude_limit_deg,
+                          "gimbal_limit": self.gimbal_limit, "gravity_turn": float(s.reference == "gravity_turn"),
+                          "kick_start": s.kick_start_s, "kick_end": s.kick_end_s,
+                          "kick_angle": math.radians(s.kick_angle_deg), "sensors": float(s.observation == "sensors"),
+                          "n_steps": self.n_steps})
+        return AscentParams(task=task, tables=self.sim.tables, setup=self.sim.setup)
+
+    # ------------------------------------------------------------------------------ state
+    def new_state(self, batch: int) -> AscentState:
+        """Zeroed rows for ``batch`` episodes (reset them with :meth:`reset` before stepping)."""
+        B, n_obs = int(batch), self.observation_layout.size
+        task = TaskData(steps=np.zeros(B, dtype=np.int64), on=np.zeros(B, dtype=bool), on_step=np.zeros(B, dtype=bool),
+                        axis_ref_i=np.zeros((B, 3)), cum_error=np.zeros((B, 3)), rate_error=np.zeros((B, 3)),
+                        gyro_bias=np.zeros((B, 3)), obs=np.zeros((B, n_obs), dtype=np.float32), att=np.zeros((B, 2)),
+                        terms=REWARD.zeros(B), reward=np.zeros(B), reason=np.zeros(B, dtype=np.int64),
+                        truncated=np.zeros(B, dtype=bool), qalpha=np.zeros(B), mass=np.zeros(B))
+        return AscentState(sim=self.sim.new_data(B), task=task, events=[[] for _ in range(B)])
+
+    @staticmethod
+    def take(state: AscentState, rows: Any = None) -> AscentState:
+        """A copy of the rows ``rows`` (default all) of ``state``."""
+        idx = np.arange(len(state.task.steps)) if rows is None else _rows(rows)
+        return AscentState(sim=simdata.take(state.sim, idx), task=TaskData(*(a[idx].copy() for a in state.task)),
+                           events=[list(state.events[b]) for b in idx])
+
+    @staticmethod
+    def put(state: AscentState, rows: Any, src: AscentState) -> AscentState:
+        """Write the rows of ``src`` into the rows ``rows`` of ``state`` (in place; returns the state, a
+        new value when the simulator's context had to widen)."""
+        idx = _rows(rows)
+        sim = simdata.put(state.sim, idx, src.sim)
+        for a, b in zip(state.task, src.task):
+            if a.shape[1:] != b.shape[1:]:
+                raise ValueError(f"task rows of shape {b.shape[1:]} for {a.shape[1:]} (another observation mode?)")
+            a[idx] = b
+        events = list(state.events)
+        for i, b in enumerate(idx):
+            events[b] = list(src.events[i])
+        return AscentState(sim=sim, task=state.task, events=events)
+
+    # ------------------------------------------------------------------------------ FuncEnv
+    def initial(self, rng: Any, params: AscentParams | None = None) -> AscentState:
+        """A new state of ``len(rng)`` episodes on the pad (``rng``: a generator, or one per row)."""
+        rngs = [rng] if isinstance(rng, np.random.Generator) else list(rng)
+        state = self.new_state(len(rngs))
+        return self.reset(state, np.arange(len(rngs)), rngs, params)
+
+    def reset(self, state: AscentState, rows: Any, rng: Sequence[np.random.Generator],
+              params: AscentParams | None = None) -> AscentState:
+        """New episodes for the rows ``rows`` of ``state`` (in place), drawing from ``rng`` (one generator
+        per row); returns the state (a new value when the simulator's context had to widen)."""
+        params = self.default_params if params is None else params
+        rows, s = _rows(rows), self.spec
+        rngs = list(rng)
+        if len(rngs) != rows.size:
+            raise ValueError(f"{len(rngs)} generators for {rows.size} rows")
+        winds, scales, offsets, mis = [], [], [], []
+        ts = state.task
+        for b, g in zip(rows, rngs):
+            wind_rng = g if "wind" in s.randomize else np.random.default_rng(12345)
+            winds.append((wind_spec(s.wind, s.mission_time_s), wind_rng))
+            sc, of, m = self.dispersions(g)
+            scales.append(sc)
+            offsets.append(of)
+            mis.append(m)
+            ts.gyro_bias[b] = g.normal(0.0, s.gyro_bias_radps, 3) if "sensor_noise" in s.randomize else np.zeros(3)
+        sim = self.sim.reset_rows(rows, [w[1] for w in winds], [w[0] for w in winds], np.array(mis), np.array(scales),
+                                  np.array(offsets), data=state.sim)
+        ts.cum_error[rows] = 0.0
+        ts.rate_error[rows] = 0.0
+        ts.steps[rows] = 0
+        ts.terms[rows] = 0.0
+        ts.reward[rows] = 0.0
+        ts.reason[rows] = 0
+        ts.truncated[rows] = False
+        ts.qalpha[rows] = 0.0
+        reset_signals(rows, params.task, params.setup, sim, ts, params.tables)
+        self._add_noise(sim, ts, rows, rngs)
+        events = list(state.events)
+        for b in rows:
+            events[b] = []
+        return AscentState(sim=sim, task=ts, events=events)
+
+    def transition(self, state: AscentState, action: Any, rng: Sequence[np.random.Generator | None],
+                   params: AscentParams | None = None, *, inplace: bool = False) -> AscentState:
+        """The state one control period later, with ``action`` (B, 2) in [-1, 1] (``tvc``, clipped:
+        Gymnasium's convention for a Box) or (B, 1) in {0, 1, 2} (``rcs``: negative, no, positive roll
+        pulse). ``rng`` (B,): each row's generator for its sensor noise (None: the row draws nothing, e.g.
+        a row about to be reset). ``inplace``: reuse ``state``'s arrays (see the module docstring)."""
+        params = self.default_params if params is None else params
+        st = state if inplace else self.take(state)
+        s, sim, ts = self.spec, st.sim, st.task
+        B = ts.steps.size
+        on = ts.on
+        moment = None
+        if s.control == "tvc":
+            a = np.asarray(action, dtype=float).reshape(B, 2)
+            cmd = np.where(on[:, None], np.clip(a, -1.0, 1.0) * self.gimbal_limit, 0.0)
+        else:
+            a = np.asarray(action).reshape(B, -1)[:, 0].astype(float)
+            cmd = np.zeros((B, 2))
+            moment = np.zeros((B, 3))
+            moment[:, 0] = np.where(on, (a - 1.0) * s.rcs_torque_nm, 0.0)
+        events = self.sim.step(cmd, s.control_dt_s, moment, data=sim)
+        ts.steps[:] += 1
+        self.sim.run_rows(_SIGNALS, B, params.task, params.setup, sim, ts, params.tables)
+        if self._noisy:
+            self._add_noise(sim, ts, range(B), rng)
+        return AscentState(sim=sim, task=ts, events=events)
+
+    def observation(self, state: AscentState, rng: Any = None, params: AscentParams | None = None) -> np.ndarray:
+        """The observation (B, n_obs) float32 of every row: what the flight computer sampled (noise included)."""
+        return state.task.obs.copy()
+
+    def reward(self, state: AscentState | None, action: Any, next_state: AscentState, rng: Any = None,
+               params: AscentParams | None = None) -> np.ndarray:
+        """The reward (B,) of the transition into ``next_state`` (the sum of its ``reward_terms``)."""
+        return next_state.task.reward.copy()
+
+    def terminal(self, state: AscentState, rng: Any = None, params: AscentParams | None = None) -> np.ndarray:
+        """Whether each row ended (B,): a non-finite state, q-alpha or attitude error beyond the limit."""
+        return state.task.reason != 0
+
+    def truncation(self, state: AscentState, params: AscentParams | None = None) -> np.ndarray:
+        """Whether each row reached the mission time without terminating (B,)."""
+        return state.task.truncated.copy()
+
+    def transition_info(self, state: AscentState | None, action: Any, next_state: AscentState,
+                        params: AscentParams | None = None) -> dict[str, Any]:
+        """The per-row arrays of the Gymnasium ``info`` of the transition into ``next_state`` (it reads
+        ``next_state`` only)."""
+        sim, ts, tl = next_state.sim, next_state.task, self.timeline
+        cond = self.sim.conditions
+        i, w = tl.locate(sim.t)
+        return {"reward_terms": dict(zip(REWARD_TERMS, ts.terms.T.copy())),
+                "cumulative_rate_error": ts.cum_error.copy(), "rate_error": ts.rate_error.copy(),
+                "qbar": cond("qbar", sim).copy(), "mach": cond("mach", sim).copy(),
+                "alpha_total": cond("alpha_total", sim).copy(), "qalpha_pa_deg": ts.qalpha.copy(), "time": sim.t.copy(),
+                "stage": tl.stage[np.where(w >= 1.0, i + 1, i)], "controller_on": ts.on_step.copy(),
+                "slosh_angles": self.sim.slosh_angles(sim), "eta": self.sim.state("eta", sim).copy(),
+                "gimbal": self.gimbal(next_state), "attitude_error": ts.att.copy(), "mass": ts.mass.copy(),
+                "termination": _REASONS[ts.reason], "events": next_state.events}
+
+    def state_info(self, state: AscentState, params: AscentParams | None = None) -> dict[str, Any]:
+        """The per-row arrays of the Gymnasium ``info`` after a reset."""
+        ts = state.task
+        return {"time": state.sim.t.copy(), "cumulative_rate_error": ts.cum_error.copy(), "mass": ts.mass.copy(),
+                "controller_on": ts.on.copy()}
+
+    # ------------------------------------------------------------------------------ read-outs
+    def gimbal(self, state: AscentState) -> np.ndarray:
+        """Gimbal angles (B, 2) [rad] of every row."""
+        return ACTUATOR.view(state.sim.actuator, "gimbal").copy()
+
+    def dispersions(self, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Parameter scale and offset and thrust misalignment of one row, drawn from ``rng``.
+
+        mass: body mass x N(1, 1 %), CG station + N(0, 2 cm), inertia x N(1, 3 %); slosh_damping:
+        ratios x log-uniform [0.5, 2]; bending_frequency: x N(1, 5 %); thrust_misalignment: N(0, 0.05 deg)
+        per axis (clipped at 3 sigma)."""
+        n_p = self.sim.layout.n_p
+        scale, offset, mis = np.ones(n_p), np.zeros(n_p), np.zeros(2)
+        r = self.spec.randomize
+        if "mass" in r:
+            scale[self._i_mb] = 1.0 + np.clip(rng.normal(0.0, 0.01), -0.03, 0.03)
+            offset[self._i_cg.start] = np.clip(rng.normal(0.0, 0.02), -0.06, 0.06)
+            scale[self._i_J] = 1.0 + np.clip(rng.normal(0.0, 0.03), -0.09, 0.09)
+        if "slosh_damping" in r:
+            f = math.exp(rng.uniform(math.log(0.5), math.log(2.0)))
+            for sl in self._i_zeta:
+                scale[sl] = f
+        if "bending_frequency" in r:
+            scale[self._i_om] = 1.0 + np.clip(rng.normal(0.0, 0.05), -0.15, 0.15)
+        if "thrust_misalignment" in r:
+            mis = np.radians(np.clip(rng.normal(0.0, 0.05, 2), -0.15, 0.15))
+        return scale, offset, mis
+
+    def _add_noise(self, sim: SimData, ts: TaskData, rows: Any, rngs: Sequence[np.random.Generator | None]) -> None:
+        """Sensor noise on the observation of ``rows`` (layout SENSOR_NOISE), each row from its own
+        generator, when ``sensor_noise`` is randomised with the ``sensors`` observation."""
+        if not self._noisy:
+            return
+        obs = ts.obs
+        for b, g in zip(rows, rngs):
+            if g is None or sim.failed[b]:
+                continue
+            for sigma, start, n, per in self._noise:
+                obs[b, start:start + n] += g.normal(0.0, sigma, n) / per

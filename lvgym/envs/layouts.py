@@ -1,0 +1,111 @@
+"""Every packed vector of the ascent task, described once (see :mod:`lvgym.packing`).
+
+- :data:`TASK`: the task's parameters, one vector per env (``task``), read by the compiled signals.
+- :data:`OBSERVATIONS`: the observation of each ``observation`` mode (an interface: trained policies
+  depend on it, so it is never padded and never reordered; a new channel is a new entry at the end and a
+  new env version). Entries that mean the same in both modes have the same name and index; entries 5
+  and 6 are the angles of attack in ``state`` and the accelerometers in ``sensors``.
+- :data:`SENSOR_NOISE`: which observation entries each sensor's noise is added to.
+- :data:`REWARD`: the reward terms, in ``info["reward_terms"]`` and in the compiled kernel's order.
+- :data:`REASONS`: the termination codes.
+
+The env docstrings print these tables (:func:`observation_table`), so the docs are the layout.
+"""
+
+from __future__ import annotations
+
+from lvgym.packing import Field, Packed, rst_table
+
+__all__ = ["G0", "OBSERVATIONS", "OBS_SENSORS", "OBS_STATE", "REASONS", "REWARD", "REWARD_TERMS", "SENSOR_NOISE",
+           "TASK", "O", "OS", "RW", "T", "observation_table"]
+
+G0 = 9.80665
+
+#: parameters of one ascent task (built from its :class:`~.spec.TaskSpec`)
+TASK = Packed("task parameters", [
+    Field("on_after", 1, "s", "the controller acts from this time on (and while an engine burns)"),
+    Field("dt", 1, "s", "control period"),
+    Field("mission", 1, "s", "mission time (truncation)"),
+    Field("rate_weights", 3, "1/rad", "reward weights of the roll, pitch and yaw rate errors"),
+    Field("effort_weight", 1, "1/(rad s)", "reward weight of the gimbal effort"),
+    Field("effort_rate_weight", 1, "1/rad", "reward weight of the gimbal rate effort"),
+    Field("failure_penalty", 1, "1/s", "reward charged per second of mission left at a termination"),
+    Field("qalpha_limit", 1, "Pa deg", "structural limit of dynamic pressure times total angle of attack"),
+    Field("attitude_limit", 1, "deg", "largest attitude error"),
+    Field("gimbal_limit", 1, "rad", "gimbal limit: the action's scale"),
+    Field("gravity_turn", 1, "-", "1: the reference is the gravity-turn programme, 0: zero rate"),
+    Field("kick_start", 1, "s", "start of the pitch kick"),
+    Field("kick_end", 1, "s", "end of the pitch kick"),
+    Field("kick_angle", 1, "rad", "angle of the pitch kick"),
+    Field("sensors", 1, "-", "1: the sensors observation, 0: the ideal state"),
+    Field("n_steps", 1, "-", "control steps of the mission"),
+])
+
+_COMMON_HEAD = [
+    Field("roll_rate", 1, "rad/s", "body roll rate"),
+    Field("pitch_rate_error", 1, "rad/s", "pitch rate minus the reference pitch rate"),
+    Field("yaw_rate_error", 1, "rad/s", "yaw rate"),
+    Field("pitch_attitude_error", 1, "rad", "body axis against the reference axis, about body y"),
+    Field("yaw_attitude_error", 1, "rad", "the same about body z"),
+]
+_COMMON_TAIL = [
+    Field("mach_over_10", 1, "-", "Mach number / 10"),
+    Field("qbar_over_1e5", 1, "-", "dynamic pressure / 1e5 Pa"),
+    Field("gimbal_pitch", 1, "-", "actuator position over the gimbal limit, pitch"),
+    Field("gimbal_yaw", 1, "-", "the same, yaw"),
+    Field("time_fraction", 1, "-", "time / mission time"),
+    Field("controller_on", 1, "-", "1 when the controller acts at the next step (off before controller_on_after_s "
+          "and while no engine burns)"),
+    Field("pitch_rate_reference", 1, "rad/s", "reference pitch rate (zero, or the gravity-turn programme)"),
+]
+#: ``observation="state"``: the ideal state of the vehicle (a research option)
+OBS_STATE = Packed("observation (state)", _COMMON_HEAD + [
+    Field("alpha", 1, "rad", "angle of attack"),
+    Field("beta", 1, "rad", "sideslip"),
+] + _COMMON_TAIL, interface=True)
+#: ``observation="sensors"``: a rate gyro at the IMU station (it sees the bending slope rate; bias and noise
+#: with ``sensor_noise``), a noisy attitude and two accelerometers
+OBS_SENSORS = Packed("observation (sensors)", [
+    Field("roll_rate", 1, "rad/s", "gyro roll rate at the IMU station (bias, noise)"),
+    Field("pitch_rate_error", 1, "rad/s", "gyro pitch rate at the IMU (sees the bending slope rate) minus the "
+          "reference"),
+    Field("yaw_rate_error", 1, "rad/s", "gyro yaw rate at the IMU"),
+    Field("pitch_attitude_error", 1, "rad", "body axis against the reference axis, about body y (noise)"),
+    Field("yaw_attitude_error", 1, "rad", "the same about body z (noise)"),
+    Field("accel_z", 1, "g0", "lateral specific force along body z over g0 (accelerometer, noise)"),
+    Field("accel_y", 1, "g0", "lateral specific force along body y over g0 (accelerometer, noise)"),
+] + _COMMON_TAIL, interface=True)
+OBSERVATIONS = {"state": OBS_STATE, "sensors": OBS_SENSORS}
+#: per sensor: the TaskSpec key of its noise's standard deviation, the observation entries it is added
+#: to (consecutive) and the divisor that takes it to the entries' unit
+SENSOR_NOISE = (("gyro_noise_radps", ("roll_rate", "pitch_rate_error", "yaw_rate_error"), 1.0),
+                ("attitude_noise_rad", ("pitch_attitude_error", "yaw_attitude_error"), 1.0),
+                ("accel_noise_mps2", ("accel_z", "accel_y"), G0))
+
+#: the reward terms; they add up to the reward
+REWARD = Packed("reward terms", [
+    Field("rate_roll", 1, "rad", "-w_roll |roll rate error| dt"),
+    Field("rate_pitch", 1, "rad", "-w_pitch |pitch rate error| dt"),
+    Field("rate_yaw", 1, "rad", "-w_yaw |yaw rate error| dt"),
+    Field("effort", 1, "-", "-effort_weight * integral of (|gimbal pitch| + |gimbal yaw|) dt over the step"),
+    Field("effort_rate", 1, "-", "-effort_rate_weight * integral of |gimbal rates| dt over the step"),
+    Field("failure", 1, "rad", "on termination, -failure_penalty_rad_per_s * the mission time left"),
+], interface=True)
+REWARD_TERMS = REWARD.names
+#: termination codes (the order is the precedence: a later one overrides an earlier one)
+REASONS = ("", "attitude error beyond the limit", "q-alpha beyond the structural limit", "non-finite state")
+
+T, O, OS, RW = TASK.at, OBS_STATE.at, OBS_SENSORS.at, REWARD.at
+assert OBS_STATE.size == OBS_SENSORS.size and all(
+    OBS_STATE.offset(n) == OBS_SENSORS.offset(n) for n in OBS_STATE.names if n in OBS_SENSORS)
+
+
+def observation_table() -> str:
+    """The observation of both modes as one reStructuredText table (for the env docstrings)."""
+    rows = []
+    for (o, f), (_, g) in zip(OBS_STATE.leaves(), OBS_SENSORS.leaves()):
+        name = f"``{f.name}``" if f.name == g.name else f"``{f.name}`` / ``{g.name}``"
+        meaning = f.doc if f.name == g.name and f.doc == g.doc else f"state: {f.doc}; sensors: {g.doc}"
+        unit = f.unit if f.unit == g.unit else f"{f.unit} / {g.unit}"
+        rows.append([str(o), name, unit, meaning])
+    return rst_table(["index", "name (state / sensors)", "unit", "meaning"], rows)

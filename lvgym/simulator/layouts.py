@@ -1,0 +1,135 @@
+"""Every packed vector of the simulator, described once (names, sizes, units; see :mod:`lvgym.packing`).
+
+Per row of a batch the simulator keeps one :class:`~.data.SimData` (the row state) whose arrays use
+these layouts; the compiled functions read their offsets from the ``.at`` namedtuples below
+(``ctx[CTX.gimbal + 1]``, ``cond[D.qbar]``), Python code reads by name
+(``CONDITIONS.view(data.conditions, "qbar")``).
+
+- :data:`CONTEXT` (``ctx``): what the loads function needs at every RK4 stage besides the state and
+  the dynamics parameters: the commands held over a physics step, the thrust of the current piece,
+  offsets of the environment models' parameter blocks packed behind this header, a cache and scratch.
+- :data:`AERO` one aerodynamic block's offsets (the one in force is in the header; the table of
+  contents holds one per stage).
+- :data:`TRIG` the thrust direction's cached angles.
+- :data:`CONDITIONS` (``cond``): the flight conditions of one state, what the recorder, the task and a
+  policy see.
+- :data:`RAIL` the launch rail (one per simulator), :data:`RAIL_STATE` the row's motion along it.
+- :data:`SERVO` the gimbal servo's parameters, :data:`ACTUATOR` the row's command, gimbal and effort.
+"""
+
+from __future__ import annotations
+
+from lvgym.environment.aerokernels import FLOW
+from lvgym.environment.atmosphere import AIR
+from lvgym.packing import Field, Packed
+
+__all__ = ["ACTUATOR", "AERO", "CONDITIONS", "CONTEXT", "RAIL", "RAIL_STATE", "SERVO", "TRIG",
+           "A", "CTX", "D", "RL", "RS", "SV", "TG", "AE"]
+
+#: flight conditions of one state at one time
+CONDITIONS = Packed("flight conditions", [
+    Field("altitude", 1, "m", "geodetic altitude above the WGS84 ellipsoid (or the flat Earth)"),
+    Field("air", AIR.size, "-", "the atmosphere model's output (layout AIR)", sub=AIR),
+    Field("wind_n", 3, "m/s", "wind velocity, local north-east-down"),
+    Field("v_air_b", 3, "m/s", "velocity relative to the air, body frame"),
+    Field("flow", FLOW.size, "-", "the aerodynamic model's flow state (layout FLOW)", sub=FLOW),
+    Field("f_aero_b", 3, "N", "aerodynamic force, body frame"),
+    Field("m_aero_b", 3, "N m", "aerodynamic moment about the CG of B, body frame"),
+    Field("f_aero_i", 3, "N", "aerodynamic force, inertial frame"),
+    Field("g_i", 3, "m/s^2", "gravitational acceleration, inertial frame"),
+    Field("thrust", 1, "N", "thrust max(T_0 - A_e p, 0)"),
+    Field("thrust_b", 3, "N", "thrust in the undeformed engine frame (body axes), gimbal and misalignment applied"),
+])
+
+#: offsets of one aerodynamic model's blocks in the context (entries are indices into ``ctx``)
+AERO = Packed("aerodynamic block", [
+    Field("params", 1, "-", "offset of the model's parameters"),
+    Field("grid", 1, "-", "offset of the table's grid"),
+    Field("dims", 1, "-", "offset of the grid's dimensions"),
+    Field("table", 1, "-", "offset of the coefficient table"),
+    Field("n_col", 1, "-", "columns of the table"),
+    Field("end", 1, "-", "end of the block"),
+])
+
+#: thrust direction cache: recomputed only when the angles change (the gimbal is held over an RK4 step)
+TRIG = Packed("thrust angle cache", [
+    Field("pitch", 1, "rad", "gimbal + misalignment, pitch (NaN: empty)"),
+    Field("yaw", 1, "rad", "gimbal + misalignment, yaw"),
+    Field("cos_pitch", 1, "-", "its cosine"),
+    Field("sin_pitch", 1, "-", "its sine"),
+    Field("cos_yaw", 1, "-", ""),
+    Field("sin_yaw", 1, "-", ""),
+])
+
+#: header of the per-row context; the models' parameter blocks follow it (their offsets are in it)
+CONTEXT = Packed("simulator context", [
+    Field("gimbal", 2, "rad", "gimbal angles in force (pitch, yaw): the servo's position, held over a physics step"),
+    Field("misalignment", 2, "rad", "fixed thrust misalignment (pitch, yaw), drawn at reset"),
+    Field("moment_b", 3, "N m", "commanded body moment (reaction control), held over the control period"),
+    Field("thrust0", 1, "N", "vacuum thrust T_0 of the current piece (timeline, at its middle)"),
+    Field("exit_area", 1, "m^2", "total nozzle exit area of the current piece"),
+    Field("time0", 1, "s", "start time of the current piece: the stepper's time is relative to it"),
+    Field("aero_on", 1, "-", "1: aerodynamic loads, 0: none (flow angles only)"),
+    Field("site", 1, "-", "offset of the launch site's block"),
+    Field("gravity", 1, "-", "offset of the gravity model's block"),
+    Field("atmosphere", 1, "-", "offset of the atmosphere model's block"),
+    Field("wind", 1, "-", "offset of the wind model's block"),
+    Field("wind_end", 1, "-", "end of the wind model's block"),
+    Field("aero", AERO.size, "-", "the aerodynamic block in force (layout AERO)"),
+    Field("stage", 1, "-", "the stage whose aerodynamic block is in force (the lowest attached one)"),
+    Field("n_stages", 1, "-", "rows of the aerodynamic table of contents"),
+    Field("toc", 1, "-", "offset of the table of contents: one AERO row per stage"),
+    Field("gravity_work", 1, "-", "offset of the gravity kernel's scratch block"),
+    Field("trig", TRIG.size, "-", "thrust angle cache (layout TRIG)"),
+    Field("scratch", CONDITIONS.size, "-", "flight conditions of the latest RK4 stage (layout CONDITIONS)"),
+    Field("scratch_dcm", 9, "-", "a 3x3 matrix of scratch"),
+])
+
+#: the launch rail of a simulator
+RAIL = Packed("launch rail", [
+    Field("omega_e", 1, "rad/s", "Earth rotation rate (0 on a flat Earth)"),
+    Field("x_base", 1, "m", "station of the vehicle's base"),
+    Field("length", 1, "m", "rail length"),
+    Field("r_pad_e", 3, "m", "pad position, Earth-fixed (the inertial frame at t = 0)"),
+    Field("axis_e", 3, "-", "unit vector along the rail, Earth-fixed"),
+    Field("q_bi0", 4, "-", "attitude on the rail at t = 0 (scalar first)"),
+])
+
+#: a row's motion on the pad and rail
+RAIL_STATE = Packed("rail state", [
+    Field("on", 1, "-", "1 while held on the pad or rail"),
+    Field("lifted", 1, "-", "1 once lifted off"),
+    Field("s", 1, "m", "travel of the structure along the rail (frozen at rail exit)"),
+    Field("t_lift", 1, "s", "lift-off time (NaN before)"),
+    Field("t_exit", 1, "s", "rail exit time (NaN before)"),
+])
+
+#: parameters of the gimbal servo (one per simulator)
+SERVO = Packed("servo parameters", [
+    Field("on", 1, "-", "1: second-order servo; 0: the gimbal takes the command at once"),
+    Field("frequency", 1, "rad/s", "natural frequency"),
+    Field("damping", 1, "-", "damping ratio"),
+    Field("limit", 1, "rad", "position limit"),
+    Field("rate_limit", 1, "rad/s", "rate limit"),
+])
+
+#: a row's actuator: the command, the servo's state and the effort over the last control period
+ACTUATOR = Packed("actuator", [
+    Field("command", 2, "rad", "gimbal command (pitch, yaw) held over the control period"),
+    Field("gimbal", 2, "rad", "gimbal angles (pitch, yaw): the servo's position"),
+    Field("gimbal_rate", 2, "rad/s", "gimbal rates"),
+    Field("effort", 1, "rad s", "integral of |gimbal pitch| + |gimbal yaw| over the last control period"),
+    Field("effort_rate", 1, "rad", "integral of |gimbal rate pitch| + |gimbal rate yaw| over the last control period"),
+])
+
+#: offsets for compiled code
+CTX, AE, TG, D = CONTEXT.at, AERO.at, TRIG.at, CONDITIONS.at
+RL, RS, SV, A = RAIL.at, RAIL_STATE.at, SERVO.at, ACTUATOR.at
+
+
+def _doc() -> str:
+    return "\n\n".join(f"``{lay.title}`` ({lay.size} entries):\n\n{lay.table()}" for lay in
+                       (CONTEXT, AERO, TRIG, CONDITIONS, RAIL, RAIL_STATE, SERVO, ACTUATOR))
+
+
+__doc__ = (__doc__ or "") + "\n" + _doc()
