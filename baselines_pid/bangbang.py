@@ -1,10 +1,11 @@
 """Bang-bang roll-rate control with reaction-control pulses (thesis 5.2-5.3, Stratos III/IV).
 
 ``lvgym/StratosIII-v0`` (``control="rcs"``) takes ``MultiDiscrete([3])`` actions: 0 a negative roll
-torque, 1 none, 2 a positive one. The law fires against the roll rate (obs[0], rad/s) when its size
+torque, 1 none, 2 a positive one. The law fires against the roll rate (``roll_rate``, rad/s) when its size
 exceeds the deadband, with a hysteresis: once firing, it keeps firing until the rate is back inside
 ``release_fraction`` of the deadband (fewer pulses than a plain relay chattering on the deadband edge).
-It is off while the env's controller-on flag (obs[12]) is 0.
+It is off while the env's controller-on flag (``controller_on``) is 0. The entries are read by name from
+the observation layout (:data:`lvgym.envs.layouts.OBSERVATIONS`; both modes have them at the same index).
 """
 
 from __future__ import annotations
@@ -14,7 +15,10 @@ from typing import Any
 
 import numpy as np
 
+from lvgym.envs.layouts import OBS_STATE
+
 NEGATIVE, NONE, POSITIVE = 0, 1, 2
+_ROLL, _ON = OBS_STATE.index("roll_rate"), OBS_STATE.index("controller_on")
 
 
 class BangBangRollPolicy:
@@ -48,4 +52,4 @@ class BangBangRollPolicy:
 
     def act(self, observation: np.ndarray, info: dict[str, Any]) -> np.ndarray:
         obs = np.asarray(observation, dtype=float)
-        return np.array([self.command(float(obs[0]), float(obs[12]) >= 0.5)], dtype=np.int64)
+        return np.array([self.command(float(obs[_ROLL]), float(obs[_ON]) >= 0.5)], dtype=np.int64)

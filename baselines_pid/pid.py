@@ -22,14 +22,20 @@ units of its Simulink model: rad of gimbal per rad/s of rate error (Kp), per rad
 The ratios are the same in degrees (deg of gimbal per deg/s). The policies below divide the gimbal angle
 by the gimbal limit to give the env's action in [-1, 1].
 
-Signs. The env's observation holds the rate error ``rate - reference`` (obs[1] pitch, obs[2] yaw); a
-positive pitch (yaw) gimbal gives a positive pitch (yaw) rate (checked by experiment in the tests), so the
-policy feeds ``e = -obs[1:3]`` to the law and commands ``u``.
+Signs. The env's observation holds the rate error ``rate - reference`` (entries ``pitch_rate_error``
+and ``yaw_rate_error`` of the env's observation layout); a positive pitch (yaw) gimbal gives a positive
+pitch (yaw) rate (checked by experiment in the tests), so the policy feeds ``e = -(rate error)`` to the
+law and commands ``u``.
+
+Facts from the env. The policies are built for an env (``env=``, as the benchmark does) and take from it
+what they would otherwise work out again: the gimbal limit (the action's scale and the output limit), the
+control period, and the observation layout; at every step the env's ``info`` gives the time and the
+stack's mass, and the observation the controller-on flag (off before the controller starts and during
+staging coasts).
 
 Scheduling (:class:`GainSchedule`): gains interpolated linearly on a monotonic scheduling variable,
-``mass`` (the default, as the thesis: the vehicle mass at the current time, from the vehicle's mass model
-tabulated over the mission once at construction), ``time`` [s] or ``mach``; beyond the table the end
-gains are held.
+``mass`` (the default, as the thesis: ``info["mass"]``, the vehicle's mass at the current time), ``time``
+[s] or ``mach``; beyond the table the end gains are held.
 """
 
 from __future__ import annotations
@@ -37,7 +43,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Sequence
+from typing import Any
 
 import numpy as np
 import yaml
@@ -46,8 +52,6 @@ SCHEDULES = Path(__file__).resolve().parent / "schedules"
 VARIABLES = ("mass", "time", "mach")
 #: the thesis's single gain set (6.3.1), tuned on the rigid SMILE at 28.8 s; N as Table 6.10's 28.8 s row
 THESIS_SINGLE = {"kp": 8.98, "ki": 3.92, "kd": 4.57, "n": 500.0}
-#: controller off-windows of the thesis's SMILE study: the first 2 s and the staging coast [s]
-SMILE_OFF_WINDOWS = ((0.0, 2.0), (43.0, 45.0))
 
 
 class DiscretePID:
@@ -160,35 +164,27 @@ class GainSchedule:
             return cls.from_dict(yaml.safe_load(f))
 
 
-def mass_of_time(vehicle: str = "smile", t_end: float = 60.0, dt: float = 0.05):
-    """Vehicle mass [kg] as a function of time [s], tabulated from the mass model (one evaluation at
-    construction; staging drops are kept by the timeline's rows on both sides of each event)."""
-    from lvgym.simulator import build_timeline
-    from lvgym.vehicle import MassModel, load_vehicle
-
-    tl = build_timeline(MassModel(load_vehicle(vehicle)), "rigid", t_end, dt)
-    return lambda t: float(tl.interp("mass", [t])[0])
-
-
 class PIDPolicy:
     """Pitch and yaw rate PID (identical gains per axis, the vehicle being axisymmetric) as a benchmark
     :class:`~lvgym.benchmark.policy.Policy` of the TVC envs.
 
-    ``gimbal_limit_deg``: the env's action scale (the action is gimbal / limit) and the output limit;
-    ``off_windows``: time windows [s] where the controller is off, besides the env's controller-on flag
-    (obs[12]); ``mission_time_s``: reads the time from obs[11] when ``info`` has none (right after reset).
+    ``env``: the lvgym env (single or vector) it flies; the gimbal limit (the action is gimbal / limit,
+    also the output limit), the control period and the observation's layout come from it. The controller
+    acts while the observation's ``controller_on`` entry is 1. ``act`` needs ``info["time"]`` (every lvgym
+    ``info`` has it, the reset's too).
     """
 
     def __init__(self, kp: float = THESIS_SINGLE["kp"], ki: float = THESIS_SINGLE["ki"],
-                 kd: float = THESIS_SINGLE["kd"], n: float | None = THESIS_SINGLE["n"], *, dt: float = 0.02,
-                 gimbal_limit_deg: float = 5.0, mission_time_s: float = 60.0,
-                 off_windows: Sequence[tuple[float, float]] = SMILE_OFF_WINDOWS, name: str = "pid") -> None:
+                 kd: float = THESIS_SINGLE["kd"], n: float | None = THESIS_SINGLE["n"], *, env: Any,
+                 name: str = "pid") -> None:
+        task = env.unwrapped
         self.name = name
-        self.dt = float(dt)
-        self.limit = math.radians(gimbal_limit_deg)
-        self.mission_time_s = float(mission_time_s)
-        self.off_windows = tuple((float(a), float(b)) for a, b in off_windows)
-        self.axes = [DiscretePID(kp, ki, kd, n, dt, -self.limit, self.limit) for _ in range(2)]
+        self.dt = float(task.task.control_dt_s)
+        self.limit = float(task.gimbal_limit)
+        lay = task.observation_layout
+        self._i_err = [lay.index("pitch_rate_error"), lay.index("yaw_rate_error")]
+        self._i_on, self._i_mach = lay.index("controller_on"), lay.index("mach_over_10")
+        self.axes = [DiscretePID(kp, ki, kd, n, self.dt, -self.limit, self.limit) for _ in range(2)]
         self.last_gimbal = np.zeros(2)
 
     def reset(self) -> None:
@@ -196,75 +192,63 @@ class PIDPolicy:
             pid.reset()
         self.last_gimbal = np.zeros(2)
 
-    def time(self, observation: np.ndarray, info: dict[str, Any]) -> float:
-        t = info.get("time") if info else None
-        return float(t) if t is not None else float(observation[11]) * self.mission_time_s
+    def enabled(self, observation: np.ndarray) -> bool:
+        """The env's controller-on flag for the coming step."""
+        return float(observation[self._i_on]) >= 0.5
 
-    def enabled(self, observation: np.ndarray, t: float) -> bool:
-        if float(observation[12]) < 0.5:
-            return False
-        return not any(a <= t < b for a, b in self.off_windows)
-
-    def schedule_gains(self, observation: np.ndarray, t: float) -> None:
+    def schedule_gains(self, observation: np.ndarray, info: dict[str, Any]) -> None:
         """Hook for gain scheduling (nothing for fixed gains)."""
 
     def act(self, observation: np.ndarray, info: dict[str, Any]) -> np.ndarray:
         obs = np.asarray(observation, dtype=float)
-        t = self.time(obs, info)
-        on = self.enabled(obs, t)
-        self.schedule_gains(obs, t)
-        errors = -obs[1:3]                            # reference - rate, pitch and yaw
+        on = self.enabled(obs)
+        self.schedule_gains(obs, info)
+        errors = -obs[self._i_err]                    # reference - rate, pitch and yaw
         self.last_gimbal = np.array([pid.update(e, on) for pid, e in zip(self.axes, errors)])
         return np.clip(self.last_gimbal / self.limit, -1.0, 1.0).astype(np.float32)
 
 
 class GainScheduledPIDPolicy(PIDPolicy):
-    """:class:`PIDPolicy` with gains from a :class:`GainSchedule` updated at every step.
+    """:class:`PIDPolicy` with gains from a :class:`GainSchedule` updated at every step: on ``mass``
+    (``info["mass"]`` [kg]), ``time`` (``info["time"]`` [s]) or ``mach`` (the observation's Mach entry)."""
 
-    ``mass``: the vehicle's mass as a function of time (a callable of t [s]; default: tabulated from the
-    mass model of ``vehicle``); ``time``: the env's time; ``mach``: obs[7] * 10."""
-
-    def __init__(self, schedule: GainSchedule | str | Path, *, vehicle: str = "smile", mass_fn=None,
-                 name: str = "gs-pid", **kw: Any) -> None:
+    def __init__(self, schedule: GainSchedule | str | Path, *, env: Any, name: str = "gs-pid") -> None:
         self.schedule = schedule if isinstance(schedule, GainSchedule) else GainSchedule.load(schedule)
         g = self.schedule.gains(self.schedule.points[0])
-        super().__init__(*g, name=name, **kw)
-        self.mass_fn = mass_fn
-        if self.schedule.variable == "mass" and mass_fn is None:
-            self.mass_fn = mass_of_time(vehicle, max(self.mission_time_s, 1.0))
+        super().__init__(*g, env=env, name=name)
         self.value = float("nan")
 
-    def variable(self, observation: np.ndarray, t: float) -> float:
+    def variable(self, observation: np.ndarray, info: dict[str, Any]) -> float:
         v = self.schedule.variable
         if v == "mass":
-            return self.mass_fn(t)
+            return float(info["mass"])
         if v == "time":
-            return t
-        return float(observation[7]) * 10.0
+            return float(info["time"])
+        return float(observation[self._i_mach]) * 10.0
 
-    def schedule_gains(self, observation: np.ndarray, t: float) -> None:
-        self.value = self.variable(observation, t)
+    def schedule_gains(self, observation: np.ndarray, info: dict[str, Any]) -> None:
+        self.value = self.variable(observation, info)
         g = self.schedule.gains(self.value)
         for pid in self.axes:
             pid.set_gains(*g)
 
 
 # ---------------------------------------------------------------------------- presets
-def smile_single_pid(**kw: Any) -> PIDPolicy:
-    """The thesis's single gain set (Kp 8.98, Ki 3.92, Kd 4.57, N 500) on SMILE."""
-    return PIDPolicy(name=kw.pop("name", "pid-thesis"), **kw)
+def smile_single_pid(env: Any, name: str = "pid-thesis") -> PIDPolicy:
+    """The thesis's single gain set (Kp 8.98, Ki 3.92, Kd 4.57, N 500) on SMILE's ``env``."""
+    return PIDPolicy(env=env, name=name)
 
 
-def smile_scheduled_pid(schedule: str = "smile_thesis", **kw: Any) -> GainScheduledPIDPolicy:
-    """Gain-scheduled PID on SMILE: ``smile_thesis`` (Table 6.10, on mass) or ``smile`` (our tuning)."""
-    return GainScheduledPIDPolicy(schedule, vehicle="smile", name=kw.pop("name", f"gs-pid-{schedule}"), **kw)
+def smile_scheduled_pid(env: Any, schedule: str = "smile_thesis", name: str | None = None) -> GainScheduledPIDPolicy:
+    """Gain-scheduled PID on SMILE's ``env``: ``smile_thesis`` (Table 6.10, on mass) or ``smile`` (our tuning)."""
+    return GainScheduledPIDPolicy(schedule, env=env, name=name or f"gs-pid-{schedule}")
 
 
-def smile_tuned_pid(schedule: str = "smile", t_design: float = 28.8, **kw: Any) -> PIDPolicy:
+def smile_tuned_pid(env: Any, schedule: str = "smile", t_design: float = 28.8, name: str = "pid") -> PIDPolicy:
     """One gain set from our rigid tuning: the row of ``schedules/<schedule>.yaml`` nearest ``t_design``
-    [s] (28.8 s, the thesis's design point), held over the flight."""
+    [s] (28.8 s, the thesis's design point), held over the flight of ``env``."""
     ours = GainSchedule.load(schedule)
     rows = ours.meta["rows"]
     i = int(np.argmin(np.abs(np.array([r["time_s"] for r in rows]) - t_design)))
-    return PIDPolicy(*ours.gains(ours.points[i]), name=kw.pop("name", "pid"), **kw)
+    return PIDPolicy(*ours.gains(ours.points[i]), env=env, name=name)
 

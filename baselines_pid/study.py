@@ -32,19 +32,24 @@ THESIS = {  # cumulative rate error over 60 s [rad] (thesis 6.3.1, figures 6.21 
 
 
 def controllers() -> dict[str, Any]:
+    """The study's controllers: name -> a function of the env that builds the policy for it."""
     ours = GainSchedule.load("smile")
     i = int(np.argmin(np.abs(np.array([r["time_s"] for r in ours.meta["rows"]]) - 28.8)))
     single = ours.gains(ours.points[i])
-    return {"uncontrolled": lambda: ZeroPolicy(),
-            "pid-thesis": lambda: smile_single_pid(name="pid-thesis"),
-            "gs-pid-thesis": lambda: smile_scheduled_pid("smile_thesis", name="gs-pid-thesis"),
-            "pid-tuned": lambda: PIDPolicy(*single, name="pid-tuned"),
-            "gs-pid-tuned": lambda: smile_scheduled_pid("smile", name="gs-pid-tuned")}
+    return {"uncontrolled": lambda env: ZeroPolicy(),
+            "pid-thesis": lambda env: smile_single_pid(env, name="pid-thesis"),
+            "gs-pid-thesis": lambda env: smile_scheduled_pid(env, "smile_thesis", name="gs-pid-thesis"),
+            "pid-tuned": lambda env: PIDPolicy(*single, env=env, name="pid-tuned"),
+            "gs-pid-tuned": lambda env: smile_scheduled_pid(env, "smile", name="gs-pid-tuned")}
 
 
-def fly(policy: Any, model: str, wind: str = "profile", seed: int = 0, **options: Any) -> dict[str, np.ndarray]:
-    """One 60 s episode; returns time, pitch/yaw rate errors, gimbal and cumulative errors per step."""
+def fly(make: Any, model: str, wind: str = "profile", seed: int = 0, **options: Any) -> dict[str, np.ndarray]:
+    """One 60 s episode of the policy ``make(env)``; returns time, pitch/yaw rate errors, gimbal and
+    cumulative errors per step."""
     env = gym.make("lvgym/SmileAscent-v0", model=model, wind=wind, **options)
+    policy = make(env)
+    lay = env.unwrapped.observation_layout
+    cols = [lay.index(n) for n in ("pitch_rate_error", "yaw_rate_error", "gimbal_pitch", "gimbal_yaw")]
     obs, info = env.reset(seed=seed)
     policy.reset()
     rows, done = [], False
@@ -53,7 +58,7 @@ def fly(policy: Any, model: str, wind: str = "profile", seed: int = 0, **options
         obs, _, term, trunc, info = env.step(action)
         done = term or trunc
         cum = info["cumulative_rate_error"]
-        rows.append((info["time"], obs[1], obs[2], obs[9], obs[10], cum[1], cum[2]))
+        rows.append((info["time"], *obs[cols], cum[1], cum[2]))
     a = np.array(rows, dtype=float)
     return {"t": a[:, 0], "pitch": a[:, 1], "yaw": a[:, 2], "gimbal": a[:, 3:5], "cum_pitch": a[:, 5],
             "cum_yaw": a[:, 6], "termination": info.get("termination", ""), "t_end": float(a[-1, 0])}
@@ -99,7 +104,7 @@ def study(wind: str = "profile", out: Path | None = None, names=None, log=print)
     for name, make in controllers().items():
         if names and name not in names:
             continue
-        runs = {model: fly(make(), model, wind) for model in ("rigid", "nonrigid")}
+        runs = {model: fly(make, model, wind) for model in ("rigid", "nonrigid")}
         results[name] = {m: {"cum_pitch_rad": float(r["cum_pitch"][-1]), "cum_yaw_rad": float(r["cum_yaw"][-1]),
                              "cum_pitch_before_staging_rad": float(np.interp(43.0, r["t"], r["cum_pitch"])),
                              "cum_yaw_before_staging_rad": float(np.interp(43.0, r["t"], r["cum_yaw"])),

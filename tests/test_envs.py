@@ -6,7 +6,7 @@ import pytest
 from gymnasium.utils.env_checker import check_env as gym_check_env
 
 import lvgym  # noqa: F401  (registers the envs)
-from lvgym.envs import OBS_NAMES, REWARD_TERMS, TaskSpec
+from lvgym.envs import OBS_STATE, REWARD_TERMS, TaskSpec
 from lvgym.errors import ConfigError
 
 ENV_IDS = ("lvgym/SmileAscent-v0", "lvgym/StratosIII-v0", "lvgym/SlenderAscent-v0")
@@ -77,7 +77,7 @@ def test_controller_is_off_during_the_staging_coast():
     env = gym.make("lvgym/SmileAscent-v0", model="rigid").unwrapped
     env.reset(seed=0)
     ons = {}
-    while env.core.sim.t[0] < 45.5:
+    while env.sim.t[0] < 45.5:
         _, _, term, trunc, info = env.step(np.zeros(2, dtype=np.float32))
         ons[round(info["time"], 2)] = info["controller_on"]
         assert not term
@@ -143,7 +143,7 @@ def test_bad_options_name_the_key():
 
 def test_observation_names_match_the_space():
     env = gym.make("lvgym/StratosIII-v0")
-    assert env.observation_space.shape == (len(OBS_NAMES),)
+    assert env.observation_space.shape == (OBS_STATE.size,)
     assert env.action_space == gym.spaces.MultiDiscrete([3])
     assert gym.make("lvgym/StratosIII-v0", control="tvc").action_space.shape == (2,)
 
@@ -172,12 +172,12 @@ def test_slender_aerodynamics_frozen_at_mach_2_by_default():
     gimbal at zero in turbulence the vehicle flies the 10 s; with the full Mach tables (``aero_mach=None``)
     its fins lose lift above Mach 3 and q-alpha passes the limit before 7.5 s (docs/vehicles.md)."""
     env = gym.make("lvgym/SlenderAscent-v0", model="rigid", wind="turbulence", randomize=["wind"])
-    assert env.unwrapped.core.sim.vehicle.aerodynamics["mach"] == [2.0]
+    assert env.unwrapped.sim.vehicle.aerodynamics["mach"] == [2.0]
     info = _fly_zero(env)
     assert info["termination"] == "" and info["time"] == pytest.approx(10.0)
     assert info["mach"] > 5.0                                  # 5.96: the task's fast, high-q part is flown
     full = gym.make("lvgym/SlenderAscent-v0", model="rigid", wind="turbulence", randomize=["wind"], aero_mach=None)
-    assert "mach" not in full.unwrapped.core.sim.vehicle.aerodynamics
+    assert "mach" not in full.unwrapped.sim.vehicle.aerodynamics
     info = _fly_zero(full)
     assert info["termination"] == "q-alpha beyond the structural limit" and info["time"] < 7.5
     with pytest.raises(ConfigError, match="aero_mach"):

@@ -55,18 +55,40 @@ def test_off_freezes_integral_and_avoids_kick():
     assert pid.integral == 0.0 and pid.e_prev is None
 
 
-def test_policy_off_windows_and_sign():
-    pol = PIDPolicy(1.0, 0.0, 0.0, None, gimbal_limit_deg=5.0)
+@pytest.fixture(scope="module")
+def smile_env():
+    return gym.make("lvgym/SmileAscent-v0", model="rigid")
+
+
+def test_policy_reads_the_env_and_its_sign(smile_env):
+    env = smile_env
+    pol = PIDPolicy(1.0, 0.0, 0.0, None, env=env)
     assert isinstance(pol, Policy)
-    obs = np.zeros(14, np.float32)
-    obs[1], obs[12] = 0.01, 1.0
+    assert pol.limit == env.unwrapped.gimbal_limit == pytest.approx(math.radians(5.0))
+    assert pol.dt == env.unwrapped.task.control_dt_s
+    lay = env.unwrapped.observation_layout
+    obs = lay.pack({"pitch_rate_error": 0.01, "controller_on": 1.0}).astype(np.float32)
     a = pol.act(obs, {"time": 10.0})
     assert a[0] == pytest.approx(-0.01 / math.radians(5.0), rel=1e-5)   # positive pitch-rate error -> down
-    assert np.all(pol.act(obs, {"time": 1.0}) == 0) and np.all(pol.act(obs, {"time": 44.0}) == 0)
-    obs[12] = 0.0
+    obs[lay.index("controller_on")] = 0.0                     # the env's flag switches it off
     assert np.all(pol.act(obs, {"time": 10.0}) == 0)
-    obs[12], obs[11] = 1.0, 0.5                                # time from obs[11] when info is empty
-    assert pol.time(obs, {}) == pytest.approx(30.0)
+
+
+def test_controller_flag_of_the_env_is_off_at_start_and_in_the_staging_coast(smile_env):
+    """The PID keeps no off-windows of its own: the env's flag is off for the first 2 s and from burnout
+    (43 s) to second-stage ignition (45 s), the thesis's windows (6.3)."""
+    env = smile_env
+    obs, info = env.reset(seed=0)
+    lay = env.unwrapped.observation_layout
+    flags = [(info["time"], obs[lay.index("controller_on")])]
+    while True:
+        obs, _, term, trunc, info = env.step(np.zeros(2, np.float32))
+        flags.append((info["time"], obs[lay.index("controller_on")]))
+        if term or trunc:
+            break
+    t, on = np.array(flags).T
+    assert np.all(on[(t < 1.99) | ((t > 43.01) & (t < 44.99))] == 0.0)
+    assert np.all(on[((t > 2.01) & (t < 42.99)) | (t > 45.01)] == 1.0)
 
 
 def test_schedule_interpolation_and_monotonic_check():
@@ -78,11 +100,13 @@ def test_schedule_interpolation_and_monotonic_check():
         GainSchedule("mass", (10.0, 8.0, 9.0), (1, 1, 1), (0, 0, 0), (0, 0, 0), (1, 1, 1))
     thesis = GainSchedule.load("smile_thesis")
     assert thesis.gains(6347.0)[:3] == pytest.approx((8.98, 3.92, 4.57))
-    pol = smile_scheduled_pid()                                # mass from the mass model: 6346 kg at 28.8 s
-    pol.schedule_gains(np.zeros(14), 28.8)
+    env = gym.make("lvgym/SmileAscent-v0", model="rigid")
+    pol = smile_scheduled_pid(env)                            # mass from the env: 6346 kg at 28.8 s
+    mass = float(env.unwrapped.timeline.interp("mass", [28.8])[0])
+    pol.schedule_gains(np.zeros(14), {"mass": mass, "time": 28.8})
     assert pol.value == pytest.approx(6347.0, abs=5.0)
     assert pol.axes[0].kp == pytest.approx(8.98, abs=0.02)
-    tuned = GainScheduledPIDPolicy("smile")
+    tuned = GainScheduledPIDPolicy("smile", env=env)
     assert tuned.schedule.variable == "mass" and len(tuned.schedule.points) >= 4
 
 
@@ -129,11 +153,12 @@ def test_bangbang_law():
     obs, info = env.reset(seed=0)
     for _ in range(60):                                               # spin up with positive pulses
         obs, *_, info = env.step(np.array([POSITIVE]))
-    spun = abs(obs[0])
+    roll = env.unwrapped.observation_layout.index("roll_rate")
+    spun = abs(obs[roll])
     bb = BangBangRollPolicy(deadband_degps=0.5)
     for _ in range(100):
         obs, *_, info = env.step(bb.act(obs, info))
-    assert abs(obs[0]) < 0.2 * spun
+    assert abs(obs[roll]) < 0.2 * spun
 
 
 def test_closed_loop_pid_beats_zero_under_wind():
@@ -142,11 +167,12 @@ def test_closed_loop_pid_beats_zero_under_wind():
 
     def run(policy):
         env = gym.make("lvgym/SmileAscent-v0", model="rigid", wind="profile")
+        policy = policy(env)
         obs, info = env.reset(seed=0)
         policy.reset()
         for _ in range(400):                                          # 8 s
             obs, *_, info = env.step(policy.act(obs, info))
         return float(info["cumulative_rate_error"][1:].sum())
 
-    zero, pid = run(ZeroPolicy()), run(PIDPolicy(*gains))
+    zero, pid = run(lambda env: ZeroPolicy()), run(lambda env: PIDPolicy(*gains, env=env))
     assert pid < 0.7 * zero

@@ -15,7 +15,8 @@ from scipy.spatial.transform import Rotation
 import lvgym  # noqa: F401  (registers the envs)
 from lvgym.simulator import Simulator
 from lvgym.simulator.core import dcm_batch
-from lvgym.simulator.servo import Servo, servo_step_k
+from lvgym.simulator.layouts import ACTUATOR
+from lvgym.simulator.servo import DIRECT, Servo, servo_step_k
 
 G0 = 9.80665
 
@@ -36,12 +37,12 @@ def test_observation_and_reference_equal_numpy_formulas(observation):
     env = gym.make("lvgym/SmileAscent-v0", model="nonrigid", wind="gust", reference="gravity_turn",
                    observation=observation, randomize=["wind", "mass", "thrust_misalignment"])
     env.reset(seed=3)
-    core = env.unwrapped.core
-    sim, spec = core.sim, core.spec
+    core = env.unwrapped
+    sim, spec, lay = core.sim, core.task, core.observation_layout
     rng = np.random.default_rng(0)
     checked = 0
     for k in range(700):
-        axis_before = core.axis_ref_i[0].copy()
+        axis_before = core.state.task.axis_ref_i[0].copy()
         obs, _, term, trunc, info = env.step(rng.uniform(-0.3, 0.3, 2).astype(np.float32))
         assert not term and not trunc
         if k % 70 != 69:
@@ -52,8 +53,8 @@ def test_observation_and_reference_equal_numpy_formulas(observation):
         C = dcm_batch(sim.state("q_bi")[:1])[0]
         # the reference axis turned by ref * dt about the body pitch axis
         turn = Rotation.from_rotvec(ref * spec.control_dt_s * C[:, 1])
-        np.testing.assert_allclose(core.axis_ref_i[0], turn.apply(axis_before), atol=1e-12)
-        e_b = C.T @ np.cross(C[:, 0], core.axis_ref_i[0])
+        np.testing.assert_allclose(core.state.task.axis_ref_i[0], turn.apply(axis_before), atol=1e-12)
+        e_b = C.T @ np.cross(C[:, 0], core.state.task.axis_ref_i[0])
         w = sim.state("omega_bi_b")[0].copy()
         if observation == "sensors":
             dphi = core.timeline.left("dphi_sensor", sim.t)[0, 0]            # IMU slopes (K,)
@@ -61,13 +62,19 @@ def test_observation_and_reference_equal_numpy_formulas(observation):
             w += np.array([0.0, -dphi @ eta_dot[1], dphi @ eta_dot[0]])
             f = sim.conditions("f_aero_b")[0] + sim.conditions("thrust_b")[0]
             m = core.timeline.interp("mass", sim.t)[0]
-            flow = f[[2, 1]] / m / G0
+            flow = {"accel_z": f[2] / m / G0, "accel_y": f[1] / m / G0}
         else:
-            flow = [sim.conditions("alpha")[0], sim.conditions("beta")[0]]
+            flow = {"alpha": sim.conditions("alpha")[0], "beta": sim.conditions("beta")[0]}
         on = float(t >= spec.controller_on_after_s and bool(core.timeline.left("burning", sim.t)[0]))
-        expected = np.concatenate([[w[0], w[1] - ref, w[2]], -e_b[1:], flow,
-                                   [sim.conditions("mach")[0] / 10, sim.conditions("qbar")[0] / 1e5],
-                                   sim.gimbal[0] / core.gimbal_limit, [t / spec.mission_time_s, on, ref]])
+        g = sim.gimbal[0] / core.gimbal_limit
+        expected = lay.pack({"roll_rate": w[0], "pitch_rate_error": w[1] - ref, "yaw_rate_error": w[2],
+                             "pitch_attitude_error": -e_b[1], "yaw_attitude_error": -e_b[2], **flow,
+                             "mach_over_10": sim.conditions("mach")[0] / 10, "qbar_over_1e5": sim.conditions("qbar")[0] / 1e5,
+                             "gimbal_pitch": g[0], "gimbal_yaw": g[1], "time_fraction": t / spec.mission_time_s,
+                             "controller_on": on, "pitch_rate_reference": ref})
+        assert set(lay.names) == {"roll_rate", "pitch_rate_error", "yaw_rate_error", "pitch_attitude_error",
+                                  "yaw_attitude_error", *flow, "mach_over_10", "qbar_over_1e5", "gimbal_pitch",
+                                  "gimbal_yaw", "time_fraction", "controller_on", "pitch_rate_reference"}
         np.testing.assert_allclose(obs, expected.astype(np.float32), rtol=2e-6, atol=1e-7)
         assert info["attitude_error"] == pytest.approx(-e_b[1:], abs=1e-12)
         checked += 1
@@ -76,29 +83,31 @@ def test_observation_and_reference_equal_numpy_formulas(observation):
 
 def test_servo_hand_numbers():
     s = Servo(frequency=15.0, damping=0.7, limit=math.radians(5.0), rate_limit=math.radians(30.0)).params()
-    pos, rate = np.zeros(2), np.zeros(2)
-    cmd = np.array([math.radians(0.1), -math.radians(0.1)])
-    servo_step_k(s, cmd, pos, rate, 0.01)
+    act = ACTUATOR.zeros()
+    cmd, pos, rate = (ACTUATOR.view(act, n) for n in ("command", "gimbal", "gimbal_rate"))
+    cmd[:] = [math.radians(0.1), -math.radians(0.1)]
+    servo_step_k(s, act, 0.01)
     # semi-implicit Euler from rest: rate = h w^2 c, position = h rate
     np.testing.assert_allclose(rate, 0.01 * 225.0 * cmd)
     np.testing.assert_allclose(pos, 0.01 * 0.01 * 225.0 * cmd)
     # a large command is clipped to the 5 deg limit; the rate saturates at 30 deg/s on the way, then the
     # position stops at 5 deg (rate zeroed there)
     pos[:], rate[:] = 0.0, 0.0
-    big = np.array([1.0, -1.0])
-    servo_step_k(s, big, pos, rate, 0.01)
+    small = cmd.copy()
+    cmd[:] = [1.0, -1.0]
+    servo_step_k(s, act, 0.01)
     np.testing.assert_allclose(np.abs(rate), 0.01 * 225.0 * math.radians(5.0))
     peak = 0.0
     for _ in range(100):
-        servo_step_k(s, big, pos, rate, 0.01)
+        servo_step_k(s, act, 0.01)
         peak = max(peak, np.abs(rate).max())
     assert peak == pytest.approx(math.radians(30.0), rel=1e-12)
     np.testing.assert_allclose(pos, [math.radians(5.0), -math.radians(5.0)])
     np.testing.assert_allclose(rate, 0.0)
     # no servo: the position is the command
-    direct = np.zeros(5)
-    servo_step_k(direct, cmd, pos, rate, 0.01)
-    np.testing.assert_array_equal(pos, cmd)
+    cmd[:] = small
+    servo_step_k(DIRECT, act, 0.01)
+    np.testing.assert_array_equal(pos, small)
 
 
 def test_servo_rejects_bad_values():

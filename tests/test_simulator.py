@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from lvgym.environment import Environment
-from lvgym.simulator import DIAG, SITES, Simulator
+from lvgym.simulator import CONDITIONS, SITES, Simulator
 from lvgym.vehicle import MassModel
 
 
@@ -26,7 +26,7 @@ def test_flight_conditions_equal_the_environment_models(smile):
     x[lay["omega_bi_b"]] = rng.normal(0.0, 0.1, 3)
     sim.x[0] = x
     sim.t[0] = 12.0
-    sim._update_conditions()
+    sim.update_conditions()
     env = Environment(sim.site, gravity=sim.gravity, atmosphere=sim.atmosphere, wind=sim.wind,
                       aerodynamics=sim.aerodynamics)
     env.reset(np.random.default_rng(0))
@@ -137,7 +137,7 @@ def test_conditions_names_are_checked(smile):
     smile.reset()
     with pytest.raises(KeyError, match="one of"):
         smile.conditions("altitud")
-    assert set(DIAG) >= {"altitude", "mach", "qbar", "alpha", "thrust"}
+    assert set(CONDITIONS.names) >= {"altitude", "mach", "qbar", "alpha", "thrust"}
     assert "flat" in SITES
 
 

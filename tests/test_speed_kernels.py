@@ -227,16 +227,21 @@ def test_collected_rank_one_updates_equal_successive_ones():
 
 
 def test_signals_and_slosh_angles_on_row_ranges_equal_one_range():
-    from lvgym.envs import AscentBatch, TaskSpec
+    from lvgym.envs import AscentFuncEnv, TaskSpec
     from lvgym.envs.ascent import SmileAscentEnv
     task = TaskSpec.build(SmileAscentEnv.DEFAULTS, {"model": "nonrigid", "wind": "random", "randomize": True})
     outs = []
     for threads in (1, 3):
-        core = AscentBatch(task, 24)
-        core.sim.threads = threads
-        core.reset_rows(np.arange(24), [np.random.default_rng(10 + b) for b in range(24)])
+        func = AscentFuncEnv(task)
+        func.sim.threads = threads
+        rngs = [np.random.default_rng(10 + b) for b in range(24)]
+        state = func.initial(rngs)
         a = np.random.default_rng(0).uniform(-1.0, 1.0, (30, 24, 2))
-        res = [core.step(a[k]) for k in range(30)]
-        outs.append((np.array([r[0] for r in res]), np.array([r[1] for r in res]), res[-1][4]["slosh_angles"]))
+        res = []
+        for k in range(30):
+            state = func.transition(state, a[k], rngs, inplace=True)
+            res.append((func.observation(state), func.reward(None, a[k], state),
+                        func.transition_info(None, a[k], state)))
+        outs.append((np.array([r[0] for r in res]), np.array([r[1] for r in res]), res[-1][2]["slosh_angles"]))
     for one, many in zip(*outs):
         np.testing.assert_array_equal(one, many)

@@ -78,21 +78,17 @@ class Trajectory:
 
 @dataclass
 class TrajectoryBuilder:
-    """Collects a :class:`Trajectory` from the ``info`` dicts of ``env.step`` (lvgym envs).
-
-    The rate error of step ``k`` is recovered from ``info["cumulative_rate_error"]`` as
-    ``(c_k - c_{k-1}) / dt``, so its sum times ``dt`` is the env's own cumulative rate error."""
+    """Collects a :class:`Trajectory` from the ``info`` dicts of ``env.step`` (lvgym envs): the step's
+    rate error is the env's own ``info["rate_error"]`` (the one it integrates into
+    ``info["cumulative_rate_error"]``)."""
 
     dt_s: float
-    _prev: np.ndarray = field(default_factory=lambda: np.zeros(3))
     _rows: list[tuple[Any, ...]] = field(default_factory=list)
     termination: str = ""
 
     def add(self, reward: float, info: dict[str, Any]) -> None:
         """Record one step's reward and info."""
-        cum = np.asarray(info["cumulative_rate_error"], dtype=float)
-        rate = (cum - self._prev) / self.dt_s
-        self._prev = cum.copy()
+        rate = np.asarray(info["rate_error"], dtype=float)
         self._rows.append((rate, np.asarray(info["gimbal"], dtype=float), float(info["alpha_total"]),
                            float(info["qalpha_pa_deg"]), float(reward), float(info["time"]), float(info["qbar"])))
         if info.get("termination"):

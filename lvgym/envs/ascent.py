@@ -18,7 +18,8 @@ episode's sum is minus the weighted cumulative rate error in rad) ``- effort_wei
 (``effort``) ``- effort_rate_weight * int |gimbal rate| dt`` (``effort_rate``) and, on termination,
 ``- failure_penalty_rad_per_s * remaining time`` (``failure``). ``info["reward_terms"]`` holds each term;
 they add up to the reward. ``info["rate_error"]`` holds the step's ``|rate - reference|`` [rad/s] (roll,
-pitch, yaw), ``info["cumulative_rate_error"]`` its integral [rad], ``info["mass"]`` the stack's mass [kg].
+pitch, yaw), ``info["cumulative_rate_error"]`` its integral [rad], ``info["effort_rad_s"]`` the step's integral
+of ``|gimbal pitch| + |gimbal yaw|`` (the reward's ``effort``), ``info["mass"]`` the stack's mass [kg].
 
 Actions: a ``Box`` action outside [-1, 1] is clipped (Gymnasium's convention).
 

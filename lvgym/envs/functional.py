@@ -266,7 +266,8 @@ class AscentFuncEnv(FuncEnv):
                 "alpha_total": cond("alpha_total", sim).copy(), "qalpha_pa_deg": ts.qalpha.copy(), "time": sim.t.copy(),
                 "stage": tl.stage[np.where(w >= 1.0, i + 1, i)], "controller_on": ts.on_step.copy(),
                 "slosh_angles": self.sim.slosh_angles(sim), "eta": self.sim.state("eta", sim).copy(),
-                "gimbal": self.gimbal(next_state), "attitude_error": ts.att.copy(), "mass": ts.mass.copy(),
+                "gimbal": self.gimbal(next_state), "effort_rad_s": self.effort(next_state),
+                "attitude_error": ts.att.copy(), "mass": ts.mass.copy(),
                 "termination": _REASONS[ts.reason], "events": next_state.events}
 
     def state_info(self, state: AscentState, params: AscentParams | None = None) -> dict[str, Any]:
@@ -279,6 +280,11 @@ class AscentFuncEnv(FuncEnv):
     def gimbal(self, state: AscentState) -> np.ndarray:
         """Gimbal angles (B, 2) [rad] of every row."""
         return ACTUATOR.view(state.sim.actuator, "gimbal").copy()
+
+    def effort(self, state: AscentState) -> np.ndarray:
+        """Integral of |gimbal pitch| + |gimbal yaw| over the last control period (B,) [rad s], at the
+        physics steps (the reward's ``effort`` term is minus ``effort_weight`` times it)."""
+        return state.sim.actuator[:, ACTUATOR.index("effort")].copy()
 
     def dispersions(self, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Parameter scale and offset and thrust misalignment of one row, drawn from ``rng``.

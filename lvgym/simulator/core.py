@@ -281,7 +281,7 @@ class Simulator:
         self._place_on_pad(rows, d)
         q_si = self.layout.view(d.x, "state", "q_si")
         q_si[rows] = d.x[rows][:, None, self.layout.state["q_bi"]]
-        conditions_rows(rows.astype(np.int64), d, self.tables)
+        self.update_conditions(rows, d)
         if own:
             self.data = d
         return d
@@ -360,6 +360,13 @@ class Simulator:
                 evs.append((float(rs[b, RAIL_STATE.index("t_exit")]), "rail exit"))
             events[b] = sorted(evs, key=lambda e: e[0])
         return events
+
+    def update_conditions(self, rows: Any = None, data: SimData | None = None) -> None:
+        """Recompute the flight conditions (and the thrust and aerodynamic block in force) of the rows
+        ``rows`` (default all) at their current times, e.g. after their state was written by hand."""
+        d = self.data if data is None else data
+        idx = np.arange(d.t.size) if rows is None else np.atleast_1d(np.asarray(rows, dtype=np.int64))
+        conditions_rows(idx.astype(np.int64), d, self.tables)
 
     # ------------------------------------------------------------------------------ read-outs
     # the arrays of :attr:`data` (views: writing them writes the rows)
