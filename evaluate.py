@@ -18,7 +18,6 @@ from __future__ import annotations
 
 import argparse
 import datetime as dt
-import signal
 import sys
 import time
 from dataclasses import asdict, dataclass, field
@@ -27,6 +26,7 @@ from typing import Any
 
 from lvgym.benchmark import (EXECUTORS, PROTOCOL_VERSION, SEED_SETS, SUITES, ZERO, PolicySpec, degradation,
                              evaluate, get_suite, markdown_table, summarize, write_results)
+from lvgym.parallel import exit_on_sigterm
 
 #: policy names -> how a worker builds them (factories are imported lazily, in the workers)
 POLICIES: dict[str, PolicySpec] = {
@@ -130,14 +130,10 @@ def _unique(specs: list[PolicySpec]) -> list[PolicySpec]:
     return out
 
 
-def _terminate(signum: int, frame: Any) -> None:
-    raise SystemExit(128 + signum)
-
-
 def main(argv: list[str] | None = None) -> dict[str, Any]:
     """Run the comparison, print the Markdown table, write the result files; returns the results."""
     args = parse_args(argv)
-    signal.signal(signal.SIGTERM, _terminate)        # clean up temporary files on kill (SIGTERM)
+    exit_on_sigterm()                                # clean up temporary files on kill (SIGTERM)
     policies = _unique([resolve_policy(n) for n in args.policies])
     try:
         suites = [get_suite(n) for n in args.suites]

@@ -22,7 +22,6 @@ import datetime as dt
 import json
 import os
 import platform
-import signal
 import subprocess
 import sys
 import time
@@ -31,6 +30,8 @@ from pathlib import Path
 from typing import Any
 
 import yaml
+
+from lvgym.parallel import exit_on_sigterm
 
 ROOT = Path(__file__).resolve().parent
 DEFAULT_EVAL_SUITES = {"lvgym/SmileAscent-v0": "smile-windy", "lvgym/SlenderAscent-v0": "slender-ld30"}
@@ -131,7 +132,8 @@ def build_parser(suppress: bool = False) -> argparse.ArgumentParser:
         elif f.name == "eval_mission_time_s":
             kw["type"] = float
         if f.name == "algo":
-            kw["choices"] = ("ppo", "sac", "td3")
+            from agents.config import ALGOS
+            kw["choices"] = tuple(ALGOS)
         if f.name == "eval_select":
             kw["choices"] = ("trained", "all")
         p.add_argument(flag, **kw)
@@ -246,10 +248,6 @@ def _write_yaml(path: Path, data: dict[str, Any]) -> None:
     atomic_write_text(path, yaml.safe_dump(_plain(data), sort_keys=False, width=120))
 
 
-def _terminate(signum: int, frame: Any) -> None:
-    raise SystemExit(128 + signum)
-
-
 # ------------------------------------------------------------------------------------------ main
 def prepare(args: Args, given: set[str]) -> tuple[Args, dict[str, Any], Path, bool]:
     """The run's arguments, its ``config.yaml`` content, its folder and whether it resumes."""
@@ -300,7 +298,8 @@ def train(argv: list[str] | None = None) -> Path:
     from agents.callbacks import (CheckpointCallback, ProgressBarCallback, ValidationEvaluator, clean_incomplete,
                                   latest_checkpoint, load_replay_buffer, load_rng)
     from agents.config import build_config
-    from agents.policy import ALGO_NAMES, policy_files
+    from agents.config import ALGOS
+    from agents.policy import policy_files
 
     args, given = parse_args(argv)
     args, config, run_dir, resumed = prepare(args, given)
@@ -319,7 +318,7 @@ def train(argv: list[str] | None = None) -> Path:
     seed = training_seed(int(config["seed"]), start, cfg.n_envs)
     venv = make_venv(config["env_id"], cfg.n_envs, seed, config["env_kwargs"], cfg.normalize, cfg.hyper.gamma,
                      policy_files(stem)[1] if stem is not None else None)
-    cls = getattr(sb3, ALGO_NAMES[config["algo"]])
+    cls = getattr(sb3, ALGOS[config["algo"]])
     if stem is not None:
         model = cls.load(str(policy_files(stem)[0]), env=venv, device="cpu")
         load_rng(stem.with_name(stem.name + "_rng.pkl"))
@@ -349,7 +348,7 @@ def train(argv: list[str] | None = None) -> Path:
         select = config.get("eval_select", "all")
         evaluator = ValidationEvaluator(suite, args.eval_episodes, over,
                                         select_on=config["env_kwargs"].get("model") if select == "trained" else None)
-    meta = {"algo": ALGO_NAMES[config["algo"]], "env_id": config["env_id"], "env_kwargs": config["env_kwargs"],
+    meta = {"algo": ALGOS[config["algo"]], "env_id": config["env_id"], "env_kwargs": config["env_kwargs"],
             "run": config["name"], "seed": config["seed"], "target_timesteps": target,
             "git_commit": config.get("git_commit"), "lvgym_version": config.get("lvgym_version")}
     checkpoint = CheckpointCallback(run_dir, args.checkpoint_freq, meta, venv if hasattr(venv, "obs_rms") else None,
@@ -373,7 +372,7 @@ def train(argv: list[str] | None = None) -> Path:
 
 
 def main(argv: list[str] | None = None) -> None:
-    signal.signal(signal.SIGTERM, _terminate)
+    exit_on_sigterm()                                # clean up temporary files on kill (SIGTERM)
     train(argv)
 
 

@@ -29,7 +29,8 @@ import yaml
 from lvgym.errors import ConfigError, check_bool, check_choice, check_number
 
 HYPERPARAMS_DIR = Path(__file__).resolve().parent / "hyperparams"
-ALGOS = ("ppo", "sac", "td3")
+#: the algorithms train.py trains: name -> stable-baselines3 class (the one list of them)
+ALGOS = {"ppo": "PPO", "sac": "SAC", "td3": "TD3"}
 ACTIVATIONS = ("tanh", "relu", "elu", "leaky_relu")
 LR_SCHEDULES = ("constant", "linear")
 ACTION_NOISES = ("none", "normal", "ornstein_uhlenbeck")
@@ -284,7 +285,7 @@ def parse_overrides(items: list[str] | tuple[str, ...]) -> dict[str, Any]:
 
 def read_entries(algo: str, path: str | Path | None = None) -> tuple[dict[str, Any], str]:
     """The raw YAML mapping of ``algo``'s file and the file's name."""
-    check_choice("algo", algo, ALGOS, None)
+    check_choice("algo", algo, tuple(ALGOS), None)
     p = Path(path) if path is not None else HYPERPARAMS_DIR / f"{algo}.yaml"
     src = str(p)
     if not p.is_file():
@@ -298,7 +299,7 @@ def read_entries(algo: str, path: str | Path | None = None) -> tuple[dict[str, A
 def build_config(algo: str, env_id: str, entry: Mapping[str, Any], source: str = "",
                  overrides: Mapping[str, Any] | None = None) -> AgentConfig:
     """Validate one entry (a plain mapping, e.g. from YAML or a run's ``config.yaml``) with dotted overrides."""
-    check_choice("algo", algo, ALGOS, None)
+    check_choice("algo", algo, tuple(ALGOS), None)
     src = source or None
     raw = copy.deepcopy(dict(entry))
     for key, value in (overrides or {}).items():

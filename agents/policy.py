@@ -27,7 +27,8 @@ import numpy as np
 
 from lvgym.benchmark.results import atomic_path, atomic_write_text
 
-ALGO_NAMES = {"ppo": "PPO", "sac": "SAC", "td3": "TD3"}
+from .config import ALGOS
+
 VECNORM_SUFFIX = "_vecnormalize.pkl"
 
 
@@ -89,9 +90,6 @@ def resolve_model_path(path: str | Path) -> Path:
     raise FileNotFoundError(f"{str(p)!r}: no such SB3 model (.zip) or run folder")
 
 
-ALGOS = ("PPO", "SAC", "TD3", "A2C", "DDPG")
-
-
 def _sidecar_algo(path: Path) -> str | None:
     side = path.with_suffix(".json")
     if side.is_file():
@@ -116,14 +114,16 @@ def _guess_algo(path: Path) -> str | None:
 
 def guess_and_load(path: str | Path) -> Any:
     """The SB3 model at ``path`` when no sidecar names its algorithm: the algorithm suggested by the
-    policy class stored in the zip first, then every algorithm of ``ALGOS`` in turn."""
+    policy class stored in the zip first, then every algorithm train.py trains
+    (:data:`agents.config.ALGOS`) in turn."""
     import stable_baselines3 as sb3
 
     path = Path(path)
     if not path.is_file():
         raise FileNotFoundError(f"policy {str(path)!r}: no such SB3 model file")
     first = _sidecar_algo(path) or _guess_algo(path)
-    order = [first] + [a for a in ALGOS if a != first] if first else list(ALGOS)
+    known = list(ALGOS.values())
+    order = [first] + [a for a in known if a != first] if first else known
     errors = []
     for algo in order:
         cls = getattr(sb3, algo, None)
@@ -152,10 +152,10 @@ def load_model(zip_path: str | Path, algo: str | None = None) -> Any:
     algo = algo or read_meta(zip_path).get("algo")
     if algo is None:
         return guess_and_load(zip_path)
-    name = ALGO_NAMES.get(str(algo).lower(), str(algo).upper())
+    name = ALGOS.get(str(algo).lower(), str(algo).upper())
     cls = getattr(sb3, name, None)
     if cls is None:
-        raise ValueError(f"{str(zip_path)!r}: algo = {algo!r}: one of {sorted(ALGO_NAMES.values())}")
+        raise ValueError(f"{str(zip_path)!r}: algo = {algo!r}: one of {sorted(ALGOS.values())}")
     return cls.load(str(zip_path), device="cpu")
 
 

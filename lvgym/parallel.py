@@ -15,11 +15,22 @@ from collections.abc import Callable, Sequence
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from typing import Any, TypeVar
 
-__all__ = ["EXECUTORS", "default_workers", "run_map"]
+__all__ = ["EXECUTORS", "default_workers", "exit_on_sigterm", "run_map"]
 
 EXECUTORS = ("local", "serial", "ray")
 T = TypeVar("T")
 R = TypeVar("R")
+
+
+def exit_on_sigterm() -> None:
+    """Make SIGTERM end this process like ``sys.exit(128 + SIGTERM)``: ``finally`` blocks and context
+    managers run (temporary files are removed, workers stopped), as on Ctrl-C. For the command lines."""
+    import signal
+
+    def _exit(signum: int, frame: Any) -> None:
+        raise SystemExit(128 + signum)
+
+    signal.signal(signal.SIGTERM, _exit)
 
 
 def default_workers() -> int:
