@@ -34,11 +34,34 @@ from typing import Any
 import numba as nb
 import numpy as np
 
-__all__ = ["Field", "Linear", "LinearField", "Packed", "PADDING", "at", "at_py", "rst_table"]
+__all__ = ["Field", "Linear", "LinearField", "Packed", "PADDING", "at", "at_py", "is_offsets", "offsets_layout", "rst_table"]
 
 #: whether internal layouts are padded (see the module docstring; a test switch, read once at import)
 PADDING = os.environ.get("LVGYM_LAYOUT_PADDING", "") not in ("", "0")
-_PAD = "pad"
+#: every offset namedtuple a layout made (``.at``, ``.fixed``, ``.per_slosh``): what a kernel may index with
+_OFFSET_TUPLES: list[tuple] = []
+
+
+def is_offsets(obj: Any) -> bool:
+    """Whether ``obj`` is an offsets namedtuple of a layout (a kernel's allowed source of indices)."""
+    return any(obj is t for t in _OFFSET_TUPLES)
+
+
+def offsets_layout(obj: Any) -> Any:
+    """The layout (:class:`Packed` or :class:`Linear`) whose offsets namedtuple ``obj`` is, or None."""
+    for t, lay in zip(_OFFSET_TUPLES, _LAYOUTS):
+        if obj is t:
+            return lay
+    return None
+
+
+_LAYOUTS: list[Any] = []
+
+
+def _register(offsets: tuple, layout: Any) -> tuple:
+    _OFFSET_TUPLES.append(offsets)
+    _LAYOUTS.append(layout)
+    return offsets
 
 
 @dataclass(frozen=True)
@@ -102,7 +125,7 @@ class Packed:
             o += f.size
         self.size = o
         self._entries = entries
-        self.at = namedtuple(_tuple_name(title), list(entries))(*(e[0] for e in entries.values()))
+        self.at = _register(namedtuple(_tuple_name(title), list(entries))(*(e[0] for e in entries.values())), self)
 
     # ------------------------------------------------------------------ look-up
     def __len__(self) -> int:
@@ -250,10 +273,10 @@ class Linear:
         self.size_form = (a, b, c, d)
         self._forms = forms
         tname = _tuple_name(title)
-        self.at = namedtuple(tname, names)(*forms.values())
+        self.at = _register(namedtuple(tname, names)(*forms.values()), self)
         fixed = [n for n, (_, pb, pc, pd) in forms.items() if pb == pc == pd == 0]
-        self.fixed = namedtuple(tname + "Fixed", fixed)(*(forms[n][0] for n in fixed))
-        self.per_slosh = namedtuple(tname + "PerSlosh", names)(*(f.per_slosh for f in self.fields))
+        self.fixed = _register(namedtuple(tname + "Fixed", fixed)(*(forms[n][0] for n in fixed)), self)
+        self.per_slosh = _register(namedtuple(tname + "PerSlosh", names)(*(f.per_slosh for f in self.fields)), self)
 
     @property
     def names(self) -> tuple[str, ...]:
