@@ -129,3 +129,30 @@ def test_rcs_task_and_state_info():
     assert info["time"][0] == 0.0 and info["mass"][0] > 0.0
     state = func.transition(state, np.array([[2]]), rng)
     assert func.transition_info(None, None, state)["time"][0] == pytest.approx(func.spec.control_dt_s)
+
+
+@pytest.mark.parametrize("env_id, bad, match", [
+    ("lvgym/StratosIII-v0", [7], r"action \[7\]: the action space is MultiDiscrete\(\[3\]\)"),
+    ("lvgym/StratosIII-v0", [-1], r"action \[-1\]: the action space"),
+    ("lvgym/StratosIII-v0", [1, 1], r"action \[1, 1\] has shape \(2,\): expected \(1,\)"),
+    ("lvgym/StratosIII-v0", [0.5], r"whole numbers 0"),
+    ("lvgym/SmileAscent-v0", [0.1, 0.2, 0.3], r"has shape \(3,\): expected \(2,\), an element of the action space Box"),
+    ("lvgym/SmileAscent-v0", [np.nan, 0.0], r"is not finite: the action space is Box"),
+    ("lvgym/SmileAscent-v0", [np.inf, 0.0], r"is not finite"),
+])
+def test_actions_outside_the_space_are_refused_with_the_action_and_the_space(env_id, bad, match):
+    env = gym.make(env_id, model="rigid")
+    env.reset(seed=0)
+    with pytest.raises(ValueError, match=match):
+        env.step(np.array(bad) if not isinstance(bad, list) or np.isnan(bad).any() or np.isinf(bad).any() else bad)
+    obs, *_ = env.step(env.action_space.sample())         # the env is still usable
+    assert np.isfinite(obs).all()
+
+
+def test_vector_env_refuses_a_wrong_batch_of_actions():
+    venv = gym.make_vec("lvgym/SmileAscent-v0", num_envs=3, vectorization_mode="vector_entry_point", model="rigid")
+    venv.reset(seed=0)
+    with pytest.raises(ValueError, match=r"has shape \(6,\): expected \(3, 2\), 3 row\(s\)"):
+        venv.step(np.zeros(6, np.float32))
+    with pytest.raises(ValueError, match="not finite"):
+        venv.step(np.full((3, 2), np.nan, np.float32))

@@ -21,7 +21,8 @@ they add up to the reward. ``info["rate_error"]`` holds the step's ``|rate - ref
 pitch, yaw), ``info["cumulative_rate_error"]`` its integral [rad], ``info["effort_rad_s"]`` the step's integral
 of ``|gimbal pitch| + |gimbal yaw|`` (the reward's ``effort``), ``info["mass"]`` the stack's mass [kg].
 
-Actions: a ``Box`` action outside [-1, 1] is clipped (Gymnasium's convention).
+Actions: a ``Box`` action outside [-1, 1] is clipped (Gymnasium's convention); an action of another shape,
+a non-finite one, or an RCS action outside {0, 1, 2} raises a ``ValueError`` naming the action and the space.
 
 Termination: a non-finite state (``info["termination"] == "non-finite state"``, never an exception),
 dynamic pressure times total angle of attack above ``qalpha_limit_pa_deg``, attitude error above
@@ -155,7 +156,8 @@ class AscentEnv(gym.Env):
         if self.state is None:
             raise RuntimeError("call reset() before step()")
         func = self.func
-        self.state = func.transition(self.state, np.asarray(action)[None], [self.np_random], inplace=True)
+        a = func.check_action(action)
+        self.state = func.transition(self.state, a[None], [self.np_random], inplace=True, checked=True)
         ts = self.state.task
         row = _row(func.transition_info(None, action, self.state), 0)
         w = self.state.sim.x[0, self.sim.layout.state["omega_bi_b"]]

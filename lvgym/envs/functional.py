@@ -81,6 +81,13 @@ def cached_timeline(key: Any, model: str, t_end: float, physics_dt: float, n_mod
     return build_timeline(MassModel(vehicle), model, t_end, 0.05, n_modes, stations, 0.5 / physics_dt)
 
 
+def _shown(action: Any) -> str:
+    """A short text of an action for an error message."""
+    text = (np.array2string(np.asarray(action), threshold=8, precision=4, separator=", ") if np.ndim(action)
+            else repr(action))
+    return text if len(text) < 120 else text[:117] + "..."
+
+
 def _rows(rows: Any) -> np.ndarray:
     return np.atleast_1d(np.asarray(rows, dtype=np.int64))
 
@@ -210,22 +217,23 @@ class AscentFuncEnv(FuncEnv):
         return AscentState(sim=sim, task=ts, events=events)
 
     def transition(self, state: AscentState, action: Any, rng: Sequence[np.random.Generator | None],
-                   params: AscentParams | None = None, *, inplace: bool = False) -> AscentState:
+                   params: AscentParams | None = None, *, inplace: bool = False, checked: bool = False) -> AscentState:
         """The state one control period later, with ``action`` (B, 2) in [-1, 1] (``tvc``, clipped:
         Gymnasium's convention for a Box) or (B, 1) in {0, 1, 2} (``rcs``: negative, no, positive roll
         pulse). ``rng`` (B,): each row's generator for its sensor noise (None: the row draws nothing, e.g.
         a row about to be reset). ``inplace``: reuse ``state``'s arrays (see the module docstring)."""
         params = self.default_params if params is None else params
+        B = state.task.steps.size
+        a = self.check_action(action, B)
         st = state if inplace else self.take(state)
         s, sim, ts = self.spec, st.sim, st.task
-        B = ts.steps.size
         on = ts.on
         moment = None
         if s.control == "tvc":
-            a = np.asarray(action, dtype=float).reshape(B, 2)
+            a = a.astype(float)
             cmd = np.where(on[:, None], np.clip(a, -1.0, 1.0) * self.gimbal_limit, 0.0)
         else:
-            a = np.asarray(action).reshape(B, -1)[:, 0].astype(float)
+            a = a[:, 0].astype(float)
             cmd = np.zeros((B, 2))
             moment = np.zeros((B, 3))
             moment[:, 0] = np.where(on, (a - 1.0) * s.rcs_torque_nm, 0.0)
@@ -235,6 +243,27 @@ class AscentFuncEnv(FuncEnv):
         if self._noisy:
             self._add_noise(sim, ts, range(B), rng)
         return AscentState(sim=sim, task=ts, events=events)
+
+    def check_action(self, action: Any, batch: int | None = None) -> np.ndarray:
+        """``action`` as an array of ``batch`` rows of the action space (None: one element of it), or a
+        ``ValueError`` naming the action and the space: a wrong shape, a non-finite TVC action, an RCS
+        action outside {0, 1, 2}. TVC values outside [-1, 1] are clipped by :meth:`transition`
+        (Gymnasium's convention for a Box)."""
+        a = np.asarray(action)
+        space = self.action_space
+        want = space.shape if batch is None else (batch, *space.shape)
+        if a.shape != want:
+            what = "an element" if batch is None else f"{batch} row(s)"
+            raise ValueError(f"action {_shown(action)} has shape {a.shape}: expected {want}, {what} of the action "
+                             f"space {space}")
+        if self.spec.control == "tvc":
+            if a.dtype.kind not in "fiu" or not np.isfinite(a).all():
+                raise ValueError(f"action {_shown(action)} is not finite: the action space is {space} (values "
+                                 "outside [-1, 1] are clipped)")
+        elif a.dtype.kind not in "fiu" or not np.all((a == 0) | (a == 1) | (a == 2)):
+            raise ValueError(f"action {_shown(action)}: the action space is {space}, whole numbers 0 (negative "
+                             "roll pulse), 1 (none) or 2 (positive)")
+        return a
 
     def observation(self, state: AscentState, rng: Any = None, params: AscentParams | None = None) -> np.ndarray:
         """The observation (B, n_obs) float32 of every row: what the flight computer sampled (noise included)."""

@@ -55,7 +55,10 @@ class AscentSB3VecEnv(VecEnv):
         if self.state is None or self._actions is None:
             raise RuntimeError("call reset() and step_async() before step_wait()")
         func = self.func
-        self.state = func.transition(self.state, self._actions.reshape(self.num_envs, -1), self._rngs, inplace=True)
+        actions = self._actions
+        if actions.ndim == 1 and self.task.control == "rcs":     # SB3 hands MultiDiscrete([3]) actions as (B,)
+            actions = actions[:, None]
+        self.state = func.transition(self.state, actions, self._rngs, inplace=True)
         obs, reward = func.observation(self.state), func.reward(None, self._actions, self.state)
         terminated, truncated = func.terminal(self.state), func.truncation(self.state)
         done = terminated | truncated

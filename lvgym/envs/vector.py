@@ -83,7 +83,7 @@ class AscentVectorEnv(VectorEnv):
         actions = np.asarray(actions)
         redo = np.flatnonzero(self._needs_reset)
         rngs = [None if r else g for g, r in zip(self._rngs, self._needs_reset)]
-        self.state = func.transition(self.state, actions.reshape(self.num_envs, -1), rngs, inplace=True)
+        self.state = func.transition(self.state, actions, rngs, inplace=True)
         info = func.transition_info(None, actions, self.state)
         reward = func.reward(None, actions, self.state)
         terminated, truncated = func.terminal(self.state), func.truncation(self.state)
