@@ -148,7 +148,8 @@ class AscentFuncEnv(FuncEnv):
                         axis_ref_i=np.zeros((B, 3)), cum_error=np.zeros((B, 3)), rate_error=np.zeros((B, 3)),
                         gyro_bias=np.zeros((B, 3)), obs=np.zeros((B, n_obs), dtype=np.float32), att=np.zeros((B, 2)),
                         terms=REWARD.zeros(B), reward=np.zeros(B), reason=np.zeros(B, dtype=np.int64),
-                        truncated=np.zeros(B, dtype=bool), qalpha=np.zeros(B), mass=np.zeros(B))
+                        truncated=np.zeros(B, dtype=bool), qalpha=np.zeros(B), mass=np.zeros(B),
+                        stage=np.zeros(B, dtype=np.int64))
         return AscentState(sim=self.sim.new_data(B), task=task, events=[[] for _ in range(B)])
 
     @staticmethod
@@ -286,14 +287,13 @@ class AscentFuncEnv(FuncEnv):
                         params: AscentParams | None = None) -> dict[str, Any]:
         """The per-row arrays of the Gymnasium ``info`` of the transition into ``next_state`` (it reads
         ``next_state`` only)."""
-        sim, ts, tl = next_state.sim, next_state.task, self.timeline
+        sim, ts = next_state.sim, next_state.task
         cond = self.sim.conditions
-        i, w = tl.locate(sim.t)
         return {"reward_terms": dict(zip(REWARD_TERMS, ts.terms.T.copy())),
                 "cumulative_rate_error": ts.cum_error.copy(), "rate_error": ts.rate_error.copy(),
                 "qbar": cond("qbar", sim).copy(), "mach": cond("mach", sim).copy(),
                 "alpha_total": cond("alpha_total", sim).copy(), "qalpha_pa_deg": ts.qalpha.copy(), "time": sim.t.copy(),
-                "stage": tl.stage[np.where(w >= 1.0, i + 1, i)], "controller_on": ts.on_step.copy(),
+                "stage": ts.stage.copy(), "controller_on": ts.on_step.copy(),
                 "slosh_angles": self.sim.slosh_angles(sim), "eta": self.sim.state("eta", sim).copy(),
                 "gimbal": self.gimbal(next_state), "effort_rad_s": self.effort(next_state),
                 "attitude_error": ts.att.copy(), "mass": ts.mass.copy(),

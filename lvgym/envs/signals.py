@@ -33,9 +33,11 @@ from .layouts import G0, RW, OS, O, T
 #: ``obs`` (B, n_obs) float32 the observation (with its noise: what the flight computer sampled); ``att``
 #: (B, 2) [rad] attitude error; ``terms`` (B, n_terms) the last step's reward terms (layout REWARD);
 #: ``reward`` (B,); ``reason`` (B,) int64 termination code (index of REASONS); ``truncated`` (B,) bool;
-#: ``qalpha`` (B,) [Pa deg]; ``mass`` (B,) [kg] the whole stack's mass at the row's time
+#: ``qalpha`` (B,) [Pa deg]; ``mass`` (B,) [kg] the whole stack's mass at the row's time; ``stage`` (B,) int64
+#: the lowest attached stage at the row's time
 TaskData = namedtuple("TaskData", ["steps", "on", "on_step", "axis_ref_i", "cum_error", "rate_error", "gyro_bias",
-                                   "obs", "att", "terms", "reward", "reason", "truncated", "qalpha", "mass"])
+                                   "obs", "att", "terms", "reward", "reason", "truncated", "qalpha", "mass",
+                                   "stage"])
 XF = STATE.fixed
 
 
@@ -136,6 +138,7 @@ def reset_signals(rows, task, setup, sim, ts, tables):
         ts.on_step[b] = ts.on[b]
         j, mass = _imu_and_mass_k(tables, t)
         ts.mass[b] = mass
+        ts.stage[b] = int(tables.stage[j])
         observe_k(task, t, xb, sim.conditions[b], sim.actuator[b], C, ts.axis_ref_i[b], ts.on[b],
                   reference_pitch_rate_k(task, t, xb, sim.conditions[b]), ts.gyro_bias[b], tables.dphi_sensor[j, 0],
                   mass, setup.n_slosh, setup.n_modes, ts.obs[b], ts.att[b])
@@ -148,8 +151,8 @@ def step_signals_range(lo, hi, task, setup, sim, ts, tables):
     Turns ``axis_ref_i`` by the reference pitch rate about the body pitch axis; writes the rate errors
     and adds them to ``cum_error`` [rad]; keeps the controller flag of the step flown in ``on_step`` and
     sets ``on`` for the next one; writes the observation without noise, the attitude error, the reward
-    terms (layout REWARD) and their sum, the termination code, ``truncated``, q-alpha [Pa deg] and the
-    mass."""
+    terms (layout REWARD) and their sum, the termination code, ``truncated``, q-alpha [Pa deg], the
+    mass and the stage."""
     dt = task[T.dt]
     C = np.empty((3, 3))
     oq, ow = XF.q_bi, XF.omega_bi_b
@@ -184,6 +187,7 @@ def step_signals_range(lo, hi, task, setup, sim, ts, tables):
         ts.on[b] = controller_on_k(task, tables.t, tables.burning, t)
         j, mass = _imu_and_mass_k(tables, t)
         ts.mass[b] = mass
+        ts.stage[b] = int(tables.stage[j])
         observe_k(task, t, xb, cond, act, C, a, ts.on[b], ref_pitch, ts.gyro_bias[b], tables.dphi_sensor[j, 0], mass,
                   setup.n_slosh, setup.n_modes, ts.obs[b], ts.att[b])
         qalpha = cond[D.qbar] * math.degrees(cond[D.alpha_total])
