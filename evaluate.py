@@ -53,7 +53,7 @@ class Args:
     """Command-line arguments (``python evaluate.py --help``)."""
 
     policies: list[str] = field(default_factory=lambda: list(DEFAULT_POLICIES))
-    """policy names (zero, pid, gs-pid) or paths of stable-baselines3 .zip models"""
+    """policy names (zero, pid, gs-pid, ...), paths of stable-baselines3 .zip models or training run folders"""
     suites: list[str] = field(default_factory=lambda: list(DEFAULT_SUITES))
     """suite names of the protocol"""
     episodes: int = DEFAULT_EPISODES
@@ -80,7 +80,8 @@ def parse_args(argv: list[str] | None = None) -> Args:
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0],
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--policies", nargs="+", default=d.policies, metavar="POLICY",
-                   help=f"names {sorted(POLICIES)} or SB3 .zip paths (default: {' '.join(d.policies)})")
+                   help=f"names {sorted(POLICIES)}, SB3 .zip paths or train.py run folders (runs/<name>: its best "
+                        f"model) (default: {' '.join(d.policies)})")
     p.add_argument("--suites", nargs="+", default=d.suites, metavar="SUITE",
                    help=f"of {sorted(SUITES)} (default: {' '.join(d.suites)})")
     p.add_argument("--episodes", type=int, default=d.episodes, help=f"per condition and policy (default {d.episodes})")
@@ -117,7 +118,8 @@ def resolve_policy(name: str) -> PolicySpec:
         if path.is_dir():                       # a training run folder: its best (or final) model
             return PolicySpec(path.name, "agents.policy:load_policy", (("path", str(path.resolve())),))
         return PolicySpec(path.stem, "agents.policy:load_policy", (("path", str(path.resolve())),))
-    raise SystemExit(f"evaluate.py: policy {name!r}: one of {sorted(POLICIES)} or a path to an SB3 .zip model")
+    raise SystemExit(f"evaluate.py: policy {name!r}: one of {sorted(POLICIES)}, a path to an SB3 .zip model or a "
+                     "train.py run folder")
 
 
 def _unique(specs: list[PolicySpec]) -> list[PolicySpec]:

@@ -132,10 +132,34 @@ def _human_viewer_checks(plt):
     before = plt.get_fignums()
     v = HumanViewer()
     assert not v.interactive()
+    with pytest.warns(UserWarning, match="cannot show a window.*rgb_array"):
+        v.show(example_frame())                    # a headless machine shows nothing: said once
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        v.show(example_frame())
         v.show(_empty(example_frame()))
     v.close()
     v.close()
     assert plt.get_fignums() == before
+
+
+def test_frames_show_model_termination_and_the_task_axes():
+    import gymnasium as gym
+    from lvgym.envs.frames import make_frame
+    rigid = gym.make("lvgym/SmileAscent-v0", model="rigid", render_mode="rgb_array")
+    rigid.reset(seed=0)
+    rigid.step(np.zeros(2, np.float32))
+    f = make_frame(rigid.unwrapped)
+    assert f.model == "rigid" and not f.bending and f.rate_axes == ("pitch", "yaw") and f.termination == ""
+    r = Renderer()
+    r.draw(f)
+    assert "bending" not in r._bend.get_text() and "[rigid]" in r._head.get_text()
+    roll = gym.make("lvgym/StratosIII-v0", model="nonrigid", render_mode="rgb_array", mission_time_s=0.1)
+    roll.reset(seed=0)
+    for _ in range(5):
+        *_, trunc, _ = roll.step(np.array([1]))
+    f = make_frame(roll.unwrapped)
+    assert f.bending and f.rate_axes == ("roll", "pitch", "yaw") and f.rates_degps.shape[1] == 3
+    assert trunc and f.termination == "mission time reached"
+    r.draw(f)
+    assert r._lines["roll"].get_visible() and "ENDED: mission time reached" in r._head.get_text()
+    assert roll.render().shape[2] == 3

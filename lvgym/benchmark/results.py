@@ -200,6 +200,8 @@ def plot_rate_error(records: Sequence[Mapping[str, Any]], write_to: IO[bytes]) -
             for x, c in zip(pos, conds):             # failed episodes as red crosses
                 ys = [r["rate_error_rad"] for r in recs if r["condition"] == c and r["policy"] == pol and r["failed"]]
                 ax.plot([x] * len(ys), ys, "x", color="red", ms=6)
+        if any(r["failed"] for r in recs):
+            ax.plot([], [], "x", color="red", ms=6, label="failed episode (error up to the failure)")
         ax.set_xticks(range(len(conds)), [c.split("/")[-1] for c in conds])
         ax.set_title(suite)
         ax.set_ylabel("cumulative pitch + yaw rate error [rad]")

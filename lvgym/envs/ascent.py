@@ -104,7 +104,7 @@ class AscentEnv(gym.Env):
         self.action_space, self.observation_space = self.func.action_space, self.func.observation_space
         self.state: AscentState | None = None
         self._renderer: Any = None
-        self._rates: list[tuple[float, float, float]] = []
+        self._rates: list[tuple[float, float, float, float]] = []     # (t, roll, pitch, yaw rate) for rendering
 
     def _select(self, variant: int) -> None:
         """Fly variant ``variant`` (its functional env is built on first use and kept)."""
@@ -161,7 +161,7 @@ class AscentEnv(gym.Env):
         ts = self.state.task
         row = _row(func.transition_info(None, action, self.state), 0)
         w = self.state.sim.x[0, self.sim.layout.state["omega_bi_b"]]
-        self._rates.append((row["time"], float(w[1]), float(w[2])))
+        self._rates.append((row["time"], float(w[0]), float(w[1]), float(w[2])))
         if self.render_mode == "human":
             self.render()
         return ts.obs[0].copy(), float(ts.reward[0]), bool(ts.reason[0] != 0), bool(ts.truncated[0]), row

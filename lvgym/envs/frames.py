@@ -35,7 +35,14 @@ def make_frame(env: Any) -> RenderFrame:
         angles = np.degrees(sim.slosh_angles()[0, :, 1])
     else:
         hinges = lengths = masses = angles = np.zeros(0)
-    rates = np.array(env._rates[-250:]) if env._rates else np.zeros((0, 3))
+    rates = np.array(env._rates[-250:]) if env._rates else np.zeros((0, 4))
+    axes = tuple(n for n, w in zip(("roll", "pitch", "yaw"), env.task.rate_weights) if w > 0) or ("pitch", "yaw")
+    ended = ""
+    if env.state is not None and env.state.task.reason[0] != 0:
+        from .layouts import REASONS
+        ended = REASONS[int(env.state.task.reason[0])]
+    elif env.state is not None and env.state.task.truncated[0]:
+        ended = "mission time reached"
     wind = sim.conditions("wind_n")[0]
     return RenderFrame(t=t, length=length, diameter=float(env.vehicle.stages[0].outer_diameter),
                        pitch_deg=float(pitch), stations=stations, deflection=deflection, slosh_stations=hinges,
@@ -44,9 +51,10 @@ def make_frame(env: Any) -> RenderFrame:
                        gimbal_deg=float(np.degrees(sim.gimbal[0, 0])),
                        wind_mps=(float(np.hypot(wind[0], wind[1])), float(-wind[2])),
                        rates_t=rates[:, 0] if rates.size else np.zeros(0),
-                       rates_degps=np.degrees(rates[:, 1:]) if rates.size else np.zeros((0, 2)),
+                       rates_degps=np.degrees(rates[:, 1:]) if rates.size else np.zeros((0, 3)),
                        stage=tl.stage_names[int(tl.left("stage", sim.t)[0])],
-                       info=f"Mach {sim.conditions('mach')[0]:.2f}  q {sim.conditions('qbar')[0] / 1e3:.1f} kPa")
+                       info=f"Mach {sim.conditions('mach')[0]:.2f}  q {sim.conditions('qbar')[0] / 1e3:.1f} kPa",
+                       model=env.task.model, termination=ended, bending=sim.dynamics.n_modes > 0, rate_axes=axes)
 
 
 def render_frame(env: Any, mode: str) -> np.ndarray | None:

@@ -3,10 +3,10 @@
 The renderer knows nothing about the environments: it draws a plain :class:`RenderFrame` (filled by
 ``lvgym/envs/frames.py``). Left panel: the vehicle in the pitch plane, tilted by its pitch attitude,
 its outline following the bending deflection magnified by ``exaggeration`` (written on the picture,
-"bending x50"), the engine nozzle turned by the gimbal angle with the thrust direction, every slosh
-pendulum as a rod from its hinge with a disc whose area grows with its mass, a wind arrow and the
-time, stage and info text. Right panel (bottom panel for a portrait ``size``): pitch and yaw body
-rates against time.
+"bending x50"; not for a model without modes), the engine nozzle turned by the gimbal angle with the
+thrust direction, every slosh pendulum as a rod from its hinge with a disc whose area grows with its
+mass, a wind arrow and the time, stage, flight model, info text and why the episode ended. Right panel
+(bottom panel for a portrait ``size``): the task's body rates against time (roll for a roll-control task).
 
 Picture conventions: x is downrange (to the right), y is up; the vertical dashed line is the local
 vertical through the vehicle's mid-length. Every angle is drawn in the sense of a positive pitch
@@ -24,7 +24,8 @@ Non-finite inputs are skipped or replaced by a neutral value (zero angle, no def
   headless and several renderers coexist; the figure and its artists are made once and updated per
   frame (``render_rgb(frame) -> uint8 (H, W, 3)``).
 - :class:`HumanViewer` (``human``): the same drawing in a pyplot window (interactive mode). Under a
-  non-interactive backend (Agg on a headless machine) it only draws to its canvas and shows nothing.
+  non-interactive backend (Agg on a headless machine) it only draws to its canvas, and says so once with a
+  warning (use ``render_mode="rgb_array"`` there).
 - :func:`render_rgb`: a one-call wrapper over a per-thread cached :class:`Renderer`.
 
 The example picture ``docs/figures/render_example.png`` is made by
@@ -70,9 +71,13 @@ class RenderFrame:
     gimbal_deg: float              #: pitch gimbal angle [deg]
     wind_mps: tuple[float, float]  #: wind in the picture plane (horizontal, vertical) [m/s]
     rates_t: np.ndarray            #: (m,) times of the strip chart [s]
-    rates_degps: np.ndarray        #: (m, 2) pitch and yaw body rate [deg/s]
+    rates_degps: np.ndarray        #: (m, 3) roll, pitch and yaw body rate [deg/s] (or (m, 2): pitch, yaw)
     stage: str = ""
     info: str = ""                 #: a short text line (e.g. Mach, q)
+    model: str = ""                #: the flight model (rigid, slosh, flex, nonrigid)
+    termination: str = ""          #: why the episode ended ("" while it flies)
+    bending: bool = True           #: the model has bending modes (else no deflection and no "bending x" note)
+    rate_axes: tuple[str, ...] = ("pitch", "yaw")   #: the rates the strip chart plots (the task's axes)
 
 
 def _num(x: object, default: float) -> float:
@@ -187,14 +192,14 @@ class Renderer:
                              family="monospace", linespacing=1.3)
         self._bend = ax.text(0.02, 0.02, "", transform=ax.transAxes, ha="left", va="bottom",
                              fontsize=fs, color="#c0392b")
-        self._lines = [ch.plot([], [], lw=1.2, color=c, label=n)[0]
-                       for c, n in (("#c0392b", "pitch"), ("#2874a6", "yaw"))]
+        self._lines = {n: ch.plot([], [], lw=1.2, color=c, label=n)[0]
+                       for c, n in (("#7d3c98", "roll"), ("#c0392b", "pitch"), ("#2874a6", "yaw"))}
         ch.axhline(0.0, color="#999999", lw=0.6)
         ch.set_title("body rates [deg/s]", fontsize=fs)
         ch.set_xlabel("t [s]", fontsize=fs)
         ch.tick_params(labelsize=fs * 0.85)
         ch.grid(True, lw=0.4, alpha=0.5)
-        ch.legend(loc="upper left", fontsize=fs * 0.85, frameon=False)
+        self._fs = fs
 
     def draw(self, frame: RenderFrame) -> None:
         """Update every artist from ``frame`` (no canvas draw)."""
@@ -299,23 +304,34 @@ class Renderer:
             self._wind.arrow_patch.set_visible(False)
         self._wind_txt.set_text(f"wind {speed:.1f} m/s")
         t = _num(f.t, float("nan"))
-        self._head.set_text(f"t = {t:7.2f} s  {f.stage}\n{f.info}\n"
-                            f"pitch {pitch:+6.2f} deg  gimbal {math.degrees(g):+5.2f} deg")
-        self._bend.set_text(f"bending x{self._ex:g}" + (" (clipped)" if clipped else "")
-                            + (f"\nslosh rods x{mag:g}" if mag > 1 and N else ""))
+        model = f"  [{f.model}]" if f.model else ""
+        ended = f"\nENDED: {f.termination}" if f.termination else ""
+        self._head.set_text(f"t = {t:7.2f} s  {f.stage}{model}\n{f.info}\n"
+                            f"pitch {pitch:+6.2f} deg  gimbal {math.degrees(g):+5.2f} deg{ended}")
+        bend = (f"bending x{self._ex:g}" + (" (clipped)" if clipped else "")) if f.bending else ""
+        slosh = f"slosh rods x{mag:g}" if mag > 1 and N else ""
+        self._bend.set_text("\n".join(x for x in (bend, slosh) if x))
         sx, sy = span * max(1.0, self._xy_ratio), span * max(1.0, 1.0 / self._xy_ratio)
         self.ax.set_xlim(-sx, sx)
         self.ax.set_ylim(-sy, sy)
 
     def _draw_chart(self, f: RenderFrame) -> None:
-        """The strip chart: pitch and yaw rate [deg/s] against t [s], symmetric 1-2-5 limits."""
+        """The strip chart: the task's body rates [deg/s] against t [s], symmetric 1-2-5 limits."""
         tt = _arr(f.rates_t)
+        cols = ("roll", "pitch", "yaw") if np.ndim(f.rates_degps) == 2 and np.shape(f.rates_degps)[1] == 3 \
+            else ("pitch", "yaw")
         rr = _arr(f.rates_degps)
-        rr = rr.reshape(-1, 2) if rr.size % 2 == 0 else np.zeros((0, 2))
+        rr = rr.reshape(-1, len(cols)) if rr.size % len(cols) == 0 else np.zeros((0, len(cols)))
         m = min(tt.size, rr.shape[0])
         tt, rr = tt[:m], rr[:m]
-        for i, line in enumerate(self._lines):
-            line.set_data(tt, rr[:, i])
+        shown = [n for n in f.rate_axes if n in cols] or list(cols)
+        for name, line in self._lines.items():
+            on = name in shown
+            line.set_visible(on)
+            line.set_label(name if on else "_" + name)
+            line.set_data(tt, rr[:, cols.index(name)] if on else [])
+        rr = rr[:, [cols.index(n) for n in shown]]
+        self.chart.legend(loc="upper left", fontsize=self._fs * 0.85, frameon=False)
         ft = tt[np.isfinite(tt)]
         now = _num(f.t, 0.0)
         t0, t1 = (float(ft.min()), float(ft.max())) if ft.size else (now - 1.0, now)
@@ -382,6 +398,12 @@ class HumanViewer:
             r.fig.canvas.draw_idle()
             plt.pause(0.001)
         else:
+            if not getattr(self, "_warned", False):
+                import warnings
+                warnings.warn(f"render_mode='human': matplotlib's backend {plt.get_backend()!r} cannot show a "
+                              "window (a headless machine?); nothing is displayed. Use render_mode='rgb_array' "
+                              "for images, or set MPLBACKEND to an interactive backend.", stacklevel=3)
+                self._warned = True
             r.fig.canvas.draw()
 
     def close(self) -> None:
