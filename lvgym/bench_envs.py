@@ -6,6 +6,12 @@ actions from mid-flight states (the first 2 s on the pad and before the controll
 by a warm-up). Three ways: one env through ``gymnasium.make`` (with its wrappers), the native
 ``VectorEnv`` of N rows (``gymnasium.make_vec``; rows split over the threads of the simulator), and the
 SB3 ``VecEnv`` adapter (which builds one info dict per row, as SB3 requires).
+
+Numbers from different machines differ (the same 2-core kind has given 60 % of another's). So the table also
+gives a ratio that does not depend on the machine: the cost of one env step (per simulator thread) in steps
+of the bare dynamics core (one RK4 step of the same vehicle size with held loads, :mod:`lvgym.bench`),
+measured in the same run. A SMILE env step does 2 RK4 steps, each with 4 evaluations of the flight loads,
+plus the servo, the events and the task signals, so the ratio is at least 2.
 """
 
 from __future__ import annotations
@@ -65,13 +71,50 @@ def sb3(model: str, n: int, min_time: float) -> float:
     return n * _timed(lambda: env.step(a), 20, min_time)
 
 
-def run(min_time: float = 2.0, batch: int = 1024) -> list[tuple[str, str, float]]:
+#: the dynamics core's size of each model of SmileAscent-v0 (slosh pendulums, modes per plane)
+CORE_SIZE = {"rigid": (0, 0), "nonrigid": (6, 2)}
+
+
+def core(model: str, min_time: float) -> float:
+    """RK4 vehicle-steps per second of the bare dynamics core for the model's size (one thread, a batch
+    of 256 with held loads: :func:`lvgym.bench.vehicle`)."""
+    from lvgym.bench import vehicle
+    from lvgym.dynamics import step_batch, zoh_loads
+
+    n_slosh, n_modes = CORE_SIZE[model]
+    m, x, p, u = vehicle(n_slosh, n_modes, 256)
+    n_u = m.layout.n_u
+    step_batch(zoh_loads, x, p, u, 0.0, 1e-3, 20, n_slosh, n_modes, True, n_u)
+    return 256 * 20 * _timed(lambda: step_batch(zoh_loads, x, p, u, 0.0, 1e-3, 20, n_slosh, n_modes, True, n_u),
+                             20, min_time)
+
+
+def run(min_time: float = 2.0, batch: int = 1024) -> list[tuple[str, str, float, float]]:
+    """``(model, how, env-steps/s, core RK4 steps per env step and thread)`` rows."""
+    from lvgym.simulator.core import _default_threads
+
+    threads = _default_threads()
     rows = []
     for model in ("rigid", "nonrigid"):
-        rows.append((model, "single env (gymnasium.make)", single(model, min_time)))
-        rows.append((model, f"VectorEnv, {batch} rows", vector(model, batch, min_time)))
-        rows.append((model, f"SB3 VecEnv, {batch} rows", sb3(model, batch, min_time)))
+        base = core(model, min_time)
+        for how, rate, used in (("single env (gymnasium.make)", single(model, min_time), 1),
+                                (f"VectorEnv, {batch} rows", vector(model, batch, min_time), threads),
+                                (f"SB3 VecEnv, {batch} rows", sb3(model, batch, min_time), threads)):
+            rows.append((model, how, rate, base * used / rate))
+        rows.append((model, "dynamics core alone, 256 vehicles, 1 thread [RK4 steps/s]", base, 1.0))
     return rows
+
+
+def cpu_name() -> str:
+    """The CPU's model name (``/proc/cpuinfo``), else what ``platform`` knows."""
+    try:
+        with open("/proc/cpuinfo", encoding="utf-8") as f:
+            for line in f:
+                if line.startswith("model name"):
+                    return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return platform.processor() or platform.machine()
 
 
 def main() -> None:
@@ -81,12 +124,12 @@ def main() -> None:
     args = parser.parse_args()
     rows = run(args.min_time, args.batch)
     from lvgym.simulator.core import _default_threads
-    print(f"# {ENV_ID} env steps per second ({platform.processor() or platform.machine()}, "
-          f"{os.cpu_count()} cores, {_default_threads()} simulator threads)\n")
-    print("| model | how | env-steps/s |")
-    print("|---|---|---|")
-    for model, how, rate in rows:
-        print(f"| {model} | {how} | {rate:,.0f} |")
+    print(f"# {ENV_ID} env steps per second ({cpu_name()}, {os.cpu_count()} cores, {_default_threads()} simulator "
+          "threads)\n")
+    print("| model | how | env-steps/s | cost of an env step in core RK4 steps (per thread) |")
+    print("|---|---|---|---|")
+    for model, how, rate, ratio in rows:
+        print(f"| {model} | {how} | {rate:,.0f} | {ratio:.1f} |")
 
 
 if __name__ == "__main__":
