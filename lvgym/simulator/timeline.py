@@ -220,7 +220,8 @@ def _grid(mm: MassModel, t_end: float, dt: float) -> tuple[list[float], list[tup
 
 
 def build_timeline(mass_model: MassModel, model: str, t_end: float, dt: float = 0.05,
-                   n_modes: int | None = None, sensor_stations=(), mode_cutoff_hz: float = np.inf) -> Timeline:
+                   n_modes: int | None = None, sensor_stations=(), mode_cutoff_hz: float = np.inf,
+                   cache: bool = True) -> Timeline:
     """Tabulate ``mass_model``'s vehicle from lift-off to ``t_end`` [s] for the dynamics ``model``
     (one of ``MODELS``) every ``dt`` [s] (and at every event and thrust-table breakpoint), with
     ``n_modes`` bending modes per plane (default: the vehicle file's; 0 for rigid and slosh) and
@@ -229,11 +230,20 @@ def build_timeline(mass_model: MassModel, model: str, t_end: float, dt: float = 
     Modes above ``mode_cutoff_hz`` are decoupled (their shapes and slopes at the gimbal, hinges and
     sensors set to zero): they stay at rest. The simulator cuts at the Nyquist frequency of its RK4
     step, ``1 / (2 physics_dt)``: a stiff upper stage's 200 Hz mode coupled to its slosh masses makes
-    a 10 ms RK4 step diverge, and no load sampled at that step could excite it faithfully."""
+    a 10 ms RK4 step diverge, and no load sampled at that step could excite it faithfully.
+
+    ``cache``: look the timeline up in the on-disk cache first and store it there (:mod:`.cache`: keyed by
+    the vehicle's whole content, these arguments and the source of the code that builds it)."""
     if model not in MODELS:
         raise ValueError(f"model = {model!r}: one of {MODELS}")
     if not t_end > 0.0 or not dt > 0.0:
         raise ValueError(f"t_end = {t_end!r} and dt = {dt!r} must be > 0 s")
+    if cache:
+        from .cache import cached
+        return cached(mass_model, (model, float(t_end), float(dt), n_modes, tuple(np.ravel(sensor_stations).tolist()),
+                                   float(mode_cutoff_hz)),
+                      lambda: build_timeline(mass_model, model, t_end, dt, n_modes, sensor_stations, mode_cutoff_hz,
+                                             cache=False))
     mm = mass_model
     vehicle = mm.vehicle
     sensors = np.asarray(sensor_stations, dtype=float).reshape(-1)

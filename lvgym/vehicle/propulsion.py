@@ -13,7 +13,6 @@ quadratic), which makes tank-empty times exact event times.
 from __future__ import annotations
 
 import numpy as np
-from scipy.optimize import brentq
 
 from .config import G0, Engine
 
@@ -88,6 +87,8 @@ class EngineModel:
             return mass / rate if rate > 0.0 else np.inf
         if self.consumed(tau0, self.burn_end) < mass:
             return np.inf
+        from scipy.optimize import brentq       # imported here: scipy.optimize takes 0.5 s to import
+
         return brentq(lambda tau: self.consumed(tau0, tau) - mass, tau0, self.burn_end, xtol=1e-12) - tau0
 
     def thrust(self, tau: float, throttle: float = 1.0, p_ambient: float = 0.0) -> float:
