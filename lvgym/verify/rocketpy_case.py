@@ -75,7 +75,9 @@ SENSITIVITIES: dict[str, dict[str, Any]] = {
 @dataclass(frozen=True)
 class Trajectory:
     """One simulator's flight: ``apogee`` [m] above the pad, ``max_mach`` [-], ``t_apogee``, ``t_max_mach``
-    and ``t_burnout`` [s]; histories ``t`` [s], ``altitude`` [m], ``mach`` [-]; ``wall_time`` [s]."""
+    and ``t_burnout`` [s]; histories ``t`` [s], ``altitude`` [m], ``mach`` [-]; ``wall_time`` [s] in all, of
+    which ``setup_time`` [s] before the flight (lvgym: the simulator with its timeline and the reset; RocketPy:
+    the environment, motor and rocket, before ``Flight`` integrates)."""
 
     name: str
     apogee: float
@@ -87,6 +89,12 @@ class Trajectory:
     altitude: np.ndarray
     mach: np.ndarray
     wall_time: float
+    setup_time: float = float("nan")
+
+    @property
+    def flight_time(self) -> float:
+        """Wall time of the flight alone [s]."""
+        return self.wall_time - self.setup_time
 
 
 @dataclass(frozen=True)
@@ -109,10 +117,15 @@ class Comparison:
                 ("t_apogee", "time of apogee [s]", "{:.2f}"),
                 ("t_max_mach", "time of maximum Mach [s]", "{:.2f}"),
                 ("t_burnout", "burnout [s] (RocketPy: given)", "{:.3f}"),
-                ("wall_time", "run time [s]", "{:.1f}")]
+                ("setup_time", "wall time, set-up [s]", "{:.3f}"), ("flight_time", "wall time, flight [s]", "{:.3f}"),
+                ("wall_time", "wall time, in all [s]", "{:.3f}")]
         out = ["| quantity | lvgym (rigid) | RocketPy | (lvgym - RocketPy) / RocketPy |", "|---|---:|---:|---:|"]
         for key, label, fmt in rows:
-            rel = "" if key == "wall_time" else f"{100 * self.relative(key):+.3f} %"
+            if key.endswith("_time") and key != "t_burnout":
+                ratio = getattr(self.rocketpy, key) / getattr(self.lvgym, key)
+                rel = f"lvgym {ratio:.1f} times faster"
+            else:
+                rel = f"{100 * self.relative(key):+.3f} %"
             out.append(f"| {label} | {fmt.format(getattr(self.lvgym, key))} | "
                        f"{fmt.format(getattr(self.rocketpy, key))} | {rel} |")
         return "\n".join(out)
@@ -143,6 +156,7 @@ def fly_lvgym(elevation_deg: float = ELEVATION_DEG, rail_length: float = RAIL_LE
     start = time.perf_counter()
     sim = lvgym_simulator(elevation_deg, rail_length, t_end)
     sim.reset()
+    setup = time.perf_counter() - start
     up = np.array([1.0, 0.0, 0.0])                       # flat site: the launch frame's +x is up
     t, alt, mach = [0.0], [float(sim.conditions("altitude")[0])], [float(sim.conditions("mach")[0])]
     while True:
@@ -160,7 +174,7 @@ def fly_lvgym(elevation_deg: float = ELEVATION_DEG, rail_length: float = RAIL_LE
     tm, max_mach = _peak(np.array(t), np.array(mach))
     burnout = next(tt for tt, e in sim.timeline.events if e.endswith("burnout"))
     return Trajectory("lvgym", apogee, max_mach, ta, tm, float(burnout), np.array(t), np.array(alt),
-                      np.array(mach), time.perf_counter() - start)
+                      np.array(mach), time.perf_counter() - start, setup)
 
 
 # ------------------------------------------------------------------------------------------ mass split
@@ -276,7 +290,8 @@ def _tabulated_motor_class() -> type:
 
 def rocketpy_flight(elevation_deg: float = ELEVATION_DEG, rail_length: float = RAIL_LENGTH, *,
                     motor: str = "tabulated", earth_rotation: bool = False, atmosphere: str = "us76",
-                    patch_issue_1186: bool = False, jet_damping: bool = True) -> tuple[Any, MassSplit]:
+                    patch_issue_1186: bool = False, jet_damping: bool = True,
+                    timings: dict[str, float] | None = None) -> tuple[Any, MassSplit]:
     """RocketPy's ``Flight`` of ``stratos3`` (see the module docstring) and the :class:`MassSplit` it used.
 
     ``motor``: ``"tabulated"`` (propellant CG and inertia from lvgym's timeline) or ``"generic"``
@@ -353,6 +368,8 @@ def rocketpy_flight(elevation_deg: float = ELEVATION_DEG, rail_length: float = R
 
         rocket.nozzle_to_cdm = 0.0
         rocket.nozzle_gyration_tensor = Matrix([[0.0, 0.0, 0.0], [0.0, 0.0, 0.0], [0.0, 0.0, 0.0]])
+    if timings is not None:
+        timings["setup_done"] = time.perf_counter()
     flight = Flight(rocket=rocket, environment=env, rail_length=rail_length, inclination=elevation_deg,
                     heading=90.0, terminate_on_apogee=True, max_time=600.0, max_time_step=RP_MAX_STEP)
     return flight, split
@@ -362,7 +379,8 @@ def fly_rocketpy(elevation_deg: float = ELEVATION_DEG, rail_length: float = RAIL
                  **options: Any) -> Trajectory:
     """Fly RocketPy (``options`` of :func:`rocketpy_flight`); altitudes shifted to lvgym's datum."""
     start = time.perf_counter()
-    flight, split = rocketpy_flight(elevation_deg, rail_length, **options)
+    timings: dict[str, float] = {}
+    flight, split = rocketpy_flight(elevation_deg, rail_length, timings=timings, **options)
     sol = np.asarray(flight.solution)
     t = sol[:, 0]
     datum = (split.length + split.cdm) * math.sin(math.radians(elevation_deg))     # CDM above the base
@@ -371,7 +389,7 @@ def fly_rocketpy(elevation_deg: float = ELEVATION_DEG, rail_length: float = RAIL
     tm, max_mach = _peak(t, mach)
     return Trajectory("RocketPy", float(flight.apogee - flight.env.elevation + datum), max_mach,
                       float(flight.apogee_time), tm, float(flight.rocket.motor.burn_out_time), t, alt, mach,
-                      time.perf_counter() - start)
+                      time.perf_counter() - start, timings["setup_done"] - start)
 
 
 # ------------------------------------------------------------------------------------------ report
