@@ -295,7 +295,8 @@ class AscentFuncEnv(FuncEnv):
                 "alpha_total": cond("alpha_total", sim).copy(), "qalpha_pa_deg": ts.qalpha.copy(), "time": sim.t.copy(),
                 "stage": ts.stage.copy(), "controller_on": ts.on_step.copy(),
                 "slosh_angles": self.sim.slosh_angles(sim), "eta": self.sim.state("eta", sim).copy(),
-                "gimbal": self.gimbal(next_state), "effort_rad_s": self.effort(next_state),
+                "gimbal": self.gimbal(next_state), "gimbal_rate": ACTUATOR.view(sim.actuator, "gimbal_rate").copy(),
+                "effort_rad_s": self.effort(next_state),
                 "attitude_error": ts.att.copy(), "mass": ts.mass.copy(),
                 "termination": _REASONS[ts.reason], "events": next_state.events}
 

@@ -1,0 +1,123 @@
+"""Episode metrics for protocol v1: a headline score that charges failures, rate errors per flight phase,
+what flexibility does, and a q-alpha constraint cost (protocol v0's metrics, :mod:`.metrics`, are frozen).
+
+:class:`FlightLog` collects an episode from the ``info`` dicts of ``env.step`` and the task's options;
+:func:`flight_metrics` gives, in SI units and radians:
+
+==========================  ======  =================================================================
+score                       rad     ``rate_error_rad`` plus, for a failed episode, ``failure_penalty_rad_per_s``
+                                    (the env's reward rate, 0.1 rad/s by default) times the mission time
+                                    left: a failure at t is charged as if the rest of the flight had that
+                                    rate error, so that failing early never scores better than flying
+rate_error_rad              rad     cumulative pitch + yaw rate error up to the end of the episode (the
+                                    thesis's criterion, as in v0)
+rate_error_<phase>_rad      rad     the same within each phase (``PHASES``, they add up to the whole):
+                                    ``max_q`` from the first to the last step before the first burnout with
+                                    the dynamic pressure at least ``MAX_Q_FRACTION`` of its peak, ``boost``
+                                    the rest of the flight up to that burnout, ``coast`` from it to the
+                                    next ignition, ``upper`` after that ignition (0 for a phase not flown)
+peak_eta                    sqrt(kg) m  largest |modal coordinate| of any mode and plane
+peak_slosh_deg              deg     largest pendulum angle from the body axis (pendulums with mass)
+gimbal_rate_limit_s         s       time at the gimbal rate limit (within 1 %)
+qalpha_cost_s               s       time with q-alpha above ``QALPHA_COST_FRACTION`` of the structural limit,
+                                    a constraint cost for safe RL (the termination stays at the limit)
+failed, failure_reason      -       as v0
+==========================  ======  =================================================================
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+__all__ = ["FlightLog", "MAX_Q_FRACTION", "PHASES", "QALPHA_COST_FRACTION", "flight_metrics"]
+
+PHASES = ("boost", "max_q", "coast", "upper")
+#: the max-q region: dynamic pressure at least this fraction of its peak before the first burnout [-]
+MAX_Q_FRACTION = 0.8
+#: q-alpha above this fraction of the structural limit counts towards the constraint cost [-]
+QALPHA_COST_FRACTION = 0.8
+
+
+@dataclass
+class FlightLog:
+    """One episode, step by step (``add(reward, info)``), with the task's facts: ``dt_s`` control period,
+    ``mission_time_s``, ``failure_penalty_rad_per_s``, ``qalpha_limit_pa_deg``, ``gimbal_rate_limit_radps``
+    (0: not counted). Build it from an lvgym env with :meth:`for_env`."""
+
+    dt_s: float
+    mission_time_s: float
+    failure_penalty_rad_per_s: float
+    qalpha_limit_pa_deg: float
+    gimbal_rate_limit_radps: float = 0.0
+    rows: list[tuple[Any, ...]] = field(default_factory=list)
+    events: list[tuple[float, str]] = field(default_factory=list)
+    peak_eta: float = 0.0
+    peak_slosh: float = 0.0
+    termination: str = ""
+
+    @classmethod
+    def for_env(cls, env: Any) -> FlightLog:
+        u = env.unwrapped
+        s = u.task
+        return cls(s.control_dt_s, s.mission_time_s, s.failure_penalty_rad_per_s, s.qalpha_limit_pa_deg,
+                   math.radians(s.gimbal_rate_limit_degps))
+
+    def add(self, reward: float, info: dict[str, Any]) -> None:
+        """Record one step's info."""
+        e = np.asarray(info["rate_error"], dtype=float)
+        rate = np.asarray(info.get("gimbal_rate", (0.0, 0.0)), dtype=float)
+        self.rows.append((float(info["time"]), e[1] + e[2], float(info["qbar"]), float(info["qalpha_pa_deg"]),
+                          float(np.max(np.abs(rate))) if rate.size else 0.0))
+        eta = np.abs(np.asarray(info.get("eta", ()), dtype=float))
+        if eta.size and np.isfinite(eta).any():
+            self.peak_eta = max(self.peak_eta, float(np.nanmax(eta)))
+        slosh = np.abs(np.asarray(info.get("slosh_angles", ()), dtype=float))
+        if slosh.size and np.isfinite(slosh).any():
+            self.peak_slosh = max(self.peak_slosh, float(np.nanmax(slosh)))
+        self.events += [(float(t), str(text)) for t, text in info.get("events", ())]
+        if info.get("termination"):
+            self.termination = str(info["termination"])
+
+
+def _phase_masks(t: np.ndarray, qbar: np.ndarray, events: list[tuple[float, str]]) -> dict[str, np.ndarray]:
+    """Boolean masks of the steps of each phase (a step belongs to the phase its end time is in)."""
+    burnout = next((te for te, text in sorted(events) if "burnout" in text), math.inf)
+    ignition = next((te for te, text in sorted(events) if "ignition" in text and te >= burnout), math.inf)
+    first = t <= burnout
+    peak = float(np.max(qbar[first])) if first.any() else 0.0
+    high = first & (qbar >= MAX_Q_FRACTION * peak) & (peak > 0.0)
+    if high.any():                                     # from the first to the last step above the fraction
+        max_q = first & (t >= t[high][0]) & (t <= t[high][-1])
+    else:
+        max_q = np.zeros_like(first)
+    return {"boost": first & ~max_q, "max_q": max_q, "coast": (t > burnout) & (t <= ignition), "upper": t > ignition}
+
+
+def flight_metrics(log: FlightLog) -> dict[str, Any]:
+    """The v1 metrics of one episode (see the module docstring)."""
+    dt = float(log.dt_s)
+    if log.rows:
+        t, e, qbar, qalpha, rate = (np.array(c, dtype=float) for c in zip(*log.rows))
+    else:
+        t = e = qbar = qalpha = rate = np.zeros(0)
+    e = np.nan_to_num(e, nan=0.0)
+    out: dict[str, Any] = {"rate_error_rad": float(e.sum() * dt)}
+    failed = bool(log.termination)
+    t_end = float(t[-1]) if t.size else 0.0
+    charge = log.failure_penalty_rad_per_s * max(log.mission_time_s - t_end, 0.0) if failed else 0.0
+    out["score"] = out["rate_error_rad"] + charge
+    masks = _phase_masks(t, qbar, log.events) if t.size else {p: np.zeros(0, bool) for p in PHASES}
+    for name in PHASES:
+        out[f"rate_error_{name}_rad"] = float(e[masks[name]].sum() * dt)
+    out["peak_eta"] = float(log.peak_eta)
+    out["peak_slosh_deg"] = math.degrees(log.peak_slosh)
+    lim = float(log.gimbal_rate_limit_radps)
+    out["gimbal_rate_limit_s"] = float(np.sum(rate >= 0.99 * lim) * dt) if lim > 0 else 0.0
+    out["qalpha_cost_s"] = float(np.sum(np.nan_to_num(qalpha) > QALPHA_COST_FRACTION * log.qalpha_limit_pa_deg) * dt)
+    out["failed"] = failed
+    out["failure_reason"] = log.termination
+    return out
