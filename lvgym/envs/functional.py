@@ -117,6 +117,7 @@ class AscentFuncEnv(FuncEnv):
         self.action_space = (spaces.Box(-1.0, 1.0, (2,), np.float32) if s.control == "tvc" else spaces.MultiDiscrete([3]))
         self.observation_space = spaces.Box(-np.inf, np.inf, (self.observation_layout.size,), np.float32)
         self._noisy = s.observation == "sensors" and "sensor_noise" in s.randomize
+        self._neutral = 0.0 if s.control == "tvc" else 1.0        # the action that commands nothing
         self._noise = [(getattr(s, key), self.observation_layout.slice(names[0]).start, len(names), per)
                        for key, names, per in SENSOR_NOISE if names[0] in self.observation_layout]
         lay = self.sim.layout
@@ -135,6 +136,7 @@ class AscentFuncEnv(FuncEnv):
                           "effort_rate_weight": s.effort_rate_weight, "failure_penalty": s.failure_penalty_rad_per_s,
                           "qalpha_limit": s.qalpha_limit_pa_deg, "attitude_limit": s.attitude_limit_deg,
                           "gimbal_limit": self.gimbal_limit, "gravity_turn": float(s.reference == "gravity_turn"),
+                          "earth_velocity": float(s.reference_velocity == "earth"),
                           "kick_start": s.kick_start_s, "kick_end": s.kick_end_s,
                           "kick_angle": math.radians(s.kick_angle_deg), "sensors": float(s.observation == "sensors"),
                           "n_steps": self.n_steps})
@@ -149,7 +151,9 @@ class AscentFuncEnv(FuncEnv):
                         gyro_bias=np.zeros((B, 3)), obs=np.zeros((B, n_obs), dtype=np.float32), att=np.zeros((B, 2)),
                         terms=REWARD.zeros(B), reward=np.zeros(B), reason=np.zeros(B, dtype=np.int64),
                         truncated=np.zeros(B, dtype=bool), qalpha=np.zeros(B), mass=np.zeros(B),
-                        stage=np.zeros(B, dtype=np.int64))
+                        stage=np.zeros(B, dtype=np.int64),
+                        pending=np.full((B, max(self.spec.action_delay_steps, 1), self.action_space.shape[0]),
+                                        self._neutral))
         return AscentState(sim=self.sim.new_data(B), task=task, events=[[] for _ in range(B)])
 
     @staticmethod
@@ -210,6 +214,7 @@ class AscentFuncEnv(FuncEnv):
         ts.reason[rows] = 0
         ts.truncated[rows] = False
         ts.qalpha[rows] = 0.0
+        ts.pending[rows] = self._neutral
         reset_signals(rows, params.task, params.setup, sim, ts, params.tables)
         self._add_noise(sim, ts, rows, rngs)
         events = list(state.events)
@@ -229,6 +234,12 @@ class AscentFuncEnv(FuncEnv):
         st = state if inplace else self.take(state)
         s, sim, ts = self.spec, st.sim, st.task
         on = ts.on
+        if s.action_delay_steps:                      # the oldest sampled action acts; this one waits
+            q = ts.pending
+            now = q[:, 0].copy()
+            q[:, :-1] = q[:, 1:]
+            q[:, -1] = a
+            a = now
         moment = None
         if s.control == "tvc":
             a = a.astype(float)

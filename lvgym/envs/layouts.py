@@ -34,6 +34,7 @@ TASK = Packed("task parameters", [
     Field("attitude_limit", 1, "deg", "largest attitude error"),
     Field("gimbal_limit", 1, "rad", "gimbal limit: the action's scale"),
     Field("gravity_turn", 1, "-", "1: the reference is the gravity-turn programme, 0: zero rate"),
+    Field("earth_velocity", 1, "-", "1: the gravity turn follows the velocity relative to the Earth, 0: inertial"),
     Field("kick_start", 1, "s", "start of the pitch kick"),
     Field("kick_end", 1, "s", "end of the pitch kick"),
     Field("kick_angle", 1, "rad", "angle of the pitch kick"),

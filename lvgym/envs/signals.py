@@ -21,7 +21,7 @@ import numpy as np
 from lvgym.dynamics.layout import STATE, X
 from lvgym.packing import at
 from lvgym.rotations import quat_to_dcm
-from lvgym.simulator.layouts import A, D
+from lvgym.simulator.layouts import RL, A, D
 from lvgym.simulator.timeline import locate_k
 
 from .layouts import G0, RW, OS, O, T
@@ -34,10 +34,11 @@ from .layouts import G0, RW, OS, O, T
 #: (B, 2) [rad] attitude error; ``terms`` (B, n_terms) the last step's reward terms (layout REWARD);
 #: ``reward`` (B,); ``reason`` (B,) int64 termination code (index of REASONS); ``truncated`` (B,) bool;
 #: ``qalpha`` (B,) [Pa deg]; ``mass`` (B,) [kg] the whole stack's mass at the row's time; ``stage`` (B,) int64
-#: the lowest attached stage at the row's time
+#: the lowest attached stage at the row's time; ``pending`` (B, D, n_a) the actions sampled but not yet
+#: acting (``action_delay_steps`` D; one neutral slot when there is no delay), the oldest first
 TaskData = namedtuple("TaskData", ["steps", "on", "on_step", "axis_ref_i", "cum_error", "rate_error", "gyro_bias",
                                    "obs", "att", "terms", "reward", "reason", "truncated", "qalpha", "mass",
-                                   "stage"])
+                                   "stage", "pending"])
 XF = STATE.fixed
 
 
@@ -49,10 +50,11 @@ def controller_on_k(task, tl_t, tl_burning, t):
 
 
 @nb.njit(cache=True, nogil=True)
-def reference_pitch_rate_k(task, t, x, cond):
+def reference_pitch_rate_k(task, omega_e, t, x, cond):
     """Reference pitch rate [rad/s]: zero, or the gravity-turn programme (a kick of ``kick_angle``
     between ``kick_start`` and ``kick_end``, then ``-g sin(theta) / V`` with theta the velocity's angle
-    from the local vertical; negative turns the nose downrange)."""
+    from the local vertical; negative turns the nose downrange). The velocity is the inertial one, or
+    with ``earth_velocity`` the one relative to the Earth turning at ``omega_e`` [rad/s] about z_i."""
     if task[T.gravity_turn] == 0.0:
         return 0.0
     if task[T.kick_start] <= t < task[T.kick_end]:
@@ -61,8 +63,10 @@ def reference_pitch_rate_k(task, t, x, cond):
         return 0.0
     gx, gy, gz = cond[D.g_i], cond[D.g_i + 1], cond[D.g_i + 2]
     gn = math.sqrt(gx * gx + gy * gy + gz * gz)
-    ov = XF.v_zw_i
+    ov, orr = XF.v_zw_i, XF.r_zw_i
     vx, vy, vz = x[ov], x[ov + 1], x[ov + 2]
+    if task[T.earth_velocity] != 0.0:                 # v - omega_e x r, omega_e along z_i
+        vx, vy = vx + omega_e * x[orr + 1], vy - omega_e * x[orr]
     speed = max(math.sqrt(vx * vx + vy * vy + vz * vz), 1.0)
     cos_th = min(max(-(vx * gx + vy * gy + vz * gz) / (gn * speed), -1.0), 1.0)
     return -gn * math.sqrt(1.0 - cos_th * cos_th) / speed
@@ -140,7 +144,7 @@ def reset_signals(rows, task, setup, sim, ts, tables):
         ts.mass[b] = mass
         ts.stage[b] = int(tables.stage[j])
         observe_k(task, t, xb, sim.conditions[b], sim.actuator[b], C, ts.axis_ref_i[b], ts.on[b],
-                  reference_pitch_rate_k(task, t, xb, sim.conditions[b]), ts.gyro_bias[b], tables.dphi_sensor[j, 0],
+                  reference_pitch_rate_k(task, setup.rail[RL.omega_e], t, xb, sim.conditions[b]), ts.gyro_bias[b], tables.dphi_sensor[j, 0],
                   mass, setup.n_slosh, setup.n_modes, ts.obs[b], ts.att[b])
 
 
@@ -154,12 +158,13 @@ def step_signals_range(lo, hi, task, setup, sim, ts, tables):
     terms (layout REWARD) and their sum, the termination code, ``truncated``, q-alpha [Pa deg], the
     mass and the stage."""
     dt = task[T.dt]
+    omega_e = setup.rail[RL.omega_e]
     C = np.empty((3, 3))
     oq, ow = XF.q_bi, XF.omega_bi_b
     for b in range(lo, hi):
         xb, cond, a, t = sim.x[b], sim.conditions[b], ts.axis_ref_i[b], sim.t[b]
         quat_to_dcm(xb[oq], xb[oq + 1], xb[oq + 2], xb[oq + 3], C)
-        ref_pitch = reference_pitch_rate_k(task, t, xb, cond)
+        ref_pitch = reference_pitch_rate_k(task, omega_e, t, xb, cond)
         if ref_pitch != 0.0:                  # Rodrigues: turn a about the body pitch axis k
             ang = ref_pitch * dt
             k0, k1, k2 = C[0, 1], C[1, 1], C[2, 1]

@@ -17,6 +17,7 @@ WIND_TIERS = ("none", "profile", "gust", "turbulence", "random")
 RANDOMIZE = ("wind", "thrust_misalignment", "mass", "slosh_damping", "bending_frequency", "sensor_noise")
 OBSERVATIONS = ("state", "sensors")
 REFERENCES = ("zero_rate", "gravity_turn")
+REFERENCE_VELOCITIES = ("inertial", "earth")
 CONTROLS = ("tvc", "rcs")
 
 
@@ -54,7 +55,11 @@ class TaskSpec:
     wind: a tier of ``WIND_TIERS``; randomize: the set of ``RANDOMIZE`` names drawn from the env's generator
     at every reset; observation: ``state`` (ideal) or ``sensors`` (IMU at ``imu_station_m``);
     reference: ``zero_rate`` or ``gravity_turn`` (pitch kick, then the rate that keeps the flight-path
-    angle's turn); control: ``tvc`` (Box(-1, 1) per gimbal axis) or ``rcs`` (MultiDiscrete([3]) roll pulses);
+    angle's turn); reference_velocity: the velocity whose angle from the vertical the gravity turn
+    follows, ``inertial`` (v0) or ``earth`` (relative to the rotating Earth: at Andøya the inertial one
+    carries about 160 m/s of Earth rotation); action_delay_steps: control periods between sampling and
+    actuation (the flight computer's computational delay; 0: an action acts at once); control: ``tvc``
+    (Box(-1, 1) per gimbal axis) or ``rcs`` (MultiDiscrete([3]) roll pulses);
     actuator: natural frequency [rad/s], damping, gimbal limit [deg] (None: the engine's), rate limit
     [deg/s]; rcs_torque_nm: roll torque of a pulse; reward: rate_weights (roll, pitch, yaw) per rad,
     effort_weight per rad of gimbal per second, effort_rate_weight per rad/s of gimbal rate per second,
@@ -77,6 +82,7 @@ class TaskSpec:
     observation: str = "state"
     imu_station_m: float | None = None
     reference: str = "zero_rate"
+    reference_velocity: str = "inertial"
     kick_start_s: float = 5.0
     kick_end_s: float = 15.0
     kick_angle_deg: float = 5.0
@@ -93,6 +99,7 @@ class TaskSpec:
     qalpha_limit_pa_deg: float = 250e3
     attitude_limit_deg: float = 30.0
     n_modes: int | None = None
+    action_delay_steps: int = 0
     gyro_noise_radps: float = 2e-4
     gyro_bias_radps: float = 1e-3
     accel_noise_mps2: float = 0.05
@@ -103,6 +110,8 @@ class TaskSpec:
         check_choice("wind", self.wind, WIND_TIERS)
         check_choice("observation", self.observation, OBSERVATIONS)
         check_choice("reference", self.reference, REFERENCES)
+        check_choice("reference_velocity", self.reference_velocity, REFERENCE_VELOCITIES)
+        check_number("action_delay_steps", self.action_delay_steps, 0, 50, integer=True)
         check_choice("control", self.control, CONTROLS)
         r = self.randomize
         names = set(RANDOMIZE) if r is True else set() if r in (False, None) else set(r) if not isinstance(r, str) else {r}
