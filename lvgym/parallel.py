@@ -150,7 +150,9 @@ def _ray(fn: Callable[[T], R], tasks: Sequence[T], done: Callable[[int, R], None
     if started and os.environ.get("RAY_ADDRESS"):     # join the cluster named by RAY_ADDRESS
         ray.init(log_to_driver=False, configure_logging=False)
     elif started:                                     # a local Ray of `workers` CPUs, for this map
-        ray.init(num_cpus=workers, include_dashboard=False, log_to_driver=False, configure_logging=False)
+        # address="local": a new instance even if `ray start` ran on this machine (ray.init would join it)
+        ray.init(address="local", num_cpus=workers, include_dashboard=False, log_to_driver=False,
+                 configure_logging=False)
     from ray.exceptions import RayTaskError
 
     try:

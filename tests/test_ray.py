@@ -11,10 +11,12 @@ from __future__ import annotations
 
 import importlib.util
 import os
+import shutil
 import signal
 import socket
 import subprocess
 import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -47,13 +49,16 @@ def ray_cluster(request, tmp_path_factory):
 
     port = _free_port()
     log = tmp_path_factory.mktemp("ray") / "ray_start.log"
+    # its own temp dir (short: Ray puts sockets in it): the cluster's address file stays out of /tmp/ray,
+    # where a later plain ray.init() would look for a cluster to join
+    temp_dir = tempfile.mkdtemp(prefix="lvray")
     env = dict(os.environ)
     env["RAY_GRACEFUL_SHUTDOWN_DRAIN_TIMEOUT_S"] = "0"          # stop at once on SIGTERM
     env["PYTHONPATH"] = os.pathsep.join([str(ROOT), env.get("PYTHONPATH", "")]).rstrip(os.pathsep)
     env.pop("RAY_ADDRESS", None)
     ray_bin = Path(sys.executable).with_name("ray")
     cmd = [str(ray_bin), "start", "--head", "--node-ip-address=127.0.0.1", f"--port={port}", "--num-cpus=2",
-           "--include-dashboard=false", "--disable-usage-stats", "--block"]
+           "--include-dashboard=false", "--disable-usage-stats", f"--temp-dir={temp_dir}", "--block"]
     with open(log, "wb") as out:
         proc = subprocess.Popen(cmd, cwd=ROOT, env=env, stdout=out, stderr=subprocess.STDOUT, start_new_session=True)
     old = os.environ.get("RAY_ADDRESS")
@@ -70,6 +75,7 @@ def ray_cluster(request, tmp_path_factory):
             except subprocess.TimeoutExpired:
                 os.killpg(proc.pid, signal.SIGKILL)             # its own process group (start_new_session)
                 proc.wait()
+        shutil.rmtree(temp_dir, ignore_errors=True)
 
     request.addfinalizer(stop)
     deadline = time.monotonic() + 120
