@@ -26,7 +26,9 @@ from typing import Any
 
 from lvgym.benchmark import (EXECUTORS, PROTOCOL_VERSION, SEED_SETS, SUITES, ZERO, PolicySpec, degradation,
                              evaluate, get_suite, markdown_table, summarize, write_results)
-from lvgym.parallel import exit_on_sigterm
+from lvgym.cli import fail, one_line_errors
+from lvgym.errors import ConfigError
+from lvgym.parallel import TaskFailed, exit_on_sigterm
 
 #: policy names -> how a worker builds them (factories are imported lazily, in the workers)
 POLICIES: dict[str, PolicySpec] = {
@@ -46,6 +48,8 @@ DEFAULT_SUITES = ["smile-windy"]
 #: episodes per condition and policy of the default run (2 conditions x 4 policies x 50 = 400 episodes of 60 s:
 #: about 100 s on 2 free cores with the four default policies)
 DEFAULT_EPISODES = 50
+#: the longest episode an env takes (``lvgym.envs.TaskSpec.mission_time_s``) [s]
+MAX_MISSION_TIME_S = 3600.0
 
 
 @dataclass
@@ -92,11 +96,14 @@ def parse_args(argv: list[str] | None = None) -> Args:
     p.add_argument("--mission-time-s", type=float, default=None, help="shorten episodes (smoke tests only)")
     p.add_argument("--no-plots", dest="plots", action="store_false", help="skip the PNG plots")
     p.add_argument("--no-progress", dest="progress", action="store_false", help="hide the progress bar")
-    ns = p.parse_args(argv)
+    ns = one_line_errors(p).parse_args(argv)
+    # every value checked here, before any worker starts (an env would refuse it only in the worker)
     if ns.episodes < 1:
-        p.error(f"--episodes {ns.episodes}: at least 1")
+        p.error(f"--episodes = {ns.episodes}: an integer >= 1")
     if ns.workers is not None and ns.workers < 1:
-        p.error(f"--workers {ns.workers}: at least 1")
+        p.error(f"--workers = {ns.workers}: an integer >= 1")
+    if ns.mission_time_s is not None and not 0.0 < ns.mission_time_s <= MAX_MISSION_TIME_S:
+        p.error(f"--mission-time-s = {ns.mission_time_s}: a number of seconds in (0, {MAX_MISSION_TIME_S:g}]")
     return Args(**vars(ns))
 
 
@@ -144,7 +151,13 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
     if args.mission_time_s is not None:
         suites = [s.with_options(mission_time_s=float(args.mission_time_s)) for s in suites]
     t0 = time.perf_counter()
-    records = evaluate(policies, suites, args.episodes, args.seed_set, args.executor, args.workers, args.progress)
+    try:
+        records = evaluate(policies, suites, args.episodes, args.seed_set, args.executor, args.workers,
+                           args.progress)
+    except TaskFailed as exc:                        # a bad value met in a worker: its message, in one line
+        if isinstance(exc.__cause__, ConfigError):
+            fail("evaluate.py", exc)
+        raise
     wall = time.perf_counter() - t0
     summary = summarize(records)
     deg = degradation(summary)

@@ -12,7 +12,14 @@ VecNormalize statistics, generator states, replay buffer; see ``agents/callbacks
 ``evaluations.json`` (validation on the benchmark protocol's validation seeds), ``best_model.*`` and
 ``final_model.*`` (load with ``agents.policy.SB3Policy`` or pass the ``.zip`` to ``evaluate.py``).
 ``--resume`` restarts from the newest complete checkpoint with the run's own configuration, the same
-target step count, the normalisation statistics and the step counter (``reset_num_timesteps=False``).
+target step count, the normalisation statistics and the step counter (``reset_num_timesteps=False``),
+and says what it resumed from (or that there was no checkpoint yet).
+
+Nothing is lost to a kill but the last minute: a checkpoint is written every ``--checkpoint-freq`` env
+steps and every ``--checkpoint-interval-s`` seconds of wall time (60 s), and on SIGTERM or SIGINT (Ctrl-C)
+the run writes one at the next env step and exits (status 128 + the signal; a second signal stops at
+once). Every option is checked before the run folder is made: a bad value is a one-line error and
+leaves nothing behind.
 """
 
 from __future__ import annotations
@@ -31,11 +38,14 @@ from typing import Any
 
 import yaml
 
+from lvgym.cli import fail, one_line_errors, option_number
+from lvgym.errors import ConfigError
 from lvgym.parallel import exit_on_sigterm
 
 ROOT = Path(__file__).resolve().parent
 DEFAULT_EVAL_SUITES = {"lvgym/SmileAscent-v0": "smile-windy", "lvgym/SlenderAscent-v0": "slender-ld30"}
-RESUME_OVERRIDABLE = ("resume", "progress", "torch_threads", "verbose", "total_timesteps")
+RESUME_OVERRIDABLE = ("resume", "progress", "torch_threads", "verbose", "total_timesteps", "checkpoint_interval_s")
+PROG = "train.py"
 
 
 @dataclass
@@ -72,6 +82,8 @@ class Args:
     """run name (default <algo>-<env>-<model>-s<seed>-<time>)"""
     checkpoint_freq: int = 200_000
     """env steps between checkpoints"""
+    checkpoint_interval_s: float = 60.0
+    """wall-clock seconds between checkpoints besides --checkpoint-freq (0: by steps only)"""
     keep_checkpoints: int = 3
     """newest checkpoints kept (plus the best)"""
     eval_freq: int = 1_000_000
@@ -105,8 +117,10 @@ def _number(text: str) -> int:
 def build_parser(suppress: bool = False) -> argparse.ArgumentParser:
     """The argparse parser of :class:`Args` (``suppress``: omit the arguments not given)."""
     d = Args()
-    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0], formatter_class=argparse.RawDescriptionHelpFormatter,
+    p = argparse.ArgumentParser(prog=PROG, description=__doc__.split("\n\n")[0],
+                                formatter_class=argparse.RawDescriptionHelpFormatter,
                                 argument_default=argparse.SUPPRESS if suppress else None)
+    one_line_errors(p)
     doc = {f.name: "" for f in fields(Args)}
     import ast
     import inspect
@@ -115,6 +129,7 @@ def build_parser(suppress: bool = False) -> argparse.ArgumentParser:
     for a, b in zip(body, body[1:]):
         if isinstance(a, ast.AnnAssign) and isinstance(b, ast.Expr) and isinstance(b.value, ast.Constant):
             doc[a.target.id] = str(b.value.value)
+    choices = _choices()
     for f in fields(Args):
         flag, default = "--" + f.name.replace("_", "-"), getattr(d, f.name)
         kw: dict[str, Any] = {"help": f"{doc[f.name]} (default: {default})"}
@@ -129,15 +144,26 @@ def build_parser(suppress: bool = False) -> argparse.ArgumentParser:
             kw["type"] = _number
         elif f.name in ("seed", "n_envs", "keep_checkpoints", "eval_episodes", "torch_threads", "verbose"):
             kw["type"] = int
-        elif f.name == "eval_mission_time_s":
+        elif f.name in ("eval_mission_time_s", "checkpoint_interval_s"):
             kw["type"] = float
         if f.name == "algo":
             from agents.config import ALGOS
             kw["choices"] = tuple(ALGOS)
+        if f.name in choices:
+            kw["choices"] = choices[f.name]
         if f.name == "eval_select":
             kw["choices"] = ("trained", "all")
         p.add_argument(flag, **kw)
     return p
+
+
+def _choices() -> dict[str, tuple[str, ...]]:
+    """The allowed values of the options that name things (the lists of the envs and the simulator)."""
+    import lvgym
+    from lvgym.envs.spec import OBSERVATIONS, WIND_TIERS
+    from lvgym.simulator import MODELS
+
+    return {"env_id": tuple(lvgym.ENV_IDS), "model": tuple(MODELS), "wind": WIND_TIERS, "observation": OBSERVATIONS}
 
 
 def parse_args(argv: list[str] | None = None) -> tuple[Args, set[str]]:
@@ -157,10 +183,38 @@ def env_kwargs_of(args: Args) -> dict[str, Any]:
     out: dict[str, Any] = {"model": args.model, "wind": args.wind, "randomize": r, "observation": args.observation}
     for item in args.env_kwargs:
         key, sep, text = item.partition("=")
-        if not sep:
-            raise SystemExit(f"train.py: --env-kwargs {item!r}: KEY=VALUE")
-        out[key.strip()] = yaml.safe_load(text)
+        if not sep or not key.strip():
+            raise ConfigError("--env-kwargs", item, "KEY=VALUE, e.g. mission_time_s=20")
+        try:
+            out[key.strip()] = yaml.safe_load(text)
+        except yaml.YAMLError:
+            raise ConfigError("--env-kwargs", item, "KEY=VALUE with a YAML value, e.g. rate_weights=[0,1,1]") from None
     return out
+
+
+def check_options(args: Args) -> None:
+    """The numbers and names of the command line that nothing else checks (ConfigError naming the option)."""
+    from lvgym.envs.spec import RANDOMIZE
+
+    option_number("--total-timesteps", args.total_timesteps, 1, 10**12, integer=True)
+    option_number("--checkpoint-freq", args.checkpoint_freq, 1, 10**12, integer=True)
+    option_number("--checkpoint-interval-s", args.checkpoint_interval_s, 0.0, 86_400.0)
+    option_number("--keep-checkpoints", args.keep_checkpoints, 1, 10**6, integer=True)
+    option_number("--eval-freq", args.eval_freq, 0, 10**12, integer=True)
+    option_number("--eval-episodes", args.eval_episodes, 1, 10**6, integer=True)
+    option_number("--eval-mission-time-s", args.eval_mission_time_s, 0.0, 3600.0, lo_open=True)
+    option_number("--torch-threads", args.torch_threads, 1, 1024, integer=True)
+    option_number("--verbose", args.verbose, 0, 2, integer=True)
+    option_number("--n-envs", args.n_envs, 1, 4096, integer=True)
+    known = set(RANDOMIZE) | {"all", "none", "true", "false", "True", "False"}
+    for r in args.randomize:
+        if r not in known:
+            raise ConfigError("--randomize", r, f"names of {list(RANDOMIZE)}, or 'all' or 'none'")
+    if args.eval_suite not in (None, "none"):
+        from lvgym.benchmark.suites import SUITES
+
+        if args.eval_suite not in SUITES:
+            raise ConfigError("--eval-suite", args.eval_suite, f"one of {sorted(SUITES)} or 'none'")
 
 
 def provenance() -> dict[str, Any]:
@@ -250,129 +304,175 @@ def _write_yaml(path: Path, data: dict[str, Any]) -> None:
 
 # ------------------------------------------------------------------------------------------ main
 def prepare(args: Args, given: set[str]) -> tuple[Args, dict[str, Any], Path, bool]:
-    """The run's arguments, its ``config.yaml`` content, its folder and whether it resumes."""
+    """The run's arguments, its ``config.yaml`` content, its folder and whether it resumes: every option
+    checked, nothing written (:func:`create_run` writes). Raises ConfigError or SystemExit (one line)."""
     from agents.config import build_config, load_config, parse_overrides
 
+    check_options(args)
     if args.resume:
         run_dir = Path(args.resume)
         cfg_path = run_dir / "config.yaml"
         if not cfg_path.is_file():
-            raise SystemExit(f"train.py: --resume {args.resume}: no config.yaml there (not a run folder)")
+            raise SystemExit(f"{PROG}: --resume {args.resume}: no config.yaml there (not a run folder)")
         extra = sorted(given - set(RESUME_OVERRIDABLE))
         if extra:
-            raise SystemExit(f"train.py: --resume takes the run's own config.yaml; only {list(RESUME_OVERRIDABLE)} "
+            raise SystemExit(f"{PROG}: --resume takes the run's own config.yaml; only {list(RESUME_OVERRIDABLE)} "
                              f"may be given with it, not {['--' + e.replace('_', '-') for e in extra]}")
-        config = yaml.safe_load(cfg_path.read_text(encoding="utf-8"))
+        from lvgym.vehicle.yamlfile import read_yaml
+
+        config = read_yaml(cfg_path)[0]
         stored = Args(**{**config["args"], **{k: getattr(args, k) for k in given if k != "resume"}, "resume": None})
         if "total_timesteps" in given:
             config["total_timesteps"] = int(args.total_timesteps)
-            _write_yaml(cfg_path, config)
         build_config(stored.algo, stored.env_id, config["hyperparams"], str(cfg_path))  # still valid?
         return stored, config, run_dir, True
     overrides = parse_overrides(args.hp)
     if args.n_envs is not None:
         overrides["n_envs"] = args.n_envs
     cfg = load_config(args.algo, args.env_id, overrides, args.hyperparams)
+    training_seed(args.seed, 0, cfg.n_envs)
     env_kwargs = env_kwargs_of(args)
     suite = args.eval_suite or DEFAULT_EVAL_SUITES.get(args.env_id, "none")
     name = args.name or (f"{args.algo}-{args.env_id.split('/')[-1].split('-')[0].lower()}-{args.model}-s{args.seed}-"
                          f"{dt.datetime.now().strftime('%Y%m%d-%H%M%S')}")
     run_dir = Path(args.runs_dir) / name
     if (run_dir / "config.yaml").exists():
-        raise SystemExit(f"train.py: {run_dir} exists; continue it with --resume {run_dir} or choose another --name")
+        raise SystemExit(f"{PROG}: {run_dir} exists; continue it with --resume {run_dir} or choose another --name")
     config = {"name": name, "args": asdict(args), "algo": args.algo, "env_id": args.env_id, "env_kwargs": env_kwargs,
               "total_timesteps": int(args.total_timesteps or cfg.n_timesteps), "seed": args.seed,
               "eval_suite": suite, "eval_select": args.eval_select, "hyperparams": cfg.to_dict(),
               "hyperparams_source": cfg.source,
               "created_utc": dt.datetime.now(dt.timezone.utc).isoformat(timespec="seconds"), **provenance()}
-    run_dir.mkdir(parents=True, exist_ok=True)
-    _write_yaml(run_dir / "config.yaml", config)
     return args, config, run_dir, False
 
 
+def create_run(config: dict[str, Any], run_dir: Path) -> None:
+    """Write the run's ``config.yaml`` (a new run: make its folder; a resumed one: its new target)."""
+    run_dir.mkdir(parents=True, exist_ok=True)
+    _write_yaml(run_dir / "config.yaml", config)
+
+
+def _resume_note(run_dir: Path, state: dict[str, Any] | None, target: int) -> str:
+    if state is None:
+        return (f"{PROG}: {run_dir} has no complete checkpoint to resume from (it was stopped before its first "
+                "one): training starts again at step 0")
+    step, wall = int(state["num_timesteps"]), state.get("train_wall_s")
+    spent = f", after {wall / 60:.1f} min of training" if wall is not None else ""
+    return (f"{PROG}: resuming {run_dir} from checkpoint step_{step:012d}: step {step:,} of {target:,}, saved "
+            f"{state.get('saved_utc', '?')}{spent}")
+
+
 def train(argv: list[str] | None = None) -> Path:
-    """Run (or resume) a training run; returns its folder."""
+    """Run (or resume) a training run; returns its folder. SIGTERM and SIGINT write a checkpoint and
+    then exit with ``SystemExit(128 + signal)``."""
+    from agents.callbacks import SignalStop
+
+    args, given = parse_args(argv)
+    stop = SignalStop()
+    with stop.installed():
+        return _train(args, given, stop)
+
+
+def _train(args: Args, given: set[str], stop: Any) -> Path:
     import stable_baselines3 as sb3
     import torch
 
     from agents.callbacks import (CheckpointCallback, ProgressBarCallback, ValidationEvaluator, clean_incomplete,
                                   latest_checkpoint, load_replay_buffer, load_rng)
-    from agents.config import build_config
-    from agents.config import ALGOS
+    from agents.config import ALGOS, build_config
     from agents.policy import policy_files
 
-    args, given = parse_args(argv)
-    args, config, run_dir, resumed = prepare(args, given)
-    torch.set_num_threads(max(1, args.torch_threads))
-    cfg = build_config(config["algo"], config["env_id"], config["hyperparams"], str(run_dir / "config.yaml"))
-    target = int(config["total_timesteps"])
-    ckpt_dir = run_dir / "checkpoints"
-    state: dict[str, Any] | None = None
-    stem: Path | None = None
-    if resumed:
-        clean_incomplete(ckpt_dir)
-        latest = latest_checkpoint(ckpt_dir)
-        if latest is not None:
-            stem, state = latest[0].with_suffix(""), latest[1]
-    start = int(state["num_timesteps"]) if state else 0
-    seed = training_seed(int(config["seed"]), start, cfg.n_envs)
-    venv = make_venv(config["env_id"], cfg.n_envs, seed, config["env_kwargs"], cfg.normalize, cfg.hyper.gamma,
-                     policy_files(stem)[1] if stem is not None else None)
-    cls = getattr(sb3, ALGOS[config["algo"]])
-    if stem is not None:
-        model = cls.load(str(policy_files(stem)[0]), env=venv, device="cpu")
-        load_rng(stem.with_name(stem.name + "_rng.pkl"))
-        load_replay_buffer(model, stem)
-        venv.seed(seed)                                      # fresh episodes for the new segment
-    else:
-        kw = cfg.sb3_kwargs()
-        noise, sigma = kw.pop("action_noise_spec", ("none", 0.0))
-        if noise != "none":
-            import numpy as np
-            from stable_baselines3.common.noise import NormalActionNoise, OrnsteinUhlenbeckActionNoise
+    try:                                             # everything checked before the run folder is made
+        args, config, run_dir, resumed = prepare(args, given)
+        cfg = build_config(config["algo"], config["env_id"], config["hyperparams"], str(run_dir / "config.yaml"))
+        target = int(config["total_timesteps"])
+        ckpt_dir = run_dir / "checkpoints"
+        state: dict[str, Any] | None = None
+        stem: Path | None = None
+        if resumed:
+            latest = latest_checkpoint(ckpt_dir)
+            if latest is not None:
+                stem, state = latest[0].with_suffix(""), latest[1]
+        start = int(state["num_timesteps"]) if state else 0
+        seed = training_seed(int(config["seed"]), start, cfg.n_envs)
+    except ConfigError as exc:
+        fail(PROG, exc)
+    try:                                             # the env's keywords (--model, --wind, --env-kwargs, ...)
+        venv = make_venv(config["env_id"], cfg.n_envs, seed, config["env_kwargs"], cfg.normalize, cfg.hyper.gamma,
+                         policy_files(stem)[1] if stem is not None else None)
+    except (ConfigError, ValueError) as exc:
+        fail(PROG, f"{config['env_id']} option {exc}")
+    try:
+        if not resumed or "total_timesteps" in given:
+            create_run(config, run_dir)
+        if resumed:
+            clean_incomplete(ckpt_dir)
+            print(_resume_note(run_dir, state, target), file=sys.stderr)
+        torch.set_num_threads(max(1, args.torch_threads))
+        cls = getattr(sb3, ALGOS[config["algo"]])
+        if stem is not None:
+            model = cls.load(str(policy_files(stem)[0]), env=venv, device="cpu")
+            load_rng(stem.with_name(stem.name + "_rng.pkl"))
+            load_replay_buffer(model, stem)
+            venv.seed(seed)                                      # fresh episodes for the new segment
+        else:
+            kw = cfg.sb3_kwargs()
+            noise, sigma = kw.pop("action_noise_spec", ("none", 0.0))
+            if noise != "none":
+                import numpy as np
+                from stable_baselines3.common.noise import NormalActionNoise, OrnsteinUhlenbeckActionNoise
 
-            n = venv.action_space.shape[0]
-            kw["action_noise"] = (NormalActionNoise if noise == "normal" else OrnsteinUhlenbeckActionNoise)(
-                np.zeros(n), sigma * np.ones(n))
-        model = cls("MlpPolicy", venv, seed=int(config["seed"]), device="cpu", verbose=0, **kw)
-    model.set_logger(make_logger(run_dir, start, args.verbose))
-    with open(run_dir / "segments.jsonl", "a", encoding="utf-8") as f:
-        f.write(json.dumps({"start_step": start, "env_seed": seed, "target": target, "resumed": resumed,
-                            "started_utc": dt.datetime.now(dt.timezone.utc).isoformat(timespec="seconds"),
-                            "pid": os.getpid(), **provenance()}) + "\n")
-    suite = config.get("eval_suite", "none")
-    evaluator = None
-    if suite != "none" and args.eval_freq > 0:
-        over = {"mission_time_s": args.eval_mission_time_s} if args.eval_mission_time_s else None
-        # runs made before eval_select existed selected on every condition
-        select = config.get("eval_select", "all")
-        evaluator = ValidationEvaluator(suite, args.eval_episodes, over,
-                                        select_on=config["env_kwargs"].get("model") if select == "trained" else None)
-    meta = {"algo": ALGOS[config["algo"]], "env_id": config["env_id"], "env_kwargs": config["env_kwargs"],
-            "run": config["name"], "seed": config["seed"], "target_timesteps": target,
-            "git_commit": config.get("git_commit"), "lvgym_version": config.get("lvgym_version")}
-    checkpoint = CheckpointCallback(run_dir, args.checkpoint_freq, meta, venv if hasattr(venv, "obs_rms") else None,
-                                    evaluator, args.eval_freq, args.keep_checkpoints, state, verbose=args.verbose)
-    remaining = target - start
-    t0 = time.perf_counter()
-    if remaining > 0:
-        model.learn(total_timesteps=remaining, callback=[checkpoint, ProgressBarCallback(args.progress)],
-                    reset_num_timesteps=not resumed or stem is None, log_interval=1, progress_bar=False)
-    elif not (run_dir / "final_model.json").is_file():
-        checkpoint.init_callback(model)
-        checkpoint.on_training_end()
-    wall = time.perf_counter() - t0
-    done = int(model.num_timesteps) - start
-    print(f"{run_dir}: {model.num_timesteps} / {target} steps ({done / max(wall, 1e-9):.0f} steps/s this segment)",
-          file=sys.stderr)
-    if evaluator is not None:
-        evaluator.close()
-    venv.close()
+                n = venv.action_space.shape[0]
+                kw["action_noise"] = (NormalActionNoise if noise == "normal" else OrnsteinUhlenbeckActionNoise)(
+                    np.zeros(n), sigma * np.ones(n))
+            model = cls("MlpPolicy", venv, seed=int(config["seed"]), device="cpu", verbose=0, **kw)
+        model.set_logger(make_logger(run_dir, start, args.verbose))
+        with open(run_dir / "segments.jsonl", "a", encoding="utf-8") as f:
+            f.write(json.dumps({"start_step": start, "env_seed": seed, "target": target, "resumed": resumed,
+                                "started_utc": dt.datetime.now(dt.timezone.utc).isoformat(timespec="seconds"),
+                                "pid": os.getpid(), **provenance()}) + "\n")
+        suite = config.get("eval_suite", "none")
+        evaluator = None
+        if suite != "none" and args.eval_freq > 0:
+            over = {"mission_time_s": args.eval_mission_time_s} if args.eval_mission_time_s else None
+            # runs made before eval_select existed selected on every condition
+            select = config.get("eval_select", "all")
+            evaluator = ValidationEvaluator(suite, args.eval_episodes, over,
+                                            select_on=config["env_kwargs"].get("model") if select == "trained" else None)
+        meta = {"algo": ALGOS[config["algo"]], "env_id": config["env_id"], "env_kwargs": config["env_kwargs"],
+                "run": config["name"], "seed": config["seed"], "target_timesteps": target,
+                "git_commit": config.get("git_commit"), "lvgym_version": config.get("lvgym_version")}
+        checkpoint = CheckpointCallback(run_dir, args.checkpoint_freq, meta, venv if hasattr(venv, "obs_rms") else None,
+                                        evaluator, args.eval_freq, args.keep_checkpoints, state, verbose=args.verbose,
+                                        interval_s=args.checkpoint_interval_s, stop=stop)
+        remaining = target - start
+        t0 = time.perf_counter()
+        with stop.armed():                           # from here a signal checkpoints first
+            if remaining > 0:
+                model.learn(total_timesteps=remaining, callback=[checkpoint, ProgressBarCallback(args.progress)],
+                            reset_num_timesteps=not resumed or stem is None, log_interval=1, progress_bar=False)
+            elif not (run_dir / "final_model.json").is_file():
+                checkpoint.init_callback(model)
+                checkpoint.on_training_end()
+        wall = time.perf_counter() - t0
+        done = int(model.num_timesteps) - start
+        print(f"{run_dir}: {model.num_timesteps} / {target} steps ({done / max(wall, 1e-9):.0f} steps/s this segment)",
+              file=sys.stderr)
+        if evaluator is not None:
+            evaluator.close()
+    finally:
+        venv.close()
+    if stop.signum is not None:
+        last = latest_checkpoint(ckpt_dir)
+        where = f"checkpoint step_{int(last[1]['num_timesteps']):012d}" if last else "no checkpoint"
+        print(f"{PROG}: stopped by {stop.name} at step {model.num_timesteps:,}; {where} written; continue with "
+              f"python train.py --resume {run_dir}", file=sys.stderr)
+        raise SystemExit(128 + stop.signum)
     return run_dir
 
 
 def main(argv: list[str] | None = None) -> None:
-    exit_on_sigterm()                                # clean up temporary files on kill (SIGTERM)
+    exit_on_sigterm()                                # SIGTERM before training: clean up and exit
     train(argv)
 
 

@@ -9,6 +9,10 @@ A checkpoint ``checkpoints/step_<N>`` (N = env steps, 12 digits) is::
 
 each file written atomically and the JSON last: a checkpoint exists once its JSON does, so a run killed at
 any moment resumes from a complete checkpoint (files of a half-written one are removed on resume).
+Checkpoints are due every ``save_freq`` env steps and every ``interval_s`` seconds of wall time (so a
+kill loses at most about that much work), and on SIGTERM or SIGINT (:class:`SignalStop`): training then
+stops at the next env step, the checkpoint is written (without validation) and the run exits; a PPO
+rollout cut short is not trained on (SAC and TD3 keep its transitions in the replay buffer).
 Checkpoints are taken at rollout boundaries (after a PPO update, before the next rollout), so the weights,
 the optimiser, the step counter and the statistics agree. Validation (when due) runs at a checkpoint, on
 the checkpointed model, with the protocol's validation seeds; its result is part of the checkpoint's JSON,
@@ -18,12 +22,15 @@ next to ``checkpoints/`` are copies in the :mod:`agents.policy` layout (loadable
 
 from __future__ import annotations
 
+import contextlib
 import json
 import pickle
 import random
 import re
+import signal
 import sys
 import time
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -154,17 +161,69 @@ class ValidationEvaluator:
         self._envs.clear()
 
 
+# ------------------------------------------------------------------------------------------ signals
+class SignalStop:
+    """SIGTERM and SIGINT as a request to checkpoint and stop. While :meth:`installed`, a signal outside
+    :meth:`armed` (nothing to save yet) or a second signal raises ``SystemExit(128 + signal)`` at once;
+    inside :meth:`armed` the first one only sets :attr:`signum`, which :class:`CheckpointCallback` reads at
+    the next env step. Outside the main thread (no signal handlers there) it does nothing."""
+
+    SIGNALS = (signal.SIGTERM, signal.SIGINT)
+
+    def __init__(self) -> None:
+        self.signum: int | None = None
+        self._armed = False
+
+    @property
+    def name(self) -> str:
+        return signal.Signals(self.signum).name if self.signum is not None else ""
+
+    def _handle(self, signum: int, frame: Any) -> None:
+        if not self._armed or self.signum is not None:
+            raise SystemExit(128 + signum)
+        self.signum = signum
+        print(f"\n{signal.Signals(signum).name}: writing a checkpoint at the next env step, then exiting "
+              "(send it again to stop at once)", file=sys.stderr)
+
+    @contextlib.contextmanager
+    def installed(self) -> Iterator[SignalStop]:
+        old = {}
+        try:
+            for s in self.SIGNALS:
+                old[s] = signal.signal(s, self._handle)
+        except ValueError:                              # not the main thread: leave the handlers alone
+            pass
+        try:
+            yield self
+        finally:
+            for s, handler in old.items():
+                signal.signal(s, handler)
+
+    @contextlib.contextmanager
+    def armed(self) -> Iterator[SignalStop]:
+        self._armed = True
+        try:
+            yield self
+        finally:
+            self._armed = False
+
+
 # ------------------------------------------------------------------------------------------ checkpoints
 class CheckpointCallback(BaseCallback):
     """Checkpoint every ``save_freq`` env steps (at the first rollout boundary past it) and at the end;
     validate with ``evaluator`` at the checkpoints at least ``eval_freq`` steps after the last validation
-    (and at the end; ``eval_freq <= 0`` or no evaluator: never). Keeps the newest ``keep`` checkpoints and
-    the best one. ``meta``: written into every JSON (algo, env id and kwargs, ...). ``state``: the JSON of
-    the checkpoint a resumed run starts from (restores the evaluation history and the best)."""
+    (and at the end; ``eval_freq <= 0`` or no evaluator: never). Also checkpoints (without validation) at
+    the first rollout boundary ``interval_s`` seconds of wall time after the last checkpoint (0: never),
+    and when ``stop`` (a :class:`SignalStop`) has a signal: training then ends at the next env step with a
+    checkpoint and without ``final_model``. Keeps the newest ``keep`` checkpoints and the best one.
+    ``meta``: written into every JSON (algo, env id and kwargs, ...). ``state``: the JSON of the
+    checkpoint a resumed run starts from (restores the evaluation history, the best and the wall time
+    spent, ``train_wall_s``)."""
 
     def __init__(self, run_dir: str | Path, save_freq: int, meta: dict[str, Any], vecnormalize: Any = None,
                  evaluator: ValidationEvaluator | None = None, eval_freq: int = 0, keep: int = 3,
-                 state: dict[str, Any] | None = None, verbose: int = 0) -> None:
+                 state: dict[str, Any] | None = None, verbose: int = 0, interval_s: float = 0.0,
+                 stop: SignalStop | None = None) -> None:
         super().__init__(verbose)
         self.run_dir = Path(run_dir)
         self.folder = self.run_dir / "checkpoints"
@@ -177,26 +236,44 @@ class CheckpointCallback(BaseCallback):
         state = state or {}
         self.evaluations: list[dict[str, Any]] = list(state.get("evaluations", []))
         self.best: dict[str, Any] | None = state.get("best")
-        self.last_save = int(state.get("num_timesteps", -1))
+        self.last_save = int(state.get("num_timesteps", -1))      # any checkpoint
+        self.last_step_save = self.last_save                        # the last one due by steps
         self.last_eval = int(self.evaluations[-1]["num_timesteps"]) if self.evaluations else 0
+        self.interval_s = float(interval_s)
+        self.stop = stop
+        self.wall0 = float(state.get("train_wall_s", 0.0))
+        self.t_start = self.last_save_time = time.monotonic()
 
     def _init_callback(self) -> None:
         self.folder.mkdir(parents=True, exist_ok=True)
+        self.t_start = self.last_save_time = time.monotonic()
         if self.last_save < 0:
-            self.last_save = self.num_timesteps
+            self.last_save = self.last_step_save = self.num_timesteps
         if self.best is not None:                   # a resumed run: best_model.* as of its checkpoint
             self._copy_best()
 
+    @property
+    def stopping(self) -> bool:
+        return self.stop is not None and self.stop.signum is not None
+
     def _on_step(self) -> bool:
-        return True
+        return not self.stopping                    # False ends model.learn (then _on_training_end)
 
     def _on_rollout_start(self) -> None:
-        if self.num_timesteps - self.last_save >= self.save_freq:
-            due = self.evaluator is not None and self.eval_freq > 0 and \
+        by_steps = self.num_timesteps - self.last_step_save >= self.save_freq     # the same steps on every run
+        by_time = self.interval_s > 0 and time.monotonic() - self.last_save_time >= self.interval_s
+        if (by_steps or by_time) and self.num_timesteps != self.last_save:
+            due = by_steps and self.evaluator is not None and self.eval_freq > 0 and \
                 self.num_timesteps - self.last_eval >= self.eval_freq
             self.save(evaluate=due)
+            if by_steps:
+                self.last_step_save = self.num_timesteps
 
     def _on_training_end(self) -> None:
+        if self.stopping:                           # a signal: checkpoint now, no validation, no final model
+            if self.num_timesteps != self.last_save or not list_checkpoints(self.folder):
+                self.save(evaluate=False)
+            return
         if self.num_timesteps != self.last_save or not list_checkpoints(self.folder):
             self.save(evaluate=self.evaluator is not None and self.eval_freq > 0)
         last = list_checkpoints(self.folder)
@@ -226,9 +303,11 @@ class CheckpointCallback(BaseCallback):
             if self.best is None or result["score"] < self.best["score"]:
                 self.best, new_best = {"num_timesteps": step, "score": result["score"], "stem": stem.name}, True
         state = {**self.meta, "num_timesteps": step, "saved_utc": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
+                 "train_wall_s": round(self.wall0 + time.monotonic() - self.t_start, 3),
                  "evaluations": self.evaluations, "best": self.best}
         atomic_write_text(json_path, json_text(state))            # the commit: the checkpoint now exists
         self.last_save = step
+        self.last_save_time = time.monotonic()
         if evaluate:
             atomic_write_text(self.run_dir / "evaluations.json", json_text(self.evaluations))
         if new_best:
@@ -338,5 +417,5 @@ def evaluate_saved(path: str | Path, suite: str = "smile-windy", episodes: int =
         ev.close()
 
 
-__all__ = ["CheckpointCallback", "ProgressBarCallback", "ValidationEvaluator", "checkpoint_stem", "clean_incomplete",
+__all__ = ["CheckpointCallback", "ProgressBarCallback", "SignalStop", "ValidationEvaluator", "checkpoint_stem", "clean_incomplete",
            "evaluate_saved", "latest_checkpoint", "list_checkpoints", "load_replay_buffer", "load_rng", "save_rng"]

@@ -19,6 +19,7 @@ the key path, the value and what is allowed.
 from __future__ import annotations
 
 import copy
+import difflib
 from collections.abc import Mapping
 from dataclasses import asdict, dataclass, field, fields
 from pathlib import Path
@@ -49,13 +50,19 @@ def _layers(key: str, value: Any, src: str | None) -> tuple[int, ...]:
     return tuple(int(v) for v in value)
 
 
+def _unknown(key: str, allowed: list[str] | tuple[str, ...]) -> str:
+    """``"unknown key; allowed: [...]"`` with ``"; did you mean 'x'?"`` when an allowed key is close."""
+    near = difflib.get_close_matches(str(key).rpartition(".")[2], list(allowed), n=1, cutoff=0.7)
+    return f"unknown key; allowed: {list(allowed)}" + (f"; did you mean {near[0]!r}?" if near else "")
+
+
 def _known(prefix: str, data: Mapping[str, Any], cls: type, src: str | None) -> None:
     if not isinstance(data, Mapping):
         raise ConfigError(prefix.rstrip("."), data, f"a mapping of {sorted(f.name for f in fields(cls))}", src)
     allowed = sorted(f.name for f in fields(cls))
     for key, value in data.items():
         if key not in allowed:
-            raise ConfigError(f"{prefix}{key}", value, f"unknown key; allowed: {allowed}", src)
+            raise ConfigError(f"{prefix}{key}", value, _unknown(key, allowed), src)
 
 
 # ------------------------------------------------------------------------------------------ dataclasses
@@ -279,7 +286,10 @@ def parse_overrides(items: list[str] | tuple[str, ...]) -> dict[str, Any]:
         key, sep, text = item.partition("=")
         if not sep or not key.strip():
             raise ConfigError("--hp", item, "KEY=VALUE with a dotted key, e.g. algo.n_steps=64")
-        out[key.strip()] = yaml.safe_load(text)
+        try:
+            out[key.strip()] = yaml.safe_load(text)
+        except yaml.YAMLError:
+            raise ConfigError("--hp", item, "KEY=VALUE with a YAML value, e.g. policy.net_arch=[32,32]") from None
     return out
 
 
@@ -290,7 +300,9 @@ def read_entries(algo: str, path: str | Path | None = None) -> tuple[dict[str, A
     src = str(p)
     if not p.is_file():
         raise ConfigError("hyperparams", src, "an existing YAML file", None)
-    data = yaml.safe_load(p.read_text(encoding="utf-8")) or {}
+    from lvgym.vehicle.yamlfile import read_yaml
+
+    data = read_yaml(p, src)[0] or {}                # syntax errors, unsafe tags, duplicate keys: with the line
     if not isinstance(data, dict):
         raise ConfigError("<top level>", type(data).__name__, "a mapping of env ids to entries", src)
     return data, src
@@ -307,7 +319,7 @@ def build_config(algo: str, env_id: str, entry: Mapping[str, Any], source: str =
         src = f"{source} with overrides" if source else "overrides"
     for key, value in raw.items():
         if key not in _ENTRY_KEYS:
-            raise ConfigError(key, value, f"unknown key; allowed: {list(_ENTRY_KEYS)}", src)
+            raise ConfigError(key, value, _unknown(key, _ENTRY_KEYS), src)
     hyper_cls: type = PPOConfig if algo == "ppo" else OffPolicyConfig
     algo_raw = raw.get("algo", {}) or {}
     if algo != "ppo":

@@ -2,7 +2,8 @@
 
 Every controller implements the benchmark's policy interface (:class:`lvgym.benchmark.Policy`):
 ``reset()`` and ``act(observation, info) -> action``. ``python -m baselines_pid.tune --vehicle smile``
-regenerates a gain schedule from the rigid linearisation; ``python -m baselines_pid.study`` runs the
+tunes a gain schedule on the rigid linearisation (into ``results/schedules/``; ``--overwrite`` replaces
+the shipped one in ``schedules/``); ``python -m baselines_pid.study`` runs the
 thesis's control study (docs/control-study.md).
 """
 

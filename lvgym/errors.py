@@ -25,21 +25,51 @@ class ConfigError(ValueError):
         What is allowed, in words, e.g. ``"must be in [0, 1]"`` or ``"one of 'us76', 'exponential'"``.
     source:
         The file (or other origin) the value came from, if any.
+    line:
+        The line of ``source`` (1-based) where the key is, if known.
     """
 
-    def __init__(self, key: str, value: Any, allowed: str, source: str | None = None):
+    def __init__(self, key: str, value: Any, allowed: str, source: str | None = None, line: int | None = None):
         self.key = key
         self.value = value
         self.allowed = allowed
         self.source = source
-        where = f"{source}: " if source else ""
+        self.line = line
+        at = f"line {line}" if line is not None else ""
+        where = f"{source}, {at}: " if source and at else f"{source or at}: " if source or at else ""
         shown = "<missing>" if value is MISSING else repr(value)
         super().__init__(f"{where}{key} = {shown}: {allowed}")
+
+    def __reduce__(self) -> tuple:
+        # pickle by the four fields (an exception pickles its ``args``, here the one message, and the
+        # constructor wants four): a ConfigError raised in a worker process reaches the parent intact.
+        # A value that does not pickle travels as its repr.
+        import pickle
+
+        value = self.value
+        try:
+            pickle.dumps(value)
+        except Exception:  # noqa: BLE001
+            value = _Shown(repr(value))
+        return (type(self), (self.key, value, self.allowed, self.source, self.line), self.__dict__ | {"value": value})
+
+
+class _Shown:
+    """Stands in for a value that does not pickle: shows as the original's repr."""
+
+    def __init__(self, text: str) -> None:
+        self.text = text
+
+    def __repr__(self) -> str:
+        return self.text
 
 
 class _Missing:
     def __repr__(self) -> str:
         return "<missing>"
+
+    def __reduce__(self) -> str:
+        return "MISSING"                              # unpickles as the one marker (``value is MISSING``)
 
 
 #: marker for a required key that is absent

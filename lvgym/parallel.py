@@ -5,6 +5,12 @@ The one executor of the benchmark's episodes (:func:`lvgym.benchmark.evaluate`) 
 (the studies write their cache there, so an interrupted study keeps every run that finished). Results
 come back in the order of the tasks whatever the executor. Pool workers are spawned (they inherit no
 numba or BLAS threads) and exit when their parent dies, so a killed run leaves no workers behind.
+
+An exception raised in a task reaches the caller as itself, with its own message, whatever the executor:
+the worker checks that it survives pickling and, if it does not, sends a :class:`WorkerError` carrying
+its type, message and traceback instead (a pool would otherwise break with ``BrokenProcessPool`` and
+lose the message); Ray's ``RayTaskError`` wrapper is removed. With ``describe``, the error is a
+:class:`TaskFailed` naming the task, raised from the original.
 """
 
 from __future__ import annotations
@@ -15,7 +21,8 @@ from collections.abc import Callable, Sequence
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from typing import Any, TypeVar
 
-__all__ = ["EXECUTORS", "default_workers", "exit_on_sigterm", "run_map"]
+__all__ = ["EXECUTORS", "TaskFailed", "WorkerError", "check_workers", "default_workers", "exit_on_sigterm",
+           "run_map"]
 
 EXECUTORS = ("local", "serial", "ray")
 T = TypeVar("T")
@@ -55,6 +62,46 @@ def _exit_with_parent(parent: int) -> None:
     threading.Thread(target=watch, name="exit-with-parent", daemon=True).start()
 
 
+class WorkerError(RuntimeError):
+    """An exception of a task that could not be sent back from its worker as itself (it does not pickle):
+    its type, message and the worker's traceback, as text."""
+
+
+class TaskFailed(RuntimeError):
+    """Task ``describe(task)`` failed; raised from the task's own exception (``__cause__``)."""
+
+
+def check_workers(workers: Any, option: str = "workers") -> int | None:
+    """``workers`` (None: the default) when it is an integer >= 1; else a ConfigError naming ``option``."""
+    if workers is None:
+        return None
+    import numbers
+
+    from lvgym.errors import check_number
+
+    if isinstance(workers, numbers.Integral) and not isinstance(workers, bool):
+        workers = int(workers)                        # numpy integers too
+    return check_number(option, workers, 1, 100_000, integer=True)
+
+
+def _call(fn: Callable[[T], R], task: T) -> R:
+    """``fn(task)`` in a worker, its exception made safe to send back (see the module docstring)."""
+    try:
+        return fn(task)
+    except Exception as exc:
+        import pickle
+
+        try:
+            pickle.loads(pickle.dumps(exc))
+        except Exception:  # noqa: BLE001
+            import traceback
+
+            text = "".join(traceback.format_exception(exc))
+            raise WorkerError(f"{type(exc).__module__}.{type(exc).__qualname__}: {exc}\n\nworker traceback:\n"
+                              f"{text}") from None
+        raise
+
+
 class _TaskError(Exception):
     """The exception of task ``index``, raised from it (``__cause__``)."""
 
@@ -78,7 +125,7 @@ def _local(fn: Callable[[T], R], tasks: Sequence[T], done: Callable[[int, R], No
     # spawn: workers inherit neither the parent's threads (numba, BLAS) nor its open files
     with ProcessPoolExecutor(max_workers=workers, mp_context=mp.get_context("spawn"),
                              initializer=_exit_with_parent, initargs=(os.getpid(),)) as pool:
-        futures = {pool.submit(fn, t): i for i, t in enumerate(tasks)}
+        futures = {pool.submit(_call, fn, t): i for i, t in enumerate(tasks)}
         pending = set(futures)
         try:
             while pending:
@@ -103,10 +150,14 @@ def _ray(fn: Callable[[T], R], tasks: Sequence[T], done: Callable[[int, R], None
     if started and os.environ.get("RAY_ADDRESS"):     # join the cluster named by RAY_ADDRESS
         ray.init(log_to_driver=False, configure_logging=False)
     elif started:                                     # a local Ray of `workers` CPUs, for this map
-        ray.init(num_cpus=workers, include_dashboard=False, log_to_driver=False, configure_logging=False)
+        # address="local": a new instance even if `ray start` ran on this machine (ray.init would join it)
+        ray.init(address="local", num_cpus=workers, include_dashboard=False, log_to_driver=False,
+                 configure_logging=False)
+    from ray.exceptions import RayTaskError
+
     try:
-        remote = ray.remote(num_cpus=1)(fn)
-        refs = [remote.remote(t) for t in tasks]
+        remote = ray.remote(num_cpus=1)(_call)
+        refs = [remote.remote(fn, t) for t in tasks]
         index = {r: i for i, r in enumerate(refs)}
         pending = list(refs)
         try:
@@ -115,7 +166,10 @@ def _ray(fn: Callable[[T], R], tasks: Sequence[T], done: Callable[[int, R], None
                 for ref in finished:
                     try:
                         r = ray.get(ref)
-                    except Exception as exc:
+                    except RayTaskError as exc:                     # the task's own exception
+                        cause = exc.cause if isinstance(exc.cause, BaseException) else exc
+                        raise _TaskError(index[ref]) from cause
+                    except Exception as exc:                        # worker died, cancelled, ...
                         raise _TaskError(index[ref]) from exc
                     done(index[ref], r)
         except BaseException:
@@ -136,14 +190,16 @@ def run_map(fn: Callable[[T], R], tasks: Sequence[T], executor: str = "local", w
     worker runs serially), ``serial`` (this process) or ``ray`` (Ray tasks; starts a local Ray with
     ``workers`` CPUs unless ``ray.init`` was called already or ``$RAY_ADDRESS`` names a cluster to join).
     ``fn`` must be a module-level function and the tasks picklable. ``on_result(i, result)`` is called in
-    this process as each task finishes. An exception in a task stops the map and is raised here, as a
-    ``RuntimeError`` naming the task by ``describe(task)`` when ``describe`` is given."""
+    this process as each task finishes. An exception in a task stops the map and is raised here as
+    itself, or as a :class:`TaskFailed` (a ``RuntimeError``) naming the task by ``describe(task)`` when
+    ``describe`` is given. ``workers`` must be an integer >= 1 (a ConfigError otherwise)."""
     if executor not in EXECUTORS:
         raise ValueError(f"executor = {executor!r}: one of {EXECUTORS}")
+    workers = check_workers(workers)
     results: list[Any] = [None] * len(tasks)
     if not tasks:
         return []
-    n = max(1, min(int(workers) if workers else default_workers(), len(tasks)))
+    n = max(1, min(workers or default_workers(), len(tasks)))
     from tqdm.auto import tqdm
 
     with tqdm(total=len(tasks), desc=desc, unit=unit, disable=not progress, file=sys.stderr,
@@ -164,5 +220,5 @@ def run_map(fn: Callable[[T], R], tasks: Sequence[T], executor: str = "local", w
         except _TaskError as exc:
             if describe is None:
                 raise exc.__cause__ from None
-            raise RuntimeError(f"task failed: {describe(tasks[exc.index])}: {exc.__cause__}") from exc.__cause__
+            raise TaskFailed(f"task failed: {describe(tasks[exc.index])}: {exc.__cause__}") from exc.__cause__
     return results

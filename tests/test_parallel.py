@@ -31,3 +31,48 @@ def test_a_failing_task_is_named(executor):
 def test_unknown_executor_is_refused():
     with pytest.raises(ValueError, match="executor"):
         run_map(_square_or_fail, [1], "threads")
+
+
+# ------------------------------------------------------------------ errors from workers (issue 19)
+class _Unpicklable(Exception):
+    def __init__(self, a, b):                       # pickles as args (one message): cannot be rebuilt
+        super().__init__(f"{a} and {b}")
+
+
+def _raise_config_error(x):
+    from lvgym.errors import ConfigError
+
+    raise ConfigError("stages[0].tanks[1].fill_ratio", x, "must be in [0, 1]", "v.yaml", 12)
+
+
+def _raise_unpicklable(x):
+    raise _Unpicklable("left", x)
+
+
+@pytest.mark.parametrize("executor", ["serial", "local"])
+def test_a_config_error_in_a_worker_reaches_the_caller_as_itself(executor):
+    from lvgym.errors import ConfigError
+
+    with pytest.raises(ConfigError) as err:
+        run_map(_raise_config_error, [1.3, 1.4], executor, workers=2, progress=False)
+    assert str(err.value) in ("v.yaml, line 12: stages[0].tanks[1].fill_ratio = 1.3: must be in [0, 1]",
+                              "v.yaml, line 12: stages[0].tanks[1].fill_ratio = 1.4: must be in [0, 1]")
+    assert err.value.key == "stages[0].tanks[1].fill_ratio" and err.value.line == 12
+    with pytest.raises(RuntimeError, match=r"task failed: x = 1\.3: v\.yaml, line 12: .*fill_ratio = 1\.3") as err:
+        run_map(_raise_config_error, [1.3], executor, workers=2, progress=False, describe=lambda x: f"x = {x}")
+    assert isinstance(err.value.__cause__, ConfigError)
+
+
+def test_an_exception_that_does_not_pickle_arrives_as_a_worker_error():
+    from lvgym.parallel import WorkerError
+
+    with pytest.raises(WorkerError, match=r"(?s)_Unpicklable: left and right\n\nworker traceback:\n.*_raise_unpicklable"):
+        run_map(_raise_unpicklable, ["right", "right"], "local", workers=2, progress=False)
+
+
+@pytest.mark.parametrize("workers", [0, -1, 1.5, "2"])
+def test_bad_worker_counts_are_refused_before_any_worker_starts(workers):
+    from lvgym.errors import ConfigError
+
+    with pytest.raises(ConfigError, match=r"^workers = .*: an integer in \[1, 100000\]$"):
+        run_map(_square_or_fail, [1], "local", workers=workers, progress=False)

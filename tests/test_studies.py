@@ -175,6 +175,7 @@ def test_tw_sweep_runs_and_thrust_to_weight_grows_with_mass_flow(tmp_path):
 
 @pytest.mark.slow
 def test_ray_executor_matches_serial():
-    pytest.importorskip("ray")
+    import ray  # noqa: F401  (a test dependency: a missing Ray fails here; tests/test_ray.py runs a real cluster)
+
     tasks = [{"diameter": d} for d in (0.2, 0.3, 0.4)]         # an lvgym function: Ray workers import it
     assert run_map(run_key, tasks, executor="ray", workers=2, progress=False) == [run_key(t) for t in tasks]

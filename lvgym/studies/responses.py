@@ -56,8 +56,9 @@ PROFILE_WIND: dict[str, Any] = {"model": "profile", "altitude_m": [0.0, 1000.0, 
 DEPARTED_DEG = 20.0           # a run whose total angle of attack exceeds this [deg] ...
 QBAR_MIN = 5000.0             # ... while the dynamic pressure is above this [Pa] departed
 AERO_MODES = ("reference", "own", "tables")
+MACH_MAX = 25.0               # the highest Mach number the aerodynamic tables may be frozen at
 
-__all__ = ["AERO_MODES", "DEPARTED_DEG", "QBAR_MIN", "FACTORS", "G0", "PROFILE_WIND", "RECORD", "RESPONSES",
+__all__ = ["AERO_MODES", "DEPARTED_DEG", "MACH_MAX", "QBAR_MIN", "FACTORS", "G0", "PROFILE_WIND", "RECORD", "RESPONSES",
            "RunSetup", "deflection",
            "responses", "run_case"]
 
@@ -83,6 +84,27 @@ class RunSetup:
     aero_mach: float = 2.0
     model: str = "nonrigid"
     n_stations: int = 41
+
+    def __post_init__(self) -> None:
+        """Every value checked here, in the parent process, before a run starts in a worker."""
+        from lvgym.errors import ConfigError, check_choice, check_number
+
+        check_number("t_end", self.t_end, 0.0, 3600.0, lo_open=True)
+        check_number("physics_dt", self.physics_dt, 0.0, 0.05, lo_open=True)
+        check_number("sample_dt", self.sample_dt, self.physics_dt, self.t_end)
+        k = self.sample_dt / self.physics_dt
+        if abs(k - round(k)) > 1e-6:
+            raise ConfigError("sample_dt", self.sample_dt, f"a whole multiple of physics_dt = {self.physics_dt}")
+        check_number("elevation_deg", self.elevation_deg, 1.0, 90.0)
+        check_number("rail_length", self.rail_length, 0.0, 1000.0)
+        check_choice("aero", self.aero, AERO_MODES)
+        check_number("aero_mach", self.aero_mach, 0.0, MACH_MAX)
+        check_number("n_stations", self.n_stations, 2, 10_000, integer=True)
+        from lvgym.simulator import MODELS, SITES
+
+        check_choice("model", self.model, tuple(MODELS))
+        if not isinstance(self.site, str) or self.site not in SITES:
+            raise ConfigError("site", self.site, f"one of {sorted(SITES)}")
 
     def as_dict(self) -> dict[str, Any]:
         d = asdict(self)

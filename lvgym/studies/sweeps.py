@@ -16,16 +16,19 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from lvgym.errors import ConfigError
 from lvgym.vehicle.slender import DEFAULTS
 
 from .responses import RunSetup
 from .runs import case
 
-__all__ = ["LD_LENGTH", "TW_LD", "ld_cases", "peak", "rise_ld", "thesis_deflection", "thesis_frequency_hz",
+__all__ = ["LD_LENGTH", "LD_RANGE", "TW_LD", "TW_RANGE", "ld_cases", "peak", "rise_ld", "thesis_deflection", "thesis_frequency_hz",
            "tw_cases"]
 
 LD_LENGTH = 8.5          # [m] length of the L/D sweep
 TW_LD = 30.0             # [-] slenderness of the T/W sweep
+LD_RANGE = (0.2, 0.5)    # [m] diameters of the L/D sweep
+TW_RANGE = (10.0, 30.0)  # [kg/s] mass flows of the T/W sweep
 
 
 def thesis_frequency_hz(diameter: np.ndarray | float) -> np.ndarray:
@@ -39,23 +42,30 @@ def thesis_deflection(diameter: np.ndarray | float) -> np.ndarray:
     return 0.1438 * np.asarray(diameter, float) ** -0.511
 
 
-def _grid(lo: float, hi: float, step: float) -> np.ndarray:
+def _grid(lo: float, hi: float, step: float, what: str = "step") -> np.ndarray:
+    """``lo`` to ``hi`` in ``round((hi - lo) / step)`` equal steps; ``step`` in ``(0, hi - lo]``."""
+    if isinstance(step, bool) or not isinstance(step, (int, float, np.floating)) or not 0.0 < step <= hi - lo:
+        raise ConfigError("step", step, f"a number in (0, {hi - lo:g}]: the {what} between runs")
+    if not lo < hi:
+        raise ConfigError("range", (lo, hi), "low < high")
     n = int(round((hi - lo) / step))
     return np.round(np.linspace(lo, hi, n + 1), 9)
 
 
-def ld_cases(step: float = 0.001, setup: RunSetup | None = None, lo: float = 0.2, hi: float = 0.5) -> list[dict]:
+def ld_cases(step: float = 0.001, setup: RunSetup | None = None, lo: float = LD_RANGE[0],
+             hi: float = LD_RANGE[1]) -> list[dict]:
     """Runs of the L/D sweep: diameters ``lo`` to ``hi`` [m] every ``step`` [m] at L = 8.5 m."""
     s = setup or RunSetup()
     return [case(LD_LENGTH, d, DEFAULTS["fill"], DEFAULTS["mass_flow"], DEFAULTS["slosh_damping"], s)
-            for d in _grid(lo, hi, step)]
+            for d in _grid(lo, hi, step, "diameter [m]")]
 
 
-def tw_cases(step: float = 0.1, setup: RunSetup | None = None, lo: float = 10.0, hi: float = 30.0) -> list[dict]:
+def tw_cases(step: float = 0.1, setup: RunSetup | None = None, lo: float = TW_RANGE[0],
+             hi: float = TW_RANGE[1]) -> list[dict]:
     """Runs of the T/W sweep: mass flows ``lo`` to ``hi`` [kg/s] every ``step`` at L/D 30."""
     s = setup or RunSetup()
     return [case(LD_LENGTH, LD_LENGTH / TW_LD, DEFAULTS["fill"], m, DEFAULTS["slosh_damping"], s)
-            for m in _grid(lo, hi, step)]
+            for m in _grid(lo, hi, step, "mass flow [kg/s]")]
 
 
 def peak(table: pd.DataFrame, x: str, y: str) -> tuple[float, float]:

@@ -1,12 +1,15 @@
 """Whole-vehicle consistency checks of a parsed definition (what one key alone cannot tell).
 
 Overlapping tanks, a gimbal outside the vehicle, a tank that feeds an engine its stage does not have,
-a mixture with no oxidiser, a staging sequence that skips a stage: each raises
-:class:`lvgym.errors.ConfigError` naming the file, the key path, the value and what is allowed.
+a mixture with no oxidiser, a staging sequence that skips a stage; a tank, grain or nozzle wider than its
+stage; an engine or a structure whose CG or gimbal is outside its stage (along the axis or off it); a
+sensor off the stack: each raises :class:`lvgym.errors.ConfigError` naming the file, the key path, the
+value and what is allowed.
 """
 
 from __future__ import annotations
 
+import math
 from typing import TYPE_CHECKING
 
 from lvgym.errors import ConfigError
@@ -57,6 +60,7 @@ def check_vehicle(v: Vehicle) -> None:
         for e in s.engines:
             _check_mixture(s, e, src)
     _check_parts_and_sections(v, length, src)
+    _check_fit(v, src)
     ranges.sort(key=lambda r: -r[0])
     for (top_a, bottom_a, _, name_a), (top_b, _, key_b, name_b) in zip(ranges, ranges[1:]):
         if top_b > bottom_a + _TOL:
@@ -110,6 +114,41 @@ def _check_parts_and_sections(v, length: float, src: str | None) -> None:
             raise ConfigError(f"{upper.key}.top", upper.top, f"stages with bending sections must touch: the bottom "
                               f"of {upper.name!r} ({upper.bottom:g}) must equal the top of {lower.name!r} "
                               f"({lower.top:g})", src)
+
+
+def _check_fit(v, src: str | None) -> None:
+    """Every part within the radius of its stage, engines and structures within their stage's stations."""
+    widest = max(s.outer_diameter for s in v.stages) / 2
+    for s in v.stages:
+        radius = s.outer_diameter / 2
+        for t in s.tanks:
+            if t.inner_radius > radius + _TOL:
+                raise ConfigError(f"{t.key}.inner_radius", t.inner_radius, f"at most the outer radius of stage "
+                                  f"{s.name!r}, {radius:g} m (outer_diameter {s.outer_diameter:g}): a tank must fit "
+                                  "inside its stage", src)
+        if s.grain is not None and s.grain.outer_radius > radius + _TOL:
+            raise ConfigError(f"{s.grain.key}.outer_radius", s.grain.outer_radius, f"at most the outer radius of "
+                              f"stage {s.name!r}, {radius:g} m: the grain must fit inside its stage", src)
+        points = [(f"{s.key}.structure.cg", s.structure.cg)]
+        for e in s.engines:
+            points += [(f"{e.key}.cg", e.part.cg), (f"{e.key}.gimbal", e.gimbal)]
+            exit_d = math.sqrt(4.0 * e.nozzle_exit_area / math.pi)
+            if exit_d > s.outer_diameter + _TOL:
+                raise ConfigError(f"{e.key}.nozzle_exit_area", e.nozzle_exit_area, f"a nozzle exit no wider than "
+                                  f"stage {s.name!r} ({s.outer_diameter:g} m): at most "
+                                  f"{math.pi * s.outer_diameter**2 / 4:.4g} m^2 (this one is {exit_d:.3g} m across)",
+                                  src)
+        for key, point in points:
+            x, off = float(point[0]), math.hypot(float(point[1]), float(point[2]))
+            if not s.bottom - _TOL <= x <= s.top + _TOL:
+                raise ConfigError(key, x, f"must lie within stage {s.name!r}: station in [{s.bottom:g}, {s.top:g}]", src)
+            if off > radius + _TOL:
+                raise ConfigError(key, [float(c) for c in point], f"must lie within stage {s.name!r}: at most its "
+                                  f"radius {radius:g} m off the axis (this is {off:.3g} m)", src)
+    for key, part in (("payload.cg", v.payload), ("fairing.cg", v.fairing)):
+        if part is not None and math.hypot(float(part.cg[1]), float(part.cg[2])) > widest + _TOL:
+            raise ConfigError(key, [float(c) for c in part.cg], f"must lie within the stack: at most its largest "
+                              f"radius {widest:g} m off the axis", src)
 
 
 def _unique(names: list[str], key: str, what: str, src: str | None) -> None:

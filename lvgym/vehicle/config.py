@@ -5,7 +5,7 @@ bottom), an optional payload and fairing, a staging sequence and the options of 
 Positions are stations: body-axis coordinates from the nose tip in metres, zero or negative
 (``-9.0`` or ``[-9.0, 0, 0]``). The format is documented key by key in ``docs/vehicles.md``; the
 shipped vehicles live in ``lvgym/vehicles/``. Every error names the file, the key path, the value and
-what is allowed, e.g. ``smile.yaml: stages[0].tanks[1].fill_ratio = 1.3: must be in [0, 1]``.
+what is allowed, e.g. ``smile.yaml, line 84: stages[0].tanks[1].fill_ratio = 1.3: must be in [0, 1]``.
 """
 
 from __future__ import annotations
@@ -15,7 +15,6 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import yaml
 
 from lvgym.errors import ConfigError
 
@@ -25,6 +24,15 @@ from .reader import Reader
 G0 = 9.80665
 VEHICLE_DIR = Path(__file__).resolve().parent.parent / "vehicles"
 TANK_ROLES = ("oxidiser", "fuel", "propellant")
+# Physical ranges of single values (docs/vehicles.md); how parts fit together is checked in checks.py.
+MAX_LENGTH = 1000.0        # [m] stations, lengths and heights
+MAX_DIAMETER = 50.0        # [m] stage and section diameters (tank and grain radii: half of it)
+MAX_MASS = 1e7             # [kg] one rigid part
+MAX_DENSITY = 25_000.0     # [kg/m^3] liquids and grains (osmium is 22,590)
+MAX_MASS_FLOW = 1e5        # [kg/s] one engine (an F-1 burnt 2,600)
+MAX_ISP = 10_000.0         # [s]
+MAX_THRUST = 1e9           # [N] one engine (an F-1 gave 7.8e6)
+MAX_TIME = 1e5             # [s] burn times, delays, jettison
 
 
 @dataclass(frozen=True)
@@ -41,7 +49,7 @@ class RigidPart:
 
     @staticmethod
     def read(r: Reader, name: str) -> RigidPart:
-        return RigidPart(name=name, mass=r.number("mass", lo=0.0), cg=r.station("cg"),
+        return RigidPart(name=name, mass=r.number("mass", lo=0.0, hi=MAX_MASS), cg=r.station("cg"),
                          inertia=r.inertia("inertia", [0.0, 0.0, 0.0]))
 
 
@@ -60,12 +68,12 @@ class Section:
 
     @staticmethod
     def read(r: Reader, stage_diameter: float) -> Section:
-        top = r.number("top", hi=0.0)
-        bottom = r.number("bottom", hi=top, hi_open=True)
-        EI = r.number("EI", None, lo=0.0, lo_open=True)
+        top = r.number("top", lo=-MAX_LENGTH, hi=0.0)
+        bottom = r.number("bottom", lo=-MAX_LENGTH, hi=top, hi_open=True)
+        EI = r.number("EI", None, lo=0.0, hi=1e15, lo_open=True)
         material = r.text("material", None)
-        thickness = r.number("wall_thickness", None, lo=0.0, lo_open=True)
-        diameter = r.number("outer_diameter", stage_diameter, lo=0.0, lo_open=True)
+        thickness = r.number("wall_thickness", None, lo=0.0, lo_open=True, hi=0.5 * MAX_DIAMETER)
+        diameter = r.number("outer_diameter", stage_diameter, lo=0.0, lo_open=True, hi=MAX_DIAMETER)
         if (EI is None) == (material is None):
             raise r.error("EI", EI, "give either EI or material with wall_thickness, not both or neither")
         if material is not None and thickness is None:
@@ -103,20 +111,22 @@ class Engine:
     def read(r: Reader) -> Engine:
         name = r.text("name")
         part = RigidPart.read(r, name)
-        isp = r.number("isp", None, lo=0.0, lo_open=True)
+        isp = r.number("isp", None, lo=0.0, lo_open=True, hi=MAX_ISP)
         table = r.table("thrust_table", None)
         if (isp is None) == (table is None):
             raise r.error("isp", isp, "give either isp (thrust equation) or thrust_table, not both or neither")
         if table is not None and (table[0, 0] < 0.0 or np.any(table[:, 1] < 0.0)):
             raise r.error("thrust_table", table.tolist(), "times and thrusts must be >= 0")
+        if table is not None and np.any(table[:, 1] > MAX_THRUST):
+            raise r.error("thrust_table", table.tolist(), f"thrusts must be <= {MAX_THRUST:g} N")
         if table is not None and not np.any(table[:, 1] > 0.0):
             raise r.error("thrust_table", table.tolist(), "needs a thrust > 0 somewhere (it has no impulse)")
         engine = Engine(
             name=name, part=part, gimbal=r.station("gimbal"),
-            mass_flow=r.number("mass_flow", lo=0.0, lo_open=True), isp=isp, thrust_table=table,
-            mixture_ratio=r.number("mixture_ratio", None, lo=0.0, lo_open=True),
-            nozzle_exit_area=r.number("nozzle_exit_area", 0.0, lo=0.0),
-            nozzle_exit_pressure=r.number("nozzle_exit_pressure", 0.0, lo=0.0),
+            mass_flow=r.number("mass_flow", lo=0.0, lo_open=True, hi=MAX_MASS_FLOW), isp=isp, thrust_table=table,
+            mixture_ratio=r.number("mixture_ratio", None, lo=0.0, lo_open=True, hi=100.0),
+            nozzle_exit_area=r.number("nozzle_exit_area", 0.0, lo=0.0, hi=np.pi * MAX_DIAMETER**2 / 4),
+            nozzle_exit_pressure=r.number("nozzle_exit_pressure", 0.0, lo=0.0, hi=1e8),
             throttle=r.pair("throttle", [1.0, 1.0], lo=0.0, hi=2.0),
             gimbal_limit=np.radians(r.number("gimbal_limit_deg", 5.0, lo=0.0, hi=45.0)), key=r.path)
         if table is not None and engine.throttle != (1.0, 1.0):
@@ -162,13 +172,15 @@ class Tank:
     @staticmethod
     def read(r: Reader) -> Tank:
         tank = Tank(
-            name=r.text("name"), inner_radius=r.number("inner_radius", lo=0.0, lo_open=True),
-            height=r.number("height", lo=0.0, lo_open=True), top=r.number("top", hi=0.0),
-            density=r.number("density", lo=0.0, lo_open=True), fill_ratio=r.number("fill_ratio", lo=0.0, hi=1.0),
+            name=r.text("name"), inner_radius=r.number("inner_radius", lo=0.0, lo_open=True, hi=0.5 * MAX_DIAMETER),
+            height=r.number("height", lo=0.0, lo_open=True, hi=MAX_LENGTH),
+            top=r.number("top", lo=-MAX_LENGTH, hi=0.0),
+            density=r.number("density", lo=0.0, lo_open=True, hi=MAX_DENSITY),
+            fill_ratio=r.number("fill_ratio", lo=0.0, hi=1.0),
             engine=r.text("engine"), role=r.text("role", choices=TANK_ROLES),
             share=r.number("share", 1.0, lo=0.0, hi=1.0, lo_open=True),
             slip_factor=r.number("slip_factor", 0.95, lo=0.0, hi=1.0),
-            slosh_damping=r.number("slosh_damping", 0.01, lo=0.0), slosh=r.flag("slosh", True), key=r.path)
+            slosh_damping=r.number("slosh_damping", 0.01, lo=0.0, hi=10.0), slosh=r.flag("slosh", True), key=r.path)
         r.done()
         return tank
 
@@ -200,11 +212,12 @@ class Grain:
 
     @staticmethod
     def read(r: Reader) -> Grain:
-        outer = r.number("outer_radius", lo=0.0, lo_open=True)
-        grain = Grain(name=r.text("name"), top=r.number("top", hi=0.0),
-                      length=r.number("length", lo=0.0, lo_open=True), outer_radius=outer,
+        outer = r.number("outer_radius", lo=0.0, lo_open=True, hi=0.5 * MAX_DIAMETER)
+        grain = Grain(name=r.text("name"), top=r.number("top", lo=-MAX_LENGTH, hi=0.0),
+                      length=r.number("length", lo=0.0, lo_open=True, hi=MAX_LENGTH), outer_radius=outer,
                       port_radius=r.number("port_radius", lo=0.0, hi=outer, hi_open=True),
-                      density=r.number("density", lo=0.0, lo_open=True), engine=r.text("engine"), key=r.path)
+                      density=r.number("density", lo=0.0, lo_open=True, hi=MAX_DENSITY), engine=r.text("engine"),
+                      key=r.path)
         r.done()
         return grain
 
@@ -236,7 +249,7 @@ class Stage:
     @staticmethod
     def read(r: Reader) -> Stage:
         name = r.text("name")
-        diameter = r.number("outer_diameter", lo=0.0, lo_open=True)
+        diameter = r.number("outer_diameter", lo=0.0, lo_open=True, hi=MAX_DIAMETER)
         s = r.child("structure")
         structure = RigidPart.read(s, f"{name} structure")
         s.done()
@@ -249,7 +262,8 @@ class Stage:
         if not isinstance(aero, dict):
             raise r.error("aerodynamics", aero, "must be a mapping (the stack's aerodynamics once this stage is "
                           "the lowest attached one)")
-        stage = Stage(name=name, top=r.number("top", hi=0.0), length=r.number("length", lo=0.0, lo_open=True),
+        stage = Stage(name=name, top=r.number("top", lo=-MAX_LENGTH, hi=0.0),
+                      length=r.number("length", lo=0.0, lo_open=True, hi=MAX_LENGTH),
                       outer_diameter=diameter, structure=structure,
                       engines=tuple(Engine.read(e) for e in r.children("engines", [])),
                       tanks=tuple(Tank.read(t) for t in r.children("tanks", [])),
@@ -272,9 +286,9 @@ class StagingStep:
 
     @staticmethod
     def read(r: Reader) -> StagingStep:
-        step = StagingStep(stage=r.text("stage"), ignition_delay=r.number("ignition_delay", 0.0, lo=0.0),
-                           burn_time=r.number("burn_time", None, lo=0.0, lo_open=True),
-                           separation_delay=r.number("separation_delay", None, lo=0.0))
+        step = StagingStep(stage=r.text("stage"), ignition_delay=r.number("ignition_delay", 0.0, lo=0.0, hi=MAX_TIME),
+                           burn_time=r.number("burn_time", None, lo=0.0, lo_open=True, hi=MAX_TIME),
+                           separation_delay=r.number("separation_delay", None, lo=0.0, hi=MAX_TIME))
         r.done()
         return step
 
@@ -301,12 +315,14 @@ class StructureOptions:
             return StructureOptions()
         sensors = r.raw("sensor_stations", [])
         if not isinstance(sensors, list) or not all(
-                isinstance(s, (int, float)) and not isinstance(s, bool) and -np.inf < s <= 0 for s in sensors):
-            raise r.error("sensor_stations", sensors, "must be a list of finite stations <= 0")
-        opts = StructureOptions(n_modes=r.integer("n_modes", 2, lo=0), damping=r.number("damping", 0.01, lo=0.0),
-                                recompute_interval=r.number("recompute_interval", None, lo=0.0, lo_open=True),
+                isinstance(s, (int, float)) and not isinstance(s, bool) and -MAX_LENGTH <= s <= 0 for s in sensors):
+            raise r.error("sensor_stations", sensors, f"must be a list of finite stations in [{-MAX_LENGTH:g}, 0]")
+        opts = StructureOptions(n_modes=r.integer("n_modes", 2, lo=0, hi=20),
+                                damping=r.number("damping", 0.01, lo=0.0, hi=1.0),
+                                recompute_interval=r.number("recompute_interval", None, lo=0.0, lo_open=True,
+                                                            hi=MAX_TIME),
                                 sensor_stations=tuple(float(s) for s in sensors),
-                                first_mode_hz=r.number("first_mode_hz", None, lo=0.0, lo_open=True),
+                                first_mode_hz=r.number("first_mode_hz", None, lo=0.0, lo_open=True, hi=1000.0),
                                 aeroelastic=r.flag("aeroelastic", False))
         r.done()
         return opts
@@ -339,17 +355,35 @@ class Vehicle:
         return tuple(t for s in self.stages for t in s.tanks)
 
 
+def shipped_vehicles() -> list[str]:
+    """Names of the vehicles shipped in ``lvgym/vehicles/``."""
+    return sorted(p.stem for p in VEHICLE_DIR.glob("*.yaml"))
+
+
 def load_vehicle(name_or_path: str | Path) -> Vehicle:
-    """Read a vehicle: a shipped name (``"smile"``) or a path to a YAML file."""
+    """Read a vehicle: a shipped name (``"smile"``) or a path to a YAML file.
+
+    Every problem is a :class:`ConfigError` naming the file (and, where it is known, the line), the key
+    path, the value and what is allowed: a missing file (with the shipped vehicles), a YAML syntax error,
+    an unsafe tag, a duplicate key (:mod:`.yamlfile`), an unknown, missing or out-of-range value, and
+    parts that do not fit the vehicle (:mod:`.checks`)."""
+    from .yamlfile import read_yaml, with_line
+
     path = Path(name_or_path)
     if not path.suffix:
         path = VEHICLE_DIR / f"{name_or_path}.yaml"
         if not path.exists():
-            shipped = sorted(p.stem for p in VEHICLE_DIR.glob("*.yaml"))
-            raise ConfigError("vehicle", str(name_or_path), f"one of the shipped vehicles {shipped} or a YAML path")
-    with open(path, encoding="utf-8") as fh:
-        data = yaml.safe_load(fh)
-    return parse_vehicle(data, source=path.name)
+            raise ConfigError("vehicle", str(name_or_path), f"one of the shipped vehicles {shipped_vehicles()} or a "
+                              "YAML path")
+    elif not path.is_file():
+        what = "it is a folder" if path.is_dir() else "there is no such file"
+        raise ConfigError("vehicle", str(name_or_path), f"an existing YAML file ({what}) or one of the shipped "
+                          f"vehicles {shipped_vehicles()}")
+    data, lines = read_yaml(path, source=path.name)
+    try:
+        return parse_vehicle(data, source=path.name)
+    except ConfigError as exc:
+        raise with_line(exc, lines) from None
 
 
 def parse_vehicle(data: Any, source: str | None = None) -> Vehicle:
@@ -366,7 +400,7 @@ def parse_vehicle(data: Any, source: str | None = None) -> Vehicle:
     fairing, jettison = None, None
     if fairing_r:
         fairing = RigidPart.read(fairing_r, "fairing")
-        jettison = fairing_r.number("jettison_time", None, lo=0.0)
+        jettison = fairing_r.number("jettison_time", None, lo=0.0, hi=MAX_TIME)
         fairing_r.done()
     aero = r.raw("aerodynamics", {})
     if not isinstance(aero, dict):

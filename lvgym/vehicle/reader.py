@@ -3,11 +3,13 @@
 :class:`Reader` wraps one mapping at a key path. Its typed getters (``number``, ``text``, ``vector3``,
 ``inertia``, ``table``, ``child``, ``children``) remember which keys were read; :meth:`Reader.done`
 then rejects every key that was not, so a typo (``fill_raito``) is an error instead of a silently
-ignored option.
+ignored option. A missing required key next to a near spelling of it, or an unknown key near an allowed
+one, says which (``did you mean 'fill_ratio'?``, by :mod:`difflib`).
 """
 
 from __future__ import annotations
 
+import difflib
 import math
 from collections.abc import Mapping, Sequence
 from typing import Any
@@ -17,6 +19,8 @@ import numpy as np
 from lvgym.errors import MISSING, ConfigError
 
 REQUIRED = MISSING
+#: the largest distance of a station from the nose tip [m]
+STATION_LIMIT = 1000.0
 
 
 class Reader:
@@ -55,16 +59,21 @@ class Reader:
         value = self.data.get(name)
         if value is None:
             if default is REQUIRED:
-                raise self.error(name, MISSING, "required")
+                near = difflib.get_close_matches(name, [str(k) for k in self.data if k != name], n=1, cutoff=0.7)
+                hint = f" (the mapping has {near[0]!r}: did you mean {name!r}?)" if near else ""
+                raise self.error(name, MISSING, f"required{hint}")
             return default
         return value
 
     def done(self) -> None:
         """Reject every key that no getter read."""
-        unknown = sorted(set(map(str, self.data)) - self._used)
+        keys = {str(k): k for k in self.data}
+        unknown = sorted(set(keys) - self._used)
         if unknown:
             allowed = ", ".join(sorted(self._used)) or "no keys"
-            raise self.error(unknown[0], self.data[unknown[0]], f"unknown key; allowed here: {allowed}")
+            near = difflib.get_close_matches(unknown[0], sorted(self._used), n=1, cutoff=0.7)
+            hint = f"; did you mean {near[0]!r}?" if near else ""
+            raise self.error(unknown[0], self.data[keys[unknown[0]]], f"unknown key; allowed here: {allowed}{hint}")
 
     # -- typed getters --------------------------------------------------------------------------
     def number(self, name: str, default: Any = REQUIRED, *, lo: float | None = None,
@@ -86,13 +95,17 @@ class Reader:
             raise self.error(name, value, f"must be in {left}{lo_s}, {hi_s}{right}")
         return value
 
-    def integer(self, name: str, default: Any = REQUIRED, *, lo: int | None = None) -> int:
-        """An integer ``>= lo``."""
+    def integer(self, name: str, default: Any = REQUIRED, *, lo: int | None = None, hi: int | None = None) -> int:
+        """An integer in ``[lo, hi]``."""
         value = self.raw(name, default)
         if isinstance(value, bool) or not isinstance(value, int):
             raise self.error(name, value, "must be an integer")
         if lo is not None and value < lo:
-            raise self.error(name, value, f"must be an integer >= {lo}")
+            raise self.error(name, value, f"must be an integer >= {lo}" if hi is None else
+                             f"must be an integer in [{lo}, {hi}]")
+        if hi is not None and value > hi:
+            raise self.error(name, value, f"must be an integer <= {hi}" if lo is None else
+                             f"must be an integer in [{lo}, {hi}]")
         return value
 
     def flag(self, name: str, default: Any = REQUIRED) -> bool:
@@ -124,6 +137,8 @@ class Reader:
         vec = self._floats(name, value, 3)
         if vec[0] > 0.0:
             raise self.error(name, value, "stations are measured aft of the nose tip: x must be <= 0")
+        if vec[0] < -STATION_LIMIT or np.any(np.abs(vec[1:]) > STATION_LIMIT):
+            raise self.error(name, value, f"coordinates within {STATION_LIMIT:g} m of the nose tip")
         return vec
 
     def inertia(self, name: str, default: Any = REQUIRED) -> np.ndarray:
@@ -141,8 +156,13 @@ class Reader:
             raise self.error(name, value, "must be [Ixx, Iyy, Izz] or a 3x3 matrix")
         if not np.allclose(J, J.T, rtol=0.0, atol=1e-9 * max(1.0, np.abs(J).max())):
             raise self.error(name, value, "must be symmetric")
-        if np.linalg.eigvalsh(J).min() < -1e-9 * max(1.0, np.abs(J).max()):
+        tol = 1e-9 * max(1.0, np.abs(J).max())
+        moments = np.linalg.eigvalsh(J)
+        if moments.min() < -tol:
             raise self.error(name, value, "must be positive semi-definite (no negative moments of inertia)")
+        if moments[0] + moments[1] < moments[2] - max(tol, 1e-6 * moments[2]):
+            raise self.error(name, value, "principal moments that a body can have: each at most the sum of the "
+                             f"other two (these are {', '.join(f'{m:g}' for m in moments)})")
         return J
 
     def table(self, name: str, default: Any = REQUIRED, *, columns: int = 2,

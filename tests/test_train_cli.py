@@ -1,0 +1,122 @@
+"""train.py as a new user meets it (issue 19): a mistyped option is one line and leaves no run folder,
+checkpoints by wall time, a checkpoint on SIGTERM and SIGINT, and ``--resume`` says what it resumed from.
+Runs are tiny (as in test_agents.py): a few hundred env steps of 2 s episodes with 8-unit networks."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from agents.callbacks import latest_checkpoint, list_checkpoints
+
+from test_agents import ROOT, TRAIN, _argv
+
+
+def _train_process(argv: list[str], log: Path) -> subprocess.Popen:
+    with open(log, "wb") as out:
+        return subprocess.Popen([sys.executable, str(ROOT / "train.py"), *argv], cwd=ROOT, stdout=out,
+                                stderr=subprocess.STDOUT, start_new_session=True)
+
+
+def _wait(cond, proc: subprocess.Popen, log: Path, what: str, timeout: float = 120.0) -> None:
+    deadline = time.monotonic() + timeout
+    while not cond():
+        if proc.poll() is not None or time.monotonic() > deadline:
+            proc.kill()
+            proc.wait()
+            raise AssertionError(f"{what} did not happen (exit {proc.returncode}):\n{log.read_text()[-3000:]}")
+        time.sleep(0.05)
+
+
+@pytest.mark.parametrize("extra, message", [
+    (["--model", "flexible"], r"argument --model: invalid choice: 'flexible' \(choose from 'rigid', 'slosh'"),
+    (["--hp", "algo.gama=0.99"], r"algo\.gama = 0\.99: unknown key; allowed: \[.*\]; did you mean 'gamma'\?"),
+    (["--total-timesteps", "-5"], r"--total-timesteps = -5: an integer in \[1, "),
+    (["--checkpoint-freq", "0"], r"--checkpoint-freq = 0: an integer in \[1, "),
+    (["--checkpoint-interval-s", "-1"], r"--checkpoint-interval-s = -1\.0: a number in \[0\.0, "),
+    (["--env-kwargs", "mission_time_s=-3"], r"lvgym/SmileAscent-v0 option mission_time_s = -3: a number in \(0\.0, "),
+    (["--env-kwargs", "mision_time_s=3"], r"mision_time_s = 3: unknown option"),
+    (["--hp", "policy.net_arch=[8,"], r"--hp = 'policy\.net_arch=\[8,': KEY=VALUE with a YAML value"),
+    (["--randomize", "winds"], r"--randomize = 'winds': names of \["),
+    (["--eval-suite", "nope"], r"--eval-suite = 'nope': one of \["),
+    (["--seed", "99999"], r"--seed 99999 with 4 envs: rows seed \.\. seed \+ n_envs - 1 must be validation seeds"),
+])
+def test_a_bad_option_is_one_line_and_leaves_no_run_folder(tmp_path, capsys, extra, message):
+    with pytest.raises(SystemExit) as exit_:
+        TRAIN.train([*_argv(tmp_path, "typo", steps=128), *extra])
+    text = exit_.value.code if isinstance(exit_.value.code, str) else capsys.readouterr().err
+    assert text.startswith("train.py: ") and len(text.strip().splitlines()) == 1, text
+    import re
+
+    assert re.search(message, text), text
+    assert not list(tmp_path.iterdir()), "a refused command left files behind"
+
+
+def test_the_corrected_command_runs_after_a_typo(tmp_path):
+    with pytest.raises(SystemExit):
+        TRAIN.train([*_argv(tmp_path, "fixed", steps=128, extra=("--eval-freq", "0")), "--model", "flexible"])
+    run = TRAIN.train(_argv(tmp_path, "fixed", steps=128, extra=("--eval-freq", "0", "--model", "rigid")))
+    assert (run / "final_model.json").is_file()
+
+
+def test_resume_says_there_was_nothing_to_resume_from(tmp_path, capsys):
+    args, given = TRAIN.parse_args(_argv(tmp_path, "early", steps=128, extra=("--eval-freq", "0")))
+    _, config, run_dir, _ = TRAIN.prepare(args, given)
+    TRAIN.create_run(config, run_dir)                  # a run killed before its first checkpoint
+    TRAIN.train(["--resume", str(run_dir), "--no-progress"])
+    err = capsys.readouterr().err
+    assert f"{run_dir} has no complete checkpoint to resume from" in err and "starts again at step 0" in err
+    assert latest_checkpoint(run_dir / "checkpoints")[1]["num_timesteps"] >= 128
+
+
+def test_a_kill_loses_at_most_the_wall_time_interval(tmp_path, capsys):
+    argv = _argv(tmp_path, "timed", steps=10**7, extra=("--eval-freq", "0", "--checkpoint-freq", "1000000000",
+                                                        "--checkpoint-interval-s", "0.5"))
+    log = tmp_path / "train.log"
+    proc = _train_process(argv, log)
+    folder = tmp_path / "timed" / "checkpoints"
+    try:
+        _wait(lambda: len(list_checkpoints(folder)) >= 2, proc, log, "two wall-time checkpoints")
+    finally:
+        os.kill(proc.pid, signal.SIGKILL)
+        proc.wait()
+    (first, _), (last, _) = list_checkpoints(folder)[0], list_checkpoints(folder)[-1]
+    assert 0 < first < last < 10**9                        # not the step schedule: wall time
+    state = json.loads((folder / f"step_{last:012d}.json").read_text())
+    assert state["train_wall_s"] > 0
+    TRAIN.train(["--resume", str(tmp_path / "timed"), "--total-timesteps", str(last + 128), "--no-progress"])
+    err = capsys.readouterr().err
+    assert f"resuming {tmp_path / 'timed'} from checkpoint step_{last:012d}: step {last:,} of {last + 128:,}" in err
+    segments = [json.loads(x) for x in (tmp_path / "timed" / "segments.jsonl").read_text().splitlines()]
+    assert segments[-1]["start_step"] == last
+
+
+@pytest.mark.parametrize("signum", [signal.SIGTERM, signal.SIGINT])
+def test_a_signal_writes_a_checkpoint_before_the_run_exits(tmp_path, signum):
+    argv = _argv(tmp_path, "sig", steps=10**7, extra=("--eval-freq", "0", "--checkpoint-freq", "1000000000",
+                                                      "--checkpoint-interval-s", "0"))
+    log = tmp_path / "train.log"
+    proc = _train_process(argv, log)
+    progress = tmp_path / "sig" / "progress_000000000000.csv"
+    try:                                                   # an update logged: training is under way
+        _wait(lambda: progress.is_file() and len(progress.read_text().splitlines()) >= 3, proc, log, "training")
+        assert not list_checkpoints(tmp_path / "sig" / "checkpoints")
+        os.kill(proc.pid, signum)
+        proc.wait(timeout=60)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+    assert proc.returncode == 128 + signum, log.read_text()[-2000:]
+    text = log.read_text()
+    assert f"stopped by {signal.Signals(signum).name} at step" in text and "--resume" in text
+    (step, _), = list_checkpoints(tmp_path / "sig" / "checkpoints")
+    assert step >= 2 * 4 * 32                              # at least the two logged rollouts of 4 x 32 steps
+    assert not (tmp_path / "sig" / "final_model.json").exists()    # the run is not finished
