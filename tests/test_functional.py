@@ -156,3 +156,43 @@ def test_vector_env_refuses_a_wrong_batch_of_actions():
         venv.step(np.zeros(6, np.float32))
     with pytest.raises(ValueError, match="not finite"):
         venv.step(np.full((3, 2), np.nan, np.float32))
+
+
+def test_an_action_acts_after_the_delay():
+    """action_delay_steps = 2: what the policy samples at step k commands the gimbal at step k + 2."""
+    from lvgym.simulator.layouts import ACTUATOR
+    opts = dict(randomize=False, wind="none", observation="state", controller_on_after_s=0.0)
+    late, now = _func(action_delay_steps=2, **opts), _func(**opts)
+    rng = [np.random.default_rng(0)]
+    a, b = late.initial(rng), now.initial(rng)
+    acts = np.linspace(-0.9, 0.9, 8).reshape(4, 1, 2)
+    cmds = []
+    for k in range(6):
+        a = late.transition(a, acts[k] if k < 4 else np.zeros((1, 2)), rng, inplace=True)
+        cmds.append(ACTUATOR.view(a.sim.actuator, "command")[0].copy())
+    np.testing.assert_array_equal(cmds[0], [0.0, 0.0])
+    np.testing.assert_array_equal(cmds[1], [0.0, 0.0])
+    for k in range(2, 6):
+        np.testing.assert_allclose(cmds[k], acts[k - 2, 0] * late.gimbal_limit, rtol=1e-15)
+    b = now.transition(b, acts[0], rng)
+    np.testing.assert_allclose(ACTUATOR.view(b.sim.actuator, "command")[0], acts[0, 0] * now.gimbal_limit)
+
+
+@pytest.mark.parametrize("velocity", ["inertial", "earth"])
+def test_gravity_turn_follows_the_chosen_velocity(velocity):
+    from lvgym.simulator.core import WGS84_OMEGA
+    func = _func(randomize=False, wind="none", observation="state", reference="gravity_turn",
+                 reference_velocity=velocity, kick_start_s=2.0, kick_end_s=4.0, mission_time_s=8.0)
+    rng = [np.random.default_rng(0)]
+    state = func.initial(rng)
+    for _ in range(300):
+        state = func.transition(state, np.zeros((1, 2)), rng, inplace=True)
+    lay = func.sim.layout
+    r, v = state.sim.x[0, lay.state["r_zw_i"]], state.sim.x[0, lay.state["v_zw_i"]]
+    if velocity == "earth":
+        v = v - np.cross([0.0, 0.0, WGS84_OMEGA], r)
+    g = func.sim.conditions("g_i", state.sim)[0]
+    sin_th = np.linalg.norm(np.cross(v / np.linalg.norm(v), -g / np.linalg.norm(g)))
+    expected = -np.linalg.norm(g) * sin_th / np.linalg.norm(v)
+    ref = func.observation(state)[0, func.observation_layout.index("pitch_rate_reference")]
+    assert ref == pytest.approx(expected, rel=1e-5)
