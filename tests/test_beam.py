@@ -303,3 +303,21 @@ def test_docstring_examples():
     for module in (lvgym.vehicle.beam, lvgym.vehicle.sections):
         result = doctest.testmod(module)
         assert result.attempted > 0 and result.failed == 0
+
+
+def test_modes_do_not_depend_on_the_blas_thread_count():
+    """Threaded BLAS changed the mode shapes in their last bits with the thread count (and a flight in
+    its fourth digit between a serial run and a worker process); the modal analysis runs on one thread."""
+    from threadpoolctl import threadpool_limits
+
+    from lvgym.vehicle import MassModel, load_vehicle
+    from lvgym.vehicle.structure import ModeSchedule
+    mm = MassModel(load_vehicle("smile"))
+    state = mm.initial_state()
+    out = []
+    for threads in (1, 2):
+        with threadpool_limits(limits=threads, user_api="blas"):
+            m = ModeSchedule(mm, n_modes=2, sensor_stations=np.array([-4.0])).modes(state, mm.properties(state))
+        out.append((m.omega, m.phi_gimbal, m.dphi_sensor, m.phi_hinge))
+    for a, b in zip(*out):
+        np.testing.assert_array_equal(a, b)

@@ -14,6 +14,9 @@ This module computes them for a beam of piecewise-constant sections with point m
   M-orthogonal to them, so every elastic mode has zero linear and angular momentum.
 * Modes are mass-normalised, ``q_k^T M q_k = 1 kg``: ``phi`` is in 1/sqrt(kg), the modal coordinate
   ``eta`` in sqrt(kg) m, and the physical deflection is ``sum_k eta_k phi_k(x)``.
+* Reproducible: the linear algebra runs on one BLAS thread (``threadpoolctl``). Threaded BLAS sums in an
+  order that depends on the thread count, which changed the mode shapes in their last bits, and a
+  60 s flight then in its fourth digit, between a serial run and one in a worker process.
 * Sign: every mode has ``phi > 0`` at the nose tip (the largest station), so recomputing the modes of
   a slowly changing stack does not flip them. (Should the tip be a node of a mode, |phi| below 1e-9
   of its largest value, the largest entry is made positive instead.)
@@ -42,6 +45,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 from scipy.linalg import eigh, null_space
+from threadpoolctl import threadpool_limits
 
 from lvgym.errors import ConfigError
 
@@ -191,6 +195,15 @@ class BeamModes:
 
 def modes(stations, EI, mass_per_length, *, point_masses: Sequence = (), n_modes: int = 3,
           query_stations=()) -> BeamModes:
+    """First ``n_modes`` elastic free-free bending modes of a beam (see :func:`_modes`), computed on one
+    BLAS thread so that they do not depend on the machine's thread count."""
+    with threadpool_limits(limits=1, user_api="blas"):
+        return _modes(stations, EI, mass_per_length, point_masses=point_masses, n_modes=n_modes,
+                      query_stations=query_stations)
+
+
+def _modes(stations, EI, mass_per_length, *, point_masses: Sequence = (), n_modes: int = 3,
+           query_stations=()) -> BeamModes:
     """First ``n_modes`` elastic free-free bending modes of a beam.
 
     Parameters
