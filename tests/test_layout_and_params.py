@@ -69,14 +69,62 @@ def test_bad_slosh_entries():
                                        np.zeros(NonRigidModel(2, 1).layout.n_u))
 
 
-def test_kernel_offsets_agree_with_the_layout():
-    from lvgym.dynamics import kernels as k
+def test_slosh_block_offsets():
     lay = Layout(2, 3)
-    assert (k.X_R, k.X_V, k.X_Q, k.X_W, k.X_ETA) == tuple(
-        lay.state[n].start for n in ("r_zw_i", "v_zw_i", "q_bi", "omega_bi_b", "eta"))
-    assert (k.P_M, k.P_CG, k.P_J, k.P_GIM, k.P_MODES) == tuple(
-        lay.params[n].start for n in ("m_b", "r_cg", "J_b", "r_gimbal", "omega_modes"))
-    assert (k.U_F, k.U_M, k.U_T, k.U_G, k.U_ETA) == tuple(
-        lay.loads[n].start for n in ("f_b_i", "m_b_b", "thrust_b", "g_i", "f_eta"))
     assert lay.slosh_block == 8 + 3 and lay.slosh_param(1, "phi").start == \
         lay.params["slosh"].start + lay.slosh_block + 8
+
+
+@pytest.mark.parametrize("n, k", [(0, 0), (1, 1), (6, 2), (0, 4)])
+def test_compiled_offset_forms_agree_with_the_layout(n, k):
+    """The forms the kernels evaluate (``at(X.eta_dot, K, N)``, the pendulum strides, the sizes) give
+    the offsets of :class:`Layout`."""
+    from lvgym.dynamics.layout import SIZES, SLOSH_BLOCK, X_PER_SLOSH, P, S, U, X
+    from lvgym.packing import at_py
+
+    lay = Layout(n, k)
+    for table, forms in ((lay.state, X), (lay.params, P), (lay.loads, U)):
+        assert {name: at_py(getattr(forms, name), k, n) for name in table} == \
+            {name: sl.start for name, sl in table.items()}
+    assert (at_py(SIZES.state, k, n), at_py(SIZES.params, k, n), at_py(SIZES.loads, k, n)) == \
+        (lay.n_x, lay.n_p, lay.n_u)
+    assert at_py(SIZES.speeds, k, n) == 6 + 2 * k and at_py(SLOSH_BLOCK, k, n) == lay.slosh_block
+    for j in range(n):
+        assert at_py(X.q_si, k, n) + j * X_PER_SLOSH.q_si == lay.state["q_si"].start + 4 * j
+        assert at_py(X.omega_si_s, k, n) + j * X_PER_SLOSH.omega_si_s == lay.state["omega_si_s"].start + 2 * j
+        for name in Layout.SLOSH_FIELDS:
+            start = at_py(P.slosh, k, n) + j * at_py(SLOSH_BLOCK, k, n) + at_py(getattr(S, name), k, n)
+            assert start == lay.slosh_param(j, name).start
+
+
+@pytest.mark.parametrize("n, k", [(0, 0), (3, 2)])
+def test_workspace_is_sized_by_the_layouts(n, k):
+    from lvgym.dynamics.kernels import term_rows
+    from lvgym.dynamics.layout import ATTITUDES, RK4_ROWS, SLOSH_WORK, TERMS_PER_PENDULUM, WORK_ROWS
+    from lvgym.dynamics.stepper import make_workspace
+
+    lay = Layout(n, k)
+    ws = make_workspace(n, k, lay.n_u)
+    nr = 6 + 2 * k
+    assert (ws.n_slosh, ws.n_modes) == (n, k) and (ws.deriv.n_slosh, ws.deriv.n_modes) == (n, k)
+    assert ws.buf.shape == (RK4_ROWS.size, lay.n_x) and not ws.buf.any()   # zero: padding keeps zero rates
+    assert ws.u.shape == (lay.n_u,) and ws.deriv.A.shape == (nr, nr) and ws.deriv.rhs.shape == (nr,)
+    assert ws.deriv.slosh.shape == (max(n, 1), SLOSH_WORK.size) and ws.deriv.C.shape == (ATTITUDES.size, 3, 3)
+    assert ws.deriv.work.shape == (WORK_ROWS.size(k, n), max(nr, 3))
+    # every rank-one term's two rows lie in the field ``terms`` of the work rows
+    rows = [r for q in range(TERMS_PER_PENDULUM * n) for r in term_rows(q)]
+    terms = WORK_ROWS.resolve(k, n).slice("terms")
+    assert len(set(rows)) == len(rows) and all(terms.start <= r < terms.stop for r in rows)
+
+
+def test_dynamics_kernels_define_no_offsets_of_their_own():
+    """The kernels take every offset from a layout: no integer offset constants in their modules."""
+    import re
+
+    from lvgym.dynamics import invariants, kernels, stepper
+
+    for module in (kernels, stepper, invariants):
+        own = [name for name, value in vars(module).items()
+               if isinstance(value, int) and not isinstance(value, bool) and re.fullmatch(r"_?[A-Z][A-Z0-9_]*", name)
+               and not name.endswith("_SIZE") and name != "_TERMS"]
+        assert not own, f"{module.__name__} defines offsets {own}"

@@ -207,9 +207,9 @@ def _rank_ones_former(A, H, c, n):
 
 @nb.njit(cache=True)
 def _rank_ones_collected(A, H, c, n):
-    G = np.empty((1 + 2 * H.shape[0], n))
+    G = np.empty((kernels.term_rows(H.shape[0])[0], n))
     for q in range(H.shape[0]):
-        G[2 + 2 * q, :] = H[q, :n]
+        G[kernels.term_rows(q)[1], :] = H[q, :n]
         kernels._scaled_row(G, q, c[q], n)
     kernels._add_sym_outers(A, G, H.shape[0], n)
 

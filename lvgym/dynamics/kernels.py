@@ -19,29 +19,91 @@ and costs a rank-one update per point-mass pendulum. ``B_j`` maps the rigid/elas
 hinge velocity, ``Q_j = (1 - s_j) I + s_j n_j n_j^T`` with ``s_j = L^2 / (L^2 + J/m)`` (the rod
 projector ``n n^T`` for a point mass: the rod transmits tension only).
 
-Everything here is plain loops over small arrays compiled with numba; a batch is a loop over the
-same per-vehicle kernel, so one code path serves one vehicle and many.
+:func:`vehicle_deriv` follows those steps, one compiled piece each (inlined, so the pieces cost
+nothing): the loads (:func:`_gimbal_thrust`, and the external force and moment in
+:func:`_rigid_body`), the rigid body (:func:`_rigid_body`: mass matrix and right-hand side of B), the
+modes (:func:`_modes`), the slosh elimination (:func:`_eliminate_pendulum`, per pendulum), the solve
+(:func:`_solve`) and the back-substitution (:func:`_kinematics`, :func:`_pendulum_accelerations`).
+
+Every offset comes from a layout: the state, parameters, loads and speeds from :mod:`.layout`, the
+kernel's own work arrays from ``SLOSH_WORK``, ``WORK_ROWS``, ``RANK_ONE`` and ``ATTITUDES`` there too
+(so the padding switch of :mod:`lvgym.packing` moves them); the scratch is one :data:`DerivWork`. Everything is plain
+loops over small arrays compiled with numba; a batch is a loop over the same per-vehicle kernel, so
+one code path serves one vehicle and many.
 """
 
 from __future__ import annotations
 
 import math
+from collections import namedtuple
 
 import numba as nb
 import numpy as np
+from numba.core import cgutils, types
+from numba.extending import intrinsic
+from numba.np.arrayobj import make_array
 
+from lvgym.packing import at
 from lvgym.rotations import quat_to_dcm
 
-# offsets of the fixed-size parts of the flat vectors (layout.py; tests/test_layout_and_params.py
-# checks that the two agree)
-X_R, X_V, X_Q, X_W, X_ETA = 0, 3, 6, 10, 13
-P_M, P_CG, P_J, P_GIM, P_MODES = 0, 1, 4, 13, 16
-U_F, U_M, U_T, U_G, U_ETA = 0, 3, 6, 9, 12
-# per-slosh work row kept for the back-substitution: y_s(3) z_s(3) rho_b(3) (g - beta)_i(3) tau(2) m L k2
-_S_Y, _S_Z, _S_RHO, _S_GB, _S_TAU, _S_M, _S_L, _S_K2 = 0, 3, 6, 9, 12, 14, 15, 16
-SLOSH_WORK = 17
+from .layout import ATTITUDES, RANK_ONE, SIZES, SLOSH_BLOCK, SLOSH_WORK, WORK_ROWS, X_PER_SLOSH, P, S, U, V, X
+
+# ---------------------------------------------------------------------------- the kernel's own arrays
+# the same for compiled code (numba freezes module globals that are numbers and tuples)
+SW, RO, WR, AT = SLOSH_WORK.at, RANK_ONE.at, WORK_ROWS.at, ATTITUDES.at
+_SLOSH_WORK_SIZE, _RANK_ONE_SIZE, _ATTITUDES_SIZE = SLOSH_WORK.size, RANK_ONE.size, ATTITUDES.size
+_WORK_SIZE = WORK_ROWS.size_form
+_TERMS = WORK_ROWS.fixed.terms
+
+#: scratch of :func:`vehicle_deriv` (made by :func:`make_deriv_work`; the part ``deriv`` of the
+#: stepper's :data:`~lvgym.dynamics.stepper.Workspace`)
+DerivWork = namedtuple("DerivWork", [
+    "n_slosh", "n_modes",               # N pendulums, K modes per plane
+    "A", "rhs", "h",                    # reduced system (n_r, n_r), its right-hand side and a row (n_r,)
+    "C",                                # (ATTITUDES.size, 3, 3): the attitude matrices C_ib, C_is
+    "slosh",                            # (max(N, 1), SLOSH_WORK.size): rows kept for the back-substitution
+    "work",                             # WORK_ROWS rows of max(n_r, 3) columns
+])
 
 
+@nb.njit(cache=True, error_model="numpy")
+def make_deriv_work(n_slosh, n_modes):
+    """A :data:`DerivWork` for ``n_slosh`` pendulums and ``n_modes`` modes per plane."""
+    K = n_modes
+    N = n_slosh
+    nr = at(SIZES.speeds, K, N)
+    return DerivWork(N, K, np.empty((nr, nr)), np.empty(nr), np.empty(nr), np.empty((_ATTITUDES_SIZE, 3, 3)),
+                     np.zeros((max(N, 1), _SLOSH_WORK_SIZE)), np.empty((at(_WORK_SIZE, K, N), max(nr, 3))))
+
+
+@intrinsic
+def unowned(typingctx, a):
+    """A view of the array ``a`` that holds no reference to its memory (a null meminfo).
+
+    Numba increments and decrements the reference count of every array view it makes and of every
+    array argument of a compiled function it calls, with atomic instructions on the owner's counter;
+    rows of one batch share that counter, so the threads that step row ranges contend for it. Passing
+    unowned views of the rows to the per-stage functions (the loads, the derivative) makes those
+    updates no-ops. The caller must keep ``a``'s owner alive while the view is in use."""
+    if not isinstance(a, types.Array):
+        return None
+
+    def codegen(context, builder, sig, args):
+        src = make_array(a)(context, builder, value=args[0])
+        dst = make_array(a)(context, builder)
+        dst.meminfo = cgutils.get_null_value(dst.meminfo.type)
+        dst.parent = cgutils.get_null_value(dst.parent.type)
+        dst.nitems = src.nitems
+        dst.itemsize = src.itemsize
+        dst.data = src.data
+        dst.shape = src.shape
+        dst.strides = src.strides
+        return dst._getvalue()
+
+    return a(a), codegen
+
+
+# ---------------------------------------------------------------------------- small helpers
 @nb.njit(cache=True, error_model="numpy", inline="always")
 def _quat_rate(q, o, w1, w2, w3, out, oo):
     """``out[oo:oo+4] = 0.5 q (x) (0, w)`` for the quaternion ``q[o:o+4]`` and body rate w."""
@@ -81,91 +143,89 @@ def _cholesky_solve(A, b, n):
 
 
 @nb.njit(cache=True, error_model="numpy", inline="always")
+def term_rows(q):
+    """Rows of ``c_q h_q`` and ``h_q`` (rank-one term ``q``) in the ``work`` matrix (:data:`WORK_ROWS`)."""
+    r = _TERMS + q * _RANK_ONE_SIZE
+    return r + RO.ch, r + RO.h
+
+
+@nb.njit(cache=True, error_model="numpy", inline="always")
 def _scaled_row(G, q, c, n):
-    """Rank-one term ``q`` of :func:`_add_sym_outers`: ``G[1 + 2q] = c G[2 + 2q]`` (first n entries)."""
+    """Rank-one term ``q`` of :func:`_add_sym_outers`: its row ``c h`` from its row ``h`` (first n
+    entries)."""
+    rc, rh = term_rows(q)
     for i in range(n):
-        G[1 + 2 * q, i] = c * G[2 + 2 * q, i]
+        G[rc, i] = c * G[rh, i]
 
 
 @nb.njit(cache=True, error_model="numpy", inline="always")
 def _add_sym_outers(A, G, nq, n):
-    """``A += sum_q c_q h_q h_q^T`` on the lower triangle of the leading n x n block, with ``c_q h_q``
-    and ``h_q`` in the rows ``1 + 2q`` and ``2 + 2q`` of ``G``; each entry is summed in a register in
-    the order of q (the same sums as nq successive rank-one updates)."""
+    """``A += sum_q c_q h_q h_q^T`` on the lower triangle of the leading n x n block, with the rows
+    ``c_q h_q`` and ``h_q`` of ``G`` at :func:`term_rows`; each entry is summed in a register in the
+    order of q (the same sums as nq successive rank-one updates)."""
     for i in range(n):
         for q in range(nq):
-            ci = G[1 + 2 * q, i]
+            rc, rh = term_rows(q)
+            ci = G[rc, i]
             for k in range(i + 1):
-                A[i, k] += ci * G[2 + 2 * q, k]
+                A[i, k] += ci * G[rh, k]
 
 
 @nb.njit(cache=True, error_model="numpy", inline="always")
-def _body_row_map(C, rho0, rho1, rho2, phi, a0, a1, a2, K, h):
+def _body_row_map(C, rho0, rho1, rho2, phi, a0, a1, a2, K, N, h):
     """``h = Bt^T a_b`` for a body-frame vector ``a_b`` at a node with offset rho from the CG and
     mode shape phi: ``h = [C a_b, rho x a_b, phi a_b,y, phi a_b,z]`` (the transpose of the map from
-    rigid and elastic speeds to the node velocity)."""
-    h[0] = C[0, 0] * a0 + C[0, 1] * a1 + C[0, 2] * a2
-    h[1] = C[1, 0] * a0 + C[1, 1] * a1 + C[1, 2] * a2
-    h[2] = C[2, 0] * a0 + C[2, 1] * a1 + C[2, 2] * a2
-    h[3] = rho1 * a2 - rho2 * a1
-    h[4] = rho2 * a0 - rho0 * a2
-    h[5] = rho0 * a1 - rho1 * a0
+    rigid and elastic speeds to the node velocity; ``h`` is a vector of speeds, :data:`.layout.SPEEDS`)."""
+    o_v, o_w, o_e = at(V.v_zw_i, K, N), at(V.omega_bi_b, K, N), at(V.eta_dot, K, N)
+    h[o_v] = C[0, 0] * a0 + C[0, 1] * a1 + C[0, 2] * a2
+    h[o_v + 1] = C[1, 0] * a0 + C[1, 1] * a1 + C[1, 2] * a2
+    h[o_v + 2] = C[2, 0] * a0 + C[2, 1] * a1 + C[2, 2] * a2
+    h[o_w] = rho1 * a2 - rho2 * a1
+    h[o_w + 1] = rho2 * a0 - rho0 * a2
+    h[o_w + 2] = rho0 * a1 - rho1 * a0
     for k in range(K):
-        h[6 + k] = phi[k] * a1
-        h[6 + K + k] = phi[k] * a2
+        h[o_e + k] = phi[k] * a1
+        h[o_e + K + k] = phi[k] * a2
 
 
-@nb.njit(cache=True, error_model="numpy")
-def vehicle_deriv(x, p, u, n_slosh, n_modes, xdot, A, rhs, h, C, S, work):
-    """Time derivative ``xdot`` of one vehicle's state ``x`` for parameters ``p`` and loads ``u``.
+@nb.njit(cache=True, error_model="numpy", inline="always")
+def hinge_offset(x, p, j, cg0, cg1, cg2, K, N):
+    """Pendulum j's deflected hinge from the CG ``cg`` of B ``rho = r_hinge - r_cg + Psi eta`` and the
+    hinge deflection rate ``Psi eta_dot`` (y and z), body frame: ``(rho0, rho1, rho2, vy, vz)``."""
+    o = at(P.slosh, K, N) + j * at(SLOSH_BLOCK, K, N)
+    o_phi = o + at(S.phi, K, N)
+    o_hinge = o + at(S.r_hinge, K, N)
+    o_eta, o_etad = at(X.eta, K, N), at(X.eta_dot, K, N)
+    py = pz = vy = vz = 0.0
+    for k in range(K):
+        ph = p[o_phi + k]
+        py += ph * x[o_eta + k]
+        pz += ph * x[o_eta + K + k]
+        vy += ph * x[o_etad + k]
+        vz += ph * x[o_etad + K + k]
+    r0 = p[o_hinge] - cg0
+    r1 = p[o_hinge + 1] - cg1 + py
+    r2 = p[o_hinge + 2] - cg2 + pz
+    return r0, r1, r2, vy, vz
 
-    Work arrays (any contents; sized by the caller, see ``make_workspace``): ``A`` (n_r, n_r),
-    ``rhs`` and ``h`` (n_r,), ``C`` (2, 3, 3), ``S`` (max(N, 1), SLOSH_WORK), ``work`` (1 + 8N,
-    max(n_r, 3)), with ``n_r = 6 + 2K``.
-    """
-    K = n_modes
-    N = n_slosh
-    nr = 6 + 2 * K
-    Cb = C[0]
-    Cs = C[1]
-    quat_to_dcm(x[X_Q], x[X_Q + 1], x[X_Q + 2], x[X_Q + 3], Cb)
-    w0, w1, w2 = x[X_W], x[X_W + 1], x[X_W + 2]
-    o_eta = X_ETA
-    o_etad = X_ETA + 2 * K
-    o_qs = X_ETA + 4 * K
-    o_ws = o_qs + 4 * N
-    o_om = P_MODES
-    o_ze = P_MODES + K
-    o_pg = P_MODES + 2 * K
-    o_dg = P_MODES + 3 * K
-    o_sl = P_MODES + 4 * K
-    sb = 8 + K
-    m_b = p[P_M]
-    cgx, cgy, cgz = p[P_CG], p[P_CG + 1], p[P_CG + 2]
 
-    # ---------------------------------------------------------------- mass matrix of B and modes
-    for i in range(nr):
-        for k in range(nr):
-            A[i, k] = 0.0
-    for i in range(3):
-        A[i, i] = m_b
-        for k in range(3):
-            A[3 + i, 3 + k] = p[P_J + 3 * i + k]
-    for i in range(6, nr):
-        A[i, i] = 1.0
-
-    # ---------------------------------------------------------------- thrust at the deflected gimbal
-    sy = 0.0
-    sz = 0.0
-    dy = 0.0
-    dz = 0.0
+# ---------------------------------------------------------------------------- the steps of the equations
+@nb.njit(cache=True, error_model="numpy", inline="always")
+def _gimbal_thrust(x, p, u, cg0, cg1, cg2, K, N):
+    """Thrust tilted by the mode slope at the gimbal and the deflected gimbal from the CG of B
+    (thesis eq. 2.20-2.22), body frame: ``(f0, f1, f2, re0, re1, re2)``."""
+    o_eta = at(X.eta, K, N)
+    o_pg = at(P.phi_gimbal, K, N)
+    o_dg = at(P.dphi_gimbal, K, N)
+    sy = sz = dy = dz = 0.0
     for k in range(K):
         sy += p[o_dg + k] * x[o_eta + k]
         sz += p[o_dg + k] * x[o_eta + K + k]
         dy += p[o_pg + k] * x[o_eta + k]
         dz += p[o_pg + k] * x[o_eta + K + k]
     # rotate the engine-frame thrust by theta = (0, -sz, sy) (Rodrigues)
-    t0, t1, t2 = u[U_T], u[U_T + 1], u[U_T + 2]
+    o_t = at(U.thrust_b, K, N)
+    t0, t1, t2 = u[o_t], u[o_t + 1], u[o_t + 2]
     th1 = -sz
     th2 = sy
     ang = math.sqrt(th1 * th1 + th2 * th2)
@@ -184,179 +244,258 @@ def vehicle_deriv(x, p, u, n_slosh, n_modes, xdot, A, rhs, h, C, S, work):
         f2 = t2 * ca + c2 * sa + e2 * ed * (1.0 - ca)
     else:
         f0, f1, f2 = t0, t1, t2
-    rex = p[P_GIM] - cgx
-    rey = p[P_GIM + 1] - cgy + dy
-    rez = p[P_GIM + 2] - cgz + dz
+    o_gim = at(P.r_gimbal, K, N)
+    re0 = p[o_gim] - cg0
+    re1 = p[o_gim + 1] - cg1 + dy
+    re2 = p[o_gim + 2] - cg2 + dz
+    return f0, f1, f2, re0, re1, re2
 
-    # ---------------------------------------------------------------- right-hand side of B and modes
+
+@nb.njit(cache=True, error_model="numpy", inline="always")
+def _rigid_body(p, u, Cb, w0, w1, w2, f0, f1, f2, re0, re1, re2, K, N, A, rhs):
+    """Mass matrix of B (zero elsewhere in ``A``) and the right-hand side of its Newton and Euler
+    equations: external force, gravity and thrust (inertial); external moment, gyroscopic term and
+    thrust moment (body)."""
+    nr = at(SIZES.speeds, K, N)
+    o_v = at(V.v_zw_i, K, N)
+    o_w = at(V.omega_bi_b, K, N)
+    o_J = at(P.J_b, K, N)
+    m_b = p[at(P.m_b, K, N)]
+    for i in range(nr):
+        for k in range(nr):
+            A[i, k] = 0.0
     for i in range(3):
-        rhs[i] = u[U_F + i] + m_b * u[U_G + i] + Cb[i, 0] * f0 + Cb[i, 1] * f1 + Cb[i, 2] * f2
+        A[o_v + i, o_v + i] = m_b
+        for k in range(3):
+            A[o_w + i, o_w + k] = p[o_J + 3 * i + k]
+    o_f = at(U.f_b_i, K, N)
+    o_g = at(U.g_i, K, N)
+    for i in range(3):
+        rhs[o_v + i] = u[o_f + i] + m_b * u[o_g + i] + Cb[i, 0] * f0 + Cb[i, 1] * f1 + Cb[i, 2] * f2
     # Euler: m - omega x J omega + thrust moment
-    Jw0 = p[P_J] * w0 + p[P_J + 1] * w1 + p[P_J + 2] * w2
-    Jw1 = p[P_J + 3] * w0 + p[P_J + 4] * w1 + p[P_J + 5] * w2
-    Jw2 = p[P_J + 6] * w0 + p[P_J + 7] * w1 + p[P_J + 8] * w2
-    rhs[3] = u[U_M] - (w1 * Jw2 - w2 * Jw1) + (rey * f2 - rez * f1)
-    rhs[4] = u[U_M + 1] - (w2 * Jw0 - w0 * Jw2) + (rez * f0 - rex * f2)
-    rhs[5] = u[U_M + 2] - (w0 * Jw1 - w1 * Jw0) + (rex * f1 - rey * f0)
+    Jw0 = p[o_J] * w0 + p[o_J + 1] * w1 + p[o_J + 2] * w2
+    Jw1 = p[o_J + 3] * w0 + p[o_J + 4] * w1 + p[o_J + 5] * w2
+    Jw2 = p[o_J + 6] * w0 + p[o_J + 7] * w1 + p[o_J + 8] * w2
+    o_m = at(U.m_b_b, K, N)
+    rhs[o_w] = u[o_m] - (w1 * Jw2 - w2 * Jw1) + (re1 * f2 - re2 * f1)
+    rhs[o_w + 1] = u[o_m + 1] - (w2 * Jw0 - w0 * Jw2) + (re2 * f0 - re0 * f2)
+    rhs[o_w + 2] = u[o_m + 2] - (w0 * Jw1 - w1 * Jw0) + (re0 * f1 - re1 * f0)
+
+
+@nb.njit(cache=True, error_model="numpy", inline="always")
+def _modes(x, p, u, f1, f2, K, N, A, rhs):
+    """Unit modal masses in ``A`` and the modal right-hand side: generalised forces, the thrust's
+    through the mode shape at the gimbal, damping and stiffness (y-plane modes, then z)."""
+    o_r = at(V.eta_dot, K, N)
+    for i in range(2 * K):
+        A[o_r + i, o_r + i] = 1.0
+    o_om, o_ze, o_pg = at(P.omega_modes, K, N), at(P.zeta_modes, K, N), at(P.phi_gimbal, K, N)
+    o_fe = at(U.f_eta, K, N)
+    o_eta, o_etad = at(X.eta, K, N), at(X.eta_dot, K, N)
     for k in range(K):
         om = p[o_om + k]
         c = 2.0 * p[o_ze + k] * om
         kk = om * om
         pg = p[o_pg + k]
-        rhs[6 + k] = (u[U_ETA + k] + pg * f1 - c * x[o_etad + k] - kk * x[o_eta + k])
-        rhs[6 + K + k] = (u[U_ETA + K + k] + pg * f2 - c * x[o_etad + K + k]
-                          - kk * x[o_eta + K + k])
+        rhs[o_r + k] = (u[o_fe + k] + pg * f1 - c * x[o_etad + k] - kk * x[o_eta + k])
+        rhs[o_r + K + k] = (u[o_fe + K + k] + pg * f2 - c * x[o_etad + K + k]
+                            - kk * x[o_eta + K + k])
 
-    # ---------------------------------------------------------------- slosh pendulums (Schur complement)
-    # body rate in inertial components
-    wi0 = Cb[0, 0] * w0 + Cb[0, 1] * w1 + Cb[0, 2] * w2
-    wi1 = Cb[1, 0] * w0 + Cb[1, 1] * w1 + Cb[1, 2] * w2
-    wi2 = Cb[2, 0] * w0 + Cb[2, 1] * w1 + Cb[2, 2] * w2
-    nq = 0                                  # rank-one terms of A_r collected in work
-    for j in range(N):
-        o = o_sl + j * sb
-        m = p[o]
-        S[j, _S_M] = m
-        if m <= 0.0:
-            continue
-        L = p[o + 1]
-        k2 = p[o + 2] / m
-        S[j, _S_L] = L
-        S[j, _S_K2] = k2
-        qo = o_qs + 4 * j
-        quat_to_dcm(x[qo], x[qo + 1], x[qo + 2], x[qo + 3], Cs)
-        for i in range(3):
-            S[j, _S_Y + i] = Cs[i, 1]
-            S[j, _S_Z + i] = Cs[i, 2]
-        # deflected hinge offset from the CG and hinge deflection rate, body frame
-        py = 0.0
-        pz = 0.0
-        vy = 0.0
-        vz = 0.0
-        for k in range(K):
-            ph = p[o + 8 + k]
-            py += ph * x[o_eta + k]
-            pz += ph * x[o_eta + K + k]
-            vy += ph * x[o_etad + k]
-            vz += ph * x[o_etad + K + k]
-        r0 = p[o + 3] - cgx
-        r1 = p[o + 4] - cgy + py
-        r2 = p[o + 5] - cgz + pz
-        S[j, _S_RHO] = r0
-        S[j, _S_RHO + 1] = r1
-        S[j, _S_RHO + 2] = r2
-        # bias acceleration of the mass: C [w x (w x rho) + 2 w x (Psi eta_dot)] + L |w_s|^2 n_i
-        a0 = w1 * r2 - w2 * r1
-        a1 = w2 * r0 - w0 * r2
-        a2 = w0 * r1 - w1 * r0
-        b0 = w1 * a2 - w2 * a1 + 2.0 * (w1 * vz - w2 * vy)
-        b1 = w2 * a0 - w0 * a2 + 2.0 * (-w0 * vz)
-        b2 = w0 * a1 - w1 * a0 + 2.0 * (w0 * vy)
-        ws1 = x[o_ws + 2 * j]
-        ws2 = x[o_ws + 2 * j + 1]
-        cen = L * (ws1 * ws1 + ws2 * ws2)
-        for i in range(3):
-            beta = Cb[i, 0] * b0 + Cb[i, 1] * b1 + Cb[i, 2] * b2 + cen * Cs[i, 0]
-            S[j, _S_GB + i] = u[U_G + i] - beta
-        # damper torque per unit slosh mass, s-frame (y, z): -c (w_s - omega_b components)
-        cd = 2.0 * p[o + 6] * p[o + 7] * L * L
-        tau1 = -cd * (ws1 - (Cs[0, 1] * wi0 + Cs[1, 1] * wi1 + Cs[2, 1] * wi2))
-        tau2 = -cd * (ws2 - (Cs[0, 2] * wi0 + Cs[1, 2] * wi1 + Cs[2, 2] * wi2))
-        S[j, _S_TAU] = tau1
-        S[j, _S_TAU + 1] = tau2
-        # reaction torque on B, body frame: -m C^T (tau1 y_s + tau2 z_s)
-        for i in range(3):
-            rhs[3 + i] -= m * (Cb[0, i] * (tau1 * Cs[0, 1] + tau2 * Cs[0, 2])
-                               + Cb[1, i] * (tau1 * Cs[1, 1] + tau2 * Cs[1, 2])
-                               + Cb[2, i] * (tau1 * Cs[2, 1] + tau2 * Cs[2, 2]))
-        s = L * L / (L * L + k2)
-        lam = L / (L * L + k2)
-        # rod direction in body frame
-        nb0 = Cb[0, 0] * Cs[0, 0] + Cb[1, 0] * Cs[1, 0] + Cb[2, 0] * Cs[2, 0]
-        nb1 = Cb[0, 1] * Cs[0, 0] + Cb[1, 1] * Cs[1, 0] + Cb[2, 1] * Cs[2, 0]
-        nb2 = Cb[0, 2] * Cs[0, 0] + Cb[1, 2] * Cs[1, 0] + Cb[2, 2] * Cs[2, 0]
-        phi = p[o + 8:o + 8 + K]
-        # the rank-one terms c h h^T of A_r are collected (rows c h and h of work) and summed after
-        # the loop, entry by entry in the same order: no load and store of A per pendulum
-        _body_row_map(Cb, r0, r1, r2, phi, nb0, nb1, nb2, K, work[2 + 2 * nq])
-        _scaled_row(work, nq, m * s, nr)
-        nq += 1
-        if s < 1.0:
-            for r in range(3):
-                _body_row_map(Cb, r0, r1, r2, phi, 1.0 if r == 0 else 0.0,
-                              1.0 if r == 1 else 0.0, 1.0 if r == 2 else 0.0, K, work[2 + 2 * nq])
-                _scaled_row(work, nq, m * (1.0 - s), nr)
-                nq += 1
-        # z = Q (g - beta) - lam (tau1 z_s - tau2 y_s), then rhs += m Bt^T C^T z
-        gb0, gb1, gb2 = S[j, _S_GB], S[j, _S_GB + 1], S[j, _S_GB + 2]
-        nd = Cs[0, 0] * gb0 + Cs[1, 0] * gb1 + Cs[2, 0] * gb2
-        z = work[0]
-        for i in range(3):
-            z[i] = ((1.0 - s) * S[j, _S_GB + i] + s * nd * Cs[i, 0]
-                    - lam * (tau1 * Cs[i, 2] - tau2 * Cs[i, 1]))
-        zb0 = Cb[0, 0] * z[0] + Cb[1, 0] * z[1] + Cb[2, 0] * z[2]
-        zb1 = Cb[0, 1] * z[0] + Cb[1, 1] * z[1] + Cb[2, 1] * z[2]
-        zb2 = Cb[0, 2] * z[0] + Cb[1, 2] * z[1] + Cb[2, 2] * z[2]
-        _body_row_map(Cb, r0, r1, r2, phi, zb0, zb1, zb2, K, h)
-        for i in range(nr):
-            rhs[i] += m * h[i]
 
-    # ---------------------------------------------------------------- solve the reduced system
+@nb.njit(cache=True, error_model="numpy", inline="always")
+def _eliminate_pendulum(j, x, p, u, K, N, Cb, Cs, w0, w1, w2, wi0, wi1, wi2, cg0, cg1, cg2, rhs, h, sw, work, nq):
+    """Eliminate pendulum j by its Schur complement, per unit slosh mass: add its damper's reaction
+    torque and ``m B^T C^T z`` to ``rhs``, collect its rank-one terms ``m s n n^T`` (and ``m (1 - s) I``
+    for a slosh body with inertia) in ``work`` from term ``nq`` on, keep in its row ``j`` of ``sw`` what the
+    back-substitution needs (an inactive pendulum, ``m <= 0``, only its mass). Returns the number of
+    terms collected so far."""
+    nr = at(SIZES.speeds, K, N)
+    o = at(P.slosh, K, N) + j * at(SLOSH_BLOCK, K, N)
+    m = p[o + at(S.m, K, N)]
+    sw[j, SW.m] = m
+    if m <= 0.0:
+        return nq
+    L = p[o + at(S.length, K, N)]
+    k2 = p[o + at(S.inertia, K, N)] / m
+    sw[j, SW.length] = L
+    sw[j, SW.k2] = k2
+    qo = at(X.q_si, K, N) + j * X_PER_SLOSH.q_si
+    quat_to_dcm(x[qo], x[qo + 1], x[qo + 2], x[qo + 3], Cs)
+    for i in range(3):
+        sw[j, SW.y_s + i] = Cs[i, 1]
+        sw[j, SW.z_s + i] = Cs[i, 2]
+    # deflected hinge offset from the CG and hinge deflection rate, body frame
+    r0, r1, r2, vy, vz = hinge_offset(x, p, j, cg0, cg1, cg2, K, N)
+    sw[j, SW.rho_b] = r0
+    sw[j, SW.rho_b + 1] = r1
+    sw[j, SW.rho_b + 2] = r2
+    # bias acceleration of the mass: C [w x (w x rho) + 2 w x (Psi eta_dot)] + L |w_s|^2 n_i
+    a0 = w1 * r2 - w2 * r1
+    a1 = w2 * r0 - w0 * r2
+    a2 = w0 * r1 - w1 * r0
+    b0 = w1 * a2 - w2 * a1 + 2.0 * (w1 * vz - w2 * vy)
+    b1 = w2 * a0 - w0 * a2 + 2.0 * (-w0 * vz)
+    b2 = w0 * a1 - w1 * a0 + 2.0 * (w0 * vy)
+    wo = at(X.omega_si_s, K, N) + j * X_PER_SLOSH.omega_si_s
+    ws1 = x[wo]
+    ws2 = x[wo + 1]
+    cen = L * (ws1 * ws1 + ws2 * ws2)
+    o_g = at(U.g_i, K, N)
+    for i in range(3):
+        beta = Cb[i, 0] * b0 + Cb[i, 1] * b1 + Cb[i, 2] * b2 + cen * Cs[i, 0]
+        sw[j, SW.g_beta + i] = u[o_g + i] - beta
+    # damper torque per unit slosh mass, s-frame (y, z): -c (w_s - omega_b components)
+    cd = 2.0 * p[o + at(S.zeta, K, N)] * p[o + at(S.omega, K, N)] * L * L
+    tau1 = -cd * (ws1 - (Cs[0, 1] * wi0 + Cs[1, 1] * wi1 + Cs[2, 1] * wi2))
+    tau2 = -cd * (ws2 - (Cs[0, 2] * wi0 + Cs[1, 2] * wi1 + Cs[2, 2] * wi2))
+    sw[j, SW.tau] = tau1
+    sw[j, SW.tau + 1] = tau2
+    # reaction torque on B, body frame: -m C^T (tau1 y_s + tau2 z_s)
+    o_rw = at(V.omega_bi_b, K, N)
+    for i in range(3):
+        rhs[o_rw + i] -= m * (Cb[0, i] * (tau1 * Cs[0, 1] + tau2 * Cs[0, 2])
+                              + Cb[1, i] * (tau1 * Cs[1, 1] + tau2 * Cs[1, 2])
+                              + Cb[2, i] * (tau1 * Cs[2, 1] + tau2 * Cs[2, 2]))
+    s = L * L / (L * L + k2)
+    lam = L / (L * L + k2)
+    # rod direction in body frame
+    nb0 = Cb[0, 0] * Cs[0, 0] + Cb[1, 0] * Cs[1, 0] + Cb[2, 0] * Cs[2, 0]
+    nb1 = Cb[0, 1] * Cs[0, 0] + Cb[1, 1] * Cs[1, 0] + Cb[2, 1] * Cs[2, 0]
+    nb2 = Cb[0, 2] * Cs[0, 0] + Cb[1, 2] * Cs[1, 0] + Cb[2, 2] * Cs[2, 0]
+    o_phi = o + at(S.phi, K, N)
+    phi = p[o_phi:o_phi + K]
+    # the rank-one terms c h h^T of A_r are collected (rows c h and h of work) and summed after
+    # the loop, entry by entry in the same order: no load and store of A per pendulum
+    _body_row_map(Cb, r0, r1, r2, phi, nb0, nb1, nb2, K, N, work[term_rows(nq)[1]])
+    _scaled_row(work, nq, m * s, nr)
+    nq += 1
+    if s < 1.0:
+        for r in range(3):
+            _body_row_map(Cb, r0, r1, r2, phi, 1.0 if r == 0 else 0.0, 1.0 if r == 1 else 0.0,
+                          1.0 if r == 2 else 0.0, K, N, work[term_rows(nq)[1]])
+            _scaled_row(work, nq, m * (1.0 - s), nr)
+            nq += 1
+    # z = Q (g - beta) - lam (tau1 z_s - tau2 y_s), then rhs += m Bt^T C^T z
+    gb0, gb1, gb2 = sw[j, SW.g_beta], sw[j, SW.g_beta + 1], sw[j, SW.g_beta + 2]
+    nd = Cs[0, 0] * gb0 + Cs[1, 0] * gb1 + Cs[2, 0] * gb2
+    z = work[at(WR.scratch, K, N)]
+    for i in range(3):
+        z[i] = ((1.0 - s) * sw[j, SW.g_beta + i] + s * nd * Cs[i, 0]
+                - lam * (tau1 * Cs[i, 2] - tau2 * Cs[i, 1]))
+    zb0 = Cb[0, 0] * z[0] + Cb[1, 0] * z[1] + Cb[2, 0] * z[2]
+    zb1 = Cb[0, 1] * z[0] + Cb[1, 1] * z[1] + Cb[2, 1] * z[2]
+    zb2 = Cb[0, 2] * z[0] + Cb[1, 2] * z[1] + Cb[2, 2] * z[2]
+    _body_row_map(Cb, r0, r1, r2, phi, zb0, zb1, zb2, K, N, h)
+    for i in range(nr):
+        rhs[i] += m * h[i]
+    return nq
+
+
+@nb.njit(cache=True, error_model="numpy", inline="always")
+def _solve(A, rhs, work, nq, K, N):
+    """Add the collected rank-one terms to ``A`` and solve ``A_r u_dot = b`` in place: ``rhs`` then
+    holds the accelerations of the speeds (:data:`.layout.SPEEDS`)."""
+    nr = at(SIZES.speeds, K, N)
     _add_sym_outers(A, work, nq, nr)
     _cholesky_solve(A, rhs, nr)
-    # rhs now holds [v_dot_i, omega_dot_b, eta_ddot]
 
-    # ---------------------------------------------------------------- kinematics and outputs
+
+@nb.njit(cache=True, error_model="numpy", inline="always")
+def _kinematics(x, rhs, w0, w1, w2, K, N, xdot):
+    """The derivatives of the position, attitude and modal coordinates (kinematics) and of the rigid
+    and elastic speeds (the solution ``rhs``)."""
+    o_r = at(X.r_zw_i, K, N)
+    o_v = at(X.v_zw_i, K, N)
+    o_q = at(X.q_bi, K, N)
+    o_w = at(X.omega_bi_b, K, N)
+    o_eta, o_etad = at(X.eta, K, N), at(X.eta_dot, K, N)
+    r_v, r_w, r_e = at(V.v_zw_i, K, N), at(V.omega_bi_b, K, N), at(V.eta_dot, K, N)
     for i in range(3):
-        xdot[X_R + i] = x[X_V + i]
-        xdot[X_V + i] = rhs[i]
-        xdot[X_W + i] = rhs[3 + i]
-    _quat_rate(x, X_Q, w0, w1, w2, xdot, X_Q)
+        xdot[o_r + i] = x[o_v + i]
+        xdot[o_v + i] = rhs[r_v + i]
+        xdot[o_w + i] = rhs[r_w + i]
+    _quat_rate(x, o_q, w0, w1, w2, xdot, o_q)
     for k in range(2 * K):
         xdot[o_eta + k] = x[o_etad + k]
-        xdot[o_etad + k] = rhs[6 + k]
+        xdot[o_etad + k] = rhs[r_e + k]
 
-    # ---------------------------------------------------------------- pendulum accelerations
-    wd0, wd1, wd2 = rhs[3], rhs[4], rhs[5]
+
+@nb.njit(cache=True, error_model="numpy", inline="always")
+def _pendulum_accelerations(x, p, rhs, Cb, sw, K, N, xdot):
+    """Back-substitution: each pendulum's angular acceleration from the hinge acceleration and the
+    quantities its elimination kept, and its attitude rate (an inactive pendulum's state is frozen)."""
+    r_v, r_w, r_e = at(V.v_zw_i, K, N), at(V.omega_bi_b, K, N), at(V.eta_dot, K, N)
+    wd0, wd1, wd2 = rhs[r_w], rhs[r_w + 1], rhs[r_w + 2]
     for j in range(N):
-        qo = o_qs + 4 * j
-        wo = o_ws + 2 * j
-        if S[j, _S_M] <= 0.0:
+        qo = at(X.q_si, K, N) + j * X_PER_SLOSH.q_si
+        wo = at(X.omega_si_s, K, N) + j * X_PER_SLOSH.omega_si_s
+        if sw[j, SW.m] <= 0.0:
             for i in range(4):
                 xdot[qo + i] = 0.0
             xdot[wo] = 0.0
             xdot[wo + 1] = 0.0
             continue
-        o = o_sl + j * sb
-        L = S[j, _S_L]
-        k2 = S[j, _S_K2]
-        r0, r1, r2 = S[j, _S_RHO], S[j, _S_RHO + 1], S[j, _S_RHO + 2]
-        ey = 0.0
-        ez = 0.0
+        o_phi = at(P.slosh, K, N) + j * at(SLOSH_BLOCK, K, N) + at(S.phi, K, N)
+        L = sw[j, SW.length]
+        k2 = sw[j, SW.k2]
+        r0, r1, r2 = sw[j, SW.rho_b], sw[j, SW.rho_b + 1], sw[j, SW.rho_b + 2]
+        ey = ez = 0.0
         for k in range(K):
-            ph = p[o + 8 + k]
-            ey += ph * rhs[6 + k]
-            ez += ph * rhs[6 + K + k]
+            ph = p[o_phi + k]
+            ey += ph * rhs[r_e + k]
+            ez += ph * rhs[r_e + K + k]
         # hinge acceleration (without bias), body frame: C^T v_dot + omega_dot x rho + Psi eta_ddot
         hb0 = wd1 * r2 - wd2 * r1
         hb1 = wd2 * r0 - wd0 * r2 + ey
         hb2 = wd0 * r1 - wd1 * r0 + ez
-        dy = 0.0
-        dz = 0.0
+        dy = dz = 0.0
         for i in range(3):
-            ai = rhs[i] + Cb[i, 0] * hb0 + Cb[i, 1] * hb1 + Cb[i, 2] * hb2
-            d = S[j, _S_GB + i] - ai
-            dy += S[j, _S_Y + i] * d
-            dz += S[j, _S_Z + i] * d
+            ai = rhs[r_v + i] + Cb[i, 0] * hb0 + Cb[i, 1] * hb1 + Cb[i, 2] * hb2
+            d = sw[j, SW.g_beta + i] - ai
+            dy += sw[j, SW.y_s + i] * d
+            dz += sw[j, SW.z_s + i] * d
         den = L * L + k2
-        xdot[wo] = (L * dz + S[j, _S_TAU]) / den
-        xdot[wo + 1] = (-L * dy + S[j, _S_TAU + 1]) / den
+        xdot[wo] = (L * dz + sw[j, SW.tau]) / den
+        xdot[wo + 1] = (-L * dy + sw[j, SW.tau + 1]) / den
         _quat_rate(x, qo, 0.0, x[wo], x[wo + 1], xdot, qo)
 
 
+# ---------------------------------------------------------------------------- the equations of motion
 @nb.njit(cache=True, error_model="numpy")
-def make_workspace(n_slosh, n_modes):
-    """Allocate the work arrays of ``vehicle_deriv``: (A, rhs, h, C, S, work)."""
-    nr = 6 + 2 * n_modes
-    return (np.empty((nr, nr)), np.empty(nr), np.empty(nr), np.empty((2, 3, 3)),
-            np.zeros((max(n_slosh, 1), SLOSH_WORK)), np.empty((1 + 8 * n_slosh, max(nr, 3))))
+def vehicle_deriv(x, p, u, xdot, ws):
+    """Time derivative ``xdot`` of one vehicle's state ``x`` for parameters ``p`` and loads ``u``
+    (layouts :data:`.layout.STATE`, :data:`.layout.PARAMS`, :data:`.layout.LOADS` for ``ws.n_modes``
+    modes per plane and ``ws.n_slosh`` pendulums), with the scratch ``ws``, a :data:`DerivWork` (the
+    part ``deriv`` of the stepper's ``Workspace``; any contents). Only the state's fields of ``xdot`` are
+    written.
+
+    The arrays are used through :func:`unowned` views (the caller holds them for the call): numba
+    would otherwise count references to them across the inlined steps, with atomic instructions."""
+    K = ws.n_modes
+    N = ws.n_slosh
+    x, p, u, xdot = unowned(x), unowned(p), unowned(u), unowned(xdot)
+    A, rhs, h, sw, work = unowned(ws.A), unowned(ws.rhs), unowned(ws.h), unowned(ws.slosh), unowned(ws.work)
+    C = unowned(ws.C)
+    Cb, Cs = C[AT.C_ib], C[AT.C_is]
+    o_q = at(X.q_bi, K, N)
+    quat_to_dcm(x[o_q], x[o_q + 1], x[o_q + 2], x[o_q + 3], Cb)
+    o_w = at(X.omega_bi_b, K, N)
+    w0, w1, w2 = x[o_w], x[o_w + 1], x[o_w + 2]
+    o_cg = at(P.r_cg, K, N)
+    cg0, cg1, cg2 = p[o_cg], p[o_cg + 1], p[o_cg + 2]
+    # loads, rigid body and modes
+    f0, f1, f2, re0, re1, re2 = _gimbal_thrust(x, p, u, cg0, cg1, cg2, K, N)
+    _rigid_body(p, u, Cb, w0, w1, w2, f0, f1, f2, re0, re1, re2, K, N, A, rhs)
+    _modes(x, p, u, f1, f2, K, N, A, rhs)
+    # slosh pendulums, eliminated one by one; the body rate in inertial components for their dampers
+    wi0 = Cb[0, 0] * w0 + Cb[0, 1] * w1 + Cb[0, 2] * w2
+    wi1 = Cb[1, 0] * w0 + Cb[1, 1] * w1 + Cb[1, 2] * w2
+    wi2 = Cb[2, 0] * w0 + Cb[2, 1] * w1 + Cb[2, 2] * w2
+    nq = 0                                  # rank-one terms of A_r collected in work
+    for j in range(N):
+        nq = _eliminate_pendulum(j, x, p, u, K, N, Cb, Cs, w0, w1, w2, wi0, wi1, wi2, cg0, cg1, cg2, rhs, h, sw,
+                                 work, nq)
+    # the reduced system, then the back-substitution
+    _solve(A, rhs, work, nq, K, N)
+    _kinematics(x, rhs, w0, w1, w2, K, N, xdot)
+    _pendulum_accelerations(x, p, rhs, Cb, sw, K, N, xdot)

@@ -18,13 +18,16 @@ their offsets from them (``at(X.eta_dot, K, N)``, see :mod:`lvgym.packing`).
 
 from __future__ import annotations
 
+from collections import namedtuple
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from lvgym.packing import Linear, LinearField, Packed
+from lvgym.packing import Field, Linear, LinearField, Packed
 
-__all__ = ["LOADS", "Layout", "P", "PARAMS", "SLOSH", "SLOSH_FIELDS", "SPEEDS", "STATE", "S", "U", "V", "X"]
+__all__ = ["ATTITUDES", "LOADS", "Layout", "P", "PARAMS", "RANK_ONE", "RK4_ROWS", "SIZES", "SLOSH", "SLOSH_BLOCK",
+           "SLOSH_FIELDS", "SLOSH_WORK", "SPEEDS", "STATE", "S", "TERMS_PER_PENDULUM", "U", "V", "WORK_ROWS", "X",
+           "X_PER_SLOSH"]
 
 # ---------------------------------------------------------------------------- the one description
 #: state x (K modes per plane, N pendulums)
@@ -84,10 +87,58 @@ SPEEDS = Linear("rigid and elastic speeds", [
 #: offset forms for compiled code: ``at(X.eta_dot, K, N)``, ``at(P.slosh, K, N) + j * at(SLOSH_BLOCK, K, N)
 #: + at(S.phi, K, N)``; the fields that depend on neither K nor N are also plain integers in ``*.fixed``
 X, P, U, S, V = STATE.at, PARAMS.at, LOADS.at, SLOSH.at, SPEEDS.at
+#: size forms of the vectors, for compiled code: ``at(SIZES.state, K, N)`` is the length of ``x``,
+#: ``at(SIZES.speeds, K, N)`` the order of the reduced system
+SIZES = namedtuple("DynamicsSizes", ["state", "params", "loads", "slosh", "speeds"])(
+    STATE.size_form, PARAMS.size_form, LOADS.size_form, SLOSH.size_form, SPEEDS.size_form)
 #: size form of one pendulum's parameter block
 SLOSH_BLOCK = SLOSH.size_form
+#: entries per pendulum of the state fields, for compiled code: pendulum j's quaternion starts at
+#: ``at(X.q_si, K, N) + j * X_PER_SLOSH.q_si``
+X_PER_SLOSH = STATE.per_slosh
 #: names of one pendulum's parameters, in order
 SLOSH_FIELDS = SLOSH.names
+
+# ---------------------------------------------------------------------------- work arrays of the kernels
+# (internal: the scratch of vehicle_deriv and rk4_vehicle, described here like the vectors above)
+#: per-pendulum row of the work array ``slosh``: what the elimination keeps for the back-substitution
+SLOSH_WORK = Packed("slosh work", [
+    Field("y_s", 3, "-", "pendulum axis y_s, inertial components"),
+    Field("z_s", 3, "-", "pendulum axis z_s, inertial components"),
+    Field("rho_b", 3, "m", "deflected hinge from the CG of B, body frame"),
+    Field("g_beta", 3, "m/s^2", "gravity less the bias acceleration of the slosh mass, inertial"),
+    Field("tau", 2, "m^2/s^2", "damper torque per unit slosh mass, s frame (y_s, z_s)"),
+    Field("m", 1, "kg", "slosh mass (<= 0: the pendulum is inactive)"),
+    Field("length", 1, "m", "pendulum length L"),
+    Field("k2", 1, "m^2", "transverse inertia per unit slosh mass J/m"),
+])
+#: one rank-one term ``c h h^T`` of the reduced matrix: two rows of the ``work`` matrix
+RANK_ONE = Packed("rank-one term", [
+    Field("ch", 1, "-", "c h, a row of speeds"),
+    Field("h", 1, "-", "h, a row of speeds"),
+])
+#: rank-one terms per pendulum at most: the rod, and the three axes when the slosh body has inertia
+TERMS_PER_PENDULUM = 4
+#: rows of the ``work`` matrix (``max(n_r, 3)`` columns)
+WORK_ROWS = Linear("work rows", [
+    LinearField("scratch", 1, unit="m/s^2", doc="z, the pendulum's projected acceleration (3 columns)"),
+    LinearField("terms", per_slosh=TERMS_PER_PENDULUM * RANK_ONE.size, doc="the rank-one terms, in order"),
+])
+#: the attitude matrices (3 x 3 each) in the array ``C`` of the kernels' ``DerivWork``
+ATTITUDES = Packed("attitude matrices", [
+    Field("C_ib", 1, "-", "C_ib = R(q_bi), body to inertial"),
+    Field("C_is", 1, "-", "C_is = R(q_si) of the pendulum being eliminated, pendulum to inertial"),
+])
+
+#: rows of the RK4 buffer ``buf`` of :func:`lvgym.dynamics.stepper.rk4_vehicle`, each a state vector
+RK4_ROWS = Packed("rk4 rows", [
+    Field("k1", 1, "-", "stage derivative 1"),
+    Field("k2", 1, "-", "stage derivative 2"),
+    Field("k3", 1, "-", "stage derivative 3"),
+    Field("k4", 1, "-", "stage derivative 4"),
+    Field("x_stage", 1, "-", "state of the current stage"),
+    Field("x_prop", 1, "-", "state at the start of the step, propagated over h/2"),
+])
 
 
 @dataclass(frozen=True)

@@ -154,7 +154,7 @@ class NonRigidModel:
     def derivative(self, x: np.ndarray, p: np.ndarray, u: np.ndarray) -> np.ndarray:
         """State derivative ``xdot``, shaped like ``x``."""
         xb, pb, ub = self._batches(x, p, u)
-        out = np.empty_like(xb)
+        out = np.zeros_like(xb)          # the unused entries of a padded layout: zero derivative
         deriv_batch(xb, pb, ub, self.n_slosh, self.n_modes, out)
         return _shape_like(out, x)
 
