@@ -13,6 +13,7 @@ Also: every layout's offsets tile its vector, and the tables in the docstrings a
 import ast
 import importlib
 import inspect
+import math
 import textwrap
 
 import numpy as np
@@ -45,14 +46,24 @@ class _Check:
         self.layouts = {k for k, v in module_globals.items() if is_offsets(v)}
         self.globals = module_globals
         self.derived: set[str] = set()
+        self.sizes: dict[str, int] = {}                # derived names with a known field size
         self.problems: list[str] = []
 
     def _size(self, node: ast.AST) -> int | None:
-        """The field size of ``LAYOUT.field`` (None when not such an attribute or not known)."""
+        """The field size of ``LAYOUT.field``, ``at(LAYOUT.field, K, N)`` or a name assigned from one
+        (None when not such an expression or not known)."""
+        if isinstance(node, ast.Call) and isinstance(node.func, ast.Name) and node.func.id == "at" and node.args:
+            node = node.args[0]
+        if isinstance(node, ast.Name):
+            return self.sizes.get(node.id)
         if isinstance(node, ast.Attribute) and isinstance(node.value, ast.Name) and node.value.id in self.layouts:
             lay = offsets_layout(self.globals[node.value.id])
             if isinstance(lay, Packed) and node.attr in lay:
                 return lay.field(node.attr).size
+            field = next((f for f in getattr(lay, "fields", ()) if f.name == node.attr), None)
+            if field is not None and hasattr(field, "per_mode") and field.per_mode == field.per_slosh == \
+                    field.per_both == 0:
+                return field.const
             return _COMPONENT
         return None
 
@@ -67,6 +78,8 @@ class _Check:
             return self.layout_expr(node.left) or self.layout_expr(node.right)
         if isinstance(node, ast.BinOp) and isinstance(node.op, ast.Mult):   # a stride of the layout times j
             return any(isinstance(s, ast.Attribute) and self.layout_expr(s) for s in (node.left, node.right))
+        if isinstance(node, ast.IfExp):
+            return self.layout_expr(node.body) and self.layout_expr(node.orelse)
         return False
 
     def check_expr(self, node: ast.AST, where: str, bare_ok: bool, upper: bool = False) -> None:
@@ -74,17 +87,21 @@ class _Check:
             if not (bare_ok and node.value < 3):
                 self.problems.append(f"{where}: a bare integer index {node.value}")
             return
+        # a square matrix field stored row major (``J_b``): ``o_J + 3 * i + k`` is its entry (i, k)
+        sizes = [s for s in (self._size(n) for n in ast.walk(node)) if s is not None]
+        matrix = {int(round(math.sqrt(s))) for s in sizes if s > 1 and int(round(math.sqrt(s))) ** 2 == s}
         for sub in ast.walk(node):
             if not isinstance(sub, ast.BinOp):
                 continue
             ints = [s for s in (sub.left, sub.right) if isinstance(s, ast.Constant) and isinstance(s.value, int)]
             if not ints:
                 continue
-            if isinstance(sub.op, ast.Mult):
-                self.problems.append(f"{where}: {ast.unparse(sub)} multiplies an offset by hand")
-                continue
             other = sub.right if ints[0] is sub.left else sub.left
             c = ints[0].value
+            if isinstance(sub.op, ast.Mult):
+                if not (c in matrix and isinstance(other, ast.Name)):
+                    self.problems.append(f"{where}: {ast.unparse(sub)} multiplies an offset by hand")
+                continue
             size = self._size(other)
             limit = (size if size is not None else _COMPONENT) + (1 if upper else 0)
             plain = not any(isinstance(n, ast.Constant) and isinstance(n.value, int) for n in ast.walk(other))
@@ -106,6 +123,9 @@ class _Check:
                 for t, v in zip(targets, values):
                     if isinstance(t, ast.Name) and self.layout_expr(v):
                         self.derived.add(t.id)
+                        size = self._size(v)
+                        if size is not None and (isinstance(v, ast.Attribute) or isinstance(v, ast.Call)):
+                            self.sizes[t.id] = size
         for node in ast.walk(fn):
             if not isinstance(node, ast.Subscript):
                 continue
@@ -143,17 +163,19 @@ def test_kernels_take_their_offsets_from_a_layout(module):
 
 
 def test_the_check_sees_offsets_worked_out_by_hand():
-    glob = {"CTX": Packed("t", [Field("gimbal", 2), Field("q", 4)]).at}
+    glob = {"CTX": Packed("t", [Field("gimbal", 2), Field("q", 4)]).at, "M": Packed("m", [Field("m", 9)]).at}
     bad = ["def k(x, K, j):\n    return x[13 + 2 * K + K + j]",
            "def k(x, j):\n    o = 21 + 4 * j\n    return x[o + 1]",
            "def k(x):\n    return x[6]",
            "def k(x):\n    return x[CTX.gimbal + 2]",                 # beyond the 2-entry field
            "def k(x, o):\n    return x[o + 8]",
-           "def k(rhs):\n    for i in range(3):\n        rhs[3 + i] = 0.0"]
+           "def k(rhs):\n    for i in range(3):\n        rhs[3 + i] = 0.0",
+           "def k(x, i):\n    return x[CTX.q + 3 * i]"]                 # a 4-entry field is no matrix
     good = ["def k(x, j):\n    return x[CTX.gimbal + 1] + x[CTX.q + 3] + x[j] + x[0]",
             "def k(x, K, N):\n    o = at(X, K, N)\n    return x[o + 2]",
             "def k(x):\n    return x[CTX.q:CTX.q + 4]",
-            "def k(t, tl):\n    i = search(tl, t) - 1\n    return tl[i + 1] - tl[i]"]
+            "def k(t, tl):\n    i = search(tl, t) - 1\n    return tl[i + 1] - tl[i]",
+            "def k(x, i, j):\n    o = M.m\n    return x[o + 3 * i + j] + x[o + 8]"]
     for src in bad:
         assert _Check(src, glob).run(), src
     for src in good:

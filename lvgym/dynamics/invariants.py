@@ -12,15 +12,25 @@ from __future__ import annotations
 import numba as nb
 import numpy as np
 
-from lvgym.packing import at
+from lvgym.packing import Field, Packed, at
 from lvgym.rotations import quat_to_dcm
 
 from .kernels import hinge_offset
 from .layout import SLOSH_BLOCK, X_PER_SLOSH, P, S, X
 
-#: names of the columns written by ``energy_batch``
-ENERGY_TERMS = ("kinetic", "gravitational", "elastic", "total", "internal", "rotation", "bending",
-                "slosh")
+#: the columns written by ``energy_batch`` (an interface: callers read them in this order)
+ENERGY = Packed("energy terms", [
+    Field("kinetic", 1, "J", "kinetic energy of B, the modes and the slosh bodies"),
+    Field("gravitational", 1, "J", "potential -m g . r in the uniform field"),
+    Field("elastic", 1, "J", "0.5 eta^T Omega^2 eta"),
+    Field("total", 1, "J", "kinetic + gravitational + elastic"),
+    Field("internal", 1, "J", "rotation + bending + slosh motion relative to the CG of B (DESIGN.md note 7)"),
+    Field("rotation", 1, "J", "rotation of B"),
+    Field("bending", 1, "J", "kinetic and elastic energy of the modes"),
+    Field("slosh", 1, "J", "slosh motion relative to the CG of B"),
+], interface=True)
+ENERGY_TERMS = ENERGY.names
+_E = ENERGY.at
 
 
 @nb.njit(cache=True)
@@ -104,14 +114,14 @@ def energy_batch(x, p, g, n_slosh, n_modes, out):
             ke_s_rel += 0.5 * ms * ((vc[0] - v0) ** 2 + (vc[1] - v1) ** 2 + (vc[2] - v2) ** 2) + rot
             pe_g -= ms * (g[b, 0] * rc[0] + g[b, 1] * rc[1] + g[b, 2] * rc[2])
         kin = ke_t + ke_r + ke_f + ke_s
-        out[b, 0] = kin
-        out[b, 1] = pe_g
-        out[b, 2] = pe_f
-        out[b, 3] = kin + pe_g + pe_f
-        out[b, 4] = ke_r + ke_f + pe_f + ke_s_rel
-        out[b, 5] = ke_r
-        out[b, 6] = ke_f + pe_f
-        out[b, 7] = ke_s_rel
+        out[b, _E.kinetic] = kin
+        out[b, _E.gravitational] = pe_g
+        out[b, _E.elastic] = pe_f
+        out[b, _E.total] = kin + pe_g + pe_f
+        out[b, _E.internal] = ke_r + ke_f + pe_f + ke_s_rel
+        out[b, _E.rotation] = ke_r
+        out[b, _E.bending] = ke_f + pe_f
+        out[b, _E.slosh] = ke_s_rel
 
 
 @nb.njit(cache=True)

@@ -29,7 +29,7 @@ import numba as nb
 import numpy as np
 
 from lvgym.dynamics.layout import STATE, X
-from lvgym.dynamics.stepper import _alloc, rk4_vehicle, unowned
+from lvgym.dynamics.stepper import make_workspace, rk4_vehicle, unowned
 from lvgym.packing import at
 from lvgym.rotations import quat_to_dcm
 
@@ -120,7 +120,7 @@ def advance_range(lo, hi, loads_fn, data, tables, setup, duration):
     n_x = x.shape[1]
     n_p = p.shape[1]
     n_slosh, n_modes = setup.n_slosh, setup.n_modes
-    buf, E, ws = _alloc(n_x, setup.n_u, n_slosh, n_modes)
+    ws = make_workspace(n_slosh, n_modes, setup.n_u)
     pn = np.empty(n_p)
     C = np.empty((3, 3))
     n = max(1, int(math.ceil(duration / setup.physics_dt - 1e-9)))
@@ -156,7 +156,7 @@ def advance_range(lo, hi, loads_fn, data, tables, setup, duration):
                 pb[:] = pn
                 _piece_thrust_k(cb, tables, tm)
                 cb[CTX.time0] = ta
-                rk4_vehicle(loads_fn, 0.0, te - ta, xb, pb, cb, n_slosh, n_modes, True, buf, E, ws)
+                rk4_vehicle(loads_fn, 0.0, te - ta, xb, pb, cb, True, ws)
                 ta = te
                 if rs[RS.on] != 0.0:
                     constrain_k(xb, ta, rail, data.x_cg0[b], pb[PF.r_cg], rs)
