@@ -157,6 +157,12 @@ def normalise_quaternions(x, n_slosh, n_modes):
             x[qo + i] /= n
 
 
+@nb.njit(cache=True, error_model="numpy")
+def rk4_vehicle_call(loads_fn, t, h, x, p, c, exact_modes, ws):
+    """:func:`rk4_vehicle` as a function of its own (not inlined into the caller)."""
+    rk4_vehicle(loads_fn, t, h, x, p, c, exact_modes, ws)
+
+
 @nb.njit(cache=True, error_model="numpy", inline="always")
 def rk4_vehicle(loads_fn, t, h, x, p, c, exact_modes, ws):
     """Advance one vehicle's state x in place by one step h from time t, with the parameters ``p``

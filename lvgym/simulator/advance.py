@@ -29,7 +29,7 @@ import numba as nb
 import numpy as np
 
 from lvgym.dynamics.layout import STATE, X
-from lvgym.dynamics.stepper import make_workspace, rk4_vehicle, unowned
+from lvgym.dynamics.stepper import make_workspace, rk4_vehicle_call, unowned
 from lvgym.packing import at
 from lvgym.rotations import quat_to_dcm
 
@@ -156,7 +156,7 @@ def advance_range(lo, hi, loads_fn, data, tables, setup, duration):
                 pb[:] = pn
                 _piece_thrust_k(cb, tables, tm)
                 cb[CTX.time0] = ta
-                rk4_vehicle(loads_fn, 0.0, te - ta, xb, pb, cb, True, ws)
+                rk4_vehicle_call(loads_fn, 0.0, te - ta, xb, pb, cb, True, ws)
                 ta = te
                 if rs[RS.on] != 0.0:
                     constrain_k(xb, ta, rail, data.x_cg0[b], pb[PF.r_cg], rs)
