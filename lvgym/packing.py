@@ -125,6 +125,7 @@ class Packed:
             o += f.size
         self.size = o
         self._entries = entries
+        self._views: dict[str, tuple[slice, tuple[int, ...] | None]] = {}     # name -> (slice, shape), on first use
         self.at = _register(namedtuple(_tuple_name(title), list(entries))(*(e[0] for e in entries.values())), self)
 
     # ------------------------------------------------------------------ look-up
@@ -183,13 +184,16 @@ class Packed:
     def view(self, array: np.ndarray, name: str) -> np.ndarray:
         """A view of ``name`` in ``array`` (``(..., size)``), in the field's shape: ``(..., *shape)``;
         a scalar field with ``shape=()`` gives ``(...)``."""
-        if np.shape(array)[-1:] != (self.size,):
+        if array.shape[-1] != self.size:
             raise ValueError(f"{self.title}: an array of shape {np.shape(array)}: expected (..., {self.size})")
-        f = self.field(name)
-        part = array[..., self.slice(name)]
-        if f.shape is not None:
-            part = part.reshape(part.shape[:-1] + tuple(f.shape))
-        return part
+        try:
+            sl, shape = self._views[name]
+        except KeyError:
+            f = self.field(name)
+            o = self._entries[name][0]
+            sl, shape = self._views.setdefault(name, (slice(o, o + f.size), None if f.shape is None else tuple(f.shape)))
+        part = array[..., sl]
+        return part if shape is None else part.reshape(part.shape[:-1] + shape)
 
     def pack(self, values: dict[str, Any], batch: int | None = None) -> np.ndarray:
         """A vector (or ``batch`` rows) with the named ``values`` broadcast into their fields, zeros

@@ -227,10 +227,11 @@ class AscentFuncEnv(FuncEnv):
         """The state one control period later, with ``action`` (B, 2) in [-1, 1] (``tvc``, clipped:
         Gymnasium's convention for a Box) or (B, 1) in {0, 1, 2} (``rcs``: negative, no, positive roll
         pulse). ``rng`` (B,): each row's generator for its sensor noise (None: the row draws nothing, e.g.
-        a row about to be reset). ``inplace``: reuse ``state``'s arrays (see the module docstring)."""
+        a row about to be reset). ``inplace``: reuse ``state``'s arrays (see the module docstring);
+        ``checked``: the caller has passed ``action`` through :meth:`check_action` already."""
         params = self.default_params if params is None else params
         B = state.task.steps.size
-        a = self.check_action(action, B)
+        a = np.asarray(action) if checked else self.check_action(action, B)
         st = state if inplace else self.take(state)
         s, sim, ts = self.spec, st.sim, st.task
         on = ts.on

@@ -176,6 +176,7 @@ class Simulator:
         self.dynamics = self.timeline.dynamics
         self.layout = self.dynamics.layout
         self._i_cg = self.layout.params["r_cg"].start
+        self._i_slosh_m = [self.layout.slosh_param(j, "m").start for j in range(self.dynamics.n_slosh)]
         # launch attitude: the pad frame tilted from the vertical towards downrange (+z_b) about y_b
         tilt = math.pi / 2 - self.elevation
         R = np.array([[math.cos(tilt), 0.0, math.sin(tilt)], [0.0, 1.0, 0.0], [-math.sin(tilt), 0.0, math.cos(tilt)]])
@@ -423,8 +424,7 @@ class Simulator:
         out = np.zeros((B, N, 2))
         if N:
             self.run_rows(_SLOSH, B, d.x, N, self.dynamics.n_modes, out)
-            m_j = d.p[:, [self.layout.slosh_param(j, "m").start for j in range(N)]]
-            out[m_j <= 0.0] = np.nan
+            out[d.p[:, self._i_slosh_m] <= 0.0] = np.nan
         return out
 
     def lateral_cg_offset(self) -> np.ndarray:
