@@ -9,15 +9,15 @@ longer bounded by the highest bending frequency, and the modes are not artificia
 RK4 loses ``(Omega h)^6 / 72`` of a mode's energy per step: 1.5e-4 of a 15 Hz mode over 15 s at 1 ms).
 ``rk4-classic`` is the plain scheme, kept for comparison.
 
-Loads come from a compiled loads function ``loads_fn(t, x, p, c, u)`` evaluated at every RK4 stage:
+Loads come from a compiled loads function ``loads_fn(t, x, p, ctx, u)`` evaluated at every RK4 stage:
 it writes the loads ``u`` of one vehicle from the stage time, state, parameters and the caller's
-command/context vector ``c``. The default ``zoh_loads`` copies ``c`` (loads held over the step); a
+command/context vector ``ctx``. The default ``zoh_loads`` copies ``ctx`` (loads held over the step); a
 simulator whose loads depend on the state (gravity with altitude, aerodynamics) compiles its own
 with ``compile_loads`` and hands it to the same ``step_batch``. Loads functions are numba ``cfunc``
 objects of ``LOADS_SIGNATURE``, so the stepper is compiled once and cached on disk.
 
 A caller that steps vehicles itself (the simulator) makes one :data:`Workspace` with
-``make_workspace(n_slosh, n_modes, n_u)`` and calls ``rk4_vehicle(loads_fn, t, h, x, p, c,
+``make_workspace(n_slosh, n_modes, n_u)`` and calls ``rk4_vehicle(loads_fn, t, h, x, p, ctx,
 exact_modes, ws)`` per step; the offsets of every array come from :mod:`.layout` and from
 :data:`.layout.RK4_ROWS`.
 """
@@ -64,20 +64,20 @@ def make_workspace(n_slosh, n_modes, n_u):
 
 
 _vec = nb.types.float64[::1]
-#: signature of a loads function ``loads_fn(t, x, p, c, u) -> None``
+#: signature of a loads function ``loads_fn(t, x, p, ctx, u) -> None``
 LOADS_SIGNATURE = nb.types.void(nb.types.float64, _vec, _vec, _vec, _vec)
 
 
 def compile_loads(fn):
-    """Compile a Python loads function ``fn(t, x, p, c, u)`` (numba-compatible code) for the
+    """Compile a Python loads function ``fn(t, x, p, ctx, u)`` (numba-compatible code) for the
     stepper."""
     return nb.cfunc(LOADS_SIGNATURE, cache=True)(fn)
 
 
-def _zoh(t, x, p, c, u):
+def _zoh(t, x, p, ctx, u):
     """Default loads function: the loads are the command vector, held over the step."""
     for i in range(u.size):
-        u[i] = c[i]
+        u[i] = ctx[i]
 
 
 zoh_loads = compile_loads(_zoh)
@@ -158,16 +158,16 @@ def normalise_quaternions(x, n_slosh, n_modes):
 
 
 @nb.njit(cache=True, error_model="numpy")
-def rk4_vehicle_call(loads_fn, t, h, x, p, c, exact_modes, ws):
+def rk4_vehicle_call(loads_fn, t, h, x, p, ctx, exact_modes, ws):
     """:func:`rk4_vehicle` as a function of its own (not inlined into the caller)."""
-    rk4_vehicle(loads_fn, t, h, x, p, c, exact_modes, ws)
+    rk4_vehicle(loads_fn, t, h, x, p, ctx, exact_modes, ws)
 
 
 @nb.njit(cache=True, error_model="numpy", inline="always")
-def rk4_vehicle(loads_fn, t, h, x, p, c, exact_modes, ws):
+def rk4_vehicle(loads_fn, t, h, x, p, ctx, exact_modes, ws):
     """Advance one vehicle's state x in place by one step h from time t, with the parameters ``p``
-    held and the loads written by ``loads_fn(t, x, p, c, ws.u)`` at every stage from the caller's
-    command/context vector ``c``; ``ws`` is a :data:`Workspace` of :func:`make_workspace` (its sizes
+    held and the loads written by ``loads_fn(t, x, p, ctx, ws.u)`` at every stage from the caller's
+    command/context vector ``ctx``; ``ws`` is a :data:`Workspace` of :func:`make_workspace` (its sizes
     say how many pendulums and modes ``x`` has). Unused entries of a padded state keep their values.
 
     With ``P`` the exact free-mode propagator over h/2 (the identity for ``exact_modes=False`` or
@@ -190,7 +190,7 @@ def rk4_vehicle(loads_fn, t, h, x, p, c, exact_modes, ws):
     if use_if:
         modal_propagator(p, N, K, 0.5 * h, E)
 
-    loads_fn(t, x, p, c, u)
+    loads_fn(t, x, p, ctx, u)
     vehicle_deriv(x, p, u, k1, dw)
     if use_if:
         _nonlinear_part(x, p, N, K, k1)
@@ -201,14 +201,14 @@ def rk4_vehicle(loads_fn, t, h, x, p, c, exact_modes, ws):
         _propagate(E, N, K, xs)
         _propagate(E, N, K, px)
 
-    loads_fn(t + 0.5 * h, xs, p, c, u)
+    loads_fn(t + 0.5 * h, xs, p, ctx, u)
     vehicle_deriv(xs, p, u, k2, dw)
     if use_if:
         _nonlinear_part(xs, p, N, K, k2)
     for i in range(n):
         xs[i] = px[i] + 0.5 * h * k2[i]
 
-    loads_fn(t + 0.5 * h, xs, p, c, u)
+    loads_fn(t + 0.5 * h, xs, p, ctx, u)
     vehicle_deriv(xs, p, u, k3, dw)
     if use_if:
         _nonlinear_part(xs, p, N, K, k3)
@@ -217,7 +217,7 @@ def rk4_vehicle(loads_fn, t, h, x, p, c, exact_modes, ws):
     if use_if:
         _propagate(E, N, K, xs)
 
-    loads_fn(t + h, xs, p, c, u)
+    loads_fn(t + h, xs, p, ctx, u)
     vehicle_deriv(xs, p, u, k4, dw)
     if use_if:
         _nonlinear_part(xs, p, N, K, k4)
@@ -236,17 +236,17 @@ def rk4_vehicle(loads_fn, t, h, x, p, c, exact_modes, ws):
 
 
 @nb.njit(cache=True, error_model="numpy")
-def step_batch(loads_fn, x, p, c, t0, h, n_steps, n_slosh, n_modes, exact_modes, n_u):
+def step_batch(loads_fn, x, p, ctx, t0, h, n_steps, n_slosh, n_modes, exact_modes, n_u):
     """Advance every row of the batch state ``x`` (B, n_x) in place by ``n_steps`` steps of ``h``
     seconds from ``t0``, with parameters ``p`` (B, n_p) held and loads of length ``n_u`` written by
-    ``loads_fn`` from the command/context rows ``c`` (B, n_c) at every stage."""
+    ``loads_fn`` from the command/context rows ``ctx`` (B, n_ctx) at every stage."""
     B = x.shape[0]
     ws = make_workspace(n_slosh, n_modes, n_u)
     for b in range(B):
         xb = x[b]
         t = t0
         for _ in range(n_steps):
-            rk4_vehicle(loads_fn, t, h, xb, p[b], c[b], exact_modes, ws)
+            rk4_vehicle(loads_fn, t, h, xb, p[b], ctx[b], exact_modes, ws)
             t += h
 
 
