@@ -215,8 +215,33 @@ class SB3Policy:
             raise ValueError(f"policy {self.name!r}: observation of shape {obs.shape}, trained on {expected}")
         if self.normalizer is not None and getattr(self.normalizer, "norm_obs", True):
             obs = np.asarray(self.normalizer.normalize_obs(obs), dtype=np.float32)
-        action, _ = self.model.predict(obs, deterministic=self.deterministic)
-        return np.asarray(action)
+        fast = self._fast_path()
+        if fast is None:
+            action, _ = self.model.predict(obs, deterministic=self.deterministic)
+            return np.asarray(action)
+        import torch
+
+        policy, low, high = fast
+        with torch.no_grad():                      # what model.predict does, without its per-call checks
+            out = policy._predict(torch.as_tensor(obs[None]), deterministic=self.deterministic)
+        return np.clip(out.cpu().numpy().reshape(low.shape), low, high)
+
+    def _fast_path(self) -> tuple[Any, np.ndarray, np.ndarray] | None:
+        """``(policy, low, high)`` when ``model.predict`` of one flat observation reduces to the policy's
+        ``_predict`` and a clip to the Box (no image transposition, no squashing, on the CPU), else None.
+        About three times faster per step than ``predict`` (tests/test_agents.py checks both agree)."""
+        if not hasattr(self, "_fast"):
+            from gymnasium import spaces
+
+            m = self.model
+            pol = getattr(m, "policy", None)
+            ok = (pol is not None and isinstance(m.action_space, spaces.Box)
+                  and isinstance(m.observation_space, spaces.Box) and len(m.observation_space.shape) == 1
+                  and not getattr(pol, "squash_output", False) and str(getattr(m, "device", "cpu")) == "cpu")
+            if ok:
+                pol.set_training_mode(False)
+            self._fast = (pol, m.action_space.low, m.action_space.high) if ok else None
+        return self._fast
 
 
 #: the policy shipped for ``lvgym/SmileAscent-v0`` (its sidecar JSON holds the training set-up; the command

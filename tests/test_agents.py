@@ -226,3 +226,18 @@ def test_validation_selects_on_the_training_model_or_on_every_condition():
     names = {m: ValidationEvaluator("smile-windy", 1, select_on=m).selected for m in ("rigid", "nonrigid", "flex", None)}
     assert names["rigid"] == ["smile-windy/rigid"] and names["nonrigid"] == ["smile-windy/nonrigid"]
     assert names["flex"] == names[None] == ["smile-windy/rigid", "smile-windy/nonrigid"]   # not flown: all
+
+
+def test_the_fast_action_path_equals_predict():
+    """SB3Policy.act skips model.predict's per-call checks for a flat Box observation; the action must be
+    exactly predict's."""
+    from agents.policy import shipped_policy
+    p = shipped_policy()
+    assert p._fast_path() is not None
+    rng = np.random.default_rng(3)
+    for _ in range(200):
+        obs = (rng.normal(size=14) * rng.choice([0.01, 1.0, 10.0])).astype(np.float32)
+        a = p.act(obs, {})
+        o = np.asarray(p.normalizer.normalize_obs(obs), dtype=np.float32)
+        b, _ = p.model.predict(o, deterministic=True)
+        assert a.dtype == b.dtype and np.array_equal(a, b)
