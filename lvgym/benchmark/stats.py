@@ -19,6 +19,7 @@ Every random draw has a seed (``seed``), so an interval is reproducible.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass
 from typing import Any
@@ -40,13 +41,13 @@ def bootstrap_ci(values: Sequence[float], statistic: Callable[[np.ndarray], floa
     x = np.asarray(values, dtype=float)
     x = x[np.isfinite(x)]
     if x.size == 0:
-        return math_nan(), math_nan()
+        return math.nan, math.nan
     if x.size == 1 or np.all(x == x[0]):
         v = float(statistic(x))
         return v, v
     fn = statistic if statistic in (np.mean, np.median) else (
         lambda s, axis=-1: np.apply_along_axis(statistic, axis, s))
-    lo = hi = math_nan()
+    lo = hi = math.nan
     for method in ("BCa", "percentile"):               # BCa is undefined for some tiny samples
         with np.errstate(all="ignore"):
             res = stats.bootstrap((x,), fn, n_resamples=reps, confidence_level=level, method=method,
@@ -55,11 +56,6 @@ def bootstrap_ci(values: Sequence[float], statistic: Callable[[np.ndarray], floa
         if np.isfinite(lo) and np.isfinite(hi):
             break
     return lo, hi
-
-
-def math_nan() -> float:
-    """NaN (an interval of no values)."""
-    return float("nan")
 
 
 @dataclass(frozen=True)

@@ -60,7 +60,7 @@ def key(mass_model: Any, args: tuple) -> str:
     return h.hexdigest()[:40]
 
 
-def _load(path: Path, mass_model: Any) -> Any:
+def _load(path: Path) -> Any:
     from lvgym.dynamics import NonRigidModel
 
     from .timeline import Timeline
@@ -101,7 +101,7 @@ def cached(mass_model: Any, args: tuple, build: Callable[[], Any]) -> Any:
     path = folder / f"{key(mass_model, args)}.npz"
     if path.is_file():
         try:
-            return _load(path, mass_model)
+            return _load(path)
         except Exception:                                 # noqa: BLE001 (a damaged file: build it again)
             pass
     tl = build()

@@ -53,7 +53,7 @@ from . import data as simdata
 from .advance import StepSetup, advance_range, conditions_rows, constrain_k, slosh_angles_range
 from .data import SimData
 from .flight import flight_loads, pack_context, stack_contexts
-from .layouts import ACTUATOR, CONDITIONS, CONTEXT, RAIL, RAIL_STATE
+from .layouts import ACTUATOR, CONDITIONS, CONTEXT, RAIL, RAIL_STATE, RS
 from .servo import DIRECT, Servo
 from .timeline import MODELS, Timeline, build_timeline
 
@@ -345,7 +345,7 @@ class Simulator:
         CONTEXT.view(d.ctx[:, :CONTEXT.size], "moment_b")[:] = 0.0 if moment is None else np.broadcast_to(moment, (B, 3))
         t0 = d.t.copy()
         rs = d.rail_state
-        i_on, i_lifted = RAIL_STATE.index("on"), RAIL_STATE.index("lifted")
+        i_on, i_lifted = RS.on, RS.lifted
         lifted0, on0 = rs[:, i_lifted].copy(), rs[:, i_on].copy()
         self.run_rows(_ADVANCE, B, flight_loads, d, self.tables, self.setup, float(duration))
         events: list[list[tuple[float, str]]] = [[] for _ in range(B)]
@@ -356,9 +356,9 @@ class Simulator:
         for b in np.flatnonzero(hit.any(axis=1) | new_lift | new_exit):
             evs = [self.timeline.events[i] for i in np.flatnonzero(hit[b])]
             if new_lift[b]:
-                evs.append((float(rs[b, RAIL_STATE.index("t_lift")]), "lift-off"))
+                evs.append((float(rs[b, RS.t_lift]), "lift-off"))
             if new_exit[b]:
-                evs.append((float(rs[b, RAIL_STATE.index("t_exit")]), "rail exit"))
+                evs.append((float(rs[b, RS.t_exit]), "rail exit"))
             events[b] = sorted(evs, key=lambda e: e[0])
         return events
 
@@ -390,17 +390,17 @@ class Simulator:
     @property
     def on_rail(self) -> np.ndarray:
         """Whether each row is still held on the pad or rail."""
-        return self.data.rail_state[:, RAIL_STATE.index("on")] != 0.0
+        return self.data.rail_state[:, RS.on] != 0.0
 
     @property
     def lifted(self) -> np.ndarray:
         """Whether each row has lifted off."""
-        return self.data.rail_state[:, RAIL_STATE.index("lifted")] != 0.0
+        return self.data.rail_state[:, RS.lifted] != 0.0
 
     @property
     def rail_s(self) -> np.ndarray:
         """Travel of the structure along the rail [m] (frozen at rail exit)."""
-        return self.data.rail_state[:, RAIL_STATE.index("s")]
+        return self.data.rail_state[:, RS.s]
 
     def conditions(self, name: str, data: SimData | None = None) -> np.ndarray:
         """Flight condition ``name`` (an entry of :data:`.layouts.CONDITIONS`) of every row at its

@@ -32,7 +32,7 @@ import numpy as np
 
 from .layouts import ACTUATOR, CONDITIONS, RAIL_STATE
 
-__all__ = ["SimData", "allocate", "copy", "put", "take", "widen"]
+__all__ = ["SimData", "allocate", "put", "take", "widen"]
 
 SimData = namedtuple("SimData", ["t", "x", "p", "ctx", "scale", "offset", "x_cg0", "failed", "rail_state", "actuator",
                                  "conditions"])
@@ -63,11 +63,6 @@ def take(data: SimData, rows: Any = None) -> SimData:
         return SimData(*(a.copy() for a in data))
     rows = np.atleast_1d(np.asarray(rows, dtype=np.int64))
     return SimData(*(a[rows].copy() for a in data))
-
-
-def copy(data: SimData) -> SimData:
-    """A deep copy of ``data``."""
-    return take(data)
 
 
 def put(data: SimData, rows: Any, src: SimData) -> SimData:
