@@ -43,6 +43,7 @@ from lvgym.simulator.servo import Servo
 from lvgym.vehicle import MassModel, Vehicle, load_vehicle
 from lvgym.vehicle.slender import slender_vehicle
 
+from .coast import coast_moment
 from .layouts import OBSERVATIONS, REASONS, REWARD, REWARD_TERMS, SENSOR_NOISE, TASK
 from .signals import TaskData, reset_signals, step_signals_range
 from .spec import TaskSpec, wind_spec
@@ -123,6 +124,7 @@ class AscentFuncEnv(FuncEnv):
         lay = self.sim.layout
         self._i_mb, self._i_J = lay.params["m_b"], lay.params["J_b"]
         self._i_cg, self._i_om = lay.params["r_cg"], lay.params["omega_modes"]
+        self._i_ref = self.observation_layout.index("pitch_rate_reference")
         self._i_zeta = [lay.slosh_param(j, "zeta") for j in range(self.sim.dynamics.n_slosh)]
         super().__init__()
 
@@ -245,6 +247,8 @@ class AscentFuncEnv(FuncEnv):
         if s.control == "tvc":
             a = a.astype(float)
             cmd = np.where(on[:, None], np.clip(a, -1.0, 1.0) * self.gimbal_limit, 0.0)
+            if s.coast_control:
+                moment = self._coast(sim, ts)
         else:
             a = a[:, 0].astype(float)
             cmd = np.zeros((B, 2))
@@ -256,6 +260,21 @@ class AscentFuncEnv(FuncEnv):
         if self._noisy:
             self._add_noise(sim, ts, range(B), rng)
         return AscentState(sim=sim, task=ts, events=events)
+
+    def _coast(self, sim: SimData, ts: TaskData) -> np.ndarray | None:
+        """Body moments (B, 3) [N m] of the coast attitude hold (:mod:`.coast`) for the rows in a coast
+        (the policy off after ``controller_on_after_s``), None when no row is."""
+        rows = np.flatnonzero(~ts.on & ~sim.failed & (sim.t >= self.spec.controller_on_after_s - 1e-9))
+        if rows.size == 0:
+            return None
+        lay = self.sim.layout
+        omega = sim.x[rows][:, lay.state["omega_bi_b"]]
+        J = sim.p[rows][:, self._i_J].reshape(-1, 3, 3)
+        rate = np.stack([omega[:, 1] - ts.obs[rows, self._i_ref], omega[:, 2]], axis=1)
+        moment = np.zeros((ts.on.size, 3))
+        moment[rows, 1:] = coast_moment(ts.att[rows], rate, np.stack([J[:, 1, 1], J[:, 2, 2]], axis=1),
+                                        self.spec.coast_bandwidth_radps, self.spec.coast_torque_nm)
+        return moment
 
     def check_action(self, action: Any, batch: int | None = None) -> np.ndarray:
         """``action`` as an array of ``batch`` rows of the action space (None: one element of it), or a

@@ -10,7 +10,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
-from lvgym.errors import ConfigError, check_choice, check_number
+from lvgym.errors import ConfigError, check_bool, check_choice, check_number
 from lvgym.simulator import MODELS
 
 WIND_TIERS = ("none", "profile", "gust", "turbulence", "random")
@@ -65,7 +65,10 @@ class TaskSpec:
     effort_weight per rad of gimbal per second, effort_rate_weight per rad/s of gimbal rate per second,
     failure_penalty_rad_per_s times the remaining mission time on termination; qalpha_limit_pa_deg:
     structural limit of dynamic pressure times total angle of attack; attitude_limit_deg: largest
-    attitude error; n_modes: bending modes per plane (None: the vehicle's).
+    attitude error; n_modes: bending modes per plane (None: the vehicle's); coast_control: while no engine
+    burns after ``controller_on_after_s`` (a staging coast), reaction control holds the attitude
+    (:mod:`.coast`: a proportional-derivative law on the attitude error and the body rates of bandwidth
+    ``coast_bandwidth_radps`` [rad/s], each of pitch and yaw limited to ``coast_torque_nm`` [N m]).
     """
 
     vehicle: Any
@@ -100,6 +103,9 @@ class TaskSpec:
     attitude_limit_deg: float = 30.0
     n_modes: int | None = None
     action_delay_steps: int = 0
+    coast_control: bool = False
+    coast_torque_nm: float = 300.0
+    coast_bandwidth_radps: float = 3.0
     gyro_noise_radps: float = 2e-4
     gyro_bias_radps: float = 1e-3
     accel_noise_mps2: float = 0.05
@@ -113,6 +119,7 @@ class TaskSpec:
         check_choice("reference_velocity", self.reference_velocity, REFERENCE_VELOCITIES)
         check_number("action_delay_steps", self.action_delay_steps, 0, 50, integer=True)
         check_choice("control", self.control, CONTROLS)
+        check_bool("coast_control", self.coast_control)
         r = self.randomize
         names = set(RANDOMIZE) if r is True else set() if r in (False, None) else set(r) if not isinstance(r, str) else {r}
         bad = sorted(names - set(RANDOMIZE))
@@ -135,7 +142,8 @@ class TaskSpec:
                             ("kick_start_s", 0.0, 3600.0), ("kick_end_s", 0.0, 3600.0),
                             ("kick_angle_deg", -90.0, 90.0), ("gyro_noise_radps", 0.0, 1.0),
                             ("gyro_bias_radps", 0.0, 1.0), ("accel_noise_mps2", 0.0, 100.0),
-                            ("attitude_noise_rad", 0.0, 1.0)):
+                            ("attitude_noise_rad", 0.0, 1.0), ("coast_torque_nm", 0.0, 1e6),
+                            ("coast_bandwidth_radps", 0.01, 100.0)):
             check_number(key, getattr(self, key), lo, hi)
         if self.kick_end_s <= self.kick_start_s:
             raise ConfigError("kick_end_s", self.kick_end_s, f"a time after kick_start_s = {self.kick_start_s}")
