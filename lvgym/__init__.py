@@ -9,6 +9,7 @@ __version__ = "0.1.0"
 #: env id -> (entry point, vector entry point)
 ENV_IDS = {
     "lvgym/SmileAscent-v0": ("lvgym.envs.ascent:SmileAscentEnv", "lvgym.envs:smile_ascent_vector"),
+    "lvgym/SmileAscent-v1": ("lvgym.envs.ascent:SmileAscentV1Env", "lvgym.envs:smile_ascent_v1_vector"),
     "lvgym/StratosIII-v0": ("lvgym.envs.ascent:StratosIIIEnv", "lvgym.envs:stratos3_vector"),
     "lvgym/SlenderAscent-v0": ("lvgym.envs.ascent:SlenderAscentEnv", "lvgym.envs:slender_ascent_vector"),
 }

@@ -58,3 +58,38 @@ def test_coast_control_options_are_checked():
         gym.make("lvgym/SmileAscent-v0", coast_control=1)
     with pytest.raises(ConfigError, match="coast_torque_nm"):
         gym.make("lvgym/SmileAscent-v0", coast_torque_nm=-1.0)
+
+
+def test_settling_thrust_is_a_body_force_at_the_cg():
+    """The simulator's commanded body force: F along +x_b adds F / m to the acceleration along the body
+    axis (checked against a flight without it over one short step on the pad-free upper stage coast)."""
+    env = gym.make("lvgym/SmileAscent-v0", model="rigid", mission_time_s=44.9, settling_thrust_n=1e4)
+    ref = gym.make("lvgym/SmileAscent-v0", model="rigid", mission_time_s=44.9)
+    for e in (env, ref):
+        e.reset(seed=1)
+    u, r = env.unwrapped, ref.unwrapped
+    lay = u.sim.layout.state
+    while True:
+        _, _, _, _, info = env.step(np.zeros(2, np.float32))
+        ref.step(np.zeros(2, np.float32))
+        if info["time"] >= 43.5 - 1e-9:
+            break
+    # equal until the burnout at 43 s (the force acts only in a coast), then the speed gain is F / m t
+    v = u.sim.data.x[0, lay["v_zw_i"]]
+    v_ref = r.sim.data.x[0, lay["v_zw_i"]]
+    gain = float(np.linalg.norm(v) - np.linalg.norm(v_ref))
+    assert gain == pytest.approx(1e4 / info["mass"] * 0.5, rel=0.05)
+
+
+def test_smile_v1_defaults_and_staging():
+    """SmileAscent-v1: the smile_v1 vehicle (separation at 53 s, ignition at 54 s), 70 s, reaction control
+    and settling thrust in the coast, one control period of delay."""
+    env = gym.make("lvgym/SmileAscent-v1", model="rigid").unwrapped
+    spec = env.specs[0]
+    assert spec.coast_control and spec.settling_thrust_n == 18000.0 and spec.action_delay_steps == 1
+    assert spec.mission_time_s == 70.0 and spec.reference_velocity == "earth"
+    times = {e: t for t, e in env.timeline.events}
+    assert times["stage 'stage1' burnout"] == pytest.approx(43.0)
+    assert times["stage 'stage1' separation"] == pytest.approx(53.0)
+    assert times["stage 'stage2' ignition"] == pytest.approx(54.0)
+    assert env.sim.stage_aerodynamics[1] is not env.sim.stage_aerodynamics[0]   # the upper stack's own

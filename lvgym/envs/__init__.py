@@ -1,6 +1,7 @@
 """Gymnasium environments of lvgym, registered on ``import lvgym``:
 
 - ``lvgym/SmileAscent-v0`` (:class:`~.ascent.SmileAscentEnv`): SMILE's first-stage flight, TVC;
+- ``lvgym/SmileAscent-v1`` (:class:`~.ascent.SmileAscentV1Env`): SMILE as protocol v1 flies it (draft);
 - ``lvgym/StratosIII-v0`` (:class:`~.ascent.StratosIIIEnv`): Stratos III through its thrust drop, roll RCS;
 - ``lvgym/SlenderAscent-v0`` (:class:`~.ascent.SlenderAscentEnv`): the parametric L/D vehicle.
 
@@ -15,20 +16,25 @@ from __future__ import annotations
 
 from typing import Any
 
-from .ascent import AscentEnv, SlenderAscentEnv, SmileAscentEnv, StratosIIIEnv
+from .ascent import AscentEnv, SlenderAscentEnv, SmileAscentEnv, SmileAscentV1Env, StratosIIIEnv
 from .functional import AscentFuncEnv, AscentParams, AscentState
 from .layouts import OBS_SENSORS, OBS_STATE, OBSERVATIONS, REWARD_TERMS, TASK
 from .snapshot import EpisodeState
 from .spec import RANDOMIZE, WIND_TIERS, TaskSpec
 from .vector import AscentVectorEnv
 
-ENVS = {"lvgym/SmileAscent-v0": SmileAscentEnv, "lvgym/StratosIII-v0": StratosIIIEnv,
+ENVS = {"lvgym/SmileAscent-v0": SmileAscentEnv, "lvgym/SmileAscent-v1": SmileAscentV1Env, "lvgym/StratosIII-v0": StratosIIIEnv,
         "lvgym/SlenderAscent-v0": SlenderAscentEnv}
 
 
 def smile_ascent_vector(num_envs: int = 1, **options: Any) -> AscentVectorEnv:
     """``vector_entry_point`` of ``lvgym/SmileAscent-v0``."""
     return AscentVectorEnv(SmileAscentEnv, num_envs, **options)
+
+
+def smile_ascent_v1_vector(num_envs: int = 1, **options: Any) -> AscentVectorEnv:
+    """``vector_entry_point`` of ``lvgym/SmileAscent-v1``."""
+    return AscentVectorEnv(SmileAscentV1Env, num_envs, **options)
 
 
 def stratos3_vector(num_envs: int = 1, **options: Any) -> AscentVectorEnv:
@@ -59,5 +65,6 @@ def __getattr__(name: str) -> Any:
 
 __all__ = ["ENVS", "OBSERVATIONS", "OBS_SENSORS", "OBS_STATE", "RANDOMIZE", "REWARD_TERMS", "TASK", "WIND_TIERS",
            "AscentEnv", "AscentFuncEnv", "AscentParams", "AscentSB3VecEnv", "AscentState", "AscentVectorEnv",
-           "EpisodeState", "SlenderAscentEnv", "SmileAscentEnv", "StratosIIIEnv", "TaskSpec", "make_sb3_vec_env",
-           "slender_ascent_vector", "smile_ascent_vector", "stratos3_vector"]
+           "EpisodeState", "SlenderAscentEnv", "SmileAscentEnv", "SmileAscentV1Env", "StratosIIIEnv", "TaskSpec",
+           "make_sb3_vec_env", "slender_ascent_vector", "smile_ascent_v1_vector", "smile_ascent_vector",
+           "stratos3_vector"]

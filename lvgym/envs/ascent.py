@@ -214,6 +214,23 @@ class SmileAscentEnv(AscentEnv):
     DEFAULTS = {"vehicle": "smile", "site": "andoya", "mission_time_s": 60.0, "rate_weights": (0.0, 1.0, 1.0)}
 
 
+class SmileAscentV1Env(SmileAscentEnv):
+    """``lvgym/SmileAscent-v1``: SMILE as protocol v1 flies it (a draft until issue 16 freezes it).
+
+    The vehicle ``smile_v1`` (lvgym/vehicles/smile_v1.yaml): the upper stack flies its own, finless
+    aerodynamics after separation, which comes 10 s after the 43 s burnout at about 1.8 kPa (the finned
+    stack coasts, statically stable); stage 2 ignites at 54 s; 70 s of mission. Through the coast the
+    vehicle holds its attitude by reaction control (``coast_control``, 300 N m, 3 rad/s) and settles its
+    propellant with ullage thrust (``settling_thrust_n`` = 18 kN, 1.35 times the drag at burnout:
+    docs/vehicles.md). The flight computer's computational delay is one control period
+    (``action_delay_steps=1``); the gravity turn, when asked for, follows the Earth-relative velocity.
+    Everything else as ``SmileAscent-v0``."""
+
+    DEFAULTS = {**SmileAscentEnv.DEFAULTS, "vehicle": "smile_v1", "mission_time_s": 70.0,
+                "reference_velocity": "earth", "action_delay_steps": 1, "coast_control": True,
+                "settling_thrust_n": 18000.0}
+
+
 class StratosIIIEnv(AscentEnv):
     """``lvgym/StratosIII-v0``: Stratos III through its thrust drop (thesis 5.2-5.3).
 

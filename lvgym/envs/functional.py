@@ -243,38 +243,46 @@ class AscentFuncEnv(FuncEnv):
             q[:, :-1] = q[:, 1:]
             q[:, -1] = a
             a = now
-        moment = None
+        moment = force = None
         if s.control == "tvc":
             a = a.astype(float)
             cmd = np.where(on[:, None], np.clip(a, -1.0, 1.0) * self.gimbal_limit, 0.0)
-            if s.coast_control:
-                moment = self._coast(sim, ts)
+            if s.coast_control or s.settling_thrust_n > 0.0:
+                moment, force = self._coast(sim, ts)
         else:
             a = a[:, 0].astype(float)
             cmd = np.zeros((B, 2))
             moment = np.zeros((B, 3))
             moment[:, 0] = np.where(on, (a - 1.0) * s.rcs_torque_nm, 0.0)
-        events = self.sim.step(cmd, s.control_dt_s, moment, data=sim)
+        events = self.sim.step(cmd, s.control_dt_s, moment, data=sim, force=force)
         ts.steps[:] += 1
         self.sim.run_rows(_SIGNALS, B, params.task, params.setup, sim, ts, params.tables)
         if self._noisy:
             self._add_noise(sim, ts, range(B), rng)
         return AscentState(sim=sim, task=ts, events=events)
 
-    def _coast(self, sim: SimData, ts: TaskData) -> np.ndarray | None:
-        """Body moments (B, 3) [N m] of the coast attitude hold (:mod:`.coast`) for the rows in a coast
-        (the policy off after ``controller_on_after_s``), None when no row is."""
-        rows = np.flatnonzero(~ts.on & ~sim.failed & (sim.t >= self.spec.controller_on_after_s - 1e-9))
+    def _coast(self, sim: SimData, ts: TaskData) -> tuple[np.ndarray | None, np.ndarray | None]:
+        """Body moments and forces (B, 3) [N m], [N] of the coast (the policy off after
+        ``controller_on_after_s``): the attitude hold of :mod:`.coast` (``coast_control``) and the settling
+        thrust along +x_b (``settling_thrust_n``); None when no row coasts."""
+        spec = self.spec
+        rows = np.flatnonzero(~ts.on & ~sim.failed & (sim.t >= spec.controller_on_after_s - 1e-9))
         if rows.size == 0:
-            return None
-        lay = self.sim.layout
-        omega = sim.x[rows][:, lay.state["omega_bi_b"]]
-        J = sim.p[rows][:, self._i_J].reshape(-1, 3, 3)
-        rate = np.stack([omega[:, 1] - ts.obs[rows, self._i_ref], omega[:, 2]], axis=1)
-        moment = np.zeros((ts.on.size, 3))
-        moment[rows, 1:] = coast_moment(ts.att[rows], rate, np.stack([J[:, 1, 1], J[:, 2, 2]], axis=1),
-                                        self.spec.coast_bandwidth_radps, self.spec.coast_torque_nm)
-        return moment
+            return None, None
+        B = ts.on.size
+        force = None
+        if spec.settling_thrust_n > 0.0:
+            force = np.zeros((B, 3))
+            force[rows, 0] = spec.settling_thrust_n
+        moment = None
+        if spec.coast_control:
+            omega = sim.x[rows][:, self.sim.layout.state["omega_bi_b"]]
+            J = sim.p[rows][:, self._i_J].reshape(-1, 3, 3)
+            rate = np.stack([omega[:, 1] - ts.obs[rows, self._i_ref], omega[:, 2]], axis=1)
+            moment = np.zeros((B, 3))
+            moment[rows, 1:] = coast_moment(ts.att[rows], rate, np.stack([J[:, 1, 1], J[:, 2, 2]], axis=1),
+                                            spec.coast_bandwidth_radps, spec.coast_torque_nm)
+        return moment, force
 
     def check_action(self, action: Any, batch: int | None = None) -> np.ndarray:
         """``action`` as an array of ``batch`` rows of the action space (None: one element of it), or a

@@ -68,7 +68,9 @@ class TaskSpec:
     attitude error; n_modes: bending modes per plane (None: the vehicle's); coast_control: while no engine
     burns after ``controller_on_after_s`` (a staging coast), reaction control holds the attitude
     (:mod:`.coast`: a proportional-derivative law on the attitude error and the body rates of bandwidth
-    ``coast_bandwidth_radps`` [rad/s], each of pitch and yaw limited to ``coast_torque_nm`` [N m]).
+    ``coast_bandwidth_radps`` [rad/s], each of pitch and yaw limited to ``coast_torque_nm`` [N m]);
+    settling_thrust_n: axial thrust [N] of ullage motors along +x_b through the same coasts, so that the
+    propellant stays settled against the drag (0: none).
     """
 
     vehicle: Any
@@ -106,6 +108,7 @@ class TaskSpec:
     coast_control: bool = False
     coast_torque_nm: float = 300.0
     coast_bandwidth_radps: float = 3.0
+    settling_thrust_n: float = 0.0
     gyro_noise_radps: float = 2e-4
     gyro_bias_radps: float = 1e-3
     accel_noise_mps2: float = 0.05
@@ -142,7 +145,7 @@ class TaskSpec:
                             ("kick_start_s", 0.0, 3600.0), ("kick_end_s", 0.0, 3600.0),
                             ("kick_angle_deg", -90.0, 90.0), ("gyro_noise_radps", 0.0, 1.0),
                             ("gyro_bias_radps", 0.0, 1.0), ("accel_noise_mps2", 0.0, 100.0),
-                            ("attitude_noise_rad", 0.0, 1.0), ("coast_torque_nm", 0.0, 1e6),
+                            ("attitude_noise_rad", 0.0, 1.0), ("coast_torque_nm", 0.0, 1e6), ("settling_thrust_n", 0.0, 1e7),
                             ("coast_bandwidth_radps", 0.01, 100.0)):
             check_number(key, getattr(self, key), lo, hi)
         if self.kick_end_s <= self.kick_start_s:

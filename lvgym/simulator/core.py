@@ -326,10 +326,11 @@ class Simulator:
         list(_pool(self.threads).map(lambda ch: fn(ch[0], ch[1], *args), chunks))
 
     def step(self, gimbal: Any, duration: float, moment: Any = None,
-             data: SimData | None = None) -> list[list[tuple[float, str]]]:
+             data: SimData | None = None, *, force: Any = None) -> list[list[tuple[float, str]]]:
         """Advance every row by ``duration`` [s] with the gimbal command ``gimbal`` (B, 2) [rad]
-        (pitch, yaw; see :mod:`.flight` for the signs) and a commanded body moment ``moment`` (B, 3)
-        [N m] (reaction control; default none) held; returns each row's events. ``data``: the rows
+        (pitch, yaw; see :mod:`.flight` for the signs), a commanded body moment ``moment`` (B, 3)
+        [N m] (reaction control; default none) and a body force at the CG ``force`` (B, 3) [N], body
+        axes (settling thrust; default none) held; returns each row's events. ``data``: the rows
         (default :attr:`data`), changed in place.
 
         Without a servo the gimbal takes the command at once; with one (``servo=``) it moves towards
@@ -343,6 +344,7 @@ class Simulator:
             raise ValueError(f"duration = {duration!r}: must be > 0 s")
         ACTUATOR.view(d.actuator, "command")[:] = np.broadcast_to(np.asarray(gimbal, dtype=float), (B, 2))
         CONTEXT.view(d.ctx[:, :CONTEXT.size], "moment_b")[:] = 0.0 if moment is None else np.broadcast_to(moment, (B, 3))
+        CONTEXT.view(d.ctx[:, :CONTEXT.size], "force_b")[:] = 0.0 if force is None else np.broadcast_to(force, (B, 3))
         t0 = d.t.copy()
         rs = d.rail_state
         i_on, i_lifted = RS.on, RS.lifted

@@ -126,8 +126,9 @@ def flight_conditions_k(t, x, p, ctx, cond):
 
 
 def _flight_loads(t, x, p, ctx, u):
-    """Loads of the dynamics core from the flight conditions: aerodynamic force (inertial) and moment
-    about the CG, thrust in the engine frame, gravity; no generalised modal forces."""
+    """Loads of the dynamics core from the flight conditions: aerodynamic force (inertial) plus the
+    commanded body force ``force_b`` turned to inertial axes, aerodynamic plus commanded moment about the
+    CG, thrust in the engine frame, gravity; no generalised modal forces."""
     flight_conditions_at(ctx[CTX.time0] + t, x, p, ctx, ctx, CTX.scratch, False)
     sc = CTX.scratch
     for i in range(3):
@@ -135,6 +136,11 @@ def _flight_loads(t, x, p, ctx, u):
         u[UF.m_b_b + i] = ctx[sc + D.m_aero_b + i] + ctx[CTX.moment_b + i]
         u[UF.thrust_b + i] = ctx[sc + D.thrust_b + i]
         u[UF.g_i + i] = ctx[sc + D.g_i + i]
+    fb = CTX.force_b
+    if ctx[fb] != 0.0 or ctx[fb + 1] != 0.0 or ctx[fb + 2] != 0.0:     # C_ib is in the scratch matrix
+        C = ctx[CTX.scratch_dcm:CTX.scratch_dcm + 9].reshape((3, 3))
+        for i in range(3):
+            u[UF.f_b_i + i] += C[i, 0] * ctx[fb] + C[i, 1] * ctx[fb + 1] + C[i, 2] * ctx[fb + 2]
     for i in range(UF.f_eta, u.size):
         u[i] = 0.0
 

@@ -66,6 +66,8 @@ CONTEXT = Packed("simulator context", [
     Field("gimbal", 2, "rad", "gimbal angles in force (pitch, yaw): the servo's position, held over a physics step"),
     Field("misalignment", 2, "rad", "fixed thrust misalignment (pitch, yaw), drawn at reset"),
     Field("moment_b", 3, "N m", "commanded body moment (reaction control), held over the control period"),
+    Field("force_b", 3, "N", "commanded body force at the CG, body frame (settling thrust), held over the control "
+          "period"),
     Field("thrust0", 1, "N", "vacuum thrust T_0 of the current piece (timeline, at its middle)"),
     Field("exit_area", 1, "m^2", "total nozzle exit area of the current piece"),
     Field("time0", 1, "s", "start time of the current piece: the stepper's time is relative to it"),
