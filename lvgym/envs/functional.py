@@ -38,7 +38,7 @@ from gymnasium.experimental.functional import FuncEnv
 from lvgym.simulator import SimData, Simulator, Timeline, build_timeline
 from lvgym.simulator import data as simdata
 from lvgym.simulator.core import Kernel
-from lvgym.simulator.layouts import ACTUATOR
+from lvgym.simulator.layouts import ACTUATOR, DISPERSION
 from lvgym.simulator.servo import Servo
 from lvgym.vehicle import MassModel, Vehicle, load_vehicle
 from lvgym.vehicle.slender import slender_vehicle
@@ -126,6 +126,10 @@ class AscentFuncEnv(FuncEnv):
         self._i_cg, self._i_om = lay.params["r_cg"], lay.params["omega_modes"]
         self._i_ref = self.observation_layout.index("pitch_rate_reference")
         self._i_zeta = [lay.slosh_param(j, "zeta") for j in range(self.sim.dynamics.n_slosh)]
+        self._i_slosh_m = [lay.slosh_param(j, "m") for j in range(self.sim.dynamics.n_slosh)]
+        self._i_slosh_f = [(lay.slosh_param(j, "length"), lay.slosh_param(j, "omega"))
+                           for j in range(self.sim.dynamics.n_slosh)]
+        self._i_zm = lay.params["zeta_modes"]
         super().__init__()
 
     # ------------------------------------------------------------------------------ parameters
@@ -196,18 +200,19 @@ class AscentFuncEnv(FuncEnv):
         rngs = list(rng)
         if len(rngs) != rows.size:
             raise ValueError(f"{len(rngs)} generators for {rows.size} rows")
-        winds, scales, offsets, mis = [], [], [], []
+        winds, scales, offsets, mis, loads = [], [], [], [], []
         ts = state.task
         for b, g in zip(rows, rngs):
             wind_rng = g if "wind" in s.randomize else np.random.default_rng(12345)
             winds.append((wind_spec(s.wind, s.mission_time_s), wind_rng))
-            sc, of, m = self.dispersions(g)
+            sc, of, m, ld = self.dispersions(g)
             scales.append(sc)
             offsets.append(of)
             mis.append(m)
+            loads.append(ld)
             ts.gyro_bias[b] = g.normal(0.0, s.gyro_bias_radps, 3) if "sensor_noise" in s.randomize else np.zeros(3)
         sim = self.sim.reset_rows(rows, [w[1] for w in winds], [w[0] for w in winds], np.array(mis), np.array(scales),
-                                  np.array(offsets), data=state.sim)
+                                  np.array(offsets), data=state.sim, dispersion=np.array(loads))
         ts.cum_error[rows] = 0.0
         ts.rate_error[rows] = 0.0
         ts.steps[rows] = 0
@@ -355,28 +360,58 @@ class AscentFuncEnv(FuncEnv):
         physics steps (the reward's ``effort`` term is minus ``effort_weight`` times it)."""
         return state.sim.actuator[:, ACTUATOR.index("effort")].copy()
 
-    def dispersions(self, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Parameter scale and offset and thrust misalignment of one row, drawn from ``rng``.
+    def dispersions(self, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Parameter scale and offset, thrust misalignment and load dispersions (layout
+        :data:`~lvgym.simulator.layouts.DISPERSION`) of one row, drawn from ``rng`` in this order; every
+        normal draw is clipped at 3 sigma.
 
-        mass: body mass x N(1, 1 %), CG station + N(0, 2 cm), inertia x N(1, 3 %); slosh_damping:
-        ratios x log-uniform [0.5, 2]; bending_frequency: x N(1, 5 %); thrust_misalignment: N(0, 0.05 deg)
-        per axis (clipped at 3 sigma)."""
+        Protocol v0's: mass: body mass x N(1, 1 %), CG station + N(0, 2 cm), inertia x N(1, 3 %);
+        slosh_damping: ratios x log-uniform [0.5, 2]; bending_frequency: x N(1, 5 %); thrust_misalignment:
+        N(0, 0.05 deg) per axis. Added for v1 (docs/benchmark.md gives the reasoning of each range):
+        aerodynamics: normal force and moment x N(1, 5 %), axial force x N(1, 5 %), centre of pressure
+        + N(0, 0.25 calibre); thrust_level: x N(1, 1 %); slosh_mass: pendulum masses x N(1, 5 %);
+        slosh_frequency: x N(1, 5 %) (pendulum lengths / f^2, the damper's frequency x f);
+        bending_damping: ratios x log-uniform [0.5, 2]."""
         n_p = self.sim.layout.n_p
         scale, offset, mis = np.ones(n_p), np.zeros(n_p), np.zeros(2)
+        loads = DISPERSION.pack({"thrust_scale": 1.0, "normal_scale": 1.0, "axial_scale": 1.0})
         r = self.spec.randomize
+
+        def normal(sigma: float, limit: float, n: int | None = None) -> Any:
+            return np.clip(rng.normal(0.0, sigma, n), -limit, limit)
+
         if "mass" in r:
-            scale[self._i_mb] = 1.0 + np.clip(rng.normal(0.0, 0.01), -0.03, 0.03)
-            offset[self._i_cg.start] = np.clip(rng.normal(0.0, 0.02), -0.06, 0.06)
-            scale[self._i_J] = 1.0 + np.clip(rng.normal(0.0, 0.03), -0.09, 0.09)
+            scale[self._i_mb] = 1.0 + normal(0.01, 0.03)
+            offset[self._i_cg.start] = normal(0.02, 0.06)
+            scale[self._i_J] = 1.0 + normal(0.03, 0.09)
         if "slosh_damping" in r:
             f = math.exp(rng.uniform(math.log(0.5), math.log(2.0)))
             for sl in self._i_zeta:
                 scale[sl] = f
         if "bending_frequency" in r:
-            scale[self._i_om] = 1.0 + np.clip(rng.normal(0.0, 0.05), -0.15, 0.15)
+            scale[self._i_om] = 1.0 + normal(0.05, 0.15)
         if "thrust_misalignment" in r:
-            mis = np.radians(np.clip(rng.normal(0.0, 0.05, 2), -0.15, 0.15))
-        return scale, offset, mis
+            mis = np.radians(normal(0.05, 0.15, 2))
+        if "aerodynamics" in r:
+            k = DISPERSION.index
+            loads[k("normal_scale")] = 1.0 + normal(0.05, 0.15)
+            loads[k("axial_scale")] = 1.0 + normal(0.05, 0.15)
+            calibre = self.vehicle.stages[0].outer_diameter
+            loads[k("cp_shift")] = normal(0.25 * calibre, 0.75 * calibre)
+        if "thrust_level" in r:
+            loads[DISPERSION.index("thrust_scale")] = 1.0 + normal(0.01, 0.03)
+        if "slosh_mass" in r:
+            f = 1.0 + normal(0.05, 0.15)
+            for sl in self._i_slosh_m:
+                scale[sl] *= f
+        if "slosh_frequency" in r:
+            f = 1.0 + normal(0.05, 0.15)
+            for length, omega in self._i_slosh_f:
+                scale[length] /= f * f
+                scale[omega] *= f
+        if "bending_damping" in r:
+            scale[self._i_zm] = math.exp(rng.uniform(math.log(0.5), math.log(2.0)))
+        return scale, offset, mis, loads
 
     def _add_noise(self, sim: SimData, ts: TaskData, rows: Any, rngs: Sequence[np.random.Generator | None]) -> None:
         """Sensor noise on the observation of ``rows`` (layout SENSOR_NOISE), each row from its own

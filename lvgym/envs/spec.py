@@ -14,7 +14,10 @@ from lvgym.errors import ConfigError, check_bool, check_choice, check_number
 from lvgym.simulator import MODELS
 
 WIND_TIERS = ("none", "profile", "gust", "turbulence", "random")
-RANDOMIZE = ("wind", "thrust_misalignment", "mass", "slosh_damping", "bending_frequency", "sensor_noise")
+#: protocol v0's randomisations (what ``randomize=True`` means)
+RANDOMIZE_V0 = ("wind", "thrust_misalignment", "mass", "slosh_damping", "bending_frequency", "sensor_noise")
+#: every randomisation by name (``lvgym.envs.functional.AscentFuncEnv.dispersions`` draws them)
+RANDOMIZE = RANDOMIZE_V0 + ("aerodynamics", "thrust_level", "slosh_mass", "slosh_frequency", "bending_damping")
 OBSERVATIONS = ("state", "sensors")
 REFERENCES = ("zero_rate", "gravity_turn")
 REFERENCE_VELOCITIES = ("inertial", "earth")
@@ -53,7 +56,7 @@ class TaskSpec:
     (truncation); control_dt_s / physics_dt_s: policy period and largest RK4 step; controller_on_after_s:
     the controller is off (gimbal held at zero) before this time and while no engine burns (staging coast);
     wind: a tier of ``WIND_TIERS``; randomize: the set of ``RANDOMIZE`` names drawn from the env's generator
-    at every reset; observation: ``state`` (ideal) or ``sensors`` (IMU at ``imu_station_m``);
+    at every reset (``True``: protocol v0's six, ``RANDOMIZE_V0``); observation: ``state`` (ideal) or ``sensors`` (IMU at ``imu_station_m``);
     reference: ``zero_rate`` or ``gravity_turn`` (pitch kick, then the rate that keeps the flight-path
     angle's turn); reference_velocity: the velocity whose angle from the vertical the gravity turn
     follows, ``inertial`` (v0) or ``earth`` (relative to the rotating Earth: at Andøya the inertial one
@@ -124,10 +127,10 @@ class TaskSpec:
         check_choice("control", self.control, CONTROLS)
         check_bool("coast_control", self.coast_control)
         r = self.randomize
-        names = set(RANDOMIZE) if r is True else set() if r in (False, None) else set(r) if not isinstance(r, str) else {r}
+        names = set(RANDOMIZE_V0) if r is True else set() if r in (False, None) else set(r) if not isinstance(r, str) else {r}
         bad = sorted(names - set(RANDOMIZE))
         if bad:
-            raise ConfigError("randomize", bad[0], f"True, False or a set of {RANDOMIZE}")
+            raise ConfigError("randomize", bad[0], f"True (the v0 set {RANDOMIZE_V0}), False or a set of {RANDOMIZE}")
         object.__setattr__(self, "randomize", frozenset(names))
         check_number("mission_time_s", self.mission_time_s, 0.0, 3600.0, lo_open=True)
         check_number("physics_dt_s", self.physics_dt_s, 0.0, 0.05, lo_open=True)

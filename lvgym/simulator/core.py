@@ -53,7 +53,7 @@ from . import data as simdata
 from .advance import StepSetup, advance_range, conditions_rows, constrain_k, slosh_angles_range
 from .data import SimData
 from .flight import flight_loads, pack_context, stack_contexts
-from .layouts import ACTUATOR, CONDITIONS, CONTEXT, RAIL, RAIL_STATE, RS
+from .layouts import ACTUATOR, CONDITIONS, CONTEXT, DISPERSION, RAIL, RAIL_STATE, RS
 from .servo import DIRECT, Servo
 from .timeline import MODELS, Timeline, build_timeline
 
@@ -226,25 +226,26 @@ class Simulator:
 
     def reset(self, batch: int = 1, rng: np.random.Generator | None = None, winds: Sequence[Any] | None = None,
               misalignment: np.ndarray | None = None, param_scale: np.ndarray | None = None,
-              param_offset: np.ndarray | None = None) -> None:
+              param_offset: np.ndarray | None = None, dispersion: np.ndarray | None = None) -> None:
         """Put ``batch`` vehicles on the pad at t = 0 (see :meth:`reset_rows` for the options)."""
         B = int(batch)
         if B < 1:
             raise ValueError(f"batch = {batch!r}: at least one vehicle")
         self.data = self.reset_rows(np.arange(B), rng, winds, misalignment, param_scale, param_offset,
-                                    data=self.new_data(B))
+                                    data=self.new_data(B), dispersion=dispersion)
 
     def reset_rows(self, rows: Any, rng: np.random.Generator | Sequence[np.random.Generator] | None = None,
                    winds: Sequence[Any] | None = None, misalignment: np.ndarray | None = None,
                    param_scale: np.ndarray | None = None, param_offset: np.ndarray | None = None,
-                   data: SimData | None = None) -> SimData:
+                   data: SimData | None = None, dispersion: np.ndarray | None = None) -> SimData:
         """Put the vehicles ``rows`` back on the pad at t = 0; the others are untouched.
 
         ``rng``: one generator, or one per row, for whatever is random (the wind models' ``reset``);
         ``winds``: one wind model (name, mapping or model) per row (default: the simulator's ``wind``);
         ``misalignment`` (R, 2) [rad] fixed thrust misalignment (pitch, yaw); ``param_scale`` /
         ``param_offset`` (R, n_p): a row flies ``timeline params * scale + offset`` (dispersions of mass,
-        CG, inertia, slosh damping, bending frequencies). ``data``: the rows to reset (default
+        CG, inertia, slosh damping, bending frequencies); ``dispersion`` (R, n) the rows' load dispersions
+        (layout :data:`.layouts.DISPERSION`; default neutral). ``data``: the rows to reset (default
         :attr:`data`, which is then updated); returns them (a new value when the context widened)."""
         own = data is None
         if own and self.batch == 0:
@@ -272,6 +273,9 @@ class Simulator:
         if misalignment is not None:
             CONTEXT.view(d.ctx[:, :CONTEXT.size], "misalignment")[rows] = np.broadcast_to(
                 np.asarray(misalignment, float), (R, 2))
+        if dispersion is not None:
+            CONTEXT.view(d.ctx[:, :CONTEXT.size], "dispersion")[rows] = np.broadcast_to(
+                np.asarray(dispersion, float), (R, DISPERSION.size))
         d.t[rows] = 0.0
         d.p[rows] = self.timeline.params_at(d.t[rows], d.scale[rows], d.offset[rows])
         d.x[rows] = self.layout.zeros_state(R)

@@ -23,6 +23,11 @@ undeformed engine frame (body axes) is set by the gimbal angles ``delta_p``, ``d
 fixed misalignment: ``e = (cos dp cos dy, -sin dy, sin dp cos dy)`` with ``dp = delta_p + mis_p`` and
 ``dy = delta_y + mis_y``, so that a positive ``delta_p`` pitches the nose up about ``+y_b`` and a positive
 ``delta_y`` yaws it about ``+z_b`` for an engine aft of the centre of gravity.
+
+Dispersions (the context's ``dispersion`` block, layout :data:`.layouts.DISPERSION`, neutral by default):
+the thrust times ``thrust_scale``; the aerodynamic axial force times ``axial_scale``; the normal force and
+the moment about the CG times ``normal_scale``, and the normal force moved ``cp_shift`` [m] towards the
+nose, which adds ``cp_shift e_x x f_normal`` to the moment.
 """
 
 from __future__ import annotations
@@ -43,7 +48,7 @@ from lvgym.environment.gravity import gravity_at, harmonics_work
 from lvgym.environment.wind import wind_ned_at
 from lvgym.rotations import quat_to_dcm
 
-from .layouts import AE, AERO, CONDITIONS, CONTEXT, CTX, TG, TRIG, D
+from .layouts import AE, AERO, CONDITIONS, CONTEXT, CTX, DISPERSION, DS, TG, TRIG, D
 
 XF, PF, UF = STATE.fixed, PARAMS.fixed, LOADS.fixed      # dynamics offsets independent of K and N
 N_COND = CONDITIONS.size
@@ -101,11 +106,19 @@ def flight_conditions_at(t, x, p, ctx, cond, oc, full):
         for i in range(3):
             cond[fa + i] = 0.0
             cond[ma + i] = 0.0
+    ds = CTX.dispersion
+    kn, dx = ctx[ds + DS.normal_scale], ctx[ds + DS.cp_shift]
+    if kn != 1.0 or dx != 0.0 or ctx[ds + DS.axial_scale] != 1.0:
+        fy, fz = kn * cond[fa + 1], kn * cond[fa + 2]
+        cond[fa] *= ctx[ds + DS.axial_scale]
+        cond[fa + 1], cond[fa + 2] = fy, fz
+        cond[ma + 1] = kn * cond[ma + 1] - dx * fz           # (dx e_x) x f_normal
+        cond[ma + 2] = kn * cond[ma + 2] + dx * fy
     for i in range(3):
         cond[oc + D.f_aero_i + i] = C[i, 0] * cond[fa] + C[i, 1] * cond[fa + 1] + C[i, 2] * cond[fa + 2]
     thrust = 0.0
     if ctx[CTX.thrust0] > 0.0:
-        thrust = max(ctx[CTX.thrust0] - ctx[CTX.exit_area] * pres, 0.0)
+        thrust = max(ctx[CTX.thrust0] - ctx[CTX.exit_area] * pres, 0.0) * ctx[ds + DS.thrust_scale]
     cond[oc + D.thrust] = thrust
     dp = ctx[CTX.gimbal] + ctx[CTX.misalignment]
     dy = ctx[CTX.gimbal + 1] + ctx[CTX.misalignment + 1]
@@ -186,6 +199,7 @@ def pack_context(site: np.ndarray, gravity: np.ndarray, atmosphere: np.ndarray, 
     trig = view("trig")                                        # the thrust angles' cache is empty
     trig[TRIG.index("pitch")] = trig[TRIG.index("yaw")] = np.nan
     view("aero_on")[:] = 0.0 if aero is None else 1.0
+    view("dispersion")[:] = DISPERSION.pack({"thrust_scale": 1.0, "normal_scale": 1.0, "axial_scale": 1.0})
     offset = CONTEXT.size
     for key, block in zip(("site", "gravity", "atmosphere", "wind"), blocks):
         view(key)[:] = offset

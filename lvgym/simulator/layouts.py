@@ -10,7 +10,7 @@ these layouts; the compiled functions read their offsets from the ``.at`` namedt
   offsets of the environment models' parameter blocks packed behind this header, a cache and scratch.
 - :data:`AERO` one aerodynamic block's offsets (the one in force is in the header; the table of
   contents holds one per stage).
-- :data:`TRIG` the thrust direction's cached angles.
+- :data:`TRIG` the thrust direction's cached angles; :data:`DISPERSION` a row's load dispersions.
 - :data:`CONDITIONS` (``cond``): the flight conditions of one state, what the recorder, the task and a
   policy see.
 - :data:`RAIL` the launch rail (one per simulator), :data:`RAIL_STATE` the row's motion along it.
@@ -23,7 +23,7 @@ from lvgym.environment.aerokernels import FLOW
 from lvgym.environment.atmosphere import AIR
 from lvgym.packing import Field, Packed
 
-__all__ = ["ACTUATOR", "AERO", "CONDITIONS", "CONTEXT", "RAIL", "RAIL_STATE", "SERVO", "TRIG",
+__all__ = ["ACTUATOR", "AERO", "CONDITIONS", "CONTEXT", "DISPERSION", "DS", "RAIL", "RAIL_STATE", "SERVO", "TRIG",
            "A", "CTX", "D", "RL", "RS", "SV", "TG", "AE"]
 
 #: flight conditions of one state at one time
@@ -61,6 +61,14 @@ TRIG = Packed("thrust angle cache", [
     Field("sin_yaw", 1, "-", ""),
 ])
 
+#: a row's dispersions of the loads (neutral: 1, 1, 1, 0), drawn at reset by the task
+DISPERSION = Packed("load dispersions", [
+    Field("thrust_scale", 1, "-", "factor on the thrust (the mass flow is the timeline's: an Isp dispersion)"),
+    Field("normal_scale", 1, "-", "factor on the aerodynamic normal force (y_b, z_b) and on the moment about the CG"),
+    Field("axial_scale", 1, "-", "factor on the aerodynamic axial force (x_b)"),
+    Field("cp_shift", 1, "m", "shift of the normal force's point of action along +x_b (towards the nose)"),
+])
+
 #: header of the per-row context; the models' parameter blocks follow it (their offsets are in it)
 CONTEXT = Packed("simulator context", [
     Field("gimbal", 2, "rad", "gimbal angles in force (pitch, yaw): the servo's position, held over a physics step"),
@@ -72,6 +80,7 @@ CONTEXT = Packed("simulator context", [
     Field("exit_area", 1, "m^2", "total nozzle exit area of the current piece"),
     Field("time0", 1, "s", "start time of the current piece: the stepper's time is relative to it"),
     Field("aero_on", 1, "-", "1: aerodynamic loads, 0: none (flow angles only)"),
+    Field("dispersion", DISPERSION.size, "-", "the row's load dispersions (layout DISPERSION)", sub=DISPERSION),
     Field("site", 1, "-", "offset of the launch site's block"),
     Field("gravity", 1, "-", "offset of the gravity model's block"),
     Field("atmosphere", 1, "-", "offset of the atmosphere model's block"),
@@ -125,13 +134,13 @@ ACTUATOR = Packed("actuator", [
 ])
 
 #: offsets for compiled code
-CTX, AE, TG, D = CONTEXT.at, AERO.at, TRIG.at, CONDITIONS.at
+CTX, AE, TG, D, DS = CONTEXT.at, AERO.at, TRIG.at, CONDITIONS.at, DISPERSION.at
 RL, RS, SV, A = RAIL.at, RAIL_STATE.at, SERVO.at, ACTUATOR.at
 
 
 def _doc() -> str:
     return "\n\n".join(f"``{lay.title}`` ({lay.size} entries):\n\n{lay.table()}" for lay in
-                       (CONTEXT, AERO, TRIG, CONDITIONS, RAIL, RAIL_STATE, SERVO, ACTUATOR))
+                       (CONTEXT, AERO, TRIG, DISPERSION, CONDITIONS, RAIL, RAIL_STATE, SERVO, ACTUATOR))
 
 
 __doc__ = (__doc__ or "") + "\n" + _doc()
