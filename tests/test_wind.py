@@ -358,3 +358,26 @@ def test_sum_is_reproduced_from_a_saved_generator_state():
     again.bit_generator.state = saved
     wind.reset(again)
     np.testing.assert_array_equal(wind.velocity_ned(np.array([1000.0, 5000.0]), 0.0), first)
+
+
+def test_random_gust_draws_within_its_ranges_and_is_the_gust_it_drew():
+    from lvgym.environment import make
+    from lvgym.environment.wind import GustWind
+    w = make("wind", {"model": "random_gust", "onset_m": [8000.0, 11500.0]})
+    seen = []
+    for seed in range(20):
+        w.reset(np.random.default_rng(seed))
+        d = w.drawn
+        assert 5.0 <= d["amplitude"] <= 15.0 and 30.0 <= d["length"] <= 300.0
+        assert 8000.0 <= d["onset"] <= 11500.0 and 0.0 <= d["direction_deg"] <= 360.0
+        np.testing.assert_array_equal(w.params, GustWind(shape="bump", **d).params)
+        # the bump peaks at the amplitude one ramp length above the onset and is gone two lengths above
+        peak = w.velocity_ned(d["onset"] + d["length"])
+        assert np.linalg.norm(peak) == pytest.approx(d["amplitude"], rel=1e-9)
+        assert np.linalg.norm(w.velocity_ned(d["onset"] + 2.0 * d["length"] + 1.0)) == pytest.approx(0.0, abs=1e-9)
+        seen.append(d["amplitude"])
+    assert len(set(seen)) == 20                                  # a new gust at every reset
+    w.reset(np.random.default_rng(3))
+    a = w.params.copy()
+    w.reset(np.random.default_rng(3))
+    np.testing.assert_array_equal(a, w.params)                  # seeded

@@ -395,6 +395,30 @@ class JetStreamWind(_Wind):
         self._params = self.profile.params
 
 
+@register("wind", "random_gust")
+class RandomGustWind(_Wind):
+    """A discrete 1-cosine gust (:class:`GustWind`, ``shape="bump"``, onset by altitude) whose amplitude
+    [m/s], length [m] (the ramp: half the gust's wavelength), direction it blows FROM [deg] and onset
+    altitude [m] are drawn uniformly from their ranges ``[low, high]`` at every ``reset``. Defaults:
+    ``amplitude`` (5, 15) m/s and ``length`` (30, 300) m, around the 9 m/s 1-cosine gust of 30-300 m that
+    NASA's terrestrial environment criteria add to a design wind profile; ``onset_m`` (1, 15) km, the
+    whole climb through the dense atmosphere (the max-q suite narrows it to the max-q altitude);
+    ``direction_deg`` (0, 360). ``drawn`` holds the last draw."""
+
+    def __init__(self, amplitude=(5.0, 15.0), length=(30.0, 300.0), direction_deg=(0.0, 360.0),
+                 onset_m=(1000.0, 15000.0)) -> None:
+        self.ranges = {"amplitude": _range("wind.amplitude", amplitude, 0.0, 100.0),
+                       "length": _range("wind.length", length, 1.0, 10000.0),
+                       "direction_deg": _range("wind.direction_deg", direction_deg, -360.0, 720.0),
+                       "onset": _range("wind.onset_m", onset_m, 0.0, 1e5)}
+        self.drawn: dict[str, float] = {}
+
+    def reset(self, rng: np.random.Generator) -> None:
+        super().reset(rng)
+        self.drawn = {k: float(rng.uniform(lo, hi)) for k, (lo, hi) in self.ranges.items()}
+        self._params = GustWind(shape="bump", **self.drawn).params
+
+
 @register("wind", "sum")
 class SumWind(_Wind):
     """Sum of several wind models, e.g. ``{"model": "sum", "models": ["jet_stream", "dryden"]}``.

@@ -13,7 +13,10 @@ from typing import Any
 from lvgym.errors import ConfigError, check_bool, check_choice, check_number
 from lvgym.simulator import MODELS
 
-WIND_TIERS = ("none", "profile", "gust", "turbulence", "random")
+#: protocol v0's wind tiers, then v1's
+WIND_TIERS = ("none", "profile", "gust", "turbulence", "random", "turbulence_gust", "maxq_gust")
+#: the onset altitudes [m] of the ``maxq_gust`` tier's gust: SMILE's max q is at 9.8 km (docs/vehicles.md)
+MAXQ_GUST_ONSET_M = (8000.0, 11500.0)
 #: protocol v0's randomisations (what ``randomize=True`` means)
 RANDOMIZE_V0 = ("wind", "thrust_misalignment", "mass", "slosh_damping", "bending_frequency", "sensor_noise")
 #: every randomisation by name (``lvgym.envs.functional.AscentFuncEnv.dispersions`` draws them)
@@ -29,7 +32,10 @@ def wind_spec(tier: str, mission_time: float) -> Any:
 
     ``profile``: a fixed 20 m/s west wind above a power-law boundary layer; ``gust``: a 15 m/s
     1-cosine gust 200 m long at 3 km; ``turbulence``: moderate Dryden turbulence (MIL-F-8785C) over a
-    10 m/s west wind; ``random``: a random jet-stream profile plus moderate Dryden turbulence."""
+    10 m/s west wind; ``random``: a random jet-stream profile plus moderate Dryden turbulence.
+    Protocol v1's: ``turbulence_gust``: ``turbulence`` plus a random 1-cosine gust (``random_gust``: 5-15 m/s,
+    30-300 m, from any direction, onset 1-15 km); ``maxq_gust``: a random jet-stream profile plus a random
+    gust whose onset lies in the max-q region (``MAXQ_GUST_ONSET_M``)."""
     profile = {"model": "profile", "altitude_m": [0.0, 1000.0, 10000.0, 100000.0],
                "speed": [5.0, 12.0, 20.0, 20.0], "direction_deg": [270.0, 270.0, 270.0, 270.0]}
     if tier == "none":
@@ -44,6 +50,11 @@ def wind_spec(tier: str, mission_time: float) -> Any:
                                            {"model": "dryden", "intensity": "moderate", "wind_from_deg": 270.0}]}
     if tier == "random":
         return {"model": "sum", "models": [{"model": "jet_stream"}, {"model": "dryden", "intensity": "moderate"}]}
+    if tier == "turbulence_gust":
+        return {"model": "sum", "models": [*wind_spec("turbulence", mission_time)["models"], {"model": "random_gust"}]}
+    if tier == "maxq_gust":
+        return {"model": "sum", "models": [{"model": "jet_stream"},
+                                           {"model": "random_gust", "onset_m": list(MAXQ_GUST_ONSET_M)}]}
     raise ConfigError("wind", tier, f"one of {WIND_TIERS}")
 
 
