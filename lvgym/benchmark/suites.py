@@ -25,6 +25,13 @@ slender-ld30       SlenderAscent-v0       L/D = 30 (8.5 m x 0.2833 m); turbulenc
                                           thrust misalignment and bending frequency dispersed
 =================  =====================  ==========================================================
 
+Protocol v1 (a draft, version ``v1-draft``, until issue 16 freezes it) adds, on ``SmileAscent-v1``:
+
+==================  ===============================================================================
+smile-v1            70 s, v0's turbulence plus a random 1-cosine gust, every dispersion (``V1_DISPERSIONS``)
+smile-v1-maxq-gust  35 s, a random jet stream plus a random gust in the max-q region, every dispersion
+==================  ===============================================================================
+
 ``slender-ld30`` is provisional: there is no slender baseline yet. SlenderAscent-v0 freezes the vehicle's
 aerodynamics at Mach 2 (the thesis's constant coefficients; with the full tables the vehicle turns
 statically unstable above Mach 3.85 and no policy survives). Dynamic pressure reaches 500-700 kPa, so
@@ -121,7 +128,7 @@ class Suite:
         if not options:
             return self
         conds = tuple(c.with_options(**options) for c in self.conditions)
-        return replace(self, conditions=conds, version=f"{PROTOCOL_VERSION}+override",
+        return replace(self, conditions=conds, version=f"{self.version}+override",
                        overrides=_freeze({**dict(self.overrides), **options}))
 
 
@@ -149,6 +156,27 @@ SUITES: dict[str, Suite] = {s.name: s for s in (
           _pair("slender-ld30", SLENDER, "turbulence", ("wind", "thrust_misalignment", "bending_frequency"),
                 length=8.5, diameter=0.2833)),
 )}
+
+
+#: protocol v1 while issue 16 builds it: results carry this version and are not protocol numbers until
+#: the version is frozen as ``v1``
+PROTOCOL_V1 = "v1-draft"
+SMILE_V1 = "lvgym/SmileAscent-v1"
+#: every randomisation of v1 (v0's and the Monte Carlo dispersions of docs/benchmark.md)
+V1_DISPERSIONS = ("wind", "thrust_misalignment", "mass", "slosh_damping", "bending_frequency", "sensor_noise",
+                  "aerodynamics", "thrust_level", "slosh_mass", "slosh_frequency", "bending_damping")
+
+#: the suites of protocol v1 (a draft: they may still change until the version is frozen)
+SUITES_V1: dict[str, Suite] = {s.name: s for s in (
+    Suite("smile-v1", "SMILE v1 (own upper-stage aerodynamics, staging at 1.8 kPa, coast control, one period of "
+          "delay), 70 s, turbulence and a random 1-cosine gust, every dispersion",
+          _pair("smile-v1", SMILE_V1, "turbulence_gust", V1_DISPERSIONS), version=PROTOCOL_V1),
+    Suite("smile-v1-maxq-gust", "SMILE v1 through max q, 35 s: a random jet stream and a random 1-cosine gust in "
+          "the max-q region (8-11.5 km), every dispersion",
+          _pair("smile-v1-maxq-gust", SMILE_V1, "maxq_gust", V1_DISPERSIONS, mission_time_s=35.0),
+          version=PROTOCOL_V1),
+)}
+SUITES.update(SUITES_V1)
 
 
 def get_suite(name: str) -> Suite:
