@@ -65,7 +65,8 @@ class TaskSpec:
     effort_weight per rad of gimbal per second, effort_rate_weight per rad/s of gimbal rate per second,
     failure_penalty_rad_per_s times the remaining mission time on termination; qalpha_limit_pa_deg:
     structural limit of dynamic pressure times total angle of attack; attitude_limit_deg: largest
-    attitude error; n_modes: bending modes per plane (None: the vehicle's).
+    attitude error; n_modes: bending modes per plane (None: the vehicle's); aeroelastic: the strip-theory
+    aeroelastic loads (True, False, None: the vehicle file's flag; False in v0).
     """
 
     vehicle: Any
@@ -104,6 +105,7 @@ class TaskSpec:
     gyro_bias_radps: float = 1e-3
     accel_noise_mps2: float = 0.05
     attitude_noise_rad: float = 1e-3
+    aeroelastic: bool | None = False
 
     def __post_init__(self) -> None:
         check_choice("model", self.model, MODELS)
@@ -145,6 +147,8 @@ class TaskSpec:
         if len(w) != 3 or any(not isinstance(v, (int, float)) or v < 0 for v in w):
             raise ConfigError("rate_weights", self.rate_weights, "three numbers >= 0 (roll, pitch, yaw) per rad")
         object.__setattr__(self, "rate_weights", tuple(float(v) for v in w))
+        if self.aeroelastic not in (None, True, False):
+            raise ConfigError("aeroelastic", self.aeroelastic, "True, False or None (the vehicle file's flag)")
         if self.n_modes is not None and (not isinstance(self.n_modes, int) or not 0 <= self.n_modes <= 10):
             raise ConfigError("n_modes", self.n_modes, "None or an integer in [0, 10]")
 
