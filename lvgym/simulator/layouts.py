@@ -82,10 +82,11 @@ AEROELASTIC = Packed("aeroelastic block", [
     Field("toc", 1, "-", "offset of the table of contents: one STRIPS row per stage"),
     Field("phi", 1, "-", "offset of the mode shapes at the strips (K, n) [1/sqrt(kg)] of the current piece"),
     Field("dphi", 1, "-", "offset of the mode slopes at the strips (K, n) [1/(m sqrt(kg))] of the current piece"),
-    Field("f_b", 1, "-", "offset of scratch: the elastic force increment (3) [N], body frame"),
-    Field("m_b", 1, "-", "offset of scratch: the elastic moment increment about the CG of B (3) [N m]"),
-    Field("f_eta", 1, "-", "offset of scratch: the generalised modal forces (2K) [sqrt(kg) m/s^2]"),
-    Field("df", 1, "-", "offset of scratch: the strip forces (n, 2) [N]"),
+    Field("f_eta", 1, "-", "offset of scratch: the generalised modal forces (2K) [sqrt(kg) m/s^2], up to df"),
+    Field("df", 1, "-", "offset of scratch: the strip forces (n, 2) [N], up to end"),
+    Field("end", 1, "-", "end of the aeroelastic blocks"),
+    Field("f_b", 3, "N", "scratch: the elastic force increment, body frame"),
+    Field("m_b", 3, "N m", "scratch: the elastic moment increment about the CG of B, body frame"),
     Field("strip", STRIPS.size, "-", "the strip block of the stage in force (layout STRIPS)", sub=STRIPS),
 ])
 

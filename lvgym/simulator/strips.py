@@ -100,10 +100,11 @@ def pack_strips(header: np.ndarray, offset: int, setup: StripSetup) -> list[np.n
     values = {"on": 1.0, "n_modes": K, "n_slosh": setup.n_slosh, "n_strip": n, "toc": offset}
     blocks.append(np.concatenate(toc))
     offset += blocks[-1].size
-    for name, size in (("phi", K * n), ("dphi", K * n), ("f_b", 3), ("m_b", 3), ("f_eta", 2 * K), ("df", 2 * n)):
+    for name, size in (("phi", K * n), ("dphi", K * n), ("f_eta", 2 * K), ("df", 2 * n)):
         values[name] = offset
         blocks.append(np.zeros(size))
         offset += size
+    values["end"] = offset
     for name, value in values.items():
         header[AEROELASTIC.index(name)] = value
     header[AEROELASTIC.slice("strip")] = toc[0]
@@ -141,14 +142,16 @@ def strip_loads_at(x, p_cg, ctx, cond, oc):
     ox, om = int(ctx[a + AEL.x_strip]), int(ctx[a + AEL.mach])
     n_m, oa = int(ctx[a + AEL.n_mach]), int(ctx[a + AEL.cna])
     op, od = int(ctx[a + AEL.phi]), int(ctx[a + AEL.dphi])
-    of, omb, oe, odf = int(ctx[a + AEL.f_b]), int(ctx[a + AEL.m_b]), int(ctx[a + AEL.f_eta]), int(ctx[a + AEL.df])
+    oe, odf, end = int(ctx[a + AEL.f_eta]), int(ctx[a + AEL.df]), int(ctx[a + AEL.end])
+    of, omb = a + AEL.f_b, a + AEL.m_b
+    n_eta = odf - oe                                      # 2K modal coordinates (y plane, then z)
     o_eta, o_etad = at(X.eta, K, N), at(X.eta_dot, K, N)
     ow, va = at(X.omega_bi_b, K, N), oc + D.v_air_b
     strip_loads_k(cond[va:va + 3], x[ow:ow + 3], cond[oc + D.density], cond[oc + D.speed_of_sound], p_cg,
                   ctx[ox:ox + n], ctx[om:om + n_m], ctx[oa:oa + n_m * n].reshape((n_m, n)),
                   ctx[a + AEL.s_ref], ctx[op:op + K * n].reshape((K, n)), ctx[od:od + K * n].reshape((K, n)),
-                  x[o_eta:o_eta + 2 * K], x[o_etad:o_etad + 2 * K], False, ctx[of:of + 3], ctx[omb:omb + 3],
-                  ctx[oe:oe + 2 * K], ctx[odf:odf + 2 * n].reshape((n, 2)))
+                  x[o_eta:o_eta + n_eta], x[o_etad:o_etad + n_eta], False, ctx[of:of + 3], ctx[omb:omb + 3],
+                  ctx[oe:odf], ctx[odf:end].reshape((n, 2)))
     for i in range(3):
         cond[oc + D.f_aero_b + i] += ctx[of + i]
         cond[oc + D.m_aero_b + i] += ctx[omb + i]
@@ -159,7 +162,7 @@ def strip_modal_forces_k(ctx, u):
     """The modal forces of the latest :func:`strip_loads_at` into the loads ``u`` (``f_eta``)."""
     a = CTX.aeroelastic
     K, N = int(ctx[a + AEL.n_modes]), int(ctx[a + AEL.n_slosh])
-    o, oe = at(U.f_eta, K, N), int(ctx[a + AEL.f_eta])
-    for k in range(2 * K):
+    o, oe, odf = at(U.f_eta, K, N), int(ctx[a + AEL.f_eta]), int(ctx[a + AEL.df])
+    for k in range(odf - oe):
         u[o + k] = ctx[oe + k]
 
