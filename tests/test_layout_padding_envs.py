@@ -51,6 +51,9 @@ def fly_all() -> dict[str, np.ndarray]:
     slender = gym.make("lvgym/SlenderAscent-v0", model="nonrigid", wind="turbulence", randomize=True,
                        mission_time_s=1.5)
     run("slender", slender, smile_scheduled_pid(slender, "smile"), 100)
+    flexible = gym.make("lvgym/SlenderAscent-v0", model="nonrigid", wind="turbulence", mission_time_s=1.0,
+                        aeroelastic=True)
+    run("slender_aeroelastic", flexible, smile_scheduled_pid(flexible, "smile"), 50)
     venv = gym.make_vec("lvgym/SmileAscent-v0", num_envs=3, vectorization_mode="vector_entry_point",
                         model="flex", wind="random", randomize=True, mission_time_s=1.0)
     obs, _ = venv.reset(seed=2)

@@ -84,7 +84,8 @@ class TaskSpec:
     (:mod:`.coast`: a proportional-derivative law on the attitude error and the body rates of bandwidth
     ``coast_bandwidth_radps`` [rad/s], each of pitch and yaw limited to ``coast_torque_nm`` [N m]);
     settling_thrust_n: axial thrust [N] of ullage motors along +x_b through the same coasts, so that the
-    propellant stays settled against the drag (0: none).
+    propellant stays settled against the drag (0: none); aeroelastic: the strip-theory
+    aeroelastic loads (True, False, None: the vehicle file's flag; False in v0).
     """
 
     vehicle: Any
@@ -127,6 +128,7 @@ class TaskSpec:
     gyro_bias_radps: float = 1e-3
     accel_noise_mps2: float = 0.05
     attitude_noise_rad: float = 1e-3
+    aeroelastic: bool | None = False
 
     def __post_init__(self) -> None:
         check_choice("model", self.model, MODELS)
@@ -170,6 +172,8 @@ class TaskSpec:
         if len(w) != 3 or any(not isinstance(v, (int, float)) or v < 0 for v in w):
             raise ConfigError("rate_weights", self.rate_weights, "three numbers >= 0 (roll, pitch, yaw) per rad")
         object.__setattr__(self, "rate_weights", tuple(float(v) for v in w))
+        if self.aeroelastic not in (None, True, False):
+            raise ConfigError("aeroelastic", self.aeroelastic, "True, False or None (the vehicle file's flag)")
         if self.n_modes is not None and (not isinstance(self.n_modes, int) or not 0 <= self.n_modes <= 10):
             raise ConfigError("n_modes", self.n_modes, "None or an integer in [0, 10]")
 

@@ -1,14 +1,14 @@
 """Simulator layer: the vehicle, its environment and the dynamics core flown together (no rewards, no
 spaces). :class:`Simulator` steps a batch whose state is one :class:`SimData` value; :class:`Timeline`
-tabulates the mass model and modes; :mod:`.flight` holds the compiled loads; :mod:`.layouts` describes
+tabulates the mass model and modes; :mod:`.flight` holds the compiled loads (:mod:`.strips` their aeroelastic part); :mod:`.layouts` describes
 every packed vector; :mod:`.record` records, saves and plots trajectories."""
 
-from .core import SITES, Kernel, Simulator
+from .core import SITES, Kernel, Simulator, aeroelastic_strips
 from .data import SimData
 from .flight import flight_conditions_batch, flight_loads, pack_context
 from .layouts import CONDITIONS, CONTEXT
 from .record import Recorder, fly, load
 from .timeline import MODELS, Tables, Timeline, build_timeline
 
-__all__ = ["CONDITIONS", "CONTEXT", "Kernel", "MODELS", "Recorder", "SITES", "SimData", "Simulator", "Tables",
+__all__ = ["CONDITIONS", "aeroelastic_strips", "CONTEXT", "Kernel", "MODELS", "Recorder", "SITES", "SimData", "Simulator", "Tables",
            "Timeline", "build_timeline", "fly", "flight_conditions_batch", "flight_loads", "load", "pack_context"]

@@ -34,9 +34,10 @@ from lvgym.packing import at
 from lvgym.rotations import quat_to_dcm
 
 from .flight import PF, XF, flight_conditions_k, select_aero_k
-from .layouts import CTX, RL, RS, A
+from .layouts import AEL, CTX, RL, RS, A
+from .strips import strip_modes_k
 from .servo import servo_step_k
-from .timeline import held_k, interp_k, params_k
+from .timeline import held_k, interp_k, locate_k, params_k
 
 #: constants of a simulator's step: ``rail`` (layout RAIL), ``servo`` (layout SERVO), ``physics_dt`` [s]
 #: the largest RK4 step, ``n_slosh`` and ``n_modes`` of the dynamics model, ``n_u`` its loads' length
@@ -104,10 +105,14 @@ def constrain_k(x, t, rail, x_cg0, x_cg, rs):
 
 @nb.njit(cache=True, nogil=True, inline="always")
 def _piece_thrust_k(ctx, tables, t):
-    """Thrust ``T_0``, exit area and aerodynamic block of the timeline at time ``t`` into the context."""
+    """Thrust ``T_0``, exit area, aerodynamic block (and the mode shapes at the aeroelastic strips) of the
+    timeline at time ``t`` into the context."""
     ctx[CTX.thrust0] = interp_k(tables.t, tables.thrust0, t)
     ctx[CTX.exit_area] = interp_k(tables.t, tables.exit_area, t)
     select_aero_k(ctx, held_k(tables.t, tables.stage, t))
+    if ctx[CTX.aeroelastic + AEL.on] != 0.0:
+        i, w = locate_k(tables.t, t)
+        strip_modes_k(ctx, tables.phi_strip, tables.dphi_strip, i + 1 if w >= 1.0 else i)
 
 
 @nb.njit(cache=True, nogil=True)

@@ -27,7 +27,7 @@ from lvgym import packing
 __all__ = ["cache_dir", "cached", "key"]
 
 _ARRAYS = ("t", "params", "hold", "thrust0", "exit_area", "mass", "cg", "inertia", "slosh_mass", "burning", "stage",
-           "sensor_stations", "phi_sensor", "dphi_sensor")
+           "sensor_stations", "phi_sensor", "dphi_sensor", "strip_stations", "phi_strip", "dphi_strip")
 
 
 def cache_dir() -> Path | None:

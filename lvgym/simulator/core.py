@@ -54,6 +54,7 @@ from .advance import StepSetup, advance_range, conditions_rows, constrain_k, slo
 from .data import SimData
 from .flight import flight_loads, pack_context, stack_contexts
 from .layouts import ACTUATOR, CONDITIONS, CONTEXT, DISPERSION, RAIL, RAIL_STATE, RS
+from .strips import StripSetup, strip_models, strip_stations
 from .servo import DIRECT, Servo
 from .timeline import MODELS, Timeline, build_timeline
 
@@ -103,6 +104,30 @@ SITES = {
 }
 
 
+def stage_aerodynamics(vehicle: Vehicle, aerodynamics: Any = "vehicle") -> list[Any]:
+    """The aerodynamic model of each stage (in force while it is the lowest attached one; all None
+    without aerodynamics): ``"vehicle"`` gives the vehicle file's ``aerodynamics`` and each stage's own
+    where it has one, else the stack's before it; a name, mapping or model flies the whole flight."""
+    from_vehicle = isinstance(aerodynamics, str) and aerodynamics == "vehicle"
+    if from_vehicle:
+        aerodynamics = vehicle.aerodynamics or None
+    first = make("aerodynamics", aerodynamics) if isinstance(aerodynamics, (str, dict)) else aerodynamics
+    out = [first]
+    for stage in vehicle.stages[1:]:
+        own = stage.aerodynamics if from_vehicle and first is not None else None
+        out.append(make("aerodynamics", own) if own else out[-1])
+    return out
+
+
+def aeroelastic_strips(vehicle: Vehicle, aerodynamics: Any = "vehicle", aeroelastic: bool | None = None
+                       ) -> np.ndarray | None:
+    """The strip stations (n_stages, n) [m] a timeline needs for a simulator of ``vehicle`` with these
+    options (None: no aeroelastic loads), for :func:`.timeline.build_timeline`'s ``strip_stations``."""
+    on = vehicle.structure.aeroelastic if aeroelastic is None else aeroelastic
+    stages = stage_aerodynamics(vehicle, aerodynamics) if on else [None]
+    return None if stages[0] is None else strip_stations(strip_models(stages))
+
+
 def dcm_batch(q: np.ndarray) -> np.ndarray:
     """``C_ib`` (B, 3, 3) of the quaternions ``q_bi`` (B, 4)."""
     out = np.empty((q.shape[0], 3, 3))
@@ -127,7 +152,11 @@ class Simulator:
     n_modes: bending modes per plane (default: the vehicle file's; modes above the Nyquist frequency of
         the RK4 step, ``1 / (2 physics_dt)``, are decoupled, see :func:`.timeline.build_timeline`);
         sensor_stations [m]: where the mode slopes are tabulated (an IMU); cg_convention: ``static`` or
-        ``thesis``; timeline_dt [s]; timeline: a prebuilt :class:`Timeline` to share between simulators.
+        ``thesis``; timeline_dt [s]; timeline: a prebuilt :class:`Timeline` to share between simulators
+        (with the aeroelastic loads on, built with :func:`aeroelastic_strips`' stations).
+    aeroelastic: the strip-theory aeroelastic loads (:mod:`.strips`): True, False or None (the vehicle
+        file's ``structure.aeroelastic``). They act only on a model with bending modes and aerodynamics;
+        the v0 envs pass False.
     """
 
     def __init__(self, vehicle: str | Vehicle = "smile", model: str = "nonrigid", *, site: Any = "andoya",
@@ -135,7 +164,7 @@ class Simulator:
                  t_end: float = 60.0, physics_dt: float = 0.01, elevation_deg: float = 90.0, rail_length: float = 0.0,
                  n_modes: int | None = None, sensor_stations: Sequence[float] = (), cg_convention: str = "static",
                  timeline_dt: float = 0.05, timeline: Timeline | None = None, servo: Servo | None = None,
-                 threads: int | None = None) -> None:
+                 threads: int | None = None, aeroelastic: bool | None = None) -> None:
         if model not in MODELS:
             raise ValueError(f"model = {model!r}: one of {MODELS}")
         if not 0.0 < physics_dt <= 0.1:
@@ -154,26 +183,30 @@ class Simulator:
         self.gravity = make("gravity", gravity) if isinstance(gravity, (str, dict)) else gravity
         self.atmosphere = make("atmosphere", atmosphere) if isinstance(atmosphere, (str, dict)) else atmosphere
         self.wind = wind
-        from_vehicle = isinstance(aerodynamics, str) and aerodynamics == "vehicle"
-        if from_vehicle:
-            aerodynamics = self.vehicle.aerodynamics or None
-        self.aerodynamics = (make("aerodynamics", aerodynamics) if isinstance(aerodynamics, (str, dict))
-                             else aerodynamics)
-        # per stage (the lowest attached one): the stage's own ``aerodynamics`` from the vehicle file
-        # when there is one, else the stack's before it
-        self.stage_aerodynamics = [self.aerodynamics]
-        for stage in self.vehicle.stages[1:]:
-            own = stage.aerodynamics if from_vehicle and self.aerodynamics is not None else None
-            self.stage_aerodynamics.append(make("aerodynamics", own) if own else self.stage_aerodynamics[-1])
+        self.stage_aerodynamics = stage_aerodynamics(self.vehicle, aerodynamics)
+        self.aerodynamics = self.stage_aerodynamics[0]
+        if aeroelastic not in (None, True, False):
+            raise ValueError(f"aeroelastic = {aeroelastic!r}: True, False or None (the vehicle file's)")
+        self.aeroelastic = bool(self.vehicle.structure.aeroelastic if aeroelastic is None else aeroelastic)
+        strips = (strip_models(self.stage_aerodynamics) if self.aeroelastic and self.aerodynamics is not None
+                  else None)
+        stations = None if strips is None else strip_stations(strips)
         self.physics_dt = float(physics_dt)
         self.elevation = math.radians(elevation_deg)
         self.rail_length = float(rail_length)
         self.mass_model = MassModel(self.vehicle, cg_convention)
         self.timeline = timeline if timeline is not None else build_timeline(
-            self.mass_model, model, t_end, timeline_dt, n_modes, sensor_stations, 0.5 / physics_dt)
+            self.mass_model, model, t_end, timeline_dt, n_modes, sensor_stations, 0.5 / physics_dt,
+            strip_stations=stations)
         if timeline is not None and timeline.model != model:
             raise ValueError(f"the timeline flies model {timeline.model!r}, not {model!r}")
         self.dynamics = self.timeline.dynamics
+        K = self.dynamics.n_modes
+        if stations is not None and K > 0 and not np.array_equal(self.timeline.strip_stations, stations):
+            raise ValueError("the timeline has no mode shapes at the aeroelastic strips: build it with "
+                             "strip_stations=aeroelastic_strips(...) or pass aeroelastic=False")
+        #: the strip models in force (one per stage), or None: no aeroelastic loads
+        self.strips = None if strips is None or K == 0 else StripSetup(strips, K, self.dynamics.n_slosh)
         self.layout = self.dynamics.layout
         self._i_cg = self.layout.params["r_cg"].start
         self._i_slosh_m = [self.layout.slosh_param(j, "m").start for j in range(self.dynamics.n_slosh)]
@@ -264,7 +297,7 @@ class Simulator:
             args = {id(m): m.kernel_args() for m in self.stage_aerodynamics}
             aero = [args[id(m)] for m in self.stage_aerodynamics]
         ctx = [pack_context(self.site.params, self.gravity.params, self.atmosphere.params,
-                            self._wind_params(w, g), aero) for w, g in zip(winds, rngs)]
+                            self._wind_params(w, g), aero, self.strips) for w, g in zip(winds, rngs)]
         d = simdata.widen(d, max(r.size for r in ctx))
         d.ctx[rows] = stack_contexts(ctx + [np.zeros(d.ctx.shape[1])])[:R]
         n_p = self.layout.n_p

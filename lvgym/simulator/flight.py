@@ -14,8 +14,12 @@ different times), the aerodynamic block in force (``aero``, chosen per stage fro
 :func:`select_aero_k`), a scratch block the compiled functions write into (so that an evaluation
 allocates nothing; each row is only ever evaluated by one thread at a time), followed by the parameter
 arrays of the launch site, gravity, atmosphere, wind and aerodynamic models, packed end to end with their
-start offsets in the header (rows of a batch may have different wind blocks; shorter rows are padded).
-:func:`pack_context` builds it.
+start offsets in the header (rows of a batch may have different wind blocks; shorter rows are padded),
+and, with the aeroelastic strip loads on, their blocks (:mod:`.strips`). :func:`pack_context` builds it.
+
+Aeroelastic loads (:mod:`.strips`, off unless the context's ``aeroelastic.on`` is set): the strips'
+elastic force and moment are added to the table's (so the conditions hold them too) and their modal
+forces are the core's ``f_eta``; without them ``f_eta`` is zero.
 
 Thrust: ``T = max(T_0 - A_e p_amb, 0)`` with ``T_0`` and the total nozzle exit area ``A_e`` [m^2] from the
 mass model's timeline and ``p_amb`` the ambient pressure at the stage's altitude. Its direction in the
@@ -48,7 +52,8 @@ from lvgym.environment.gravity import gravity_at, harmonics_work
 from lvgym.environment.wind import wind_ned_at
 from lvgym.rotations import quat_to_dcm
 
-from .layouts import AE, AERO, CONDITIONS, CONTEXT, CTX, DISPERSION, DS, TG, TRIG, D
+from .layouts import AE, AEL, AERO, CONDITIONS, CONTEXT, CTX, DISPERSION, DS, TG, TRIG, D
+from .strips import pack_strips, strip_loads_at, strip_modal_forces_k, strip_stage_k
 
 XF, PF, UF = STATE.fixed, PARAMS.fixed, LOADS.fixed      # dynamics offsets independent of K and N
 N_COND = CONDITIONS.size
@@ -114,6 +119,8 @@ def flight_conditions_at(t, x, p, ctx, cond, oc, full):
         cond[fa + 1], cond[fa + 2] = fy, fz
         cond[ma + 1] = kn * cond[ma + 1] - dx * fz           # (dx e_x) x f_normal
         cond[ma + 2] = kn * cond[ma + 2] + dx * fy
+    if ctx[CTX.aeroelastic + AEL.on] != 0.0:
+        strip_loads_at(x, p[PF.r_cg], ctx, cond, oc)
     for i in range(3):
         cond[oc + D.f_aero_i + i] = C[i, 0] * cond[fa] + C[i, 1] * cond[fa + 1] + C[i, 2] * cond[fa + 2]
     thrust = 0.0
@@ -141,7 +148,8 @@ def flight_conditions_k(t, x, p, ctx, cond):
 def _flight_loads(t, x, p, ctx, u):
     """Loads of the dynamics core from the flight conditions: aerodynamic force (inertial) plus the
     commanded body force ``force_b`` turned to inertial axes, aerodynamic plus commanded moment about the
-    CG, thrust in the engine frame, gravity; no generalised modal forces."""
+    CG, thrust in the engine frame, gravity; generalised modal forces from the aeroelastic strips when
+    they are on, else none."""
     flight_conditions_at(ctx[CTX.time0] + t, x, p, ctx, ctx, CTX.scratch, False)
     sc = CTX.scratch
     for i in range(3):
@@ -156,6 +164,8 @@ def _flight_loads(t, x, p, ctx, u):
             u[UF.f_b_i + i] += C[i, 0] * ctx[fb] + C[i, 1] * ctx[fb + 1] + C[i, 2] * ctx[fb + 2]
     for i in range(UF.f_eta, u.size):
         u[i] = 0.0
+    if ctx[CTX.aeroelastic + AEL.on] != 0.0:
+        strip_modal_forces_k(ctx, u)
 
 
 flight_loads = compile_loads(_flight_loads)
@@ -179,16 +189,19 @@ def select_aero_k(ctx, stage):
     o = int(ctx[CTX.toc]) + AERO_SIZE * s
     for i in range(AERO_SIZE):
         ctx[CTX.aero + i] = ctx[o + i]
+    if ctx[CTX.aeroelastic + AEL.on] != 0.0:
+        strip_stage_k(ctx, s)
     ctx[CTX.stage] = s
 
 
 def pack_context(site: np.ndarray, gravity: np.ndarray, atmosphere: np.ndarray, wind: np.ndarray,
-                 aero: Any) -> np.ndarray:
+                 aero: Any, strips: Any = None) -> np.ndarray:
     """Context vector of one vehicle from the models' parameter arrays; commands are zero.
 
     ``aero``: None (no aerodynamic loads), one model's ``kernel_args()``, or a list of them, one per
     stage: entry ``s`` is in force while stage ``s`` is the lowest attached one (the same tuple object
-    given for several stages is packed once). Stage 0's block is in force at first."""
+    given for several stages is packed once). Stage 0's block is in force at first. ``strips``: None
+    (no aeroelastic loads) or a :data:`.strips.StripSetup` (one strip model per stage)."""
     per_stage = [None] if aero is None else (list(aero) if isinstance(aero, list) else [aero])
     blocks = [np.asarray(site, float), np.asarray(gravity, float), np.asarray(atmosphere, float),
               np.asarray(wind, float)]
@@ -228,6 +241,8 @@ def pack_context(site: np.ndarray, gravity: np.ndarray, atmosphere: np.ndarray, 
     offset += blocks[-1].size
     view("gravity_work")[:] = offset
     blocks.append(np.zeros(harmonics_work(blocks[1])))
+    if strips is not None:
+        blocks += pack_strips(view("aeroelastic"), offset + blocks[-1].size, strips)
     view("aero")[:] = toc[0]
     view("stage")[:] = 0.0
     return np.concatenate([header, *blocks])

@@ -11,6 +11,9 @@ these layouts; the compiled functions read their offsets from the ``.at`` namedt
 - :data:`AERO` one aerodynamic block's offsets (the one in force is in the header; the table of
   contents holds one per stage).
 - :data:`TRIG` the thrust direction's cached angles; :data:`DISPERSION` a row's load dispersions.
+- :data:`AEROELASTIC` the strip-theory aeroelastic loads' block in the header (:mod:`.strips`): sizes,
+  offsets of the mode shapes at the strips and of the loads' scratch, and the :data:`STRIPS` block of the
+  stage in force (the table of contents holds one per stage).
 - :data:`CONDITIONS` (``cond``): the flight conditions of one state, what the recorder, the task and a
   policy see.
 - :data:`RAIL` the launch rail (one per simulator), :data:`RAIL_STATE` the row's motion along it.
@@ -23,8 +26,8 @@ from lvgym.environment.aerokernels import FLOW
 from lvgym.environment.atmosphere import AIR
 from lvgym.packing import Field, Packed
 
-__all__ = ["ACTUATOR", "AERO", "CONDITIONS", "CONTEXT", "DISPERSION", "DS", "RAIL", "RAIL_STATE", "SERVO", "TRIG",
-           "A", "CTX", "D", "RL", "RS", "SV", "TG", "AE"]
+__all__ = ["ACTUATOR", "AERO", "AEROELASTIC", "CONDITIONS", "CONTEXT", "DISPERSION", "RAIL", "RAIL_STATE", "SERVO",
+           "STRIPS", "TRIG", "A", "AEL", "CTX", "D", "DS", "RL", "RS", "SV", "TG", "AE", "STR"]
 
 #: flight conditions of one state at one time
 CONDITIONS = Packed("flight conditions", [
@@ -69,6 +72,32 @@ DISPERSION = Packed("load dispersions", [
     Field("cp_shift", 1, "m", "shift of the normal force's point of action along +x_b (towards the nose)"),
 ])
 
+#: one stage's strips (entries are indices into ``ctx``, but ``s_ref``)
+STRIPS = Packed("strip block", [
+    Field("x_strip", 1, "-", "offset of the strip stations (n) [m]"),
+    Field("mach", 1, "-", "offset of the Mach grid of the CN-alpha table (n_mach)"),
+    Field("n_mach", 1, "-", "Mach numbers of the grid"),
+    Field("cna", 1, "-", "offset of the strips' CN-alpha shares (n_mach, n) [1/rad], row major"),
+    Field("s_ref", 1, "m^2", "reference area of the shares"),
+])
+
+#: the aeroelastic strip loads of a row: sizes, offsets of the per-piece mode shapes and the scratch
+AEROELASTIC = Packed("aeroelastic block", [
+    Field("on", 1, "-", "1: strip-theory elastic loads and modal forces added to the table aerodynamics"),
+    Field("n_modes", 1, "-", "bending modes per plane K of the dynamics layout"),
+    Field("n_slosh", 1, "-", "slosh pendulums N of the dynamics layout"),
+    Field("n_strip", 1, "-", "strips n (the same for every stage)"),
+    Field("toc", 1, "-", "offset of the table of contents: one STRIPS row per stage"),
+    Field("phi", 1, "-", "offset of the mode shapes at the strips (K, n) [1/sqrt(kg)] of the current piece"),
+    Field("dphi", 1, "-", "offset of the mode slopes at the strips (K, n) [1/(m sqrt(kg))] of the current piece"),
+    Field("f_eta", 1, "-", "offset of scratch: the generalised modal forces (2K) [sqrt(kg) m/s^2], up to df"),
+    Field("df", 1, "-", "offset of scratch: the strip forces (n, 2) [N], up to end"),
+    Field("end", 1, "-", "end of the aeroelastic blocks"),
+    Field("f_b", 3, "N", "scratch: the elastic force increment, body frame"),
+    Field("m_b", 3, "N m", "scratch: the elastic moment increment about the CG of B, body frame"),
+    Field("strip", STRIPS.size, "-", "the strip block of the stage in force (layout STRIPS)", sub=STRIPS),
+])
+
 #: header of the per-row context; the models' parameter blocks follow it (their offsets are in it)
 CONTEXT = Packed("simulator context", [
     Field("gimbal", 2, "rad", "gimbal angles in force (pitch, yaw): the servo's position, held over a physics step"),
@@ -92,6 +121,7 @@ CONTEXT = Packed("simulator context", [
     Field("toc", 1, "-", "offset of the table of contents: one AERO row per stage"),
     Field("gravity_work", 1, "-", "offset of the gravity kernel's scratch block"),
     Field("trig", TRIG.size, "-", "thrust angle cache (layout TRIG)"),
+    Field("aeroelastic", AEROELASTIC.size, "-", "strip-theory aeroelastic loads (layout AEROELASTIC)"),
     Field("scratch", CONDITIONS.size, "-", "flight conditions of the latest RK4 stage (layout CONDITIONS)"),
     Field("scratch_dcm", 9, "-", "a 3x3 matrix of scratch"),
 ])
@@ -135,12 +165,14 @@ ACTUATOR = Packed("actuator", [
 
 #: offsets for compiled code
 CTX, AE, TG, D, DS = CONTEXT.at, AERO.at, TRIG.at, CONDITIONS.at, DISPERSION.at
+AEL, STR = AEROELASTIC.at, STRIPS.at
 RL, RS, SV, A = RAIL.at, RAIL_STATE.at, SERVO.at, ACTUATOR.at
 
 
 def _doc() -> str:
     return "\n\n".join(f"``{lay.title}`` ({lay.size} entries):\n\n{lay.table()}" for lay in
-                       (CONTEXT, AERO, TRIG, DISPERSION, CONDITIONS, RAIL, RAIL_STATE, SERVO, ACTUATOR))
+                       (CONTEXT, AERO, TRIG, DISPERSION, AEROELASTIC, STRIPS, CONDITIONS, RAIL, RAIL_STATE, SERVO,
+                        ACTUATOR))
 
 
 __doc__ = (__doc__ or "") + "\n" + _doc()

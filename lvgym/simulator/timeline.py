@@ -29,6 +29,7 @@ import numba as nb
 import numpy as np
 
 from lvgym.dynamics import NonRigidModel
+from lvgym.environment.aeroelastic import resample_modes
 from lvgym.vehicle import MassModel
 from lvgym.vehicle.massmodel import BURNING, SEPARATED
 from lvgym.vehicle.structure import ModeSchedule
@@ -47,7 +48,9 @@ class Timeline:
     [m], ``inertia`` (n, 3, 3) [kg m^2] of the whole stack; ``slosh_mass`` (n, N) [kg];
     ``burning`` (n,) any engine burning; ``stage`` (n,) index of the lowest attached stage;
     ``phi_sensor`` (n, S, K) mode shapes and ``dphi_sensor`` (n, S, K) slopes at the sensor stations
-    ``sensor_stations`` (S,) [m];
+    ``sensor_stations`` (S,) [m]; ``strip_stations`` (n_stages, n) [m] the aeroelastic strips of each
+    stage (n = 0: none) with ``phi_strip`` (n, K, n_strip) mode shapes and ``dphi_strip`` slopes at the
+    strips of the row's lowest attached stage (linear between the beam's nodes);
     ``events`` ((time, description), ...)."""
 
     model: str
@@ -68,6 +71,9 @@ class Timeline:
     sensor_stations: np.ndarray
     phi_sensor: np.ndarray
     dphi_sensor: np.ndarray
+    strip_stations: np.ndarray
+    phi_strip: np.ndarray
+    dphi_strip: np.ndarray
     events: tuple[tuple[float, str], ...]
 
     @property
@@ -122,15 +128,18 @@ class Timeline:
                       burning=np.ascontiguousarray(self.burning, dtype=float),
                       mass=np.ascontiguousarray(self.mass, dtype=float),
                       dphi_sensor=np.ascontiguousarray(self.dphi_sensor, dtype=float),
+                      phi_strip=np.ascontiguousarray(self.phi_strip, dtype=float),
+                      dphi_strip=np.ascontiguousarray(self.dphi_strip, dtype=float),
                       event_times=np.ascontiguousarray(self.event_times, dtype=float))
 
 
 #: the timeline's columns as compiled code reads them: ``t`` (n,) [s] rows; ``params`` (n, n_p);
 #: ``hold`` (n_p,) bool; ``thrust0`` (n,) [N]; ``exit_area`` (n,) [m^2]; ``stage`` (n,) lowest attached
 #: stage; ``burning`` (n,) 1 while an engine burns; ``mass`` (n,) [kg]; ``dphi_sensor`` (n, S, K)
-#: [1/(m sqrt(kg))]; ``event_times`` (E,) [s], each once
+#: [1/(m sqrt(kg))]; ``phi_strip``, ``dphi_strip`` (n, K, n_strip) at the aeroelastic strips;
+#: ``event_times`` (E,) [s], each once
 Tables = namedtuple("Tables", ["t", "params", "hold", "thrust0", "exit_area", "stage", "burning", "mass",
-                               "dphi_sensor", "event_times"])
+                               "dphi_sensor", "phi_strip", "dphi_strip", "event_times"])
 
 
 # ---------------------------------------------------------------------------- compiled look-ups (the only ones)
@@ -194,9 +203,14 @@ def params_rows(tl_t, tl_p, hold, scale, offset, t, out):
         params_k(tl_t, tl_p, hold, scale[b], offset[b], t[b], out[b])
 
 
+def _kept(modes, cutoff_hz: float) -> np.ndarray:
+    """Which modes are at or below ``cutoff_hz`` (the others are decoupled)."""
+    return modes.omega <= 2.0 * np.pi * cutoff_hz
+
+
 def _cut(modes, cutoff_hz: float):
     """The modes with those above ``cutoff_hz`` decoupled."""
-    keep = modes.omega <= 2.0 * np.pi * cutoff_hz
+    keep = _kept(modes, cutoff_hz)
     if keep.all():
         return modes
     return replace(modes, phi_gimbal=modes.phi_gimbal * keep, dphi_gimbal=modes.dphi_gimbal * keep,
@@ -221,7 +235,7 @@ def _grid(mm: MassModel, t_end: float, dt: float) -> tuple[list[float], list[tup
 
 def build_timeline(mass_model: MassModel, model: str, t_end: float, dt: float = 0.05,
                    n_modes: int | None = None, sensor_stations=(), mode_cutoff_hz: float = np.inf,
-                   cache: bool = True) -> Timeline:
+                   cache: bool = True, strip_stations=None) -> Timeline:
     """Tabulate ``mass_model``'s vehicle from lift-off to ``t_end`` [s] for the dynamics ``model``
     (one of ``MODELS``) every ``dt`` [s] (and at every event and thrust-table breakpoint), with
     ``n_modes`` bending modes per plane (default: the vehicle file's; 0 for rigid and slosh) and
@@ -232,6 +246,11 @@ def build_timeline(mass_model: MassModel, model: str, t_end: float, dt: float = 
     step, ``1 / (2 physics_dt)``: a stiff upper stage's 200 Hz mode coupled to its slosh masses makes
     a 10 ms RK4 step diverge, and no load sampled at that step could excite it faithfully.
 
+    ``strip_stations`` (n_stages, n) [m]: the aeroelastic strips of each stage (:mod:`.strips`; None:
+    none); each row tabulates the mode shapes and slopes at the strips of its lowest attached stage,
+    interpolated linearly between the beam's nodes (the strips are not added to the beam's mesh, so the
+    modes are those of a timeline without strips), decoupled modes zero.
+
     ``cache``: look the timeline up in the on-disk cache first and store it there (:mod:`.cache`: keyed by
     the vehicle's whole content, these arguments and the source of the code that builds it)."""
     if model not in MODELS:
@@ -240,13 +259,17 @@ def build_timeline(mass_model: MassModel, model: str, t_end: float, dt: float = 
         raise ValueError(f"t_end = {t_end!r} and dt = {dt!r} must be > 0 s")
     if cache:
         from .cache import cached
+        strips_key = None if strip_stations is None else np.asarray(strip_stations, float).tolist()
         return cached(mass_model, (model, float(t_end), float(dt), n_modes, tuple(np.ravel(sensor_stations).tolist()),
-                                   float(mode_cutoff_hz)),
+                                   float(mode_cutoff_hz), strips_key),
                       lambda: build_timeline(mass_model, model, t_end, dt, n_modes, sensor_stations, mode_cutoff_hz,
-                                             cache=False))
+                                             cache=False, strip_stations=strip_stations))
     mm = mass_model
     vehicle = mm.vehicle
     sensors = np.asarray(sensor_stations, dtype=float).reshape(-1)
+    strips = np.zeros((len(vehicle.stages), 0)) if strip_stations is None else np.asarray(strip_stations, float)
+    if strips.ndim != 2 or strips.shape[0] != len(vehicle.stages):
+        raise ValueError(f"strip_stations of shape {strips.shape}: expected ({len(vehicle.stages)}, n), one row per stage")
     with_modes = model in ("flex", "nonrigid")
     K = (vehicle.structure.n_modes if n_modes is None else int(n_modes)) if with_modes else 0
     with_slosh = model in ("slosh", "nonrigid")
@@ -257,7 +280,7 @@ def build_timeline(mass_model: MassModel, model: str, t_end: float, dt: float = 
     event_times = {t for t, _ in events}
     lay = dyn.layout
     rows: dict[str, list] = {k: [] for k in ("t", "p", "T0", "Ae", "m", "cg", "J", "ms", "burn", "stage", "phi",
-                                                 "dphi")}
+                                                 "dphi", "phi_strip", "dphi_strip")}
     state = mm.initial_state()
     for t in times:
         samples = []
@@ -276,6 +299,16 @@ def build_timeline(mass_model: MassModel, model: str, t_end: float, dt: float = 
             else:
                 m_b, cg, J = props.mass, props.cg, props.inertia
             modes = schedule.modes(s, props) if schedule is not None else None
+            attached = [si for si, ph in enumerate(s.phase) if ph != SEPARATED]
+            lowest = min(attached) if attached else len(s.phase) - 1
+            if modes is not None and strips.shape[1]:
+                beam, keep = modes.beam, _kept(modes, mode_cutoff_hz)
+                on_strips = resample_modes(strips[lowest], beam.node_stations, beam.phi_nodes.T, beam.dphi_nodes.T)
+                rows["phi_strip"].append(on_strips[0] * keep[:, None])
+                rows["dphi_strip"].append(on_strips[1] * keep[:, None])
+            else:
+                rows["phi_strip"].append(np.zeros((K, strips.shape[1])))
+                rows["dphi_strip"].append(np.zeros((K, strips.shape[1])))
             if modes is not None:
                 modes = _cut(modes, mode_cutoff_hz)
             slosh = []
@@ -291,7 +324,6 @@ def build_timeline(mass_model: MassModel, model: str, t_end: float, dt: float = 
                            zeta_modes=modes.zeta if modes is not None else (),
                            phi_gimbal=modes.phi_gimbal if modes is not None else (),
                            dphi_gimbal=modes.dphi_gimbal if modes is not None else (), slosh=slosh)
-            attached = [si for si, ph in enumerate(s.phase) if ph != SEPARATED]
             rows["t"].append(tt)
             rows["p"].append(p)
             rows["T0"].append(T0)
@@ -301,7 +333,7 @@ def build_timeline(mass_model: MassModel, model: str, t_end: float, dt: float = 
             rows["J"].append(props.inertia)
             rows["ms"].append(props.slosh_mass)
             rows["burn"].append(any(ph == BURNING for ph in s.phase) and T0 > 0.0)
-            rows["stage"].append(min(attached) if attached else len(s.phase) - 1)
+            rows["stage"].append(lowest)
             for key, name in (("phi", "phi_sensor"), ("dphi", "dphi_sensor")):
                 rows[key].append(getattr(modes, name) if modes is not None and sensors.size
                                  else np.zeros((sensors.size, K)))
@@ -318,4 +350,6 @@ def build_timeline(mass_model: MassModel, model: str, t_end: float, dt: float = 
                     sensor_stations=sensors,
                     phi_sensor=np.array(rows["phi"]).reshape(len(rows["t"]), sensors.size, K),
                     dphi_sensor=np.array(rows["dphi"]).reshape(len(rows["t"]), sensors.size, K),
+                    strip_stations=strips, phi_strip=np.array(rows["phi_strip"]).reshape(len(rows["t"]), K, strips.shape[1]),
+                    dphi_strip=np.array(rows["dphi_strip"]).reshape(len(rows["t"]), K, strips.shape[1]),
                     events=tuple((float(t), e) for t, e in events))

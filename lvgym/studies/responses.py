@@ -178,7 +178,8 @@ def run_case(params: dict[str, Any]) -> dict[str, Any]:
     stations = np.linspace(0.0, -L, int(setup.n_stations))
     sim = Simulator(vehicle=vehicle, model=setup.model, site=setup.site, wind=setup.wind, aerodynamics=aero,
                     t_end=setup.t_end, physics_dt=setup.physics_dt, elevation_deg=setup.elevation_deg,
-                    rail_length=setup.rail_length, sensor_stations=stations, threads=1)
+                    rail_length=setup.rail_length, sensor_stations=stations, threads=1,
+                    aeroelastic=False)          # the thesis's study flew no aeroelastic loads
     sim.reset(batch=1, rng=np.random.default_rng(0))
     n = int(round(setup.t_end / setup.sample_dt))
     ts, etas, cgs, alphas = [0.0], [sim.state("eta")[0].copy()], [sim.lateral_cg_offset()[0]], [0.0]
