@@ -69,9 +69,9 @@ class FlightLog:
     gyro_index: tuple[int, int, int] | None = None
     rows: list[tuple[Any, ...]] = field(default_factory=list)
     gyro_rows: list[tuple[float, float]] = field(default_factory=list)
+    eta: list[Any] = field(default_factory=list)
+    slosh: list[Any] = field(default_factory=list)
     events: list[tuple[float, str]] = field(default_factory=list)
-    peak_eta: float = 0.0
-    peak_slosh: float = 0.0
     termination: str = ""
 
     @classmethod
@@ -85,20 +85,19 @@ class FlightLog:
                    math.radians(s.gimbal_rate_limit_degps), gyro)
 
     def add(self, reward: float, info: dict[str, Any], gyro_minus_body_radps: tuple[float, float] | None = None) -> None:
-        """Record one step's info (and, with a gyro, the step's gyro minus body rate, pitch and yaw [rad/s])."""
-        e = np.asarray(info["rate_error"], dtype=float)
-        rate = np.asarray(info.get("gimbal_rate", (0.0, 0.0)), dtype=float)
-        self.rows.append((float(info["time"]), e, float(info["qbar"]), float(info["qalpha_pa_deg"]),
-                          float(np.max(np.abs(rate))) if rate.size else 0.0))
+        """Record one step's info (and, with a gyro, the step's gyro minus body rate, pitch and yaw [rad/s]).
+        Arrays are kept as they come (an env's info holds fresh arrays every step) and reduced by
+        :func:`flight_metrics`."""
+        self.rows.append((info["time"], info["rate_error"], info["qbar"], info["qalpha_pa_deg"],
+                          info.get("gimbal_rate", (0.0, 0.0))))
         if gyro_minus_body_radps is not None:
-            self.gyro_rows.append((float(gyro_minus_body_radps[0]), float(gyro_minus_body_radps[1])))
-        eta = np.abs(np.asarray(info.get("eta", ()), dtype=float))
-        if eta.size and np.isfinite(eta).any():
-            self.peak_eta = max(self.peak_eta, float(np.nanmax(eta)))
-        slosh = np.abs(np.asarray(info.get("slosh_angles", ()), dtype=float))
-        if slosh.size and np.isfinite(slosh).any():
-            self.peak_slosh = max(self.peak_slosh, float(np.nanmax(slosh)))
-        self.events += [(float(t), str(text)) for t, text in info.get("events", ())]
+            self.gyro_rows.append(gyro_minus_body_radps)
+        if "eta" in info:
+            self.eta.append(info["eta"])
+        if "slosh_angles" in info:
+            self.slosh.append(info["slosh_angles"])
+        if info.get("events"):
+            self.events += [(float(t), str(text)) for t, text in info["events"]]
         if info.get("termination"):
             self.termination = str(info["termination"])
 
@@ -110,7 +109,7 @@ class FlightLog:
             u = env.unwrapped
             w = u.sim.state("omega_bi_b", u.state.sim)[0]
             ip, iy, iref = self.gyro_index
-            diff = (float(observation[ip]) + float(observation[iref]) - float(w[1]), float(observation[iy]) - float(w[2]))
+            diff = (float(observation[ip]) + float(observation[iref]) - w[1], float(observation[iy]) - w[2])
         self.add(reward, info, diff)
 
 
@@ -128,13 +127,29 @@ def _phase_masks(t: np.ndarray, qbar: np.ndarray, events: list[tuple[float, str]
     return {"boost": first & ~max_q, "max_q": max_q, "coast": (t > burnout) & (t <= ignition), "upper": t > ignition}
 
 
+def _peak(arrays: list[Any]) -> float:
+    """Largest absolute finite value of the recorded arrays (0.0 for none: no mode, no pendulum with mass)."""
+    if not arrays:
+        return 0.0
+    try:
+        x = np.abs(np.asarray(arrays, dtype=float)).ravel()
+    except ValueError:                                 # shapes that change within the episode
+        x = np.abs(np.concatenate([np.ravel(np.asarray(a, dtype=float)) for a in arrays]))
+    x = x[np.isfinite(x)]
+    return float(x.max()) if x.size else 0.0
+
+
 def flight_metrics(log: FlightLog) -> dict[str, Any]:
     """The v1 metrics of one episode (see the module docstring). ``rate_error_rad`` is summed as protocol
     v0's :func:`~.metrics.episode_metrics` sums it (per axis, then pitch + yaw), so the two agree bit for bit."""
     dt = float(log.dt_s)
     n = len(log.rows)
     if n:
-        t, e, qbar, qalpha, rate = (np.array(c, dtype=float) for c in zip(*log.rows))
+        cols = list(zip(*log.rows))
+        t, qbar, qalpha = (np.array(cols[i], dtype=float) for i in (0, 2, 3))
+        e = np.array(cols[1], dtype=float)
+        rate = np.abs(np.array(cols[4], dtype=float)).reshape(n, -1)
+        rate = rate.max(axis=1) if rate.shape[1] else np.zeros(n)
     else:
         t = qbar = qalpha = rate = np.zeros(0)
         e = np.zeros((0, 3))
@@ -149,8 +164,8 @@ def flight_metrics(log: FlightLog) -> dict[str, Any]:
     pitch_yaw = e[:, 1] + e[:, 2]
     for name in PHASES:
         out[f"rate_error_{name}_rad"] = float(pitch_yaw[masks[name]].sum() * dt)
-    out["peak_eta"] = float(log.peak_eta)
-    out["peak_slosh_deg"] = math.degrees(log.peak_slosh)
+    out["peak_eta"] = _peak(log.eta)
+    out["peak_slosh_deg"] = math.degrees(_peak(log.slosh))
     if log.gyro_index is not None and log.gyro_rows:
         g = np.abs(np.nan_to_num(np.array(log.gyro_rows, dtype=float), nan=0.0))
         out["gyro_minus_body_rate_rad"] = float(g.sum() * dt)
