@@ -330,6 +330,9 @@ def test_registry_names_what_is_missing(monkeypatch):
     assert ev.resolve_policy("zero") == ZERO
     args = ev.parse_args([])
     assert args.policies == ["zero", "pid", "gs-pid", "ppo"] and args.suites == ["smile-windy"] and args.executor == "local"
+    assert args.reference is None and ev.parse_args(["--reference", "pid"]).reference == "pid"
+    with pytest.raises(SystemExit, match="--reference = 'ghost'"):          # refused before any episode runs
+        ev.main(["--policies", "zero", "--reference", "ghost", "--no-progress"])
 
 
 def test_cli_end_to_end(tmp_path, tiny_sb3):
