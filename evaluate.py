@@ -12,6 +12,20 @@ observations). Suites are names of ``lvgym.benchmark.SUITES``. Episodes run on a
 by default; the Markdown table is printed, and CSV, JSON, the table and PNG plots go to ``--out``
 (each file written atomically: an interrupted run leaves no half-written file). ``--seed-set
 validation`` evaluates on the training seeds; reported numbers use the ``test`` seeds (the default).
+
+The tables (per suite; every mean with its 95 % bootstrap interval over the seeds, lower is better):
+  1. summary: condition x policy, ranked by failure rate, then by score (the rate error plus, for a failed
+     episode, the env's failure penalty for the mission left), with the rate error, CVaR10, max rate,
+     effort, max alpha and q-alpha;
+  2. rate error per flight phase: policy x model x (boost, max q, coast, upper stage, total);
+  3. rigid-to-non-rigid degradation: failure rates rigid and non-rigid, score and rate error of both
+     with their ratio and paired difference (a failed episode is charged by its score, so the score's
+     degradation counts the failures);
+  4. paired comparison: each policy against the reference (``--reference``, else the best-ranked
+     policy of the condition) on the same seeds: mean difference of the score with its interval,
+     wins/ties/losses, Wilcoxon and t p-values, rliable's IQM and probability of improvement;
+  5. agents over training runs (policies labelled ``<agent>-s<seed>``): rliable's IQM over the runs.
+docs/benchmark.md defines every metric.
 """
 
 from __future__ import annotations
@@ -24,8 +38,8 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
-from lvgym.benchmark import (EXECUTORS, PROTOCOL_VERSION, SEED_SETS, SUITES, ZERO, PolicySpec, degradation,
-                             evaluate, get_suite, markdown_table, summarize, write_results)
+from lvgym.benchmark import (EXECUTORS, PROTOCOL_VERSION, SEED_SETS, SUITES, ZERO, PolicySpec, compare, degradation,
+                             evaluate, get_suite, markdown_table, run_groups, summarize, write_results)
 from lvgym.cli import fail, one_line_errors
 from lvgym.errors import ConfigError
 from lvgym.parallel import TaskFailed, exit_on_sigterm
@@ -70,6 +84,8 @@ class Args:
     """folder of the result files"""
     seed_set: str = "test"
     """test (reported numbers) or validation (training and tuning)"""
+    reference: str | None = None
+    """policy label every policy is compared with (default: the best-ranked policy of each condition)"""
     mission_time_s: float | None = None
     """shorten every episode to this many seconds (smoke tests; results are marked '+override')"""
     plots: bool = True
@@ -81,7 +97,7 @@ class Args:
 def parse_args(argv: list[str] | None = None) -> Args:
     """Parse the command line into :class:`Args`."""
     d = Args()
-    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0],
+    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0], epilog=__doc__.split("\n\n", 2)[2],
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--policies", nargs="+", default=d.policies, metavar="POLICY",
                    help=f"names {sorted(POLICIES)}, SB3 .zip paths or train.py run folders (runs/<name>: its best "
@@ -93,6 +109,9 @@ def parse_args(argv: list[str] | None = None) -> Args:
     p.add_argument("--workers", type=int, default=d.workers, help="default: the CPUs available")
     p.add_argument("--out", default=d.out, help=f"results folder (default {d.out}/)")
     p.add_argument("--seed-set", choices=SEED_SETS, default=d.seed_set, help="default: test")
+    p.add_argument("--reference", default=None, metavar="POLICY",
+                   help="the policy label the paired comparison takes as reference (default: the best-ranked "
+                        "policy of each condition)")
     p.add_argument("--mission-time-s", type=float, default=None, help="shorten episodes (smoke tests only)")
     p.add_argument("--no-plots", dest="plots", action="store_false", help="skip the PNG plots")
     p.add_argument("--no-progress", dest="progress", action="store_false", help="hide the progress bar")
@@ -144,6 +163,9 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
     args = parse_args(argv)
     exit_on_sigterm()                                # clean up temporary files on kill (SIGTERM)
     policies = _unique([resolve_policy(n) for n in args.policies])
+    if args.reference is not None and args.reference not in [p.name for p in policies]:
+        raise SystemExit(f"evaluate.py: --reference = {args.reference!r}: one of the policy labels "
+                         f"{[p.name for p in policies]}")
     try:
         suites = [get_suite(n) for n in args.suites]
     except ValueError as exc:
@@ -160,7 +182,9 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
         raise
     wall = time.perf_counter() - t0
     summary = summarize(records)
-    deg = degradation(summary)
+    deg = degradation(summary, "score", records=records) + degradation(summary, "rate_error_rad", records=records)
+    comparison = compare(records, summary, "score", args.reference)
+    groups = run_groups(records, "score")
     meta = {
         "protocol": PROTOCOL_VERSION, "seed_set": args.seed_set, "episodes": args.episodes, "args": asdict(args),
         "suites": {s.name: {"version": s.version, "description": s.description, "overrides": dict(s.overrides),
@@ -170,12 +194,14 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
         "policies": [{"name": p.name, "factory": p.factory, "kwargs": dict(p.kwargs)} for p in policies],
         "wall_time_s": round(wall, 3), "created_utc": dt.datetime.now(dt.timezone.utc).isoformat(timespec="seconds"),
     }
-    table = markdown_table(summary, deg, meta)
-    paths = write_results(args.out, records, summary, deg, meta, plots=args.plots)
+    table = markdown_table(summary, deg, meta, comparison, groups)
+    paths = write_results(args.out, records, summary, deg, meta, plots=args.plots, comparison=comparison,
+                          groups=groups)
     print(table)
     print(f"{len(records)} episodes in {wall:.1f} s ({args.executor}); results in {Path(args.out)}/: "
           f"{', '.join(sorted(paths))}", file=sys.stderr)
-    return {"records": records, "summary": summary, "degradation": deg, "meta": meta, "table": table}
+    return {"records": records, "summary": summary, "degradation": deg, "comparison": comparison,
+            "run_groups": groups, "meta": meta, "table": table}
 
 
 if __name__ == "__main__":

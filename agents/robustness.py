@@ -1,7 +1,11 @@
 """The robustness experiment: policies trained on the rigid model against policies trained on the
 non-rigid model (slosh and bending), both evaluated on the rigid and the non-rigid conditions of the
-benchmark suites. The protocol's degradation table (non-rigid over rigid rate error, per policy) then
-shows what a rigid-trained policy loses on the flexible, sloshing vehicle, and what non-rigid training buys.
+benchmark suites. The protocol's degradation table (per policy: the failure rates rigid and non-rigid
+beside the non-rigid over rigid ratio and paired difference of the score and of the rate error) then shows
+what a rigid-trained policy loses on the flexible, sloshing vehicle, and what non-rigid training buys. The
+score charges a failed episode for the mission it did not fly, so its degradation counts failures (a run
+that fails every episode no longer looks robust); the rate error stops at a failure. The runs are labelled
+``<agent>-s<seed>``, so ``evaluate.py`` also gives each agent's IQM over its training runs.
 
     python -m agents.robustness --dry-run                 # print the commands
     python -m agents.robustness                           # train 2 models x 3 seeds, then evaluate

@@ -111,9 +111,12 @@ def test_summary_and_degradation_by_hand():
     assert d["policy"] == "p" and d["condition"] == "s/nonrigid" and d["reference"] == "s/rigid"
     assert d["mean_ratio"] == 2.0 and d["mean_diff"] == 2.0
     assert d["cvar10_ratio"] == 2.0 and d["failure_rate_diff"] == pytest.approx(1 / 3)
+    assert d["failure_rate_rigid"] == 0.0 and d["failure_rate"] == pytest.approx(1 / 3)
+    lo, hi = rigid["rate_error_rad_ci_low"], rigid["rate_error_rad_ci_high"]
+    assert 1.0 <= lo < 2.0 < hi <= 3.0                       # a bootstrap interval of the mean of 1, 2, 3
     table = markdown_table([rigid, nonrigid], [d])
-    assert "| rigid | p | 2.0000 ± 1.0000 | 3.0000 |" in table
-    assert "| p | nonrigid | 2.0000 | 4.0000 | 2.000 | +2.0000 | 2.000 | +33 pp |" in table
+    assert f"| rigid | p | 1 | 0 % [0, 0] | - | 2.0000 [{lo:.4f}, {hi:.4f}] | 3.0000 |" in table
+    assert "| p | nonrigid | 0 % | 33 % | 2.0000 | 4.0000 | 2.000 | +2.0000 | - |" in table
 
 
 # ---------------------------------------------------------------------------------------------- suites
@@ -330,6 +333,9 @@ def test_registry_names_what_is_missing(monkeypatch):
     assert ev.resolve_policy("zero") == ZERO
     args = ev.parse_args([])
     assert args.policies == ["zero", "pid", "gs-pid", "ppo"] and args.suites == ["smile-windy"] and args.executor == "local"
+    assert args.reference is None and ev.parse_args(["--reference", "pid"]).reference == "pid"
+    with pytest.raises(SystemExit, match="--reference = 'ghost'"):          # refused before any episode runs
+        ev.main(["--policies", "zero", "--reference", "ghost", "--no-progress"])
 
 
 def test_cli_end_to_end(tmp_path, tiny_sb3):
@@ -339,8 +345,9 @@ def test_cli_end_to_end(tmp_path, tiny_sb3):
     assert proc.returncode == 0, proc.stderr
     assert "| rigid | zero |" in proc.stdout and "| nonrigid | tiny |" in proc.stdout
     assert "episodes" in proc.stderr                                  # the progress bar
-    assert {"episodes.csv", "summary.csv", "degradation.csv", "table.md", "results.json", "rate_error.png",
-            "degradation.png"} <= {p.name for p in out.iterdir()}
+    assert {"episodes.csv", "summary.csv", "degradation.csv", "comparison.csv", "table.md", "results.json",
+            "rate_error.png", "degradation.png"} <= {p.name for p in out.iterdir()}
+    assert "per flight phase" in proc.stdout and "Paired comparison" in proc.stdout
     _complete(out)
     rows = list(csv.DictReader(io.StringIO((out / "episodes.csv").read_text())))
     assert len(rows) == 2 * 2 * 2 and {r["policy"] for r in rows} == {"zero", "tiny"}
@@ -373,3 +380,137 @@ def test_v0_effort_metric_stays_the_sampled_one():
             break
     assert reward_effort == pytest.approx(-env.unwrapped.task.effort_weight * integral, rel=1e-12)
     assert integral == pytest.approx(v0, rel=2e-3) and integral != v0
+
+
+# ---------------------------------------------------------------------------------------------- v1 metrics
+class HardOver:
+    """The gimbal held hard over in pitch: the vehicle departs within a few seconds."""
+
+    name = "hard-over"
+
+    def reset(self) -> None:
+        pass
+
+    def act(self, observation, info):
+        return np.array([1.0, 0.0], dtype=np.float32)
+
+
+def test_records_carry_the_v1_metrics_and_failing_early_never_pays():
+    import gymnasium as gym
+
+    from lvgym.benchmark import V1_METRICS
+    from lvgym.benchmark.scoring import PHASES
+    env = gym.make("lvgym/SmileAscent-v0", wind="turbulence", randomize=["wind"], mission_time_s=20.0)
+    for seed in (10_000, 10_001):
+        zero = play_episode(ZeroPolicy(), env, seed)
+        hard = play_episode(HardOver(), env, seed)
+        for rec in (zero, hard):
+            assert set(V1_METRICS) <= set(rec)
+            assert rec["score"] >= rec["rate_error_rad"]
+            assert sum(rec[f"rate_error_{p}_rad"] for p in PHASES) == pytest.approx(rec["rate_error_rad"], rel=1e-12)
+        assert not zero["failed"] and zero["score"] == zero["rate_error_rad"]
+        assert hard["failed"] and hard["duration_s"] < 6.0
+        # the failing policy has the lower thesis criterion, and the worse score: by the mission it did not fly
+        assert hard["rate_error_rad"] < zero["rate_error_rad"] < hard["score"]
+        assert hard["score"] == pytest.approx(hard["rate_error_rad"] + 0.1 * (20.0 - hard["duration_s"]))
+        assert hard["gimbal_rate_limit_s"] > 0 and zero["gimbal_rate_limit_s"] == 0.0
+
+
+def test_gyro_minus_body_rate_against_the_ideal_observation():
+    """The sensors observation's gyro against the body rate, checked side by side with the ideal-state
+    observation of the same seed (whose rate entries are the body's): the zero policy flies the same
+    flight under both observations."""
+    import gymnasium as gym
+
+    from lvgym.envs.layouts import OBS_SENSORS, OBS_STATE
+    kw = {"model": "nonrigid", "wind": "turbulence", "randomize": ["wind"], "mission_time_s": 4.0}
+    sens, ideal = (gym.make("lvgym/SmileAscent-v0", observation=o, **kw) for o in ("sensors", "state"))
+    seed, dt = 10_000, 0.02
+    sens.reset(seed=seed)
+    ideal.reset(seed=seed)
+    total = 0.0
+    while True:
+        o_s, _, te, tr, _ = sens.step(np.zeros(2, np.float32))
+        o_i, *_ = ideal.step(np.zeros(2, np.float32))
+        total += (abs(float(o_s[OBS_SENSORS.index("pitch_rate_error")]) - float(o_i[OBS_STATE.index("pitch_rate_error")]))
+                  + abs(float(o_s[OBS_SENSORS.index("yaw_rate_error")]) - float(o_i[OBS_STATE.index("yaw_rate_error")])))
+        if te or tr:
+            break
+    total *= dt
+    rec = play_episode(ZeroPolicy(), sens, seed)
+    assert rec["gyro_minus_body_rate_rad"] > 0
+    # the observation is float32: the two ways agree to its rounding (1e-7 rad/s per sample and axis)
+    assert rec["gyro_minus_body_rate_rad"] == pytest.approx(total, abs=200 * 2 * 1e-7 * dt + 1e-6 * total)
+    assert play_episode(ZeroPolicy(), ideal, seed)["gyro_minus_body_rate_rad"] == 0.0      # no gyro: 0 by definition
+    rigid = gym.make("lvgym/SmileAscent-v0", observation="sensors", **{**kw, "model": "rigid"})
+    assert play_episode(ZeroPolicy(), rigid, seed)["gyro_minus_body_rate_rad"] < 1e-3 * rec["gyro_minus_body_rate_rad"]
+
+
+def _v1_rec(policy: str, seed: int, score: float, failed: bool = False, cond: str = "s/rigid",
+            model: str = "rigid") -> dict:
+    r = _rec(cond, model, score if not failed else score / 2, failed)
+    r.update(policy=policy, seed=seed, score=score, rate_error_boost_rad=0.25 * r["rate_error_rad"],
+             rate_error_max_q_rad=0.5 * r["rate_error_rad"], rate_error_coast_rad=0.0,
+             rate_error_upper_rad=0.25 * r["rate_error_rad"])
+    return r
+
+
+def test_tables_rank_by_failure_rate_then_score():
+    recs = [_v1_rec("flies-badly", s, 3.0 + 0.1 * s) for s in range(4)]
+    recs += [_v1_rec("fails-once", s, 1.0 + 0.1 * s, failed=(s == 0)) for s in range(4)]
+    recs += [_v1_rec("flies-well", s, 2.0 + 0.1 * s) for s in range(4)]
+    recs += [_v1_rec("flies-well-too", s, 2.0 + 0.1 * s) for s in range(4)]
+    summary = summarize(recs)
+    assert [r["policy"] for r in summary] == ["flies-badly", "fails-once", "flies-well", "flies-well-too"]
+    assert {r["policy"]: r["rank"] for r in summary} == {"flies-well": 1, "flies-well-too": 1, "flies-badly": 3,
+                                                        "fails-once": 4}
+    table = markdown_table(summary, [])
+    order = [line.split("|")[2].strip() for line in table.splitlines() if line.startswith("| rigid |")]
+    assert order == ["flies-well", "flies-well-too", "flies-badly", "fails-once"]
+    for r in summary:                                   # every mean with an interval that brackets it
+        for m in ("score", "rate_error_rad", "max_rate_radps", "rate_error_boost_rad", "failure_rate"):
+            mean = r[m if m == "failure_rate" else f"{m}_mean"]
+            assert r[f"{m}_ci_low"] <= mean <= r[f"{m}_ci_high"], (r["policy"], m)
+        assert r["score_ci_low"] < r["score_ci_high"]
+        phases = sum(r[f"rate_error_{p}_rad_mean"] for p in ("boost", "max_q", "coast", "upper"))
+        assert phases == pytest.approx(r["rate_error_rad_mean"])
+
+
+def test_paired_comparison_and_agents_over_runs():
+    from lvgym.benchmark import compare, run_groups
+    from lvgym.benchmark.stats import paired
+    recs = [_v1_rec("a", s, 1.0 + 0.1 * s) for s in range(5)]
+    recs += [_v1_rec("b", s, 1.2 + 0.1 * s * s) for s in range(5)]
+    summary = summarize(recs)
+    rows = compare(recs, summary, reps=200)
+    best, other = rows
+    assert best["policy"] == best["reference"] == "a" and math.isnan(best["diff"])
+    want = paired([1.2 + 0.1 * s * s for s in range(5)], [1.0 + 0.1 * s for s in range(5)])
+    assert other["policy"] == "b" and other["reference"] == "a" and other["n"] == 5
+    assert other["diff"] == pytest.approx(want.mean_diff) and other["p_wilcoxon"] == want.p_wilcoxon
+    assert (other["wins"], other["ties"], other["losses"]) == (0, 0, 5)
+    assert other["diff_ci_low"] <= other["diff"] <= other["diff_ci_high"]
+    assert other["iqm_ci_low"] <= other["iqm"] <= other["iqm_ci_high"]
+    assert 0.0 <= other["p_improvement_ci_low"] <= other["p_improvement"] <= other["p_improvement_ci_high"] < 0.5
+    named = compare(recs, summary, reference="b", reps=200)
+    assert [r["reference"] for r in named] == ["b", "b"] and named[0]["diff"] == pytest.approx(-want.mean_diff)
+    table = markdown_table(summary, [], comparison=rows)
+    assert "| rigid | a | 1 |" in table and "(reference)" in table and "| 0/0/5 |" in table
+    runs = [dict(r, policy=f"agent-s{k}") for k, part in enumerate((recs[:5], recs[5:])) for r in part]
+    (g,) = run_groups(runs, reps=200)
+    assert g["agent"] == "agent" and g["runs"] == 2 and g["episodes"] == 5
+    assert g["iqm_ci_low"] <= g["iqm"] <= g["iqm_ci_high"]
+
+
+def test_score_degradation_counts_failures_with_a_paired_test():
+    recs = [_v1_rec("p", s, 1.0 + 0.1 * s) for s in range(4)]
+    recs += [_v1_rec("p", s, 2.0 + 0.1 * s, failed=(s < 2), cond="s/nonrigid", model="nonrigid") for s in range(4)]
+    summary = summarize(recs)
+    (d,) = degradation(summary, "score", records=recs)
+    assert d["metric"] == "score" and d["failure_rate_rigid"] == 0.0 and d["failure_rate"] == 0.5
+    assert d["mean_diff"] == pytest.approx(1.0) and d["paired_n"] == 4
+    assert d["diff_ci_low"] == pytest.approx(1.0) and d["diff_ci_high"] == pytest.approx(1.0)   # the same diff each seed
+    (e,) = degradation(summary, "rate_error_rad", records=recs)
+    assert e["mean_diff"] < d["mean_diff"]              # the failed episodes' rate errors stopped early
+    table = markdown_table(summary, [d, e])
+    assert "| p | nonrigid | 0 % | 50 % | 1.1500 | 2.1500 | 1.870 | +1.0000 [+1.0000, +1.0000] |" in table

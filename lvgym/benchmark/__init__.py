@@ -2,13 +2,18 @@
 
 - :mod:`.policy`: the :class:`Policy` interface (``name``, ``reset()``, ``act(observation, info)``);
 - :mod:`.suites`: :data:`SUITES` (conditions and seed sets, :data:`PROTOCOL_VERSION`);
-- :mod:`.metrics`: per-episode metrics, per-suite mean / std / CVaR10 / failure rate, degradation;
+- :mod:`.metrics`: per-episode metrics of v0, per-suite mean with its interval / std / CVaR10 / failure
+  rate, ranks, degradation;
+- :mod:`.scoring`: v1's per-episode metrics (failure-charged score, phases, flexibility, q-alpha cost);
+- :mod:`.stats`: bootstrap intervals, paired tests, rliable's IQM and probability of improvement;
+- :mod:`.compare`: the paired comparison of policies and agents over training runs;
 - :mod:`.runner`: :func:`run_episode` and :func:`evaluate` (serial, local process pool or Ray);
-- :mod:`.results`: atomic CSV / JSON / Markdown / PNG result files;
+- :mod:`.tables`, :mod:`.results`: the Markdown tables; atomic CSV / JSON / Markdown / PNG result files;
 """
 
-from .metrics import (CVAR_LEVEL, SUMMARY_METRICS, Trajectory, TrajectoryBuilder, cvar, degradation, episode_metrics,
-                      summarize)
+from .compare import compare, run_groups
+from .metrics import (CVAR_LEVEL, SUMMARY_METRICS, V1_METRICS, Trajectory, TrajectoryBuilder, cvar, degradation,
+                      episode_metrics, rank, summarize)
 from .policy import Policy, ZeroPolicy
 from .results import atomic_write, atomic_write_text, markdown_table, write_results
 from .runner import EXECUTORS, ZERO, PolicySpec, build_policy, evaluate, make_tasks, play_episode, run_episode
@@ -17,7 +22,6 @@ from .suites import (DEFAULT_SUITE, PROTOCOL_VERSION, SEED_SETS, SUITES, TEST_SE
 
 __all__ = ["CVAR_LEVEL", "Condition", "DEFAULT_SUITE", "EXECUTORS", "PROTOCOL_VERSION", "Policy", "PolicySpec",
            "SEED_SETS", "SUITES", "SUMMARY_METRICS", "Suite", "TEST_SEED0", "Trajectory", "TrajectoryBuilder",
-           "VALIDATION_SEED0", "ZERO", "ZeroPolicy", "atomic_write", "atomic_write_text", "build_policy", "cvar",
-           "degradation", "episode_metrics", "evaluate", "get_suite", "make_tasks", "markdown_table", "play_episode",
-           "run_episode",
-           "summarize", "write_results"]
+           "V1_METRICS", "VALIDATION_SEED0", "ZERO", "ZeroPolicy", "atomic_write", "atomic_write_text", "build_policy",
+           "compare", "cvar", "degradation", "episode_metrics", "evaluate", "get_suite", "make_tasks",
+           "markdown_table", "play_episode", "rank", "run_episode", "run_groups", "summarize", "write_results"]

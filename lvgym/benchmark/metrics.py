@@ -25,16 +25,25 @@ A failed episode's integrals stop at the failure: read them with its failure rat
 charges the remaining time instead). NaN samples (a non-finite state) are ignored by the maxima (0.0
 without any sample).
 
-Per suite, for each (suite, condition, policy) (:func:`summarize`): ``mean``, ``std`` (sample standard
-deviation, ``ddof = 1``; 0 for one episode), ``cvar10`` (conditional value at risk at 10 %: the mean of
-the worst ``ceil(0.1 n)`` episodes, at least one; worst is the largest value, the smallest for
-``episode_return``), ``failure_rate`` (failed episodes over episodes) and ``n``.
+Every record also carries protocol v1's metrics (:mod:`.scoring`: the failure-charged ``score``, the
+per-phase rate errors, what flexibility does, the q-alpha constraint cost); these definitions are v0's
+and stay as they are.
+
+Per suite, for each (suite, condition, policy) (:func:`summarize`): ``mean``, ``ci_low`` and ``ci_high``
+(the 95 % BCa bootstrap interval of the mean over the seeds, :func:`.stats.bootstrap_ci`), ``std``
+(sample standard deviation, ``ddof = 1``; 0 for one episode), ``cvar10`` (conditional value at risk at
+10 %: the mean of the worst ``ceil(0.1 n)`` episodes, at least one; worst is the largest value, the
+smallest for ``episode_return``), ``failure_rate`` (failed episodes over episodes, with its interval),
+``n`` and ``rank``: the place of the policy within its (suite, condition), by failure rate, then by mean
+``score`` (lower is better for both; :func:`rank_key`).
 
 Degradation (:func:`degradation`), per policy, for each condition against the ``rigid`` condition of its
 group (same env, wind, randomisation and seeds; only the flight model differs):
 ``ratio = mean_model / mean_rigid`` and ``diff = mean_model - mean_rigid`` of ``rate_error_rad``
-(ratio 1.0 and diff 0 mean the policy does not notice slosh and bending), also for ``cvar10``, and
-``failure_rate_diff``.
+(ratio 1.0 and diff 0 mean the policy does not notice slosh and bending), also for ``cvar10``, the
+failure rates of both conditions and ``failure_rate_diff``; with the episode records, the paired test of
+the per-seed differences (:func:`.stats.paired`). Of the ``score`` (``metric="score"``) the degradation
+counts failures by itself: a failed episode is charged by its score for the mission it did not fly.
 """
 
 from __future__ import annotations
@@ -46,9 +55,15 @@ from typing import Any
 
 import numpy as np
 
+from .scoring import PHASES
+from .stats import bootstrap_ci, paired
+
 #: metrics summarised per suite (all "lower is better" except those in :data:`HIGHER_IS_BETTER`)
 SUMMARY_METRICS = ("rate_error_rad", "rate_error_pitch_rad", "rate_error_yaw_rad", "max_rate_radps", "effort_rad_s",
                    "max_alpha_rad", "max_qalpha_pa_deg", "episode_return")
+#: protocol v1's metrics (:mod:`.scoring`), summarised beside v0's when the records carry them
+V1_METRICS = ("score", *(f"rate_error_{p}_rad" for p in PHASES), "peak_eta", "peak_slosh_deg",
+              "gyro_minus_body_rate_rad", "gimbal_rate_limit_s", "qalpha_cost_s")
 HIGHER_IS_BETTER = frozenset({"episode_return"})
 CVAR_LEVEL = 0.10
 #: dynamic pressure [Pa] from which the angle of attack counts in ``max_alpha_rad``
@@ -149,42 +164,84 @@ def _std(x: np.ndarray) -> float:
     return float(np.std(x, ddof=1)) if x.size > 1 else 0.0
 
 
-def summarize(records: Iterable[dict[str, Any]], metrics: Sequence[str] = SUMMARY_METRICS) -> list[dict[str, Any]]:
-    """One row per (suite, condition, policy), in order of first appearance: ``n``, ``failure_rate``,
-    the failure reasons with their counts, and ``<metric>_mean``, ``_std``, ``_cvar10`` of every metric."""
+def rank_key(row: dict[str, Any]) -> tuple[float, float]:
+    """The order of the tables: failure rate first, then the mean ``score`` (``rate_error_rad`` for
+    records without it); lower is better for both."""
+    return (float(row["failure_rate"]), float(row.get("score_mean", row["rate_error_rad_mean"])))
+
+
+def rank(summary: Sequence[dict[str, Any]]) -> list[dict[str, Any]]:
+    """Set ``rank`` (1: the best, ties share the smaller place) in every row within its (suite,
+    condition), by :func:`rank_key`; returns the rows sorted by suite and condition (in order of first
+    appearance), then by rank (ties in order of appearance)."""
+    groups: dict[tuple[Any, Any], list[dict[str, Any]]] = {}
+    for r in summary:
+        groups.setdefault((r["suite"], r["condition"]), []).append(r)
+    out = []
+    for rows in groups.values():
+        ordered = sorted(rows, key=rank_key)
+        for i, r in enumerate(ordered):
+            same = i > 0 and rank_key(r) == rank_key(ordered[i - 1])
+            r["rank"] = ordered[i - 1]["rank"] if same else i + 1
+        out += ordered
+    return out
+
+
+def summarize(records: Iterable[dict[str, Any]], metrics: Sequence[str] | None = None) -> list[dict[str, Any]]:
+    """One row per (suite, condition, policy), in order of first appearance: ``n``, ``failure_rate``
+    with its interval, the failure reasons with their counts, ``<metric>_mean``, ``_ci_low``,
+    ``_ci_high``, ``_std``, ``_cvar10`` of every metric (default: :data:`SUMMARY_METRICS` and those of
+    :data:`V1_METRICS` the records carry) and ``rank`` (:func:`rank`)."""
     groups: dict[tuple[Any, ...], list[dict[str, Any]]] = {}
     for r in records:
         groups.setdefault(tuple(r[k] for k in GROUP_KEYS), []).append(r)
     rows = []
     for key, recs in groups.items():
         first = recs[0]
+        names = metrics if metrics is not None else SUMMARY_METRICS + tuple(m for m in V1_METRICS if m in first)
         row: dict[str, Any] = dict(zip(GROUP_KEYS, key))
         for k in ("group", "model", "wind"):
             if k in first:
                 row[k] = first[k]
         row["n"] = len(recs)
-        failed = [bool(r["failed"]) for r in recs]
+        failed = np.array([bool(r["failed"]) for r in recs], dtype=float)
         row["failure_rate"] = float(np.mean(failed))
+        row["failure_rate_ci_low"], row["failure_rate_ci_high"] = bootstrap_ci(failed)
         reasons: dict[str, int] = {}
         for r in recs:
             if r["failed"]:
                 reasons[r["failure_reason"]] = reasons.get(r["failure_reason"], 0) + 1
         row["failure_reasons"] = "; ".join(f"{k}: {v}" for k, v in sorted(reasons.items()))
-        for m in metrics:
+        for m in names:
             x = np.array([r[m] for r in recs], dtype=float)
             row[f"{m}_mean"] = float(np.mean(x))
+            row[f"{m}_ci_low"], row[f"{m}_ci_high"] = bootstrap_ci(x)
             row[f"{m}_std"] = _std(x)
             row[f"{m}_cvar10"] = cvar(x, CVAR_LEVEL, m not in HIGHER_IS_BETTER)
         rows.append(row)
+    rank(rows)
     return rows
 
 
-def degradation(summary: Iterable[dict[str, Any]], metric: str = "rate_error_rad",
-                reference_model: str = "rigid") -> list[dict[str, Any]]:
+def per_seed(records: Iterable[dict[str, Any]], metric: str) -> dict[tuple[Any, ...], dict[int, float]]:
+    """``{(suite, condition, policy): {seed: value}}`` of ``metric``."""
+    out: dict[tuple[Any, ...], dict[int, float]] = {}
+    for r in records:
+        out.setdefault(tuple(r[k] for k in GROUP_KEYS), {})[int(r["seed"])] = float(r[metric])
+    return out
+
+
+def degradation(summary: Iterable[dict[str, Any]], metric: str = "rate_error_rad", reference_model: str = "rigid",
+                records: Iterable[dict[str, Any]] | None = None) -> list[dict[str, Any]]:
     """Per (suite, group, policy), every non-reference condition against the reference (``rigid``) one:
     ``ratio = mean / mean_rigid``, ``diff = mean - mean_rigid`` (units of ``metric``), the same for the
-    CVaR10, and ``failure_rate_diff``. A zero reference mean gives a ratio of ``inf`` (or NaN for 0/0)."""
+    CVaR10, the failure rates (``failure_rate_<reference_model>``, ``failure_rate``) and
+    ``failure_rate_diff``. A zero reference mean gives a ratio of ``inf`` (or NaN for 0/0). With
+    ``records``: the paired comparison of the two conditions on their common seeds
+    (:func:`.stats.paired` of ``metric``, model minus reference): ``paired_n``, ``diff_ci_low``,
+    ``diff_ci_high``, ``p_wilcoxon``, ``p_ttest`` (NaN without common seeds)."""
     rows = list(summary)
+    seeds = per_seed(records, metric) if records is not None else None
     ref = {(r["suite"], r.get("group", r["suite"]), r["policy"]): r for r in rows if r.get("model") == reference_model}
     out = []
     for r in rows:
@@ -201,6 +258,18 @@ def degradation(summary: Iterable[dict[str, Any]], metric: str = "rate_error_rad
             d[f"{stat}_diff"] = a - b
             with np.errstate(divide="ignore", invalid="ignore"):
                 d[f"{stat}_ratio"] = float(np.float64(a) / np.float64(b))
+        d[f"failure_rate_{reference_model}"] = float(base["failure_rate"])
+        d["failure_rate"] = float(r["failure_rate"])
         d["failure_rate_diff"] = float(r["failure_rate"] - base["failure_rate"])
+        if seeds is not None:
+            mine = seeds.get((r["suite"], r["condition"], r["policy"]), {})
+            theirs = seeds.get((base["suite"], base["condition"], base["policy"]), {})
+            common = sorted(set(mine) & set(theirs))
+            d["paired_n"] = len(common)
+            if common:
+                p = paired([mine[s] for s in common], [theirs[s] for s in common])
+                d.update(diff_ci_low=p.ci_low, diff_ci_high=p.ci_high, p_wilcoxon=p.p_wilcoxon, p_ttest=p.p_ttest)
+            else:
+                d.update(diff_ci_low=math.nan, diff_ci_high=math.nan, p_wilcoxon=math.nan, p_ttest=math.nan)
         out.append(d)
     return out

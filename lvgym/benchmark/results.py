@@ -7,9 +7,11 @@ either complete (new or old) or absent, never half-written; an exception while w
 temporary file, and temporaries left by killed processes are removed by the next write to the folder.
 
 Files (:func:`write_results`): ``episodes.csv`` (one row per episode, SI units and radians),
-``summary.csv`` (per suite, condition and policy), ``degradation.csv``, ``table.md`` (what
-:func:`markdown_table` prints), ``results.json`` (all of it with the run's metadata; written last),
-``rate_error.png`` and ``degradation.png``.
+``summary.csv`` (per suite, condition and policy, with intervals and ranks), ``degradation.csv`` (one row
+per policy, condition and metric: ``rate_error_rad`` and ``score``), ``comparison.csv`` (the paired
+comparison, :mod:`.compare`), ``run_groups.csv`` (agents over training runs, when there are any),
+``table.md`` (what :func:`~.tables.markdown_table` prints), ``results.json`` (all of it with the run's
+metadata; written last), ``rate_error.png`` and ``degradation.png``.
 """
 
 from __future__ import annotations
@@ -26,6 +28,11 @@ from pathlib import Path
 from typing import IO, Any
 
 import numpy as np
+
+from .tables import markdown_table
+
+__all__ = ["atomic_path", "atomic_write", "atomic_write_text", "csv_text", "json_text", "markdown_table",
+           "plot_degradation", "plot_rate_error", "remove_stale_temporaries", "write_results"]
 
 _TMP = re.compile(r"^\..+\.(\d+)\.tmp$")
 
@@ -121,52 +128,6 @@ def json_text(obj: Any) -> str:
     return json.dumps(_plain(obj), indent=1, sort_keys=False) + "\n"
 
 
-def _pct(x: float) -> str:
-    return f"{100.0 * x:.0f} %"
-
-
-def markdown_table(summary: Sequence[Mapping[str, Any]], degradation: Sequence[Mapping[str, Any]],
-                   meta: Mapping[str, Any] | None = None) -> str:
-    """The comparison as Markdown: per suite one table (condition x policy) and one of the degradation.
-
-    Columns: cumulative pitch + yaw rate error [rad] (mean +- std, CVaR10), mean of the maximum rate
-    error [deg/s], control effort [deg s], maximum angle of attack [deg] (q >= 5 kPa) and q-alpha
-    [kPa deg], failure rate; degradation: rate error of the non-rigid condition over the rigid one."""
-    meta = dict(meta or {})
-    out: list[str] = []
-    suites = list(dict.fromkeys(r["suite"] for r in summary))
-    for suite in suites:
-        rows = [r for r in summary if r["suite"] == suite]
-        info = meta.get("suites", {}).get(suite, {}) if isinstance(meta.get("suites"), Mapping) else {}
-        head = f"### {suite}"
-        if info:
-            head += (f" (protocol {info.get('version', '?')}, {meta.get('seed_set', '?')} seeds "
-                     f"{info.get('first_seed', '?')}-{info.get('last_seed', '?')}, {rows[0]['n']} episodes each)")
-        out += [head, "", "| condition | policy | rate error [rad] | CVaR10 [rad] | max rate [deg/s] | effort [deg s] "
-                "| max alpha [deg] | max q-alpha [kPa deg] | failures |",
-                "|---|---|---:|---:|---:|---:|---:|---:|---:|"]
-        for r in rows:
-            d = math.degrees
-            fail = _pct(r["failure_rate"]) + (f" ({r['failure_reasons']})" if r.get("failure_reasons") else "")
-            out.append(f"| {r['condition'].split('/')[-1]} | {r['policy']} "
-                       f"| {r['rate_error_rad_mean']:.4f} ± {r['rate_error_rad_std']:.4f} "
-                       f"| {r['rate_error_rad_cvar10']:.4f} | {d(r['max_rate_radps_mean']):.3f} "
-                       f"| {d(r['effort_rad_s_mean']):.2f} | {d(r['max_alpha_rad_mean']):.2f} "
-                       f"| {r['max_qalpha_pa_deg_mean'] / 1e3:.2f} | {fail} |")
-        deg = [g for g in degradation if g["suite"] == suite]
-        if deg:
-            out += ["", f"Rigid-to-non-rigid degradation of the rate error ({suite}): ratio = non-rigid / rigid, "
-                    "diff = non-rigid - rigid", "",
-                    "| policy | condition | rigid [rad] | non-rigid [rad] | ratio | diff [rad] | CVaR10 ratio "
-                    "| failure rate diff |", "|---|---|---:|---:|---:|---:|---:|---:|"]
-            for g in deg:
-                out.append(f"| {g['policy']} | {g['condition'].split('/')[-1]} | {g['rigid_mean']:.4f} "
-                           f"| {g['mean']:.4f} | {g['mean_ratio']:.3f} | {g['mean_diff']:+.4f} "
-                           f"| {g['cvar10_ratio']:.3f} | {100.0 * g['failure_rate_diff']:+.0f} pp |")
-        out.append("")
-    return "\n".join(out)
-
-
 # ---------------------------------------------------------------------------------------------- plots
 def _figure(width: float, height: float) -> Any:
     """A matplotlib Figure on the Agg canvas (no pyplot, no global backend change)."""
@@ -212,26 +173,31 @@ def plot_rate_error(records: Sequence[Mapping[str, Any]], write_to: IO[bytes]) -
 
 
 def plot_degradation(degradation: Sequence[Mapping[str, Any]], write_to: IO[bytes]) -> None:
-    """Bars of the rigid-to-non-rigid ratio of the mean rate error per suite and policy (1 = no change)."""
-    fig = _figure(6.0, 3.8)
-    ax = fig.add_subplot(1, 1, 1)
-    labels = list(dict.fromkeys(f"{g['suite']}\n{g['condition'].split('/')[-1]}" for g in degradation))
-    pols = list(dict.fromkeys(g["policy"] for g in degradation))
-    width = 0.8 / max(1, len(pols))
-    for j, pol in enumerate(pols):
-        xs, ys = [], []
-        for g in degradation:
-            if g["policy"] == pol:
-                label = f"{g['suite']}\n{g['condition'].split('/')[-1]}"
-                xs.append(labels.index(label) + (j - (len(pols) - 1) / 2) * width)
-                ys.append(g["mean_ratio"] if math.isfinite(g["mean_ratio"]) else np.nan)
-        ax.bar(xs, ys, width * 0.9, color=f"C{j}", label=pol)
-    ax.axhline(1.0, color="k", lw=0.8)
-    ax.set_xticks(range(len(labels)), labels, fontsize=8)
-    ax.set_ylabel("rate error, non-rigid / rigid")
-    ax.grid(alpha=0.3, axis="y")
-    if pols:
-        ax.legend(fontsize=8)
+    """Bars of the rigid-to-non-rigid ratio of the mean per suite and policy (1 = no change), one panel
+    per metric of the rows (``score``, which counts failures, and ``rate_error_rad``)."""
+    labels_of = {"score": "score", "rate_error_rad": "rate error"}
+    metrics = list(dict.fromkeys(g.get("metric", "rate_error_rad") for g in degradation))
+    fig = _figure(6.0 * max(1, len(metrics)), 3.8)
+    for k, metric in enumerate(metrics):
+        rows = [g for g in degradation if g.get("metric", "rate_error_rad") == metric]
+        ax = fig.add_subplot(1, len(metrics), k + 1)
+        labels = list(dict.fromkeys(f"{g['suite']}\n{g['condition'].split('/')[-1]}" for g in rows))
+        pols = list(dict.fromkeys(g["policy"] for g in rows))
+        width = 0.8 / max(1, len(pols))
+        for j, pol in enumerate(pols):
+            xs, ys = [], []
+            for g in rows:
+                if g["policy"] == pol:
+                    label = f"{g['suite']}\n{g['condition'].split('/')[-1]}"
+                    xs.append(labels.index(label) + (j - (len(pols) - 1) / 2) * width)
+                    ys.append(g["mean_ratio"] if math.isfinite(g["mean_ratio"]) else np.nan)
+            ax.bar(xs, ys, width * 0.9, color=f"C{j}", label=pol)
+        ax.axhline(1.0, color="k", lw=0.8)
+        ax.set_xticks(range(len(labels)), labels, fontsize=8)
+        ax.set_ylabel(f"{labels_of.get(metric, metric)}, non-rigid / rigid")
+        ax.grid(alpha=0.3, axis="y")
+        if pols:
+            ax.legend(fontsize=8)
     fig.tight_layout()
     fig.savefig(write_to, format="png")
 
@@ -239,7 +205,8 @@ def plot_degradation(degradation: Sequence[Mapping[str, Any]], write_to: IO[byte
 # ---------------------------------------------------------------------------------------------- all files
 def write_results(out: str | os.PathLike[str], records: Sequence[Mapping[str, Any]],
                   summary: Sequence[Mapping[str, Any]], degradation: Sequence[Mapping[str, Any]],
-                  meta: Mapping[str, Any], plots: bool = True) -> dict[str, Path]:
+                  meta: Mapping[str, Any], plots: bool = True, comparison: Sequence[Mapping[str, Any]] = (),
+                  groups: Sequence[Mapping[str, Any]] = ()) -> dict[str, Path]:
     """Write every result file into ``out`` (created if missing), each atomically; ``results.json``
     last. Returns the paths by name."""
     folder = Path(out)
@@ -249,12 +216,18 @@ def write_results(out: str | os.PathLike[str], records: Sequence[Mapping[str, An
     paths["episodes.csv"] = atomic_write_text(folder / "episodes.csv", csv_text(records))
     paths["summary.csv"] = atomic_write_text(folder / "summary.csv", csv_text(summary))
     paths["degradation.csv"] = atomic_write_text(folder / "degradation.csv", csv_text(degradation))
-    paths["table.md"] = atomic_write_text(folder / "table.md", markdown_table(summary, degradation, meta))
+    if comparison:
+        paths["comparison.csv"] = atomic_write_text(folder / "comparison.csv", csv_text(comparison))
+    if groups:
+        paths["run_groups.csv"] = atomic_write_text(folder / "run_groups.csv", csv_text(groups))
+    paths["table.md"] = atomic_write_text(folder / "table.md",
+                                          markdown_table(summary, degradation, meta, comparison, groups))
     if plots:
         paths["rate_error.png"] = atomic_write(folder / "rate_error.png", lambda f: plot_rate_error(records, f), True)
         if degradation:
             paths["degradation.png"] = atomic_write(folder / "degradation.png",
                                                     lambda f: plot_degradation(degradation, f), True)
     paths["results.json"] = atomic_write_text(folder / "results.json", json_text(
-        {"meta": meta, "summary": summary, "degradation": degradation, "episodes": records}))
+        {"meta": meta, "summary": summary, "degradation": degradation, "comparison": list(comparison),
+         "run_groups": list(groups), "episodes": records}))
     return paths

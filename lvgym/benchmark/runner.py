@@ -20,8 +20,8 @@ from lvgym.parallel import EXECUTORS, default_workers, run_map
 
 from .metrics import TrajectoryBuilder, episode_metrics
 from .policy import Policy, ZeroPolicy
+from .scoring import FlightLog, flight_metrics
 from .suites import PROTOCOL_VERSION, Condition, Suite
-
 
 
 @dataclass(frozen=True)
@@ -87,19 +87,30 @@ def _env(condition: Condition) -> Any:
 
 
 def play_episode(policy: Policy, env: Any, seed: int) -> dict[str, Any]:
-    """Fly one episode of a policy object on an lvgym env reset with ``seed``; returns
-    :func:`~.metrics.episode_metrics`. In-process (e.g. a validation callback during training:
-    ``play_episode(policy, condition.make_env(), seed)`` over ``suite.seeds("validation", n)``)."""
+    """Fly one episode of a policy object on an lvgym env reset with ``seed``; returns protocol v0's
+    :func:`~.metrics.episode_metrics` (frozen) and, beside them, the v1 metrics of
+    :func:`~.scoring.flight_metrics` (``score``, the per-phase rate errors, the flexibility metrics,
+    ``qalpha_cost_s``; its ``rate_error_rad`` and failure fields are v0's, bit for bit). In-process (e.g.
+    a validation callback during training: ``play_episode(policy, condition.make_env(), seed)`` over
+    ``suite.seeds("validation", n)``)."""
     obs, info = env.reset(seed=int(seed))
     policy.reset()
     traj = TrajectoryBuilder(float(env.unwrapped.task.control_dt_s))
+    log = FlightLog.for_env(env)
     while True:
         action = policy.act(obs, info)
         obs, reward, terminated, truncated, info = env.step(action)
         traj.add(reward, info)
+        log.step(env, obs, reward, info)
         if terminated or truncated:
             break
-    return episode_metrics(traj.build())
+    record = episode_metrics(traj.build())
+    v1 = flight_metrics(log)
+    for key in ("rate_error_rad", "failed", "failure_reason"):     # one definition, written once (v0's)
+        value = v1.pop(key)
+        if value != record[key]:
+            raise AssertionError(f"{key}: v1 {value!r} against v0 {record[key]!r}")
+    return {**record, **v1}
 
 
 def run_episode(policy_spec: PolicySpec, condition: Condition, seed: int) -> dict[str, Any]:

@@ -18,6 +18,13 @@ rate_error_<phase>_rad      rad     the same within each phase (``PHASES``, they
                                     next ignition, ``upper`` after that ignition (0 for a phase not flown)
 peak_eta                    sqrt(kg) m  largest |modal coordinate| of any mode and plane
 peak_slosh_deg              deg     largest pendulum angle from the body axis (pendulums with mass)
+gyro_minus_body_rate_rad    rad     ``int (|g_pitch - w_pitch| + |g_yaw - w_yaw|) dt``: the rate the observation's
+                                    gyro gives (``g``: its ``pitch_rate_error`` plus ``pitch_rate_reference``,
+                                    its ``yaw_rate_error``) against the body rate ``w`` (``omega_bi_b``) at the
+                                    end of each control step: the bending slope rate at the IMU, bias, noise
+                                    and whatever sensor dynamics and delay the observation has; 0.0 when the
+                                    observation is the ideal state (``IDEAL_OBSERVATIONS``: its rate *is* the
+                                    body rate, nothing is measured)
 gimbal_rate_limit_s         s       time at the gimbal rate limit (within 1 %)
 qalpha_cost_s               s       time with q-alpha above ``QALPHA_COST_FRACTION`` of the structural limit,
                                     a constraint cost for safe RL (the termination stays at the limit)
@@ -33,54 +40,77 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["FlightLog", "MAX_Q_FRACTION", "PHASES", "QALPHA_COST_FRACTION", "flight_metrics"]
+__all__ = ["FlightLog", "IDEAL_OBSERVATIONS", "MAX_Q_FRACTION", "PHASES", "QALPHA_COST_FRACTION", "flight_metrics"]
 
 PHASES = ("boost", "max_q", "coast", "upper")
 #: the max-q region: dynamic pressure at least this fraction of its peak before the first burnout [-]
 MAX_Q_FRACTION = 0.8
 #: q-alpha above this fraction of the structural limit counts towards the constraint cost [-]
 QALPHA_COST_FRACTION = 0.8
+#: observation options whose rates are the body's own (no gyro): ``gyro_minus_body_rate_rad`` is 0 there
+IDEAL_OBSERVATIONS = ("state",)
+#: observation entries that carry the gyro's view of the body rate [rad/s]
+GYRO_ENTRIES = ("pitch_rate_error", "yaw_rate_error", "pitch_rate_reference")
 
 
 @dataclass
 class FlightLog:
-    """One episode, step by step (``add(reward, info)``), with the task's facts: ``dt_s`` control period,
-    ``mission_time_s``, ``failure_penalty_rad_per_s``, ``qalpha_limit_pa_deg``, ``gimbal_rate_limit_radps``
-    (0: not counted). Build it from an lvgym env with :meth:`for_env`."""
+    """One episode, step by step (``add(reward, info)``, or :meth:`step` with the env and observation),
+    with the task's facts: ``dt_s`` control period, ``mission_time_s``, ``failure_penalty_rad_per_s``,
+    ``qalpha_limit_pa_deg``, ``gimbal_rate_limit_radps`` (0: not counted) and ``gyro_index``: the
+    observation's indices of :data:`GYRO_ENTRIES` (None: an ideal-state observation, no gyro). Build it from
+    an lvgym env with :meth:`for_env`."""
 
     dt_s: float
     mission_time_s: float
     failure_penalty_rad_per_s: float
     qalpha_limit_pa_deg: float
     gimbal_rate_limit_radps: float = 0.0
+    gyro_index: tuple[int, int, int] | None = None
     rows: list[tuple[Any, ...]] = field(default_factory=list)
+    gyro_rows: list[tuple[float, float]] = field(default_factory=list)
+    eta: list[Any] = field(default_factory=list)
+    slosh: list[Any] = field(default_factory=list)
     events: list[tuple[float, str]] = field(default_factory=list)
-    peak_eta: float = 0.0
-    peak_slosh: float = 0.0
     termination: str = ""
 
     @classmethod
     def for_env(cls, env: Any) -> FlightLog:
         u = env.unwrapped
         s = u.task
+        gyro = None
+        if s.observation not in IDEAL_OBSERVATIONS:
+            gyro = tuple(u.observation_layout.index(name) for name in GYRO_ENTRIES)
         return cls(s.control_dt_s, s.mission_time_s, s.failure_penalty_rad_per_s, s.qalpha_limit_pa_deg,
-                   math.radians(s.gimbal_rate_limit_degps))
+                   math.radians(s.gimbal_rate_limit_degps), gyro)
 
-    def add(self, reward: float, info: dict[str, Any]) -> None:
-        """Record one step's info."""
-        e = np.asarray(info["rate_error"], dtype=float)
-        rate = np.asarray(info.get("gimbal_rate", (0.0, 0.0)), dtype=float)
-        self.rows.append((float(info["time"]), e[1] + e[2], float(info["qbar"]), float(info["qalpha_pa_deg"]),
-                          float(np.max(np.abs(rate))) if rate.size else 0.0))
-        eta = np.abs(np.asarray(info.get("eta", ()), dtype=float))
-        if eta.size and np.isfinite(eta).any():
-            self.peak_eta = max(self.peak_eta, float(np.nanmax(eta)))
-        slosh = np.abs(np.asarray(info.get("slosh_angles", ()), dtype=float))
-        if slosh.size and np.isfinite(slosh).any():
-            self.peak_slosh = max(self.peak_slosh, float(np.nanmax(slosh)))
-        self.events += [(float(t), str(text)) for t, text in info.get("events", ())]
+    def add(self, reward: float, info: dict[str, Any], gyro_minus_body_radps: tuple[float, float] | None = None) -> None:
+        """Record one step's info (and, with a gyro, the step's gyro minus body rate, pitch and yaw [rad/s]).
+        Arrays are kept as they come (an env's info holds fresh arrays every step) and reduced by
+        :func:`flight_metrics`."""
+        self.rows.append((info["time"], info["rate_error"], info["qbar"], info["qalpha_pa_deg"],
+                          info.get("gimbal_rate", (0.0, 0.0))))
+        if gyro_minus_body_radps is not None:
+            self.gyro_rows.append(gyro_minus_body_radps)
+        if "eta" in info:
+            self.eta.append(info["eta"])
+        if "slosh_angles" in info:
+            self.slosh.append(info["slosh_angles"])
+        if info.get("events"):
+            self.events += [(float(t), str(text)) for t, text in info["events"]]
         if info.get("termination"):
             self.termination = str(info["termination"])
+
+    def step(self, env: Any, observation: np.ndarray, reward: float, info: dict[str, Any]) -> None:
+        """Record one ``env.step``'s result: :meth:`add`, with the gyro's view read from ``observation``
+        against the body rate of the env's state (lvgym envs) when the observation has a gyro."""
+        diff = None
+        if self.gyro_index is not None:
+            u = env.unwrapped
+            w = u.sim.state("omega_bi_b", u.state.sim)[0]
+            ip, iy, iref = self.gyro_index
+            diff = (float(observation[ip]) + float(observation[iref]) - w[1], float(observation[iy]) - w[2])
+        self.add(reward, info, diff)
 
 
 def _phase_masks(t: np.ndarray, qbar: np.ndarray, events: list[tuple[float, str]]) -> dict[str, np.ndarray]:
@@ -97,24 +127,50 @@ def _phase_masks(t: np.ndarray, qbar: np.ndarray, events: list[tuple[float, str]
     return {"boost": first & ~max_q, "max_q": max_q, "coast": (t > burnout) & (t <= ignition), "upper": t > ignition}
 
 
+def _peak(arrays: list[Any]) -> float:
+    """Largest absolute finite value of the recorded arrays (0.0 for none: no mode, no pendulum with mass)."""
+    if not arrays:
+        return 0.0
+    try:
+        x = np.abs(np.asarray(arrays, dtype=float)).ravel()
+    except ValueError:                                 # shapes that change within the episode
+        x = np.abs(np.concatenate([np.ravel(np.asarray(a, dtype=float)) for a in arrays]))
+    x = x[np.isfinite(x)]
+    return float(x.max()) if x.size else 0.0
+
+
 def flight_metrics(log: FlightLog) -> dict[str, Any]:
-    """The v1 metrics of one episode (see the module docstring)."""
+    """The v1 metrics of one episode (see the module docstring). ``rate_error_rad`` is summed as protocol
+    v0's :func:`~.metrics.episode_metrics` sums it (per axis, then pitch + yaw), so the two agree bit for bit."""
     dt = float(log.dt_s)
-    if log.rows:
-        t, e, qbar, qalpha, rate = (np.array(c, dtype=float) for c in zip(*log.rows))
+    n = len(log.rows)
+    if n:
+        cols = list(zip(*log.rows))
+        t, qbar, qalpha = (np.array(cols[i], dtype=float) for i in (0, 2, 3))
+        e = np.array(cols[1], dtype=float)
+        rate = np.abs(np.array(cols[4], dtype=float)).reshape(n, -1)
+        rate = rate.max(axis=1) if rate.shape[1] else np.zeros(n)
     else:
-        t = e = qbar = qalpha = rate = np.zeros(0)
-    e = np.nan_to_num(e, nan=0.0)
-    out: dict[str, Any] = {"rate_error_rad": float(e.sum() * dt)}
+        t = qbar = qalpha = rate = np.zeros(0)
+        e = np.zeros((0, 3))
+    e = np.abs(np.nan_to_num(np.reshape(e, (n, 3)), nan=0.0))
+    integral = e.sum(axis=0) * dt if n else np.zeros(3)
+    out: dict[str, Any] = {"rate_error_rad": float(integral[1] + integral[2])}
     failed = bool(log.termination)
     t_end = float(t[-1]) if t.size else 0.0
     charge = log.failure_penalty_rad_per_s * max(log.mission_time_s - t_end, 0.0) if failed else 0.0
     out["score"] = out["rate_error_rad"] + charge
     masks = _phase_masks(t, qbar, log.events) if t.size else {p: np.zeros(0, bool) for p in PHASES}
+    pitch_yaw = e[:, 1] + e[:, 2]
     for name in PHASES:
-        out[f"rate_error_{name}_rad"] = float(e[masks[name]].sum() * dt)
-    out["peak_eta"] = float(log.peak_eta)
-    out["peak_slosh_deg"] = math.degrees(log.peak_slosh)
+        out[f"rate_error_{name}_rad"] = float(pitch_yaw[masks[name]].sum() * dt)
+    out["peak_eta"] = _peak(log.eta)
+    out["peak_slosh_deg"] = math.degrees(_peak(log.slosh))
+    if log.gyro_index is not None and log.gyro_rows:
+        g = np.abs(np.nan_to_num(np.array(log.gyro_rows, dtype=float), nan=0.0))
+        out["gyro_minus_body_rate_rad"] = float(g.sum() * dt)
+    else:
+        out["gyro_minus_body_rate_rad"] = 0.0
     lim = float(log.gimbal_rate_limit_radps)
     out["gimbal_rate_limit_s"] = float(np.sum(rate >= 0.99 * lim) * dt) if lim > 0 else 0.0
     out["qalpha_cost_s"] = float(np.sum(np.nan_to_num(qalpha) > QALPHA_COST_FRACTION * log.qalpha_limit_pa_deg) * dt)

@@ -1,0 +1,191 @@
+"""The comparison as Markdown: per suite the ranked summary, the rate error per flight phase, the
+rigid-to-non-rigid degradation and the paired comparison of the policies.
+
+Every mean is printed with its 95 % bootstrap interval over the seeds as ``mean [low, high]``
+(:func:`.metrics.summarize`). Rows of a condition are in the order of :func:`.metrics.rank`: failure
+rate, then mean score (lower is better).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+from .metrics import rank
+from .scoring import PHASES
+
+__all__ = ["comparison_table", "degradation_table", "markdown_table", "phase_table", "run_groups_table",
+           "summary_table"]
+
+Row = Mapping[str, Any]
+
+
+def _ci(row: Row, metric: str, fmt: str = ".4f", scale: float = 1.0) -> str:
+    """``mean [low, high]`` of ``metric`` in ``row`` (times ``scale``); ``-`` when the row lacks it."""
+    if f"{metric}_mean" not in row:
+        return "-"
+    m, lo, hi = (scale * float(row.get(f"{metric}_{k}", math.nan)) for k in ("mean", "ci_low", "ci_high"))
+    return f"{m:{fmt}} [{lo:{fmt}}, {hi:{fmt}}]"
+
+
+def _interval(mean: float, lo: float, hi: float, fmt: str = ".4f") -> str:
+    return f"{mean:{fmt}} [{lo:{fmt}}, {hi:{fmt}}]"
+
+
+def _pct(x: float) -> str:
+    return f"{100.0 * x:.0f} %"
+
+
+def _failures(row: Row) -> str:
+    text = _pct(row["failure_rate"])
+    if "failure_rate_ci_low" in row:
+        text += f" [{100.0 * row['failure_rate_ci_low']:.0f}, {100.0 * row['failure_rate_ci_high']:.0f}]"
+    return text + (f" ({row['failure_reasons']})" if row.get("failure_reasons") else "")
+
+
+def _p(x: float) -> str:
+    return "-" if not math.isfinite(x) else f"{x:.3g}"
+
+
+def _short(condition: str) -> str:
+    return condition.split("/")[-1]
+
+
+def _suites(rows: Sequence[Row]) -> list[str]:
+    return list(dict.fromkeys(r["suite"] for r in rows))
+
+
+def _of_suite(rows: Sequence[Row], suite: str) -> list[Row]:
+    return [r for r in rows if r["suite"] == suite]
+
+
+def summary_table(summary: Sequence[Row]) -> list[str]:
+    """Lines of one suite's ranked table (condition x policy)."""
+    deg = math.degrees
+    out = ["| condition | policy | rank | failures [95 % CI] | score [rad] | rate error [rad] | CVaR10 [rad] "
+           "| max rate [deg/s] | effort [deg s] | max alpha [deg] | max q-alpha [kPa deg] |",
+           "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
+    for r in rank([dict(r) for r in summary]):
+        out.append(f"| {_short(r['condition'])} | {r['policy']} | {r['rank']} | {_failures(r)} | {_ci(r, 'score')} "
+                   f"| {_ci(r, 'rate_error_rad')} | {r['rate_error_rad_cvar10']:.4f} "
+                   f"| {_ci(r, 'max_rate_radps', '.2f', deg(1.0))} | {_ci(r, 'effort_rad_s', '.1f', deg(1.0))} "
+                   f"| {_ci(r, 'max_alpha_rad', '.2f', deg(1.0))} | {_ci(r, 'max_qalpha_pa_deg', '.1f', 1e-3)} |")
+    return out
+
+
+def phase_table(summary: Sequence[Row]) -> list[str]:
+    """Lines of one suite's table of the cumulative pitch + yaw rate error per flight phase (policy x
+    model; the phases add up to the total), or none when the rows lack the phases."""
+    if not summary or f"rate_error_{PHASES[0]}_rad_mean" not in summary[0]:
+        return []
+    head = " | ".join(f"{p.replace('_', ' ')} [rad]" for p in PHASES)
+    out = [f"| policy | model | {head} | total [rad] | failures |", "|---|---|" + "---:|" * (len(PHASES) + 2)]
+    policies = list(dict.fromkeys(r["policy"] for r in summary))
+    for pol in policies:
+        for r in (r for r in summary if r["policy"] == pol):
+            cells = " | ".join(_ci(r, f"rate_error_{p}_rad") for p in PHASES)
+            out.append(f"| {pol} | {r.get('model', _short(r['condition']))} | {cells} | {_ci(r, 'rate_error_rad')} "
+                       f"| {_pct(r['failure_rate'])} |")
+    return out
+
+
+def degradation_table(degradation: Sequence[Row]) -> list[str]:
+    """Lines of one suite's rigid-to-non-rigid table: the failure rates of both, then the score and the
+    rate error of both with the ratio and the paired difference (non-rigid - rigid) where computed."""
+    by_key: dict[tuple[Any, ...], dict[str, Row]] = {}
+    for g in degradation:
+        by_key.setdefault((g["policy"], g["condition"]), {})[g["metric"]] = g
+    metrics = [m for m in ("score", "rate_error_rad") if any(m in v for v in by_key.values())]
+    head, align = "| policy | condition | failures rigid | failures non-rigid |", "|---|---|---:|---:|"
+    label = {"score": "score", "rate_error_rad": "rate error"}
+    for m in metrics:
+        head += f" {label[m]} rigid [rad] | {label[m]} non-rigid [rad] | ratio | diff [rad] [95 % CI] | p (Wilcoxon) |"
+        align += "---:|---:|---:|---:|---:|"
+    out = [head, align]
+    for (pol, cond), rows in by_key.items():
+        first = next(iter(rows.values()))
+        line = (f"| {pol} | {_short(cond)} | {_pct(first['failure_rate_rigid'])} | {_pct(first['failure_rate'])} |"
+                if "failure_rate_rigid" in first else f"| {pol} | {_short(cond)} | - | - |")
+        for m in metrics:
+            g = rows.get(m)
+            if g is None:
+                line += " - | - | - | - | - |"
+                continue
+            diff = f"{g['mean_diff']:+.4f}"
+            if "diff_ci_low" in g:
+                diff += f" [{g['diff_ci_low']:+.4f}, {g['diff_ci_high']:+.4f}]"
+            line += (f" {g['rigid_mean']:.4f} | {g['mean']:.4f} | {g['mean_ratio']:.3f} | {diff} "
+                     f"| {_p(g.get('p_wilcoxon', math.nan))} |")
+        out.append(line)
+    return out
+
+
+def comparison_table(comparison: Sequence[Row]) -> list[str]:
+    """Lines of one suite's paired comparison with the reference policy of each condition."""
+    if not comparison:
+        return []
+    out = ["| condition | policy | rank | IQM score [rad] | against | diff [rad] [95 % CI] | wins/ties/losses "
+           "| p (Wilcoxon) | p (t) | P(better) [95 % CI] |", "|---|---|---:|---:|---|---:|---:|---:|---:|---:|"]
+    for c in comparison:
+        iqm = _interval(c["iqm"], c["iqm_ci_low"], c["iqm_ci_high"])
+        if c["policy"] == c["reference"]:
+            out.append(f"| {_short(c['condition'])} | {c['policy']} | {c['rank']} | {iqm} | (reference) | | | | | |")
+            continue
+        diff = f"{c['diff']:+.4f} [{c['diff_ci_low']:+.4f}, {c['diff_ci_high']:+.4f}]"
+        poi = _interval(c["p_improvement"], c["p_improvement_ci_low"], c["p_improvement_ci_high"], ".2f")
+        out.append(f"| {_short(c['condition'])} | {c['policy']} | {c['rank']} | {iqm} | {c['reference']} | {diff} "
+                   f"| {c['wins']}/{c['ties']}/{c['losses']} | {_p(c['p_wilcoxon'])} | {_p(c['p_ttest'])} | {poi} |")
+    return out
+
+
+def run_groups_table(groups: Sequence[Row]) -> list[str]:
+    """Lines of one suite's table of agents over their training runs."""
+    if not groups:
+        return []
+    out = ["| condition | agent | runs | episodes | mean score [rad] | IQM score [rad] [95 % CI] |",
+           "|---|---|---:|---:|---:|---:|"]
+    for g in groups:
+        out.append(f"| {_short(g['condition'])} | {g['agent']} | {g['runs']} | {g['episodes']} | {g['mean']:.4f} "
+                   f"| {_interval(g['iqm'], g['iqm_ci_low'], g['iqm_ci_high'])} |")
+    return out
+
+
+def _section(title: str, lines: list[str]) -> list[str]:
+    return ["", title, "", *lines] if lines else []
+
+
+def markdown_table(summary: Sequence[Row], degradation: Sequence[Row], meta: Mapping[str, Any] | None = None,
+                   comparison: Sequence[Row] = (), groups: Sequence[Row] = ()) -> str:
+    """The comparison as Markdown, per suite: the ranked summary (:func:`summary_table`), the rate
+    error per phase (:func:`phase_table`), the degradation (:func:`degradation_table`), the paired
+    comparison (:func:`comparison_table`) and the agents over training runs (:func:`run_groups_table`)."""
+    meta = dict(meta or {})
+    out: list[str] = []
+    for suite in _suites(summary):
+        rows = _of_suite(summary, suite)
+        info = meta.get("suites", {}).get(suite, {}) if isinstance(meta.get("suites"), Mapping) else {}
+        head = f"### {suite}"
+        if info:
+            head += (f" (protocol {info.get('version', '?')}, {meta.get('seed_set', '?')} seeds "
+                     f"{info.get('first_seed', '?')}-{info.get('last_seed', '?')}, {rows[0]['n']} episodes each)")
+        out += [head, "", "Ranked by failure rate, then by score (a failed episode's rate error plus the failure "
+                "penalty for the mission left); means with 95 % bootstrap intervals over the seeds.", "",
+                *summary_table(rows)]
+        out += _section(f"Cumulative pitch + yaw rate error per flight phase ({suite}): boost to max q, the max-q "
+                        "region, the staging coast, the upper stage; the phases add up to the total",
+                        phase_table(rows))
+        deg = _of_suite(degradation, suite)
+        out += _section(f"Rigid-to-non-rigid degradation ({suite}): ratio = non-rigid / rigid, diff = non-rigid - "
+                        "rigid on the same seeds. The score charges a failed episode for the mission left, so its "
+                        "degradation counts the failures; the rate error (the thesis's criterion) stops at a "
+                        "failure", degradation_table(deg) if deg else [])
+        comp = _of_suite(comparison, suite)
+        if comp:
+            out += _section(f"Paired comparison of the score ({suite}) with the reference policy of each "
+                            "condition on the same seeds: diff = policy - reference (negative: better); P(better): "
+                            "rliable's probability that an episode of the policy scores lower", comparison_table(comp))
+        out += _section(f"Agents over their training runs ({suite}): rliable's IQM of the score over "
+                        "(runs, episodes)", run_groups_table(_of_suite(groups, suite)))
+        out.append("")
+    return "\n".join(out)
