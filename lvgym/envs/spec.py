@@ -11,7 +11,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from lvgym.errors import ConfigError, check_choice, check_number
-from lvgym.simulator import MODELS
+from lvgym.simulator import MODE_BASES, MODELS, SLOSH_FREQUENCIES
 
 WIND_TIERS = ("none", "profile", "gust", "turbulence", "random")
 RANDOMIZE = ("wind", "thrust_misalignment", "mass", "slosh_damping", "bending_frequency", "sensor_noise")
@@ -65,7 +65,9 @@ class TaskSpec:
     effort_weight per rad of gimbal per second, effort_rate_weight per rad/s of gimbal rate per second,
     failure_penalty_rad_per_s times the remaining mission time on termination; qalpha_limit_pa_deg:
     structural limit of dynamic pressure times total angle of attack; attitude_limit_deg: largest
-    attitude error; n_modes: bending modes per plane (None: the vehicle's).
+    attitude error; n_modes: bending modes per plane (None: the vehicle's); mode_interval_s, mode_basis,
+    slosh_frequency: the Simulator's ``mode_interval`` (None: the vehicle's), ``mode_basis`` (``held`` v0,
+    ``projected``) and ``slosh_frequency`` (``vacuum_thrust`` v0, ``specific_force``).
     """
 
     vehicle: Any
@@ -104,6 +106,9 @@ class TaskSpec:
     gyro_bias_radps: float = 1e-3
     accel_noise_mps2: float = 0.05
     attitude_noise_rad: float = 1e-3
+    mode_interval_s: float | None = None
+    mode_basis: str = "held"
+    slosh_frequency: str = "vacuum_thrust"
 
     def __post_init__(self) -> None:
         check_choice("model", self.model, MODELS)
@@ -113,6 +118,10 @@ class TaskSpec:
         check_choice("reference_velocity", self.reference_velocity, REFERENCE_VELOCITIES)
         check_number("action_delay_steps", self.action_delay_steps, 0, 50, integer=True)
         check_choice("control", self.control, CONTROLS)
+        check_choice("mode_basis", self.mode_basis, MODE_BASES)
+        check_choice("slosh_frequency", self.slosh_frequency, SLOSH_FREQUENCIES)
+        if self.mode_interval_s is not None:
+            check_number("mode_interval_s", self.mode_interval_s, 0.0, 1e5, lo_open=True)
         r = self.randomize
         names = set(RANDOMIZE) if r is True else set() if r in (False, None) else set(r) if not isinstance(r, str) else {r}
         bad = sorted(names - set(RANDOMIZE))

@@ -45,6 +45,7 @@ import numpy as np
 
 from lvgym.environment import LaunchSite, make
 from lvgym.environment.earth import WGS84_OMEGA, dcm_to_quat
+from lvgym.errors import check_choice
 from lvgym.parallel import default_workers
 from lvgym.rotations import quat_to_dcm_batch
 from lvgym.vehicle import MassModel, Vehicle, load_vehicle
@@ -54,6 +55,7 @@ from .advance import StepSetup, advance_range, conditions_rows, constrain_k, slo
 from .data import SimData
 from .flight import flight_loads, pack_context, stack_contexts
 from .layouts import ACTUATOR, CONDITIONS, CONTEXT, RAIL, RAIL_STATE, RS
+from .piece import SLOSH_FREQUENCIES
 from .servo import DIRECT, Servo
 from .timeline import MODELS, Timeline, build_timeline
 
@@ -128,6 +130,14 @@ class Simulator:
         the RK4 step, ``1 / (2 physics_dt)``, are decoupled, see :func:`.timeline.build_timeline`);
         sensor_stations [m]: where the mode slopes are tabulated (an IMU); cg_convention: ``static`` or
         ``thesis``; timeline_dt [s]; timeline: a prebuilt :class:`Timeline` to share between simulators.
+    mode_interval [s]: recompute the modes also every so many seconds (None: the vehicle file's setting);
+        mode_basis: ``held`` (v0: the modal coordinates kept as numbers across a change of the modes) or
+        ``projected`` (the deflection field kept, see :mod:`.timeline`); with a prebuilt ``timeline`` they
+        must be its own (``mode_interval`` None or equal).
+    slosh_frequency: the pendulums' damper frequency, ``vacuum_thrust`` (v0: ``sqrt(T_0 / m / L)`` from the
+        timeline's vacuum thrust) or ``specific_force`` (``sqrt(|a_x| / L)`` from the axial specific force,
+        thrust at ambient pressure plus the aerodynamic axial force over the mass, of the row's latest
+        flight conditions; see :mod:`.piece`).
     """
 
     def __init__(self, vehicle: str | Vehicle = "smile", model: str = "nonrigid", *, site: Any = "andoya",
@@ -135,7 +145,8 @@ class Simulator:
                  t_end: float = 60.0, physics_dt: float = 0.01, elevation_deg: float = 90.0, rail_length: float = 0.0,
                  n_modes: int | None = None, sensor_stations: Sequence[float] = (), cg_convention: str = "static",
                  timeline_dt: float = 0.05, timeline: Timeline | None = None, servo: Servo | None = None,
-                 threads: int | None = None) -> None:
+                 threads: int | None = None, mode_interval: float | None = None, mode_basis: str = "held",
+                 slosh_frequency: str = "vacuum_thrust") -> None:
         if model not in MODELS:
             raise ValueError(f"model = {model!r}: one of {MODELS}")
         if not 0.0 < physics_dt <= 0.1:
@@ -169,10 +180,16 @@ class Simulator:
         self.elevation = math.radians(elevation_deg)
         self.rail_length = float(rail_length)
         self.mass_model = MassModel(self.vehicle, cg_convention)
+        self.slosh_frequency = check_choice("slosh_frequency", slosh_frequency, SLOSH_FREQUENCIES)
         self.timeline = timeline if timeline is not None else build_timeline(
-            self.mass_model, model, t_end, timeline_dt, n_modes, sensor_stations, 0.5 / physics_dt)
+            self.mass_model, model, t_end, timeline_dt, n_modes, sensor_stations, 0.5 / physics_dt,
+            mode_interval=mode_interval, mode_basis=mode_basis)
         if timeline is not None and timeline.model != model:
             raise ValueError(f"the timeline flies model {timeline.model!r}, not {model!r}")
+        if timeline is not None and (mode_basis != timeline.mode_basis or
+                                     mode_interval not in (None, timeline.mode_interval)):
+            raise ValueError(f"mode_basis = {mode_basis!r}, mode_interval = {mode_interval!r}: the timeline's are "
+                             f"{timeline.mode_basis!r}, {timeline.mode_interval!r}")
         self.dynamics = self.timeline.dynamics
         self.layout = self.dynamics.layout
         self._i_cg = self.layout.params["r_cg"].start
@@ -191,7 +208,8 @@ class Simulator:
         self.tables = self.timeline.tables
         self.setup = StepSetup(rail=self.rail, servo=DIRECT if servo is None else servo.params(),
                                physics_dt=self.physics_dt, n_slosh=self.dynamics.n_slosh,
-                               n_modes=self.dynamics.n_modes, n_u=self.layout.n_u)
+                               n_modes=self.dynamics.n_modes, n_u=self.layout.n_u,
+                               slosh_frequency=SLOSH_FREQUENCIES.index(self.slosh_frequency))
         self._event_times_all = np.array([t for t, _ in self.timeline.events], dtype=float)
         self.data: SimData = self.new_data(0)
 
