@@ -234,3 +234,25 @@ def test_a_prebuilt_timeline_must_match_the_mode_options(projected_timeline):
         Simulator("smile", model="nonrigid", timeline=projected_timeline)
     with pytest.raises(ValueError, match="mode_interval"):
         Simulator("smile", model="nonrigid", timeline=projected_timeline, mode_basis="projected", mode_interval=1.0)
+
+
+def test_task_options_reach_the_simulator():
+    import gymnasium as gym
+
+    import lvgym  # noqa: F401
+    from lvgym.errors import ConfigError
+    env = gym.make("lvgym/SmileAscent-v0", model="nonrigid", mission_time_s=5.0, mode_interval_s=2.0,
+                   mode_basis="projected", slosh_frequency="specific_force")
+    env.reset(seed=3)
+    sim = env.unwrapped.func.sim
+    assert sim.timeline.mode_basis == "projected" and sim.timeline.mode_interval == 2.0
+    assert sim.slosh_frequency == "specific_force" and sim.setup.slosh_frequency == 1
+    np.testing.assert_allclose(sim.timeline.mode_change_t, [2.0, 4.0, 6.0])
+    for _ in range(120):                                          # through the change at 2 s
+        env.step(np.zeros(2, dtype=np.float32))
+    default = gym.make("lvgym/SmileAscent-v0", mission_time_s=5.0).unwrapped.func
+    assert default.spec.mode_basis == "held" and default.spec.mode_interval_s is None
+    assert default.sim.slosh_frequency == "vacuum_thrust" and default.timeline.mode_change_t.size == 0
+    for key, value in (("mode_basis", "rotated"), ("slosh_frequency", "vacuum"), ("mode_interval_s", -1.0)):
+        with pytest.raises(ConfigError, match=key):
+            gym.make("lvgym/SmileAscent-v0", **{key: value})
