@@ -75,12 +75,14 @@ def cached_vehicle(key: Any) -> Vehicle:
 
 @functools.lru_cache(maxsize=32)
 def cached_timeline(key: Any, model: str, t_end: float, physics_dt: float, n_modes: int | None,
-                    imu: float, aeroelastic: bool | None = False) -> Timeline:
+                    imu: float, aeroelastic: bool | None = False, mode_interval: float | None = None,
+                    mode_basis: str = "held") -> Timeline:
     """Timelines are shared between the envs of a process (they are read-only)."""
     vehicle = cached_vehicle(key)
     stations = [imu, *np.linspace(0.0, -vehicle.length, RENDER_STATIONS).tolist()]
     return build_timeline(MassModel(vehicle), model, t_end, 0.05, n_modes, stations, 0.5 / physics_dt,
-                          strip_stations=aeroelastic_strips(vehicle, aeroelastic=aeroelastic))
+                          strip_stations=aeroelastic_strips(vehicle, aeroelastic=aeroelastic),
+                          mode_interval=mode_interval, mode_basis=mode_basis)
 
 
 def _shown(action: Any) -> str:
@@ -108,14 +110,14 @@ class AscentFuncEnv(FuncEnv):
         self.vehicle = vehicle = cached_vehicle(key)
         self.imu = s.imu_station_m if s.imu_station_m is not None else -0.25 * vehicle.length
         self.timeline = tl = cached_timeline(key, s.model, s.mission_time_s + 1.0, s.physics_dt_s, s.n_modes, self.imu,
-                                             s.aeroelastic)
+                                             s.aeroelastic, s.mode_interval_s, s.mode_basis)
         limits = [math.degrees(e.gimbal_limit) for e in vehicle.stages[0].engines if e.gimbal_limit is not None]
         self.gimbal_limit = math.radians(s.gimbal_limit_deg if s.gimbal_limit_deg is not None
                                          else (min(limits) if limits else 5.0))
         servo = Servo(s.actuator_frequency, s.actuator_damping, self.gimbal_limit, math.radians(s.gimbal_rate_limit_degps))
         self.sim = Simulator(vehicle, s.model, site=s.site, elevation_deg=s.elevation_deg,
                              rail_length=s.rail_length_m, physics_dt=s.physics_dt_s, timeline=tl, servo=servo,
-                             aeroelastic=s.aeroelastic)
+                             aeroelastic=s.aeroelastic, mode_basis=s.mode_basis, slosh_frequency=s.slosh_frequency)
         self.n_steps = int(round(s.mission_time_s / s.control_dt_s))
         self.observation_layout = OBSERVATIONS[s.observation]
         self.action_space = (spaces.Box(-1.0, 1.0, (2,), np.float32) if s.control == "tvc" else spaces.MultiDiscrete([3]))

@@ -11,7 +11,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from lvgym.errors import ConfigError, check_bool, check_choice, check_number
-from lvgym.simulator import MODELS
+from lvgym.simulator import MODE_BASES, MODELS, SLOSH_FREQUENCIES
 
 #: protocol v0's wind tiers, then v1's
 WIND_TIERS = ("none", "profile", "gust", "turbulence", "random", "turbulence_gust", "maxq_gust")
@@ -85,7 +85,9 @@ class TaskSpec:
     ``coast_bandwidth_radps`` [rad/s], each of pitch and yaw limited to ``coast_torque_nm`` [N m]);
     settling_thrust_n: axial thrust [N] of ullage motors along +x_b through the same coasts, so that the
     propellant stays settled against the drag (0: none); aeroelastic: the strip-theory
-    aeroelastic loads (True, False, None: the vehicle file's flag; False in v0).
+    aeroelastic loads (True, False, None: the vehicle file's flag; False in v0); mode_interval_s, mode_basis,
+    slosh_frequency: the Simulator's ``mode_interval`` (None: the vehicle's), ``mode_basis`` (``held`` v0,
+    ``projected``) and ``slosh_frequency`` (``vacuum_thrust`` v0, ``specific_force``).
     """
 
     vehicle: Any
@@ -129,6 +131,9 @@ class TaskSpec:
     accel_noise_mps2: float = 0.05
     attitude_noise_rad: float = 1e-3
     aeroelastic: bool | None = False
+    mode_interval_s: float | None = None
+    mode_basis: str = "held"
+    slosh_frequency: str = "vacuum_thrust"
 
     def __post_init__(self) -> None:
         check_choice("model", self.model, MODELS)
@@ -139,6 +144,10 @@ class TaskSpec:
         check_number("action_delay_steps", self.action_delay_steps, 0, 50, integer=True)
         check_choice("control", self.control, CONTROLS)
         check_bool("coast_control", self.coast_control)
+        check_choice("mode_basis", self.mode_basis, MODE_BASES)
+        check_choice("slosh_frequency", self.slosh_frequency, SLOSH_FREQUENCIES)
+        if self.mode_interval_s is not None:
+            check_number("mode_interval_s", self.mode_interval_s, 0.0, 1e5, lo_open=True)
         r = self.randomize
         names = set(RANDOMIZE_V0) if r is True else set() if r in (False, None) else set(r) if not isinstance(r, str) else {r}
         bad = sorted(names - set(RANDOMIZE))

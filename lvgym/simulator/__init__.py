@@ -7,8 +7,9 @@ from .core import SITES, Kernel, Simulator, aeroelastic_strips
 from .data import SimData
 from .flight import flight_conditions_batch, flight_loads, pack_context
 from .layouts import CONDITIONS, CONTEXT
+from .piece import SLOSH_FREQUENCIES
 from .record import Recorder, fly, load
-from .timeline import MODELS, Tables, Timeline, build_timeline
+from .timeline import MODE_BASES, MODELS, Tables, Timeline, build_timeline
 
-__all__ = ["CONDITIONS", "aeroelastic_strips", "CONTEXT", "Kernel", "MODELS", "Recorder", "SITES", "SimData", "Simulator", "Tables",
+__all__ = ["CONDITIONS", "aeroelastic_strips", "CONTEXT", "Kernel", "MODE_BASES", "MODELS", "Recorder", "SLOSH_FREQUENCIES", "SITES", "SimData", "Simulator", "Tables",
            "Timeline", "build_timeline", "fly", "flight_conditions_batch", "flight_loads", "load", "pack_context"]

@@ -3,10 +3,14 @@
 Per row and per physics step of ``h = duration / ceil(duration / physics_dt)`` seconds:
 
 1. the gimbal servo moves towards the command (:func:`.servo.servo_step_k`; or takes it at once);
-2. the step is cut at every event time of the timeline inside it; on each piece the dynamics
-   parameters (timeline rows interpolated, mode data held, then ``* scale + offset``), ``T_0`` and the
-   nozzle exit area are taken at the middle of the piece; when the CG station moves, the state is
-   shifted so that the structure stays in place (:meth:`NonRigidModel.shift_cg`);
+2. the step is cut at every event time of the timeline inside it (and at every change of the mode
+   basis the timeline projects across); on each piece the dynamics parameters (timeline rows
+   interpolated, mode data held, then ``* scale + offset``), ``T_0`` and the nozzle exit area are taken
+   at the middle of the piece; when the CG station moves, the state is shifted so that the structure
+   stays in place (:meth:`NonRigidModel.shift_cg`); a piece that starts at a change of the mode basis
+   first projects the modal state onto the new modes, and with ``slosh_frequency`` 1 the pendulums'
+   damper frequency comes from the axial specific force of the row's latest flight conditions
+   (:mod:`.piece`);
 3. one RK4 step of the dynamics core with the flight loads (:func:`lvgym.dynamics.stepper.rk4_vehicle`);
 4. while on the pad or rail, the vehicle is put back on the rail line (:func:`constrain_k`) and the
    lift-off and rail-exit times are recorded at the physics step where they happen.
@@ -35,13 +39,15 @@ from lvgym.rotations import quat_to_dcm
 
 from .flight import PF, XF, flight_conditions_k, select_aero_k
 from .layouts import AEL, CTX, RL, RS, A
+from .piece import axial_specific_force_k, project_at_k, slosh_frequency_k
 from .strips import strip_modes_k
 from .servo import servo_step_k
 from .timeline import held_k, interp_k, locate_k, params_k
 
 #: constants of a simulator's step: ``rail`` (layout RAIL), ``servo`` (layout SERVO), ``physics_dt`` [s]
-#: the largest RK4 step, ``n_slosh`` and ``n_modes`` of the dynamics model, ``n_u`` its loads' length
-StepSetup = namedtuple("StepSetup", ["rail", "servo", "physics_dt", "n_slosh", "n_modes", "n_u"])
+#: the largest RK4 step, ``n_slosh`` and ``n_modes`` of the dynamics model, ``n_u`` its loads' length,
+#: ``slosh_frequency`` the index of the damper frequency in :data:`.piece.SLOSH_FREQUENCIES` (0: the timeline's)
+StepSetup = namedtuple("StepSetup", ["rail", "servo", "physics_dt", "n_slosh", "n_modes", "n_u", "slosh_frequency"])
 XS = STATE.per_slosh
 _EPS = 1e-12
 
@@ -127,6 +133,9 @@ def advance_range(lo, hi, loads_fn, data, tables, setup, duration):
     n_slosh, n_modes = setup.n_slosh, setup.n_modes
     ws = make_workspace(n_slosh, n_modes, setup.n_u)
     pn = np.empty(n_p)
+    tmp = np.empty(n_modes)
+    ch_t, ch_T = tables.mode_change_t, tables.mode_transfer
+    by_force = setup.slosh_frequency != 0 and n_slosh > 0
     C = np.empty((3, 3))
     n = max(1, int(math.ceil(duration / setup.physics_dt - 1e-9)))
     h = duration / n
@@ -142,6 +151,7 @@ def advance_range(lo, hi, loads_fn, data, tables, setup, duration):
             t[b] += duration
             continue
         t_start = t[b]
+        first = True                  # the row's latest flight conditions: data.conditions, then the scratch
         for k in range(n):
             servo_step_k(servo, act, h)
             cb[CTX.gimbal], cb[CTX.gimbal + 1] = act[A.gimbal], act[A.gimbal + 1]
@@ -153,8 +163,20 @@ def advance_range(lo, hi, loads_fn, data, tables, setup, duration):
                 for e in ev_t:
                     if ta + _EPS < e < te - _EPS:
                         te = e
+                for e in ch_t:
+                    if ta + _EPS < e < te - _EPS:
+                        te = e
                 tm = 0.5 * (ta + te)
                 params_k(tables.t, tables.params, tables.hold, scale, offset, tm, pn)
+                if ch_t.size:
+                    project_at_k(xb, ta, ch_t, ch_T, _EPS, n_slosh, n_modes, tmp)
+                if by_force:
+                    if first:
+                        a_x = axial_specific_force_k(data.conditions[b], 0, pb, n_slosh, n_modes)
+                    else:
+                        a_x = axial_specific_force_k(cb, CTX.scratch, pb, n_slosh, n_modes)
+                    slosh_frequency_k(pn, scale, offset, a_x, n_slosh, n_modes)
+                first = False
                 d = pn[PF.r_cg] - pb[PF.r_cg]
                 if d != 0.0:
                     shift_cg_k(xb, d, C)

@@ -27,7 +27,8 @@ from lvgym import packing
 __all__ = ["cache_dir", "cached", "key"]
 
 _ARRAYS = ("t", "params", "hold", "thrust0", "exit_area", "mass", "cg", "inertia", "slosh_mass", "burning", "stage",
-           "sensor_stations", "phi_sensor", "dphi_sensor", "strip_stations", "phi_strip", "dphi_strip")
+           "sensor_stations", "phi_sensor", "dphi_sensor", "strip_stations", "phi_strip", "dphi_strip", "mode_change_t",
+           "mode_transfer")
 
 
 def cache_dir() -> Path | None:
@@ -69,13 +70,15 @@ def _load(path: Path) -> Any:
         meta = [str(x) for x in f["meta"]]
         n_slosh, n_modes = (int(v) for v in f["sizes"])
         event_t = f["event_t"]
+        interval = float(f["mode_interval"])
+        basis = str(f["mode_basis"])
     model, n_stage = meta[0], int(meta[1])
     stage_names, rest = tuple(meta[2:2 + n_stage]), meta[2 + n_stage:]
     n_names = int(rest[0])
     slosh_names, event_text = tuple(rest[1:1 + n_names]), rest[1 + n_names:]
     return Timeline(model=model, dynamics=NonRigidModel(n_slosh, n_modes), stage_names=stage_names,
                     slosh_names=slosh_names, events=tuple((float(t), e) for t, e in zip(event_t, event_text)),
-                    **arrays)
+                    mode_interval=None if np.isnan(interval) else interval, mode_basis=basis, **arrays)
 
 
 def _store(path: Path, tl: Any) -> None:
@@ -86,7 +89,9 @@ def _store(path: Path, tl: Any) -> None:
     try:
         with os.fdopen(fd, "wb") as f:
             np.savez(f, meta=np.array(meta), sizes=np.array([tl.dynamics.n_slosh, tl.dynamics.n_modes]),
-                     event_t=np.array([t for t, _ in tl.events], dtype=float), **{k: getattr(tl, k) for k in _ARRAYS})
+                     event_t=np.array([t for t, _ in tl.events], dtype=float),
+                     mode_interval=np.nan if tl.mode_interval is None else tl.mode_interval,
+                     mode_basis=np.array(tl.mode_basis), **{k: getattr(tl, k) for k in _ARRAYS})
         os.replace(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)

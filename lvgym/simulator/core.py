@@ -45,6 +45,7 @@ import numpy as np
 
 from lvgym.environment import LaunchSite, make
 from lvgym.environment.earth import WGS84_OMEGA, dcm_to_quat
+from lvgym.errors import check_choice
 from lvgym.parallel import default_workers
 from lvgym.rotations import quat_to_dcm_batch
 from lvgym.vehicle import MassModel, Vehicle, load_vehicle
@@ -54,6 +55,7 @@ from .advance import StepSetup, advance_range, conditions_rows, constrain_k, slo
 from .data import SimData
 from .flight import flight_loads, pack_context, stack_contexts
 from .layouts import ACTUATOR, CONDITIONS, CONTEXT, DISPERSION, RAIL, RAIL_STATE, RS
+from .piece import SLOSH_FREQUENCIES
 from .strips import StripSetup, strip_models, strip_stations
 from .servo import DIRECT, Servo
 from .timeline import MODELS, Timeline, build_timeline
@@ -157,6 +159,14 @@ class Simulator:
     aeroelastic: the strip-theory aeroelastic loads (:mod:`.strips`): True, False or None (the vehicle
         file's ``structure.aeroelastic``). They act only on a model with bending modes and aerodynamics;
         the v0 envs pass False.
+    mode_interval [s]: recompute the modes also every so many seconds (None: the vehicle file's setting);
+        mode_basis: ``held`` (v0: the modal coordinates kept as numbers across a change of the modes) or
+        ``projected`` (the deflection field kept, see :mod:`.timeline`); with a prebuilt ``timeline`` they
+        must be its own (``mode_interval`` None or equal).
+    slosh_frequency: the pendulums' damper frequency, ``vacuum_thrust`` (v0: ``sqrt(T_0 / m / L)`` from the
+        timeline's vacuum thrust) or ``specific_force`` (``sqrt(|a_x| / L)`` from the axial specific force,
+        thrust at ambient pressure plus the aerodynamic axial force over the mass, of the row's latest
+        flight conditions; see :mod:`.piece`).
     """
 
     def __init__(self, vehicle: str | Vehicle = "smile", model: str = "nonrigid", *, site: Any = "andoya",
@@ -164,7 +174,8 @@ class Simulator:
                  t_end: float = 60.0, physics_dt: float = 0.01, elevation_deg: float = 90.0, rail_length: float = 0.0,
                  n_modes: int | None = None, sensor_stations: Sequence[float] = (), cg_convention: str = "static",
                  timeline_dt: float = 0.05, timeline: Timeline | None = None, servo: Servo | None = None,
-                 threads: int | None = None, aeroelastic: bool | None = None) -> None:
+                 threads: int | None = None, aeroelastic: bool | None = None, mode_interval: float | None = None,
+                 mode_basis: str = "held", slosh_frequency: str = "vacuum_thrust") -> None:
         if model not in MODELS:
             raise ValueError(f"model = {model!r}: one of {MODELS}")
         if not 0.0 < physics_dt <= 0.1:
@@ -195,11 +206,16 @@ class Simulator:
         self.elevation = math.radians(elevation_deg)
         self.rail_length = float(rail_length)
         self.mass_model = MassModel(self.vehicle, cg_convention)
+        self.slosh_frequency = check_choice("slosh_frequency", slosh_frequency, SLOSH_FREQUENCIES)
         self.timeline = timeline if timeline is not None else build_timeline(
             self.mass_model, model, t_end, timeline_dt, n_modes, sensor_stations, 0.5 / physics_dt,
-            strip_stations=stations)
+            strip_stations=stations, mode_interval=mode_interval, mode_basis=mode_basis)
         if timeline is not None and timeline.model != model:
             raise ValueError(f"the timeline flies model {timeline.model!r}, not {model!r}")
+        if timeline is not None and (mode_basis != timeline.mode_basis or
+                                     mode_interval not in (None, timeline.mode_interval)):
+            raise ValueError(f"mode_basis = {mode_basis!r}, mode_interval = {mode_interval!r}: the timeline's are "
+                             f"{timeline.mode_basis!r}, {timeline.mode_interval!r}")
         self.dynamics = self.timeline.dynamics
         K = self.dynamics.n_modes
         if stations is not None and K > 0 and not np.array_equal(self.timeline.strip_stations, stations):
@@ -224,7 +240,8 @@ class Simulator:
         self.tables = self.timeline.tables
         self.setup = StepSetup(rail=self.rail, servo=DIRECT if servo is None else servo.params(),
                                physics_dt=self.physics_dt, n_slosh=self.dynamics.n_slosh,
-                               n_modes=self.dynamics.n_modes, n_u=self.layout.n_u)
+                               n_modes=self.dynamics.n_modes, n_u=self.layout.n_u,
+                               slosh_frequency=SLOSH_FREQUENCIES.index(self.slosh_frequency))
         self._event_times_all = np.array([t for t, _ in self.timeline.events], dtype=float)
         self.data: SimData = self.new_data(0)
 

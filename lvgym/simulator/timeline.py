@@ -9,6 +9,13 @@ costs a table look-up instead of a mass-model evaluation and a batch of vehicles
 looks up its rows in one call. Event times are stored twice (the row before and the row after), and the
 simulator lands its steps on them, so nothing is interpolated across a separation.
 
+Mode data are held piecewise constant between the times the modes are recomputed (separations, and every
+``mode_interval`` seconds when set). ``mode_basis`` says what becomes of the modal state at such a change:
+``held`` (v0) keeps the numbers ``eta``, ``eta_dot`` as they are in the new basis; ``projected`` keeps the
+deflection field: the timeline stores one transfer matrix per change (:func:`lvgym.vehicle.structure.mode_transfer`,
+rows of modes above the cut-off zeroed, several changes at one time multiplied into one), the simulator
+cuts its steps at the change times and applies the matrix there (:mod:`.piece`).
+
 ``model`` picks which parameters the dynamics core flies (thesis section 4.4):
 
 =============  ===============================================================================
@@ -30,11 +37,13 @@ import numpy as np
 
 from lvgym.dynamics import NonRigidModel
 from lvgym.environment.aeroelastic import resample_modes
+from lvgym.errors import check_choice, check_number
 from lvgym.vehicle import MassModel
 from lvgym.vehicle.massmodel import BURNING, SEPARATED
-from lvgym.vehicle.structure import ModeSchedule
+from lvgym.vehicle.structure import ModeSchedule, mode_transfer
 
 MODELS = ("rigid", "slosh", "flex", "nonrigid")
+MODE_BASES = ("held", "projected")
 _TINY = 1e-9          # the row before an event is taken this fraction of the time before it
 
 
@@ -51,7 +60,10 @@ class Timeline:
     ``sensor_stations`` (S,) [m]; ``strip_stations`` (n_stages, n) [m] the aeroelastic strips of each
     stage (n = 0: none) with ``phi_strip`` (n, K, n_strip) mode shapes and ``dphi_strip`` slopes at the
     strips of the row's lowest attached stage (linear between the beam's nodes);
-    ``events`` ((time, description), ...)."""
+    ``events`` ((time, description), ...); ``mode_change_t`` (C,) [s] the changes of the mode basis
+    (``mode_basis="projected"``; none when ``held``) and ``mode_transfer`` (C, K, K) their matrices
+    (``eta_new = T eta_old``); ``mode_interval`` [s] (None: at separations only) and ``mode_basis`` the
+    options it was built with."""
 
     model: str
     dynamics: NonRigidModel
@@ -75,6 +87,10 @@ class Timeline:
     phi_strip: np.ndarray
     dphi_strip: np.ndarray
     events: tuple[tuple[float, str], ...]
+    mode_change_t: np.ndarray
+    mode_transfer: np.ndarray
+    mode_interval: float | None = None
+    mode_basis: str = "held"
 
     @property
     def t_end(self) -> float:
@@ -130,16 +146,20 @@ class Timeline:
                       dphi_sensor=np.ascontiguousarray(self.dphi_sensor, dtype=float),
                       phi_strip=np.ascontiguousarray(self.phi_strip, dtype=float),
                       dphi_strip=np.ascontiguousarray(self.dphi_strip, dtype=float),
-                      event_times=np.ascontiguousarray(self.event_times, dtype=float))
+                      event_times=np.ascontiguousarray(self.event_times, dtype=float),
+                      mode_change_t=np.ascontiguousarray(self.mode_change_t, dtype=float),
+                      mode_transfer=np.ascontiguousarray(self.mode_transfer, dtype=float))
 
 
 #: the timeline's columns as compiled code reads them: ``t`` (n,) [s] rows; ``params`` (n, n_p);
 #: ``hold`` (n_p,) bool; ``thrust0`` (n,) [N]; ``exit_area`` (n,) [m^2]; ``stage`` (n,) lowest attached
 #: stage; ``burning`` (n,) 1 while an engine burns; ``mass`` (n,) [kg]; ``dphi_sensor`` (n, S, K)
 #: [1/(m sqrt(kg))]; ``phi_strip``, ``dphi_strip`` (n, K, n_strip) at the aeroelastic strips;
-#: ``event_times`` (E,) [s], each once
+#: ``event_times`` (E,) [s], each once; ``mode_change_t`` (C,) [s] and ``mode_transfer``
+#: (C, K, K) the changes of the mode basis the step projects the modal state across (none: held)
 Tables = namedtuple("Tables", ["t", "params", "hold", "thrust0", "exit_area", "stage", "burning", "mass",
-                               "dphi_sensor", "phi_strip", "dphi_strip", "event_times"])
+                               "dphi_sensor", "phi_strip", "dphi_strip", "event_times", "mode_change_t",
+                               "mode_transfer"])
 
 
 # ---------------------------------------------------------------------------- compiled look-ups (the only ones)
@@ -235,7 +255,8 @@ def _grid(mm: MassModel, t_end: float, dt: float) -> tuple[list[float], list[tup
 
 def build_timeline(mass_model: MassModel, model: str, t_end: float, dt: float = 0.05,
                    n_modes: int | None = None, sensor_stations=(), mode_cutoff_hz: float = np.inf,
-                   cache: bool = True, strip_stations=None) -> Timeline:
+                   cache: bool = True, strip_stations=None, *, mode_interval: float | None = None,
+                   mode_basis: str = "held") -> Timeline:
     """Tabulate ``mass_model``'s vehicle from lift-off to ``t_end`` [s] for the dynamics ``model``
     (one of ``MODELS``) every ``dt`` [s] (and at every event and thrust-table breakpoint), with
     ``n_modes`` bending modes per plane (default: the vehicle file's; 0 for rigid and slosh) and
@@ -250,6 +271,9 @@ def build_timeline(mass_model: MassModel, model: str, t_end: float, dt: float = 
     none); each row tabulates the mode shapes and slopes at the strips of its lowest attached stage,
     interpolated linearly between the beam's nodes (the strips are not added to the beam's mesh, so the
     modes are those of a timeline without strips), decoupled modes zero.
+    ``mode_interval`` [s]: recompute the modes also every so many seconds of flight (None: the vehicle
+    file's ``structure.recompute_interval``, else at separations only); ``mode_basis``: ``held`` or
+    ``projected``, see the module docstring.
 
     ``cache``: look the timeline up in the on-disk cache first and store it there (:mod:`.cache`: keyed by
     the vehicle's whole content, these arguments and the source of the code that builds it)."""
@@ -257,13 +281,17 @@ def build_timeline(mass_model: MassModel, model: str, t_end: float, dt: float = 
         raise ValueError(f"model = {model!r}: one of {MODELS}")
     if not t_end > 0.0 or not dt > 0.0:
         raise ValueError(f"t_end = {t_end!r} and dt = {dt!r} must be > 0 s")
+    check_choice("mode_basis", mode_basis, MODE_BASES)
+    if mode_interval is not None:
+        mode_interval = check_number("mode_interval", mode_interval, 0.0, 1e5, lo_open=True)
     if cache:
         from .cache import cached
         strips_key = None if strip_stations is None else np.asarray(strip_stations, float).tolist()
         return cached(mass_model, (model, float(t_end), float(dt), n_modes, tuple(np.ravel(sensor_stations).tolist()),
-                                   float(mode_cutoff_hz), strips_key),
+                                   float(mode_cutoff_hz), strips_key, mode_interval, mode_basis),
                       lambda: build_timeline(mass_model, model, t_end, dt, n_modes, sensor_stations, mode_cutoff_hz,
-                                             cache=False, strip_stations=strip_stations))
+                                             cache=False, strip_stations=strip_stations, mode_interval=mode_interval,
+                                             mode_basis=mode_basis))
     mm = mass_model
     vehicle = mm.vehicle
     sensors = np.asarray(sensor_stations, dtype=float).reshape(-1)
@@ -275,7 +303,10 @@ def build_timeline(mass_model: MassModel, model: str, t_end: float, dt: float = 
     with_slosh = model in ("slosh", "nonrigid")
     N = mm.n_slosh if with_slosh else 0
     dyn = NonRigidModel(N, K)
-    schedule = ModeSchedule(mm, n_modes=K, sensor_stations=sensors) if K > 0 else None
+    schedule = ModeSchedule(mm, n_modes=K, recompute_interval=mode_interval, sensor_stations=sensors) if K > 0 else None
+    projected = mode_basis == "projected"
+    changes: list[tuple[float, np.ndarray]] = []          # (time, transfer matrix) of each change of basis
+    last = None                                           # the modes of the previous row
     times, events = _grid(mm, t_end, dt)
     event_times = {t for t, _ in events}
     lay = dyn.layout
@@ -309,6 +340,13 @@ def build_timeline(mass_model: MassModel, model: str, t_end: float, dt: float = 
             else:
                 rows["phi_strip"].append(np.zeros((K, strips.shape[1])))
                 rows["dphi_strip"].append(np.zeros((K, strips.shape[1])))
+            if projected and modes is not None:
+                if last is not None and modes is not last:
+                    T = mode_transfer(last, modes) * (modes.omega <= 2.0 * np.pi * mode_cutoff_hz)[:, None]
+                    if changes and changes[-1][0] == tt:          # two changes at one time: one matrix
+                        T = T @ changes.pop()[1]
+                    changes.append((tt, T))
+                last = modes
             if modes is not None:
                 modes = _cut(modes, mode_cutoff_hz)
             slosh = []
@@ -352,4 +390,7 @@ def build_timeline(mass_model: MassModel, model: str, t_end: float, dt: float = 
                     dphi_sensor=np.array(rows["dphi"]).reshape(len(rows["t"]), sensors.size, K),
                     strip_stations=strips, phi_strip=np.array(rows["phi_strip"]).reshape(len(rows["t"]), K, strips.shape[1]),
                     dphi_strip=np.array(rows["dphi_strip"]).reshape(len(rows["t"]), K, strips.shape[1]),
-                    events=tuple((float(t), e) for t, e in events))
+                    events=tuple((float(t), e) for t, e in events),
+                    mode_change_t=np.array([t for t, _ in changes], dtype=float),
+                    mode_transfer=np.array([T for _, T in changes], dtype=float).reshape(len(changes), K, K),
+                    mode_interval=mode_interval, mode_basis=mode_basis)

@@ -53,7 +53,7 @@ from .sections import (MATERIALS, BeamMesh, DistributedMass, Material, PointMass
                        mesh_stack, per_element, point_mass_array, stations_on, tube)
 
 __all__ = ["PointMass", "Section", "DistributedMass", "BeamModes", "BeamMesh", "modes", "assemble",
-           "mesh_stack", "stack_modes", "thesis_comparison", "thesis_comparison_markdown"]
+           "mesh_stack", "stack_modes", "transfer", "thesis_comparison", "thesis_comparison_markdown"]
 
 
 def _hermite(xi: np.ndarray, h: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -170,6 +170,7 @@ class BeamModes:
     inertia_cg: float
     _x: np.ndarray = field(repr=False)      # nodes, ascending [m]
     _q: np.ndarray = field(repr=False)      # DOF vectors on ascending nodes, (2n, K)
+    _m: np.ndarray = field(repr=False)      # consistent mass matrix on the DOFs of _q, (2n, 2n)
 
     @property
     def n_modes(self) -> int:
@@ -260,7 +261,7 @@ def _modes(stations, EI, mass_per_length, *, point_masses: Sequence = (), n_mode
     return BeamModes(omega=fa(omega), node_stations=fa(x[order]), phi_nodes=fa(q[0::2][order]),
                      dphi_nodes=fa(q[1::2][order]), query_stations=fa(query), phi=fa(phi_q), dphi=fa(dphi_q),
                      mass=float(mass), cg_station=float(cg), inertia_cg=float(second - mass * cg * cg),
-                     _x=fa(x), _q=fa(q))
+                     _x=fa(x), _q=fa(q), _m=fa(M))
 
 
 def stack_modes(sections: Sequence[Section], point_masses: Sequence = (),
@@ -272,6 +273,25 @@ def stack_modes(sections: Sequence[Section], point_masses: Sequence = (),
                       element_length=element_length)
     return modes(mesh.stations, mesh.EI, mesh.mass_per_length, point_masses=mesh.point_masses,
                  n_modes=n_modes, query_stations=query_stations)
+
+
+def transfer(old: BeamModes, new: BeamModes) -> np.ndarray:
+    """Matrix ``T`` (K_new, K_old) that carries modal coordinates from the basis of ``old`` to that of
+    ``new`` with the deflection field kept: ``eta_new = T eta_old``, ``T = Q_new^T M_new Q_old``.
+
+    ``Q_old`` are the old mass-normalised shapes and slopes read at the new beam's nodes (the common
+    station grid; the old element shape functions interpolate between the old nodes), ``M_new`` the new
+    consistent mass matrix: ``T eta_old`` is the M_new-orthogonal projection of the old field
+    ``sum_k eta_k phi_k(x)`` onto the new elastic modes. Only the part of the old beam that the new one
+    covers counts (after a separation, the stack still attached); what of it is rigid-body motion of
+    the new beam, or lies outside its first K_new modes, is dropped (the modal truncation). For
+    ``old is new`` (or equal beams) ``T`` is the identity to rounding."""
+    x = np.clip(new._x, old._x[0], old._x[-1])
+    with threadpool_limits(limits=1, user_api="blas"):          # reproducible sums, as :func:`modes`
+        w, theta = _interpolate(old._x, old._q, x)              # (n_new, K_old) each
+        q_old = np.empty((2 * x.size, old.n_modes))
+        q_old[0::2], q_old[1::2] = w, theta
+        return new._q.T @ (new._m @ q_old)
 
 
 # ---------------------------------------------------------------------------- thesis comparison

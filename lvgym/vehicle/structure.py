@@ -13,7 +13,8 @@ The beam of the attached stages carries
 
 :class:`ModeSchedule` decides when the modes are recomputed: by default they are frozen at lift-off (the
 thesis's assumption) and recomputed only when a stage separates; with ``recompute_interval`` [s] (vehicle
-file, ``structure.recompute_interval``) also as propellant burns. ``structure.first_mode_hz`` calibrates
+file, ``structure.recompute_interval``) also as propellant burns. :func:`mode_transfer` carries the modal
+coordinates across such a change of basis. ``structure.first_mode_hz`` calibrates
 the stiffness to a known first frequency at lift-off (one factor on every section's EI).
 """
 
@@ -25,7 +26,7 @@ import numpy as np
 
 from lvgym.errors import ConfigError
 
-from .beam import BeamModes, stack_modes
+from .beam import BeamModes, stack_modes, transfer
 from .config import Vehicle
 from .massmodel import SEPARATED, MassModel, MassProperties, MassState
 from .sections import MATERIALS, DistributedMass, PointMass, Section, tube
@@ -163,6 +164,16 @@ def vehicle_modes(vehicle: Vehicle, state: MassState, props: MassProperties, n_m
                         phi_gimbal=beam.phi[0].copy(), dphi_gimbal=beam.dphi[0].copy(),
                         phi_hinge=beam.phi[1:1 + N].copy(), sensor_stations=sensors,
                         phi_sensor=beam.phi[1 + N:].copy(), dphi_sensor=beam.dphi[1 + N:].copy(), beam=beam)
+
+
+def mode_transfer(old: VehicleModes, new: VehicleModes) -> np.ndarray:
+    """Matrix ``T`` (K_new, K_old) with ``eta_new = T eta_old`` (and the same for ``eta_dot``) when the
+    modes change from ``old`` to ``new``: the deflection field of the attached stack kept, projected
+    onto the new mass-normalised shapes (:func:`.beam.transfer`). The same matrix serves both planes
+    (y and z share shapes); without modes it is empty."""
+    if old.beam is None or new.beam is None:
+        return np.zeros((new.omega.size, old.omega.size))
+    return transfer(old.beam, new.beam)
 
 
 class ModeSchedule:
