@@ -224,11 +224,15 @@ class SmileAscentV1Env(SmileAscentEnv):
     propellant with ullage thrust (``settling_thrust_n`` = 18 kN, 1.35 times the drag at burnout:
     docs/vehicles.md). The flight computer's computational delay is one control period
     (``action_delay_steps=1``); the gravity turn, when asked for, follows the Earth-relative velocity.
-    Everything else as ``SmileAscent-v0``."""
+    The bending modes are recomputed every 2 s with the modal state projected across each change
+    (``mode_interval_s``, ``mode_basis="projected"``), the slosh dampers take their frequency from the
+    axial specific force (``slosh_frequency="specific_force"``) and the aeroelastic strip loads follow the
+    vehicle file (``aeroelastic=None``; SMILE's flag is off). Everything else as ``SmileAscent-v0``."""
 
     DEFAULTS = {**SmileAscentEnv.DEFAULTS, "vehicle": "smile_v1", "mission_time_s": 70.0,
                 "reference_velocity": "earth", "action_delay_steps": 1, "coast_control": True,
-                "settling_thrust_n": 18000.0}
+                "settling_thrust_n": 18000.0, "aeroelastic": None, "mode_interval_s": 2.0, "mode_basis": "projected",
+                "slosh_frequency": "specific_force"}
 
 
 class StratosIIIEnv(AscentEnv):
