@@ -12,6 +12,8 @@ ENV_IDS = {
     "lvgym/SmileAscent-v1": ("lvgym.envs.ascent:SmileAscentV1Env", "lvgym.envs:smile_ascent_v1_vector"),
     "lvgym/StratosIII-v0": ("lvgym.envs.ascent:StratosIIIEnv", "lvgym.envs:stratos3_vector"),
     "lvgym/SlenderAscent-v0": ("lvgym.envs.ascent:SlenderAscentEnv", "lvgym.envs:slender_ascent_vector"),
+    "lvgym/StratosIII-v1": ("lvgym.envs.ascent:StratosIIIV1Env", "lvgym.envs:stratos3_v1_vector"),
+    "lvgym/SlenderAscent-v1": ("lvgym.envs.ascent:SlenderAscentV1Env", "lvgym.envs:slender_ascent_v1_vector"),
 }
 
 

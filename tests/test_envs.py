@@ -9,7 +9,8 @@ import lvgym  # noqa: F401  (registers the envs)
 from lvgym.envs import OBS_STATE, REWARD_TERMS, TaskSpec
 from lvgym.errors import ConfigError
 
-ENV_IDS = ("lvgym/SmileAscent-v0", "lvgym/SmileAscent-v1", "lvgym/StratosIII-v0", "lvgym/SlenderAscent-v0")
+ENV_IDS = ("lvgym/SmileAscent-v0", "lvgym/SmileAscent-v1", "lvgym/StratosIII-v0", "lvgym/StratosIII-v1",
+           "lvgym/SlenderAscent-v0", "lvgym/SlenderAscent-v1")
 MODELS = ("rigid", "slosh", "flex", "nonrigid")
 
 

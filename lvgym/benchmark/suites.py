@@ -30,6 +30,10 @@ Protocol v1 (a draft, version ``v1-draft``, until issue 16 freezes it) adds, on 
 ==================  ===============================================================================
 smile-v1            70 s, v0's turbulence plus a random 1-cosine gust, every dispersion (``V1_DISPERSIONS``)
 smile-v1-maxq-gust  35 s, a random jet stream plus a random gust in the max-q region, every dispersion
+stratos-tvc-v1      Stratos III with TVC (StratosIII-v1), 30 s, turbulence, every dispersion
+slender-v1          the L/D 30 slender vehicle with its aeroelastic loads (SlenderAscent-v1), 10 s, turbulence,
+                    every dispersion; provisional until it has a baseline (the gimbal at zero fails on
+                    q-alpha at 4.1-4.7 s)
 ==================  ===============================================================================
 
 ``slender-ld30`` is provisional: there is no slender baseline yet. SlenderAscent-v0 freezes the vehicle's
@@ -171,6 +175,13 @@ SUITES_V1: dict[str, Suite] = {s.name: s for s in (
     Suite("smile-v1", "SMILE v1 (own upper-stage aerodynamics, staging at 1.8 kPa, coast control, one period of "
           "delay), 70 s, turbulence and a random 1-cosine gust, every dispersion",
           _pair("smile-v1", SMILE_V1, "turbulence_gust", V1_DISPERSIONS), version=PROTOCOL_V1),
+    Suite("stratos-tvc-v1", "Stratos III with TVC (StratosIII-v1), 30 s, turbulence drawn per seed; thrust "
+          "misalignment, mass, aerodynamics, thrust level and the slosh and bending dispersions",
+          _pair("stratos-tvc-v1", "lvgym/StratosIII-v1", "turbulence", V1_DISPERSIONS), version=PROTOCOL_V1),
+    Suite("slender-v1", "Slender vehicle L/D = 30 (SlenderAscent-v1: aeroelastic strip loads), 10 s, turbulence, "
+          "every dispersion (provisional: no slender baseline yet, issue 17)",
+          _pair("slender-v1", "lvgym/SlenderAscent-v1", "turbulence", V1_DISPERSIONS, length=8.5, diameter=0.2833),
+          version=PROTOCOL_V1),
     Suite("smile-v1-maxq-gust", "SMILE v1 through max q, 35 s: a random jet stream and a random 1-cosine gust in "
           "the max-q region (8-11.5 km), every dispersion",
           _pair("smile-v1-maxq-gust", SMILE_V1, "maxq_gust", V1_DISPERSIONS, mission_time_s=35.0),

@@ -3,7 +3,9 @@
 - ``lvgym/SmileAscent-v0`` (:class:`~.ascent.SmileAscentEnv`): SMILE's first-stage flight, TVC;
 - ``lvgym/SmileAscent-v1`` (:class:`~.ascent.SmileAscentV1Env`): SMILE as protocol v1 flies it (draft);
 - ``lvgym/StratosIII-v0`` (:class:`~.ascent.StratosIIIEnv`): Stratos III through its thrust drop, roll RCS;
-- ``lvgym/SlenderAscent-v0`` (:class:`~.ascent.SlenderAscentEnv`): the parametric L/D vehicle.
+- ``lvgym/SlenderAscent-v0`` (:class:`~.ascent.SlenderAscentEnv`): the parametric L/D vehicle;
+- ``lvgym/StratosIII-v1``, ``lvgym/SlenderAscent-v1``: Stratos III with TVC and the slender vehicle with
+  protocol v1's physics and timing (drafts).
 
 Each is a thin adapter over the functional env :class:`~.functional.AscentFuncEnv` (explicit state and
 parameters, batched over rows); each has a native batched ``VectorEnv`` as its ``vector_entry_point``
@@ -16,7 +18,8 @@ from __future__ import annotations
 
 from typing import Any
 
-from .ascent import AscentEnv, SlenderAscentEnv, SmileAscentEnv, SmileAscentV1Env, StratosIIIEnv
+from .ascent import (AscentEnv, SlenderAscentEnv, SlenderAscentV1Env, SmileAscentEnv, SmileAscentV1Env,
+                     StratosIIIEnv, StratosIIIV1Env)
 from .functional import AscentFuncEnv, AscentParams, AscentState
 from .layouts import OBS_SENSORS, OBS_STATE, OBSERVATIONS, REWARD_TERMS, TASK
 from .snapshot import EpisodeState
@@ -24,7 +27,8 @@ from .spec import RANDOMIZE, WIND_TIERS, TaskSpec
 from .vector import AscentVectorEnv
 
 ENVS = {"lvgym/SmileAscent-v0": SmileAscentEnv, "lvgym/SmileAscent-v1": SmileAscentV1Env, "lvgym/StratosIII-v0": StratosIIIEnv,
-        "lvgym/SlenderAscent-v0": SlenderAscentEnv}
+        "lvgym/SlenderAscent-v0": SlenderAscentEnv, "lvgym/StratosIII-v1": StratosIIIV1Env,
+        "lvgym/SlenderAscent-v1": SlenderAscentV1Env}
 
 
 def smile_ascent_vector(num_envs: int = 1, **options: Any) -> AscentVectorEnv:
@@ -47,6 +51,16 @@ def slender_ascent_vector(num_envs: int = 1, **options: Any) -> AscentVectorEnv:
     return AscentVectorEnv(SlenderAscentEnv, num_envs, **options)
 
 
+def stratos3_v1_vector(num_envs: int = 1, **options: Any) -> AscentVectorEnv:
+    """``vector_entry_point`` of ``lvgym/StratosIII-v1``."""
+    return AscentVectorEnv(StratosIIIV1Env, num_envs, **options)
+
+
+def slender_ascent_v1_vector(num_envs: int = 1, **options: Any) -> AscentVectorEnv:
+    """``vector_entry_point`` of ``lvgym/SlenderAscent-v1``."""
+    return AscentVectorEnv(SlenderAscentV1Env, num_envs, **options)
+
+
 def make_sb3_vec_env(env_id: str, num_envs: int = 1, seed: int | None = None, **options: Any):
     """A stable-baselines3 ``VecEnv`` of ``num_envs`` rows of ``env_id`` (batched, one simulator;
     :class:`~.sb3.AscentSB3VecEnv`, imported here so that ``import lvgym`` does not import SB3)."""
@@ -65,6 +79,7 @@ def __getattr__(name: str) -> Any:
 
 __all__ = ["ENVS", "OBSERVATIONS", "OBS_SENSORS", "OBS_STATE", "RANDOMIZE", "REWARD_TERMS", "TASK", "WIND_TIERS",
            "AscentEnv", "AscentFuncEnv", "AscentParams", "AscentSB3VecEnv", "AscentState", "AscentVectorEnv",
-           "EpisodeState", "SlenderAscentEnv", "SmileAscentEnv", "SmileAscentV1Env", "StratosIIIEnv", "TaskSpec",
-           "make_sb3_vec_env", "slender_ascent_vector", "smile_ascent_v1_vector", "smile_ascent_vector",
+           "EpisodeState", "SlenderAscentEnv", "SlenderAscentV1Env", "SmileAscentEnv", "SmileAscentV1Env",
+           "StratosIIIEnv", "StratosIIIV1Env", "TaskSpec", "make_sb3_vec_env", "slender_ascent_v1_vector",
+           "slender_ascent_vector", "smile_ascent_v1_vector", "smile_ascent_vector", "stratos3_v1_vector",
            "stratos3_vector"]

@@ -214,6 +214,11 @@ class SmileAscentEnv(AscentEnv):
     DEFAULTS = {"vehicle": "smile", "site": "andoya", "mission_time_s": 60.0, "rate_weights": (0.0, 1.0, 1.0)}
 
 
+#: the physics and timing of protocol v1 that every v1 env shares (issue 16; docs/benchmark.md)
+V1_OPTIONS = {"reference_velocity": "earth", "action_delay_steps": 1, "aeroelastic": None, "mode_interval_s": 2.0,
+              "mode_basis": "projected", "slosh_frequency": "specific_force"}
+
+
 class SmileAscentV1Env(SmileAscentEnv):
     """``lvgym/SmileAscent-v1``: SMILE as protocol v1 flies it (a draft until issue 16 freezes it).
 
@@ -229,10 +234,8 @@ class SmileAscentV1Env(SmileAscentEnv):
     axial specific force (``slosh_frequency="specific_force"``) and the aeroelastic strip loads follow the
     vehicle file (``aeroelastic=None``; SMILE's flag is off). Everything else as ``SmileAscent-v0``."""
 
-    DEFAULTS = {**SmileAscentEnv.DEFAULTS, "vehicle": "smile_v1", "mission_time_s": 70.0,
-                "reference_velocity": "earth", "action_delay_steps": 1, "coast_control": True,
-                "settling_thrust_n": 18000.0, "aeroelastic": None, "mode_interval_s": 2.0, "mode_basis": "projected",
-                "slosh_frequency": "specific_force"}
+    DEFAULTS = {**SmileAscentEnv.DEFAULTS, **V1_OPTIONS, "vehicle": "smile_v1", "mission_time_s": 70.0,
+                "coast_control": True, "settling_thrust_n": 18000.0}
 
 
 class StratosIIIEnv(AscentEnv):
@@ -285,3 +288,22 @@ class SlenderAscentEnv(AscentEnv):
 def slender_key(length: float, diameter: float, aero_mach: float | None) -> tuple:
     """The vehicle key of :func:`~.functional.cached_vehicle` of one slender vehicle [m, m, -]."""
     return ("slender", float(length), float(diameter), aero_mach)
+
+
+class StratosIIIV1Env(StratosIIIEnv):
+    """``lvgym/StratosIII-v1``: Stratos III with thrust-vector control (the hypothetical TVC of
+    ``StratosIII-v0``'s ``control="tvc"``) and protocol v1's physics and timing (a draft until issue 16
+    freezes it): one control period of delay, modes recomputed every 2 s and projected, slosh dampers on
+    the specific force. Reward weights pitch and yaw; roll is left to the vehicle."""
+
+    DEFAULTS = {**StratosIIIEnv.DEFAULTS, **V1_OPTIONS, "control": "tvc", "rate_weights": (0.0, 1.0, 1.0)}
+
+
+class SlenderAscentV1Env(SlenderAscentEnv):
+    """``lvgym/SlenderAscent-v1``: the slender vehicle with protocol v1's physics and timing (a draft):
+    one control period of delay, modes recomputed every 2 s and projected, slosh dampers on the specific
+    force, and the strip-theory aeroelastic loads its vehicle file asks for. With them the bent vehicle
+    loses its static stability near 350-450 kPa (docs/aerodynamics.md): the gimbal at zero fails on
+    q-alpha at 4.1-4.7 s of the 10 s flight (test seeds 10000-10002 of the slender-ld30 options)."""
+
+    DEFAULTS = {**SlenderAscentEnv.DEFAULTS, **V1_OPTIONS}
