@@ -25,7 +25,7 @@ from .spec import TaskSpec
 def batch_task(env_cls: type, options: dict[str, Any]) -> TaskSpec:
     """The task of ``num_envs`` rows of ``env_cls`` with ``options`` (one vehicle for all rows)."""
     options = dict(options)
-    if env_cls is SlenderAscentEnv:
+    if issubclass(env_cls, SlenderAscentEnv):
         length, diameter = options.pop("length", 8.5), options.pop("diameter", 0.3)
         if np.size(diameter) != 1:
             raise ValueError("diameter ranges are drawn per episode by the single SlenderAscent env only; "
