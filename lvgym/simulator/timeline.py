@@ -121,16 +121,18 @@ class Timeline:
                       stage=np.ascontiguousarray(self.stage, dtype=float),
                       burning=np.ascontiguousarray(self.burning, dtype=float),
                       mass=np.ascontiguousarray(self.mass, dtype=float),
+                      phi_sensor=np.ascontiguousarray(self.phi_sensor, dtype=float),
                       dphi_sensor=np.ascontiguousarray(self.dphi_sensor, dtype=float),
                       event_times=np.ascontiguousarray(self.event_times, dtype=float))
 
 
 #: the timeline's columns as compiled code reads them: ``t`` (n,) [s] rows; ``params`` (n, n_p);
 #: ``hold`` (n_p,) bool; ``thrust0`` (n,) [N]; ``exit_area`` (n,) [m^2]; ``stage`` (n,) lowest attached
-#: stage; ``burning`` (n,) 1 while an engine burns; ``mass`` (n,) [kg]; ``dphi_sensor`` (n, S, K)
-#: [1/(m sqrt(kg))]; ``event_times`` (E,) [s], each once
+#: stage; ``burning`` (n,) 1 while an engine burns; ``mass`` (n,) [kg]; ``phi_sensor`` (n, S, K)
+#: [1/sqrt(kg)] and ``dphi_sensor`` (n, S, K) [1/(m sqrt(kg))] mode shapes and slopes at the sensor stations;
+#: ``event_times`` (E,) [s], each once
 Tables = namedtuple("Tables", ["t", "params", "hold", "thrust0", "exit_area", "stage", "burning", "mass",
-                               "dphi_sensor", "event_times"])
+                               "phi_sensor", "dphi_sensor", "event_times"])
 
 
 # ---------------------------------------------------------------------------- compiled look-ups (the only ones)
