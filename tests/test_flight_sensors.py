@@ -19,7 +19,7 @@ import lvgym  # noqa: F401  (registers the envs)
 from lvgym.envs import TaskSpec
 from lvgym.envs.ascent import SmileAscentEnv
 from lvgym.envs.functional import AscentFuncEnv
-from lvgym.envs.layouts import OBS_FLIGHT, OBS_SENSORS, OBSERVATIONS, FLIGHT_DRAWS
+from lvgym.envs.layouts import FLIGHT_DRAWS, NAV, OBS_FLIGHT, OBS_SENSORS, OBSERVATIONS
 from lvgym.rotations import quat_mul
 from lvgym.simulator import Simulator
 from lvgym.simulator.imu import Imu, imu_output_k, lti_step_k, specific_force_k
@@ -189,7 +189,7 @@ def _attitude_flight(n, amp=1.0, **kw):
         q_true = f.sim.layout.view(state.sim.x, "state", "q_bi")[0]
         w = f.sim.layout.view(state.sim.x, "state", "omega_bi_b")[0]
         lag = w * _TAU                                 # the filters' group delay times the rate
-        out.append((state.sim.t[0], _rotvec_error(q_true, state.task.q_nav[0]) + lag, state.task.gyro_bias[0].copy()))
+        out.append((state.sim.t[0], _rotvec_error(q_true, NAV.view(state.task.nav, "q_nav")[0]) + lag, state.task.gyro_bias[0].copy()))
     return out
 
 

@@ -36,39 +36,39 @@ import numpy as np
 
 from lvgym.simulator.imu import imu_output_k
 
-from .layouts import FD, G0, OF, T
+from .layouts import FD, G0, NV, OF, T
 
 __all__ = ["flight_sample_k", "integrate_attitude_k"]
 
 
 @nb.njit(cache=True, nogil=True, inline="always")
-def integrate_attitude_k(q, w0, w1, w2, dt):
-    """``q`` (4,) scalar first, in place: ``q (x) exp(theta / 2)`` with ``theta = (w0, w1, w2) dt``
+def integrate_attitude_k(q, o, w0, w1, w2, dt):
+    """The quaternion ``q[o:o + 4]`` (scalar first), in place: ``q (x) exp(theta / 2)`` with ``theta = (w0, w1, w2) dt``
     [rad/s, s] a body-frame rotation vector, then normalised."""
     t0, t1, t2 = w0 * dt, w1 * dt, w2 * dt
     ang = math.sqrt(t0 * t0 + t1 * t1 + t2 * t2)
     c = math.cos(0.5 * ang)
     s = math.sin(0.5 * ang) / ang if ang > 1e-12 else 0.5
     d1, d2, d3 = s * t0, s * t1, s * t2
-    a0, a1, a2, a3 = q[0], q[1], q[2], q[3]
-    q[0] = a0 * c - a1 * d1 - a2 * d2 - a3 * d3
-    q[1] = a0 * d1 + a1 * c + a2 * d3 - a3 * d2
-    q[2] = a0 * d2 - a1 * d3 + a2 * c + a3 * d1
-    q[3] = a0 * d3 + a1 * d2 - a2 * d1 + a3 * c
-    n = math.sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3])
-    for i in range(4):
-        q[i] /= n
+    a0, a1, a2, a3 = q[o], q[o + 1], q[o + 2], q[o + 3]
+    b0 = a0 * c - a1 * d1 - a2 * d2 - a3 * d3
+    b1 = a0 * d1 + a1 * c + a2 * d3 - a3 * d2
+    b2 = a0 * d2 - a1 * d3 + a2 * c + a3 * d1
+    b3 = a0 * d3 + a1 * d2 - a2 * d1 + a3 * c
+    n = math.sqrt(b0 * b0 + b1 * b1 + b2 * b2 + b3 * b3)
+    q[o], q[o + 1], q[o + 2], q[o + 3] = b0 / n, b1 / n, b2 / n, b3 / n
 
 
 @nb.njit(cache=True, nogil=True)
-def flight_sample_k(task, imu, st, ref_pitch, bias, draws, q_nav, gyro, obs, first):
+def flight_sample_k(task, imu, st, ref_pitch, bias, draws, nav, obs, first):
     """One sample of the flight computer: the rate and accelerometer entries of ``obs`` (layout
-    OBS_FLIGHT) and the strapdown attitude ``q_nav`` (the caller turns it into the attitude entries).
+    OBS_FLIGHT) and the strapdown attitude in ``nav`` (layout NAV; the caller turns it into the attitude
+    entries).
 
     ``imu`` the IMU's parameters, ``st`` the row's IMU filter states; ``ref_pitch`` [rad/s]; ``bias``
-    (3,) [rad/s] the gyro bias, ``draws`` the step's draws (layout FLIGHT_DRAWS), ``q_nav`` (4,) the
-    strapdown attitude, ``gyro`` (3,) [rad/s] the last sample (all in place). ``first``: the sample at
-    a reset (no bias step, no integration; ``q_nav`` already holds the true attitude)."""
+    (3,) [rad/s] the gyro bias, ``draws`` the step's draws (layout FLIGHT_DRAWS), ``nav`` the strapdown
+    attitude and the last sample (all in place). ``first``: the sample at a reset (no bias step, no
+    integration; ``nav`` already holds the true attitude)."""
     rate = np.empty(3)
     force = np.empty(2)
     imu_output_k(imu, st, rate, force)
@@ -78,9 +78,11 @@ def flight_sample_k(task, imu, st, ref_pitch, bias, draws, q_nav, gyro, obs, fir
     m0 = rate[0] + bias[0] + draws[FD.gyro_noise]
     m1 = rate[1] + bias[1] + draws[FD.gyro_noise + 1]
     m2 = rate[2] + bias[2] + draws[FD.gyro_noise + 2]
+    og = NV.gyro
     if not first:
-        integrate_attitude_k(q_nav, 0.5 * (gyro[0] + m0), 0.5 * (gyro[1] + m1), 0.5 * (gyro[2] + m2), task[T.dt])
-    gyro[0], gyro[1], gyro[2] = m0, m1, m2
+        integrate_attitude_k(nav, NV.q_nav, 0.5 * (nav[og] + m0), 0.5 * (nav[og + 1] + m1), 0.5 * (nav[og + 2] + m2),
+                             task[T.dt])
+    nav[og], nav[og + 1], nav[og + 2] = m0, m1, m2
     obs[OF.roll_rate] = m0
     obs[OF.pitch_rate_error] = m1 - ref_pitch
     obs[OF.yaw_rate_error] = m2

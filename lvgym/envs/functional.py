@@ -46,7 +46,7 @@ from lvgym.simulator.servo import Servo
 from lvgym.vehicle import MassModel, Vehicle, load_vehicle
 from lvgym.vehicle.slender import slender_vehicle
 
-from .layouts import FLIGHT_DRAWS, OBSERVATIONS, REASONS, REWARD, REWARD_TERMS, SENSOR_NOISE, TASK
+from .layouts import FLIGHT_DRAWS, NAV, OBSERVATIONS, REASONS, REWARD, REWARD_TERMS, SENSOR_NOISE, TASK
 from .signals import TaskData, reset_signals, step_signals_range
 from .spec import TaskSpec, wind_spec
 
@@ -168,7 +168,7 @@ class AscentFuncEnv(FuncEnv):
                         stage=np.zeros(B, dtype=np.int64),
                         pending=np.full((B, max(self.spec.action_delay_steps, 1), self.action_space.shape[0]),
                                         self._neutral),
-                        q_nav=np.zeros((B, 4)), gyro=np.zeros((B, 3)), draws=FLIGHT_DRAWS.zeros(B))
+                        nav=NAV.zeros(B), draws=FLIGHT_DRAWS.zeros(B))
         return AscentState(sim=self.sim.new_data(B), task=task, events=[[] for _ in range(B)])
 
     @staticmethod

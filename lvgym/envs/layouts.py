@@ -5,7 +5,8 @@
   depend on it, so it is never padded and never reordered; a new channel is a new entry at the end and a
   new env version). Entries that mean the same in every mode have the same name and index; entries 5
   and 6 are the angles of attack in ``state`` and the accelerometers in ``sensors`` and ``flight``.
-- :data:`FLIGHT_DRAWS`: one control step's random draws of the ``flight`` sensors.
+- :data:`FLIGHT_DRAWS`: one control step's random draws of the ``flight`` sensors; :data:`NAV` the flight
+  computer's navigation state.
 - :data:`SENSOR_NOISE`: which observation entries each sensor's noise is added to.
 - :data:`REWARD`: the reward terms, in ``info["reward_terms"]`` and in the compiled kernel's order.
 - :data:`REASONS`: the termination codes.
@@ -17,8 +18,8 @@ from __future__ import annotations
 
 from lvgym.packing import Field, Packed, rst_table
 
-__all__ = ["FLIGHT_DRAWS", "FLIGHT_SOURCE", "G0", "OBSERVATIONS", "OBS_FLIGHT", "OBS_SENSORS", "OBS_STATE", "REASONS", "REWARD", "REWARD_TERMS", "SENSOR_NOISE",
-           "TASK", "FD", "O", "OF", "OS", "RW", "T", "observation_table"]
+__all__ = ["FLIGHT_DRAWS", "FLIGHT_SOURCE", "G0", "NAV", "OBSERVATIONS", "OBS_FLIGHT", "OBS_SENSORS", "OBS_STATE", "REASONS", "REWARD", "REWARD_TERMS", "SENSOR_NOISE",
+           "TASK", "FD", "NV", "O", "OF", "OS", "RW", "T", "observation_table"]
 
 G0 = 9.80665
 
@@ -104,6 +105,11 @@ FLIGHT_SOURCE = {
     "model (taken exact)", "gimbal_pitch": "actuator position feedback", "gimbal_yaw": "actuator position feedback",
     "time_fraction": "clock", "controller_on": "sequencer", "pitch_rate_reference": "guidance (taken exact)",
 }
+#: the flight computer's navigation state of a row (``observation="flight"``)
+NAV = Packed("navigation state", [
+    Field("q_nav", 4, "-", "strapdown attitude, the estimate of q_bi (scalar first)"),
+    Field("gyro", 3, "rad/s", "the last gyro sample (bias and noise included), body axes"),
+])
 #: one control step's draws of the ``flight`` sensors of a row (from its generator, already scaled)
 FLIGHT_DRAWS = Packed("flight sensor draws", [
     Field("gyro_noise", 3, "rad/s", "angle random walk: white rate noise of the sample, sigma ARW / sqrt(dt)"),
@@ -130,7 +136,8 @@ REWARD_TERMS = REWARD.names
 #: termination codes (the order is the precedence: a later one overrides an earlier one)
 REASONS = ("", "attitude error beyond the limit", "q-alpha beyond the structural limit", "non-finite state")
 
-T, O, OS, OF, RW, FD = TASK.at, OBS_STATE.at, OBS_SENSORS.at, OBS_FLIGHT.at, REWARD.at, FLIGHT_DRAWS.at
+T, O, OS, OF, RW, FD, NV = (TASK.at, OBS_STATE.at, OBS_SENSORS.at, OBS_FLIGHT.at, REWARD.at, FLIGHT_DRAWS.at,
+                             NAV.at)
 assert all(lay.size == OBS_STATE.size and all(OBS_STATE.offset(n) == lay.offset(n) for n in OBS_STATE.names if n in lay)
            for lay in (OBS_SENSORS, OBS_FLIGHT))
 assert OBS_SENSORS.names == OBS_FLIGHT.names

@@ -25,7 +25,7 @@ from lvgym.simulator.layouts import RL, A, D
 from lvgym.simulator.timeline import locate_k
 
 from .flightcomputer import flight_sample_k
-from .layouts import G0, RW, OF, OS, O, T
+from .layouts import G0, NV, RW, OF, OS, O, T
 
 #: the task's rows (B leading): ``steps`` (B,) int64 control steps flown; ``on`` (B,) bool the controller
 #: acts at the next step; ``on_step`` (B,) bool it acted during the last step; ``axis_ref_i`` (B, 3) the
@@ -37,12 +37,12 @@ from .layouts import G0, RW, OF, OS, O, T
 #: ``qalpha`` (B,) [Pa deg]; ``mass`` (B,) [kg] the whole stack's mass at the row's time; ``stage`` (B,) int64
 #: the lowest attached stage at the row's time; ``pending`` (B, D, n_a) the actions sampled but not yet
 #: acting (``action_delay_steps`` D; one neutral slot when there is no delay), the oldest first; with
-#: ``observation="flight"`` (:mod:`.flightcomputer`; zeros otherwise): ``q_nav`` (B, 4) the strapdown
-#: attitude (scalar first), ``gyro`` (B, 3) [rad/s] the last gyro sample, ``draws`` (B, n_draws) the step's
-#: sensor draws (layout FLIGHT_DRAWS)
+#: ``observation="flight"`` (:mod:`.flightcomputer`; zeros otherwise): ``nav`` (B, n_nav) the strapdown
+#: attitude and the last gyro sample (layout NAV), ``draws`` (B, n_draws) the step's sensor draws (layout
+#: FLIGHT_DRAWS)
 TaskData = namedtuple("TaskData", ["steps", "on", "on_step", "axis_ref_i", "cum_error", "rate_error", "gyro_bias",
                                    "obs", "att", "terms", "reward", "reason", "truncated", "qalpha", "mass",
-                                   "stage", "pending", "q_nav", "gyro", "draws"])
+                                   "stage", "pending", "nav", "draws"])
 XF = STATE.fixed
 
 
@@ -127,11 +127,11 @@ def flight_observe_k(task, setup, sim, ts, b, a, ref_pitch, first):
     """The flight computer's sample (:mod:`.flightcomputer`) into the entries 0-6 of row ``b``'s
     observation: gyro and accelerometers from the IMU, the attitude error of the strapdown attitude
     against the reference axis ``a``."""
-    flight_sample_k(task, setup.imu, sim.imu[b], ref_pitch, ts.gyro_bias[b], ts.draws[b], ts.q_nav[b], ts.gyro[b],
-                    ts.obs[b], first)
-    q = ts.q_nav[b]
+    nav = ts.nav[b]
+    flight_sample_k(task, setup.imu, sim.imu[b], ref_pitch, ts.gyro_bias[b], ts.draws[b], nav, ts.obs[b], first)
+    oq = NV.q_nav
     C = np.empty((3, 3))
-    quat_to_dcm(q[0], q[1], q[2], q[3], C)
+    quat_to_dcm(nav[oq], nav[oq + 1], nav[oq + 2], nav[oq + 3], C)
     att = np.empty(2)
     attitude_error_k(C, a, att)
     ts.obs[b, OF.pitch_attitude_error] = att[0]
@@ -169,7 +169,7 @@ def reset_signals(rows, task, setup, sim, ts, tables):
                   mass, setup.n_slosh, setup.n_modes, ts.obs[b], ts.att[b])
         if task[T.flight] != 0.0:
             for i in range(4):
-                ts.q_nav[b, i] = xb[oq + i]
+                ts.nav[b, NV.q_nav + i] = xb[oq + i]
             flight_observe_k(task, setup, sim, ts, b, ts.axis_ref_i[b], ref_pitch, True)
 
 
