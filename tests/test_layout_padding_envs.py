@@ -45,6 +45,9 @@ def fly_all() -> dict[str, np.ndarray]:
     smile = gym.make("lvgym/SmileAscent-v0", model="nonrigid", wind="turbulence", randomize=True,
                      observation="sensors", mission_time_s=3.0)
     run("smile", smile, smile_scheduled_pid(smile, "smile"), 200)
+    flight = gym.make("lvgym/SmileAscent-v0", model="nonrigid", wind="turbulence", randomize=True,
+                      observation="flight", mission_time_s=2.0)
+    run("flight", flight, smile_scheduled_pid(flight, "smile"), 120)
     from baselines_pid.bangbang import BangBangRollPolicy
     run("stratos", gym.make("lvgym/StratosIII-v0", model="nonrigid", wind="profile", mission_time_s=2.0),
         BangBangRollPolicy(0.2), 120)

@@ -125,12 +125,16 @@ class AscentFuncEnv(FuncEnv):
         self.observation_space = spaces.Box(-np.inf, np.inf, (self.observation_layout.size,), np.float32)
         self._noisy = s.observation == "sensors" and "sensor_noise" in s.randomize
         self._flight_noisy = s.observation == "flight" and "sensor_noise" in s.randomize
-        sig = FLIGHT_DRAWS.zeros()
-        FLIGHT_DRAWS.view(sig, "gyro_noise")[:] = s.gyro_arw_rad_per_sqrt_s / math.sqrt(s.control_dt_s)
-        FLIGHT_DRAWS.view(sig, "accel_noise")[:] = s.accel_noise_mps2
-        self._draw_sigma_reset = sig.copy()                # no bias step at a reset
-        FLIGHT_DRAWS.view(sig, "bias_step")[:] = s.gyro_bias_rw_radps_per_sqrt_s * math.sqrt(s.control_dt_s)
-        self._draw_sigma = sig
+        # the draws' standard deviations, field by field (a row draws them in one call, whatever the layout's padding)
+        arw = s.gyro_arw_rad_per_sqrt_s / math.sqrt(s.control_dt_s)
+        step = s.gyro_bias_rw_radps_per_sqrt_s * math.sqrt(s.control_dt_s)
+        sigmas = {"gyro_noise": arw, "bias_step": step, "accel_noise": s.accel_noise_mps2}
+        self._draw_slices = [FLIGHT_DRAWS.slice(f.name) for f in FLIGHT_DRAWS.fields]
+        self._draw_sigma = np.concatenate([np.full(FLIGHT_DRAWS.field(f.name).size, sigmas[f.name])
+                                           for f in FLIGHT_DRAWS.fields])
+        self._draw_sigma_reset = np.concatenate([np.full(FLIGHT_DRAWS.field(f.name).size,
+                                                         0.0 if f.name == "bias_step" else sigmas[f.name])
+                                                 for f in FLIGHT_DRAWS.fields])      # no bias step at a reset
         self._neutral = 0.0 if s.control == "tvc" else 1.0        # the action that commands nothing
         self._noise = [(getattr(s, key), self.observation_layout.slice(names[0]).start, len(names), per)
                        for key, names, per in SENSOR_NOISE if names[0] in self.observation_layout]
@@ -377,10 +381,13 @@ class AscentFuncEnv(FuncEnv):
             return
         d = ts.draws
         for b, g in zip(rows, rngs):
+            d[b] = 0.0
             if g is None or sim.failed[b]:
-                d[b] = 0.0
-            else:
-                d[b] = g.normal(0.0, sigma)
+                continue
+            z, o = g.normal(0.0, sigma), 0
+            for sl in self._draw_slices:
+                d[b, sl] = z[o:o + sl.stop - sl.start]
+                o += sl.stop - sl.start
 
     def _add_noise(self, sim: SimData, ts: TaskData, rows: Any, rngs: Sequence[np.random.Generator | None]) -> None:
         """Sensor noise on the observation of ``rows`` (layout SENSOR_NOISE), each row from its own

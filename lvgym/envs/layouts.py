@@ -18,7 +18,8 @@ from __future__ import annotations
 
 from lvgym.packing import Field, Packed, rst_table
 
-__all__ = ["FLIGHT_DRAWS", "FLIGHT_SOURCE", "G0", "NAV", "OBSERVATIONS", "OBS_FLIGHT", "OBS_SENSORS", "OBS_STATE", "REASONS", "REWARD", "REWARD_TERMS", "SENSOR_NOISE",
+__all__ = ["FLIGHT_DRAWS", "FLIGHT_SOURCE", "G0", "NAV", "OBSERVATIONS", "OBS_FLIGHT", "OBS_SENSORS", "OBS_STATE",
+           "REASONS", "REWARD", "REWARD_TERMS", "SENSOR_NOISE",
            "TASK", "FD", "NV", "O", "OF", "OS", "RW", "T", "observation_table"]
 
 G0 = 9.80665

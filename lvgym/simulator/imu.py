@@ -50,7 +50,8 @@ from lvgym.rotations import quat_to_dcm
 from .layouts import ACCEL_ORDER, CTX, D, GYRO_ORDER, IM, IMU, IMU_STATE, IS
 from .timeline import locate_k
 
-__all__ = ["IMU_OFF", "Imu", "ImuWork", "imu_begin_k", "imu_end_k", "imu_output_k", "imu_shift_k", "lti_step_k", "make_imu_work",
+__all__ = ["IMU_OFF", "Imu", "ImuWork", "imu_begin_k", "imu_end_k", "imu_output_k", "imu_shift_k", "lti_step_k",
+           "make_imu_work",
            "specific_force_k"]
 
 XF, PF = STATE.fixed, PARAMS.fixed
