@@ -23,7 +23,8 @@ from lvgym.packing import Field, Packed, is_offsets, offsets_layout
 
 KERNEL_MODULES = ["lvgym.dynamics.kernels", "lvgym.dynamics.stepper", "lvgym.dynamics.invariants",
                   "lvgym.simulator.advance", "lvgym.simulator.flight", "lvgym.simulator.servo", "lvgym.simulator.strips",
-                  "lvgym.simulator.timeline", "lvgym.simulator.piece", "lvgym.envs.signals"]
+                  "lvgym.simulator.imu", "lvgym.simulator.timeline", "lvgym.simulator.piece", "lvgym.envs.signals",
+                  "lvgym.envs.flightcomputer"]
 #: a component index added to an offset whose field size the check cannot see (a local name): a quaternion's
 _COMPONENT = 4
 
@@ -184,8 +185,9 @@ def test_the_check_sees_offsets_worked_out_by_hand():
 
 LAYOUTS = ["lvgym.simulator.layouts:CONTEXT", "lvgym.simulator.layouts:CONDITIONS", "lvgym.simulator.layouts:RAIL",
            "lvgym.simulator.layouts:RAIL_STATE", "lvgym.simulator.layouts:SERVO", "lvgym.simulator.layouts:ACTUATOR",
+           "lvgym.simulator.layouts:IMU", "lvgym.simulator.layouts:IMU_STATE",
            "lvgym.envs.layouts:TASK", "lvgym.envs.layouts:OBS_STATE", "lvgym.envs.layouts:OBS_SENSORS",
-           "lvgym.envs.layouts:REWARD"]
+           "lvgym.envs.layouts:OBS_FLIGHT", "lvgym.envs.layouts:FLIGHT_DRAWS", "lvgym.envs.layouts:NAV", "lvgym.envs.layouts:REWARD"]
 
 
 @pytest.mark.parametrize("ref", LAYOUTS)
@@ -210,7 +212,10 @@ def test_the_docstring_tables_are_the_layouts():
         assert f.doc.split(";")[0][:30] in line
     for o, f in OBS_SENSORS.leaves():
         assert f"``{f.name}``" in ascent.__doc__
-    for lay in (sim.CONTEXT, sim.CONDITIONS, sim.ACTUATOR):
+    from lvgym.envs.layouts import FLIGHT_SOURCE, OBS_FLIGHT
+    for o, f in OBS_FLIGHT.leaves():
+        assert f.doc.split(";")[0][:30] in ascent.__doc__ and FLIGHT_SOURCE[f.name] in ascent.__doc__
+    for lay in (sim.CONTEXT, sim.CONDITIONS, sim.ACTUATOR, sim.IMU, sim.IMU_STATE):
         assert lay.table() in sim.__doc__
     for lin in (dyn.STATE, dyn.PARAMS, dyn.LOADS):
         assert lin.table() in dyn.__doc__

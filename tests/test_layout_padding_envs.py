@@ -48,6 +48,9 @@ def fly_all() -> dict[str, np.ndarray]:
     v1 = gym.make("lvgym/SmileAscent-v0", model="nonrigid", wind="turbulence", mission_time_s=3.0,
                   mode_interval_s=1.0, mode_basis="projected", slosh_frequency="specific_force")
     run("smile-modes", v1, smile_scheduled_pid(v1, "smile"), 150)        # changes of basis at 1 and 2 s
+    flight = gym.make("lvgym/SmileAscent-v0", model="nonrigid", wind="turbulence", randomize=True,
+                      observation="flight", mission_time_s=2.0)
+    run("flight", flight, smile_scheduled_pid(flight, "smile"), 120)
     from baselines_pid.bangbang import BangBangRollPolicy
     run("stratos", gym.make("lvgym/StratosIII-v0", model="nonrigid", wind="profile", mission_time_s=2.0),
         BangBangRollPolicy(0.2), 120)

@@ -6,10 +6,14 @@ explicit state; these classes only adapt one row of it to ``gymnasium.Env`` (the
 it whole, see :mod:`.snapshot`). Options are keywords (see :class:`~.spec.TaskSpec`), e.g.
 ``gymnasium.make("lvgym/SmileAscent-v0", model="rigid", wind="turbulence", randomize=True)``.
 
-Observation (``Box(-inf, inf, (14,), float32)``), for ``observation="state"`` (the ideal state, a research
-option) and ``"sensors"`` (what a flight computer has: a gyro at the IMU station that sees the bending slope
-rate, with bias and noise when ``sensor_noise`` is randomised, a noisy attitude, accelerometers); the table is
-:data:`lvgym.envs.layouts.OBSERVATIONS` (``env.unwrapped.observation_layout`` names the entries)::
+Observation (``Box(-inf, inf, (14,), float32)``), for ``observation="state"`` (the ideal state of the
+vehicle, a research option: no flight computer has its rates, attitude and angles of attack), ``"sensors"``
+(v0: a gyro at the IMU station that sees the bending slope rate, with a constant bias and noise when
+``sensor_noise`` is randomised, the true attitude plus noise, accelerometers) and ``"flight"`` (protocol v1:
+what a flight computer samples, every entry a flight-computer signal: the IMU's gyros with bandwidth,
+anti-aliasing, drifting bias and angle random walk, the attitude of their strapdown integration, the
+accelerometers with lever arm and bending; see :mod:`lvgym.envs.flightcomputer` and docs/sensors.md); the
+table is :data:`lvgym.envs.layouts.OBSERVATIONS` (``env.unwrapped.observation_layout`` names the entries)::
 
 %(observation)s
 

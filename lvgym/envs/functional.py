@@ -20,7 +20,9 @@ for a row that draws nothing; every random draw of a row comes from its generato
 Per row and reset (:meth:`AscentFuncEnv.reset`), in this order: the dispersions of ``randomize``
 (:meth:`AscentFuncEnv.dispersions`), the gyro bias (``sensor_noise``), the wind realisation (``wind``; a
 fixed generator otherwise), the first observation's noise; per step: the observation's noise
-(:data:`.layouts.SENSOR_NOISE`). So N rows and N single envs seeded alike are identical.
+(:data:`.layouts.SENSOR_NOISE`; with ``observation="flight"`` the draws of :data:`.layouts.FLIGHT_DRAWS`,
+one call per row after the simulator's step, read by the compiled flight computer). So N rows and N
+single envs seeded alike are identical.
 """
 
 from __future__ import annotations
@@ -38,13 +40,14 @@ from gymnasium.experimental.functional import FuncEnv
 from lvgym.simulator import SimData, Simulator, Timeline, aeroelastic_strips, build_timeline
 from lvgym.simulator import data as simdata
 from lvgym.simulator.core import Kernel
+from lvgym.simulator.imu import Imu
 from lvgym.simulator.layouts import ACTUATOR, DISPERSION
 from lvgym.simulator.servo import Servo
 from lvgym.vehicle import MassModel, Vehicle, load_vehicle
 from lvgym.vehicle.slender import slender_vehicle
 
 from .coast import coast_moment
-from .layouts import OBSERVATIONS, REASONS, REWARD, REWARD_TERMS, SENSOR_NOISE, TASK
+from .layouts import FLIGHT_DRAWS, NAV, OBSERVATIONS, REASONS, REWARD, REWARD_TERMS, SENSOR_NOISE, TASK
 from .signals import TaskData, reset_signals, step_signals_range
 from .spec import TaskSpec, wind_spec
 
@@ -115,14 +118,29 @@ class AscentFuncEnv(FuncEnv):
         self.gimbal_limit = math.radians(s.gimbal_limit_deg if s.gimbal_limit_deg is not None
                                          else (min(limits) if limits else 5.0))
         servo = Servo(s.actuator_frequency, s.actuator_damping, self.gimbal_limit, math.radians(s.gimbal_rate_limit_degps))
+        # the IMU is the timeline's first sensor station (cached_timeline)
+        imu = (Imu(self.imu, 0, s.gyro_bandwidth_hz, s.gyro_damping, s.antialias_hz) if s.observation == "flight"
+               else None)
         self.sim = Simulator(vehicle, s.model, site=s.site, elevation_deg=s.elevation_deg,
                              rail_length=s.rail_length_m, physics_dt=s.physics_dt_s, timeline=tl, servo=servo,
-                             aeroelastic=s.aeroelastic, mode_basis=s.mode_basis, slosh_frequency=s.slosh_frequency)
+                             aeroelastic=s.aeroelastic, mode_basis=s.mode_basis, slosh_frequency=s.slosh_frequency,
+                             imu=imu)
         self.n_steps = int(round(s.mission_time_s / s.control_dt_s))
         self.observation_layout = OBSERVATIONS[s.observation]
         self.action_space = (spaces.Box(-1.0, 1.0, (2,), np.float32) if s.control == "tvc" else spaces.MultiDiscrete([3]))
         self.observation_space = spaces.Box(-np.inf, np.inf, (self.observation_layout.size,), np.float32)
         self._noisy = s.observation == "sensors" and "sensor_noise" in s.randomize
+        self._flight_noisy = s.observation == "flight" and "sensor_noise" in s.randomize
+        # the draws' standard deviations, field by field (a row draws them in one call, whatever the layout's padding)
+        arw = s.gyro_arw_rad_per_sqrt_s / math.sqrt(s.control_dt_s)
+        step = s.gyro_bias_rw_radps_per_sqrt_s * math.sqrt(s.control_dt_s)
+        sigmas = {"gyro_noise": arw, "bias_step": step, "accel_noise": s.accel_noise_mps2}
+        self._draw_slices = [FLIGHT_DRAWS.slice(f.name) for f in FLIGHT_DRAWS.fields]
+        self._draw_sigma = np.concatenate([np.full(FLIGHT_DRAWS.field(f.name).size, sigmas[f.name])
+                                           for f in FLIGHT_DRAWS.fields])
+        self._draw_sigma_reset = np.concatenate([np.full(FLIGHT_DRAWS.field(f.name).size,
+                                                         0.0 if f.name == "bias_step" else sigmas[f.name])
+                                                 for f in FLIGHT_DRAWS.fields])      # no bias step at a reset
         self._neutral = 0.0 if s.control == "tvc" else 1.0        # the action that commands nothing
         self._noise = [(getattr(s, key), self.observation_layout.slice(names[0]).start, len(names), per)
                        for key, names, per in SENSOR_NOISE if names[0] in self.observation_layout]
@@ -150,7 +168,7 @@ class AscentFuncEnv(FuncEnv):
                           "earth_velocity": float(s.reference_velocity == "earth"),
                           "kick_start": s.kick_start_s, "kick_end": s.kick_end_s,
                           "kick_angle": math.radians(s.kick_angle_deg), "sensors": float(s.observation == "sensors"),
-                          "n_steps": self.n_steps})
+                          "n_steps": self.n_steps, "flight": float(s.observation == "flight")})
         return AscentParams(task=task, tables=self.sim.tables, setup=self.sim.setup)
 
     # ------------------------------------------------------------------------------ state
@@ -164,7 +182,8 @@ class AscentFuncEnv(FuncEnv):
                         truncated=np.zeros(B, dtype=bool), qalpha=np.zeros(B), mass=np.zeros(B),
                         stage=np.zeros(B, dtype=np.int64),
                         pending=np.full((B, max(self.spec.action_delay_steps, 1), self.action_space.shape[0]),
-                                        self._neutral))
+                                        self._neutral),
+                        nav=NAV.zeros(B), draws=FLIGHT_DRAWS.zeros(B))
         return AscentState(sim=self.sim.new_data(B), task=task, events=[[] for _ in range(B)])
 
     @staticmethod
@@ -227,6 +246,7 @@ class AscentFuncEnv(FuncEnv):
         ts.truncated[rows] = False
         ts.qalpha[rows] = 0.0
         ts.pending[rows] = self._neutral
+        self._draw_flight(sim, ts, rows, rngs, self._draw_sigma_reset)
         reset_signals(rows, params.task, params.setup, sim, ts, params.tables)
         self._add_noise(sim, ts, rows, rngs)
         events = list(state.events)
@@ -266,6 +286,7 @@ class AscentFuncEnv(FuncEnv):
             moment[:, 0] = np.where(on, (a - 1.0) * s.rcs_torque_nm, 0.0)
         events = self.sim.step(cmd, s.control_dt_s, moment, data=sim, force=force)
         ts.steps[:] += 1
+        self._draw_flight(sim, ts, range(B), rng, self._draw_sigma)
         self.sim.run_rows(_SIGNALS, B, params.task, params.setup, sim, ts, params.tables)
         if self._noisy:
             self._add_noise(sim, ts, range(B), rng)
@@ -417,6 +438,23 @@ class AscentFuncEnv(FuncEnv):
         if "bending_damping" in r:
             scale[self._i_zm] = math.exp(rng.uniform(math.log(0.5), math.log(2.0)))
         return scale, offset, mis, loads
+
+    def _draw_flight(self, sim: SimData, ts: TaskData, rows: Any, rngs: Sequence[np.random.Generator | None],
+                     sigma: np.ndarray) -> None:
+        """The flight sensors' draws of ``rows`` for this sample (layout FLIGHT_DRAWS, standard deviations
+        ``sigma``), each row from its own generator, when ``sensor_noise`` is randomised with the
+        ``flight`` observation; zero for a row without a generator or whose state failed."""
+        if not self._flight_noisy:
+            return
+        d = ts.draws
+        for b, g in zip(rows, rngs):
+            d[b] = 0.0
+            if g is None or sim.failed[b]:
+                continue
+            z, o = g.normal(0.0, sigma), 0
+            for sl in self._draw_slices:
+                d[b, sl] = z[o:o + sl.stop - sl.start]
+                o += sl.stop - sl.start
 
     def _add_noise(self, sim: SimData, ts: TaskData, rows: Any, rngs: Sequence[np.random.Generator | None]) -> None:
         """Sensor noise on the observation of ``rows`` (layout SENSOR_NOISE), each row from its own

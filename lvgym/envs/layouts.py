@@ -3,8 +3,10 @@
 - :data:`TASK`: the task's parameters, one vector per env (``task``), read by the compiled signals.
 - :data:`OBSERVATIONS`: the observation of each ``observation`` mode (an interface: trained policies
   depend on it, so it is never padded and never reordered; a new channel is a new entry at the end and a
-  new env version). Entries that mean the same in both modes have the same name and index; entries 5
-  and 6 are the angles of attack in ``state`` and the accelerometers in ``sensors``.
+  new env version). Entries that mean the same in every mode have the same name and index; entries 5
+  and 6 are the angles of attack in ``state`` and the accelerometers in ``sensors`` and ``flight``.
+- :data:`FLIGHT_DRAWS`: one control step's random draws of the ``flight`` sensors; :data:`NAV` the flight
+  computer's navigation state.
 - :data:`SENSOR_NOISE`: which observation entries each sensor's noise is added to.
 - :data:`REWARD`: the reward terms, in ``info["reward_terms"]`` and in the compiled kernel's order.
 - :data:`REASONS`: the termination codes.
@@ -16,8 +18,9 @@ from __future__ import annotations
 
 from lvgym.packing import Field, Packed, rst_table
 
-__all__ = ["G0", "OBSERVATIONS", "OBS_SENSORS", "OBS_STATE", "REASONS", "REWARD", "REWARD_TERMS", "SENSOR_NOISE",
-           "TASK", "O", "OS", "RW", "T", "observation_table"]
+__all__ = ["FLIGHT_DRAWS", "FLIGHT_SOURCE", "G0", "NAV", "OBSERVATIONS", "OBS_FLIGHT", "OBS_SENSORS", "OBS_STATE",
+           "REASONS", "REWARD", "REWARD_TERMS", "SENSOR_NOISE",
+           "TASK", "FD", "NV", "O", "OF", "OS", "RW", "T", "observation_table"]
 
 G0 = 9.80665
 
@@ -40,6 +43,7 @@ TASK = Packed("task parameters", [
     Field("kick_angle", 1, "rad", "angle of the pitch kick"),
     Field("sensors", 1, "-", "1: the sensors observation, 0: the ideal state"),
     Field("n_steps", 1, "-", "control steps of the mission"),
+    Field("flight", 1, "-", "1: the flight observation (IMU filters, drifting gyro, strapdown attitude)"),
 ])
 
 _COMMON_HEAD = [
@@ -59,7 +63,7 @@ _COMMON_TAIL = [
           "and while no engine burns)"),
     Field("pitch_rate_reference", 1, "rad/s", "reference pitch rate (zero, or the gravity-turn programme)"),
 ]
-#: ``observation="state"``: the ideal state of the vehicle (a research option)
+#: ``observation="state"``: the ideal state of the vehicle, which no flight computer has (a research option)
 OBS_STATE = Packed("observation (state)", _COMMON_HEAD + [
     Field("alpha", 1, "rad", "angle of attack"),
     Field("beta", 1, "rad", "sideslip"),
@@ -76,7 +80,44 @@ OBS_SENSORS = Packed("observation (sensors)", [
     Field("accel_z", 1, "g0", "lateral specific force along body z over g0 (accelerometer, noise)"),
     Field("accel_y", 1, "g0", "lateral specific force along body y over g0 (accelerometer, noise)"),
 ] + _COMMON_TAIL, interface=True)
-OBSERVATIONS = {"state": OBS_STATE, "sensors": OBS_SENSORS}
+#: ``observation="flight"`` (protocol v1): what a flight computer samples: the IMU's gyros at their station
+#: (bending slope rate, sensor bandwidth, anti-aliasing, drifting bias, angle random walk), the attitude
+#: its strapdown integration of them gives, the IMU's accelerometers (lever arm, bending, anti-aliasing)
+OBS_FLIGHT = Packed("observation (flight)", [
+    Field("roll_rate", 1, "rad/s", "sampled gyro roll rate at the IMU (filters, drifting bias, angle random walk)"),
+    Field("pitch_rate_error", 1, "rad/s", "sampled gyro pitch rate at the IMU (sees the bending slope rate) minus "
+          "the reference"),
+    Field("yaw_rate_error", 1, "rad/s", "sampled gyro yaw rate at the IMU"),
+    Field("pitch_attitude_error", 1, "rad", "strapdown attitude (integrated gyro rates) against the reference "
+          "axis, about body y"),
+    Field("yaw_attitude_error", 1, "rad", "the same about body z"),
+    Field("accel_z", 1, "g0", "sampled lateral specific force along body z at the IMU over g0 (lever arm, "
+          "bending, anti-aliasing, noise)"),
+    Field("accel_y", 1, "g0", "the same along body y"),
+] + _COMMON_TAIL, interface=True)
+OBSERVATIONS = {"state": OBS_STATE, "sensors": OBS_SENSORS, "flight": OBS_FLIGHT}
+#: where a flight computer gets each entry of the ``sensors`` and ``flight`` modes (the ``state`` mode's
+#: entries 0-6 are the ideal state: no flight computer has them)
+FLIGHT_SOURCE = {
+    "roll_rate": "gyro", "pitch_rate_error": "gyro, guidance", "yaw_rate_error": "gyro",
+    "pitch_attitude_error": "navigation (flight: strapdown gyro integration)", "yaw_attitude_error": "navigation",
+    "accel_z": "accelerometer", "accel_y": "accelerometer",
+    "mach_over_10": "navigation and air-data model (taken exact)", "qbar_over_1e5": "navigation and air-data "
+    "model (taken exact)", "gimbal_pitch": "actuator position feedback", "gimbal_yaw": "actuator position feedback",
+    "time_fraction": "clock", "controller_on": "sequencer", "pitch_rate_reference": "guidance (taken exact)",
+}
+#: the flight computer's navigation state of a row (``observation="flight"``)
+NAV = Packed("navigation state", [
+    Field("q_nav", 4, "-", "strapdown attitude, the estimate of q_bi (scalar first)"),
+    Field("gyro", 3, "rad/s", "the last gyro sample (bias and noise included), body axes"),
+])
+#: one control step's draws of the ``flight`` sensors of a row (from its generator, already scaled)
+FLIGHT_DRAWS = Packed("flight sensor draws", [
+    Field("gyro_noise", 3, "rad/s", "angle random walk: white rate noise of the sample, sigma ARW / sqrt(dt)"),
+    Field("bias_step", 3, "rad/s", "the gyro bias's random-walk step over the period, sigma sigma_b sqrt(dt) "
+          "(zero at a reset)"),
+    Field("accel_noise", 2, "m/s^2", "accelerometer white noise (body y, z)"),
+])
 #: per sensor: the TaskSpec key of its noise's standard deviation, the observation entries it is added
 #: to (consecutive) and the divisor that takes it to the entries' unit
 SENSOR_NOISE = (("gyro_noise_radps", ("roll_rate", "pitch_rate_error", "yaw_rate_error"), 1.0),
@@ -96,17 +137,25 @@ REWARD_TERMS = REWARD.names
 #: termination codes (the order is the precedence: a later one overrides an earlier one)
 REASONS = ("", "attitude error beyond the limit", "q-alpha beyond the structural limit", "non-finite state")
 
-T, O, OS, RW = TASK.at, OBS_STATE.at, OBS_SENSORS.at, REWARD.at
-assert OBS_STATE.size == OBS_SENSORS.size and all(
-    OBS_STATE.offset(n) == OBS_SENSORS.offset(n) for n in OBS_STATE.names if n in OBS_SENSORS)
+T, O, OS, OF, RW, FD, NV = (TASK.at, OBS_STATE.at, OBS_SENSORS.at, OBS_FLIGHT.at, REWARD.at, FLIGHT_DRAWS.at,
+                             NAV.at)
+assert all(lay.size == OBS_STATE.size and all(OBS_STATE.offset(n) == lay.offset(n) for n in OBS_STATE.names if n in lay)
+           for lay in (OBS_SENSORS, OBS_FLIGHT))
+assert OBS_SENSORS.names == OBS_FLIGHT.names
 
 
 def observation_table() -> str:
-    """The observation of both modes as one reStructuredText table (for the env docstrings)."""
+    """The observation of every mode as one reStructuredText table (for the env docstrings), with what a
+    flight computer reads each entry from (``state``'s entries 0-6 are the ideal state, for research)."""
     rows = []
-    for (o, f), (_, g) in zip(OBS_STATE.leaves(), OBS_SENSORS.leaves()):
+    for (o, f), (_, g), (_, h) in zip(OBS_STATE.leaves(), OBS_SENSORS.leaves(), OBS_FLIGHT.leaves()):
         name = f"``{f.name}``" if f.name == g.name else f"``{f.name}`` / ``{g.name}``"
-        meaning = f.doc if f.name == g.name and f.doc == g.doc else f"state: {f.doc}; sensors: {g.doc}"
+        if f.name == g.name and f.doc == g.doc == h.doc:
+            meaning = f.doc
+        else:
+            meaning = f"state: {f.doc}; sensors: {g.doc}; flight: {h.doc}"
         unit = f.unit if f.unit == g.unit else f"{f.unit} / {g.unit}"
-        rows.append([str(o), name, unit, meaning])
-    return rst_table(["index", "name (state / sensors)", "unit", "meaning"], rows)
+        source = FLIGHT_SOURCE[g.name] if f.name == g.name and f.doc == g.doc else f"state: none (ideal); " \
+            f"sensors, flight: {FLIGHT_SOURCE[g.name]}"
+        rows.append([str(o), name, unit, meaning, source])
+    return rst_table(["index", "name (state / sensors, flight)", "unit", "meaning", "flight computer source"], rows)

@@ -24,7 +24,8 @@ from lvgym.rotations import quat_to_dcm
 from lvgym.simulator.layouts import RL, A, D
 from lvgym.simulator.timeline import locate_k
 
-from .layouts import G0, RW, OS, O, T
+from .flightcomputer import flight_sample_k
+from .layouts import G0, NV, RW, OF, OS, O, T
 
 #: the task's rows (B leading): ``steps`` (B,) int64 control steps flown; ``on`` (B,) bool the controller
 #: acts at the next step; ``on_step`` (B,) bool it acted during the last step; ``axis_ref_i`` (B, 3) the
@@ -35,10 +36,13 @@ from .layouts import G0, RW, OS, O, T
 #: ``reward`` (B,); ``reason`` (B,) int64 termination code (index of REASONS); ``truncated`` (B,) bool;
 #: ``qalpha`` (B,) [Pa deg]; ``mass`` (B,) [kg] the whole stack's mass at the row's time; ``stage`` (B,) int64
 #: the lowest attached stage at the row's time; ``pending`` (B, D, n_a) the actions sampled but not yet
-#: acting (``action_delay_steps`` D; one neutral slot when there is no delay), the oldest first
+#: acting (``action_delay_steps`` D; one neutral slot when there is no delay), the oldest first; with
+#: ``observation="flight"`` (:mod:`.flightcomputer`; zeros otherwise): ``nav`` (B, n_nav) the strapdown
+#: attitude and the last gyro sample (layout NAV), ``draws`` (B, n_draws) the step's sensor draws (layout
+#: FLIGHT_DRAWS)
 TaskData = namedtuple("TaskData", ["steps", "on", "on_step", "axis_ref_i", "cum_error", "rate_error", "gyro_bias",
                                    "obs", "att", "terms", "reward", "reason", "truncated", "qalpha", "mass",
-                                   "stage", "pending"])
+                                   "stage", "pending", "nav", "draws"])
 XF = STATE.fixed
 
 
@@ -118,6 +122,22 @@ def observe_k(task, t, x, cond, act, C, a, on, ref_pitch, bias, dphi, mass, n_sl
     obs[O.pitch_rate_reference] = ref_pitch
 
 
+@nb.njit(cache=True, nogil=True)
+def flight_observe_k(task, setup, sim, ts, b, a, ref_pitch, first):
+    """The flight computer's sample (:mod:`.flightcomputer`) into the entries 0-6 of row ``b``'s
+    observation: gyro and accelerometers from the IMU, the attitude error of the strapdown attitude
+    against the reference axis ``a``."""
+    nav = ts.nav[b]
+    flight_sample_k(task, setup.imu, sim.imu[b], ref_pitch, ts.gyro_bias[b], ts.draws[b], nav, ts.obs[b], first)
+    oq = NV.q_nav
+    C = np.empty((3, 3))
+    quat_to_dcm(nav[oq], nav[oq + 1], nav[oq + 2], nav[oq + 3], C)
+    att = np.empty(2)
+    attitude_error_k(C, a, att)
+    ts.obs[b, OF.pitch_attitude_error] = att[0]
+    ts.obs[b, OF.yaw_attitude_error] = att[1]
+
+
 @nb.njit(cache=True, nogil=True, inline="always")
 def _imu_and_mass_k(tables, t):
     """Row of the timeline in force at ``t`` (for the mode slopes at the IMU) and the stack's mass [kg]."""
@@ -143,9 +163,14 @@ def reset_signals(rows, task, setup, sim, ts, tables):
         j, mass = _imu_and_mass_k(tables, t)
         ts.mass[b] = mass
         ts.stage[b] = int(tables.stage[j])
+        ref_pitch = reference_pitch_rate_k(task, setup.rail[RL.omega_e], t, xb, sim.conditions[b])
         observe_k(task, t, xb, sim.conditions[b], sim.actuator[b], C, ts.axis_ref_i[b], ts.on[b],
-                  reference_pitch_rate_k(task, setup.rail[RL.omega_e], t, xb, sim.conditions[b]), ts.gyro_bias[b], tables.dphi_sensor[j, 0],
+                  ref_pitch, ts.gyro_bias[b], tables.dphi_sensor[j, 0],
                   mass, setup.n_slosh, setup.n_modes, ts.obs[b], ts.att[b])
+        if task[T.flight] != 0.0:
+            for i in range(4):
+                ts.nav[b, NV.q_nav + i] = xb[oq + i]
+            flight_observe_k(task, setup, sim, ts, b, ts.axis_ref_i[b], ref_pitch, True)
 
 
 @nb.njit(cache=True, nogil=True)
@@ -195,6 +220,8 @@ def step_signals_range(lo, hi, task, setup, sim, ts, tables):
         ts.stage[b] = int(tables.stage[j])
         observe_k(task, t, xb, cond, act, C, a, ts.on[b], ref_pitch, ts.gyro_bias[b], tables.dphi_sensor[j, 0], mass,
                   setup.n_slosh, setup.n_modes, ts.obs[b], ts.att[b])
+        if task[T.flight] != 0.0 and not failed:
+            flight_observe_k(task, setup, sim, ts, b, a, ref_pitch, False)
         qalpha = cond[D.qbar] * math.degrees(cond[D.alpha_total])
         ts.qalpha[b] = qalpha
         code = 0

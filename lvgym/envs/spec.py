@@ -21,7 +21,7 @@ MAXQ_GUST_ONSET_M = (8000.0, 11500.0)
 RANDOMIZE_V0 = ("wind", "thrust_misalignment", "mass", "slosh_damping", "bending_frequency", "sensor_noise")
 #: every randomisation by name (``lvgym.envs.functional.AscentFuncEnv.dispersions`` draws them)
 RANDOMIZE = RANDOMIZE_V0 + ("aerodynamics", "thrust_level", "slosh_mass", "slosh_frequency", "bending_damping")
-OBSERVATIONS = ("state", "sensors")
+OBSERVATIONS = ("state", "sensors", "flight")
 REFERENCES = ("zero_rate", "gravity_turn")
 REFERENCE_VELOCITIES = ("inertial", "earth")
 CONTROLS = ("tvc", "rcs")
@@ -58,6 +58,14 @@ def wind_spec(tier: str, mission_time: float) -> Any:
     raise ConfigError("wind", tier, f"one of {WIND_TIERS}")
 
 
+#: options of the ``flight`` observation for a tactical-grade IMU where the v0 defaults of the shared keys
+#: are not (see :class:`TaskSpec`): a turn-on gyro bias of 3 deg/h per axis (1-10 deg/h for tactical FOG
+#: and MEMS gyros after calibration) and accelerometer noise of 0.02 m/s^2 per 50 Hz sample (a
+#: tactical accelerometer's 0.05-0.1 m/s/sqrt(h) velocity random walk gives about 0.01 m/s^2 at 50 Hz;
+#: doubled for the vibration of a burning motor)
+FLIGHT_DEFAULTS = {"observation": "flight", "gyro_bias_radps": 1.5e-5, "accel_noise_mps2": 0.02}
+
+
 @dataclass(frozen=True)
 class TaskSpec:
     """Options of an ascent task (units in the names; angles in degrees only where the name says so).
@@ -67,7 +75,10 @@ class TaskSpec:
     (truncation); control_dt_s / physics_dt_s: policy period and largest RK4 step; controller_on_after_s:
     the controller is off (gimbal held at zero) before this time and while no engine burns (staging coast);
     wind: a tier of ``WIND_TIERS``; randomize: the set of ``RANDOMIZE`` names drawn from the env's generator
-    at every reset (``True``: protocol v0's six, ``RANDOMIZE_V0``); observation: ``state`` (ideal) or ``sensors`` (IMU at ``imu_station_m``);
+    at every reset (``True``: protocol v0's six, ``RANDOMIZE_V0``); observation: ``state`` (the ideal
+    state, for research: no flight computer has it), ``sensors`` (v0: a gyro at ``imu_station_m`` that sees the bending slope rate, constant bias, white
+    noise, the true attitude plus noise) or ``flight`` (protocol v1: what a flight computer samples, see
+    below and docs/sensors.md);
     reference: ``zero_rate`` or ``gravity_turn`` (pitch kick, then the rate that keeps the flight-path
     angle's turn); reference_velocity: the velocity whose angle from the vertical the gravity turn
     follows, ``inertial`` (v0) or ``earth`` (relative to the rotating Earth: at Andøya the inertial one
@@ -88,6 +99,26 @@ class TaskSpec:
     aeroelastic loads (True, False, None: the vehicle file's flag; False in v0); mode_interval_s, mode_basis,
     slosh_frequency: the Simulator's ``mode_interval`` (None: the vehicle's), ``mode_basis`` (``held`` v0,
     ``projected``) and ``slosh_frequency`` (``vacuum_thrust`` v0, ``specific_force``).
+
+    Sensors. ``sensors`` adds, with ``sensor_noise`` randomised, a constant gyro bias
+    N(0, ``gyro_bias_radps``) and white noise ``gyro_noise_radps``, ``attitude_noise_rad``,
+    ``accel_noise_mps2`` per sample. ``flight`` models a tactical-grade strapdown IMU at
+    ``imu_station_m`` (:mod:`lvgym.simulator.imu`, :mod:`lvgym.envs.flightcomputer`): gyros that see the
+    bending slope rate through a second-order bandwidth (``gyro_bandwidth_hz`` = 80 Hz,
+    ``gyro_damping`` = 0.7: tactical FOG/MEMS gyros have 50-500 Hz bandwidths, the low end taken) and
+    a second-order Butterworth anti-aliasing low-pass (``antialias_hz`` = 20 Hz: below the 25 Hz
+    Nyquist frequency of the 50 Hz control sampling; it lets the 9-14 Hz bending modes through with
+    phase lag, as flight IMUs do), both advanced at every physics step; accelerometers at the same
+    station with lever arm and bending through the same low-pass, plus ``accel_noise_mps2`` per sample;
+    with ``sensor_noise`` randomised, an initial gyro bias N(0, ``gyro_bias_radps``) per axis that then
+    drifts as a random walk (``gyro_bias_rw_radps_per_sqrt_s`` = 1.5e-6 rad/s/sqrt(s): a 1-sigma wander
+    over a 100 s flight of 3 deg/h, the bias instability of a tactical-grade gyro, 1-10 deg/h) and an
+    angle random walk (``gyro_arw_rad_per_sqrt_s`` = 4.4e-5 rad/sqrt(s) = 0.15 deg/sqrt(h), tactical
+    grade 0.1-0.3 deg/sqrt(h): white rate noise ARW / sqrt(control_dt_s) per sample); the attitude is
+    the strapdown integration of the sampled gyro rates from the true attitude at the reset. The v0
+    defaults of the shared keys stay: ``gyro_bias_radps`` = 1e-3 rad/s (206 deg/h, an industrial
+    MEMS) is far above a tactical IMU's turn-on bias; :data:`FLIGHT_DEFAULTS` holds the tactical-grade
+    values for the v1 envs.
     """
 
     vehicle: Any
@@ -134,6 +165,11 @@ class TaskSpec:
     mode_interval_s: float | None = None
     mode_basis: str = "held"
     slosh_frequency: str = "vacuum_thrust"
+    gyro_bandwidth_hz: float = 80.0
+    gyro_damping: float = 0.7
+    antialias_hz: float = 20.0
+    gyro_arw_rad_per_sqrt_s: float = 4.4e-5
+    gyro_bias_rw_radps_per_sqrt_s: float = 1.5e-6
 
     def __post_init__(self) -> None:
         check_choice("model", self.model, MODELS)
@@ -171,8 +207,11 @@ class TaskSpec:
                             ("kick_angle_deg", -90.0, 90.0), ("gyro_noise_radps", 0.0, 1.0),
                             ("gyro_bias_radps", 0.0, 1.0), ("accel_noise_mps2", 0.0, 100.0),
                             ("attitude_noise_rad", 0.0, 1.0), ("coast_torque_nm", 0.0, 1e6), ("settling_thrust_n", 0.0, 1e7),
-                            ("coast_bandwidth_radps", 0.01, 100.0)):
+                            ("coast_bandwidth_radps", 0.01, 100.0), ("gyro_damping", 0.05, 10.0),
+                            ("gyro_arw_rad_per_sqrt_s", 0.0, 0.1), ("gyro_bias_rw_radps_per_sqrt_s", 0.0, 0.1)):
             check_number(key, getattr(self, key), lo, hi)
+        for key in ("gyro_bandwidth_hz", "antialias_hz"):
+            check_number(key, getattr(self, key), 0.0, 1e4, lo_open=True)
         if self.kick_end_s <= self.kick_start_s:
             raise ConfigError("kick_end_s", self.kick_end_s, f"a time after kick_start_s = {self.kick_start_s}")
         if self.gimbal_limit_deg is not None:

@@ -13,7 +13,9 @@ Per row and per physics step of ``h = duration / ceil(duration / physics_dt)`` s
    (:mod:`.piece`);
 3. one RK4 step of the dynamics core with the flight loads (:func:`lvgym.dynamics.stepper.rk4_vehicle`);
 4. while on the pad or rail, the vehicle is put back on the rail line (:func:`constrain_k`) and the
-   lift-off and rail-exit times are recorded at the physics step where they happen.
+   lift-off and rail-exit times are recorded at the physics step where they happen;
+5. with an IMU (``setup.imu``, layout :data:`.layouts.IMU`), its gyro and accelerometer filters are
+   advanced over the step with the step's mean inputs (:mod:`.imu`).
 
 After the period the flight conditions are evaluated at the row's new time with the thrust at that
 time. Rows whose state turns non-finite are flagged failed and no longer integrated. The functions
@@ -38,7 +40,8 @@ from lvgym.packing import at
 from lvgym.rotations import quat_to_dcm
 
 from .flight import PF, XF, flight_conditions_k, select_aero_k
-from .layouts import AEL, CTX, RL, RS, A
+from .imu import imu_begin_k, imu_end_k, imu_shift_k, make_imu_work
+from .layouts import AEL, CTX, IM, RL, RS, A
 from .piece import axial_specific_force_k, project_at_k, slosh_frequency_k
 from .strips import strip_modes_k
 from .servo import servo_step_k
@@ -46,8 +49,10 @@ from .timeline import held_k, interp_k, locate_k, params_k
 
 #: constants of a simulator's step: ``rail`` (layout RAIL), ``servo`` (layout SERVO), ``physics_dt`` [s]
 #: the largest RK4 step, ``n_slosh`` and ``n_modes`` of the dynamics model, ``n_u`` its loads' length,
-#: ``slosh_frequency`` the index of the damper frequency in :data:`.piece.SLOSH_FREQUENCIES` (0: the timeline's)
-StepSetup = namedtuple("StepSetup", ["rail", "servo", "physics_dt", "n_slosh", "n_modes", "n_u", "slosh_frequency"])
+#: ``slosh_frequency`` the index of the damper frequency in :data:`.piece.SLOSH_FREQUENCIES` (0: the timeline's),
+#: ``imu`` the IMU's parameters (layout IMU; ``on`` 0: no IMU)
+StepSetup = namedtuple("StepSetup", ["rail", "servo", "physics_dt", "n_slosh", "n_modes", "n_u", "slosh_frequency",
+                                     "imu"])
 XS = STATE.per_slosh
 _EPS = 1e-12
 
@@ -140,6 +145,8 @@ def advance_range(lo, hi, loads_fn, data, tables, setup, duration):
     n = max(1, int(math.ceil(duration / setup.physics_dt - 1e-9)))
     h = duration / n
     rail, servo, ev_t = setup.rail, setup.servo, tables.event_times
+    imu_on = setup.imu[IM.on] != 0.0
+    iw = make_imu_work(n_modes)
     for b in range(lo, hi):
         # rows of the caller's arrays, passed on without reference counting (see unowned)
         xb, pb, cb = unowned(x[b]), unowned(p[b]), unowned(data.ctx[b])
@@ -153,6 +160,8 @@ def advance_range(lo, hi, loads_fn, data, tables, setup, duration):
         t_start = t[b]
         first = True                  # the row's latest flight conditions: data.conditions, then the scratch
         for k in range(n):
+            if imu_on:
+                imu_begin_k(xb, n_slosh, n_modes, iw)
             servo_step_k(servo, act, h)
             cb[CTX.gimbal], cb[CTX.gimbal + 1] = act[A.gimbal], act[A.gimbal + 1]
             act[A.effort] += (abs(act[A.gimbal]) + abs(act[A.gimbal + 1])) * h
@@ -179,7 +188,11 @@ def advance_range(lo, hi, loads_fn, data, tables, setup, duration):
                 first = False
                 d = pn[PF.r_cg] - pb[PF.r_cg]
                 if d != 0.0:
+                    if imu_on:
+                        imu_shift_k(xb, iw, -1.0)
                     shift_cg_k(xb, d, C)
+                    if imu_on:
+                        imu_shift_k(xb, iw, 1.0)
                 pb[:] = pn
                 _piece_thrust_k(cb, tables, tm)
                 cb[CTX.time0] = ta
@@ -203,6 +216,8 @@ def advance_range(lo, hi, loads_fn, data, tables, setup, duration):
                 data.failed[b] = True
                 t[b] = t_start + duration
                 break
+            if imu_on:
+                imu_end_k(setup.imu, data.imu[b], xb, pb, cb, tables, tb, h, iw, n_slosh, n_modes)
         _piece_thrust_k(cb, tables, t[b])
         flight_conditions_k(t[b], xb, pb, cb, data.conditions[b])
 

@@ -54,6 +54,7 @@ from . import data as simdata
 from .advance import StepSetup, advance_range, conditions_rows, constrain_k, slosh_angles_range
 from .data import SimData
 from .flight import flight_loads, pack_context, stack_contexts
+from .imu import IMU_OFF, Imu
 from .layouts import ACTUATOR, CONDITIONS, CONTEXT, DISPERSION, RAIL, RAIL_STATE, RS
 from .piece import SLOSH_FREQUENCIES
 from .strips import StripSetup, strip_models, strip_stations
@@ -167,6 +168,9 @@ class Simulator:
         timeline's vacuum thrust) or ``specific_force`` (``sqrt(|a_x| / L)`` from the axial specific force,
         thrust at ambient pressure plus the aerodynamic axial force over the mass, of the row's latest
         flight conditions; see :mod:`.piece`).
+    imu: an :class:`~.imu.Imu` (its ``sensor`` indexes ``sensor_stations``) whose gyro and accelerometer
+        filters are advanced at every physics step into ``data.imu`` (default None: no IMU; a step must
+        then last a whole number of ``physics_dt``).
     """
 
     def __init__(self, vehicle: str | Vehicle = "smile", model: str = "nonrigid", *, site: Any = "andoya",
@@ -175,7 +179,7 @@ class Simulator:
                  n_modes: int | None = None, sensor_stations: Sequence[float] = (), cg_convention: str = "static",
                  timeline_dt: float = 0.05, timeline: Timeline | None = None, servo: Servo | None = None,
                  threads: int | None = None, aeroelastic: bool | None = None, mode_interval: float | None = None,
-                 mode_basis: str = "held", slosh_frequency: str = "vacuum_thrust") -> None:
+                 mode_basis: str = "held", slosh_frequency: str = "vacuum_thrust", imu: Imu | None = None) -> None:
         if model not in MODELS:
             raise ValueError(f"model = {model!r}: one of {MODELS}")
         if not 0.0 < physics_dt <= 0.1:
@@ -234,6 +238,10 @@ class Simulator:
         self.omega_e = 0.0 if self.site.flat_earth else WGS84_OMEGA
         self.rail = self._rail_vector()
         self.servo = servo
+        self.imu = imu
+        if imu is not None and not 0 <= imu.sensor < self.timeline.sensor_stations.size:
+            raise ValueError(f"imu.sensor = {imu.sensor}: the timeline has {self.timeline.sensor_stations.size} "
+                             "sensor stations")
         self.threads = int(threads) if threads is not None else _default_threads()
         if self.threads < 1:
             raise ValueError(f"threads = {threads!r}: at least 1")
@@ -241,7 +249,8 @@ class Simulator:
         self.setup = StepSetup(rail=self.rail, servo=DIRECT if servo is None else servo.params(),
                                physics_dt=self.physics_dt, n_slosh=self.dynamics.n_slosh,
                                n_modes=self.dynamics.n_modes, n_u=self.layout.n_u,
-                               slosh_frequency=SLOSH_FREQUENCIES.index(self.slosh_frequency))
+                               slosh_frequency=SLOSH_FREQUENCIES.index(self.slosh_frequency),
+                               imu=IMU_OFF if imu is None else imu.params(self.physics_dt))
         self._event_times_all = np.array([t for t, _ in self.timeline.events], dtype=float)
         self.data: SimData = self.new_data(0)
 
@@ -337,9 +346,21 @@ class Simulator:
         q_si = self.layout.view(d.x, "state", "q_si")
         q_si[rows] = d.x[rows][:, None, self.layout.state["q_bi"]]
         self.update_conditions(rows, d)
+        if self.imu is not None:
+            d.imu[rows] = self._imu_at_rest(rows, d)
         if own:
             self.data = d
         return d
+
+    def _imu_at_rest(self, rows: np.ndarray, d: SimData) -> np.ndarray:
+        """IMU filter states of ``rows`` at rest on the pad: the body rate (the Earth's) and the lateral
+        specific force of a body turning with the Earth, ``C_bi (omega_e x (omega_e x r) - g)``."""
+        lay = self.layout.state
+        r = d.x[rows][:, lay["r_zw_i"]]
+        a_i = -self.omega_e ** 2 * np.stack([r[:, 0], r[:, 1], np.zeros(rows.size)], axis=1)
+        f_b = np.einsum("bji,bj->bi", dcm_batch(d.x[rows][:, lay["q_bi"]]),
+                        a_i - CONDITIONS.view(d.conditions[rows], "g_i"))
+        return Imu.rest_state(d.x[rows][:, lay["omega_bi_b"]], f_b[:, 1:])
 
     def _rail_vector(self) -> np.ndarray:
         return RAIL.pack({"omega_e": self.omega_e, "x_base": -self.vehicle.length, "length": self.rail_length,
@@ -396,6 +417,11 @@ class Simulator:
             raise RuntimeError("call reset() before step()")
         if not duration > 0.0:
             raise ValueError(f"duration = {duration!r}: must be > 0 s")
+        if self.imu is not None:
+            n = max(1, math.ceil(duration / self.physics_dt - 1e-9))
+            if abs(duration / n - self.physics_dt) > 1e-9 * self.physics_dt:
+                raise ValueError(f"duration = {duration!r}: with an IMU, a whole number of physics_dt = "
+                                 f"{self.physics_dt} (its filters are discretised for that step)")
         ACTUATOR.view(d.actuator, "command")[:] = np.broadcast_to(np.asarray(gimbal, dtype=float), (B, 2))
         CONTEXT.view(d.ctx[:, :CONTEXT.size], "moment_b")[:] = 0.0 if moment is None else np.broadcast_to(moment, (B, 3))
         CONTEXT.view(d.ctx[:, :CONTEXT.size], "force_b")[:] = 0.0 if force is None else np.broadcast_to(force, (B, 3))

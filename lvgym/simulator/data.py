@@ -20,6 +20,7 @@ field           shape             meaning
 ``rail_state``  (B, n_rail)       motion on the pad and rail (:data:`.layouts.RAIL_STATE`)
 ``actuator``    (B, n_act)        command, gimbal, gimbal rate, effort (:data:`.layouts.ACTUATOR`)
 ``conditions``  (B, n_cond)       flight conditions at ``t`` (:data:`.layouts.CONDITIONS`)
+``imu``         (B, n_imu)        IMU filter states (:data:`.layouts.IMU_STATE`; zero without an IMU)
 ==============  ================  =====================================================================
 """
 
@@ -30,12 +31,12 @@ from typing import Any
 
 import numpy as np
 
-from .layouts import ACTUATOR, CONDITIONS, RAIL_STATE
+from .layouts import ACTUATOR, CONDITIONS, IMU_STATE, RAIL_STATE
 
 __all__ = ["SimData", "allocate", "put", "take", "widen"]
 
 SimData = namedtuple("SimData", ["t", "x", "p", "ctx", "scale", "offset", "x_cg0", "failed", "rail_state", "actuator",
-                                 "conditions"])
+                                 "conditions", "imu"])
 
 
 def allocate(batch: int, n_x: int, n_p: int, n_ctx: int = 0) -> SimData:
@@ -44,7 +45,7 @@ def allocate(batch: int, n_x: int, n_p: int, n_ctx: int = 0) -> SimData:
     return SimData(t=np.zeros(B), x=np.zeros((B, n_x)), p=np.zeros((B, n_p)), ctx=np.zeros((B, n_ctx)),
                    scale=np.ones((B, n_p)), offset=np.zeros((B, n_p)), x_cg0=np.zeros(B),
                    failed=np.zeros(B, dtype=bool), rail_state=RAIL_STATE.zeros(B), actuator=ACTUATOR.zeros(B),
-                   conditions=CONDITIONS.zeros(B))
+                   conditions=CONDITIONS.zeros(B), imu=IMU_STATE.zeros(B))
 
 
 def widen(data: SimData, n_ctx: int) -> SimData:

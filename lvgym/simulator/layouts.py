@@ -18,6 +18,8 @@ these layouts; the compiled functions read their offsets from the ``.at`` namedt
   policy see.
 - :data:`RAIL` the launch rail (one per simulator), :data:`RAIL_STATE` the row's motion along it.
 - :data:`SERVO` the gimbal servo's parameters, :data:`ACTUATOR` the row's command, gimbal and effort.
+- :data:`IMU` the inertial measurement unit's parameters (one per simulator; discrete filters of
+  :mod:`.imu`), :data:`IMU_STATE` the row's gyro and accelerometer filter states.
 """
 
 from __future__ import annotations
@@ -26,8 +28,9 @@ from lvgym.environment.aerokernels import FLOW
 from lvgym.environment.atmosphere import AIR
 from lvgym.packing import Field, Packed
 
-__all__ = ["ACTUATOR", "AERO", "AEROELASTIC", "CONDITIONS", "CONTEXT", "DISPERSION", "RAIL", "RAIL_STATE", "SERVO",
-           "STRIPS", "TRIG", "A", "AEL", "CTX", "D", "DS", "RL", "RS", "SV", "TG", "AE", "STR"]
+__all__ = ["ACCEL_ORDER", "ACTUATOR", "AERO", "AEROELASTIC", "CONDITIONS", "CONTEXT", "DISPERSION", "GYRO_ORDER", "IMU",
+           "IMU_STATE", "RAIL", "RAIL_STATE", "SERVO", "STRIPS", "TRIG", "A", "AEL", "CTX", "D", "DS", "IM", "IS", "RL", "RS",
+           "SV", "TG", "AE", "STR"]
 
 #: flight conditions of one state at one time
 CONDITIONS = Packed("flight conditions", [
@@ -163,16 +166,46 @@ ACTUATOR = Packed("actuator", [
     Field("effort_rate", 1, "rad", "integral of |gimbal rate pitch| + |gimbal rate yaw| over the last control period"),
 ])
 
+#: states of one gyro axis's filters (the second-order sensor bandwidth, then the second-order
+#: anti-aliasing low-pass) and of one accelerometer axis's (the anti-aliasing low-pass)
+GYRO_ORDER, ACCEL_ORDER = 4, 2
+
+#: parameters of the inertial measurement unit (one per simulator): the exact discretisations over one
+#: physics step of its continuous filters (:mod:`.imu`), the same for every axis
+IMU = Packed("imu parameters", [
+    Field("on", 1, "-", "1: the IMU's filters are advanced at every physics step; 0: no IMU"),
+    Field("station", 1, "m", "IMU station on x_b"),
+    Field("sensor", 1, "-", "index of the IMU station among the timeline's sensor stations"),
+    Field("h", 1, "s", "the physics step the filters are discretised for"),
+    Field("gyro_a", GYRO_ORDER * GYRO_ORDER, "-", "gyro filters: discrete state matrix, row major",
+          shape=(GYRO_ORDER, GYRO_ORDER)),
+    Field("gyro_b", GYRO_ORDER, "-", "gyro filters: discrete input vector"),
+    Field("gyro_c", GYRO_ORDER, "-", "gyro filters: output vector (the sampled rate)"),
+    Field("accel_a", ACCEL_ORDER * ACCEL_ORDER, "-", "accelerometer filter: discrete state matrix, row major",
+          shape=(ACCEL_ORDER, ACCEL_ORDER)),
+    Field("accel_b", ACCEL_ORDER, "-", "accelerometer filter: discrete input vector"),
+    Field("accel_c", ACCEL_ORDER, "-", "accelerometer filter: output vector (the sampled specific force)"),
+])
+
+#: a row's IMU filter states (zero and unused without an IMU)
+IMU_STATE = Packed("imu state", [
+    Field("gyro", 3 * GYRO_ORDER, "rad/s", "gyro filter states per body axis (x, y, z): sensor bandwidth "
+          "(output, its rate), then anti-aliasing (output, its rate)", shape=(3, GYRO_ORDER)),
+    Field("accel", 2 * ACCEL_ORDER, "m/s^2", "accelerometer anti-aliasing states per lateral body axis (y, z): "
+          "output, its rate", shape=(2, ACCEL_ORDER)),
+])
+
 #: offsets for compiled code
 CTX, AE, TG, D, DS = CONTEXT.at, AERO.at, TRIG.at, CONDITIONS.at, DISPERSION.at
 AEL, STR = AEROELASTIC.at, STRIPS.at
 RL, RS, SV, A = RAIL.at, RAIL_STATE.at, SERVO.at, ACTUATOR.at
+IM, IS = IMU.at, IMU_STATE.at
 
 
 def _doc() -> str:
     return "\n\n".join(f"``{lay.title}`` ({lay.size} entries):\n\n{lay.table()}" for lay in
                        (CONTEXT, AERO, TRIG, DISPERSION, AEROELASTIC, STRIPS, CONDITIONS, RAIL, RAIL_STATE, SERVO,
-                        ACTUATOR))
+                        ACTUATOR, IMU, IMU_STATE))
 
 
 __doc__ = (__doc__ or "") + "\n" + _doc()

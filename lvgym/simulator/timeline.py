@@ -143,6 +143,7 @@ class Timeline:
                       stage=np.ascontiguousarray(self.stage, dtype=float),
                       burning=np.ascontiguousarray(self.burning, dtype=float),
                       mass=np.ascontiguousarray(self.mass, dtype=float),
+                      phi_sensor=np.ascontiguousarray(self.phi_sensor, dtype=float),
                       dphi_sensor=np.ascontiguousarray(self.dphi_sensor, dtype=float),
                       phi_strip=np.ascontiguousarray(self.phi_strip, dtype=float),
                       dphi_strip=np.ascontiguousarray(self.dphi_strip, dtype=float),
@@ -153,12 +154,13 @@ class Timeline:
 
 #: the timeline's columns as compiled code reads them: ``t`` (n,) [s] rows; ``params`` (n, n_p);
 #: ``hold`` (n_p,) bool; ``thrust0`` (n,) [N]; ``exit_area`` (n,) [m^2]; ``stage`` (n,) lowest attached
-#: stage; ``burning`` (n,) 1 while an engine burns; ``mass`` (n,) [kg]; ``dphi_sensor`` (n, S, K)
-#: [1/(m sqrt(kg))]; ``phi_strip``, ``dphi_strip`` (n, K, n_strip) at the aeroelastic strips;
+#: stage; ``burning`` (n,) 1 while an engine burns; ``mass`` (n,) [kg]; ``phi_sensor`` (n, S, K)
+#: [1/sqrt(kg)] and ``dphi_sensor`` (n, S, K) [1/(m sqrt(kg))] mode shapes and slopes at the sensor stations;
+#: ``phi_strip``, ``dphi_strip`` (n, K, n_strip) at the aeroelastic strips;
 #: ``event_times`` (E,) [s], each once; ``mode_change_t`` (C,) [s] and ``mode_transfer``
 #: (C, K, K) the changes of the mode basis the step projects the modal state across (none: held)
 Tables = namedtuple("Tables", ["t", "params", "hold", "thrust0", "exit_area", "stage", "burning", "mass",
-                               "dphi_sensor", "phi_strip", "dphi_strip", "event_times", "mode_change_t",
+                               "phi_sensor", "dphi_sensor", "phi_strip", "dphi_strip", "event_times", "mode_change_t",
                                "mode_transfer"])
 
 

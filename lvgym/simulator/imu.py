@@ -1,0 +1,269 @@
+"""The inertial measurement unit: gyro and accelerometer dynamics at the IMU station, advanced at every physics step.
+
+A strapdown IMU at station ``x_imu`` on the body axis. Its sensors see the structure where it is:
+
+- the **rate gyros** see the body rate of B plus the rate of the bending slope at the station
+  (DESIGN.md, physics note 6): ``u_x = omega_x``, ``u_y = omega_y - sum_k phi'_k(x_imu) eta_dot_z,k``,
+  ``u_z = omega_z + sum_k phi'_k(x_imu) eta_dot_y,k``;
+- the **accelerometers** see the specific force at the station: that of the CG of B
+  (``C_bi (a_zw_i - g_i)``), the lever-arm terms ``omega_dot x r + omega x (omega x r)`` with ``r`` the
+  station from the CG of B, and the modal acceleration ``sum_k phi_k(x_imu) eta_ddot_k`` of each plane
+  (the y-plane modes along ``y_b``, the z-plane ones along ``z_b``). The Coriolis and centripetal terms
+  of the deflection itself (``2 omega x phi eta_dot``; ``phi eta`` is millimetres) are left out.
+
+Per physics step of ``h`` seconds the simulator (:func:`.advance.advance_range`) gives each sensor the
+**mean of its input over the step**, held over the step: for the gyro the mean of the start and end
+rates; for the accelerometer the velocity change over the step divided by ``h`` (the acceleration of
+the CG of B on the rail too, whose reaction is part of the motion; the CG's travel within the structure,
+a change of reference point, is taken out), the body-rate and modal-rate changes over ``h`` for
+``omega_dot`` and ``eta_ddot``, the attitude as the mean of the start and end ones, gravity at the end.
+This is what an integrating (delta-angle, delta-velocity) sensor delivers per step.
+
+Each input then goes through continuous linear filters, the same for every axis:
+
+- gyro: the sensor's bandwidth, ``w_g^2 / (s^2 + 2 z_g w_g s + w_g^2)`` (``w_g = 2 pi gyro_bandwidth_hz``,
+  ``z_g = gyro_damping``), then the anti-aliasing low-pass before sampling, a second-order Butterworth
+  ``w_a^2 / (s^2 + sqrt(2) w_a s + w_a^2)`` (``w_a = 2 pi antialias_hz``);
+- accelerometer: the same anti-aliasing low-pass.
+
+Both are discretised exactly for an input held over the step (zero-order hold, by
+``scipy.signal.cont2discrete`` once in Python: :meth:`Imu.params`), so the discrete filters are stable
+and exact at any step, whatever ``w h``. Their parameters are the block :data:`.layouts.IMU` of the
+simulator's step set-up; each row's filter states the field ``imu`` of its :class:`~.data.SimData`
+(layout :data:`.layouts.IMU_STATE`), started at rest on the pad (:meth:`Imu.rest_state`). Noise, bias
+and sampling belong to the flight computer that reads the filters' outputs (:mod:`lvgym.envs.flightcomputer`).
+"""
+
+from __future__ import annotations
+
+import math
+from collections import namedtuple
+from dataclasses import dataclass
+
+import numba as nb
+import numpy as np
+
+from lvgym.dynamics.layout import PARAMS, STATE, X
+from lvgym.packing import at
+from lvgym.rotations import quat_to_dcm
+
+from .layouts import ACCEL_ORDER, CTX, D, GYRO_ORDER, IM, IMU, IMU_STATE, IS
+from .timeline import locate_k
+
+__all__ = ["IMU_OFF", "Imu", "ImuWork", "imu_begin_k", "imu_end_k", "imu_output_k", "imu_shift_k", "lti_step_k",
+           "make_imu_work",
+           "specific_force_k"]
+
+XF, PF = STATE.fixed, PARAMS.fixed
+#: no IMU: the filters are not advanced (the simulator of protocol v0)
+IMU_OFF = IMU.zeros()
+_GO, _AO = GYRO_ORDER, ACCEL_ORDER
+_N_GA, _N_AA = IMU.field("gyro_a").size, IMU.field("accel_a").size
+_N_G, _N_A = IMU_STATE.field("gyro").size, IMU_STATE.field("accel").size
+
+
+def _second_order(wn: float, zeta: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``wn^2 / (s^2 + 2 zeta wn s + wn^2)`` with the states (output, its rate)."""
+    return (np.array([[0.0, 1.0], [-wn * wn, -2.0 * zeta * wn]]), np.array([[0.0], [wn * wn]]),
+            np.array([[1.0, 0.0]]))
+
+
+def _cascade(first: tuple, second: tuple) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """State space of ``second(first(u))`` (neither has a direct feed-through)."""
+    a1, b1, c1 = first
+    a2, b2, c2 = second
+    n1, n2 = a1.shape[0], a2.shape[0]
+    a = np.zeros((n1 + n2, n1 + n2))
+    a[:n1, :n1], a[n1:, :n1], a[n1:, n1:] = a1, b2 @ c1, a2
+    return a, np.vstack([b1, np.zeros((n2, 1))]), np.hstack([np.zeros((1, n1)), c2])
+
+
+@dataclass(frozen=True)
+class Imu:
+    """An IMU at station ``station_m`` [m] (``sensor``: its index among the timeline's sensor stations,
+    where the mode shapes and slopes are tabulated) with the gyro's bandwidth ``gyro_bandwidth_hz``
+    [Hz] and damping ``gyro_damping`` [-] and an anti-aliasing Butterworth low-pass at
+    ``antialias_hz`` [Hz] before sampling (see the module docstring)."""
+
+    station_m: float
+    sensor: int = 0
+    gyro_bandwidth_hz: float = 80.0
+    gyro_damping: float = 0.7
+    antialias_hz: float = 20.0
+
+    def __post_init__(self) -> None:
+        for key in ("gyro_bandwidth_hz", "gyro_damping", "antialias_hz"):
+            v = getattr(self, key)
+            if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0.0):
+                raise ValueError(f"imu.{key} = {v!r}: a finite number > 0")
+        if not (isinstance(self.sensor, int) and self.sensor >= 0):
+            raise ValueError(f"imu.sensor = {self.sensor!r}: an index >= 0")
+
+    def continuous(self) -> dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]]:
+        """The continuous filters ``(A, B, C)`` of the gyro (sensor bandwidth, then anti-aliasing) and
+        the accelerometer (anti-aliasing)."""
+        antialias = _second_order(2.0 * math.pi * self.antialias_hz, 1.0 / math.sqrt(2.0))
+        sensor = _second_order(2.0 * math.pi * self.gyro_bandwidth_hz, self.gyro_damping)
+        return {"gyro": _cascade(sensor, antialias), "accel": antialias}
+
+    def discrete(self, h: float) -> dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]]:
+        """The filters discretised exactly for an input held over steps of ``h`` [s] (zero-order hold)."""
+        from scipy.signal import cont2discrete
+        out = {}
+        for name, (a, b, c) in self.continuous().items():
+            ad, bd, cd, _, _ = cont2discrete((a, b, c, np.zeros((1, 1))), float(h), method="zoh")
+            out[name] = (ad, bd[:, 0], cd[0])
+        return out
+
+    def params(self, h: float) -> np.ndarray:
+        """The parameter block (layout :data:`.layouts.IMU`) for physics steps of ``h`` [s]."""
+        d = self.discrete(h)
+        return IMU.pack({"on": 1.0, "station": self.station_m, "sensor": float(self.sensor), "h": float(h),
+                         "gyro_a": d["gyro"][0].ravel(), "gyro_b": d["gyro"][1], "gyro_c": d["gyro"][2],
+                         "accel_a": d["accel"][0].ravel(), "accel_b": d["accel"][1], "accel_c": d["accel"][2]})
+
+    @staticmethod
+    def rest_state(rate_b: np.ndarray, force_yz_b: np.ndarray) -> np.ndarray:
+        """Filter states (R, IMU_STATE.size) at rest with the constant inputs ``rate_b`` (R, 3) [rad/s]
+        and ``force_yz_b`` (R, 2) [m/s^2]: every second-order stage's output at its input (unit DC
+        gain), its rate zero."""
+        rate_b, force_yz_b = np.atleast_2d(rate_b), np.atleast_2d(force_yz_b)
+        out = IMU_STATE.zeros(rate_b.shape[0])
+        g, a = IMU_STATE.view(out, "gyro"), IMU_STATE.view(out, "accel")
+        g[..., 0::2] = rate_b[..., None]                   # the states are (output, rate) per stage
+        a[..., 0::2] = force_yz_b[..., None]
+        return out
+
+
+#: scratch of one row's IMU step: ``omega0`` (3) [rad/s], ``v0`` (3) [m/s] (less the CG's travel),
+#: ``C0`` (3, 3) ``C_ib`` at the start of the step, ``C1`` at its end, ``eta_dot0`` (2K) modal rates at
+#: the start, ``omega1`` (3), ``a_i`` (3) [m/s^2] the CG's mean acceleration, ``g_i`` (3) gravity, ``r`` (3) [m]
+#: the IMU from the CG of B, ``u`` (3) the gyro inputs, ``f`` (3) [m/s^2] the specific force, ``tmp`` (4) scratch
+ImuWork = namedtuple("ImuWork", ["omega0", "omega1", "v0", "a_i", "g_i", "r", "C0", "C1", "eta_dot0", "u", "f",
+                                 "tmp"])
+
+
+@nb.njit(cache=True, nogil=True)
+def make_imu_work(n_modes):
+    """The scratch of :func:`imu_begin_k` / :func:`imu_end_k` for ``n_modes`` modes per plane."""
+    return ImuWork(np.zeros(3), np.zeros(3), np.zeros(3), np.zeros(3), np.zeros(3), np.zeros(3), np.zeros((3, 3)),
+                   np.zeros((3, 3)), np.zeros(2 * n_modes), np.zeros(3), np.zeros(3), np.zeros(_GO))
+
+
+@nb.njit(cache=True, nogil=True, inline="always")
+def lti_step_k(a, b, x, u, tmp):
+    """One step of a discrete filter: ``x <- a x + b u`` (``a`` (n, n), ``b`` (n,), ``x`` (n,) in
+    place; ``tmp`` at least n entries of scratch)."""
+    n = x.size
+    for i in range(n):
+        s = b[i] * u
+        for j in range(n):
+            s += a[i, j] * x[j]
+        tmp[i] = s
+    for i in range(n):
+        x[i] = tmp[i]
+
+
+@nb.njit(cache=True, nogil=True)
+def specific_force_k(a_i, g_i, C0, C1, om0, om1, h, r, out):
+    """Mean specific force [m/s^2] over a step of ``h`` [s] at the point ``r`` (3,) [m] of the rigid
+    body (from its CG, body frame) into ``out`` (3,), body frame:
+    ``1/2 (C0 + C1)^T (a_i - g_i) + omega_dot x r + omega x (omega x r)``, with ``a_i`` (3,) the CG's
+    mean inertial acceleration, ``g_i`` (3,) gravity, ``C0``/``C1`` ``C_ib`` at the start and end,
+    ``omega_dot = (om1 - om0) / h`` and ``omega = (om0 + om1) / 2`` from the body rates [rad/s] at the
+    start and end."""
+    f0, f1, f2 = a_i[0] - g_i[0], a_i[1] - g_i[1], a_i[2] - g_i[2]
+    wd0, wd1, wd2 = (om1[0] - om0[0]) / h, (om1[1] - om0[1]) / h, (om1[2] - om0[2]) / h
+    w0, w1, w2 = 0.5 * (om0[0] + om1[0]), 0.5 * (om0[1] + om1[1]), 0.5 * (om0[2] + om1[2])
+    r0, r1, r2 = r[0], r[1], r[2]
+    c0, c1, c2 = w1 * r2 - w2 * r1, w2 * r0 - w0 * r2, w0 * r1 - w1 * r0          # omega x r
+    for i in range(3):
+        out[i] = 0.5 * ((C0[0, i] + C1[0, i]) * f0 + (C0[1, i] + C1[1, i]) * f1 + (C0[2, i] + C1[2, i]) * f2)
+    out[0] += wd1 * r2 - wd2 * r1 + w1 * c2 - w2 * c1
+    out[1] += wd2 * r0 - wd0 * r2 + w2 * c0 - w0 * c2
+    out[2] += wd0 * r1 - wd1 * r0 + w0 * c1 - w1 * c0
+
+
+@nb.njit(cache=True, nogil=True, inline="always")
+def imu_begin_k(x, n_slosh, n_modes, w):
+    """Keep the start of a physics step of the state ``x`` in the scratch ``w`` (:data:`ImuWork`)."""
+    ow, ov, oq = XF.omega_bi_b, XF.v_zw_i, XF.q_bi
+    for i in range(3):
+        w.omega0[i] = x[ow + i]
+        w.v0[i] = x[ov + i]
+    quat_to_dcm(x[oq], x[oq + 1], x[oq + 2], x[oq + 3], w.C0)
+    o_etad = at(X.eta_dot, n_modes, n_slosh)
+    for k in range(w.eta_dot0.size):
+        w.eta_dot0[k] = x[o_etad + k]
+
+
+@nb.njit(cache=True, nogil=True, inline="always")
+def imu_shift_k(x, w, sign):
+    """Account for a change of the velocity's reference point (the CG's travel, :func:`.advance.shift_cg_k`):
+    called with ``sign = -1`` before it and ``+1`` after it, so that it adds to the start velocity."""
+    ov = XF.v_zw_i
+    for i in range(3):
+        w.v0[i] += sign * x[ov + i]
+
+
+@nb.njit(cache=True, nogil=True)
+def imu_end_k(prm, st, x, p, ctx, tables, t, h, w, n_slosh, n_modes):
+    """Advance a row's IMU filters ``st`` (layout IMU_STATE) over the physics step of ``h`` [s] that
+    ended at ``t`` [s] with the state ``x`` and parameters ``p`` (its start kept in ``w`` by
+    :func:`imu_begin_k`); ``prm`` the IMU block (layout IMU), ``ctx`` the row's context (gravity of
+    the latest RK4 stage), ``tables`` the timeline's (mode shapes and slopes at the IMU)."""
+    ow, ov, oq, oc = XF.omega_bi_b, XF.v_zw_i, XF.q_bi, PF.r_cg
+    K = n_modes
+    i, wt = locate_k(tables.t, t)
+    j = i + 1 if wt >= 1.0 else i
+    s = int(prm[IM.sensor])
+    phi, dphi = tables.phi_sensor[j, s], tables.dphi_sensor[j, s]
+    o_etad = at(X.eta_dot, n_modes, n_slosh)
+    u = w.u
+    for a in range(3):                               # gyro: mean body rate + mean slope rate at the IMU
+        u[a] = 0.5 * (w.omega0[a] + x[ow + a])
+    for k in range(K):
+        u[1] -= dphi[k] * 0.5 * (w.eta_dot0[K + k] + x[o_etad + K + k])
+        u[2] += dphi[k] * 0.5 * (w.eta_dot0[k] + x[o_etad + k])
+    ga = prm[IM.gyro_a:IM.gyro_a + _N_GA].reshape((_GO, _GO))
+    gb = prm[IM.gyro_b:IM.gyro_b + _GO]
+    gs = st[IS.gyro:IS.gyro + _N_G].reshape((3, _GO))
+    for a in range(3):
+        lti_step_k(ga, gb, gs[a], u[a], w.tmp)
+    # accelerometers: the CG's mean acceleration and the lever arm, then the modal acceleration
+    quat_to_dcm(x[oq], x[oq + 1], x[oq + 2], x[oq + 3], w.C1)
+    og = CTX.scratch + D.g_i
+    for a in range(3):
+        w.a_i[a] = (x[ov + a] - w.v0[a]) / h
+        w.g_i[a] = ctx[og + a]
+        w.omega1[a] = x[ow + a]
+    w.r[0] = prm[IM.station] - p[oc]
+    w.r[1], w.r[2] = -p[oc + 1], -p[oc + 2]
+    specific_force_k(w.a_i, w.g_i, w.C0, w.C1, w.omega0, w.omega1, h, w.r, w.f)
+    for k in range(K):
+        w.f[1] += phi[k] * (x[o_etad + k] - w.eta_dot0[k]) / h
+        w.f[2] += phi[k] * (x[o_etad + K + k] - w.eta_dot0[K + k]) / h
+    aa = prm[IM.accel_a:IM.accel_a + _N_AA].reshape((_AO, _AO))
+    ab = prm[IM.accel_b:IM.accel_b + _AO]
+    acs = st[IS.accel:IS.accel + _N_A].reshape((2, _AO))
+    for a in range(2):
+        lti_step_k(aa, ab, acs[a], w.f[a + 1], w.tmp)
+
+
+@nb.njit(cache=True, nogil=True, inline="always")
+def imu_output_k(prm, st, rate_b, force_yz_b):
+    """The filters' outputs: the sampled rates ``rate_b`` (3,) [rad/s] (body x, y, z) and lateral
+    specific forces ``force_yz_b`` (2,) [m/s^2] (body y, z) of the row's IMU states ``st``."""
+    gc, ac = prm[IM.gyro_c:IM.gyro_c + _GO], prm[IM.accel_c:IM.accel_c + _AO]
+    gs = st[IS.gyro:IS.gyro + _N_G].reshape((3, _GO))
+    acs = st[IS.accel:IS.accel + _N_A].reshape((2, _AO))
+    for a in range(3):
+        s = 0.0
+        for k in range(_GO):
+            s += gc[k] * gs[a, k]
+        rate_b[a] = s
+    for a in range(2):
+        s = 0.0
+        for k in range(_AO):
+            s += ac[k] * acs[a, k]
+        force_yz_b[a] = s
