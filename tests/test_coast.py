@@ -89,6 +89,7 @@ def test_smile_v1_defaults_and_staging():
     assert spec.coast_control and spec.settling_thrust_n == 18000.0 and spec.action_delay_steps == 1
     assert spec.mission_time_s == 70.0 and spec.reference_velocity == "earth"
     assert (spec.mode_interval_s, spec.mode_basis, spec.slosh_frequency) == (2.0, "projected", "specific_force")
+    assert spec.observation == "flight" and spec.gyro_bias_radps == 1.5e-5
     times = {e: t for t, e in env.timeline.events}
     assert times["stage 'stage1' burnout"] == pytest.approx(43.0)
     assert times["stage 'stage1' separation"] == pytest.approx(53.0)

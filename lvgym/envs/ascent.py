@@ -46,7 +46,7 @@ import numpy as np
 from .functional import AscentFuncEnv, AscentState
 from .layouts import observation_table
 from .snapshot import EpisodeState, rng_state, set_rng_state
-from .spec import TaskSpec
+from .spec import FLIGHT_DEFAULTS, TaskSpec
 
 __doc__ = __doc__ % {"observation": "\n".join("    " + line for line in observation_table().splitlines())}
 
@@ -219,8 +219,8 @@ class SmileAscentEnv(AscentEnv):
 
 
 #: the physics and timing of protocol v1 that every v1 env shares (issue 16; docs/benchmark.md)
-V1_OPTIONS = {"reference_velocity": "earth", "action_delay_steps": 1, "aeroelastic": None, "mode_interval_s": 2.0,
-              "mode_basis": "projected", "slosh_frequency": "specific_force"}
+V1_OPTIONS = {**FLIGHT_DEFAULTS, "reference_velocity": "earth", "action_delay_steps": 1, "aeroelastic": None,
+              "mode_interval_s": 2.0, "mode_basis": "projected", "slosh_frequency": "specific_force"}
 
 
 class SmileAscentV1Env(SmileAscentEnv):
@@ -232,7 +232,9 @@ class SmileAscentV1Env(SmileAscentEnv):
     vehicle holds its attitude by reaction control (``coast_control``, 300 N m, 3 rad/s) and settles its
     propellant with ullage thrust (``settling_thrust_n`` = 18 kN, 1.35 times the drag at burnout:
     docs/vehicles.md). The flight computer's computational delay is one control period
-    (``action_delay_steps=1``); the gravity turn, when asked for, follows the Earth-relative velocity.
+    (``action_delay_steps=1``) and the policy sees what the flight computer samples (``observation="flight"``:
+    the IMU's gyros and accelerometers through their filters, a strapdown attitude, tactical-grade
+    errors, docs/sensors.md); the gravity turn, when asked for, follows the Earth-relative velocity.
     The bending modes are recomputed every 2 s with the modal state projected across each change
     (``mode_interval_s``, ``mode_basis="projected"``), the slosh dampers take their frequency from the
     axial specific force (``slosh_frequency="specific_force"``) and the aeroelastic strip loads follow the
