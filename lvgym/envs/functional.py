@@ -41,7 +41,7 @@ from lvgym.simulator import SimData, Simulator, Timeline, aeroelastic_strips, bu
 from lvgym.simulator import data as simdata
 from lvgym.simulator.core import Kernel
 from lvgym.simulator.imu import Imu
-from lvgym.simulator.layouts import ACTUATOR, DISPERSION
+from lvgym.simulator.layouts import ACTUATOR, CONDITIONS, DISPERSION
 from lvgym.simulator.servo import Servo
 from lvgym.vehicle import MassModel, Vehicle, load_vehicle
 from lvgym.vehicle.slender import slender_vehicle
@@ -147,7 +147,6 @@ class AscentFuncEnv(FuncEnv):
         lay = self.sim.layout
         self._i_mb, self._i_J = lay.params["m_b"], lay.params["J_b"]
         self._i_cg, self._i_om = lay.params["r_cg"], lay.params["omega_modes"]
-        self._i_ref = self.observation_layout.index("pitch_rate_reference")
         self._i_zeta = [lay.slosh_param(j, "zeta") for j in range(self.sim.dynamics.n_slosh)]
         self._i_slosh_m = [lay.slosh_param(j, "m") for j in range(self.sim.dynamics.n_slosh)]
         self._i_slosh_f = [(lay.slosh_param(j, "length"), lay.slosh_param(j, "omega"))
@@ -309,9 +308,10 @@ class AscentFuncEnv(FuncEnv):
         if spec.coast_control:
             omega = sim.x[rows][:, self.sim.layout.state["omega_bi_b"]]
             J = sim.p[rows][:, self._i_J].reshape(-1, 3, 3)
-            rate = np.stack([omega[:, 1] - ts.obs[rows, self._i_ref], omega[:, 2]], axis=1)
+            cond = sim.conditions[rows]
             moment = np.zeros((B, 3))
-            moment[rows, 1:] = coast_moment(ts.att[rows], rate, np.stack([J[:, 1, 1], J[:, 2, 2]], axis=1),
+            moment[rows, 1:] = coast_moment(CONDITIONS.view(cond, "alpha")[:, 0], CONDITIONS.view(cond, "beta")[:, 0],
+                                            omega[:, 1:], np.stack([J[:, 1, 1], J[:, 2, 2]], axis=1),
                                             spec.coast_bandwidth_radps, spec.coast_torque_nm)
         return moment, force
 

@@ -91,9 +91,10 @@ class TaskSpec:
     failure_penalty_rad_per_s times the remaining mission time on termination; qalpha_limit_pa_deg:
     structural limit of dynamic pressure times total angle of attack; attitude_limit_deg: largest
     attitude error; n_modes: bending modes per plane (None: the vehicle's); coast_control: while no engine
-    burns after ``controller_on_after_s`` (a staging coast), reaction control holds the attitude
-    (:mod:`.coast`: a proportional-derivative law on the attitude error and the body rates of bandwidth
-    ``coast_bandwidth_radps`` [rad/s], each of pitch and yaw limited to ``coast_torque_nm`` [N m]);
+    burns after ``controller_on_after_s`` (a staging coast), reaction control holds the vehicle into the
+    relative wind (:mod:`.coast`: a proportional-derivative law on the angle of attack, the sideslip and the
+    body rates of bandwidth ``coast_bandwidth_radps`` [rad/s], each of pitch and yaw limited to
+    ``coast_torque_nm`` [N m]);
     settling_thrust_n: axial thrust [N] of ullage motors along +x_b through the same coasts, so that the
     propellant stays settled against the drag (0: none); aeroelastic: the strip-theory
     aeroelastic loads (True, False, None: the vehicle file's flag; False in v0); mode_interval_s, mode_basis,
@@ -154,7 +155,7 @@ class TaskSpec:
     n_modes: int | None = None
     action_delay_steps: int = 0
     coast_control: bool = False
-    coast_torque_nm: float = 300.0
+    coast_torque_nm: float = 1000.0
     coast_bandwidth_radps: float = 3.0
     settling_thrust_n: float = 0.0
     gyro_noise_radps: float = 2e-4
