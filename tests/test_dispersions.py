@@ -42,22 +42,23 @@ def test_randomize_true_keeps_the_v0_set():
     spec = TaskSpec(vehicle="smile", randomize=True)
     assert spec.randomize == frozenset(RANDOMIZE_V0)
     assert set(RANDOMIZE) - set(RANDOMIZE_V0) == {"aerodynamics", "thrust_level", "slosh_mass", "slosh_frequency",
-                                                  "bending_damping"}
+                                                  "bending_damping", "servo_bandwidth", "servo_delay"}
 
 
 @pytest.mark.parametrize("name", ["aerodynamics", "thrust_level", "slosh_mass", "slosh_frequency", "bending_damping"])
 def test_each_v1_randomisation_draws_what_it_names(name):
     env = gym.make("lvgym/SmileAscent-v0", model="nonrigid", mission_time_s=1.0, randomize=[name]).unwrapped
     func = env.func
-    scale, offset, mis, loads = func.dispersions(np.random.default_rng(5))
+    scale, offset, mis, loads, servo = func.dispersions(np.random.default_rng(5))
     again = func.dispersions(np.random.default_rng(5))
-    for a, b in zip((scale, offset, mis, loads), again):
+    for a, b in zip((scale, offset, mis, loads, servo), again):
         np.testing.assert_array_equal(a, b)                       # seeded
     neutral = DISPERSION.pack({"thrust_scale": 1.0, "normal_scale": 1.0, "axial_scale": 1.0})
     lay = func.sim.layout
     changed_params = set(np.flatnonzero(scale != 1.0))
     assert not offset.any() and not mis.any()
     n_slosh = func.sim.dynamics.n_slosh
+    np.testing.assert_array_equal(servo, [1.0, 0.0])
     if name == "aerodynamics":
         assert not changed_params
         changed = {DISPERSION.names[i] for i in np.flatnonzero(loads != neutral)}
@@ -89,3 +90,42 @@ def test_v1_randomisations_change_the_flight():
     base = fly([])
     for name in ("aerodynamics", "thrust_level"):
         assert not np.array_equal(fly([name]), base), name
+
+
+def _servo_after_one_period(servo_dispersion):
+    from lvgym.simulator.servo import Servo
+    sim = Simulator("smile", "rigid", t_end=2.0, servo=Servo(15.0, 0.7))
+    sim.reset(1, rng=np.random.default_rng(0), servo_dispersion=servo_dispersion)
+    sim.step(np.array([[0.01, 0.0]]), 0.02)              # two physics steps of 10 ms
+    first = sim.gimbal[0, 0]
+    sim.step(np.array([[0.01, 0.0]]), 0.02)
+    return first, sim.gimbal[0, 0]
+
+
+def test_servo_dispersions_against_hand_numbers():
+    h, w, c = 0.01, 15.0, 0.01
+    # semi-implicit Euler from rest: one step gives rate h w^2 c and position h^2 w^2 c
+    first_step = h * h * w * w * c
+    delayed, _ = _servo_after_one_period([[1.0, 1.0]])   # the first step follows the previous command (0)
+    assert delayed == pytest.approx(first_step, rel=1e-12)
+    nominal, nominal2 = _servo_after_one_period(None)
+    assert nominal > delayed
+    fast, _ = _servo_after_one_period([[2.0, 0.0]])
+    r1, p1 = h * (2 * w) ** 2 * c, h * h * (2 * w) ** 2 * c
+    r2 = r1 + h * ((2 * w) ** 2 * (c - p1) - 2.0 * 0.7 * (2 * w) * r1)
+    assert fast == pytest.approx(p1 + h * r2, rel=1e-12)
+    same, same2 = _servo_after_one_period([[1.0, 0.0]])
+    assert (same, same2) == (nominal, nominal2)            # neutral dispersion: bit for bit
+    with pytest.raises(ValueError, match="servo_dispersion"):
+        _servo_after_one_period([[1.0, 0.5]])
+
+
+@pytest.mark.parametrize("name", ["servo_bandwidth", "servo_delay"])
+def test_servo_randomisations_draw_what_they_name(name):
+    env = gym.make("lvgym/SmileAscent-v0", model="rigid", mission_time_s=1.0, randomize=[name]).unwrapped
+    draws = np.array([env.func.dispersions(np.random.default_rng(s))[4] for s in range(200)])
+    if name == "servo_bandwidth":
+        assert np.all(draws[:, 1] == 0.0) and 0.7 <= draws[:, 0].min() < 1.0 < draws[:, 0].max() <= 1.3
+        assert draws[:, 0].std() == pytest.approx(0.1, rel=0.2)
+    else:
+        assert np.all(draws[:, 0] == 1.0) and set(draws[:, 1]) == {0.0, 1.0}

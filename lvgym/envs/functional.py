@@ -223,19 +223,21 @@ class AscentFuncEnv(FuncEnv):
         rngs = list(rng)
         if len(rngs) != rows.size:
             raise ValueError(f"{len(rngs)} generators for {rows.size} rows")
-        winds, scales, offsets, mis, loads = [], [], [], [], []
+        winds, scales, offsets, mis, loads, servos = [], [], [], [], [], []
         ts = state.task
         for b, g in zip(rows, rngs):
             wind_rng = g if "wind" in s.randomize else np.random.default_rng(12345)
             winds.append((wind_spec(s.wind, s.mission_time_s), wind_rng))
-            sc, of, m, ld = self.dispersions(g)
+            sc, of, m, ld, sv = self.dispersions(g)
+            servos.append(sv)
             scales.append(sc)
             offsets.append(of)
             mis.append(m)
             loads.append(ld)
             ts.gyro_bias[b] = g.normal(0.0, s.gyro_bias_radps, 3) if "sensor_noise" in s.randomize else np.zeros(3)
         sim = self.sim.reset_rows(rows, [w[1] for w in winds], [w[0] for w in winds], np.array(mis), np.array(scales),
-                                  np.array(offsets), data=state.sim, dispersion=np.array(loads))
+                                  np.array(offsets), data=state.sim, dispersion=np.array(loads),
+                                  servo_dispersion=np.array(servos))
         ts.cum_error[rows] = 0.0
         ts.rate_error[rows] = 0.0
         ts.steps[rows] = 0
@@ -386,10 +388,11 @@ class AscentFuncEnv(FuncEnv):
         physics steps (the reward's ``effort`` term is minus ``effort_weight`` times it)."""
         return state.sim.actuator[:, ACTUATOR.index("effort")].copy()
 
-    def dispersions(self, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """Parameter scale and offset, thrust misalignment and load dispersions (layout
-        :data:`~lvgym.simulator.layouts.DISPERSION`) of one row, drawn from ``rng`` in this order; every
-        normal draw is clipped at 3 sigma.
+    def dispersions(self, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray,
+                                                             np.ndarray]:
+        """Parameter scale and offset, thrust misalignment, load dispersions (layout
+        :data:`~lvgym.simulator.layouts.DISPERSION`) and servo dispersion (frequency factor, delay in
+        physics steps) of one row, drawn from ``rng`` in this order; every normal draw is clipped at 3 sigma.
 
         Protocol v0's: mass: body mass x N(1, 1 %), CG station + N(0, 2 cm), inertia x N(1, 3 %);
         slosh_damping: ratios x log-uniform [0.5, 2]; bending_frequency: x N(1, 5 %); thrust_misalignment:
@@ -397,7 +400,8 @@ class AscentFuncEnv(FuncEnv):
         aerodynamics: normal force and moment x N(1, 5 %), axial force x N(1, 5 %), centre of pressure
         + N(0, 0.25 calibre); thrust_level: x N(1, 1 %); slosh_mass: pendulum masses x N(1, 5 %);
         slosh_frequency: x N(1, 5 %) (pendulum lengths / f^2, the damper's frequency x f);
-        bending_damping: ratios x log-uniform [0.5, 2]."""
+        bending_damping: ratios x log-uniform [0.5, 2]; servo_bandwidth: natural frequency x N(1, 10 %);
+        servo_delay: 0 or 1 physics step (0 or 10 ms at the default step) with equal chances."""
         n_p = self.sim.layout.n_p
         scale, offset, mis = np.ones(n_p), np.zeros(n_p), np.zeros(2)
         loads = DISPERSION.pack({"thrust_scale": 1.0, "normal_scale": 1.0, "axial_scale": 1.0})
@@ -437,7 +441,12 @@ class AscentFuncEnv(FuncEnv):
                 scale[omega] *= f
         if "bending_damping" in r:
             scale[self._i_zm] = math.exp(rng.uniform(math.log(0.5), math.log(2.0)))
-        return scale, offset, mis, loads
+        servo = np.array([1.0, 0.0])
+        if "servo_bandwidth" in r:
+            servo[0] = 1.0 + normal(0.1, 0.3)
+        if "servo_delay" in r:
+            servo[1] = float(rng.integers(0, 2))
+        return scale, offset, mis, loads, servo
 
     def _draw_flight(self, sim: SimData, ts: TaskData, rows: Any, rngs: Sequence[np.random.Generator | None],
                      sigma: np.ndarray) -> None:

@@ -2,7 +2,8 @@
 
 Per row and per physics step of ``h = duration / ceil(duration / physics_dt)`` seconds:
 
-1. the gimbal servo moves towards the command (:func:`.servo.servo_step_k`; or takes it at once);
+1. the gimbal servo moves towards the command (:func:`.servo.servo_step_k`; or takes it at once), the
+   previous period's command over the row's first ``delay`` physics steps (a dispersed servo delay);
 2. the step is cut at every event time of the timeline inside it (and at every change of the mode
    basis the timeline projects across); on each piece the dynamics parameters (timeline rows
    interpolated, mode data held, then ``* scale + offset``), ``T_0`` and the nozzle exit area are taken
@@ -162,7 +163,7 @@ def advance_range(lo, hi, loads_fn, data, tables, setup, duration):
         for k in range(n):
             if imu_on:
                 imu_begin_k(xb, n_slosh, n_modes, iw)
-            servo_step_k(servo, act, h)
+            servo_step_k(servo, act, h, k)
             cb[CTX.gimbal], cb[CTX.gimbal + 1] = act[A.gimbal], act[A.gimbal + 1]
             act[A.effort] += (abs(act[A.gimbal]) + abs(act[A.gimbal + 1])) * h
             act[A.effort_rate] += (abs(act[A.gimbal_rate]) + abs(act[A.gimbal_rate + 1])) * h
@@ -218,6 +219,7 @@ def advance_range(lo, hi, loads_fn, data, tables, setup, duration):
                 break
             if imu_on:
                 imu_end_k(setup.imu, data.imu[b], xb, pb, cb, tables, tb, h, iw, n_slosh, n_modes)
+        act[A.previous], act[A.previous + 1] = act[A.command], act[A.command + 1]
         _piece_thrust_k(cb, tables, t[b])
         flight_conditions_k(t[b], xb, pb, cb, data.conditions[b])
 

@@ -285,18 +285,20 @@ class Simulator:
 
     def reset(self, batch: int = 1, rng: np.random.Generator | None = None, winds: Sequence[Any] | None = None,
               misalignment: np.ndarray | None = None, param_scale: np.ndarray | None = None,
-              param_offset: np.ndarray | None = None, dispersion: np.ndarray | None = None) -> None:
+              param_offset: np.ndarray | None = None, dispersion: np.ndarray | None = None,
+              servo_dispersion: np.ndarray | None = None) -> None:
         """Put ``batch`` vehicles on the pad at t = 0 (see :meth:`reset_rows` for the options)."""
         B = int(batch)
         if B < 1:
             raise ValueError(f"batch = {batch!r}: at least one vehicle")
         self.data = self.reset_rows(np.arange(B), rng, winds, misalignment, param_scale, param_offset,
-                                    data=self.new_data(B), dispersion=dispersion)
+                                    data=self.new_data(B), dispersion=dispersion, servo_dispersion=servo_dispersion)
 
     def reset_rows(self, rows: Any, rng: np.random.Generator | Sequence[np.random.Generator] | None = None,
                    winds: Sequence[Any] | None = None, misalignment: np.ndarray | None = None,
                    param_scale: np.ndarray | None = None, param_offset: np.ndarray | None = None,
-                   data: SimData | None = None, dispersion: np.ndarray | None = None) -> SimData:
+                   data: SimData | None = None, dispersion: np.ndarray | None = None,
+                   servo_dispersion: np.ndarray | None = None) -> SimData:
         """Put the vehicles ``rows`` back on the pad at t = 0; the others are untouched.
 
         ``rng``: one generator, or one per row, for whatever is random (the wind models' ``reset``);
@@ -304,7 +306,8 @@ class Simulator:
         ``misalignment`` (R, 2) [rad] fixed thrust misalignment (pitch, yaw); ``param_scale`` /
         ``param_offset`` (R, n_p): a row flies ``timeline params * scale + offset`` (dispersions of mass,
         CG, inertia, slosh damping, bending frequencies); ``dispersion`` (R, n) the rows' load dispersions
-        (layout :data:`.layouts.DISPERSION`; default neutral). ``data``: the rows to reset (default
+        (layout :data:`.layouts.DISPERSION`; default neutral); ``servo_dispersion`` (R, 2) the rows' servo
+        natural-frequency factor [-] and delay [physics steps] (default 1 and 0). ``data``: the rows to reset (default
         :attr:`data`, which is then updated); returns them (a new value when the context widened)."""
         own = data is None
         if own and self.batch == 0:
@@ -341,6 +344,12 @@ class Simulator:
         d.rail_state[rows] = RAIL_STATE.pack({"on": 1.0, "t_lift": np.nan, "t_exit": np.nan})
         d.failed[rows] = False
         d.actuator[rows] = 0.0
+        if servo_dispersion is not None:
+            sd = np.broadcast_to(np.asarray(servo_dispersion, float), (R, 2))
+            if np.any(sd[:, 0] <= 0.0) or np.any(sd[:, 1] < 0.0) or np.any(sd[:, 1] != np.round(sd[:, 1])):
+                raise ValueError(f"servo_dispersion = {sd!r}: frequency factors > 0 and whole delays >= 0 steps")
+            ACTUATOR.view(d.actuator, "frequency_shift")[rows] = sd[:, :1] - 1.0
+            ACTUATOR.view(d.actuator, "delay")[rows] = sd[:, 1:]
         d.x_cg0[rows] = d.p[rows, self._i_cg]
         self._place_on_pad(rows, d)
         q_si = self.layout.view(d.x, "state", "q_si")

@@ -164,6 +164,11 @@ ACTUATOR = Packed("actuator", [
     Field("gimbal_rate", 2, "rad/s", "gimbal rates"),
     Field("effort", 1, "rad s", "integral of |gimbal pitch| + |gimbal yaw| over the last control period"),
     Field("effort_rate", 1, "rad", "integral of |gimbal rate pitch| + |gimbal rate yaw| over the last control period"),
+    Field("previous", 2, "rad", "the command of the period before (what a delayed servo still follows)"),
+    Field("delay", 1, "-", "servo delay of the row in physics steps: the first so many steps of a period follow the "
+          "previous command (dispersion; 0 nominal)"),
+    Field("frequency_shift", 1, "-", "the row's servo natural frequency is the servo's times 1 + this (dispersion; "
+          "0 nominal)"),
 ])
 
 #: states of one gyro axis's filters (the second-order sensor bandwidth, then the second-order

@@ -52,18 +52,23 @@ def _clip(v, lo, hi):
 
 
 @nb.njit(cache=True, nogil=True, inline="always")
-def servo_step_k(s, act, h):
+def servo_step_k(s, act, h, k):
     """Advance the two axes of the actuator row ``act`` (layout ``ACTUATOR``: gimbal and gimbal rate)
-    in place by ``h`` [s] towards its command [rad] with servo parameters ``s`` (layout ``SERVO``);
-    with ``s[SV.on] == 0`` the gimbal is the command and the rate is zero."""
+    in place by ``h`` [s], physics step ``k`` of a control period, towards its command [rad] (the previous
+    period's while ``k`` is below the row's ``delay``) with servo parameters ``s`` (layout ``SERVO``; the
+    natural frequency times ``1 + frequency_shift`` of the row); with ``s[SV.on] == 0`` the gimbal is the
+    command and the rate is zero."""
+    o = A.previous if k < act[A.delay] else A.command
     if s[SV.on] == 0.0:
         for i in range(2):
-            act[A.gimbal + i] = act[A.command + i]
+            act[A.gimbal + i] = act[o + i]
             act[A.gimbal_rate + i] = 0.0
         return
     w, z, lim, rl = s[SV.frequency], s[SV.damping], s[SV.limit], s[SV.rate_limit]
+    if act[A.frequency_shift] != 0.0:
+        w = w * (1.0 + act[A.frequency_shift])
     for i in range(2):
-        c = _clip(act[A.command + i], -lim, lim)
+        c = _clip(act[o + i], -lim, lim)
         pos, rate = act[A.gimbal + i], act[A.gimbal_rate + i]
         acc = w * w * (c - pos) - 2.0 * z * w * rate
         r = _clip(rate + h * acc, -rl, rl)
