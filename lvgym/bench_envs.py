@@ -91,9 +91,9 @@ def core(model: str, min_time: float) -> float:
 
 def run(min_time: float = 2.0, batch: int = 1024) -> list[tuple[str, str, float, float]]:
     """``(model, how, env-steps/s, core RK4 steps per env step and thread)`` rows."""
-    from lvgym.simulator.core import _default_threads
+    from lvgym.simulator.threads import default_threads
 
-    threads = _default_threads()
+    threads = default_threads()
     rows = []
     for model in ("rigid", "nonrigid"):
         base = core(model, min_time)
@@ -123,8 +123,8 @@ def main() -> None:
     parser.add_argument("--batch", type=int, default=1024, help="rows of the batched envs")
     args = parser.parse_args()
     rows = run(args.min_time, args.batch)
-    from lvgym.simulator.core import _default_threads
-    print(f"# {ENV_ID} env steps per second ({cpu_name()}, {os.cpu_count()} cores, {_default_threads()} simulator "
+    from lvgym.simulator.threads import default_threads
+    print(f"# {ENV_ID} env steps per second ({cpu_name()}, {os.cpu_count()} cores, {default_threads()} simulator "
           "threads)\n")
     print("| model | how | env-steps/s | cost of an env step in core RK4 steps (per thread) |")
     print("|---|---|---|---|")

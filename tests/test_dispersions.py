@@ -129,3 +129,12 @@ def test_servo_randomisations_draw_what_they_name(name):
         assert draws[:, 0].std() == pytest.approx(0.1, rel=0.2)
     else:
         assert np.all(draws[:, 0] == 1.0) and set(draws[:, 1]) == {0.0, 1.0}
+
+
+def test_slosh_frequency_dispersion_counts_once_with_the_specific_force_damper():
+    env = gym.make("lvgym/SmileAscent-v0", model="nonrigid", mission_time_s=1.0, randomize=["slosh_frequency"],
+                   slosh_frequency="specific_force").unwrapped
+    scale = env.func.dispersions(np.random.default_rng(5))[0]
+    lay = env.func.sim.layout
+    length, omega = lay.slosh_param(0, "length").start, lay.slosh_param(0, "omega").start
+    assert scale[length] != 1.0 and scale[omega] == 1.0        # sqrt(|a_x| / L) already carries f

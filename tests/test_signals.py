@@ -86,7 +86,7 @@ def test_servo_hand_numbers():
     act = ACTUATOR.zeros()
     cmd, pos, rate = (ACTUATOR.view(act, n) for n in ("command", "gimbal", "gimbal_rate"))
     cmd[:] = [math.radians(0.1), -math.radians(0.1)]
-    servo_step_k(s, act, 0.01)
+    servo_step_k(s, act, 0.01, 0)
     # semi-implicit Euler from rest: rate = h w^2 c, position = h rate
     np.testing.assert_allclose(rate, 0.01 * 225.0 * cmd)
     np.testing.assert_allclose(pos, 0.01 * 0.01 * 225.0 * cmd)
@@ -95,18 +95,18 @@ def test_servo_hand_numbers():
     pos[:], rate[:] = 0.0, 0.0
     small = cmd.copy()
     cmd[:] = [1.0, -1.0]
-    servo_step_k(s, act, 0.01)
+    servo_step_k(s, act, 0.01, 0)
     np.testing.assert_allclose(np.abs(rate), 0.01 * 225.0 * math.radians(5.0))
     peak = 0.0
     for _ in range(100):
-        servo_step_k(s, act, 0.01)
+        servo_step_k(s, act, 0.01, 0)
         peak = max(peak, np.abs(rate).max())
     assert peak == pytest.approx(math.radians(30.0), rel=1e-12)
     np.testing.assert_allclose(pos, [math.radians(5.0), -math.radians(5.0)])
     np.testing.assert_allclose(rate, 0.0)
     # no servo: the position is the command
     cmd[:] = small
-    servo_step_k(DIRECT, act, 0.01)
+    servo_step_k(DIRECT, act, 0.01, 0)
     np.testing.assert_array_equal(pos, small)
 
 

@@ -399,7 +399,8 @@ class AscentFuncEnv(FuncEnv):
         N(0, 0.05 deg) per axis. Added for v1 (docs/benchmark.md gives the reasoning of each range):
         aerodynamics: normal force and moment x N(1, 5 %), axial force x N(1, 5 %), centre of pressure
         + N(0, 0.25 calibre); thrust_level: x N(1, 1 %); slosh_mass: pendulum masses x N(1, 5 %);
-        slosh_frequency: x N(1, 5 %) (pendulum lengths / f^2, the damper's frequency x f);
+        slosh_frequency: x N(1, 5 %) (pendulum lengths / f^2, and the tabulated damper frequency x f; with
+        ``slosh_frequency="specific_force"`` the damper's frequency follows from the dispersed length);
         bending_damping: ratios x log-uniform [0.5, 2]; servo_bandwidth: natural frequency x N(1, 10 %);
         servo_delay: 0 or 1 physics step (0 or 10 ms at the default step) with equal chances."""
         n_p = self.sim.layout.n_p
@@ -436,9 +437,11 @@ class AscentFuncEnv(FuncEnv):
                 scale[sl] *= f
         if "slosh_frequency" in r:
             f = 1.0 + normal(0.05, 0.15)
+            tabulated = self.spec.slosh_frequency == "vacuum_thrust"    # else the damper's comes from the length
             for length, omega in self._i_slosh_f:
                 scale[length] /= f * f
-                scale[omega] *= f
+                if tabulated:
+                    scale[omega] *= f
         if "bending_damping" in r:
             scale[self._i_zm] = math.exp(rng.uniform(math.log(0.5), math.log(2.0)))
         servo = np.array([1.0, 0.0])

@@ -34,11 +34,8 @@ along the rail without rotating with respect to the Earth until the structure ha
 
 from __future__ import annotations
 
-import functools
 import math
-import os
 from collections.abc import Sequence
-from concurrent.futures import ThreadPoolExecutor
 from typing import Any
 
 import numpy as np
@@ -46,7 +43,6 @@ import numpy as np
 from lvgym.environment import LaunchSite, make
 from lvgym.environment.earth import WGS84_OMEGA, dcm_to_quat
 from lvgym.errors import check_choice
-from lvgym.parallel import default_workers
 from lvgym.rotations import quat_to_dcm_batch
 from lvgym.vehicle import MassModel, Vehicle, load_vehicle
 
@@ -57,47 +53,13 @@ from .flight import flight_loads, pack_context, stack_contexts
 from .imu import IMU_OFF, Imu
 from .layouts import ACTUATOR, CONDITIONS, CONTEXT, DISPERSION, RAIL, RAIL_STATE, RS
 from .piece import SLOSH_FREQUENCIES
-from .strips import StripSetup, strip_models, strip_stations
 from .servo import DIRECT, Servo
+from .strips import StripSetup, strip_models, strip_stations
+from .threads import ROWS_PER_THREAD, Kernel, default_threads, pool
 from .timeline import MODELS, Timeline, build_timeline
-
-_ROWS_PER_THREAD = 8          # smaller batches run on the calling thread
-
-
-def _default_threads() -> int:
-    """``$LVGYM_THREADS``, else the CPUs this process may run on."""
-    env = os.environ.get("LVGYM_THREADS")
-    return max(1, int(env)) if env else default_workers()
-
-
-class Kernel:
-    """A compiled function called through its compiled entry point after the first call.
-
-    Numba's dispatcher resolves the types of every argument on every call; for the loads function
-    (a cfunc) that costs about 25 us, a fifth of a whole env step. The simulator always passes the
-    same types, so after the first call (which compiles or loads the cached machine code) it calls
-    the compiled entry point directly."""
-
-    def __init__(self, dispatcher: Any) -> None:
-        self.dispatcher = dispatcher
-        self.entry: Any = None
-
-    def __call__(self, *args: Any) -> None:
-        if self.entry is None:
-            self.dispatcher(*args)
-            if len(self.dispatcher.signatures) == 1:
-                self.entry = self.dispatcher.overloads[self.dispatcher.signatures[0]].entry_point
-            return
-        self.entry(*args)
-
 
 _ADVANCE, _SLOSH = Kernel(advance_range), Kernel(slosh_angles_range)
 
-
-@functools.lru_cache(maxsize=4)
-def _pool(threads: int) -> ThreadPoolExecutor:
-    """A process-wide thread pool (the compiled step releases the GIL)."""
-    return ThreadPoolExecutor(max_workers=threads, thread_name_prefix="lvgym")
 
 #: launch sites of the shipped vehicles (public-data.md); azimuth clockwise from north
 SITES = {
@@ -242,7 +204,7 @@ class Simulator:
         if imu is not None and not 0 <= imu.sensor < self.timeline.sensor_stations.size:
             raise ValueError(f"imu.sensor = {imu.sensor}: the timeline has {self.timeline.sensor_stations.size} "
                              "sensor stations")
-        self.threads = int(threads) if threads is not None else _default_threads()
+        self.threads = int(threads) if threads is not None else default_threads()
         if self.threads < 1:
             raise ValueError(f"threads = {threads!r}: at least 1")
         self.tables = self.timeline.tables
@@ -393,7 +355,7 @@ class Simulator:
         size or the thread count changes (several compiled kernels run per step)."""
         key = (batch, self.threads)
         if getattr(self, "_chunk_key", None) != key:
-            k = max(1, min(self.threads, batch // _ROWS_PER_THREAD))
+            k = max(1, min(self.threads, batch // ROWS_PER_THREAD))
             edges = np.linspace(0, batch, k + 1).astype(int)
             self._chunk_list = [(int(a), int(z)) for a, z in zip(edges[:-1], edges[1:]) if z > a]
             self._chunk_key = key
@@ -407,7 +369,7 @@ class Simulator:
         if len(chunks) == 1:
             fn(0, batch, *args)
             return
-        list(_pool(self.threads).map(lambda ch: fn(ch[0], ch[1], *args), chunks))
+        list(pool(self.threads).map(lambda ch: fn(ch[0], ch[1], *args), chunks))
 
     def step(self, gimbal: Any, duration: float, moment: Any = None,
              data: SimData | None = None, *, force: Any = None) -> list[list[tuple[float, str]]]:
