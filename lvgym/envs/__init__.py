@@ -26,7 +26,8 @@ from .snapshot import EpisodeState
 from .spec import FLIGHT_DEFAULTS, RANDOMIZE, WIND_TIERS, TaskSpec
 from .vector import AscentVectorEnv
 
-ENVS = {"lvgym/SmileAscent-v0": SmileAscentEnv, "lvgym/SmileAscent-v1": SmileAscentV1Env, "lvgym/StratosIII-v0": StratosIIIEnv,
+ENVS = {"lvgym/SmileAscent-v0": SmileAscentEnv, "lvgym/SmileAscent-v1": SmileAscentV1Env,
+        "lvgym/StratosIII-v0": StratosIIIEnv,
         "lvgym/SlenderAscent-v0": SlenderAscentEnv, "lvgym/StratosIII-v1": StratosIIIV1Env,
         "lvgym/SlenderAscent-v1": SlenderAscentV1Env}
 
@@ -77,7 +78,8 @@ def __getattr__(name: str) -> Any:
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
-__all__ = ["ENVS", "FLIGHT_DEFAULTS", "OBSERVATIONS", "OBS_FLIGHT", "OBS_SENSORS", "OBS_STATE", "RANDOMIZE", "REWARD_TERMS", "TASK", "WIND_TIERS",
+__all__ = ["ENVS", "FLIGHT_DEFAULTS", "OBSERVATIONS", "OBS_FLIGHT", "OBS_SENSORS", "OBS_STATE", "RANDOMIZE",
+           "REWARD_TERMS", "TASK", "WIND_TIERS",
            "AscentEnv", "AscentFuncEnv", "AscentParams", "AscentSB3VecEnv", "AscentState", "AscentVectorEnv",
            "EpisodeState", "SlenderAscentEnv", "SlenderAscentV1Env", "SmileAscentEnv", "SmileAscentV1Env",
            "StratosIIIEnv", "StratosIIIV1Env", "TaskSpec", "make_sb3_vec_env", "slender_ascent_v1_vector",

@@ -229,9 +229,9 @@ class SmileAscentV1Env(SmileAscentEnv):
     The vehicle ``smile_v1`` (lvgym/vehicles/smile_v1.yaml): the upper stack flies its own, finless
     aerodynamics after separation, which comes 10 s after the 43 s burnout at about 1.8 kPa (the finned
     stack coasts, statically stable); stage 2 ignites at 54 s; 70 s of mission. Through the coast the
-    vehicle holds its attitude by reaction control (``coast_control``: into the relative wind, 1,000 N m, 3 rad/s) and settles its
-    propellant with ullage thrust (``settling_thrust_n`` = 18 kN, 1.35 times the drag at burnout:
-    docs/vehicles.md). The flight computer's computational delay is one control period
+    vehicle holds itself into the relative wind by reaction control (``coast_control``, 1,000 N m,
+    3 rad/s) and settles its propellant with ullage thrust (``settling_thrust_n`` = 18 kN, 1.35 times the
+    drag at burnout: docs/vehicles.md). The flight computer's computational delay is one control period
     (``action_delay_steps=1``) and the policy sees what the flight computer samples (``observation="flight"``:
     the IMU's gyros and accelerometers through their filters, a strapdown attitude, tactical-grade
     errors, docs/sensors.md); the gravity turn, when asked for, follows the Earth-relative velocity.
