@@ -60,7 +60,7 @@ POLICIES: dict[str, PolicySpec] = {
 DEFAULT_POLICIES = ["zero", "pid", "gs-pid", "ppo"]
 DEFAULT_SUITES = ["smile-windy"]
 #: episodes per condition and policy of the default run (2 conditions x 4 policies x 50 = 400 episodes of 60 s:
-#: 160 s of episodes on 2 cores with the four default policies, 2026-12-01)
+#: 118 s of episodes on 2 cores with the four default policies, 2026-12-02)
 DEFAULT_EPISODES = 50
 #: the longest episode an env takes (``lvgym.envs.TaskSpec.mission_time_s``) [s]
 MAX_MISSION_TIME_S = 3600.0
