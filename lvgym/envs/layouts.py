@@ -142,6 +142,7 @@ T, O, OS, OF, RW, FD, NV = (TASK.at, OBS_STATE.at, OBS_SENSORS.at, OBS_FLIGHT.at
 assert all(lay.size == OBS_STATE.size and all(OBS_STATE.offset(n) == lay.offset(n) for n in OBS_STATE.names if n in lay)
            for lay in (OBS_SENSORS, OBS_FLIGHT))
 assert OBS_SENSORS.names == OBS_FLIGHT.names
+assert OF.yaw_attitude_error == OF.pitch_attitude_error + 1     # the attitude error is written as one pair
 
 
 def observation_table() -> str:

@@ -123,19 +123,16 @@ def observe_k(task, t, x, cond, act, C, a, on, ref_pitch, bias, dphi, mass, n_sl
 
 
 @nb.njit(cache=True, nogil=True)
-def flight_observe_k(task, setup, sim, ts, b, a, ref_pitch, first):
+def flight_observe_k(task, setup, sim, ts, b, a, ref_pitch, first, C):
     """The flight computer's sample (:mod:`.flightcomputer`) into the entries 0-6 of row ``b``'s
     observation: gyro and accelerometers from the IMU, the attitude error of the strapdown attitude
-    against the reference axis ``a``."""
+    against the reference axis ``a`` (``C``: 3x3 scratch, overwritten)."""
     nav = ts.nav[b]
     flight_sample_k(task, setup.imu, sim.imu[b], ref_pitch, ts.gyro_bias[b], ts.draws[b], nav, ts.obs[b], first)
     oq = NV.q_nav
-    C = np.empty((3, 3))
     quat_to_dcm(nav[oq], nav[oq + 1], nav[oq + 2], nav[oq + 3], C)
-    att = np.empty(2)
-    attitude_error_k(C, a, att)
-    ts.obs[b, OF.pitch_attitude_error] = att[0]
-    ts.obs[b, OF.yaw_attitude_error] = att[1]
+    # pitch, then yaw: consecutive (asserted in .layouts)
+    attitude_error_k(C, a, ts.obs[b, OF.pitch_attitude_error:OF.yaw_attitude_error + 1])
 
 
 @nb.njit(cache=True, nogil=True, inline="always")
@@ -170,7 +167,7 @@ def reset_signals(rows, task, setup, sim, ts, tables):
         if task[T.flight] != 0.0:
             for i in range(4):
                 ts.nav[b, NV.q_nav + i] = xb[oq + i]
-            flight_observe_k(task, setup, sim, ts, b, ts.axis_ref_i[b], ref_pitch, True)
+            flight_observe_k(task, setup, sim, ts, b, ts.axis_ref_i[b], ref_pitch, True, C)
 
 
 @nb.njit(cache=True, nogil=True)
@@ -221,7 +218,7 @@ def step_signals_range(lo, hi, task, setup, sim, ts, tables):
         observe_k(task, t, xb, cond, act, C, a, ts.on[b], ref_pitch, ts.gyro_bias[b], tables.dphi_sensor[j, 0], mass,
                   setup.n_slosh, setup.n_modes, ts.obs[b], ts.att[b])
         if task[T.flight] != 0.0 and not failed:
-            flight_observe_k(task, setup, sim, ts, b, a, ref_pitch, False)
+            flight_observe_k(task, setup, sim, ts, b, a, ref_pitch, False, C)
         qalpha = cond[D.qbar] * math.degrees(cond[D.alpha_total])
         ts.qalpha[b] = qalpha
         code = 0
