@@ -47,12 +47,12 @@ from lvgym.parallel import TaskFailed, exit_on_sigterm
 #: policy names -> how a worker builds them (factories are imported lazily, in the workers)
 POLICIES: dict[str, PolicySpec] = {
     "zero": ZERO,
-    # our tuning on the rigid linearisation (baselines_pid.tune): one gain set, and the schedule on mass
-    "pid": PolicySpec("pid", "baselines_pid.pid:smile_tuned_pid"),
-    "gs-pid": PolicySpec("gs-pid", "baselines_pid.pid:smile_scheduled_pid", (("name", "gs-pid"), ("schedule", "smile"))),
+    # our tuning on the rigid linearisation (baselines.tune): one gain set, and the schedule on mass
+    "pid": PolicySpec("pid", "baselines.pid:smile_tuned_pid"),
+    "gs-pid": PolicySpec("gs-pid", "baselines.pid:smile_scheduled_pid", (("name", "gs-pid"), ("schedule", "smile"))),
     # the thesis's gains (6.3.1) and its Table 6.10 schedule, as published
-    "pid-thesis": PolicySpec("pid-thesis", "baselines_pid.pid:smile_single_pid"),
-    "gs-pid-thesis": PolicySpec("gs-pid-thesis", "baselines_pid.pid:smile_scheduled_pid",
+    "pid-thesis": PolicySpec("pid-thesis", "baselines.pid:smile_single_pid"),
+    "gs-pid-thesis": PolicySpec("gs-pid-thesis", "baselines.pid:smile_scheduled_pid",
                                 (("name", "gs-pid-thesis"), ("schedule", "smile_thesis"))),
     # the shipped learned policy (agents/trained/ppo_smile_ascent, docs/training.md)
     "ppo": PolicySpec("ppo", "agents.policy:shipped_policy"),

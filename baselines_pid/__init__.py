@@ -1,15 +1,5 @@
-"""PID and gain-scheduled PID TVC baselines (thesis 6.3) and a bang-bang roll controller (thesis 5.3).
+"""The old name of :mod:`baselines`, kept so that ``baselines_pid.*`` imports and ``python -m
+baselines_pid.tune`` keep working; new code imports :mod:`baselines`."""
 
-Every controller implements the benchmark's policy interface (:class:`lvgym.benchmark.Policy`):
-``reset()`` and ``act(observation, info) -> action``. ``python -m baselines_pid.tune --vehicle smile``
-tunes a gain schedule on the rigid linearisation (into ``results/schedules/``; ``--overwrite`` replaces
-the shipped one in ``schedules/``); ``python -m baselines_pid.study`` runs the
-thesis's control study (docs/control-study.md).
-"""
-
-from .bangbang import BangBangRollPolicy
-from .pid import (DiscretePID, GainSchedule, GainScheduledPIDPolicy, PIDPolicy, smile_scheduled_pid,
-                  smile_single_pid)
-
-__all__ = ["BangBangRollPolicy", "DiscretePID", "GainSchedule", "GainScheduledPIDPolicy", "PIDPolicy",
-           "smile_scheduled_pid", "smile_single_pid"]
+from baselines import *  # noqa: F401,F403
+from baselines import __all__  # noqa: F401

@@ -1,5 +1,5 @@
 """Small helpers shared by the command lines (``train.py``, ``evaluate.py``, ``python -m lvgym.studies``,
-``python -m baselines_pid.tune``): one-line errors, and options checked before any work starts.
+``python -m baselines.tune``): one-line errors, and options checked before any work starts.
 
 A command line refuses a bad value in one line that names the option, the value and what is allowed,
 before it creates a folder or starts a worker::

@@ -363,7 +363,7 @@ def test_v0_effort_metric_stays_the_sampled_one():
     the frozen v0 metric keeps its definition; protocol v1 reads the env's integral."""
     import gymnasium as gym
 
-    from baselines_pid.pid import smile_tuned_pid
+    from baselines.pid import smile_tuned_pid
     from lvgym.benchmark.runner import play_episode
     env = gym.make("lvgym/SmileAscent-v0", model="nonrigid", wind="turbulence", randomize=["wind"],
                    mission_time_s=20.0)

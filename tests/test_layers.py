@@ -15,7 +15,7 @@ import pytest
 
 import lvgym
 
-ON_TOP = ("agents", "baselines_pid")           # controllers and agents sit on top of lvgym
+ON_TOP = ("agents", "baselines", "baselines_pid")         # controllers and agents sit on top of lvgym
 ABOVE_ALL = ("gymnasium", "stable_baselines3", "torch", "lvgym.envs", "lvgym.simulator", "lvgym.benchmark") + ON_TOP
 
 FORBIDDEN = {

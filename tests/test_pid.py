@@ -1,4 +1,4 @@
-"""Tests of baselines_pid: the discrete PID law against hand numbers, schedules, the linearisation, the
+"""Tests of baselines: the discrete PID law against hand numbers, schedules, the linearisation, the
 bang-bang law and a short closed loop."""
 
 import math
@@ -9,10 +9,10 @@ import numpy as np
 import pytest
 
 import lvgym  # noqa: F401
-from baselines_pid import linearize as lin
-from baselines_pid import tune
-from baselines_pid.bangbang import NEGATIVE, NONE, POSITIVE, BangBangRollPolicy
-from baselines_pid.pid import DiscretePID, GainSchedule, GainScheduledPIDPolicy, PIDPolicy, smile_scheduled_pid
+from baselines import linearize as lin
+from baselines import tune
+from baselines.bangbang import NEGATIVE, NONE, POSITIVE, BangBangRollPolicy
+from baselines.pid import DiscretePID, GainSchedule, GainScheduledPIDPolicy, PIDPolicy, smile_scheduled_pid
 from lvgym.benchmark.policy import Policy, ZeroPolicy
 
 
@@ -176,3 +176,15 @@ def test_closed_loop_pid_beats_zero_under_wind():
 
     zero, pid = run(lambda env: ZeroPolicy()), run(lambda env: PIDPolicy(*gains, env=env))
     assert pid < 0.7 * zero
+
+
+def test_old_package_name_still_works():
+    """``baselines_pid`` (the package's old name) gives the same classes as ``baselines``."""
+    import baselines
+    import baselines_pid
+    import baselines_pid.pid
+    import baselines_pid.tune
+
+    assert baselines_pid.GainScheduledPIDPolicy is baselines.GainScheduledPIDPolicy
+    assert baselines_pid.pid.GainSchedule is baselines.pid.GainSchedule
+    assert baselines_pid.tune.main is baselines.tune.main

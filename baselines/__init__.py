@@ -1,0 +1,15 @@
+"""PID and gain-scheduled PID TVC baselines (thesis 6.3) and a bang-bang roll controller (thesis 5.3).
+
+Every controller implements the benchmark's policy interface (:class:`lvgym.benchmark.Policy`):
+``reset()`` and ``act(observation, info) -> action``. ``python -m baselines.tune --vehicle smile``
+tunes a gain schedule on the rigid linearisation (into ``results/schedules/``; ``--overwrite`` replaces
+the shipped one in ``schedules/``); ``python -m baselines.study`` runs the
+thesis's control study (docs/control-study.md).
+"""
+
+from .bangbang import BangBangRollPolicy
+from .pid import (DiscretePID, GainSchedule, GainScheduledPIDPolicy, PIDPolicy, smile_scheduled_pid,
+                  smile_single_pid)
+
+__all__ = ["BangBangRollPolicy", "DiscretePID", "GainSchedule", "GainScheduledPIDPolicy", "PIDPolicy",
+           "smile_scheduled_pid", "smile_single_pid"]

@@ -1,0 +1,254 @@
+"""Discrete PID rate controllers for thrust-vector control (thesis 6.3), as benchmark policies.
+
+The law of one axis (:class:`DiscretePID`), on the error ``e = reference - measured`` sampled every ``dt``
+seconds, discretised with backward Euler (Simulink's "backward Euler" discrete PID, parallel form)::
+
+    P_k = Kp e_k
+    I_k = I_{k-1} + Ki dt e_k                                   (held while clamped, see below)
+    D_k = (D_{k-1} + Kd N (e_k - e_{k-1})) / (1 + N dt)         (Kd N s / (s + N); N = inf: Kd (e_k - e_{k-1}) / dt)
+    u_k = clip(P_k + I_k + D_k, u_min, u_max)
+
+Backward Euler keeps the derivative filter stable for every N (the thesis's N = 500 to 2100 rad/s are
+10 to 42 times the 50 Hz sampling rate, where forward Euler would diverge), and it makes the
+derivative of a filter that fast almost the plain difference quotient.
+
+Anti-windup by clamping (conditional integration): when the unclipped output is beyond a limit and the
+error would push the integral further that way, the integral keeps its last value. Off (``enabled=False``):
+the output is 0, the integral is frozen and the derivative is restarted, so switching back on gives no
+derivative kick.
+
+Units. The thesis's gains (Kp 8.98, Ki 3.92, Kd 4.57) map a body-rate error to a gimbal angle in the SI
+units of its Simulink model: rad of gimbal per rad/s of rate error (Kp), per rad (Ki) and per rad/s^2 (Kd).
+The ratios are the same in degrees (deg of gimbal per deg/s). The policies below divide the gimbal angle
+by the gimbal limit to give the env's action in [-1, 1].
+
+Signs. The env's observation holds the rate error ``rate - reference`` (entries ``pitch_rate_error``
+and ``yaw_rate_error`` of the env's observation layout); a positive pitch (yaw) gimbal gives a positive
+pitch (yaw) rate (checked by experiment in the tests), so the policy feeds ``e = -(rate error)`` to the
+law and commands ``u``.
+
+Facts from the env. The policies are built for an env (``env=``, as the benchmark does) and take from it
+what they would otherwise work out again: the gimbal limit (the action's scale and the output limit), the
+control period, and the observation layout; at every step the env's ``info`` gives the time and the
+stack's mass, and the observation the controller-on flag (off before the controller starts and during
+staging coasts).
+
+Scheduling (:class:`GainSchedule`): gains interpolated linearly on a monotonic scheduling variable,
+``mass`` (the default, as the thesis: ``info["mass"]``, the vehicle's mass at the current time), ``time``
+[s] or ``mach``; beyond the table the end gains are held.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import yaml
+
+SCHEDULES = Path(__file__).resolve().parent / "schedules"
+VARIABLES = ("mass", "time", "mach")
+#: the thesis's single gain set (6.3.1), tuned on the rigid SMILE at 28.8 s; N as Table 6.10's 28.8 s row
+THESIS_SINGLE = {"kp": 8.98, "ki": 3.92, "kd": 4.57, "n": 500.0}
+
+
+class DiscretePID:
+    """One axis of the discrete PID law (see the module docstring): ``update(e) -> u``."""
+
+    def __init__(self, kp: float, ki: float = 0.0, kd: float = 0.0, n: float | None = None, dt: float = 0.02,
+                 u_min: float = -math.inf, u_max: float = math.inf) -> None:
+        if not dt > 0.0:
+            raise ValueError(f"dt = {dt!r}: a sampling period > 0 s")
+        if not u_min < u_max:
+            raise ValueError(f"output limits ({u_min!r}, {u_max!r}): u_min must be below u_max")
+        self.dt, self.u_min, self.u_max = float(dt), float(u_min), float(u_max)
+        self.set_gains(kp, ki, kd, n)
+        self.reset()
+
+    def set_gains(self, kp: float, ki: float, kd: float, n: float | None = None) -> None:
+        """New gains (bumpless for Ki: the integral state holds the integrated ``Ki e``)."""
+        n = math.inf if n is None else float(n)
+        for key, v in (("kp", kp), ("ki", ki), ("kd", kd)):
+            if not (math.isfinite(v) and v >= 0.0):
+                raise ValueError(f"{key} = {v!r}: a finite gain >= 0")
+        if not n > 0.0:
+            raise ValueError(f"n = {n!r}: a derivative filter coefficient > 0 rad/s (inf: unfiltered)")
+        self.kp, self.ki, self.kd, self.n = float(kp), float(ki), float(kd), n
+
+    def reset(self) -> None:
+        self.integral = 0.0
+        self.deriv = 0.0
+        self.e_prev: float | None = None
+        self.saturated = False
+
+    def update(self, e: float, enabled: bool = True) -> float:
+        e = float(e)
+        if not enabled:
+            self.deriv, self.e_prev, self.saturated = 0.0, None, False
+            return 0.0
+        de = 0.0 if self.e_prev is None else e - self.e_prev
+        if math.isinf(self.n):
+            d = self.kd * de / self.dt
+        else:
+            d = (self.deriv + self.kd * self.n * de) / (1.0 + self.n * self.dt)
+        p = self.kp * e
+        i = self.integral + self.ki * self.dt * e
+        v = p + i + d
+        if (v > self.u_max and e * self.ki > 0.0) or (v < self.u_min and e * self.ki < 0.0):
+            i = self.integral                       # clamp: do not integrate further into the limit
+            v = p + i + d
+        self.integral, self.deriv, self.e_prev = i, d, e
+        u = min(max(v, self.u_min), self.u_max)
+        self.saturated = u != v
+        return u
+
+
+@dataclass(frozen=True)
+class GainSchedule:
+    """PID gains at breakpoints of a monotonic scheduling variable, interpolated linearly (ends held)."""
+
+    variable: str
+    points: tuple[float, ...]
+    kp: tuple[float, ...]
+    ki: tuple[float, ...]
+    kd: tuple[float, ...]
+    n: tuple[float, ...]
+    meta: dict = field(default_factory=dict, compare=False)
+
+    def __post_init__(self) -> None:
+        if self.variable not in VARIABLES:
+            raise ValueError(f"variable = {self.variable!r}: one of {VARIABLES}")
+        m = len(self.points)
+        for key in ("kp", "ki", "kd", "n"):
+            if len(getattr(self, key)) != m:
+                raise ValueError(f"{key} has {len(getattr(self, key))} entries for {m} breakpoints")
+        if m < 1:
+            raise ValueError("a schedule needs at least one breakpoint")
+        d = np.diff(np.asarray(self.points, float))
+        if not (np.all(d > 0) or np.all(d < 0)):
+            raise ValueError(f"breakpoints of {self.variable!r} = {list(self.points)}: must be strictly "
+                             "monotonic (a lookup table needs a monotonic scheduling variable, thesis 6.3.1)")
+        for key in ("kp", "ki", "kd"):
+            if any(not (math.isfinite(v) and v >= 0) for v in getattr(self, key)):
+                raise ValueError(f"{key} = {list(getattr(self, key))}: finite gains >= 0")
+        if any(not v > 0 for v in self.n):
+            raise ValueError(f"n = {list(self.n)}: filter coefficients > 0")
+
+    def gains(self, value: float) -> tuple[float, float, float, float]:
+        """(kp, ki, kd, n) at ``value`` of the scheduling variable."""
+        x = np.asarray(self.points, float)
+        order = np.argsort(x)
+        return tuple(float(np.interp(value, x[order], np.asarray(getattr(self, k), float)[order]))
+                     for k in ("kp", "ki", "kd", "n"))
+
+    # ------------------------------------------------------------------ files
+    @classmethod
+    def from_dict(cls, data: dict) -> "GainSchedule":
+        rows = data["rows"]
+        var = data.get("variable", "mass")
+        key = {"mass": "mass_kg", "time": "time_s", "mach": "mach"}[var]
+        get = lambda k, default=None: tuple(float(r.get(k, default)) for r in rows)  # noqa: E731
+        meta = {k: v for k, v in data.items() if k not in ("rows", "variable")}
+        meta["rows"] = rows
+        return cls(var, get(key), get("kp"), get("ki"), get("kd"), get("n", math.inf), meta)
+
+    @classmethod
+    def load(cls, path: str | Path) -> "GainSchedule":
+        """A schedule from a YAML file (a path, or the name of one in ``baselines/schedules``)."""
+        p = Path(path)
+        if not p.exists():
+            p = SCHEDULES / (str(path) if str(path).endswith(".yaml") else f"{path}.yaml")
+        with open(p) as f:
+            return cls.from_dict(yaml.safe_load(f))
+
+
+class PIDPolicy:
+    """Pitch and yaw rate PID (identical gains per axis, the vehicle being axisymmetric) as a benchmark
+    :class:`~lvgym.benchmark.policy.Policy` of the TVC envs.
+
+    ``env``: the lvgym env (single or vector) it flies; the gimbal limit (the action is gimbal / limit,
+    also the output limit), the control period and the observation's layout come from it. The controller
+    acts while the observation's ``controller_on`` entry is 1. ``act`` needs ``info["time"]`` (every lvgym
+    ``info`` has it, the reset's too).
+    """
+
+    def __init__(self, kp: float = THESIS_SINGLE["kp"], ki: float = THESIS_SINGLE["ki"],
+                 kd: float = THESIS_SINGLE["kd"], n: float | None = THESIS_SINGLE["n"], *, env: Any,
+                 name: str = "pid") -> None:
+        task = env.unwrapped
+        self.name = name
+        self.dt = float(task.task.control_dt_s)
+        self.limit = float(task.gimbal_limit)
+        lay = task.observation_layout
+        self._i_err = [lay.index("pitch_rate_error"), lay.index("yaw_rate_error")]
+        self._i_on, self._i_mach = lay.index("controller_on"), lay.index("mach_over_10")
+        self.axes = [DiscretePID(kp, ki, kd, n, self.dt, -self.limit, self.limit) for _ in range(2)]
+        self.last_gimbal = np.zeros(2)
+
+    def reset(self) -> None:
+        for pid in self.axes:
+            pid.reset()
+        self.last_gimbal = np.zeros(2)
+
+    def enabled(self, observation: np.ndarray) -> bool:
+        """The env's controller-on flag for the coming step."""
+        return float(observation[self._i_on]) >= 0.5
+
+    def schedule_gains(self, observation: np.ndarray, info: dict[str, Any]) -> None:
+        """Hook for gain scheduling (nothing for fixed gains)."""
+
+    def act(self, observation: np.ndarray, info: dict[str, Any]) -> np.ndarray:
+        obs = np.asarray(observation, dtype=float)
+        on = self.enabled(obs)
+        self.schedule_gains(obs, info)
+        errors = -obs[self._i_err]                    # reference - rate, pitch and yaw
+        self.last_gimbal = np.array([pid.update(e, on) for pid, e in zip(self.axes, errors)])
+        return np.clip(self.last_gimbal / self.limit, -1.0, 1.0).astype(np.float32)
+
+
+class GainScheduledPIDPolicy(PIDPolicy):
+    """:class:`PIDPolicy` with gains from a :class:`GainSchedule` updated at every step: on ``mass``
+    (``info["mass"]`` [kg]), ``time`` (``info["time"]`` [s]) or ``mach`` (the observation's Mach entry)."""
+
+    def __init__(self, schedule: GainSchedule | str | Path, *, env: Any, name: str = "gs-pid") -> None:
+        self.schedule = schedule if isinstance(schedule, GainSchedule) else GainSchedule.load(schedule)
+        g = self.schedule.gains(self.schedule.points[0])
+        super().__init__(*g, env=env, name=name)
+        self.value = float("nan")
+
+    def variable(self, observation: np.ndarray, info: dict[str, Any]) -> float:
+        v = self.schedule.variable
+        if v == "mass":
+            return float(info["mass"])
+        if v == "time":
+            return float(info["time"])
+        return float(observation[self._i_mach]) * 10.0
+
+    def schedule_gains(self, observation: np.ndarray, info: dict[str, Any]) -> None:
+        self.value = self.variable(observation, info)
+        g = self.schedule.gains(self.value)
+        for pid in self.axes:
+            pid.set_gains(*g)
+
+
+# ---------------------------------------------------------------------------- presets
+def smile_single_pid(env: Any, name: str = "pid-thesis") -> PIDPolicy:
+    """The thesis's single gain set (Kp 8.98, Ki 3.92, Kd 4.57, N 500) on SMILE's ``env``."""
+    return PIDPolicy(env=env, name=name)
+
+
+def smile_scheduled_pid(env: Any, schedule: str = "smile_thesis", name: str | None = None) -> GainScheduledPIDPolicy:
+    """Gain-scheduled PID on SMILE's ``env``: ``smile_thesis`` (Table 6.10, on mass) or ``smile`` (our tuning)."""
+    return GainScheduledPIDPolicy(schedule, env=env, name=name or f"gs-pid-{schedule}")
+
+
+def smile_tuned_pid(env: Any, schedule: str = "smile", t_design: float = 28.8, name: str = "pid") -> PIDPolicy:
+    """One gain set from our rigid tuning: the row of ``schedules/<schedule>.yaml`` nearest ``t_design``
+    [s] (28.8 s, the thesis's design point), held over the flight of ``env``."""
+    ours = GainSchedule.load(schedule)
+    rows = ours.meta["rows"]
+    i = int(np.argmin(np.abs(np.array([r["time_s"] for r in rows]) - t_design)))
+    return PIDPolicy(*ours.gains(ours.points[i]), env=env, name=name)
+
