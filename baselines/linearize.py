@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import lru_cache
 from typing import Any
 
 import control
@@ -36,37 +37,68 @@ import numpy as np
 
 import lvgym  # noqa: F401  (registers the envs)
 from lvgym.simulator import flight_loads
+from lvgym.packing import Field, Packed
 from lvgym.rotations import quat_mul
 from lvgym.simulator import CONDITIONS, CONTEXT
 from lvgym.simulator.flight import flight_conditions_batch
 
-ENV_IDS = {"smile": "lvgym/SmileAscent-v0", "stratos3": "lvgym/StratosIII-v0", "slender": "lvgym/SlenderAscent-v0"}
+#: the env of each vehicle per protocol version (the vehicle's own file in v1: ``smile_v1`` for SMILE)
+ENV_IDS = {"v0": {"smile": "lvgym/SmileAscent-v0", "stratos3": "lvgym/StratosIII-v0", "slender": "lvgym/SlenderAscent-v0"},
+           "v1": {"smile": "lvgym/SmileAscent-v1", "stratos3": "lvgym/StratosIII-v1", "slender": "lvgym/SlenderAscent-v1"}}
+#: the planes of :func:`linearize`: the state entries kept, the input and the rate output of each
+PLANES = {"pitch": ("v_z", "theta_y", "omega_y", "z", "y", "gimbal_pitch", "omega_y"),
+          "yaw": ("v_y", "theta_z", "omega_z", "y", "z", "gimbal_yaw", "omega_z"),
+          "roll": (None, "theta_x", "omega_x", None, None, "moment_x", "omega_x")}
+#: inputs of the full Jacobian: pitch and yaw gimbal [rad], roll moment [N m]
+INPUTS = ("gimbal_pitch", "gimbal_yaw", "moment_x")
 
 
 @dataclass
 class OperatingPoint:
+    """A flight state to linearise about: time ``t`` [s], the dynamics state ``x``, parameters ``p`` and
+    simulator context ``c`` of one row, the simulator ``sim`` (its timeline, IMU and servo), the env's
+    task spec ``task`` and the env options it was flown with."""
+
     t: float
     x: np.ndarray
     p: np.ndarray
     c: np.ndarray
     sim: Any
     env_options: dict
+    task: Any = None
 
 
-def operating_point(vehicle: str = "smile", t: float = 28.8, model: str = "rigid", **options: Any) -> OperatingPoint:
-    """The state of ``vehicle``'s env flown with the gimbal centred and no wind up to time ``t`` [s]."""
-    env_id = ENV_IDS.get(vehicle)
+def operating_point(vehicle: str = "smile", t: float = 28.8, model: str = "rigid", protocol: str = "v0",
+                    **options: Any) -> OperatingPoint:
+    """The state of ``vehicle``'s env of ``protocol`` (``v0``, ``v1``) flown with the gimbal centred and
+    no wind up to time ``t`` [s]. In v0 the simulator flies alone; in v1 the env flies its zero action
+    control period by control period, so that its coast control and settling thrust hold the stack
+    through the staging coast as they do in the benchmark."""
+    ids = ENV_IDS.get(protocol)
+    if ids is None:
+        raise ValueError(f"protocol = {protocol!r}: one of {sorted(ENV_IDS)}")
+    env_id = ids.get(vehicle)
     if env_id is None:
-        raise ValueError(f"vehicle = {vehicle!r}: one of {sorted(ENV_IDS)}")
+        raise ValueError(f"vehicle = {vehicle!r}: one of {sorted(ids)}")
     opts = {"model": model, "wind": "none", **options}
-    if vehicle == "stratos3":
+    if vehicle == "stratos3" and protocol == "v0":
         opts.setdefault("control", "tvc")
     env = gym.make(env_id, **opts)
     env.reset(seed=0)
-    sim = env.unwrapped.sim                          # its rows are the env's state
-    if t > 0:
-        sim.step(np.zeros((1, 2)), float(t))
-    return OperatingPoint(float(sim.t[0]), sim.x[0].copy(), sim.p[0].copy(), sim.c[0].copy(), sim, opts)
+    task = env.unwrapped
+    sim = task.sim                                   # its rows are the env's state
+    if protocol == "v0":
+        if t > 0:
+            sim.step(np.zeros((1, 2)), float(t))
+    else:
+        zero = np.zeros(env.action_space.shape, env.action_space.dtype)
+        dt = float(task.task.control_dt_s)
+        while float(sim.t[0]) < float(t) - 0.5 * dt:
+            _, _, term, trunc, info = env.step(zero)
+            if term or trunc:
+                raise RuntimeError(f"{env_id} ({model}) ended at {info['time']:.2f} s before t = {t} s: "
+                                   f"{info.get('termination', '')}")
+    return OperatingPoint(float(sim.t[0]), sim.x[0].copy(), sim.p[0].copy(), sim.c[0].copy(), sim, opts, task.task)
 
 
 def _rot(q: np.ndarray, theta: np.ndarray) -> np.ndarray:
@@ -84,94 +116,141 @@ def _dcm(q: np.ndarray) -> np.ndarray:
                      [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
 
 
+@lru_cache(maxsize=None)
+def local_layout(n_modes: int, n_active: int) -> Packed:
+    """The local coordinates of :func:`linearize` for ``n_modes`` modes per plane and ``n_active``
+    pendulums with propellant (sizes in the field list)."""
+    K, na = n_modes, n_active
+    return Packed(f"local coordinates K={K} N={na}", [
+        Field("v", 3, "m/s", "body-frame components (at the operating attitude) of the CG's inertial velocity"),
+        Field("theta", 3, "rad", "small rotation of the body about its own axes"),
+        Field("omega", 3, "rad/s", "body rates"),
+        Field("eta", 2 * K, "-", "modal coordinates, y plane then z plane"),
+        Field("eta_dot", 2 * K, "1/s", "modal rates"),
+        Field("beta", 2 * na, "rad", "per active pendulum its rotation about its y_s and z_s axes"),
+        Field("omega_s", 2 * na, "rad/s", "per active pendulum its rates"),
+    ], pad=False)
+
+
 class _Coords:
-    """Local coordinates around an operating point and the derivative in them."""
+    """Local coordinates around an operating point (:func:`local_layout`) and the derivative in them."""
 
     def __init__(self, op: OperatingPoint) -> None:
         self.op = op
         self.dyn = op.sim.dynamics
         lay = self.layout = self.dyn.layout
         self.K, N = self.dyn.n_modes, self.dyn.n_slosh
-        m = lay.view(op.p, "params", "slosh") if N else np.zeros(0)
         self.active = [j for j in range(N) if op.p[lay.slosh_param(j, "m")][0] > 0.0]
         self.C0 = _dcm(op.x[lay.state["q_bi"]])
-        names = ["v_x", "v_y", "v_z", "theta_x", "theta_y", "theta_z", "omega_x", "omega_y", "omega_z"]
+        self.local = local_layout(self.K, len(self.active))
+        names = [f"{f}_{a}" for f in ("v", "theta", "omega") for a in "xyz"]
         names += [f"eta_{pl}{k}" for pl in "yz" for k in range(self.K)]
         names += [f"eta_dot_{pl}{k}" for pl in "yz" for k in range(self.K)]
         names += [f"beta_{j}_{a}" for j in self.active for a in "yz"]
         names += [f"omega_s_{j}_{a}" for j in self.active for a in "yz"]
         self.names = names
-        del m
 
     def state(self, d: np.ndarray) -> np.ndarray:
         """The full state at local coordinates ``d``."""
-        lay, K = self.layout, self.K
+        lay, loc = self.layout, self.local
         x = self.op.x.copy()
-        x[lay.state["v_zw_i"]] += self.C0 @ d[0:3]
+        x[lay.state["v_zw_i"]] += self.C0 @ loc.view(d, "v")
         s = lay.state["q_bi"]
-        x[s] = _rot(x[s], d[3:6])
-        x[lay.state["omega_bi_b"]] += d[6:9]
-        o = 9
-        x[lay.state["eta"]] += d[o:o + 2 * K]
-        x[lay.state["eta_dot"]] += d[o + 2 * K:o + 4 * K]
-        o += 4 * K
-        na = len(self.active)
+        x[s] = _rot(x[s], loc.view(d, "theta"))
+        x[lay.state["omega_bi_b"]] += loc.view(d, "omega")
+        x[lay.state["eta"]] += loc.view(d, "eta")
+        x[lay.state["eta_dot"]] += loc.view(d, "eta_dot")
         q_si = lay.view(x, "state", "q_si")
         w_si = lay.view(x, "state", "omega_si_s")
+        beta, omega_s = loc.view(d, "beta"), loc.view(d, "omega_s")
         for i, j in enumerate(self.active):
-            q_si[j] = _rot(q_si[j], [0.0, d[o + 2 * i], d[o + 2 * i + 1]])
-            w_si[j] += d[o + 2 * na + 2 * i:o + 2 * na + 2 * i + 2]
+            q_si[j] = _rot(q_si[j], [0.0, beta[2 * i], beta[2 * i + 1]])
+            w_si[j] += omega_s[2 * i:2 * i + 2]
         return x
 
-    def rates(self, d: np.ndarray, gimbal: float) -> np.ndarray:
-        """Derivatives of the dynamic coordinates (v, omega, eta, eta_dot, omega_s) at ``d``."""
-        lay, K = self.layout, self.K
+    def rates(self, d: np.ndarray, u_in: np.ndarray | None = None) -> np.ndarray:
+        """Time derivative of the local coordinates ``d`` (the kinematic rows ``theta`` and ``beta``
+        left zero: :meth:`jacobian` adds them exactly) with the input ``u_in`` (:data:`INPUTS`) added
+        to the operating point's."""
+        lay, loc = self.layout, self.local
         x = self.state(d)
         c = self.op.c.copy()
-        c[CONTEXT.offset("gimbal")] += gimbal                # the pitch entry
+        if u_in is not None:
+            c[CONTEXT.slice("gimbal")] += u_in[0:2]          # the context's own entries lead a longer vector
+            c[CONTEXT.offset("moment_b")] += u_in[2]                # about x_b
         c[CONTEXT.index("time0")] = self.op.t
         u = np.zeros(lay.n_u)
         flight_loads(0.0, x, self.op.p.copy(), c, u)
         f = self.dyn.derivative(x, self.op.p, u)
+        out = loc.zeros()
+        loc.view(out, "v")[:] = self.C0.T @ f[lay.state["v_zw_i"]]
+        loc.view(out, "omega")[:] = f[lay.state["omega_bi_b"]]
+        loc.view(out, "eta")[:] = f[lay.state["eta"]]
+        loc.view(out, "eta_dot")[:] = f[lay.state["eta_dot"]]
         w_s = lay.view(f, "state", "omega_si_s")
-        return np.concatenate([self.C0.T @ f[lay.state["v_zw_i"]], f[lay.state["omega_bi_b"]],
-                               f[lay.state["eta"]], f[lay.state["eta_dot"]],
-                               np.concatenate([w_s[j] for j in self.active]) if self.active else np.zeros(0)])
+        if self.active:
+            loc.view(out, "omega_s")[:] = np.concatenate([w_s[j] for j in self.active])
+        return out
 
     def jacobian(self, h: float = 1e-6) -> tuple[np.ndarray, np.ndarray]:
-        """``A`` (n, n) and ``B`` (n, 1) in the local coordinates (input: pitch gimbal [rad])."""
-        K, na = self.K, len(self.active)
-        n = 9 + 4 * K + 4 * na
-        dyn_rows = np.r_[0:3, 6:9, 9:9 + 4 * K, 9 + 4 * K + 2 * na:n]
-        A, B = np.zeros((n, n)), np.zeros((n, 1))
+        """``A`` (n, n) and ``B`` (n, 3) in the local coordinates (inputs :data:`INPUTS`: pitch and yaw
+        gimbal [rad], roll moment [N m]), by central differences."""
+        loc = self.local
+        n = loc.size
+        A, B = np.zeros((n, n)), np.zeros((n, len(INPUTS)))
+        v = loc.slice("v")
         for i in range(n):
             e = np.zeros(n)
-            step = h * (1e3 if i < 3 else 1.0)            # velocities in m/s
+            step = h * (1e3 if v.start <= i < v.stop else 1.0)            # velocities in m/s
             e[i] = step
-            A[dyn_rows, i] = (self.rates(e, 0.0) - self.rates(-e, 0.0)) / (2 * step)
-        B[dyn_rows, 0] = (self.rates(np.zeros(n), h) - self.rates(np.zeros(n), -h)) / (2 * h)
-        A[3:6, 6:9] += np.eye(3)                              # theta_dot = omega
-        o = 9 + 4 * K
-        A[o:o + 2 * na, o + 2 * na:o + 4 * na] += np.eye(2 * na)   # beta_dot = omega_s
+            A[:, i] = (self.rates(e) - self.rates(-e)) / (2 * step)
+        zero = np.zeros(n)
+        for k, step in enumerate((h, h, 1e3 * h)):                       # the moment in N m
+            du = np.zeros(len(INPUTS))
+            du[k] = step
+            B[:, k] = (self.rates(zero, du) - self.rates(zero, -du)) / (2 * step)
+        A[loc.slice("theta"), loc.slice("omega")] += np.eye(3)              # theta_dot = omega
+        A[loc.slice("beta"), loc.slice("omega_s")] += np.eye(loc.field("beta").size)   # beta_dot = omega_s
         return A, B
 
 
+def plane_states(names: list[str], plane: str) -> list[int]:
+    """Indices of the local coordinates ``names`` that :func:`linearize` keeps in ``plane``."""
+    if plane not in PLANES:
+        raise ValueError(f"plane = {plane!r}: one of {sorted(PLANES)}")
+    v, theta, omega, modes, pend, _, _ = PLANES[plane]
+    keep = []
+    for i, nm in enumerate(names):
+        if nm in (v, theta, omega) or (modes and nm.startswith((f"eta_{modes}", f"eta_dot_{modes}"))) or (
+                pend and nm.startswith(("beta_", "omega_s_")) and nm.endswith(f"_{pend}")):
+            keep.append(i)
+    return keep
+
+
 def linearize(vehicle: str = "smile", t: float = 28.8, model: str = "rigid", op: OperatingPoint | None = None,
-              full: bool = False, **options: Any) -> control.StateSpace:
-    """Pitch-plane state space from pitch gimbal [rad] to pitch rate [rad/s] at flight time ``t``;
-    ``full=True`` keeps every local coordinate (both planes) instead."""
+              full: bool = False, plane: str = "pitch", **options: Any) -> control.StateSpace:
+    """State space from the gimbal angle in force [rad] (roll: the roll moment [N m]) to the body rate
+    [rad/s] of ``plane`` (``pitch``, ``yaw``, ``roll``) at flight time ``t``: the rigid body, and in the
+    non-rigid model the modes of that plane's deflection and the pendulums' swing in it. ``full=True``
+    keeps every local coordinate (both planes and roll) with all three inputs and all three rates.
+    Pitch: the z-plane modes (deflection along z_b) and the pendulums' rotations about their y_s axes;
+    yaw: the y-plane modes and the rotations about z_s. The state names are those of
+    :func:`local_layout`'s entries, one per coordinate."""
     op = op if op is not None else operating_point(vehicle, t, model, **options)
     co = _Coords(op)
     A, B = co.jacobian()
     names = co.names
-    keep = list(range(len(names))) if full else [i for i, nm in enumerate(names) if nm in ("v_z", "theta_y", "omega_y")
-                                                 or nm.startswith(("eta_z", "eta_dot_z")) or nm.endswith("_y") and
-                                                 nm.startswith(("beta_", "omega_s_"))]
+    if full:
+        C = np.zeros((3, len(names)))
+        for r, a in enumerate("xyz"):
+            C[r, names.index(f"omega_{a}")] = 1.0
+        return control.ss(A, B, C, 0.0, inputs=list(INPUTS), outputs=["omega_x", "omega_y", "omega_z"], states=names)
+    keep = plane_states(names, plane)
+    *_, inp, out = PLANES[plane]
     C = np.zeros((1, len(keep)))
-    C[0, keep.index(names.index("omega_y"))] = 1.0
-    sys = control.ss(A[np.ix_(keep, keep)], B[keep], C, 0.0, inputs=["gimbal_pitch"], outputs=["omega_y"],
-                     states=[names[i] for i in keep])
-    return sys
+    C[0, keep.index(names.index(out))] = 1.0
+    return control.ss(A[np.ix_(keep, keep)], B[keep][:, [INPUTS.index(inp)]], C, 0.0, inputs=[inp], outputs=[out],
+                      states=[names[i] for i in keep])
 
 
 def aero_slopes(op: OperatingPoint, dw: float = 0.1) -> tuple[float, float, float]:
@@ -180,8 +259,8 @@ def aero_slopes(op: OperatingPoint, dw: float = 0.1) -> tuple[float, float, floa
     co = _Coords(op)
     out = []
     for s in (dw, -dw):
-        d = np.zeros(9 + 4 * co.K + 4 * len(co.active))
-        d[2] = s
+        d = co.local.zeros()
+        co.local.view(d, "v")[2] = s
         x = co.state(d)[None]
         cond = CONDITIONS.zeros(1)
         flight_conditions_batch(np.array([op.t]), x, op.p[None], op.c[None], cond)
