@@ -70,3 +70,30 @@ def test_gyro_slope_and_modes():
     assert 50.0 < modes["bending"][0] < 100.0                 # rad/s: the first bending mode at max q
     n0 = F.flight_plant(op, delay_steps=0).nstates
     assert F.flight_plant(op).nstates == n0 + 1
+
+
+def test_charts_write_figures_and_margins(tmp_path):
+    """The charts command writes one figure per thrusting row, skips a coast row, and its margins are
+    those of linearize.margins on the flight computer's loop (the rigid row at 28.8 s of the shipped
+    rigid-designed schedule: the v1 loop's delay and filters leave it under 2 dB of gain margin)."""
+    import json
+
+    import yaml
+
+    from baselines import charts
+
+    sched = tmp_path / "two.yaml"
+    sched.write_text(yaml.safe_dump({"variable": "time", "rows": [
+        {"time_s": 28.8, "kp": 0.0491, "ki": 0.3526, "kd": 0.1196, "n": 500.0},
+        {"time_s": 48.0, "kp": 0.0491, "ki": 0.3526, "kd": 0.1196, "n": 500.0}]}))
+    assert charts.main(["--schedule", str(sched), "--out", str(tmp_path)]) == 0
+    out = tmp_path / "smile_v1_two"
+    assert (out / "loop_28.8s.png").stat().st_size > 10_000 and not (out / "loop_48s.png").exists()
+    doc = json.loads((out / "margins.json").read_text())
+    assert [r["time_s"] for r in doc["rows"]] == [28.8]
+    op = L.operating_point("smile", 28.8, "rigid", protocol="v1")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        m = L.margins(charts.open_loop(op, (0.0491, 0.3526, 0.1196, 500.0)))
+    assert doc["rows"][0]["rigid"]["gain_margin_db"] == pytest.approx(m["gain_margin_db"], abs=1e-3)
+    assert 0.0 < m["gain_margin_db"] < 2.0
