@@ -167,7 +167,7 @@ def test_policy_wrapper_is_deterministic_and_respects_controller_on():
     pol = AdaptiveAugmentingPolicy(_Base(), env=env, record=True)
     assert isinstance(pol, Policy) and pol.name == "aac(stub)"
     rng = np.random.default_rng(3)
-    obs = np.zeros((300, len(OBS_FLIGHT.names) if hasattr(OBS_FLIGHT, "names") else 14))
+    obs = np.zeros((300, OBS_FLIGHT.size))
     i_on, i_err = OBS_FLIGHT.index("controller_on"), OBS_FLIGHT.index("pitch_rate_error")
     obs[50:, i_on] = 1.0
     obs[:, i_err] = rng.normal(0.0, 0.03, 300)
