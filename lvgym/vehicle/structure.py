@@ -191,15 +191,32 @@ class ModeSchedule:
         self._key: tuple | None = None
         self._modes: VehicleModes | None = None
 
+    def _due(self, t: float, attached: tuple[bool, ...]) -> bool:
+        """Whether the modes are to be recomputed at time ``t`` [s] with the stages ``attached``."""
+        last = self._modes
+        if last is None or attached != self._key or t < last.t:                 # a new stack or a new flight
+            return True
+        return self.interval is not None and t - last.t >= self.interval - 1e-12
+
     def modes(self, state: MassState, props: MassProperties | None = None) -> VehicleModes:
         """The modes in force at ``state`` (computed when the schedule says so, cached otherwise)."""
         attached = tuple(ph != SEPARATED for ph in state.phase)
-        due = self._modes is None or attached != self._key or state.t < self._modes.t  # a new flight
-        if not due and self.interval is not None:
-            due = state.t - self._modes.t >= self.interval - 1e-12
-        if due:
+        if self._due(state.t, attached):
             props = props if props is not None else self.mass_model.properties(state)
             self._modes = vehicle_modes(self.mass_model.vehicle, state, props, self.n_modes, self.sensor_stations,
                                         self.ei_factor)
             self._key = attached
         return self._modes
+
+    def modes_rows(self, state: MassState, props: MassProperties) -> list[VehicleModes]:
+        """The modes in force at each state of the batch ``state`` (with its batched ``props``), in order,
+        as :meth:`modes` one state after the other: a list of B, the same object while unchanged."""
+        attached = tuple(ph != SEPARATED for ph in state.phase)
+        out = []
+        for i, t in enumerate(state.t.tolist()):
+            if self._due(t, attached):
+                self._modes = vehicle_modes(self.mass_model.vehicle, state.row(i), props.row(i), self.n_modes,
+                                            self.sensor_stations, self.ei_factor)
+                self._key = attached
+            out.append(self._modes)
+        return out
