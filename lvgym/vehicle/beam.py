@@ -263,7 +263,8 @@ def _modes(stations, EI, mass_per_length, *, point_masses: Sequence = (), n_mode
         # the flexibility form M y = (1 / omega^2) K y: its largest eigenvalues are the lowest modes,
         # found to a relative accuracy eps * omega_k^2 / omega_1^2 instead of eps * omega_max^2 / omega_k^2
         n_r = n_dof - 2
-        mu, y = eigh(0.5 * (Mr + Mr.T), 0.5 * (Kr + Kr.T), subset_by_index=[n_r - n_modes, n_r - 1])
+        mu, y = eigh(0.5 * (Mr + Mr.T), 0.5 * (Kr + Kr.T), subset_by_index=[n_r - n_modes, n_r - 1],
+                     overwrite_a=True, overwrite_b=True, check_finite=False)       # K, M checked finite
         mu, y = mu[::-1], y[:, ::-1]
         q = T @ (y / np.sqrt(np.einsum("ik,ij,jk->k", y, Mr, y)))        # q^T M q = 1
         tip = q[-2]
