@@ -19,7 +19,8 @@ import hashlib
 import os
 import pickle
 import tempfile
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
@@ -27,7 +28,7 @@ import numpy as np
 
 from lvgym import packing
 
-__all__ = ["cache_dir", "cached", "key"]
+__all__ = ["cache_dir", "cached", "key", "using"]
 
 _ARRAYS = ("t", "params", "hold", "thrust0", "exit_area", "mass", "cg", "inertia", "slosh_mass", "burning", "stage",
            "sensor_stations", "phi_sensor", "dphi_sensor", "strip_stations", "phi_strip", "dphi_strip", "mode_change_t",
@@ -40,6 +41,20 @@ def cache_dir() -> Path | None:
     if root.lower() == "off":
         return None
     return (Path(root) if root else Path.home() / ".cache" / "lvgym") / "timelines"
+
+
+@contextmanager
+def using(folder: str | os.PathLike[str]) -> Iterator[None]:
+    """``$LVGYM_CACHE_DIR`` set to ``folder`` (or ``"off"``) inside the block, as it was after it."""
+    old = os.environ.get("LVGYM_CACHE_DIR")
+    os.environ["LVGYM_CACHE_DIR"] = os.fspath(folder)
+    try:
+        yield
+    finally:
+        if old is None:
+            del os.environ["LVGYM_CACHE_DIR"]
+        else:
+            os.environ["LVGYM_CACHE_DIR"] = old
 
 
 @functools.lru_cache(maxsize=1)

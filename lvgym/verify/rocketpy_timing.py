@@ -25,25 +25,11 @@ import argparse
 import os
 import tempfile
 import time
-from collections.abc import Iterator
-from contextlib import contextmanager
 from dataclasses import replace
 
+from lvgym.simulator.cache import using
+
 from .rocketpy_case import ELEVATION_DEG, RAIL_LENGTH, VEHICLE, Trajectory, fly_lvgym, fly_rocketpy, lvgym_simulator
-
-
-@contextmanager
-def _cache_folder(path: str) -> Iterator[None]:
-    """``$LVGYM_CACHE_DIR`` set to ``path`` inside the block."""
-    old = os.environ.get("LVGYM_CACHE_DIR")
-    os.environ["LVGYM_CACHE_DIR"] = path
-    try:
-        yield
-    finally:
-        if old is None:
-            del os.environ["LVGYM_CACHE_DIR"]
-        else:
-            os.environ["LVGYM_CACHE_DIR"] = old
 
 
 def timings(elevation_deg: float = ELEVATION_DEG, rail_length: float = RAIL_LENGTH, warm_up: bool = True
@@ -52,9 +38,9 @@ def timings(elevation_deg: float = ELEVATION_DEG, rail_length: float = RAIL_LENG
     each simulator once first (imports, Numba's kernels), untimed."""
     with tempfile.TemporaryDirectory(prefix="lvgym-timing-") as root:
         if warm_up:
-            with _cache_folder(os.path.join(root, "warm-up")):
+            with using(os.path.join(root, "warm-up")):
                 fly_lvgym(elevation_deg, rail_length)
-        with _cache_folder(os.path.join(root, "timed")):
+        with using(os.path.join(root, "timed")):
             lv_cold = fly_lvgym(elevation_deg, rail_length)
             lv_warm = fly_lvgym(elevation_deg, rail_length)
             start = time.perf_counter()
