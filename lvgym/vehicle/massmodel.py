@@ -264,7 +264,8 @@ class MassModel:
         for j, on in enumerate(state.engine_on):
             if on:
                 si, em = self.engines[j]
-                used = np.where(moved, em.consumed(prev - state.ignition[si], stops - state.ignition[si], throttle), 0.0)
+                tau0, tau1 = prev - state.ignition[si], stops - state.ignition[si]
+                used = np.where(moved, em.consumed(tau0, tau1, throttle), 0.0)
                 for kind, index, frac in self._feeds[j]:
                     taken.setdefault((kind, index), []).append(frac * used)
         out = {"tank": np.repeat(state.tank_mass[None], stops.size, axis=0),
