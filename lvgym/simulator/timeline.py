@@ -4,7 +4,9 @@ Propellant depletion and staging do not depend on the vehicle's motion (the engi
 throttle), so the dynamics parameters, the thrust and the mass properties are functions of time
 alone. :func:`build_timeline` evaluates :class:`~lvgym.vehicle.MassModel` and
 :class:`~lvgym.vehicle.structure.ModeSchedule` on a grid (every ``dt`` seconds, every breakpoint of a
-thrust table and both sides of every event) and :class:`Timeline` interpolates it linearly, so a step
+thrust table and both sides of every event), array-wise, one batch of rows per stretch between events
+(:meth:`~lvgym.vehicle.MassModel.history`; the same numbers, to the last bit, as evaluating the rows one at
+a time), and :class:`Timeline` interpolates it linearly, so a step
 costs a table look-up instead of a mass-model evaluation and a batch of vehicles at different times
 looks up its rows in one call. Event times are stored twice (the row before and the row after), and the
 simulator lands its steps on them, so nothing is interpolated across a separation.
