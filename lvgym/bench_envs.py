@@ -12,6 +12,15 @@ gives a ratio that does not depend on the machine: the cost of one env step (per
 of the bare dynamics core (one RK4 step of the same vehicle size with held loads, :mod:`lvgym.bench`),
 measured in the same run. A SMILE env step does 2 RK4 steps, each with 4 evaluations of the flight loads,
 plus the servo, the events and the task signals, so the ratio is at least 2.
+
+Construction (``--only construction``): wall time of starting a simulator, median of ``--repeats`` runs in one
+process after a warm-up (imports done, Numba's kernels loaded from its disk cache): **cold**, an empty timeline
+cache, so the mass and mode tables are built (a new or dispersed vehicle); **warm**, the same cache folder
+again, the tables read back (:mod:`lvgym.simulator.cache`). Both read the vehicle file and build the
+aerodynamic tables. Cases: the rigid Stratos III simulator of the RocketPy validation (240 s, 4,803 table rows;
+:func:`lvgym.verify.rocketpy_case.lvgym_simulator`) and ``gymnasium.make`` plus ``reset`` of SmileAscent-v0
+(non-rigid, 1,224 rows, modes at lift-off and at the separation), SmileAscent-v1 (modes every 2 s: 37 beam
+eigen-solves) and SlenderAscent-v0 (10 s).
 """
 
 from __future__ import annotations
@@ -105,6 +114,49 @@ def run(min_time: float = 2.0, batch: int = 1024) -> list[tuple[str, str, float,
     return rows
 
 
+#: construction cases: label -> what to build (:func:`construction`)
+CONSTRUCTION = {"Simulator('stratos3', 'rigid'), 240 s": "stratos3", "lvgym/SmileAscent-v0": "lvgym/SmileAscent-v0",
+                "lvgym/SmileAscent-v1": "lvgym/SmileAscent-v1", "lvgym/SlenderAscent-v0": "lvgym/SlenderAscent-v0"}
+
+
+def _start(what: str) -> None:
+    """Start the simulator of a :data:`CONSTRUCTION` case, with the processes' vehicle and timeline caches
+    emptied (each run reads its vehicle file and looks its tables up again)."""
+    from lvgym.envs import functional
+
+    functional.cached_vehicle.cache_clear()
+    functional.cached_timeline.cache_clear()
+    if what == "stratos3":
+        from lvgym.verify.rocketpy_case import lvgym_simulator
+        lvgym_simulator().reset()
+    else:
+        gym.make(what).reset(seed=0)
+
+
+def construction(repeats: int = 5) -> list[tuple[str, float, float]]:
+    """``(case, cold [s], warm [s])`` medians of ``repeats`` runs (see the module docstring)."""
+    import tempfile
+    import warnings
+
+    from lvgym.simulator.cache import using
+
+    rows = []
+    with tempfile.TemporaryDirectory(prefix="lvgym-bench-") as root, warnings.catch_warnings():
+        warnings.simplefilter("ignore", DeprecationWarning)     # v0's "out of date" notice
+        for label, what in CONSTRUCTION.items():
+            with using(os.path.join(root, f"{what.replace('/', '_')}-warm-up")):
+                _start(what)
+            cold, warm = [], []
+            for k in range(repeats):
+                with using(os.path.join(root, f"{what.replace('/', '_')}-{k}")):
+                    for times in (cold, warm):
+                        start = time.perf_counter()
+                        _start(what)
+                        times.append(time.perf_counter() - start)
+            rows.append((label, float(np.median(cold)), float(np.median(warm))))
+    return rows
+
+
 def cpu_name() -> str:
     """The CPU's model name (``/proc/cpuinfo``), else what ``platform`` knows."""
     try:
@@ -121,15 +173,24 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--min-time", type=float, default=2.0, help="seconds per measurement")
     parser.add_argument("--batch", type=int, default=1024, help="rows of the batched envs")
+    parser.add_argument("--repeats", type=int, default=5, help="runs per construction case")
+    parser.add_argument("--only", choices=("steps", "construction"), help="one of the two tables")
     args = parser.parse_args()
-    rows = run(args.min_time, args.batch)
     from lvgym.simulator.threads import default_threads
-    print(f"# {ENV_ID} env steps per second ({cpu_name()}, {os.cpu_count()} cores, {default_threads()} simulator "
-          "threads)\n")
-    print("| model | how | env-steps/s | cost of an env step in core RK4 steps (per thread) |")
-    print("|---|---|---|---|")
-    for model, how, rate, ratio in rows:
-        print(f"| {model} | {how} | {rate:,.0f} | {ratio:.1f} |")
+    if args.only != "construction":
+        rows = run(args.min_time, args.batch)
+        print(f"# {ENV_ID} env steps per second ({cpu_name()}, {os.cpu_count()} cores, {default_threads()} "
+              "simulator threads)\n")
+        print("| model | how | env-steps/s | cost of an env step in core RK4 steps (per thread) |")
+        print("|---|---|---|---|")
+        for model, how, rate, ratio in rows:
+            print(f"| {model} | {how} | {rate:,.0f} | {ratio:.1f} |")
+    if args.only != "steps":
+        print(f"\n# construction: starting a simulator [s], median of {args.repeats} ({cpu_name()})\n")
+        print("| case | cold (tables built) | warm (tables from the cache) |")
+        print("|---|---|---|")
+        for label, cold, warm in construction(args.repeats):
+            print(f"| construction, {label} | {cold:.3f} | {warm:.3f} |")
 
 
 if __name__ == "__main__":

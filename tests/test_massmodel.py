@@ -185,3 +185,31 @@ def test_hybrid_grain_burns_the_fuel_share_the_fuel_tanks_leave():
     assert s0.tank_mass[0] - s1.tank_mass[0] == pytest.approx(4.0)
     assert s0.tank_mass[1] - s1.tank_mass[1] == pytest.approx(0.8)
     assert s0.grain_mass[0] - s1.grain_mass[0] == pytest.approx(1.2)
+
+
+@pytest.mark.parametrize("name", ["stratos3", "smile", "thesis-verification"])
+def test_a_batch_is_the_states_one_at_a_time(name):
+    """history() and the batched properties give, to the last bit, what advance() through one time after
+    the other and the single-state properties give (thrust tables, a grain, three stages, separations)."""
+    mm = MassModel(load_vehicle(name))
+    event_times = [t for t, _ in mm.advance(mm.initial_state(), 80.0)[1]]
+    times = np.unique(np.concatenate([np.linspace(0.0, 80.0, 161), event_times]))
+    stretches, events = mm.history(times)
+    assert events == mm.advance(mm.initial_state(), 80.0)[1]
+    state, i = mm.initial_state(), 0
+    for batch in stretches:
+        props = mm.properties(batch)
+        thrust, flow = mm.thrust(batch, 1.0, 2e4), mm.mass_flow(batch)
+        for k in range(batch.t.size):
+            state, _ = mm.advance(state, times[i])
+            i += 1
+            one = mm.properties(state)
+            assert state.phase == batch.phase and state.engine_on == batch.engine_on
+            assert np.array_equal(state.tank_mass, batch.tank_mass[k]) and np.array_equal(state.grain_mass,
+                                                                                       batch.grain_mass[k])
+            row = props.row(k)
+            for field in ("m_b", "r_cg_b", "J_b", "slosh_mass", "pendulum_length", "hinge", "slosh_rest", "mass", "cg",
+                          "inertia", "gimbal", "mass_flow"):
+                assert np.array_equal(getattr(one, field), getattr(row, field)), field
+            assert thrust[k] == mm.thrust(state, 1.0, 2e4) and flow[k] == mm.mass_flow(state)
+    assert i == times.size

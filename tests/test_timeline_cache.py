@@ -2,14 +2,14 @@
 misses, a damaged file is rebuilt, and the cache can be switched off."""
 
 import dataclasses
-import time
 
 import numpy as np
 import pytest
 
 from lvgym.simulator import build_timeline
-from lvgym.simulator import cache
+from lvgym.simulator import cache, timeline
 from lvgym.vehicle import MassModel, load_vehicle
+from lvgym.vehicle.config import VEHICLE_DIR
 from lvgym.vehicle.slender import slender_vehicle
 
 
@@ -30,19 +30,34 @@ def folder(tmp_path, monkeypatch):
     return tmp_path / "timelines"
 
 
-def test_a_hit_is_the_timeline_and_fast(folder):
+def test_a_hit_is_the_timeline_without_building_it(folder, monkeypatch):
     mm = MassModel(load_vehicle("stratos3"))
-    args = ("nonrigid", 40.0, 0.05, None, (-2.0,), 50.0)
-    t0 = time.perf_counter()
-    built = build_timeline(mm, *args[:4], list(args[4]), args[5])
-    t_build = time.perf_counter() - t0
+    args = ("nonrigid", 40.0, 0.05, None, [-2.0], 50.0)
+    built = build_timeline(mm, *args)
     assert len(list(folder.glob("*.npz"))) == 1
-    t0 = time.perf_counter()
-    again = build_timeline(mm, *args[:4], list(args[4]), args[5])
-    t_hit = time.perf_counter() - t0
-    _same(again, build_timeline(mm, *args[:4], list(args[4]), args[5], cache=False))
+    fresh = build_timeline(mm, *args, cache=False)
+
+    def no_build(*_):
+        raise AssertionError("a cache hit must not build the timeline")
+    monkeypatch.setattr(timeline, "_pieces", no_build)
+    again = build_timeline(mm, *args)
+    _same(again, fresh)
     _same(built, again)
-    assert t_hit < 0.1 * t_build
+
+
+def test_the_key_is_the_vehicle_files_content(folder, tmp_path):
+    """A copy of a vehicle file under another name hits its entry; one changed value misses."""
+    text = (VEHICLE_DIR / "stratos3.yaml").read_text(encoding="utf-8")
+    args = ("rigid", 2.0, 0.05, None, (), np.inf)
+    copy, edited = tmp_path / "copy.yaml", tmp_path / "edited.yaml"
+    copy.write_text(text, encoding="utf-8")
+    assert text.count("fill_ratio: 0.7,") == 1
+    edited.write_text(text.replace("fill_ratio: 0.7,", "fill_ratio: 0.69,"), encoding="utf-8")
+    shipped = MassModel(load_vehicle("stratos3"))
+    assert cache.key(MassModel(load_vehicle(copy)), args) == cache.key(shipped, args)
+    assert cache.key(MassModel(load_vehicle(edited)), args) != cache.key(shipped, args)
+    a, b = build_timeline(MassModel(load_vehicle(copy)), *args), build_timeline(MassModel(load_vehicle(edited)), *args)
+    assert len(list(folder.glob("*.npz"))) == 2 and a.mass[0] > b.mass[0]
 
 
 def test_another_vehicle_or_argument_misses(folder):

@@ -62,28 +62,49 @@ class NonRigidModel:
         return f"NonRigidModel(n_slosh={self.n_slosh}, n_modes={self.n_modes})"
 
     # ----------------------------------------------------------------- building vectors by name
-    def params(self, *, m_b: float, J_b: Sequence[float] | np.ndarray, r_cg=(0.0, 0.0, 0.0),
+    def params(self, *, m_b, J_b: Sequence[float] | np.ndarray, r_cg=(0.0, 0.0, 0.0),
                r_gimbal=(0.0, 0.0, 0.0), omega_modes=(), zeta_modes=(), phi_gimbal=(),
                dphi_gimbal=(), slosh: Sequence[dict] = ()) -> np.ndarray:
         """Parameter vector from named values. ``J_b`` is a 3x3 matrix or its diagonal; ``slosh`` a
         list of N dicts with keys ``m, length, r_hinge`` and optionally ``inertia, zeta, omega, phi``.
+
+        A batch: ``m_b`` (B,) gives parameters (B, n_p), and every other value may carry the same
+        leading axis (``J_b`` (B, 3, 3) or (B, 3), ``r_cg`` (B, 3), ``omega_modes`` (B, K), a pendulum's
+        ``m`` (B,), ``r_hinge`` (B, 3), ``phi`` (B, K), ...) or be shared by all rows.
         """
         lay = self.layout
-        p = lay.zeros_params()
-        p[lay.params["m_b"]] = m_b
+        m_b = np.asarray(m_b, dtype=float)
+        if m_b.ndim > 1:
+            raise ValueError(f"m_b of shape {m_b.shape}: a mass [kg] or one per vehicle (B,)")
+        batch = m_b.shape
+        p = np.zeros(batch + (lay.n_p,))
+
+        def put(sl: slice, value, what: str) -> None:
+            v = np.asarray(value, dtype=float)
+            if sl.stop - sl.start == 1 and v.shape in ((), batch):
+                v = v[..., None]
+            try:
+                p[..., sl] = v
+            except ValueError:
+                raise ValueError(f"{what} has shape {v.shape}: expected {sl.stop - sl.start} entries"
+                                 + (f" or {batch[0]} rows of them" if batch else "")) from None
+
+        put(lay.params["m_b"], m_b, "m_b")
         J = np.asarray(J_b, dtype=float)
-        J = np.diag(J) if J.shape == (3,) else J
-        if J.shape != (3, 3):
+        if J.shape in ((3,), batch + (3,)) and J.shape != (3, 3):        # diagonals ((3, 3): a matrix)
+            J = J[..., :, None] * np.eye(3)
+        if J.shape not in ((3, 3), batch + (3, 3)):
             raise ValueError(f"J_b = {J_b!r}: a 3x3 matrix or its diagonal, in kg m^2")
-        p[lay.params["J_b"]] = J.ravel()
-        p[lay.params["r_cg"]] = r_cg
-        p[lay.params["r_gimbal"]] = r_gimbal
+        put(lay.params["J_b"], J.reshape(J.shape[:-2] + (9,)), "J_b")
+        put(lay.params["r_cg"], r_cg, "r_cg")
+        put(lay.params["r_gimbal"], r_gimbal, "r_gimbal")
         for key, value in (("omega_modes", omega_modes), ("zeta_modes", zeta_modes),
                            ("phi_gimbal", phi_gimbal), ("dphi_gimbal", dphi_gimbal)):
             value = np.zeros(self.n_modes) if len(value) == 0 else np.asarray(value, dtype=float)
-            if value.shape != (self.n_modes,):
-                raise ValueError(f"{key} has {value.size} entries: expected n_modes = {self.n_modes}")
-            p[lay.params[key]] = value
+            if value.shape[-1:] != (self.n_modes,):
+                raise ValueError(f"{key} has {value.shape[-1] if value.ndim else 1} entries: expected "
+                                 f"n_modes = {self.n_modes}")
+            put(lay.params[key], value, key)
         if len(slosh) != self.n_slosh:
             raise ValueError(f"slosh has {len(slosh)} entries: expected n_slosh = {self.n_slosh}")
         for j, s in enumerate(slosh):
@@ -95,41 +116,47 @@ class NonRigidModel:
                     raise KeyError(f"slosh[{j}] misses {key!r}")
             values = {"inertia": 0.0, "zeta": 0.0, "omega": 0.0, "phi": np.zeros(self.n_modes), **s}
             for key in Layout.SLOSH_FIELDS:
-                p[lay.slosh_param(j, key)] = values[key]
+                put(lay.slosh_param(j, key), values[key], f"slosh[{j}].{key}")
         self.check_params(p)
         return p
 
     def check_params(self, p: np.ndarray) -> None:
         """Raise ``ValueError`` naming the entry, the value and what is allowed when a parameter
-        vector (one vehicle or a batch) cannot be integrated."""
+        vector (one vehicle or a batch) cannot be integrated: the first vehicle that fails, at its
+        first failed check."""
         lay = self.layout
         pb = as_batch(p, lay.n_p, "p")
-
-        def fail(b: int, name: str, value, allowed: str):
-            where = f"vehicle {b}: " if pb.shape[0] > 1 else ""
-            value = float(value) if np.ndim(value) == 0 else value
-            raise ValueError(f"{where}{name} = {value!r}: {allowed}")
-
-        for b, row in enumerate(pb):
-            if not np.all(np.isfinite(row)):
-                fail(b, "p", row[~np.isfinite(row)].tolist(), "every parameter must be finite")
-            m_b = row[lay.params["m_b"]][0]
-            if m_b <= 0:
-                fail(b, "m_b", m_b, "the rigid-body mass must be > 0 kg")
-            J = row[lay.params["J_b"]].reshape(3, 3)
-            if not np.allclose(J, J.T) or np.any(np.linalg.eigvalsh(J) <= 0):
-                fail(b, "J_b", J.tolist(), "must be symmetric positive definite, kg m^2")
-            for key in ("omega_modes", "zeta_modes"):
-                if np.any(row[lay.params[key]] < 0):
-                    fail(b, key, row[lay.params[key]].tolist(), "must be >= 0")
-            for j in range(self.n_slosh):
-                get = {k: row[lay.slosh_param(j, k)] for k in Layout.SLOSH_FIELDS}
-                for key in ("m", "inertia", "zeta", "omega"):
-                    if get[key][0] < 0:
-                        fail(b, f"slosh[{j}].{key}", get[key][0], "must be >= 0")
-                if get["m"][0] > 0 and get["length"][0] <= 0:
-                    fail(b, f"slosh[{j}].length", get["length"][0],
-                         "an active pendulum (m > 0) needs a length > 0 m")
+        col = {k: pb[:, sl] for k, sl in lay.params.items()}
+        J = col["J_b"].reshape(-1, 3, 3)
+        # positive definite: the leading minors of the lower triangle (what an eigen-solver reads) > 0
+        a, b, c, d, e, f = J[:, 0, 0], J[:, 1, 0], J[:, 1, 1], J[:, 2, 0], J[:, 2, 1], J[:, 2, 2]
+        minor2 = a * c - b * b
+        det = a * (c * f - e * e) - b * (b * f - e * d) + d * (b * e - c * d)
+        symmetric = np.all(np.abs(J - J.transpose(0, 2, 1)) <= 1e-8 + 1e-5 * np.abs(J.transpose(0, 2, 1)),
+                           axis=(1, 2))
+        checks = [(~np.all(np.isfinite(pb), axis=1), "p", lambda r: pb[r][~np.isfinite(pb[r])].tolist(),
+                   "every parameter must be finite"),
+                  (~(col["m_b"][:, 0] > 0), "m_b", lambda r: col["m_b"][r, 0], "the rigid-body mass must be > 0 kg"),
+                  (~symmetric | ~((a > 0) & (minor2 > 0) & (det > 0)), "J_b", lambda r: J[r].tolist(),
+                   "must be symmetric positive definite, kg m^2")]
+        for key in ("omega_modes", "zeta_modes"):
+            checks.append((np.any(col[key] < 0, axis=1), key, lambda r, k=key: col[k][r].tolist(), "must be >= 0"))
+        for j in range(self.n_slosh):
+            get = {k: pb[:, lay.slosh_param(j, k)][:, 0] for k in ("m", "inertia", "zeta", "omega", "length")}
+            for key in ("m", "inertia", "zeta", "omega"):
+                checks.append((get[key] < 0, f"slosh[{j}].{key}", lambda r, k=key, g=get: g[k][r], "must be >= 0"))
+            checks.append(((get["m"] > 0) & (get["length"] <= 0), f"slosh[{j}].length",
+                           lambda r, g=get: g["length"][r], "an active pendulum (m > 0) needs a length > 0 m"))
+        bad = np.zeros(pb.shape[0], dtype=bool)
+        for mask, *_ in checks:
+            bad |= mask
+        if not bad.any():
+            return
+        r = int(np.argmax(bad))
+        mask, name, value, allowed = next(c for c in checks if c[0][r])
+        v = value(r)
+        v = float(v) if np.ndim(v) == 0 else v
+        raise ValueError(f"{'vehicle ' + str(r) + ': ' if pb.shape[0] > 1 else ''}{name} = {v!r}: {allowed}")
 
     def loads(self, *, f_b_i=(0.0, 0.0, 0.0), m_b_b=(0.0, 0.0, 0.0), thrust_b=(0.0, 0.0, 0.0),
               g_i=(0.0, 0.0, 0.0), f_eta=None) -> np.ndarray:

@@ -1,22 +1,26 @@
 """An on-disk cache of timelines: building one evaluates the mass model and the beam's modes at about a
 thousand times (a second or two); reading it back takes milliseconds.
 
-The key is a SHA-256 of the vehicle's whole content (its frozen dataclasses, pickled), the mass model's
+The key is a SHA-256 of the vehicle's whole content (its frozen dataclasses, pickled, without the name of
+the file it was read from: a copy of a file under another name hits the same entry), the mass model's
 CG convention, the timeline's arguments, whether layouts are padded, and the source files of the code that
-builds a timeline (the vehicle layer, the beam, the dynamics layout, this package's timeline), so an edited
-vehicle file or an edited mass model never reads a stale entry. The folder is ``$LVGYM_CACHE_DIR`` (default
+builds a timeline (the vehicle layer, the beam, the dynamics layout and parameter builder, the mode
+resampling at the aeroelastic strips, this package's timeline), so an edited vehicle file or an edited
+mass model never reads a stale entry. The folder is ``$LVGYM_CACHE_DIR`` (default
 ``~/.cache/lvgym``), its ``timelines/`` subfolder one ``.npz`` file per entry, written atomically; ``off``
 (or an unwritable folder) switches the cache off. A file that cannot be read is rebuilt.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import hashlib
 import os
 import pickle
 import tempfile
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
@@ -24,7 +28,7 @@ import numpy as np
 
 from lvgym import packing
 
-__all__ = ["cache_dir", "cached", "key"]
+__all__ = ["cache_dir", "cached", "key", "using"]
 
 _ARRAYS = ("t", "params", "hold", "thrust0", "exit_area", "mass", "cg", "inertia", "slosh_mass", "burning", "stage",
            "sensor_stations", "phi_sensor", "dphi_sensor", "strip_stations", "phi_strip", "dphi_strip", "mode_change_t",
@@ -39,13 +43,28 @@ def cache_dir() -> Path | None:
     return (Path(root) if root else Path.home() / ".cache" / "lvgym") / "timelines"
 
 
+@contextmanager
+def using(folder: str | os.PathLike[str]) -> Iterator[None]:
+    """``$LVGYM_CACHE_DIR`` set to ``folder`` (or ``"off"``) inside the block, as it was after it."""
+    old = os.environ.get("LVGYM_CACHE_DIR")
+    os.environ["LVGYM_CACHE_DIR"] = os.fspath(folder)
+    try:
+        yield
+    finally:
+        if old is None:
+            del os.environ["LVGYM_CACHE_DIR"]
+        else:
+            os.environ["LVGYM_CACHE_DIR"] = old
+
+
 @functools.lru_cache(maxsize=1)
 def _source_digest() -> str:
     """A digest of the source files that a timeline depends on."""
     import lvgym
     root = Path(lvgym.__file__).parent
-    files = sorted([*root.glob("vehicle/*.py"), root / "dynamics" / "layout.py", root / "packing.py",
-                    root / "simulator" / "timeline.py", Path(__file__)])
+    files = sorted([*root.glob("vehicle/*.py"), root / "dynamics" / "layout.py", root / "dynamics" / "model.py",
+                    root / "environment" / "aeroelastic.py", root / "packing.py", root / "simulator" / "timeline.py",
+                    Path(__file__)])
     h = hashlib.sha256()
     for f in files:
         h.update(f.name.encode())
@@ -56,7 +75,8 @@ def _source_digest() -> str:
 def key(mass_model: Any, args: tuple) -> str:
     """The cache key of a timeline of ``mass_model`` built with ``args``."""
     h = hashlib.sha256()
-    h.update(pickle.dumps((mass_model.vehicle, mass_model.cg_convention, args, packing.PADDING), protocol=4))
+    vehicle = dataclasses.replace(mass_model.vehicle, source=None)        # the content, not the file's name
+    h.update(pickle.dumps((vehicle, mass_model.cg_convention, args, packing.PADDING), protocol=4))
     h.update(_source_digest().encode())
     return h.hexdigest()[:40]
 

@@ -4,7 +4,9 @@ Propellant depletion and staging do not depend on the vehicle's motion (the engi
 throttle), so the dynamics parameters, the thrust and the mass properties are functions of time
 alone. :func:`build_timeline` evaluates :class:`~lvgym.vehicle.MassModel` and
 :class:`~lvgym.vehicle.structure.ModeSchedule` on a grid (every ``dt`` seconds, every breakpoint of a
-thrust table and both sides of every event) and :class:`Timeline` interpolates it linearly, so a step
+thrust table and both sides of every event), array-wise, one batch of rows per stretch between events
+(:meth:`~lvgym.vehicle.MassModel.history`; the same numbers, to the last bit, as evaluating the rows one at
+a time), and :class:`Timeline` interpolates it linearly, so a step
 costs a table look-up instead of a mass-model evaluation and a batch of vehicles at different times
 looks up its rows in one call. Event times are stored twice (the row before and the row after), and the
 simulator lands its steps on them, so nothing is interpolated across a separation.
@@ -39,7 +41,7 @@ from lvgym.dynamics import NonRigidModel
 from lvgym.environment.aeroelastic import resample_modes
 from lvgym.errors import check_choice, check_number
 from lvgym.vehicle import MassModel
-from lvgym.vehicle.massmodel import BURNING, SEPARATED
+from lvgym.vehicle.massmodel import BURNING, SEPARATED, MassState
 from lvgym.vehicle.structure import ModeSchedule, mode_transfer
 
 MODELS = ("rigid", "slosh", "flex", "nonrigid")
@@ -306,93 +308,119 @@ def build_timeline(mass_model: MassModel, model: str, t_end: float, dt: float = 
     N = mm.n_slosh if with_slosh else 0
     dyn = NonRigidModel(N, K)
     schedule = ModeSchedule(mm, n_modes=K, recompute_interval=mode_interval, sensor_stations=sensors) if K > 0 else None
-    projected = mode_basis == "projected"
-    changes: list[tuple[float, np.ndarray]] = []          # (time, transfer matrix) of each change of basis
-    last = None                                           # the modes of the previous row
     times, events = _grid(mm, t_end, dt)
-    event_times = {t for t, _ in events}
+    cols: dict[str, list] = {k: [] for k in ("t", "T0", "Ae", "burn", "stage", "modes", "m_b", "r_cg", "J_b",
+                                             "gimbal", "m", "cg", "J", "ms", "L", "hinge", "zeta")}
+    for row_t, state in _pieces(mm, times, {t for t, _ in events}):
+        props = mm.properties(state)
+        T0 = mm.thrust(state, 1.0, 0.0)
+        attached = [si for si, ph in enumerate(state.phase) if ph != SEPARATED]
+        b = row_t.size
+        cols["t"].append(row_t)
+        cols["T0"].append(T0)
+        cols["Ae"].append(np.full(b, float(sum(em.engine.nozzle_exit_area
+                                               for (_, em), on in zip(mm.engines, state.engine_on) if on))))
+        cols["burn"].append((BURNING in state.phase) & (T0 > 0.0))
+        cols["stage"].append(np.full(b, min(attached) if attached else len(state.phase) - 1))
+        cols["modes"] += schedule.modes_rows(state, props) if schedule is not None else [None] * b
+        for key, name in (("m_b", "m_b"), ("r_cg", "r_cg_b"), ("J_b", "J_b")) if with_slosh else \
+                (("m_b", "mass"), ("r_cg", "cg"), ("J_b", "inertia")):
+            cols[key].append(getattr(props, name))
+        for key, name in (("gimbal", "gimbal"), ("m", "mass"), ("cg", "cg"), ("J", "inertia"), ("ms", "slosh_mass"),
+                          ("L", "pendulum_length"), ("hinge", "hinge"), ("zeta", "slosh_damping")):
+            cols[key].append(getattr(props, name))
+    modes_rows = cols.pop("modes")
+    c = {k: np.concatenate(v) for k, v in cols.items()}
+    n = c["t"].size
+    md = _mode_rows(modes_rows, K, N, sensors.size, strips, c["stage"], mode_cutoff_hz, mode_basis == "projected",
+                    c["t"])
+    m_s, L = c["ms"][:, :N], c["L"][:, :N]
+    live = (m_s > 0) & (L > 0)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        omega_s = np.where(live, np.sqrt((c["T0"] / c["m"])[:, None] / L), 0.0)
+    slosh = [{"m": m_s[:, j], "length": np.where(m_s[:, j] > 0, L[:, j], 0.0), "r_hinge": c["hinge"][:, j],
+              "zeta": c["zeta"][:, j], "omega": omega_s[:, j], "phi": md["phi_hinge"][:, j]} for j in range(N)]
+    p = dyn.params(m_b=c["m_b"], J_b=c["J_b"], r_cg=c["r_cg"], r_gimbal=c["gimbal"], omega_modes=md["omega"],
+                   zeta_modes=md["zeta"], phi_gimbal=md["phi_gimbal"], dphi_gimbal=md["dphi_gimbal"], slosh=slosh)
     lay = dyn.layout
-    rows: dict[str, list] = {k: [] for k in ("t", "p", "T0", "Ae", "m", "cg", "J", "ms", "burn", "stage", "phi",
-                                                 "dphi", "phi_strip", "dphi_strip")}
-    state = mm.initial_state()
-    for t in times:
-        samples = []
-        if t in event_times and t > 0.0:
-            pre, _ = mm.advance(state, t - _TINY * max(1.0, t))
-            samples.append((t, pre))
-        state, _ = mm.advance(state, t)
-        samples.append((t, state))
-        for tt, s in samples:
-            props = mm.properties(s)
-            on = [(si, em) for (si, em), o in zip(mm.engines, s.engine_on) if o]
-            T0 = mm.thrust(s, 1.0, 0.0)
-            Ae = sum(em.engine.nozzle_exit_area for _, em in on)
-            if with_slosh:
-                m_b, cg, J = props.m_b, props.r_cg_b, props.J_b
-            else:
-                m_b, cg, J = props.mass, props.cg, props.inertia
-            modes = schedule.modes(s, props) if schedule is not None else None
-            attached = [si for si, ph in enumerate(s.phase) if ph != SEPARATED]
-            lowest = min(attached) if attached else len(s.phase) - 1
-            if modes is not None and strips.shape[1]:
-                beam, keep = modes.beam, _kept(modes, mode_cutoff_hz)
-                on_strips = resample_modes(strips[lowest], beam.node_stations, beam.phi_nodes.T, beam.dphi_nodes.T)
-                rows["phi_strip"].append(on_strips[0] * keep[:, None])
-                rows["dphi_strip"].append(on_strips[1] * keep[:, None])
-            else:
-                rows["phi_strip"].append(np.zeros((K, strips.shape[1])))
-                rows["dphi_strip"].append(np.zeros((K, strips.shape[1])))
-            if projected and modes is not None:
-                if last is not None and modes is not last:
-                    T = mode_transfer(last, modes) * (modes.omega <= 2.0 * np.pi * mode_cutoff_hz)[:, None]
-                    if changes and changes[-1][0] == tt:          # two changes at one time: one matrix
-                        T = T @ changes.pop()[1]
-                    changes.append((tt, T))
-                last = modes
-            if modes is not None:
-                modes = _cut(modes, mode_cutoff_hz)
-            slosh = []
-            for j in range(N):
-                m_s, L = props.slosh_mass[j], props.pendulum_length[j]
-                accel = T0 / props.mass
-                slosh.append({"m": m_s, "length": L if m_s > 0 else 0.0, "r_hinge": props.hinge[j],
-                              "zeta": props.slosh_damping[j],
-                              "omega": np.sqrt(accel / L) if (m_s > 0 and L > 0) else 0.0,
-                              "phi": modes.phi_hinge[j] if modes is not None else np.zeros(0)})
-            p = dyn.params(m_b=m_b, J_b=J, r_cg=cg, r_gimbal=props.gimbal,
-                           omega_modes=modes.omega if modes is not None else (),
-                           zeta_modes=modes.zeta if modes is not None else (),
-                           phi_gimbal=modes.phi_gimbal if modes is not None else (),
-                           dphi_gimbal=modes.dphi_gimbal if modes is not None else (), slosh=slosh)
-            rows["t"].append(tt)
-            rows["p"].append(p)
-            rows["T0"].append(T0)
-            rows["Ae"].append(Ae)
-            rows["m"].append(props.mass)
-            rows["cg"].append(props.cg)
-            rows["J"].append(props.inertia)
-            rows["ms"].append(props.slosh_mass)
-            rows["burn"].append(any(ph == BURNING for ph in s.phase) and T0 > 0.0)
-            rows["stage"].append(lowest)
-            for key, name in (("phi", "phi_sensor"), ("dphi", "dphi_sensor")):
-                rows[key].append(getattr(modes, name) if modes is not None and sensors.size
-                                 else np.zeros((sensors.size, K)))
     hold = np.zeros(lay.n_p, dtype=bool)
     for key in ("omega_modes", "zeta_modes", "phi_gimbal", "dphi_gimbal"):
         hold[lay.params[key]] = True
     for j in range(N):
         hold[lay.slosh_param(j, "phi")] = True
-    return Timeline(model=model, dynamics=dyn, t=np.array(rows["t"]), params=np.array(rows["p"]), hold=hold,
-                    thrust0=np.array(rows["T0"]), exit_area=np.array(rows["Ae"]), mass=np.array(rows["m"]),
-                    cg=np.array(rows["cg"]), inertia=np.array(rows["J"]), slosh_mass=np.array(rows["ms"]),
-                    burning=np.array(rows["burn"]), stage=np.array(rows["stage"]),
+    changes = md["changes"]
+    return Timeline(model=model, dynamics=dyn, t=c["t"], params=p, hold=hold, thrust0=c["T0"], exit_area=c["Ae"],
+                    mass=c["m"], cg=c["cg"], inertia=c["J"], slosh_mass=c["ms"], burning=c["burn"], stage=c["stage"],
                     stage_names=tuple(s.name for s in vehicle.stages), slosh_names=mm.slosh_names,
-                    sensor_stations=sensors,
-                    phi_sensor=np.array(rows["phi"]).reshape(len(rows["t"]), sensors.size, K),
-                    dphi_sensor=np.array(rows["dphi"]).reshape(len(rows["t"]), sensors.size, K),
-                    strip_stations=strips, phi_strip=np.array(rows["phi_strip"]).reshape(len(rows["t"]), K, strips.shape[1]),
-                    dphi_strip=np.array(rows["dphi_strip"]).reshape(len(rows["t"]), K, strips.shape[1]),
+                    sensor_stations=sensors, phi_sensor=md["phi_sensor"].reshape(n, sensors.size, K),
+                    dphi_sensor=md["dphi_sensor"].reshape(n, sensors.size, K), strip_stations=strips,
+                    phi_strip=md["phi_strip"], dphi_strip=md["dphi_strip"],
                     events=tuple((float(t), e) for t, e in events),
                     mode_change_t=np.array([t for t, _ in changes], dtype=float),
                     mode_transfer=np.array([T for _, T in changes], dtype=float).reshape(len(changes), K, K),
                     mode_interval=mode_interval, mode_basis=mode_basis)
+
+
+def _pieces(mm: MassModel, times: list[float], event_times: set[float]) -> list[tuple[np.ndarray, MassState]]:
+    """The rows of the timeline as ``(row times (b,) [s], batched mass state)`` pieces, one per stretch
+    between events: every grid time, and before each event time > 0 also the state a moment before it
+    (``_TINY`` of the time earlier, advanced from the grid time before; stored at the event's time)."""
+    stretches, _ = mm.history(times)
+    pieces = []
+    for k, s in enumerate(stretches):
+        row_t = s.t
+        te = float(stretches[k + 1].t[0]) if k + 1 < len(stretches) else None
+        if te is not None and te in event_times and te > 0.0:
+            pre, _ = mm.advance(s.row(-1), te - _TINY * max(1.0, te))
+            row_t = np.append(s.t, te)
+            s = replace(s, t=np.append(s.t, pre.t), tank_mass=np.vstack([s.tank_mass, pre.tank_mass]),
+                        grain_mass=np.vstack([s.grain_mass, pre.grain_mass]))
+        pieces.append((row_t, s))
+    return pieces
+
+
+def _mode_rows(modes_rows: list, K: int, N: int, S: int, strips: np.ndarray, stage: np.ndarray, cutoff_hz: float,
+               projected: bool, t: np.ndarray) -> dict[str, np.ndarray]:
+    """The mode columns of the rows (each row's :class:`~lvgym.vehicle.structure.VehicleModes` or None):
+    frequencies, damping, shapes and slopes at the gimbal, hinges (n, N, K) and sensors (n, S, K) with the
+    modes above ``cutoff_hz`` decoupled, at the strips of each row's lowest attached ``stage`` (n, K,
+    n_strip), and the changes of basis ``[(time, transfer matrix)]`` (``projected``; several changes at
+    one time multiplied into one)."""
+    n, n_strip = len(modes_rows), strips.shape[1]
+    out = {"omega": np.zeros((n, K)), "zeta": np.zeros((n, K)), "phi_gimbal": np.zeros((n, K)),
+           "dphi_gimbal": np.zeros((n, K)), "phi_hinge": np.zeros((n, N, K)), "phi_sensor": np.zeros((n, S, K)),
+           "dphi_sensor": np.zeros((n, S, K)), "phi_strip": np.zeros((n, K, n_strip)),
+           "dphi_strip": np.zeros((n, K, n_strip)), "changes": []}
+    if K == 0:
+        return out
+    cut: dict[int, tuple] = {}                          # id of the modes: (modes, its decoupled version)
+    on_strips: dict[tuple[int, int], tuple[np.ndarray, np.ndarray]] = {}
+    changes: list[tuple[float, np.ndarray]] = []
+    last = None
+    for i, modes in enumerate(modes_rows):
+        if id(modes) not in cut:
+            cut[id(modes)] = (modes, _cut(modes, cutoff_hz))
+        if projected and last is not None and modes is not last:
+            T = mode_transfer(last, modes) * _kept(modes, cutoff_hz)[:, None]
+            if changes and changes[-1][0] == t[i]:          # two changes at one time: one matrix
+                T = T @ changes.pop()[1]
+            changes.append((float(t[i]), T))
+        last = modes
+        if n_strip and (id(modes), int(stage[i])) not in on_strips:
+            beam, keep = modes.beam, _kept(modes, cutoff_hz)
+            phi, dphi = resample_modes(strips[int(stage[i])], beam.node_stations, beam.phi_nodes.T, beam.dphi_nodes.T)
+            on_strips[id(modes), int(stage[i])] = (phi * keep[:, None], dphi * keep[:, None])
+    which = {key: u for u, key in enumerate(cut)}
+    index = np.array([which[id(m)] for m in modes_rows])
+    unique = [c for _, c in cut.values()]
+    for key in ("omega", "zeta", "phi_gimbal", "dphi_gimbal", "phi_sensor", "dphi_sensor"):
+        out[key] = np.array([getattr(m, key) for m in unique]).reshape((len(unique),) + out[key].shape[1:])[index]
+    out["phi_hinge"] = np.array([m.phi_hinge[:N] for m in unique]).reshape(len(unique), N, K)[index]
+    if n_strip:
+        keys = list(on_strips)
+        pair = {k: u for u, k in enumerate(keys)}
+        at = np.array([pair[id(m), int(s)] for m, s in zip(modes_rows, stage)])
+        out["phi_strip"] = np.array([on_strips[k][0] for k in keys])[at]
+        out["dphi_strip"] = np.array([on_strips[k][1] for k in keys])[at]
+    out["changes"] = changes
+    return out

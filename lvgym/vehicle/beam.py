@@ -39,13 +39,14 @@ prints the comparison with the thesis's hollow aluminium beams (Tables 6.4 and 6
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
 from scipy.linalg import eigh, null_space
-from threadpoolctl import threadpool_limits
+from threadpoolctl import ThreadpoolController
 
 from lvgym.errors import ConfigError
 
@@ -54,6 +55,18 @@ from .sections import (MATERIALS, BeamMesh, DistributedMass, Material, PointMass
 
 __all__ = ["PointMass", "Section", "DistributedMass", "BeamModes", "BeamMesh", "modes", "assemble",
            "mesh_stack", "stack_modes", "transfer", "thesis_comparison", "thesis_comparison_markdown"]
+
+
+@functools.lru_cache(maxsize=1)
+def _blas() -> ThreadpoolController:
+    """The loaded BLAS libraries, found once (finding them reads every loaded library: 1-3 ms a time; the
+    BLAS that numpy and scipy use is loaded when this module imports scipy.linalg)."""
+    return ThreadpoolController()
+
+
+def one_blas_thread():
+    """A context in which BLAS runs on one thread (reproducible sums, see the module docstring)."""
+    return _blas().limit(limits=1, user_api="blas")
 
 
 def _hermite(xi: np.ndarray, h: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -107,17 +120,22 @@ def _assemble_sorted(x: np.ndarray, ei: np.ndarray, mpl: np.ndarray, pm: np.ndar
                    [54 * o, 13 * h, 156 * o, -22 * h], [-13 * h, -3 * h * h, -22 * h, 4 * h * h]])
     ke = np.moveaxis(kb, -1, 0) * (ei / h**3)[:, None, None]         # (n_el, 4, 4)
     me = np.moveaxis(mb, -1, 0) * (mpl * h / 420.0)[:, None, None]
-    dofs = 2 * np.arange(h.size)[:, None] + np.arange(4)             # (n_el, 4)
-    rows, cols = np.broadcast_arrays(dofs[:, :, None], dofs[:, None, :])
     K = np.zeros((n_dof, n_dof))
     M = np.zeros((n_dof, n_dof))
-    np.add.at(K, (rows, cols), ke)
-    np.add.at(M, (rows, cols), me)
-    for station, mass, inertia in pm:
-        e = min(int(np.searchsorted(x, station, side="right")) - 1, h.size - 1)
-        N, dN = _hermite(np.array((station - x[e]) / h[e]), np.array(h[e]))
-        idx = np.ix_(2 * e + np.arange(4), 2 * e + np.arange(4))
-        M[idx] += mass * np.outer(N, N) + inertia * np.outer(dN, dN)
+    # even elements, then odd ones: no two elements of a pass share a DOF, and an entry has at most two
+    # terms (one per element), which add to the same sum in either order
+    for first in (0, 1):
+        e = np.arange(first, h.size, 2)
+        d = 2 * e[:, None] + np.arange(4)                              # (elements, 4)
+        K[d[:, :, None], d[:, None, :]] += ke[e]
+        M[d[:, :, None], d[:, None, :]] += me[e]
+    if pm.size:                                  # point masses, in turn (several may share an element)
+        e = np.minimum(np.searchsorted(x, pm[:, 0], side="right") - 1, h.size - 1)
+        N, dN = _hermite((pm[:, 0] - x[e]) / h[e], h[e])              # (P, 4)
+        add = (pm[:, 1, None, None] * (N[:, :, None] * N[:, None, :])
+               + pm[:, 2, None, None] * (dN[:, :, None] * dN[:, None, :]))
+        d = 2 * e[:, None] + np.arange(4)
+        np.add.at(M, (d[:, :, None], d[:, None, :]), add)
     return K, M
 
 
@@ -198,7 +216,7 @@ def modes(stations, EI, mass_per_length, *, point_masses: Sequence = (), n_modes
           query_stations=()) -> BeamModes:
     """First ``n_modes`` elastic free-free bending modes of a beam (see :func:`_modes`), computed on one
     BLAS thread so that they do not depend on the machine's thread count."""
-    with threadpool_limits(limits=1, user_api="blas"):
+    with one_blas_thread():
         return _modes(stations, EI, mass_per_length, point_masses=point_masses, n_modes=n_modes,
                       query_stations=query_stations)
 
@@ -245,7 +263,8 @@ def _modes(stations, EI, mass_per_length, *, point_masses: Sequence = (), n_mode
         # the flexibility form M y = (1 / omega^2) K y: its largest eigenvalues are the lowest modes,
         # found to a relative accuracy eps * omega_k^2 / omega_1^2 instead of eps * omega_max^2 / omega_k^2
         n_r = n_dof - 2
-        mu, y = eigh(0.5 * (Mr + Mr.T), 0.5 * (Kr + Kr.T), subset_by_index=[n_r - n_modes, n_r - 1])
+        mu, y = eigh(0.5 * (Mr + Mr.T), 0.5 * (Kr + Kr.T), subset_by_index=[n_r - n_modes, n_r - 1],
+                     overwrite_a=True, overwrite_b=True, check_finite=False)       # K, M checked finite
         mu, y = mu[::-1], y[:, ::-1]
         q = T @ (y / np.sqrt(np.einsum("ik,ij,jk->k", y, Mr, y)))        # q^T M q = 1
         tip = q[-2]
@@ -287,7 +306,7 @@ def transfer(old: BeamModes, new: BeamModes) -> np.ndarray:
     the new beam, or lies outside its first K_new modes, is dropped (the modal truncation). For
     ``old is new`` (or equal beams) ``T`` is the identity to rounding."""
     x = np.clip(new._x, old._x[0], old._x[-1])
-    with threadpool_limits(limits=1, user_api="blas"):          # reproducible sums, as :func:`modes`
+    with one_blas_thread():          # reproducible sums, as :func:`modes`
         w, theta = _interpolate(old._x, old._q, x)              # (n_new, K_old) each
         q_old = np.empty((2 * x.size, old.n_modes))
         q_old[0::2], q_old[1::2] = w, theta

@@ -12,6 +12,11 @@
   rigid-equivalent stack (slosh masses frozen at rest into B) with exactly the same mass, CG and inertia,
   for the rigid model. Inertias are combined with the parallel-axis theorem (thesis eq. 4.10).
 
+:meth:`MassModel.history` gives the states at many times at once, one batched :class:`MassState` per stretch
+between events (a leading axis on its time and propellant), and :meth:`MassModel.properties`,
+:meth:`~MassModel.thrust` and :meth:`~MassModel.mass_flow` evaluate such a batch with the same equations
+array-wise: that is how the simulator's timeline tabulates a flight in one pass.
+
 The flow of an engine stops when any tank (or grain) feeding it is empty; the throttle scales it. A stage
 separates ``separation_delay`` after its burnout; the next stage ignites ``ignition_delay`` after that.
 The first stage ignites at lift-off, t = 0.
@@ -19,7 +24,7 @@ The first stage ignites at lift-off, t = 0.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, fields, replace
 
 import numpy as np
 
@@ -35,7 +40,11 @@ class MassState:
     """Time-varying part of the mass model. ``tank_mass`` [kg] per tank (``Vehicle.tanks`` order),
     ``grain_mass`` [kg] per stage (0 without a grain), ``phase`` per stage, ``ignition`` and
     ``burnout`` times per stage [s] (nan until they happen), ``engine_on`` per engine of the vehicle,
-    ``fairing`` attached or not."""
+    ``fairing`` attached or not.
+
+    A batch of B states that share their phases, ignitions, burnouts, engines and fairing (a stretch
+    between events, :meth:`MassModel.history`) has ``t`` (B,), ``tank_mass`` (B, n_tanks) and
+    ``grain_mass`` (B, n_stages)."""
 
     t: float
     tank_mass: np.ndarray
@@ -45,6 +54,16 @@ class MassState:
     burnout: np.ndarray
     engine_on: tuple[bool, ...]
     fairing: bool
+
+    def row(self, i: int) -> MassState:
+        """State ``i`` of a batch."""
+        return replace(self, t=float(self.t[i]), tank_mass=self.tank_mass[i].copy(),
+                       grain_mass=self.grain_mass[i].copy())
+
+    def batched(self) -> MassState:
+        """This state as a batch of one."""
+        return replace(self, t=np.array([self.t], dtype=float), tank_mass=self.tank_mass[None],
+                       grain_mass=self.grain_mass[None])
 
 
 @dataclass(frozen=True)
@@ -57,7 +76,8 @@ class MassProperties:
     ``hinge`` stations (N, 3), ``slosh_rest`` stations of the masses at rest (N, 3),
     ``slosh_damping`` ratios. Rigid-equivalent stack: ``mass`` [kg], ``cg`` (3,), ``inertia`` (3, 3)
     about ``cg``. ``gimbal``: thrust-weighted gimbal station of the burning engines (the lowest attached
-    engine's when none burns); ``mass_flow`` [kg/s]; ``tanks`` per tank (None once separated)."""
+    engine's when none burns); ``mass_flow`` [kg/s]; ``tanks`` per tank (None once separated).
+    Those of a batched state carry its leading axis B on every array and have arrays (B,) for floats."""
 
     t: float
     m_b: float
@@ -77,19 +97,41 @@ class MassProperties:
     stages: tuple[str, ...]
     tanks: tuple[TankProperties | None, ...]
 
+    def row(self, i: int) -> MassProperties:
+        """Instant ``i`` of a batch."""
+        out = {f.name: getattr(self, f.name) for f in fields(self)}
+        for name in ("t", "m_b", "mass", "mass_flow"):
+            out[name] = float(out[name][i])
+        for name in ("r_cg_b", "J_b", "slosh_mass", "pendulum_length", "hinge", "slosh_rest", "slosh_damping",
+                     "cg", "inertia", "gimbal"):
+            out[name] = out[name][i].copy()
+        out["tanks"] = tuple(None if tp is None else tp.row(i) for tp in self.tanks)
+        return MassProperties(**out)
 
-def combine(parts: list[tuple[float, np.ndarray, np.ndarray]]) -> tuple[float, np.ndarray, np.ndarray]:
+
+def combine(parts: list[tuple]) -> tuple:
     """Mass [kg], CG (3,) and inertia about the CG (3, 3) of parts ``(m, cg, J_about_own_cg)``
-    (parallel-axis theorem, thesis eq. 4.10: ``J + m (|r|^2 I - r r^T)``)."""
-    m = sum(p[0] for p in parts)
-    if m <= 0.0:
-        return 0.0, np.zeros(3), np.zeros((3, 3))
-    cg = sum(p[0] * p[1] for p in parts) / m
-    J = np.zeros((3, 3))
+    (parallel-axis theorem, thesis eq. 4.10: ``J + m (|r|^2 I - r r^T)``). Any part may carry a leading
+    batch axis B (``m`` (B,), ``cg`` (B, 3), ``J`` (B, 3, 3)); the result then does too."""
+    m = 0.0
+    for mi, _, _ in parts:
+        m = m + np.asarray(mi, dtype=float)
+    m = np.asarray(m)
+    some = m > 0.0
+    first = 0.0
+    for mi, ci, _ in parts:
+        first = first + np.asarray(mi, dtype=float)[..., None] * np.asarray(ci, dtype=float)
+    cg = first / np.where(some, m, 1.0)[..., None]
+    J = 0.0
+    eye = np.eye(3)
     for mi, ci, Ji in parts:
         r = ci - cg
-        J += Ji + mi * (r @ r * np.eye(3) - np.outer(r, r))
-    return m, cg, J
+        rr = r[..., 0] * r[..., 0] + r[..., 1] * r[..., 1] + r[..., 2] * r[..., 2]
+        J = J + (Ji + np.asarray(mi, dtype=float)[..., None, None] * (rr[..., None, None] * eye
+                                                                      - r[..., :, None] * r[..., None, :]))
+    cg = np.where(some[..., None], cg, 0.0) + np.zeros(m.shape + (3,))
+    J = np.where(some[..., None, None], J, 0.0) + np.zeros(m.shape + (3, 3))
+    return (float(m) if m.ndim == 0 else m), cg, J
 
 
 class MassModel:
@@ -174,33 +216,73 @@ class MassModel:
     def advance(self, state: MassState, t1: float, throttle: float = 1.0) -> tuple[MassState, list[tuple[float, str]]]:
         """Advance to time ``t1`` [s] at constant ``throttle``; returns the new state and the events
         ``(time, description)`` that happened in ``(state.t, t1]``, in order."""
+        stretches, events = self._walk(state, np.array([float(t1)]), throttle)
+        end = stretches[-1].row(-1)
+        return (end if end.t >= state.t else replace(end, t=state.t)), events
+
+    def history(self, times, throttle: float = 1.0, state: MassState | None = None
+                ) -> tuple[list[MassState], list[tuple[float, str]]]:
+        """The states at the ascending ``times`` [s] from ``state`` (default: lift-off) at constant
+        ``throttle``, exactly as :meth:`advance` through one time after the other would give them: one
+        batched :class:`MassState` per stretch between events (a time equal to an event's comes after it),
+        and the events ``(time, description)`` on the way, in order."""
+        stretches, events = self._walk(self.initial_state() if state is None else state,
+                                       np.asarray(times, dtype=float).reshape(-1), throttle)
+        return [s for s in stretches if s.t.size], events
+
+    def _walk(self, state: MassState, times: np.ndarray, throttle: float
+              ) -> tuple[list[MassState], list[tuple[float, str]]]:
+        """The stretches of :meth:`history` (the last one ends at ``times[-1]``) and the events."""
+        stretches: list[MassState] = []
         events: list[tuple[float, str]] = []
+        i, n = 0, times.size
         while True:
             t_event = self.next_event(state, throttle)
-            t_to = min(t_event, t1)
-            state = self._consume(state, t_to, throttle)
-            if t_event > t1:
-                return state, events
+            j = max(int(np.searchsorted(times, t_event, side="left")), i)      # times[i:j] come before it
+            last = j >= n
+            stops = times[i:j] if last else np.append(times[i:j], t_event)
+            tanks, grains = self._consume(state, stops, throttle)
+            stretches.append(replace(state, t=times[i:j].copy(), tank_mass=tanks[:j - i], grain_mass=grains[:j - i]))
+            if last:
+                return stretches, events
+            state = replace(state, t=float(t_event), tank_mass=tanks[-1].copy(), grain_mass=grains[-1].copy())
             state, happened = self._apply_events(state, throttle)
             if not happened:  # next_event promised an event that _apply_events does not see: a bug
                 raise RuntimeError(f"mass model stalled at t = {state.t!r} s (no event at the predicted time)")
             events += [(state.t, e) for e in happened]
+            i = j
 
-    def _consume(self, state: MassState, t_to: float, throttle: float) -> MassState:
-        if t_to <= state.t:
-            return state
-        tanks, grains = state.tank_mass.copy(), state.grain_mass.copy()
+    def _consume(self, state: MassState, stops: np.ndarray, throttle: float) -> tuple[np.ndarray, np.ndarray]:
+        """Propellant left in the tanks (m, n_tanks) and grains (m, n_stages) [kg] at the ascending times
+        ``stops`` (m,) [s] with the engines of ``state``: each stop's from the one before (the first from
+        ``state``), every burning engine's use taken from its stores in turn. A stop not after the one
+        before changes nothing; the rounding residue of an emptied store (1e-15 kg after split steps) is
+        no propellant."""
+        prev = np.concatenate([[state.t], stops[:-1]])
+        moved = stops > prev
+        taken: dict[tuple[str, int], list[np.ndarray]] = {}
         for j, on in enumerate(state.engine_on):
-            if not on:
-                continue
-            si, em = self.engines[j]
-            used = em.consumed(state.t - state.ignition[si], t_to - state.ignition[si], throttle)
-            for kind, index, frac in self._feeds[j]:
-                store = tanks if kind == "tank" else grains
-                left = store[index] - frac * used
-                # rounding residue of an emptied store (1e-15 kg after split steps) is no propellant
-                store[index] = left if left > 1e-9 * max(store[index], 1.0) else 0.0
-        return replace(state, t=t_to, tank_mass=tanks, grain_mass=grains)
+            if on:
+                si, em = self.engines[j]
+                tau0, tau1 = prev - state.ignition[si], stops - state.ignition[si]
+                used = np.where(moved, em.consumed(tau0, tau1, throttle), 0.0)
+                for kind, index, frac in self._feeds[j]:
+                    taken.setdefault((kind, index), []).append(frac * used)
+        out = {"tank": np.repeat(state.tank_mass[None], stops.size, axis=0),
+               "grain": np.repeat(state.grain_mass[None], stops.size, axis=0)}
+        for (kind, index), parts in taken.items():
+            start = (state.tank_mass if kind == "tank" else state.grain_mass)[index]
+            steps = np.stack(parts, axis=1).ravel()                   # stop by stop, engine by engine
+            live = np.repeat(moved, len(parts))
+            left = np.subtract.accumulate(np.concatenate([[start], steps]))
+            while True:                             # an emptied store: zero, and the rest from zero
+                gone = live & (left[1:] != 0.0) & ~(left[1:] > 1e-9 * np.maximum(left[:-1], 1.0))
+                if not gone.any():
+                    break
+                k = int(np.argmax(gone)) + 1
+                left[k:] = np.subtract.accumulate(np.concatenate([[0.0], steps[k:]]))
+            out[kind][:, index] = left[len(parts)::len(parts)]
+        return out["tank"], out["grain"]
 
     def _apply_events(self, state: MassState, throttle: float) -> tuple[MassState, list[str]]:
         v, t, tol = self.vehicle, state.t, 1e-9 * max(1.0, state.t)
@@ -234,21 +316,31 @@ class MassModel:
                        engine_on=tuple(engine_on), fairing=fairing), happened
 
     # -- properties -----------------------------------------------------------------------------
-    def mass_flow(self, state: MassState, throttle: float = 1.0) -> float:
-        """Total propellant flow of the burning engines [kg/s]."""
-        return sum(em.mass_flow(state.t - state.ignition[si], throttle)
-                   for (si, em), on in zip(self.engines, state.engine_on) if on)
+    def _sum_engines(self, state: MassState, value) -> np.ndarray | float:
+        """Sum over the burning engines of ``value(engine_model, tau)`` (``tau`` the time since the
+        engine's stage ignited [s]), a float for a state and (B,) for a batch."""
+        total = np.zeros(np.shape(state.t))
+        for (si, em), on in zip(self.engines, state.engine_on):
+            if on:
+                total = total + value(em, state.t - state.ignition[si])
+        return total[()]
 
-    def thrust(self, state: MassState, throttle: float = 1.0, p_ambient: float = 0.0) -> float:
+    def mass_flow(self, state: MassState, throttle: float = 1.0):
+        """Total propellant flow of the burning engines [kg/s]."""
+        return self._sum_engines(state, lambda em, tau: em.mass_flow(tau, throttle))
+
+    def thrust(self, state: MassState, throttle: float = 1.0, p_ambient: float = 0.0):
         """Total thrust magnitude of the burning engines [N] at ambient pressure ``p_ambient`` [Pa]."""
-        return sum(em.thrust(state.t - state.ignition[si], throttle, p_ambient)
-                   for (si, em), on in zip(self.engines, state.engine_on) if on)
+        return self._sum_engines(state, lambda em, tau: em.thrust(tau, throttle, p_ambient))
 
     def properties(self, state: MassState, throttle: float = 1.0) -> MassProperties:
-        """Mass properties of the stack in ``state`` (see :class:`MassProperties`)."""
-        v = self.vehicle
+        """Mass properties of the stack in ``state`` (see :class:`MassProperties`; a batched state gives
+        them with its leading axis)."""
+        if np.ndim(state.t) == 0:
+            return self.properties(state.batched(), throttle).row(0)
+        v, B = self.vehicle, state.t.size
         attached = [si for si, ph in enumerate(state.phase) if ph != SEPARATED]
-        parts: list[tuple[float, np.ndarray, np.ndarray]] = []
+        parts: list[tuple] = []
         tank_props: list[TankProperties | None] = []
         for si in attached:
             stage = v.stages[si]
@@ -256,44 +348,59 @@ class MassModel:
             parts.append((s.mass, s.cg, s.inertia))
             parts += [(e.part.mass, e.part.cg, e.part.inertia) for e in stage.engines]
             if stage.grain is not None:
-                m, x, J = grain_properties(stage.grain, state.grain_mass[si])
+                m, x, J = grain_properties(stage.grain, state.grain_mass[:, si])
                 parts.append((m, np.array([x, 0.0, 0.0]), J))
         for k, tank in enumerate(self.tanks):
             if state.phase[self.tank_stage[k]] == SEPARATED:
                 tank_props.append(None)
                 continue
-            tp = tank_properties(tank, state.tank_mass[k], self.cg_convention)
+            tp = tank_properties(tank, state.tank_mass[:, k], self.cg_convention)
             tank_props.append(tp)
-            parts.append((tp.fixed_mass, np.array([tp.fixed_cg, 0.0, 0.0]), tp.fixed_inertia))
+            parts.append((tp.fixed_mass, _on_axis(tp.fixed_cg), tp.fixed_inertia))
         for part, on in ((v.payload, True), (v.fairing, state.fairing)):
             if part is not None and on:
                 parts.append((part.mass, part.cg, part.inertia))
         m_b, r_cg_b, J_b = combine(parts)
+        m_b = np.broadcast_to(m_b, (B,))
         n = self.n_slosh
-        m_s, L, zeta = np.zeros(n), np.zeros(n), np.zeros(n)
-        hinge, rest = np.zeros((n, 3)), np.zeros((n, 3))
+        m_s, L = np.zeros((B, n)), np.zeros((B, n))
+        zeta = np.tile([self.tanks[k].slosh_damping for k in self.slosh_tanks], (B, 1)).reshape(B, n)
+        hinge, rest = np.zeros((B, n, 3)), np.zeros((B, n, 3))
         for j, k in enumerate(self.slosh_tanks):
             tp = tank_props[k]
-            zeta[j] = self.tanks[k].slosh_damping
             if tp is None:
-                hinge[j, 0] = rest[j, 0] = r_cg_b[0]
+                hinge[:, j, 0] = rest[:, j, 0] = r_cg_b[:, 0]
                 continue
-            m_s[j], L[j] = tp.slosh_mass, tp.pendulum_length
-            hinge[j, 0], rest[j, 0] = tp.hinge_station, tp.slosh_station
-        mass, cg, inertia = combine(parts + [(m_s[j], rest[j], np.zeros((3, 3))) for j in range(n)])
+            m_s[:, j], L[:, j] = tp.slosh_mass, tp.pendulum_length
+            hinge[:, j, 0], rest[:, j, 0] = tp.hinge_station, tp.slosh_station
+        mass, cg, inertia = combine(parts + [(m_s[:, j], rest[:, j], np.zeros((3, 3))) for j in range(n)])
         return MassProperties(t=state.t, m_b=m_b, r_cg_b=r_cg_b, J_b=J_b, slosh_names=self.slosh_names,
                               slosh_mass=m_s, pendulum_length=L, hinge=hinge, slosh_rest=rest, slosh_damping=zeta,
-                              mass=mass, cg=cg, inertia=inertia, gimbal=self._gimbal(state, attached, throttle),
-                              mass_flow=self.mass_flow(state, throttle),
+                              mass=np.broadcast_to(mass, (B,)), cg=cg, inertia=inertia,
+                              gimbal=self._gimbal(state, attached, throttle),
+                              mass_flow=np.broadcast_to(self.mass_flow(state, throttle), (B,)),
                               stages=tuple(v.stages[si].name for si in attached), tanks=tuple(tank_props))
 
     def _gimbal(self, state: MassState, attached: list[int], throttle: float) -> np.ndarray:
+        """Thrust-weighted gimbal station (B, 3) of the burning engines of a batched state, else the lowest
+        attached engine's."""
         weights, points = [], []
         for (si, em), on in zip(self.engines, state.engine_on):
             if on:
-                weights.append(max(em.thrust(state.t - state.ignition[si], throttle), 1e-12))
+                weights.append(np.maximum(em.thrust(state.t - state.ignition[si], throttle), 1e-12))
                 points.append(em.engine.gimbal)
-        if weights:
-            return np.average(points, axis=0, weights=weights)
+        if weights:                                      # as np.average: sum(w p) / sum(w)
+            total, scale = 0.0, 0.0
+            for w, g in zip(weights, points):
+                total, scale = total + g * w[:, None], scale + w
+            return total / scale[:, None]
         candidates = [em.engine.gimbal for si, em in self.engines if si in attached]
-        return min(candidates, key=lambda g: g[0]) if candidates else np.zeros(3)
+        g = min(candidates, key=lambda g: g[0]) if candidates else np.zeros(3)
+        return np.tile(g, (state.t.size, 1))
+
+
+def _on_axis(x: np.ndarray) -> np.ndarray:
+    """Points (B, 3) on the body axis at the stations ``x`` (B,) [m]."""
+    out = np.zeros((x.size, 3))
+    out[:, 0] = x
+    return out

@@ -46,35 +46,33 @@ class EngineModel:
         lo, hi = self.engine.throttle
         return float(min(max(throttle, lo), hi))
 
-    def table_thrust(self, tau: float) -> float:
-        """Tabulated thrust at ``tau`` [N], zero outside the table."""
-        if tau < self._t[0] or tau > self._t[-1]:
-            return 0.0
-        return float(np.interp(tau, self._t, self._T))
+    def table_thrust(self, tau):
+        """Tabulated thrust at ``tau`` [N] (a float or an array), zero outside the table."""
+        tau = np.asarray(tau, dtype=float)
+        return np.where((tau < self._t[0]) | (tau > self._t[-1]), 0.0, np.interp(tau, self._t, self._T))[()]
 
-    def _impulse(self, tau: float) -> float:
-        """``int_{t_0}^{tau} T dt`` of the table [N s]."""
+    def _impulse(self, tau):
+        """``int_{t_0}^{tau} T dt`` of the table [N s] (``tau`` a float or an array)."""
         t, T = self._t, self._T
-        if tau <= t[0]:
-            return 0.0
-        if tau >= t[-1]:
-            return float(self._cum[-1])
-        k = int(np.searchsorted(t, tau, side="right")) - 1
-        T_tau = T[k] + (T[k + 1] - T[k]) * (tau - t[k]) / (t[k + 1] - t[k])
-        return float(self._cum[k] + 0.5 * (tau - t[k]) * (T[k] + T_tau))
+        tau = np.asarray(tau, dtype=float)
+        k = np.clip(np.searchsorted(t, tau, side="right") - 1, 0, t.size - 2)
+        with np.errstate(divide="ignore", invalid="ignore"):          # rows outside the table: not used
+            T_tau = T[k] + (T[k + 1] - T[k]) * (tau - t[k]) / (t[k + 1] - t[k])
+            inside = self._cum[k] + 0.5 * (tau - t[k]) * (T[k] + T_tau)
+        return np.where(tau <= t[0], 0.0, np.where(tau >= t[-1], self._cum[-1], inside))[()]
 
-    def mass_flow(self, tau: float, throttle: float = 1.0) -> float:
-        """Total propellant mass flow at ``tau`` [kg/s] (>= 0)."""
+    def mass_flow(self, tau, throttle: float = 1.0):
+        """Total propellant mass flow at ``tau`` [kg/s] (>= 0; ``tau`` a float or an array)."""
         e = self.engine
         if e.thrust_table is None:
-            return self.throttle(throttle) * e.mass_flow
+            return (self.throttle(throttle) * e.mass_flow + np.zeros(np.shape(tau)))[()]
         return e.mass_flow * self.table_thrust(tau) / self._T_mean
 
-    def consumed(self, tau0: float, tau1: float, throttle: float = 1.0) -> float:
-        """Propellant used between ``tau0`` and ``tau1`` [kg], exactly."""
+    def consumed(self, tau0, tau1, throttle: float = 1.0):
+        """Propellant used between ``tau0`` and ``tau1`` [kg], exactly (floats or arrays)."""
         e = self.engine
         if e.thrust_table is None:
-            return self.throttle(throttle) * e.mass_flow * max(tau1 - tau0, 0.0)
+            return self.throttle(throttle) * e.mass_flow * np.maximum(np.subtract(tau1, tau0), 0.0)
         return e.mass_flow * (self._impulse(tau1) - self._impulse(tau0)) / self._T_mean
 
     def time_to_consume(self, tau0: float, mass: float, throttle: float = 1.0) -> float:
@@ -91,17 +89,14 @@ class EngineModel:
 
         return brentq(lambda tau: self.consumed(tau0, tau) - mass, tau0, self.burn_end, xtol=1e-12) - tau0
 
-    def thrust(self, tau: float, throttle: float = 1.0, p_ambient: float = 0.0) -> float:
-        """Thrust magnitude [N] at ``tau`` and ambient pressure ``p_ambient`` [Pa], never negative."""
+    def thrust(self, tau, throttle: float = 1.0, p_ambient=0.0):
+        """Thrust magnitude [N] at ``tau`` and ambient pressure ``p_ambient`` [Pa], never negative
+        (floats or arrays)."""
         e = self.engine
         if e.thrust_table is None:
             mdot = self.mass_flow(tau, throttle)
-            if mdot <= 0.0:
-                return 0.0
-            T = mdot * e.isp * G0 + e.nozzle_exit_area * (e.nozzle_exit_pressure - p_ambient)
-        else:
-            T = self.table_thrust(tau)
-            if T <= 0.0:
-                return 0.0
-            T += e.nozzle_exit_area * (P_SEA_LEVEL - p_ambient)
-        return max(T, 0.0)
+            T = mdot * e.isp * G0 + e.nozzle_exit_area * (e.nozzle_exit_pressure - np.asarray(p_ambient, dtype=float))
+            return np.where(mdot <= 0.0, 0.0, np.maximum(T, 0.0))[()]
+        T = self.table_thrust(tau)
+        with_p = T + e.nozzle_exit_area * (P_SEA_LEVEL - np.asarray(p_ambient, dtype=float))
+        return np.where(T <= 0.0, 0.0, np.maximum(with_p, 0.0))[()]

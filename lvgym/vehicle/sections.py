@@ -305,6 +305,18 @@ def _cumulative(s: np.ndarray, pieces: list[tuple[float, float, float]]) -> np.n
     return (rate * np.clip(s[:, None] - bottom, 0.0, top - bottom)).sum(axis=1)
 
 
+def _subdivide(kept: np.ndarray, h: float) -> np.ndarray:
+    """Nodes [m] from the descending breakpoints ``kept``: each span cut into the fewest equal elements no
+    longer than ``h`` [m], as ``np.linspace`` places them (``a + i (b - a) / n``, the span's end exact)."""
+    a, b = kept[:-1], kept[1:]
+    n = np.ceil((a - b) / h - 1e-9).astype(np.int64)              # elements per span, >= 1
+    span = np.repeat(np.arange(a.size), n)
+    i = np.arange(span.size) - np.repeat(np.cumsum(n) - n, n) + 1  # 1..n within each span
+    x = i * ((b - a) / n)[span] + a[span]
+    x[(np.cumsum(n) - 1)[n > 0]] = b[n > 0]
+    return np.concatenate([kept[:1], x])
+
+
 def mesh_stack(sections: Sequence[Section], point_masses: Sequence = (),
                distributed_masses: Sequence[DistributedMass] = (), *, query_stations=(),
                element_length: float | None = None) -> BeamMesh:
@@ -360,12 +372,11 @@ def mesh_stack(sections: Sequence[Section], point_masses: Sequence = (),
         raise ConfigError("element_length", element_length, "a finite element length > 0 m, or None")
     gap = MERGE_FRACTION * min(h, length)
     kept = [hi, lo]
-    for b in [*bounds, *pm[:, 0], *query]:
+    for b in [*bounds, *pm[:, 0].tolist(), *query.tolist()]:
         if min(abs(b - k) for k in kept) >= gap:
             kept.append(float(b))
     kept = np.sort(kept)[::-1]
-    nodes = [kept[:1]] + [np.linspace(a, b, math.ceil((a - b) / h - 1e-9) + 1)[1:] for a, b in zip(kept, kept[1:])]
-    x = np.concatenate(nodes)
+    x = _subdivide(kept, h)
     h_el = -np.diff(x)
     mpl = -np.diff(_cumulative(x, mass)) / h_el
     ei = h_el / -np.diff(_cumulative(x, stiff))

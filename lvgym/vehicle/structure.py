@@ -20,6 +20,7 @@ the stiffness to a known first frequency at lift-off (one factor on every sectio
 
 from __future__ import annotations
 
+import pickle
 from dataclasses import dataclass
 
 import numpy as np
@@ -137,10 +138,25 @@ def stiffness_factor(vehicle: Vehicle, cg_convention: str = "static") -> float:
     return float((2.0 * np.pi * target / beam.omega[0]) ** 2)
 
 
+def _stack_modes(sections: list[Section], points: list[PointMass], spread: list[DistributedMass], n_modes: int,
+                 query: np.ndarray, solved: dict[bytes, BeamModes] | None) -> BeamModes:
+    """:func:`.beam.stack_modes`, looked up first in ``solved`` (the caller's beams so far, by the exact
+    bits of their inputs, so the result is the same arrays a new solve gives), and stored there."""
+    if solved is None:
+        return stack_modes(sections, points, spread, n_modes=n_modes, query_stations=query)
+    key = pickle.dumps((sections, points, spread, n_modes, query), protocol=4)
+    if key not in solved:
+        solved[key] = stack_modes(sections, points, spread, n_modes=n_modes, query_stations=query)
+    return solved[key]
+
+
 def vehicle_modes(vehicle: Vehicle, state: MassState, props: MassProperties, n_modes: int | None = None,
-                  sensor_stations=None, ei_factor: float | None = None) -> VehicleModes:
+                  sensor_stations=None, ei_factor: float | None = None,
+                  solved: dict[bytes, BeamModes] | None = None) -> VehicleModes:
     """First ``n_modes`` (default: the vehicle file's) bending modes of the stack in ``state``;
-    ``ei_factor`` multiplies every EI (default :func:`stiffness_factor`)."""
+    ``ei_factor`` multiplies every EI (default :func:`stiffness_factor`). ``solved``: the beams solved so
+    far by the caller (a dict it keeps), so that a stack whose masses have not changed (a coast between
+    burnout and separation while the modes are recomputed every few seconds) is not solved again."""
     opts = vehicle.structure
     K = opts.n_modes if n_modes is None else int(n_modes)
     sensors = np.asarray(opts.sensor_stations if sensor_stations is None else sensor_stations, float).reshape(-1)
@@ -159,7 +175,7 @@ def vehicle_modes(vehicle: Vehicle, state: MassState, props: MassProperties, n_m
     factor = stiffness_factor(vehicle) if ei_factor is None else ei_factor
     if factor != 1.0:
         sections = [Section(sec.top, sec.bottom, sec.EI * factor, sec.mass_per_length) for sec in sections]
-    beam = stack_modes(sections, points, spread, n_modes=K, query_stations=query)
+    beam = _stack_modes(sections, points, spread, K, query, solved)
     return VehicleModes(t=props.t, omega=beam.omega.copy(), zeta=np.full(K, opts.damping),
                         phi_gimbal=beam.phi[0].copy(), dphi_gimbal=beam.dphi[0].copy(),
                         phi_hinge=beam.phi[1:1 + N].copy(), sensor_stations=sensors,
@@ -188,18 +204,36 @@ class ModeSchedule:
             else recompute_interval
         self.sensor_stations = sensor_stations
         self.ei_factor = stiffness_factor(mass_model.vehicle, mass_model.cg_convention)
+        self._solved: dict[bytes, BeamModes] = {}                # the beams of this schedule, by their inputs
         self._key: tuple | None = None
         self._modes: VehicleModes | None = None
+
+    def _due(self, t: float, attached: tuple[bool, ...]) -> bool:
+        """Whether the modes are to be recomputed at time ``t`` [s] with the stages ``attached``."""
+        last = self._modes
+        if last is None or attached != self._key or t < last.t:                 # a new stack or a new flight
+            return True
+        return self.interval is not None and t - last.t >= self.interval - 1e-12
 
     def modes(self, state: MassState, props: MassProperties | None = None) -> VehicleModes:
         """The modes in force at ``state`` (computed when the schedule says so, cached otherwise)."""
         attached = tuple(ph != SEPARATED for ph in state.phase)
-        due = self._modes is None or attached != self._key or state.t < self._modes.t  # a new flight
-        if not due and self.interval is not None:
-            due = state.t - self._modes.t >= self.interval - 1e-12
-        if due:
+        if self._due(state.t, attached):
             props = props if props is not None else self.mass_model.properties(state)
             self._modes = vehicle_modes(self.mass_model.vehicle, state, props, self.n_modes, self.sensor_stations,
-                                        self.ei_factor)
+                                        self.ei_factor, self._solved)
             self._key = attached
         return self._modes
+
+    def modes_rows(self, state: MassState, props: MassProperties) -> list[VehicleModes]:
+        """The modes in force at each state of the batch ``state`` (with its batched ``props``), in order,
+        as :meth:`modes` one state after the other: a list of B, the same object while unchanged."""
+        attached = tuple(ph != SEPARATED for ph in state.phase)
+        out = []
+        for i, t in enumerate(state.t.tolist()):
+            if self._due(t, attached):
+                self._modes = vehicle_modes(self.mass_model.vehicle, state.row(i), props.row(i), self.n_modes,
+                                            self.sensor_stations, self.ei_factor, self._solved)
+                self._key = attached
+            out.append(self._modes)
+        return out

@@ -20,7 +20,7 @@ inactive (mass 0) and the liquid is all fixed mass (DESIGN.md note 4).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 
 import numpy as np
 
@@ -36,7 +36,8 @@ CG_CONVENTIONS = ("static", "thesis")
 
 @dataclass(frozen=True)
 class TankProperties:
-    """Mass properties of one tank's liquid at one instant. Stations in metres from the nose tip.
+    """Mass properties of one tank's liquid at one instant, or at B instants (every field then carries a
+    leading axis of B, see :func:`tank_properties`). Stations in metres from the nose tip.
 
     ``liquid_mass`` [kg], ``height`` of the liquid [m], ``liquid_cg`` station [m];
     ``slosh_mass`` [kg] (0: no pendulum), ``pendulum_length`` [m] (capped at the height),
@@ -56,52 +57,59 @@ class TankProperties:
     fixed_cg: float
     fixed_inertia: np.ndarray
 
-
-def slosh_fraction(kappa: float) -> float:
-    """``m_s / m_liq = 2 tanh(kappa) / ((xi^2 - 1) kappa)`` [-], with its limit 2 / (xi^2 - 1) at 0."""
-    if kappa < 1e-8:
-        return 2.0 / (XI**2 - 1.0)
-    return 2.0 * np.tanh(kappa) / ((XI**2 - 1.0) * kappa)
+    def row(self, i: int) -> TankProperties:
+        """Instant ``i`` of a batch (floats and a (3, 3) inertia)."""
+        return TankProperties(**{f.name: (getattr(self, f.name)[i].copy() if f.name == "fixed_inertia"
+                                          else float(getattr(self, f.name)[i])) for f in fields(self)})
 
 
-def tank_properties(tank: Tank, liquid_mass: float, cg_convention: str = "static") -> TankProperties:
-    """Mass properties of ``tank`` holding ``liquid_mass`` [kg] (thesis eq. 2.23-2.29, 4.3-4.4)."""
+def slosh_fraction(kappa):
+    """``m_s / m_liq = 2 tanh(kappa) / ((xi^2 - 1) kappa)`` [-], with its limit 2 / (xi^2 - 1) at 0
+    (``kappa`` a float or an array)."""
+    k = np.asarray(kappa, dtype=float)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        out = np.where(k < 1e-8, 2.0 / (XI**2 - 1.0), 2.0 * np.tanh(k) / ((XI**2 - 1.0) * k))
+    return out[()]
+
+
+def tank_properties(tank: Tank, liquid_mass, cg_convention: str = "static") -> TankProperties:
+    """Mass properties of ``tank`` holding ``liquid_mass`` [kg] (thesis eq. 2.23-2.29, 4.3-4.4): a float
+    gives floats and a (3, 3) inertia, an array (B,) of masses the same fields with a leading axis B."""
     if cg_convention not in CG_CONVENTIONS:
         raise ValueError(f"cg_convention = {cg_convention!r}: one of {CG_CONVENTIONS}")
+    single = np.ndim(liquid_mass) == 0
     R = tank.inner_radius
-    m = max(float(liquid_mass), 0.0)
+    m = np.maximum(np.atleast_1d(np.asarray(liquid_mass, dtype=float)), 0.0)
     h = m / (np.pi * R**2 * tank.density)
     x_liq = tank.bottom + 0.5 * h
-    if h < MIN_SLOSH_HEIGHT or not tank.slosh:
-        m_s, L, L_rob, x_s, x_h = 0.0, 0.0, 0.0, x_liq, x_liq
-    else:
+    live = (h >= MIN_SLOSH_HEIGHT) & tank.slosh         # a pendulum (else none: all the liquid is fixed)
+    with np.errstate(divide="ignore", invalid="ignore"):
         kappa = XI * h / R
-        m_s = m * slosh_fraction(kappa)
-        L_rob = R / (XI * np.tanh(kappa))
-        L = min(L_rob, h)
-        x_s = x_liq + 0.5 * h - (2.0 * R / XI) * np.tanh(0.5 * kappa)
-        x_h = x_s + L
-    m_f = m - m_s
-    if m_f <= 0.0:
-        x_f = x_liq
-    elif cg_convention == "static":
-        x_f = (m * x_liq - m_s * x_s) / m_f
-    else:
-        x_f = x_liq
-    J_f = np.diag([0.5 * m_f * R**2 * (1.0 - tank.slip_factor),
-                   m_f * (3.0 * R**2 + h**2) / 12.0, m_f * (3.0 * R**2 + h**2) / 12.0])
-    return TankProperties(liquid_mass=m, height=h, liquid_cg=x_liq, slosh_mass=m_s, pendulum_length=L,
-                          pendulum_length_roberts=L_rob, slosh_station=x_s, hinge_station=x_h,
-                          fixed_mass=m_f, fixed_cg=x_f, fixed_inertia=J_f)
+        m_s = np.where(live, m * slosh_fraction(kappa), 0.0)
+        L_rob = np.where(live, R / (XI * np.tanh(kappa)), 0.0)
+        L = np.where(live, np.minimum(L_rob, h), 0.0)
+        x_s = np.where(live, x_liq + 0.5 * h - (2.0 * R / XI) * np.tanh(0.5 * kappa), x_liq)
+        x_h = np.where(live, x_s + L, x_liq)
+        m_f = m - m_s
+        static = (m * x_liq - m_s * x_s) / m_f if cg_convention == "static" else x_liq
+        x_f = np.where(m_f <= 0.0, x_liq, static)
+    J_f = np.zeros((m.size, 3, 3))
+    J_f[:, 0, 0] = 0.5 * m_f * R**2 * (1.0 - tank.slip_factor)
+    J_f[:, 1, 1] = J_f[:, 2, 2] = m_f * (3.0 * R**2 + h**2) / 12.0
+    tp = TankProperties(liquid_mass=m, height=h, liquid_cg=x_liq, slosh_mass=m_s, pendulum_length=L,
+                        pendulum_length_roberts=L_rob, slosh_station=x_s, hinge_station=x_h,
+                        fixed_mass=m_f, fixed_cg=x_f, fixed_inertia=J_f)
+    return tp.row(0) if single else tp
 
 
-def grain_properties(grain: Grain, mass: float) -> tuple[float, float, np.ndarray]:
+def grain_properties(grain: Grain, mass) -> tuple:
     """Mass [kg], CG station [m] and inertia about its CG [kg m^2] (3, 3) of a hybrid fuel grain of
     ``mass`` [kg]: a thick-walled cylinder burnt uniformly from the port, so the port radius is
-    ``sqrt(Ro^2 - m / (rho pi L))``."""
-    m = min(max(float(mass), 0.0), grain.capacity)
+    ``sqrt(Ro^2 - m / (rho pi L))``. An array (B,) of masses gives masses (B,) and inertias (B, 3, 3)."""
+    m = np.minimum(np.maximum(np.asarray(mass, dtype=float), 0.0), grain.capacity)
     Ro, Lg = grain.outer_radius, grain.length
-    r_port2 = max(Ro**2 - m / (grain.density * np.pi * Lg), 0.0)
-    Ixx = 0.5 * m * (Ro**2 + r_port2)
-    Iyy = m * (3.0 * (Ro**2 + r_port2) + Lg**2) / 12.0
-    return m, grain.top - 0.5 * Lg, np.diag([Ixx, Iyy, Iyy])
+    r_port2 = np.maximum(Ro**2 - m / (grain.density * np.pi * Lg), 0.0)
+    J = np.zeros(m.shape + (3, 3))
+    J[..., 0, 0] = 0.5 * m * (Ro**2 + r_port2)
+    J[..., 1, 1] = J[..., 2, 2] = m * (3.0 * (Ro**2 + r_port2) + Lg**2) / 12.0
+    return m[()], grain.top - 0.5 * Lg, J

@@ -4,8 +4,9 @@
 (``model="rigid"``, flat non-rotating site, constant gravity, US76, zero gimbal) and with RocketPy 1.13
 (a dev dependency, imported only inside the functions of this module), prints Markdown tables of apogee,
 maximum Mach number, their times and the burnout time of both with the relative differences, and writes
-``docs/figures/rocketpy_stratos3.png`` (altitude and Mach against time). docs/rocketpy-validation.md
-discusses the numbers.
+``docs/figures/rocketpy_stratos3.png`` (altitude and Mach against time), and ends with both codes' wall
+times for the same flight, with and without set-up, lvgym cold and warm (:mod:`.rocketpy_timing`).
+docs/rocketpy-validation.md discusses the numbers.
 
 What RocketPy is given, all taken from lvgym's own vehicle and models so that both fly the same vehicle:
 
@@ -291,7 +292,7 @@ def _tabulated_motor_class() -> type:
 def rocketpy_flight(elevation_deg: float = ELEVATION_DEG, rail_length: float = RAIL_LENGTH, *,
                     motor: str = "tabulated", earth_rotation: bool = False, atmosphere: str = "us76",
                     patch_issue_1186: bool = False, jet_damping: bool = True,
-                    timings: dict[str, float] | None = None) -> tuple[Any, MassSplit]:
+                    timings: dict[str, float] | None = None, sim: Simulator | None = None) -> tuple[Any, MassSplit]:
     """RocketPy's ``Flight`` of ``stratos3`` (see the module docstring) and the :class:`MassSplit` it used.
 
     ``motor``: ``"tabulated"`` (propellant CG and inertia from lvgym's timeline) or ``"generic"``
@@ -301,14 +302,15 @@ def rocketpy_flight(elevation_deg: float = ELEVATION_DEG, rail_length: float = R
     ``Rocket.com_to_cdm_function`` and ``Rocket.nozzle_to_cdm``, which RocketPy 1.13's
     ``Flight.u_dot_generalized`` reads as vectors from the CDM although they run towards it (RocketPy
     issue #1186, fix proposed in PR #1196); ``jet_damping=False``: a diagnostic, put the nozzle at the CDM
-    and zero its gyration tensor, which removes RocketPy's jet-damping terms (lvgym has none)."""
+    and zero its gyration tensor, which removes RocketPy's jet-damping terms (lvgym has none). ``sim``: the
+    lvgym simulator of the same launch whose vehicle and tables RocketPy is given (default: built here)."""
     from rocketpy import Environment, Flight, Function, GenericMotor, Rocket
 
     if motor not in ("tabulated", "generic"):
         raise ValueError(f"motor = {motor!r}: 'tabulated' or 'generic'")
     if atmosphere not in ("us76", "isa"):
         raise ValueError(f"atmosphere = {atmosphere!r}: 'us76' or 'isa'")
-    sim = lvgym_simulator(elevation_deg, rail_length)
+    sim = lvgym_simulator(elevation_deg, rail_length) if sim is None else sim
     vehicle, split, aero = sim.vehicle, mass_split(sim), sim.aerodynamics
     if aero is None or not hasattr(aero, "nose_shape"):
         raise ValueError(f"{vehicle.name}: needs a barrowman 'aerodynamics' section")
@@ -377,7 +379,8 @@ def rocketpy_flight(elevation_deg: float = ELEVATION_DEG, rail_length: float = R
 
 def fly_rocketpy(elevation_deg: float = ELEVATION_DEG, rail_length: float = RAIL_LENGTH,
                  **options: Any) -> Trajectory:
-    """Fly RocketPy (``options`` of :func:`rocketpy_flight`); altitudes shifted to lvgym's datum."""
+    """Fly RocketPy (``options`` of :func:`rocketpy_flight`); altitudes shifted to lvgym's datum. Its set-up
+    time includes building lvgym's simulator for the mass split unless ``options`` pass one as ``sim``."""
     start = time.perf_counter()
     timings: dict[str, float] = {}
     flight, split = rocketpy_flight(elevation_deg, rail_length, timings=timings, **options)
@@ -455,6 +458,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--figure", type=Path, default=FIGURE, help="PNG path (default: %(default)s)")
     parser.add_argument("--tol", type=float, default=0.02, help="relative tolerance (default: %(default)s)")
     parser.add_argument("--no-sensitivity", action="store_true", help="skip the RocketPy variants")
+    parser.add_argument("--no-timing", action="store_true", help="skip the wall times, cold and warm")
     args = parser.parse_args(argv)
     start = time.perf_counter()
     comparisons = [compare(e, r) for e, r in CASES]
@@ -466,6 +470,11 @@ def main(argv: list[str] | None = None) -> int:
     if not args.no_sensitivity:
         print(f"\n### RocketPy variants, elevation {comparisons[0].elevation_deg:g} deg\n")
         print(sensitivity_table(comparisons[0]))
+    if not args.no_timing:
+        from .rocketpy_timing import timing_table
+
+        print(f"\n### Wall times, {VEHICLE}, elevation {comparisons[0].elevation_deg:g} deg\n")
+        print(timing_table(comparisons[0].elevation_deg, comparisons[0].rail_length))
     print(f"\nfigure: {plot(comparisons, args.figure)}")
     print(f"apogee and maximum Mach within {100 * args.tol:g} %: {'yes' if ok else 'NO'}; "
           f"{time.perf_counter() - start:.1f} s")
