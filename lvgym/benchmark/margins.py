@@ -6,17 +6,18 @@ delay margin [ms] (docs/benchmark.md, "Time-domain margins").
     python -m lvgym.benchmark.margins --policies runs/ppo_smile --physics-dt-s 0.005   # 5 ms delay resolution
 
 Between the policy and the actuator a multiplicative gain ``k`` (:class:`~.perturb.GainPolicy`), and
-separately a pure delay (:class:`~.perturb.ActuatorDelay`, in whole physics steps), are raised by bisection
-(:func:`~.perturb.bisect_threshold`), per seed, until the episode leaves the bound (:func:`verdict`): it
-fails (any failure of the metrics), its cumulative pitch + yaw rate error ``rate_error_rad`` exceeds
-``error_ratio`` (default 2) times that of the nominal episode of the same seed, or its time at the gimbal
-rate limit ``gimbal_rate_limit_s`` exceeds ``rate_limit_ratio`` (default 2) times the nominal's, counted as at
-least ``RATE_LIMIT_FLOOR_S``. The last is there because the servo's rate limit turns a loop driven unstable
-into a bounded limit cycle of the gimbal that the rate error hardly sees. A seed's margin is the largest value tried that passed; the threshold lies
-between it and the smallest that failed (the bracket: ``gain_tol_db`` wide in gain, one physics step in
-delay). Reported per policy and condition: the smallest margin over the seeds (the margin) with its
-bracket, and the median. A seed whose nominal episode fails has no margin (counted, left out); a policy the
-injection never makes fail has a margin beyond the range searched (``>= gain_max_db``, ...).
+separately a pure delay (:class:`~.perturb.ActuatorDelay`, in whole physics steps), are raised, per seed,
+outwards from the nominal in doubling steps and then by bisection (:func:`~.perturb.find_threshold`),
+until the episode leaves the bound (:func:`verdict`): it fails (any failure of the metrics), its
+cumulative pitch + yaw rate error ``rate_error_rad`` exceeds ``error_ratio`` (default 2) times that of the
+nominal episode of the same seed, or its time at the gimbal rate limit ``gimbal_rate_limit_s`` exceeds
+``rate_limit_ratio`` (default 2) times the nominal's, counted as at least ``RATE_LIMIT_FLOOR_S``. The last
+is there because the servo's rate limit turns a loop driven unstable into a bounded limit cycle of the
+gimbal that the rate error hardly sees. A seed's margin is the largest value tried that passed; the
+threshold lies between it and the first that failed (the bracket: at most ``gain_tol_db`` wide in gain,
+one physics step in delay). Reported per policy and condition: the smallest margin over the seeds (the
+margin) with its bracket, and the median. A seed whose nominal episode fails has no margin (counted, left
+out); a policy the injection never makes fail has a margin beyond the range searched (``>= gain_max_db``).
 
 Seeds: the ``test`` seeds by default: a margin is a measurement, not tuning (``--seed-set validation`` for
 design loops). Policies are names of :data:`~.registry.POLICIES`, SB3 ``.zip`` paths or ``train.py`` run
@@ -41,7 +42,7 @@ from lvgym.cli import fail, one_line_errors, option_number
 from lvgym.errors import ConfigError, check_number
 from lvgym.parallel import EXECUTORS, TaskFailed, check_workers, exit_on_sigterm, run_map
 
-from .perturb import bisect_threshold, db_to_gain, fly
+from .perturb import db_to_gain, find_threshold, fly
 from .results import atomic_write_text, csv_text, json_text
 from .runner import PolicySpec, episode_objects
 from .suites import SEED_SETS, SUITES, Condition, Suite, get_suite
@@ -65,15 +66,17 @@ RATE_LIMIT_FLOOR_S = 1.0
 class MarginOptions:
     """The bound and the search. error_ratio: an episode leaves the bound when its ``rate_error_rad``
     exceeds this times the nominal one of its seed [-]; rate_limit_ratio: ... or its ``gimbal_rate_limit_s``
-    this times the nominal's (at least ``RATE_LIMIT_FLOOR_S``) [-] (``inf``: not a criterion); gain_max_db / gain_min_db: the range searched up
-    and down [dB]; gain_tol_db: the bracket width the gain bisection ends at [dB]; delay_max_s: the
-    largest extra delay searched [s] (its resolution is the condition's physics step)."""
+    this times the nominal's, counted as at least ``RATE_LIMIT_FLOOR_S`` [-] (``inf``: no such criterion);
+    gain_max_db / gain_min_db: the range searched up and down [dB]; gain_tol_db: the bracket width the
+    gain bisection ends at [dB]; gain_step_db: the first step of the outward search [dB] (then doubling);
+    delay_max_s: the largest extra delay searched [s] (its resolution is the condition's physics step)."""
 
     error_ratio: float = 2.0
     rate_limit_ratio: float = 2.0
     gain_max_db: float = 20.0
     gain_min_db: float = -40.0
     gain_tol_db: float = 0.25
+    gain_step_db: float = 1.0
     delay_max_s: float = 0.5
 
     def __post_init__(self) -> None:
@@ -85,12 +88,13 @@ class MarginOptions:
         if self.gain_min_db >= 0.0:
             raise ConfigError("gain_min_db", self.gain_min_db, "a number of dB in [-80, 0)")
         check_number("gain_tol_db", self.gain_tol_db, 0.0, 20.0, lo_open=True)
+        check_number("gain_step_db", self.gain_step_db, 0.0, 80.0, lo_open=True)
         check_number("delay_max_s", self.delay_max_s, 0.0, 10.0, lo_open=True)
 
 
 @dataclass(frozen=True)
 class MarginTask:
-    """One bisection: ``experiment`` of ``policy`` on ``condition`` with ``seed``."""
+    """One search: ``experiment`` of ``policy`` on ``condition`` with ``seed``."""
 
     policy: PolicySpec
     condition: Condition
@@ -135,10 +139,10 @@ def verdict(record: dict[str, Any], bound: dict[str, float]) -> str:
 
 
 def run_margin_task(task: MarginTask) -> dict[str, Any]:
-    """Fly the nominal episode of the task's seed, then bisect its experiment (see the module docstring);
+    """Fly the nominal episode of the task's seed, then search its experiment's threshold (module docstring);
     returns the seed's margin: ``passed`` (the margin, in ``unit``), ``failed_at`` (the smallest value
     tried that failed; None: none failed up to the range's end), ``nominal`` and every ``trials``
-    episode. With a failing nominal episode, ``passed`` is None and nothing is bisected."""
+    episode. With a failing nominal episode, ``passed`` is None and nothing is searched."""
     o, spec, cond, seed = task.options, task.policy, task.condition, task.seed
     nominal = _nominal(spec, cond, seed)
     h = physics_dt_s(spec, cond)
@@ -164,11 +168,11 @@ def run_margin_task(task: MarginTask) -> dict[str, Any]:
 
     if task.experiment == "delay":
         steps = max(1, int(round(o.delay_max_s / h)))
-        passed, failed, _ = bisect_threshold(passes, 0, steps, 1.0, integer=True)
+        passed, failed, _ = find_threshold(passes, 0, steps, 1.0, 1, integer=True)
         out["passed"], out["failed_at"] = passed * h * 1e3, None if failed is None else failed * h * 1e3
     else:
         limit = o.gain_max_db if task.experiment == "gain_up" else o.gain_min_db
-        out["passed"], out["failed_at"], _ = bisect_threshold(passes, 0.0, limit, o.gain_tol_db)
+        out["passed"], out["failed_at"], _ = find_threshold(passes, 0.0, limit, o.gain_tol_db, o.gain_step_db)
     out["status"] = "bracketed" if out["failed_at"] is not None else "beyond range"
     out["trials"] = trials
     return out
@@ -213,7 +217,7 @@ def run_margins(policies: Sequence[PolicySpec], where: Suite | Condition | Seque
                 seeds: int | Sequence[int] = DEFAULT_SEEDS, *, seed_set: str = "test",
                 options: MarginOptions | None = None, experiments: Sequence[str] = EXPERIMENTS,
                 executor: str = "local", workers: int | None = None, progress: bool = False) -> list[dict[str, Any]]:
-    """:func:`time_domain_margins` of every policy, their bisections on one process pool (``executor``,
+    """:func:`time_domain_margins` of every policy, their searches on one process pool (``executor``,
     ``workers`` as :func:`lvgym.parallel.run_map`); one result per policy, in order."""
     options = options or MarginOptions()
     for e in experiments:
@@ -226,7 +230,7 @@ def run_margins(policies: Sequence[PolicySpec], where: Suite | Condition | Seque
         raise ValueError("margins need at least one condition and one seed")
     tasks = [MarginTask(p, c, s, e, options) for p in policies for c in conds for s in seed_list for e in experiments]
     t0 = time.perf_counter()
-    done = run_map(run_margin_task, tasks, executor, workers, progress, desc="bisections", unit="seed",
+    done = run_map(run_margin_task, tasks, executor, workers, progress, desc="searches", unit="seed",
                    describe=_describe)
     wall = time.perf_counter() - t0
     limits = {"gain_up": options.gain_max_db, "gain_down": options.gain_min_db, "delay": options.delay_max_s * 1e3}
@@ -262,7 +266,7 @@ def time_domain_margins(policy_spec: PolicySpec, suite_or_condition: Suite | Con
     (the smallest magnitude over the seeds; None when every nominal episode fails), ``failed_at`` (the
     smallest value tried that failed on that seed; None: beyond the range ``limit``), ``bracket_width``,
     ``median``, ``worst_seed``, the counts ``n_seeds``, ``n_nominal_failed``, ``n_bracketed``; ``seeds``
-    holds every seed's bisection with its episodes, ``nominal`` the unperturbed episodes,
+    holds every seed's search with its episodes, ``nominal`` the unperturbed episodes,
     ``delay_resolution_ms`` the physics step."""
     return run_margins([policy_spec], suite_or_condition, seeds, **kwargs)[0]
 
@@ -312,8 +316,8 @@ def margins_table(results: Sequence[dict[str, Any]]) -> str:
         lines += ["", f"Margin: the smallest over {len(seeds)} {results[0]['seed_set']} seeds ({seeds[0]}-{seeds[-1]}) "
                   f"of the largest value that flew without failing, with rate_error_rad <= {opts['error_ratio']:g} x "
                   f"the seed's nominal and time at the gimbal rate limit <= {opts['rate_limit_ratio']:g} x the "
-                  f"nominal's (at least {RATE_LIMIT_FLOOR_S:g} s); 'fails': the next value tried on that seed, which failed; gain bracket "
-                  f"<= {opts['gain_tol_db']:g} dB, delay resolution "
+                  f"nominal's (at least {RATE_LIMIT_FLOOR_S:g} s); 'fails': the next value tried on that seed, "
+                  f"which failed; gain bracket <= {opts['gain_tol_db']:g} dB, delay resolution "
                   f"{', '.join(f'{r:g}' for r in sorted(res_ms))} ms (the physics step)."]
     return "\n".join(lines) + "\n"
 
@@ -369,9 +373,11 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     p.add_argument("--rate-limit-ratio", default=d.rate_limit_ratio,
                    help="bound: time at the gimbal rate limit above this times the seed's nominal (at least "
                         f"{RATE_LIMIT_FLOOR_S:g} s) fails; inf: no such bound (default {d.rate_limit_ratio:g})")
-    p.add_argument("--gain-max-db", default=d.gain_max_db, help=f"gain searched up to [dB] (default {d.gain_max_db:g})")
-    p.add_argument("--gain-min-db", default=d.gain_min_db, help=f"gain searched down to [dB] (default {d.gain_min_db:g})")
+    p.add_argument("--gain-max-db", default=d.gain_max_db, help=f"searched up to [dB] (default {d.gain_max_db:g})")
+    p.add_argument("--gain-min-db", default=d.gain_min_db, help=f"searched down to [dB] (default {d.gain_min_db:g})")
     p.add_argument("--gain-tol-db", default=d.gain_tol_db, help=f"gain bracket [dB] (default {d.gain_tol_db:g})")
+    p.add_argument("--gain-step-db", default=d.gain_step_db,
+                   help=f"first step of the outward gain search [dB], doubling (default {d.gain_step_db:g})")
     p.add_argument("--delay-max-s", default=d.delay_max_s, help=f"delay searched up to [s] (default {d.delay_max_s:g})")
     p.add_argument("--physics-dt-s", default=None,
                    help="physics step [s], the delay's resolution (default: the env's, 0.01; it also changes the "
@@ -387,7 +393,8 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
         ns.workers = check_workers(_number(ns.workers), "--workers")
         ns.physics_dt_s = option_number("--physics-dt-s", _number(ns.physics_dt_s), 0.0, 0.05, lo_open=True)
         ns.mission_time_s = option_number("--mission-time-s", _number(ns.mission_time_s), 0.0, 3600.0, lo_open=True)
-        names = ("error_ratio", "rate_limit_ratio", "gain_max_db", "gain_min_db", "gain_tol_db", "delay_max_s")
+        names = ("error_ratio", "rate_limit_ratio", "gain_max_db", "gain_min_db", "gain_tol_db", "gain_step_db",
+                 "delay_max_s")
         for key in names:
             setattr(ns, key, _number(getattr(ns, key), f"--{key.replace('_', '-')}"))
         try:

@@ -1,5 +1,5 @@
 """What the time-domain margins (:mod:`.margins`) insert between a policy and the actuator, and the
-bisection that raises it until the flight fails.
+search that raises it until the flight fails.
 
 - :class:`GainPolicy`: the policy's action times a gain ``k`` (the env then clips it to the action
   space, as it clips every action); ``20 log10 k`` dB.
@@ -10,7 +10,8 @@ bisection that raises it until the flight fails.
   first so many physics steps of a control period follow the previous period's command), the same field
   the ``servo_delay`` dispersion sets. The gimbal command is held over a control period, so both are the
   same pure shift of the command signal, and no equation is written twice.
-- :func:`bisect_threshold`: the largest value that passes, between a value known to pass and a limit.
+- :func:`find_threshold`: the largest value that passes, searched outwards from one known to pass
+  (doubling steps), then bisected.
 - :func:`fly`: one episode of a policy spec on a condition with a gain and a delay, summarised.
 """
 
@@ -30,7 +31,7 @@ from .policy import Policy
 from .runner import PolicySpec, episode_objects, play_episode
 from .suites import Condition
 
-__all__ = ["ActuatorDelay", "GainPolicy", "bisect_threshold", "db_to_gain", "fly", "gain_to_db"]
+__all__ = ["ActuatorDelay", "GainPolicy", "find_threshold", "db_to_gain", "fly", "gain_to_db"]
 
 
 def db_to_gain(db: float) -> float:
@@ -113,39 +114,51 @@ class ActuatorDelay(gym.Wrapper):
         return self.env.step(action)
 
 
-def bisect_threshold(passes: Callable[[float], bool], safe: float, limit: float, tol: float,
-                     integer: bool = False) -> tuple[float, float | None, list[tuple[float, bool]]]:
-    """Bisection between ``safe`` (known to pass, not tried) and ``limit``, either side of it, assuming
-    one crossing: the values tried move towards ``limit`` while they pass. Ends when the bracket is at
-    most ``tol`` wide (``integer``: the values are whole numbers and the bracket ends 1 wide). ``limit`` is
-    tried last, only when every value before it passed. Returns ``(passed, failed, trials)``: the value
-    closest to ``limit`` that passed, the closest to ``safe`` that failed (None: ``limit`` passed, the
-    threshold lies beyond it) and every ``(value, passed)`` in the order tried.
+def find_threshold(passes: Callable[[float], bool], safe: float, limit: float, tol: float, first_step: float,
+                   integer: bool = False) -> tuple[float, float | None, list[tuple[float, bool]]]:
+    """The largest value that passes, searched outwards from ``safe`` (known to pass, not tried) towards
+    ``limit`` (either side of it): steps of ``first_step``, doubling (``safe + first_step``, ``+ 2 first_step``,
+    ``+ 4 first_step``, ..., the last one at ``limit``) until one fails, then bisection between the last
+    that passed and the first that failed until the bracket is at most ``tol`` wide (``integer``: whole
+    values, the bracket ends 1 wide). It assumes one crossing in that bracket; searching outwards from the
+    nominal, it finds the first failure on that grid and not a wider pass region further out. Returns
+    ``(passed, failed, trials)``: the value that passed closest to the failure, the first value that
+    failed (None: ``limit`` passed, the threshold lies beyond it) and every ``(value, passed)`` in the
+    order tried.
 
-    >>> bisect_threshold(lambda x: x < 7.3, 0.0, 20.0, 0.25)[:2]
-    (7.1875, 7.34375)
+    >>> find_threshold(lambda x: x < 7.3, 0.0, 20.0, 0.25, 1.0)[:2]
+    (7.25, 7.5)
     """
-    a, b = float(safe), float(limit)
+    a, lim = float(safe), float(limit)
     if integer:
-        a, b, tol = float(round(a)), float(round(b)), 1.0
+        a, lim, tol, first_step = float(round(a)), float(round(lim)), 1.0, max(1.0, float(round(abs(first_step))))
+    direction = 1.0 if lim >= a else -1.0
+    step = abs(float(first_step))
     trials: list[tuple[float, bool]] = []
+
+    def tried(x: float) -> bool:
+        ok = bool(passes(x))
+        trials.append((x, ok))
+        return ok
+
     failed = None
-    while abs(b - a) > tol + 1e-12:
+    while a != lim:                                   # outwards
+        x = a + direction * step
+        x = lim if (x - lim) * direction >= 0.0 else x
+        if not tried(x):
+            failed = x
+            break
+        a, step = x, 2.0 * step
+    if failed is None:
+        return a, None, trials
+    b = failed
+    while abs(b - a) > tol + 1e-12:                   # then bisection of the bracket [a, b]
         m = a + (math.trunc((b - a) / 2.0) if integer else (b - a) / 2.0)
-        ok = bool(passes(m))
-        trials.append((m, ok))
-        if ok:
+        if tried(m):
             a = m
         else:
-            b, failed = m, m
-    if failed is None and b != a:
-        ok = bool(passes(b))
-        trials.append((b, ok))
-        if ok:
-            a = b
-        else:
-            failed = b
-    return a, failed, trials
+            b = m
+    return a, b, trials
 
 
 def fly(policy_spec: PolicySpec, condition: Condition, seed: int, gain: float = 1.0,
@@ -153,7 +166,8 @@ def fly(policy_spec: PolicySpec, condition: Condition, seed: int, gain: float = 
     """One episode of ``policy_spec`` on ``condition`` reset with ``seed``, its actions times ``gain`` [-]
     and delayed by ``delay_steps`` physics steps (neither when 1 and 0: the episode of
     :func:`~.runner.run_episode`); returns ``failed``, ``failure_reason``, ``rate_error_rad``, ``score``
-    [rad], ``gimbal_rate_limit_s``, ``effort_rad_s`` and ``duration_s`` [s] of its record. Envs and policies are cached per process."""
+    [rad], ``gimbal_rate_limit_s`` [s], ``effort_rad_s`` [rad s] and ``duration_s`` [s] of its record. Envs and
+    policies are cached per process."""
     env, policy = episode_objects(policy_spec, condition)
     if gain != 1.0:
         policy = GainPolicy(policy, gain)
