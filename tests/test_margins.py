@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 from lvgym.benchmark import get_suite
-from lvgym.benchmark.margins import (RATE_LIMIT_FLOOR_S, MarginOptions, _summary, bounds, main, margins_table,
-                                     time_domain_margins, verdict)
+from lvgym.benchmark.margins import (RATE_ERROR_FLOOR_RADPS, RATE_LIMIT_FLOOR_S, MarginOptions, _summary, bounds, main,
+                                     margins_table, time_domain_margins, verdict)
 from lvgym.benchmark.perturb import ActuatorDelay, GainPolicy, db_to_gain, find_threshold, gain_to_db
 from lvgym.benchmark.registry import POLICIES
 from lvgym.benchmark.suites import Condition
@@ -149,9 +149,12 @@ def test_search_finds_a_known_threshold():
 
 
 def test_bound_and_verdict():
-    nominal = {"failed": False, "failure_reason": "", "rate_error_rad": 1.5, "gimbal_rate_limit_s": 0.2}
+    nominal = {"failed": False, "failure_reason": "", "rate_error_rad": 1.5, "gimbal_rate_limit_s": 0.2,
+               "duration_s": 70.0}
     b = bounds(nominal, MarginOptions(error_ratio=2.0, rate_limit_ratio=3.0))
     assert b == {"rate_error_rad": 3.0, "gimbal_rate_limit_s": 3.0 * RATE_LIMIT_FLOOR_S}
+    calm = bounds({**nominal, "rate_error_rad": 0.003, "gimbal_rate_limit_s": 4.0}, MarginOptions())
+    assert calm == {"rate_error_rad": pytest.approx(2.0 * RATE_ERROR_FLOOR_RADPS * 70.0), "gimbal_rate_limit_s": 8.0}
     assert verdict({**nominal, "rate_error_rad": 2.9}, b) == ""
     assert verdict({**nominal, "rate_error_rad": 3.1}, b) == "rate error"
     assert verdict({**nominal, "gimbal_rate_limit_s": 3.5}, b) == "rate limit"

@@ -10,10 +10,10 @@ separately a pure delay (:class:`~.perturb.ActuatorDelay`, in whole physics step
 outwards from the nominal in doubling steps and then by bisection (:func:`~.perturb.find_threshold`),
 until the episode leaves the bound (:func:`verdict`): it fails (any failure of the metrics), its
 cumulative pitch + yaw rate error ``rate_error_rad`` exceeds ``error_ratio`` (default 2) times that of the
-nominal episode of the same seed, or its time at the gimbal rate limit ``gimbal_rate_limit_s`` exceeds
-``rate_limit_ratio`` (default 2) times the nominal's, counted as at least ``RATE_LIMIT_FLOOR_S``. The last
-is there because the servo's rate limit turns a loop driven unstable into a bounded limit cycle of the
-gimbal that the rate error hardly sees. A seed's margin is the largest value tried that passed; the
+nominal episode of the same seed (counted as at least ``RATE_ERROR_FLOOR_RADPS`` over its flight), or its
+time at the gimbal rate limit ``gimbal_rate_limit_s`` exceeds ``rate_limit_ratio`` (default 2) times the
+nominal's (counted as at least ``RATE_LIMIT_FLOOR_S``). The last is there because the servo's rate limit
+turns a loop driven unstable into a bounded limit cycle of the gimbal that the rate error hardly sees. A seed's margin is the largest value tried that passed; the
 threshold lies between it and the first that failed (the bracket: at most ``gain_tol_db`` wide in gain,
 one physics step in delay). Reported per policy and condition: the smallest margin over the seeds (the
 margin) with its bracket, and the median. A seed whose nominal episode fails has no margin (counted, left
@@ -47,7 +47,7 @@ from .results import atomic_write_text, csv_text, json_text
 from .runner import PolicySpec, episode_objects
 from .suites import SEED_SETS, SUITES, Condition, Suite, get_suite
 
-__all__ = ["EXPERIMENTS", "MarginOptions", "MarginTask", "RATE_LIMIT_FLOOR_S", "bounds",
+__all__ = ["EXPERIMENTS", "MarginOptions", "MarginTask", "RATE_ERROR_FLOOR_RADPS", "RATE_LIMIT_FLOOR_S", "bounds",
            "margin_rows", "margins_table", "run_margin_task",
            "run_margins", "time_domain_margins", "verdict", "write_margins"]
 
@@ -60,6 +60,9 @@ DEFAULT_SEEDS = 5
 PROG = "python -m lvgym.benchmark.margins"
 #: the nominal time at the gimbal rate limit counts as at least this in the rate-limit bound [s]
 RATE_LIMIT_FLOOR_S = 1.0
+#: the nominal rate error counts as at least this mean rate over the nominal flight in the rate-error bound
+#: [rad/s] (a calm, undispersed flight flies within micro-radians per second: twice that is no bound)
+RATE_ERROR_FLOOR_RADPS = 1e-3
 
 
 @dataclass(frozen=True)
@@ -121,8 +124,11 @@ def physics_dt_s(spec: PolicySpec, condition: Condition) -> float:
 
 
 def bounds(nominal: dict[str, Any], options: MarginOptions) -> dict[str, float]:
-    """The bound of a seed from its nominal episode: ``rate_error_rad`` [rad] and ``gimbal_rate_limit_s`` [s]."""
-    return {"rate_error_rad": options.error_ratio * nominal["rate_error_rad"],
+    """The bound of a seed from its nominal episode: ``rate_error_rad`` [rad] (``error_ratio`` times the
+    nominal's, counted as at least ``RATE_ERROR_FLOOR_RADPS`` times its duration) and ``gimbal_rate_limit_s``
+    [s] (``rate_limit_ratio`` times the nominal's, counted as at least ``RATE_LIMIT_FLOOR_S``)."""
+    floor = RATE_ERROR_FLOOR_RADPS * nominal["duration_s"]
+    return {"rate_error_rad": options.error_ratio * max(nominal["rate_error_rad"], floor),
             "gimbal_rate_limit_s": options.rate_limit_ratio * max(nominal["gimbal_rate_limit_s"], RATE_LIMIT_FLOOR_S)}
 
 
@@ -300,9 +306,21 @@ def _cell(s: dict[str, Any], digits: int) -> str:
     return text
 
 
+def _nominal_cell(nominal: list[dict[str, Any]]) -> str:
+    """The nominal episodes: failures, and the medians of the rate error and the time at the rate limit of
+    those that flew."""
+    flown = [n for n in nominal if not n["failed"]]
+    text = f"{len(nominal) - len(flown)}/{len(nominal)}"
+    if flown:
+        text += (f", {statistics.median(n['rate_error_rad'] for n in flown):.2f}, "
+                 f"{statistics.median(n['gimbal_rate_limit_s'] for n in flown):.1f}")
+    return text
+
+
 def margins_table(results: Sequence[dict[str, Any]]) -> str:
     """The Markdown table of the margins, with the method's line under it."""
-    lines = ["| policy | condition | gain up [dB] | gain down [dB] | delay [ms] |", "|---|---|---|---|---|"]
+    lines = ["| policy | condition | nominal: fails, rate error [rad], at rate limit [s] | gain up [dB] | "
+             "gain down [dB] | delay [ms] |", "|---|---|---|---|---|---|"]
     opts = results[0]["options"] if results else asdict(MarginOptions())
     res_ms = set()
     for res in results:
@@ -310,15 +328,16 @@ def margins_table(results: Sequence[dict[str, Any]]) -> str:
             res_ms.add(c["delay_resolution_ms"])
             cells = [_cell(c[f"{e}_{UNITS[e]}"], 0 if e == "delay" else 2) if e in res["experiments"] else "-"
                      for e in EXPERIMENTS]
-            lines.append(f"| {res['policy']} | {name} | " + " | ".join(cells) + " |")
+            lines.append(f"| {res['policy']} | {name} | {_nominal_cell(c['nominal'])} | " + " | ".join(cells) + " |")
     if results:
         seeds = results[0]["seeds"]
         lines += ["", f"Margin: the smallest over {len(seeds)} {results[0]['seed_set']} seeds ({seeds[0]}-{seeds[-1]}) "
                   f"of the largest value that flew without failing, with rate_error_rad <= {opts['error_ratio']:g} x "
-                  f"the seed's nominal and time at the gimbal rate limit <= {opts['rate_limit_ratio']:g} x the "
-                  f"nominal's (at least {RATE_LIMIT_FLOOR_S:g} s); 'fails': the next value tried on that seed, "
-                  f"which failed; gain bracket <= {opts['gain_tol_db']:g} dB, delay resolution "
-                  f"{', '.join(f'{r:g}' for r in sorted(res_ms))} ms (the physics step)."]
+                  f"the seed's nominal (at least {RATE_ERROR_FLOOR_RADPS * 1e3:g} mrad/s over its flight) and time at "
+                  f"the gimbal rate limit <= {opts['rate_limit_ratio']:g} x the nominal's (at least "
+                  f"{RATE_LIMIT_FLOOR_S:g} s); 'fails': the next value tried on that seed, "
+                  f"which failed; nominal: medians over the seeds that flew; gain bracket <= {opts['gain_tol_db']:g} "
+                  f"dB, delay resolution {', '.join(f'{r:g}' for r in sorted(res_ms))} ms (the physics step)."]
     return "\n".join(lines) + "\n"
 
 
