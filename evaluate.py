@@ -38,25 +38,13 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
-from lvgym.benchmark import (EXECUTORS, PROTOCOL_VERSION, SEED_SETS, SUITES, ZERO, PolicySpec, compare, degradation,
-                             evaluate, get_suite, markdown_table, run_groups, summarize, write_results)
+from lvgym.benchmark import (EXECUTORS, PROTOCOL_VERSION, SEED_SETS, SUITES, PolicySpec, compare, degradation, evaluate,
+                             get_suite, markdown_table, run_groups, summarize, write_results)
+from lvgym.benchmark.registry import POLICIES, resolve_policy  # noqa: F401  (the registry, shared with margins)
 from lvgym.cli import fail, one_line_errors
 from lvgym.errors import ConfigError
 from lvgym.parallel import TaskFailed, exit_on_sigterm
 
-#: policy names -> how a worker builds them (factories are imported lazily, in the workers)
-POLICIES: dict[str, PolicySpec] = {
-    "zero": ZERO,
-    # our tuning on the rigid linearisation (baselines.tune): one gain set, and the schedule on mass
-    "pid": PolicySpec("pid", "baselines.pid:smile_tuned_pid"),
-    "gs-pid": PolicySpec("gs-pid", "baselines.pid:smile_scheduled_pid", (("name", "gs-pid"), ("schedule", "smile"))),
-    # the thesis's gains (6.3.1) and its Table 6.10 schedule, as published
-    "pid-thesis": PolicySpec("pid-thesis", "baselines.pid:smile_single_pid"),
-    "gs-pid-thesis": PolicySpec("gs-pid-thesis", "baselines.pid:smile_scheduled_pid",
-                                (("name", "gs-pid-thesis"), ("schedule", "smile_thesis"))),
-    # the shipped learned policy (agents/trained/ppo_smile_ascent, docs/training.md)
-    "ppo": PolicySpec("ppo", "agents.policy:shipped_policy"),
-}
 DEFAULT_POLICIES = ["zero", "pid", "gs-pid", "ppo"]
 DEFAULT_SUITES = ["smile-windy"]
 #: episodes per condition and policy of the default run (2 conditions x 4 policies x 50 = 400 episodes of 60 s:
@@ -124,28 +112,6 @@ def parse_args(argv: list[str] | None = None) -> Args:
     if ns.mission_time_s is not None and not 0.0 < ns.mission_time_s <= MAX_MISSION_TIME_S:
         p.error(f"--mission-time-s = {ns.mission_time_s}: a number of seconds in (0, {MAX_MISSION_TIME_S:g}]")
     return Args(**vars(ns))
-
-
-def resolve_policy(name: str) -> PolicySpec:
-    """The :class:`PolicySpec` of a registered name or of a saved SB3 model path. Checks here, in the
-    main process, that the factory imports, so a missing package fails before any episode runs."""
-    if name in POLICIES:
-        spec = POLICIES[name]
-        try:
-            spec.resolve()
-        except ImportError as exc:
-            raise SystemExit(f"evaluate.py: policy {name!r} needs {spec.factory} (the "
-                             f"{spec.factory.split('.')[0].split(':')[0]} package), which is not available: {exc}")
-        return spec
-    path = Path(name)
-    if path.suffix == ".zip" or path.exists():
-        if not path.exists():
-            raise SystemExit(f"evaluate.py: policy {name!r}: no such file")
-        if path.is_dir():                       # a training run folder: its best (or final) model
-            return PolicySpec(path.name, "agents.policy:load_policy", (("path", str(path.resolve())),))
-        return PolicySpec(path.stem, "agents.policy:load_policy", (("path", str(path.resolve())),))
-    raise SystemExit(f"evaluate.py: policy {name!r}: one of {sorted(POLICIES)}, a path to an SB3 .zip model or a "
-                     "train.py run folder")
 
 
 def _unique(specs: list[PolicySpec]) -> list[PolicySpec]:

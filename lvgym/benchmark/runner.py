@@ -113,17 +113,24 @@ def play_episode(policy: Policy, env: Any, seed: int) -> dict[str, Any]:
     return {**record, **v1}
 
 
-def run_episode(policy_spec: PolicySpec, condition: Condition, seed: int) -> dict[str, Any]:
-    """One episode of ``policy_spec`` on ``condition``, reset with ``seed``; returns the record: the
-    policy and condition labels, the seed and :func:`~.metrics.episode_metrics`. A function of its
-    arguments only (envs and policies are cached per process, and reset every episode)."""
+def episode_objects(policy_spec: PolicySpec, condition: Condition) -> tuple[Any, Policy]:
+    """The env of ``condition`` and the policy of ``policy_spec`` built for it, cached per process (both
+    are reset at the start of every episode, so an episode does not depend on what ran before)."""
     env = _env(condition)
     key = (policy_spec, condition)
     if key not in _POLICIES:
         _POLICIES[key] = build_policy(policy_spec, env)
+    return env, _POLICIES[key]
+
+
+def run_episode(policy_spec: PolicySpec, condition: Condition, seed: int) -> dict[str, Any]:
+    """One episode of ``policy_spec`` on ``condition``, reset with ``seed``; returns the record: the
+    policy and condition labels, the seed and :func:`~.metrics.episode_metrics`. A function of its
+    arguments only (envs and policies are cached per process, and reset every episode)."""
+    env, policy = episode_objects(policy_spec, condition)
     return {"policy": policy_spec.name, "condition": condition.name, "group": condition.group,
             "env_id": condition.env_id, "model": condition.model, "wind": condition.wind, "seed": int(seed),
-            **play_episode(_POLICIES[key], env, seed)}
+            **play_episode(policy, env, seed)}
 
 
 @dataclass(frozen=True)
@@ -183,4 +190,4 @@ def evaluate(policies: Sequence[PolicySpec], suites: Sequence[Suite], episodes: 
 
 
 __all__ = ["EXECUTORS", "PROTOCOL_VERSION", "PolicySpec", "Task", "ZERO", "build_policy", "default_workers",
-           "evaluate", "make_tasks", "play_episode", "run_episode", "run_task", "zero_policy"]
+           "episode_objects", "evaluate", "make_tasks", "play_episode", "run_episode", "run_task", "zero_policy"]

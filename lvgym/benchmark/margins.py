@@ -1,0 +1,493 @@
+"""Time-domain margins of any policy in the nonlinear simulation: gain margins up and down [dB] and the
+delay margin [ms] (docs/benchmark.md, "Time-domain margins").
+
+    python -m lvgym.benchmark.margins                                  # pid and gs-pid on smile-v1, 5 test seeds
+    python -m lvgym.benchmark.margins --policies zero pid gs-pid ppo --seeds 10 --models rigid
+    python -m lvgym.benchmark.margins --policies runs/ppo_smile --physics-dt-s 0.005   # 5 ms delay resolution
+
+Between the policy and the actuator a multiplicative gain ``k`` (:class:`~.perturb.GainPolicy`), and
+separately a pure delay (:class:`~.perturb.ActuatorDelay`, in whole physics steps), are raised, per seed,
+outwards from the nominal in doubling steps and then by bisection (:func:`~.perturb.find_threshold`),
+until the episode leaves the bound (:func:`verdict`): it fails (any failure of the metrics), its
+cumulative pitch + yaw rate error ``rate_error_rad`` exceeds ``error_ratio`` (default 2) times that of the
+nominal episode of the same seed (counted as at least ``RATE_ERROR_FLOOR_RADPS`` over its flight), or its
+time at the gimbal rate limit ``gimbal_rate_limit_s`` exceeds ``rate_limit_ratio`` (default 2) times the
+nominal's (counted as at least ``RATE_LIMIT_FLOOR_S``). The last is there because the servo's rate limit
+turns a loop driven unstable into a bounded limit cycle of the gimbal that the rate error hardly sees. A seed's margin is the largest value tried that passed; the
+threshold lies between it and the first that failed (the bracket: at most ``gain_tol_db`` wide in gain,
+one physics step in delay). Reported per policy and condition: the smallest margin over the seeds (the
+margin) with its bracket, and the median. A seed whose nominal episode fails has no margin (counted, left
+out); a policy the injection never makes fail has a margin beyond the range searched (``>= gain_max_db``).
+
+Seeds: the ``test`` seeds by default: a margin is a measurement, not tuning (``--seed-set validation`` for
+design loops). Policies are names of :data:`~.registry.POLICIES`, SB3 ``.zip`` paths or ``train.py`` run
+folders, as ``evaluate.py`` takes them. From Python: :func:`time_domain_margins` (one policy) and
+:func:`run_margins` (several, one process pool).
+"""
+
+from __future__ import annotations
+
+import argparse
+import datetime as dt
+import math
+import statistics
+import sys
+import time
+from collections.abc import Sequence
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from typing import Any
+
+from lvgym.cli import fail, one_line_errors, option_number
+from lvgym.errors import ConfigError, check_number
+from lvgym.parallel import EXECUTORS, TaskFailed, check_workers, exit_on_sigterm, run_map
+
+from .perturb import db_to_gain, find_threshold, fly
+from .results import atomic_write_text, csv_text, json_text
+from .runner import PolicySpec, episode_objects
+from .suites import SEED_SETS, SUITES, Condition, Suite, get_suite
+
+__all__ = ["EXPERIMENTS", "MarginOptions", "MarginTask", "RATE_ERROR_FLOOR_RADPS", "RATE_LIMIT_FLOOR_S", "bounds",
+           "margin_rows", "margins_table", "run_margin_task",
+           "run_margins", "time_domain_margins", "verdict", "write_margins"]
+
+#: what is injected: the gain raised (``gain_up``, dB > 0), lowered (``gain_down``, dB < 0), a delay (``delay``, ms)
+EXPERIMENTS = ("gain_up", "gain_down", "delay")
+UNITS = {"gain_up": "dB", "gain_down": "dB", "delay": "ms"}
+DEFAULT_SUITE = "smile-v1"
+DEFAULT_POLICIES = ["pid", "gs-pid"]
+DEFAULT_SEEDS = 5
+PROG = "python -m lvgym.benchmark.margins"
+#: the nominal time at the gimbal rate limit counts as at least this in the rate-limit bound [s]
+RATE_LIMIT_FLOOR_S = 1.0
+#: the nominal rate error counts as at least this mean rate over the nominal flight in the rate-error bound
+#: [rad/s] (a calm, undispersed flight flies within micro-radians per second: twice that is no bound)
+RATE_ERROR_FLOOR_RADPS = 1e-3
+
+
+@dataclass(frozen=True)
+class MarginOptions:
+    """The bound and the search. error_ratio: an episode leaves the bound when its ``rate_error_rad``
+    exceeds this times the nominal one of its seed [-]; rate_limit_ratio: ... or its ``gimbal_rate_limit_s``
+    this times the nominal's, counted as at least ``RATE_LIMIT_FLOOR_S`` [-] (``inf``: no such criterion);
+    gain_max_db / gain_min_db: the range searched up and down [dB]; gain_tol_db: the bracket width the
+    gain bisection ends at [dB]; gain_step_db: the first step of the outward search [dB] (then doubling);
+    delay_max_s: the largest extra delay searched [s] (its resolution is the condition's physics step)."""
+
+    error_ratio: float = 2.0
+    rate_limit_ratio: float = 2.0
+    gain_max_db: float = 20.0
+    gain_min_db: float = -40.0
+    gain_tol_db: float = 0.25
+    gain_step_db: float = 1.0
+    delay_max_s: float = 0.5
+
+    def __post_init__(self) -> None:
+        check_number("error_ratio", self.error_ratio, 1.0, 1e6, lo_open=True)
+        if self.rate_limit_ratio != math.inf:
+            check_number("rate_limit_ratio", self.rate_limit_ratio, 1.0, 1e6, lo_open=True)
+        check_number("gain_max_db", self.gain_max_db, 0.0, 80.0, lo_open=True)
+        check_number("gain_min_db", self.gain_min_db, -80.0, 0.0)
+        if self.gain_min_db >= 0.0:
+            raise ConfigError("gain_min_db", self.gain_min_db, "a number of dB in [-80, 0)")
+        check_number("gain_tol_db", self.gain_tol_db, 0.0, 20.0, lo_open=True)
+        check_number("gain_step_db", self.gain_step_db, 0.0, 80.0, lo_open=True)
+        check_number("delay_max_s", self.delay_max_s, 0.0, 10.0, lo_open=True)
+
+
+@dataclass(frozen=True)
+class MarginTask:
+    """One search: ``experiment`` of ``policy`` on ``condition`` with ``seed``."""
+
+    policy: PolicySpec
+    condition: Condition
+    seed: int
+    experiment: str
+    options: MarginOptions
+
+
+_NOMINAL: dict[tuple[PolicySpec, Condition, int], dict[str, Any]] = {}
+
+
+def _nominal(spec: PolicySpec, condition: Condition, seed: int) -> dict[str, Any]:
+    """The unperturbed episode of a seed (memoised per process; it is a function of its arguments)."""
+    key = (spec, condition, int(seed))
+    if key not in _NOMINAL:
+        _NOMINAL[key] = fly(spec, condition, seed)
+    return _NOMINAL[key]
+
+
+def physics_dt_s(spec: PolicySpec, condition: Condition) -> float:
+    """The physics step of ``condition``'s env [s]: the resolution of the delay."""
+    task = episode_objects(spec, condition)[0].unwrapped.task
+    return float(task.control_dt_s) / int(task.substeps)
+
+
+def bounds(nominal: dict[str, Any], options: MarginOptions) -> dict[str, float]:
+    """The bound of a seed from its nominal episode: ``rate_error_rad`` [rad] (``error_ratio`` times the
+    nominal's, counted as at least ``RATE_ERROR_FLOOR_RADPS`` times its duration) and ``gimbal_rate_limit_s``
+    [s] (``rate_limit_ratio`` times the nominal's, counted as at least ``RATE_LIMIT_FLOOR_S``)."""
+    floor = RATE_ERROR_FLOOR_RADPS * nominal["duration_s"]
+    return {"rate_error_rad": options.error_ratio * max(nominal["rate_error_rad"], floor),
+            "gimbal_rate_limit_s": options.rate_limit_ratio * max(nominal["gimbal_rate_limit_s"], RATE_LIMIT_FLOOR_S)}
+
+
+def verdict(record: dict[str, Any], bound: dict[str, float]) -> str:
+    """Why an episode leaves the bound (``""``: it stays within): ``failure: <reason>``, ``rate error`` or
+    ``rate limit``."""
+    if record["failed"]:
+        return f"failure: {record['failure_reason']}"
+    if record["rate_error_rad"] > bound["rate_error_rad"]:
+        return "rate error"
+    if record["gimbal_rate_limit_s"] > bound["gimbal_rate_limit_s"]:
+        return "rate limit"
+    return ""
+
+
+def run_margin_task(task: MarginTask) -> dict[str, Any]:
+    """Fly the nominal episode of the task's seed, then search its experiment's threshold (module docstring);
+    returns the seed's margin: ``passed`` (the margin, in ``unit``), ``failed_at`` (the smallest value
+    tried that failed; None: none failed up to the range's end), ``nominal`` and every ``trials``
+    episode. With a failing nominal episode, ``passed`` is None and nothing is searched."""
+    o, spec, cond, seed = task.options, task.policy, task.condition, task.seed
+    nominal = _nominal(spec, cond, seed)
+    h = physics_dt_s(spec, cond)
+    out: dict[str, Any] = {"policy": spec.name, "condition": cond.name, "model": cond.model, "seed": int(seed),
+                           "experiment": task.experiment, "unit": UNITS[task.experiment], "nominal": nominal,
+                           "bounds": bounds(nominal, o), "physics_dt_s": h, "passed": None, "failed_at": None,
+                           "trials": []}
+    if nominal["failed"]:
+        out["status"] = "nominal failed"
+        return out
+    trials: list[dict[str, Any]] = []
+
+    def passes(value: float) -> bool:
+        if task.experiment == "delay":
+            record = fly(spec, cond, seed, delay_steps=int(value))
+            shown = value * h * 1e3
+        else:
+            record = fly(spec, cond, seed, gain=db_to_gain(value))
+            shown = value
+        why = verdict(record, out["bounds"])
+        trials.append({"value": shown, "passed": why == "", "verdict": why or "pass", **record})
+        return why == ""
+
+    if task.experiment == "delay":
+        steps = max(1, int(round(o.delay_max_s / h)))
+        passed, failed, _ = find_threshold(passes, 0, steps, 1.0, 1, integer=True)
+        out["passed"], out["failed_at"] = passed * h * 1e3, None if failed is None else failed * h * 1e3
+    else:
+        limit = o.gain_max_db if task.experiment == "gain_up" else o.gain_min_db
+        out["passed"], out["failed_at"], _ = find_threshold(passes, 0.0, limit, o.gain_tol_db, o.gain_step_db)
+    out["status"] = "bracketed" if out["failed_at"] is not None else "beyond range"
+    out["trials"] = trials
+    return out
+
+
+def _describe(task: MarginTask) -> str:
+    return f"margin {task.experiment} of policy {task.policy.name!r} on {task.condition.name!r} seed {task.seed}"
+
+
+def _conditions(where: Suite | Condition | Sequence[Condition]) -> list[Condition]:
+    if isinstance(where, Suite):
+        return list(where.conditions)
+    if isinstance(where, Condition):
+        return [where]
+    return list(where)
+
+
+def _seeds(where: Suite | Condition | Sequence[Condition], seeds: int | Sequence[int], seed_set: str) -> list[int]:
+    if not isinstance(seeds, int):
+        return [int(s) for s in seeds]
+    suite = where if isinstance(where, Suite) else next(iter(SUITES.values()))      # every suite has the same sets
+    return suite.seeds(seed_set, seeds)
+
+
+def _summary(seeds: list[dict[str, Any]], limit: float) -> dict[str, Any]:
+    """The margin over the seeds of one experiment: the smallest in magnitude (the worst seed) with its
+    bracket, the median, and the counts."""
+    done = [s for s in seeds if s["passed"] is not None]
+    out: dict[str, Any] = {"margin": None, "failed_at": None, "bracket_width": None, "median": None,
+                           "worst_seed": None, "n_seeds": len(seeds), "n_nominal_failed": len(seeds) - len(done),
+                           "n_bracketed": sum(s["failed_at"] is not None for s in done), "limit": limit,
+                           "episodes": sum(len(s["trials"]) for s in seeds)}
+    if done:
+        worst = min(done, key=lambda s: (abs(s["passed"]), s["seed"]))
+        out.update(margin=worst["passed"], failed_at=worst["failed_at"], worst_seed=worst["seed"],
+                   median=statistics.median(s["passed"] for s in done),
+                   bracket_width=None if worst["failed_at"] is None else abs(worst["failed_at"] - worst["passed"]))
+    return out
+
+
+def run_margins(policies: Sequence[PolicySpec], where: Suite | Condition | Sequence[Condition],
+                seeds: int | Sequence[int] = DEFAULT_SEEDS, *, seed_set: str = "test",
+                options: MarginOptions | None = None, experiments: Sequence[str] = EXPERIMENTS,
+                executor: str = "local", workers: int | None = None, progress: bool = False) -> list[dict[str, Any]]:
+    """:func:`time_domain_margins` of every policy, their searches on one process pool (``executor``,
+    ``workers`` as :func:`lvgym.parallel.run_map`); one result per policy, in order."""
+    options = options or MarginOptions()
+    for e in experiments:
+        if e not in EXPERIMENTS:
+            raise ValueError(f"experiment = {e!r}: one of {EXPERIMENTS}")
+    if seed_set not in SEED_SETS:
+        raise ValueError(f"seed_set = {seed_set!r}: one of {SEED_SETS}")
+    conds, seed_list = _conditions(where), _seeds(where, seeds, seed_set)
+    if not conds or not seed_list:
+        raise ValueError("margins need at least one condition and one seed")
+    tasks = [MarginTask(p, c, s, e, options) for p in policies for c in conds for s in seed_list for e in experiments]
+    t0 = time.perf_counter()
+    done = run_map(run_margin_task, tasks, executor, workers, progress, desc="searches", unit="seed",
+                   describe=_describe)
+    wall = time.perf_counter() - t0
+    limits = {"gain_up": options.gain_max_db, "gain_down": options.gain_min_db, "delay": options.delay_max_s * 1e3}
+    results = []
+    for p in policies:
+        mine = [r for r in done if r["policy"] == p.name]
+        per_condition = {}
+        for c in conds:
+            rows = [r for r in mine if r["condition"] == c.name]
+            h = rows[0]["physics_dt_s"]
+            nominal = {r["seed"]: r["nominal"] for r in rows}
+            per_condition[c.name] = {
+                "condition": c.to_dict(), "delay_resolution_ms": h * 1e3, "physics_dt_s": h,
+                "nominal": [{"seed": s, **nominal[s]} for s in seed_list],
+                **{f"{e}_{UNITS[e]}": _summary([r for r in rows if r["experiment"] == e], limits[e])
+                   for e in experiments},
+                "seeds": rows}
+        results.append({"policy": p.name, "factory": p.factory, "kwargs": dict(p.kwargs), "seed_set": seed_set,
+                        "seeds": seed_list, "options": asdict(options), "experiments": list(experiments),
+                        "conditions": per_condition, "episodes": sum(len(r["trials"]) + 1 for r in mine),
+                        "wall_time_s": round(wall, 3)})
+    return results
+
+
+def time_domain_margins(policy_spec: PolicySpec, suite_or_condition: Suite | Condition | Sequence[Condition],
+                        seeds: int | Sequence[int] = DEFAULT_SEEDS, **kwargs: Any) -> dict[str, Any]:
+    """The time-domain margins of one policy on every condition of a suite (or on the given conditions).
+
+    ``seeds``: a count (the first of ``seed_set``, default ``"test"``) or the seeds themselves; keywords of
+    :func:`run_margins` (``options``: a :class:`MarginOptions`, ``experiments``, ``executor``, ``workers``,
+    ``progress``). Returns ``{"policy", "seeds", "options", "conditions": {name: {...}}, "episodes",
+    "wall_time_s"}``; per condition ``gain_up_dB``, ``gain_down_dB`` and ``delay_ms`` each hold ``margin``
+    (the smallest magnitude over the seeds; None when every nominal episode fails), ``failed_at`` (the
+    smallest value tried that failed on that seed; None: beyond the range ``limit``), ``bracket_width``,
+    ``median``, ``worst_seed``, the counts ``n_seeds``, ``n_nominal_failed``, ``n_bracketed``; ``seeds``
+    holds every seed's search with its episodes, ``nominal`` the unperturbed episodes,
+    ``delay_resolution_ms`` the physics step."""
+    return run_margins([policy_spec], suite_or_condition, seeds, **kwargs)[0]
+
+
+# ------------------------------------------------------------------------------------------------ output
+def margin_rows(results: Sequence[dict[str, Any]]) -> list[dict[str, Any]]:
+    """One flat row per policy, condition and experiment (the ``margins.csv`` rows)."""
+    rows = []
+    for res in results:
+        for name, c in res["conditions"].items():
+            for e in res["experiments"]:
+                s = c[f"{e}_{UNITS[e]}"]
+                rows.append({"policy": res["policy"], "condition": name, "model": c["condition"]["model"],
+                             "experiment": e, "unit": UNITS[e], **{k: v for k, v in s.items()},
+                             "error_ratio": res["options"]["error_ratio"],
+                             "rate_limit_ratio": res["options"]["rate_limit_ratio"],
+                             "delay_resolution_ms": c["delay_resolution_ms"], "seed_set": res["seed_set"]})
+    return rows
+
+
+def _cell(s: dict[str, Any], digits: int) -> str:
+    if s["margin"] is None:
+        return f"n/a (nominal fails {s['n_nominal_failed']}/{s['n_seeds']})"
+    if s["failed_at"] is None:
+        return f"{'<=' if s['limit'] < 0 else '>='} {s['limit']:.{digits}f} (none failed)"
+    text = f"{s['margin']:.{digits}f} (fails {s['failed_at']:.{digits}f}), median {s['median']:.{digits}f}"
+    if s["n_bracketed"] < s["n_seeds"] - s["n_nominal_failed"]:
+        text += f", {s['n_seeds'] - s['n_nominal_failed'] - s['n_bracketed']} seed(s) beyond range"
+    if s["n_nominal_failed"]:
+        text += f"; nominal fails {s['n_nominal_failed']}/{s['n_seeds']}"
+    return text
+
+
+def _nominal_cell(nominal: list[dict[str, Any]]) -> str:
+    """The nominal episodes: failures, and the medians of the rate error and the time at the rate limit of
+    those that flew."""
+    flown = [n for n in nominal if not n["failed"]]
+    text = f"{len(nominal) - len(flown)}/{len(nominal)}"
+    if flown:
+        text += (f", {statistics.median(n['rate_error_rad'] for n in flown):.2f}, "
+                 f"{statistics.median(n['gimbal_rate_limit_s'] for n in flown):.1f}")
+    return text
+
+
+def margins_table(results: Sequence[dict[str, Any]]) -> str:
+    """The Markdown table of the margins, with the method's line under it."""
+    lines = ["| policy | condition | nominal: fails, rate error [rad], at rate limit [s] | gain up [dB] | "
+             "gain down [dB] | delay [ms] |", "|---|---|---|---|---|---|"]
+    opts = results[0]["options"] if results else asdict(MarginOptions())
+    res_ms = set()
+    for res in results:
+        for name, c in res["conditions"].items():
+            res_ms.add(c["delay_resolution_ms"])
+            cells = [_cell(c[f"{e}_{UNITS[e]}"], 0 if e == "delay" else 2) if e in res["experiments"] else "-"
+                     for e in EXPERIMENTS]
+            lines.append(f"| {res['policy']} | {name} | {_nominal_cell(c['nominal'])} | " + " | ".join(cells) + " |")
+    if results:
+        seeds = results[0]["seeds"]
+        lines += ["", f"Margin: the smallest over {len(seeds)} {results[0]['seed_set']} seeds ({seeds[0]}-{seeds[-1]}) "
+                  f"of the largest value that flew without failing, with rate_error_rad <= {opts['error_ratio']:g} x "
+                  f"the seed's nominal (at least {RATE_ERROR_FLOOR_RADPS * 1e3:g} mrad/s over its flight) and time at "
+                  f"the gimbal rate limit <= {opts['rate_limit_ratio']:g} x the nominal's (at least "
+                  f"{RATE_LIMIT_FLOOR_S:g} s); 'fails': the next value tried on that seed, "
+                  f"which failed; nominal: medians over the seeds that flew; gain bracket <= {opts['gain_tol_db']:g} "
+                  f"dB, delay resolution {', '.join(f'{r:g}' for r in sorted(res_ms))} ms (the physics step)."]
+    return "\n".join(lines) + "\n"
+
+
+def write_margins(out: str | Path, results: Sequence[dict[str, Any]], meta: dict[str, Any]) -> list[Path]:
+    """``margins.csv`` (:func:`margin_rows`), ``margin_trials.csv`` (every episode flown), ``margins.md``
+    (:func:`margins_table`) and ``margins.json`` (all of it and ``meta``; written last), each atomically."""
+    out = Path(out)
+    trials = [{"policy": s["policy"], "condition": s["condition"], "seed": s["seed"], "experiment": s["experiment"],
+               "unit": s["unit"], **{f"bound_{k}": v for k, v in s["bounds"].items()}, **t}
+              for res in results for c in res["conditions"].values() for s in c["seeds"] for t in s["trials"]]
+    return [atomic_write_text(out / "margins.csv", csv_text(margin_rows(results))),
+            atomic_write_text(out / "margin_trials.csv", csv_text(trials)),
+            atomic_write_text(out / "margins.md", margins_table(results)),
+            atomic_write_text(out / "margins.json", json_text({"meta": meta, "results": list(results)}))]
+
+
+# ------------------------------------------------------------------------------------------------ CLI
+def _control_dt_s(condition: Condition) -> float:
+    """The control period of ``condition``'s env [s], from its registered class's defaults."""
+    import importlib
+
+    import gymnasium
+
+    import lvgym  # noqa: F401  (registers the env ids)
+    from lvgym.envs.spec import TaskSpec
+
+    entry = gymnasium.spec(condition.env_id).entry_point
+    module, _, attr = entry.partition(":") if isinstance(entry, str) else (None, "", "")
+    defaults = getattr(importlib.import_module(module), attr).DEFAULTS if module else {}
+    return float(dict(condition.options).get("control_dt_s", defaults.get("control_dt_s", TaskSpec.control_dt_s)))
+
+
+def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
+    """The command line, every value checked before any worker starts."""
+    from .registry import POLICIES
+
+    d = MarginOptions()
+    p = one_line_errors(argparse.ArgumentParser(prog=PROG, description=__doc__.split("\n\n")[0],
+                                                epilog=__doc__.split("\n\n", 2)[2],
+                                                formatter_class=argparse.RawDescriptionHelpFormatter))
+    p.add_argument("--policies", nargs="+", default=DEFAULT_POLICIES, metavar="POLICY",
+                   help=f"names {sorted(POLICIES)}, SB3 .zip paths or train.py run folders "
+                        f"(default: {' '.join(DEFAULT_POLICIES)})")
+    p.add_argument("--suite", default=DEFAULT_SUITE, help=f"of {sorted(SUITES)} (default {DEFAULT_SUITE})")
+    p.add_argument("--models", nargs="+", default=None, metavar="MODEL",
+                   help="only the suite's conditions of these flight models (default: all, e.g. rigid and nonrigid)")
+    p.add_argument("--seeds", default=DEFAULT_SEEDS, help=f"seeds per condition (default {DEFAULT_SEEDS})")
+    p.add_argument("--seed-set", choices=SEED_SETS, default="test", help="default: test (a measurement)")
+    p.add_argument("--experiments", nargs="+", choices=EXPERIMENTS, default=list(EXPERIMENTS))
+    p.add_argument("--error-ratio", default=d.error_ratio,
+                   help=f"bound: rate_error_rad above this times the seed's nominal fails (default {d.error_ratio:g})")
+    p.add_argument("--rate-limit-ratio", default=d.rate_limit_ratio,
+                   help="bound: time at the gimbal rate limit above this times the seed's nominal (at least "
+                        f"{RATE_LIMIT_FLOOR_S:g} s) fails; inf: no such bound (default {d.rate_limit_ratio:g})")
+    p.add_argument("--gain-max-db", default=d.gain_max_db, help=f"searched up to [dB] (default {d.gain_max_db:g})")
+    p.add_argument("--gain-min-db", default=d.gain_min_db, help=f"searched down to [dB] (default {d.gain_min_db:g})")
+    p.add_argument("--gain-tol-db", default=d.gain_tol_db, help=f"gain bracket [dB] (default {d.gain_tol_db:g})")
+    p.add_argument("--gain-step-db", default=d.gain_step_db,
+                   help=f"first step of the outward gain search [dB], doubling (default {d.gain_step_db:g})")
+    p.add_argument("--delay-max-s", default=d.delay_max_s, help=f"delay searched up to [s] (default {d.delay_max_s:g})")
+    p.add_argument("--physics-dt-s", default=None,
+                   help="physics step [s], the delay's resolution (default: the env's, 0.01; it also changes the "
+                        "integration step and the servo_delay dispersion's quantum)")
+    p.add_argument("--mission-time-s", default=None, help="shorten every episode (smoke tests only)")
+    p.add_argument("--executor", choices=EXECUTORS, default="local", help="default: local process pool")
+    p.add_argument("--workers", default=None, help="default: the CPUs available")
+    p.add_argument("--out", default="results/margins", help="results folder (default results/margins/)")
+    p.add_argument("--no-progress", dest="progress", action="store_false", help="hide the progress bar")
+    ns = p.parse_args(argv)
+    try:
+        ns.seeds = option_number("--seeds", _number(ns.seeds), 1, 10_000, integer=True)
+        ns.workers = check_workers(_number(ns.workers), "--workers")
+        ns.physics_dt_s = option_number("--physics-dt-s", _number(ns.physics_dt_s), 0.0, 0.05, lo_open=True)
+        ns.mission_time_s = option_number("--mission-time-s", _number(ns.mission_time_s), 0.0, 3600.0, lo_open=True)
+        names = ("error_ratio", "rate_limit_ratio", "gain_max_db", "gain_min_db", "gain_tol_db", "gain_step_db",
+                 "delay_max_s")
+        for key in names:
+            setattr(ns, key, _number(getattr(ns, key), f"--{key.replace('_', '-')}"))
+        try:
+            ns.options = MarginOptions(**{k: getattr(ns, k) for k in names})
+        except ConfigError as exc:
+            raise ConfigError(f"--{exc.key.replace('_', '-')}", exc.value, exc.allowed) from None
+    except ConfigError as exc:
+        p.error(str(exc))
+    return ns
+
+
+def _number(text: Any, option: str = "") -> Any:
+    """A command-line number as int or float (None passes); a non-number is left for the check to refuse."""
+    if text is None or isinstance(text, (int, float)):
+        return text
+    try:
+        return int(text)
+    except ValueError:
+        try:
+            return float(text)
+        except ValueError:
+            if option:
+                raise ConfigError(option, text, "a number") from None
+            return text
+
+
+def main(argv: list[str] | None = None) -> list[dict[str, Any]]:
+    """Measure, print the table, write the result files; returns the results."""
+    from .registry import resolve_policy
+
+    args = parse_args(argv)
+    exit_on_sigterm()
+    policies = [resolve_policy(n, PROG) for n in args.policies]
+    if len({p.name for p in policies}) != len(policies):
+        fail(PROG, f"--policies {' '.join(args.policies)}: each label must be distinct")
+    try:
+        suite = get_suite(args.suite)
+    except ValueError as exc:
+        fail(PROG, exc)
+    overrides = {k: v for k, v in (("mission_time_s", args.mission_time_s), ("physics_dt_s", args.physics_dt_s))
+                 if v is not None}
+    suite = suite.with_options(**overrides)
+    conds = [c for c in suite.conditions if args.models is None or c.model in args.models]
+    if not conds:
+        fail(PROG, f"--models {' '.join(args.models)}: suite {suite.name!r} has "
+                   f"{sorted({c.model for c in suite.conditions})}")
+    if args.physics_dt_s is not None:
+        for c in conds:
+            n = _control_dt_s(c) / args.physics_dt_s
+            if abs(n - round(n)) > 1e-6:
+                fail(PROG, f"--physics-dt-s = {args.physics_dt_s}: the control period {_control_dt_s(c)} s of "
+                           f"{c.env_id} must be a whole multiple of it")
+    t0 = time.perf_counter()
+    try:
+        results = run_margins(policies, conds, suite.seeds(args.seed_set, args.seeds), seed_set=args.seed_set,
+                              options=args.options, experiments=args.experiments, executor=args.executor,
+                              workers=args.workers, progress=args.progress)
+    except TaskFailed as exc:
+        if isinstance(exc.__cause__, ConfigError):
+            fail(PROG, exc)
+        raise
+    wall = time.perf_counter() - t0
+    meta = {"suite": suite.name, "version": suite.version, "overrides": dict(suite.overrides),
+            "args": {k: v for k, v in vars(args).items() if k != "options"}, "options": asdict(args.options),
+            "wall_time_s": round(wall, 3), "episodes": sum(r["episodes"] for r in results),
+            "created_utc": dt.datetime.now(dt.timezone.utc).isoformat(timespec="seconds")}
+    paths = write_margins(args.out, results, meta)
+    print(margins_table(results))
+    print(f"{meta['episodes']} episodes in {wall:.1f} s ({args.executor}); results in {Path(args.out)}/: "
+          f"{', '.join(p.name for p in paths)}", file=sys.stderr)
+    return results
+
+
+if __name__ == "__main__":            # run as the imported module, so that the workers find its tasks by name
+    from lvgym.benchmark.margins import main as _main
+
+    _main()

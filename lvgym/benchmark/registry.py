@@ -1,0 +1,53 @@
+"""The policies the benchmark's command lines know by name (``evaluate.py``, ``python -m
+lvgym.benchmark.margins``), and how a name or a saved model's path becomes a :class:`~.runner.PolicySpec`.
+
+A spec holds an import path as a string (``"baselines.pid:smile_tuned_pid"``); the factory is imported in
+the worker that flies the policy, so this module imports neither ``baselines`` nor ``agents`` (the layers
+of DESIGN.md: the benchmark sits below the controllers and the agents).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from .runner import ZERO, PolicySpec
+
+__all__ = ["POLICIES", "resolve_policy"]
+
+#: policy names -> how a worker builds them (factories are imported lazily, in the workers)
+POLICIES: dict[str, PolicySpec] = {
+    "zero": ZERO,
+    # our tuning on the rigid linearisation (baselines.tune): one gain set, and the schedule on mass
+    "pid": PolicySpec("pid", "baselines.pid:smile_tuned_pid"),
+    "gs-pid": PolicySpec("gs-pid", "baselines.pid:smile_scheduled_pid", (("name", "gs-pid"), ("schedule", "smile"))),
+    # the thesis's gains (6.3.1) and its Table 6.10 schedule, as published
+    "pid-thesis": PolicySpec("pid-thesis", "baselines.pid:smile_single_pid"),
+    "gs-pid-thesis": PolicySpec("gs-pid-thesis", "baselines.pid:smile_scheduled_pid",
+                                (("name", "gs-pid-thesis"), ("schedule", "smile_thesis"))),
+    # the shipped learned policy (agents/trained/ppo_smile_ascent, docs/training.md)
+    "ppo": PolicySpec("ppo", "agents.policy:shipped_policy"),
+}
+
+
+def resolve_policy(name: str, prog: str = "evaluate.py") -> PolicySpec:
+    """The :class:`PolicySpec` of a registered name, of a saved stable-baselines3 model (``.zip``; an
+    optional ``<stem>_vecnormalize.pkl`` next to it normalises the observations) or of a ``train.py`` run
+    folder (its best model). Checks here, in the main process, that the factory imports, so a missing
+    package fails before any episode runs; a bad name exits with a one-line message starting ``prog:``."""
+    if name in POLICIES:
+        spec = POLICIES[name]
+        try:
+            spec.resolve()
+        except ImportError as exc:
+            raise SystemExit(f"{prog}: policy {name!r} needs {spec.factory} (the "
+                             f"{spec.factory.split('.')[0].split(':')[0]} package), which is not available: {exc}")
+        return spec
+    path = Path(name)
+    if path.suffix == ".zip" or path.exists():
+        if not path.exists():
+            raise SystemExit(f"{prog}: policy {name!r}: no such file")
+        if path.is_dir():                       # a training run folder: its best (or final) model
+            return PolicySpec(path.name, "agents.policy:load_policy", (("path", str(path.resolve())),))
+        return PolicySpec(path.stem, "agents.policy:load_policy", (("path", str(path.resolve())),))
+    raise SystemExit(f"{prog}: policy {name!r}: one of {sorted(POLICIES)}, a path to an SB3 .zip model or a "
+                     "train.py run folder")
