@@ -81,17 +81,25 @@ def vehicle_with_gyro_output(op: OperatingPoint, plane: str = "pitch") -> contro
                       states=names)
 
 
+def _check_plane(plane: str) -> None:
+    if plane not in _SLOPE:
+        raise ValueError(f"plane = {plane!r}: the TVC loop is in 'pitch' or 'yaw' (roll: linearize(plane='roll'))")
+
+
+def gyro_chain(op: OperatingPoint, plane: str = "pitch") -> control.StateSpace:
+    """Continuous chain from the gimbal angle in force [rad] to the gyro's filtered output [rad/s]: the
+    vehicle, the slope at the IMU and the gyro filters (step 3-4 of the module docstring)."""
+    _check_plane(plane)
+    chain = vehicle_with_gyro_output(op, plane)
+    f = gyro_filter_ss(op)
+    return control.ss(chain if f is None else control.series(chain, f))
+
+
 def sensed_plant(op: OperatingPoint, plane: str = "pitch") -> control.StateSpace:
     """Continuous chain from the gimbal command [rad] (after the delay and the hold) to the gyro's
     filtered output [rad/s]: servo, vehicle, slope at the IMU, gyro filters (steps 2-4 of the module
     docstring). Not for roll (its input is a moment, no servo)."""
-    if plane not in _SLOPE:
-        raise ValueError(f"plane = {plane!r}: the TVC loop is in 'pitch' or 'yaw' (roll: linearize(plane='roll'))")
-    g = control.series(servo_ss(op), vehicle_with_gyro_output(op, plane))
-    f = gyro_filter_ss(op)
-    if f is not None:
-        g = control.series(g, f)
-    g = control.ss(g)
+    g = control.ss(control.series(servo_ss(op), gyro_chain(op, plane)))
     inp = PLANES[plane][5]
     return control.ss(g.A, g.B, g.C, g.D, inputs=[f"{inp}_command"], outputs=[f"gyro_{plane}"])
 
@@ -134,12 +142,11 @@ def hold_and_sample(g: control.StateSpace, n: int) -> control.StateSpace:
     """``g`` (discrete at ``h``, no feed-through) with its input held over ``n`` of its steps and its
     output read every ``n`` steps: the system at ``n h`` (``A^n``, ``sum_i A^i B``, ``C``)."""
     A, B = np.asarray(g.A, float), np.asarray(g.B, float)
-    An, Bn, P = np.eye(A.shape[0]), np.zeros_like(B), np.eye(A.shape[0])
+    Bn, P = np.zeros_like(B), np.eye(A.shape[0])
     for _ in range(n):
         Bn = Bn + P @ B
         P = P @ A
-    An = P
-    return control.ss(An, Bn, g.C, g.D, g.dt * n)
+    return control.ss(P, Bn, g.C, g.D, g.dt * n)
 
 
 def flight_plant(op: OperatingPoint, plane: str = "pitch", dt: float | None = None,
@@ -150,8 +157,7 @@ def flight_plant(op: OperatingPoint, plane: str = "pitch", dt: float | None = No
     Euler map at the physics step (:func:`servo_discrete`), the gimbal held over each physics step into
     the vehicle and the gyro filters (ZOH at the physics step), the command held over the control
     period's physics steps and the gyro read at its end (:func:`hold_and_sample`)."""
-    if plane not in _SLOPE:
-        raise ValueError(f"plane = {plane!r}: the TVC loop is in 'pitch' or 'yaw' (roll: linearize(plane='roll'))")
+    _check_plane(plane)
     env_dt, env_delay = control_timing(op)
     dt = env_dt if dt is None else float(dt)
     delay_steps = env_delay if delay_steps is None else int(delay_steps)
@@ -159,11 +165,7 @@ def flight_plant(op: OperatingPoint, plane: str = "pitch", dt: float | None = No
     n = int(round(dt / h))
     if n < 1 or abs(n * h - dt) > 1e-9 * dt:
         raise ValueError(f"dt = {dt!r}: a whole multiple of the physics step {h!r} s")
-    chain = vehicle_with_gyro_output(op, plane)
-    f = gyro_filter_ss(op)
-    if f is not None:
-        chain = control.series(chain, f)
-    g = control.series(servo_discrete(op, h), control.c2d(control.ss(chain), h, "zoh"))
+    g = control.series(servo_discrete(op, h), control.c2d(gyro_chain(op, plane), h, "zoh"))
     g = hold_and_sample(control.ss(g), n)
     d = control.series(delay_ss(delay_steps, dt), g)
     inp = PLANES[plane][5]
