@@ -326,7 +326,7 @@ def margins_table(results: Sequence[dict[str, Any]]) -> str:
     for res in results:
         for name, c in res["conditions"].items():
             res_ms.add(c["delay_resolution_ms"])
-            cells = [_cell(c[f"{e}_{UNITS[e]}"], 0 if e == "delay" else 2) if e in res["experiments"] else "-"
+            cells = [_cell(c[f"{e}_{UNITS[e]}"], 1 if e == "delay" else 2) if e in res["experiments"] else "-"
                      for e in EXPERIMENTS]
             lines.append(f"| {res['policy']} | {name} | {_nominal_cell(c['nominal'])} | " + " | ".join(cells) + " |")
     if results:
