@@ -226,6 +226,9 @@ def run_margins(policies: Sequence[PolicySpec], where: Suite | Condition | Seque
     """:func:`time_domain_margins` of every policy, their searches on one process pool (``executor``,
     ``workers`` as :func:`lvgym.parallel.run_map`); one result per policy, in order."""
     options = options or MarginOptions()
+    names = [p.name for p in policies]
+    if len(set(names)) != len(names):
+        raise ValueError(f"policy names {names}: each must be distinct (they label the results)")
     for e in experiments:
         if e not in EXPERIMENTS:
             raise ValueError(f"experiment = {e!r}: one of {EXPERIMENTS}")
