@@ -9,6 +9,10 @@
 - :mod:`.compare`: the paired comparison of policies and agents over training runs;
 - :mod:`.runner`: :func:`run_episode` and :func:`evaluate` (serial, local process pool or Ray);
 - :mod:`.tables`, :mod:`.results`: the Markdown tables; atomic CSV / JSON / Markdown / PNG result files;
+- :mod:`.registry`: the policies the command lines know by name (import paths, never the packages);
+- :mod:`.margins`, :mod:`.perturb`: time-domain gain and delay margins of any policy
+  (``python -m lvgym.benchmark.margins``; import ``lvgym.benchmark.margins`` for
+  :func:`~.margins.time_domain_margins`: it is not imported here, so that ``-m`` runs it cleanly).
 """
 
 from .compare import compare, run_groups

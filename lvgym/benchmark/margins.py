@@ -226,6 +226,9 @@ def run_margins(policies: Sequence[PolicySpec], where: Suite | Condition | Seque
     """:func:`time_domain_margins` of every policy, their searches on one process pool (``executor``,
     ``workers`` as :func:`lvgym.parallel.run_map`); one result per policy, in order."""
     options = options or MarginOptions()
+    names = [p.name for p in policies]
+    if len(set(names)) != len(names):
+        raise ValueError(f"policy names {names}: each must be distinct (they label the results)")
     for e in experiments:
         if e not in EXPERIMENTS:
             raise ValueError(f"experiment = {e!r}: one of {EXPERIMENTS}")
@@ -326,7 +329,7 @@ def margins_table(results: Sequence[dict[str, Any]]) -> str:
     for res in results:
         for name, c in res["conditions"].items():
             res_ms.add(c["delay_resolution_ms"])
-            cells = [_cell(c[f"{e}_{UNITS[e]}"], 0 if e == "delay" else 2) if e in res["experiments"] else "-"
+            cells = [_cell(c[f"{e}_{UNITS[e]}"], 1 if e == "delay" else 2) if e in res["experiments"] else "-"
                      for e in EXPERIMENTS]
             lines.append(f"| {res['policy']} | {name} | {_nominal_cell(c['nominal'])} | " + " | ".join(cells) + " |")
     if results:
