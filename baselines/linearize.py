@@ -69,11 +69,17 @@ class OperatingPoint:
 
 
 def operating_point(vehicle: str = "smile", t: float = 28.8, model: str = "rigid", protocol: str = "v0",
-                    **options: Any) -> OperatingPoint:
+                    policy: Any = None, **options: Any) -> OperatingPoint:
     """The state of ``vehicle``'s env of ``protocol`` (``v0``, ``v1``) flown with the gimbal centred and
     no wind up to time ``t`` [s]. In v0 the simulator flies alone; in v1 the env flies its zero action
     control period by control period, so that its coast control and settling thrust hold the stack
-    through the staging coast as they do in the benchmark."""
+    through the staging coast as they do in the benchmark.
+
+    ``policy`` (v1 only): fly up to ``t`` with this controller instead of the zero action, a callable
+    ``env -> policy`` (a benchmark policy factory such as :func:`.pid.smile_scheduled_pid`) or a policy
+    (``reset()``, ``act(observation, info)``). The upper stage of ``smile_v1`` needs one: flown with
+    the zero action it tumbles and the episode ends at 60.7 s. The linearisation is still taken about
+    the gimbal centred at the state reached."""
     ids = ENV_IDS.get(protocol)
     if ids is None:
         raise ValueError(f"protocol = {protocol!r}: one of {sorted(ENV_IDS)}")
@@ -83,9 +89,15 @@ def operating_point(vehicle: str = "smile", t: float = 28.8, model: str = "rigid
     opts = {"model": model, "wind": "none", **options}
     if vehicle == "stratos3" and protocol == "v0":
         opts.setdefault("control", "tvc")
+    if policy is not None and protocol == "v0":
+        raise ValueError("policy: flies the v1 env only (v0 points are flown with the gimbal centred)")
     env = gym.make(env_id, **opts)
-    env.reset(seed=0)
+    obs, info = env.reset(seed=0)
     task = env.unwrapped
+    if policy is not None and not hasattr(policy, "act"):
+        policy = policy(env)
+    if policy is not None:
+        policy.reset()
     sim = task.sim                                   # its rows are the env's state
     if protocol == "v0":
         if t > 0:
@@ -94,7 +106,8 @@ def operating_point(vehicle: str = "smile", t: float = 28.8, model: str = "rigid
         zero = np.zeros(env.action_space.shape, env.action_space.dtype)
         dt = float(task.task.control_dt_s)
         while float(sim.t[0]) < float(t) - 0.5 * dt:
-            _, _, term, trunc, info = env.step(zero)
+            action = zero if policy is None else policy.act(obs, info)
+            obs, _, term, trunc, info = env.step(action)
             if term or trunc:
                 raise RuntimeError(f"{env_id} ({model}) ended at {info['time']:.2f} s before t = {t} s: "
                                    f"{info.get('termination', '')}")
