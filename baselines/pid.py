@@ -35,7 +35,14 @@ staging coasts).
 
 Scheduling (:class:`GainSchedule`): gains interpolated linearly on a monotonic scheduling variable,
 ``mass`` (the default, as the thesis: ``info["mass"]``, the vehicle's mass at the current time), ``time``
-[s] or ``mach``; beyond the table the end gains are held.
+[s] or ``mach``; beyond the table the end gains are held. ``interpolation: nearest`` takes the nearest
+row instead (switching at the midpoints between breakpoints): each row is then a design for its own
+stretch of the flight, as ``gs-pid-flex``'s are.
+
+Structural filters (``gs-pid-flex``, :mod:`.flexdesign`): a schedule whose rows carry a ``filter``
+(:class:`.filters.StructuralFilter`, its parameters interpolated like the gains) filters each axis's
+error before the PID, ``u = PID(F(e))``; the filter starts in the steady state of the error whenever
+the controller switches on.
 """
 
 from __future__ import annotations
@@ -48,8 +55,12 @@ from typing import Any
 import numpy as np
 import yaml
 
+from .filters import FILTER_KEYS, FilterChain, StructuralFilter
+
 SCHEDULES = Path(__file__).resolve().parent / "schedules"
 VARIABLES = ("mass", "time", "mach")
+#: how a schedule reads between breakpoints: linearly, or the nearest row (switching at the midpoints)
+INTERPOLATIONS = ("linear", "nearest")
 #: the thesis's single gain set (6.3.1), tuned on the rigid SMILE at 28.8 s; N as Table 6.10's 28.8 s row
 THESIS_SINGLE = {"kp": 8.98, "ki": 3.92, "kd": 4.57, "n": 500.0}
 
@@ -116,6 +127,8 @@ class GainSchedule:
     kd: tuple[float, ...]
     n: tuple[float, ...]
     meta: dict = field(default_factory=dict, compare=False)
+    filters: tuple[StructuralFilter, ...] | None = None
+    interpolation: str = "linear"
 
     def __post_init__(self) -> None:
         if self.variable not in VARIABLES:
@@ -135,13 +148,27 @@ class GainSchedule:
                 raise ValueError(f"{key} = {list(getattr(self, key))}: finite gains >= 0")
         if any(not v > 0 for v in self.n):
             raise ValueError(f"n = {list(self.n)}: filter coefficients > 0")
+        if self.interpolation not in INTERPOLATIONS:
+            raise ValueError(f"interpolation = {self.interpolation!r}: one of {INTERPOLATIONS}")
+        if self.filters is not None and len(self.filters) != m:
+            raise ValueError(f"filters has {len(self.filters)} entries for {m} breakpoints")
+
+    def _interp(self, value: float, column) -> float:
+        x = np.asarray(self.points, float)
+        if self.interpolation == "nearest":
+            return float(np.asarray(column, float)[int(np.argmin(np.abs(x - value)))])
+        order = np.argsort(x)
+        return float(np.interp(value, x[order], np.asarray(column, float)[order]))
+
+    def filter_at(self, value: float) -> StructuralFilter | None:
+        """The structural filter at ``value`` (each parameter interpolated linearly), or None."""
+        if self.filters is None:
+            return None
+        return StructuralFilter(**{k: self._interp(value, [getattr(f, k) for f in self.filters]) for k in FILTER_KEYS})
 
     def gains(self, value: float) -> tuple[float, float, float, float]:
         """(kp, ki, kd, n) at ``value`` of the scheduling variable."""
-        x = np.asarray(self.points, float)
-        order = np.argsort(x)
-        return tuple(float(np.interp(value, x[order], np.asarray(getattr(self, k), float)[order]))
-                     for k in ("kp", "ki", "kd", "n"))
+        return tuple(self._interp(value, getattr(self, k)) for k in ("kp", "ki", "kd", "n"))
 
     # ------------------------------------------------------------------ files
     @classmethod
@@ -150,9 +177,14 @@ class GainSchedule:
         var = data.get("variable", "mass")
         key = {"mass": "mass_kg", "time": "time_s", "mach": "mach"}[var]
         get = lambda k, default=None: tuple(float(r.get(k, default)) for r in rows)  # noqa: E731
-        meta = {k: v for k, v in data.items() if k not in ("rows", "variable")}
+        meta = {k: v for k, v in data.items() if k not in ("rows", "variable", "interpolation")}
         meta["rows"] = rows
-        return cls(var, get(key), get("kp"), get("ki"), get("kd"), get("n", math.inf), meta)
+        with_filter = [("filter" in r) for r in rows]
+        if any(with_filter) and not all(with_filter):
+            raise ValueError(f"rows {[i for i, f in enumerate(with_filter) if not f]} have no 'filter': every row or none")
+        filters = tuple(StructuralFilter.from_dict(r["filter"]) for r in rows) if all(with_filter) and rows else None
+        return cls(var, get(key), get("kp"), get("ki"), get("kd"), get("n", math.inf), meta, filters,
+                   data.get("interpolation", "linear"))
 
     @classmethod
     def load(cls, path: str | Path) -> "GainSchedule":
@@ -185,12 +217,27 @@ class PIDPolicy:
         self._i_err = [lay.index("pitch_rate_error"), lay.index("yaw_rate_error")]
         self._i_on, self._i_mach = lay.index("controller_on"), lay.index("mach_over_10")
         self.axes = [DiscretePID(kp, ki, kd, n, self.dt, -self.limit, self.limit) for _ in range(2)]
+        self.chains: list[FilterChain] | None = None      # structural filters of the error, per axis
+        self._filtering = False
         self.last_gimbal = np.zeros(2)
 
     def reset(self) -> None:
         for pid in self.axes:
             pid.reset()
+        self._filtering = False
         self.last_gimbal = np.zeros(2)
+
+    def filtered(self, errors: np.ndarray, on: bool) -> np.ndarray:
+        """The errors through the axes' structural filters (unchanged without filters or while off);
+        the filters start in the steady state of the error when the controller switches on."""
+        if self.chains is None or not on:
+            self._filtering = False
+            return errors
+        if not self._filtering:
+            for chain, e in zip(self.chains, errors):
+                chain.reset(e)
+            self._filtering = True
+        return np.array([chain.update(e) for chain, e in zip(self.chains, errors)])
 
     def enabled(self, observation: np.ndarray) -> bool:
         """The env's controller-on flag for the coming step."""
@@ -203,7 +250,7 @@ class PIDPolicy:
         obs = np.asarray(observation, dtype=float)
         on = self.enabled(obs)
         self.schedule_gains(obs, info)
-        errors = -obs[self._i_err]                    # reference - rate, pitch and yaw
+        errors = self.filtered(-obs[self._i_err], on)   # reference - rate, pitch and yaw
         self.last_gimbal = np.array([pid.update(e, on) for pid, e in zip(self.axes, errors)])
         return np.clip(self.last_gimbal / self.limit, -1.0, 1.0).astype(np.float32)
 
@@ -216,6 +263,9 @@ class GainScheduledPIDPolicy(PIDPolicy):
         self.schedule = schedule if isinstance(schedule, GainSchedule) else GainSchedule.load(schedule)
         g = self.schedule.gains(self.schedule.points[0])
         super().__init__(*g, env=env, name=name)
+        if self.schedule.filters is not None:
+            f0 = self.schedule.filter_at(self.schedule.points[0])
+            self.chains = [FilterChain(f0, self.dt) for _ in self.axes]
         self.value = float("nan")
 
     def variable(self, observation: np.ndarray, info: dict[str, Any]) -> float:
@@ -231,6 +281,11 @@ class GainScheduledPIDPolicy(PIDPolicy):
         g = self.schedule.gains(self.value)
         for pid in self.axes:
             pid.set_gains(*g)
+        if self.chains is not None:
+            filt = self.schedule.filter_at(self.value)
+            coeffs = filt.discrete(self.dt)               # the same filter on both axes
+            for chain in self.chains:
+                chain.set_filter(filt, coeffs)
 
 
 # ---------------------------------------------------------------------------- presets

@@ -137,19 +137,21 @@ def schedule(vehicle: str = "smile", times=None, bandwidth: float = 75.0, pm_deg
 RESULTS = Path("results") / "schedules"
 
 
-def output_path(vehicle: str, out: str | None, overwrite: bool) -> Path:
+def output_path(vehicle: str, out: str | None, overwrite: bool, stem: str | None = None) -> Path:
     """The file a run writes: ``out``, else the shipped schedule with ``overwrite``, else
-    ``results/schedules/<vehicle>.yaml``. A shipped schedule (a file in ``baselines/schedules/``) is
-    never written without ``overwrite``: a ``ConfigError`` naming ``--out`` instead."""
+    ``results/schedules/<stem>.yaml`` (``stem`` defaults to the vehicle). A shipped schedule (a file in
+    ``baselines/schedules/``) is never written without ``overwrite``: a ``ConfigError`` naming ``--out``
+    instead."""
     from lvgym.errors import ConfigError
 
+    stem = stem or vehicle
     if out is None:
-        return SCHEDULES / f"{vehicle}.yaml" if overwrite else RESULTS / f"{vehicle}.yaml"
+        return SCHEDULES / f"{stem}.yaml" if overwrite else RESULTS / f"{stem}.yaml"
     path = Path(out)
     shipped = path.resolve().parent == SCHEDULES.resolve()
     if shipped and path.exists() and not overwrite:
         raise ConfigError("--out", out, "not a shipped schedule (gs-pid reads it): add --overwrite to replace it, "
-                          f"or write elsewhere (default {RESULTS / (vehicle + '.yaml')})")
+                          f"or write elsewhere (default {RESULTS / (stem + '.yaml')})")
     if path.is_dir():
         raise ConfigError("--out", out, "a YAML file path, not a folder")
     return path

@@ -1,0 +1,147 @@
+"""Structural filters of a TVC loop: a lead-lag, a second-order low-pass and a notch, in series, each
+designed in continuous time and discretised at the control rate by the bilinear (Tustin) transform,
+prewarped at its own characteristic frequency (so the discrete notch and low-pass sit exactly at their
+design frequencies).
+
+The sections, all of unit gain at zero frequency (so they do not change the loop's low-frequency gain
+and a filter started in steady state passes a constant through unchanged):
+
+* lead-lag ``(s / w_z + 1) / (s / w_p + 1)`` (``lead_zero_radps``, ``lead_pole_radps``; equal: off);
+* low-pass ``w_l^2 / (s^2 + 2 z_l w_l s + w_l^2)`` (``lowpass_radps``, ``lowpass_damping``);
+* notch ``(s^2 + 2 r z_n w_n s + w_n^2) / (s^2 + 2 z_n w_n s + w_n^2)`` (``notch_radps``, width
+  ``notch_damping`` z_n, ``notch_depth`` r = the gain at ``w_n``; 1: off).
+
+:class:`StructuralFilter` holds the parameters (frozen, validated); :class:`FilterChain` runs the
+discrete filter sample by sample (direct form II transposed per section), with coefficients that may
+change between samples (a scheduled filter); :meth:`StructuralFilter.tf` is the same discrete filter
+as a python-control transfer function, for the linear design and the tests.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, fields
+
+import control
+import numpy as np
+
+__all__ = ["StructuralFilter", "FilterChain", "FILTER_KEYS"]
+
+
+@dataclass(frozen=True)
+class StructuralFilter:
+    """Continuous parameters of the filter chain [rad/s and -]; the defaults are all sections off
+    except a low-pass at 150 rad/s (about the Nyquist frequency of 50 Hz control)."""
+
+    lead_zero_radps: float = 10.0
+    lead_pole_radps: float = 10.0
+    lowpass_radps: float = 150.0
+    lowpass_damping: float = 0.7
+    notch_radps: float = 70.0
+    notch_damping: float = 0.3
+    notch_depth: float = 1.0
+
+    def __post_init__(self) -> None:
+        for f in fields(self):
+            v = getattr(self, f.name)
+            if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0.0):
+                raise ValueError(f"{f.name} = {v!r}: a finite number > 0")
+        if not self.lowpass_damping <= 2.0 or not self.notch_damping <= 2.0:
+            raise ValueError(f"lowpass_damping = {self.lowpass_damping!r}, notch_damping = {self.notch_damping!r}: "
+                             "dampings in (0, 2]")
+        if not self.notch_depth <= 1.0:
+            raise ValueError(f"notch_depth = {self.notch_depth!r}: the notch's gain at its centre, in (0, 1]")
+
+    @classmethod
+    def from_dict(cls, data: dict) -> "StructuralFilter":
+        unknown = set(data) - set(FILTER_KEYS)
+        if unknown:
+            raise ValueError(f"filter keys {sorted(unknown)}: allowed are {list(FILTER_KEYS)}")
+        return cls(**{k: float(v) for k, v in data.items()})
+
+    def as_dict(self) -> dict[str, float]:
+        return {k: float(getattr(self, k)) for k in FILTER_KEYS}
+
+    def continuous(self) -> list[tuple[list[float], list[float], float]]:
+        """The sections as (numerator, denominator, prewarp frequency [rad/s]) in ``s``."""
+        wz, wp = self.lead_zero_radps, self.lead_pole_radps
+        wl, zl = self.lowpass_radps, self.lowpass_damping
+        wn, zn, r = self.notch_radps, self.notch_damping, self.notch_depth
+        return [([1.0 / wz, 1.0], [1.0 / wp, 1.0], math.sqrt(wz * wp)),
+                ([wl * wl], [1.0, 2.0 * zl * wl, wl * wl], wl),
+                ([1.0, 2.0 * r * zn * wn, wn * wn], [1.0, 2.0 * zn * wn, wn * wn], wn)]
+
+    def discrete(self, dt: float) -> list[tuple[np.ndarray, np.ndarray]]:
+        """The sections in ``z`` at the sampling period ``dt`` [s] (Tustin, prewarped), each as
+        (b, a) of length 3 with ``a[0] = 1`` (a first-order section ``(b0 z + b1) / (z + a1)`` as
+        ``(b0, b1, 0), (1, a1, 0)``). A prewarp frequency at or above the Nyquist frequency is clamped
+        just below it."""
+        out = []
+        for b, a, w0 in self.continuous():
+            w0 = min(w0, 0.95 * math.pi / dt)
+            k = w0 / math.tan(0.5 * w0 * dt)             # s = k (z - 1) / (z + 1)
+            n = max(len(b), len(a))                      # both at the section's degree
+            b, a = [0.0] * (n - len(b)) + list(b), [0.0] * (n - len(a)) + list(a)
+            bz, az = _bilinear(b, k), _bilinear(a, k)
+            out.append((bz / az[0], az / az[0]))
+        return out
+
+    def tf(self, dt: float) -> control.TransferFunction:
+        """The discrete filter chain as a python-control transfer function at ``dt`` [s]."""
+        g = control.tf([1.0], [1.0], dt)
+        for b, a in self.discrete(dt):
+            g = g * control.tf(b, a, dt)
+        return g
+
+
+FILTER_KEYS = tuple(f.name for f in fields(StructuralFilter))
+
+
+def _bilinear(c: list[float], k: float) -> np.ndarray:
+    """A polynomial in ``s`` of degree 1 or 2 with ``s = k (z - 1) / (z + 1)``, times ``(z + 1)^degree``:
+    its coefficients in ``z`` (padded to length 3)."""
+    if len(c) == 2:
+        c0, c1 = c
+        return np.array([c0 * k + c1, c1 - c0 * k, 0.0])
+    c0, c1, c2 = c
+    kk = k * k
+    return np.array([c0 * kk + c1 * k + c2, 2.0 * (c2 - c0 * kk), c0 * kk - c1 * k + c2])
+
+
+class FilterChain:
+    """The discrete :class:`StructuralFilter` run sample by sample: ``update(x) -> y``.
+
+    Direct form II transposed per section. :meth:`set_filter` changes the coefficients and keeps the
+    states (a filter scheduled over the flight changes slowly); :meth:`reset` puts every section in
+    the steady state of a constant input ``x0`` (0 by default), so that a loop switched on does not
+    see a filter transient."""
+
+    def __init__(self, filt: StructuralFilter, dt: float) -> None:
+        if not dt > 0.0:
+            raise ValueError(f"dt = {dt!r}: a sampling period > 0 s")
+        self.dt = float(dt)
+        self.set_filter(filt)
+        self.reset()
+
+    def set_filter(self, filt: StructuralFilter, coeffs: list | None = None) -> None:
+        """New coefficients (``coeffs``: ``filt.discrete(dt)`` when already computed), states kept."""
+        self.filter = filt
+        self.coeffs = filt.discrete(self.dt) if coeffs is None else coeffs
+
+    def reset(self, x0: float = 0.0) -> None:
+        self.state = np.zeros((len(self.coeffs), 2))
+        x = float(x0)
+        for i, (b, a) in enumerate(self.coeffs):
+            y = x * b.sum() / a.sum()                    # the section's DC gain (1) times its input
+            s2 = b[2] * x - a[2] * y
+            self.state[i] = (b[1] * x - a[1] * y + s2, s2)
+            x = y
+
+    def update(self, x: float) -> float:
+        y = float(x)
+        for i, (b, a) in enumerate(self.coeffs):
+            s1, s2 = self.state[i]
+            out = b[0] * y + s1
+            self.state[i] = (b[1] * y - a[1] * out + s2, b[2] * y - a[2] * out)
+            y = out
+        return y
