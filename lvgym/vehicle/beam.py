@@ -10,8 +10,10 @@ This module computes them for a beam of piecewise-constant sections with point m
   element shape functions (they need not sit on nodes). No shear deformation and no rotary inertia
   of the sections (Euler-Bernoulli); the beam is free at both ends.
 * The two rigid-body modes (translation and rotation) are removed exactly: the generalised
-  symmetric problem ``K q = omega^2 M q`` is solved by ``scipy.linalg.eigh`` on the subspace
-  M-orthogonal to them, so every elastic mode has zero linear and angular momentum.
+  symmetric problem ``K q = omega^2 M q`` is solved on the subspace M-orthogonal to them (Lanczos on
+  the banded factors of ``K`` and ``M``, :mod:`.modesolve`), so every elastic mode has zero linear and
+  angular momentum. ``omega_k^2`` is the Rayleigh quotient of the computed shape, which is accurate to
+  about 1e-11 where the eigensolvers' eigenvalues are not (a few 1e-10).
 * Modes are mass-normalised, ``q_k^T M q_k = 1 kg``: ``phi`` is in 1/sqrt(kg), the modal coordinate
   ``eta`` in sqrt(kg) m, and the physical deflection is ``sum_k eta_k phi_k(x)``.
 * Reproducible: the linear algebra runs on one BLAS thread (``threadpoolctl``). Threaded BLAS sums in an
@@ -45,11 +47,11 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.linalg import eigh, null_space
 from threadpoolctl import ThreadpoolController
 
 from lvgym.errors import ConfigError
 
+from .modesolve import bending_energy, dense_modes, lanczos_modes
 from .sections import (MATERIALS, BeamMesh, DistributedMass, Material, PointMass, Section, frozen_array,
                        mesh_stack, per_element, point_mass_array, stations_on, tube)
 
@@ -151,6 +153,7 @@ def assemble(stations, EI, mass_per_length, point_masses: Sequence = ()) -> tupl
         p = (2 * np.arange(x.size)[::-1, None] + np.arange(2)).ravel()
         K, M = K[np.ix_(p, p)], M[np.ix_(p, p)]
     return K, M
+
 
 
 
@@ -258,20 +261,17 @@ def _modes(stations, EI, mass_per_length, *, point_masses: Sequence = (), n_mode
     mass, first, second = R[:, 0] @ MR[:, 0], R[:, 0] @ MR[:, 1], R[:, 1] @ MR[:, 1]
     cg = first / mass
     if n_modes:
-        T = null_space(MR.T)                     # (n_dof, n_dof - 2): M-orthogonal to both rigid modes
-        Kr, Mr = T.T @ K @ T, T.T @ M @ T
-        # the flexibility form M y = (1 / omega^2) K y: its largest eigenvalues are the lowest modes,
-        # found to a relative accuracy eps * omega_k^2 / omega_1^2 instead of eps * omega_max^2 / omega_k^2
-        n_r = n_dof - 2
-        mu, y = eigh(0.5 * (Mr + Mr.T), 0.5 * (Kr + Kr.T), subset_by_index=[n_r - n_modes, n_r - 1],
-                     overwrite_a=True, overwrite_b=True, check_finite=False)       # K, M checked finite
-        mu, y = mu[::-1], y[:, ::-1]
-        q = T @ (y / np.sqrt(np.einsum("ik,ij,jk->k", y, Mr, y)))        # q^T M q = 1
+        solve = lanczos_modes if n_dof - 2 >= 2 * n_modes + 20 else dense_modes
+        q = solve(K, M, R, MR, n_modes)
+        q = q - R @ np.linalg.solve(R.T @ MR, MR.T @ q)           # exactly no rigid-body motion
+        q = q / np.sqrt((q * (M @ q)).sum(axis=0))                 # q^T M q = 1
         tip = q[-2]
         big = q[np.argmax(np.abs(q[0::2]), axis=0) * 2, np.arange(n_modes)]
         sign = np.where(np.abs(tip) > 1e-9 * np.abs(big), np.sign(tip), np.sign(big))
         q = q * sign
-        omega = 1.0 / np.sqrt(mu)
+        # omega^2 from the Rayleigh quotient of the shape (q^T M q = 1), whose error is second order in
+        # the shape's: the eigensolvers' own eigenvalues are off by up to a few 1e-10 (see :mod:`.modesolve`)
+        omega = np.sqrt(bending_energy(x, ei, q))
     else:
         q, omega = np.zeros((n_dof, 0)), np.zeros(0)
     phi_q, dphi_q = _interpolate(x, q, query)
