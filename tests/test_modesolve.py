@@ -7,8 +7,9 @@ import pytest
 
 from lvgym.vehicle import MassModel, load_vehicle
 from lvgym.vehicle.beam import PointMass, Section, DistributedMass, mesh_stack, modes
-from lvgym.vehicle.beam import _assemble_sorted, _check_beam
-from lvgym.vehicle.modesolve import BANDWIDTH, bending_energy, dense_modes, lanczos_modes
+from lvgym.vehicle.beam import _assemble_band, _check_beam
+from lvgym.vehicle.modesolve import (BANDWIDTH, band_matmul, band_to_dense, bending_energy, dense_modes,
+                                     lanczos_modes)
 from lvgym.vehicle.structure import ModeSchedule
 
 SECTIONS = [Section(0.0, -2.0, 4.0e5, 8.0), Section(-2.0, -8.0, 2.0e6, 12.0), Section(-8.0, -10.0, 1.0e6, 10.0)]
@@ -17,13 +18,13 @@ LIQUID = [DistributedMass(-2.4, -7.8, 600.0)]
 
 
 def stack_matrices():
-    """x, ei, K, M, R, MR of the test stack on ascending nodes."""
+    """x, ei, banded K and M, R, MR of the test stack on ascending nodes."""
     mesh = mesh_stack(SECTIONS, POINTS, LIQUID)
     x, ei, mpl, pm, _ = _check_beam(mesh.stations, mesh.EI, mesh.mass_per_length, mesh.point_masses)
-    K, M = _assemble_sorted(x, ei, mpl, pm)
+    kb, mb = _assemble_band(x, ei, mpl, pm)
     R = np.zeros((2 * x.size, 2))
     R[0::2, 0], R[0::2, 1], R[1::2, 1] = 1.0, x, 1.0
-    return x, ei, K, M, R, M @ R
+    return x, ei, kb, mb, R, band_matmul(mb, R)
 
 
 def normalised(q, M):
@@ -62,8 +63,9 @@ def refined(K, M, q, lam, iterations=3, digits=40):
 
 
 def test_lanczos_and_dense_shapes_agree():
-    x, ei, K, M, R, MR = stack_matrices()
-    a, b = (normalised(f(K, M, R, MR, 4), M) for f in (lanczos_modes, dense_modes))
+    x, ei, kb, mb, R, MR = stack_matrices()
+    M = band_to_dense(mb)
+    a, b = (normalised(f(kb, mb, R, MR, 4), M) for f in (lanczos_modes, dense_modes))
     assert np.abs(a - b).max() <= 1e-9 * np.abs(b).max()
     assert np.abs(R.T @ M @ a).max() <= 1e-10 * np.abs(MR).max() * np.abs(a).max()
 
@@ -71,7 +73,8 @@ def test_lanczos_and_dense_shapes_agree():
 def test_modes_against_a_40_digit_refinement():
     """Frequencies to 2e-11 and shapes to 1e-9 of their largest entry (measured: 1.4e-12 and 1.9e-11 here; on
     the SMILE v1 stacks 1.4e-11 and 3.4e-10, where the old dense eigenvalues were off by up to 5.5e-10)."""
-    x, ei, K, M, R, MR = stack_matrices()
+    x, ei, kb, mb, R, MR = stack_matrices()
+    K, M = band_to_dense(kb), band_to_dense(mb)
     mesh = mesh_stack(SECTIONS, POINTS, LIQUID)
     m = modes(mesh.stations, mesh.EI, mesh.mass_per_length, point_masses=mesh.point_masses, n_modes=3)
     for k in range(3):
@@ -80,8 +83,18 @@ def test_modes_against_a_40_digit_refinement():
         assert np.abs(m._q[:, k] - q).max() <= 1e-9 * np.abs(q).max()
 
 
+def test_banded_storage_and_product():
+    x, ei, kb, mb, R, MR = stack_matrices()
+    M = band_to_dense(mb)
+    X = np.random.default_rng(2).standard_normal((M.shape[0], 3))
+    np.testing.assert_allclose(band_matmul(mb, X), M @ X, rtol=0, atol=1e-13 * np.abs(M).max() * np.abs(X).max())
+    np.testing.assert_array_equal(M, M.T)
+    assert np.abs(np.triu(M, BANDWIDTH + 1)).max() == 0.0
+
+
 def test_bending_energy_is_q_K_q():
-    x, ei, K, M, R, MR = stack_matrices()
+    x, ei, kb, mb, R, MR = stack_matrices()
+    K = band_to_dense(kb)
     q = np.random.default_rng(1).standard_normal((K.shape[0], 3))
     np.testing.assert_allclose(bending_energy(x, ei, q), np.einsum("ik,ij,jk->k", q, K, q), rtol=1e-12)
 
@@ -91,14 +104,17 @@ def test_small_beams_take_the_dense_solve():
     same small beam agrees with it."""
     x = np.linspace(-10.0, 0.0, 11)                                               # 20 elastic DOFs
     m = modes(x, 1e6, 10.0, n_modes=2)
-    K, M = _assemble_sorted(x, np.full(10, 1e6), np.full(10, 10.0), np.zeros((0, 3)))
+    kb, mb = _assemble_band(x, np.full(10, 1e6), np.full(10, 10.0), np.zeros((0, 3)))
     R = np.zeros((22, 2))
     R[0::2, 0], R[0::2, 1], R[1::2, 1] = 1.0, x, 1.0
-    MR = M @ R
-    dense = dense_modes(K, M, R, MR, 2)
-    dense = normalised(dense - R @ np.linalg.solve(R.T @ MR, MR.T @ dense), M)
+    MR = band_matmul(mb, R)
+    dense = dense_modes(kb, mb, R, MR, 2)
+    dense = dense - R @ np.linalg.solve(R.T @ MR, MR.T @ dense)
+    dense = dense / np.sqrt((dense * band_matmul(mb, dense)).sum(axis=0))
+    dense = dense * np.sign(dense[-2])
     np.testing.assert_array_equal(m._q, dense)
-    np.testing.assert_allclose(normalised(lanczos_modes(K, M, R, MR, 2), M), dense, rtol=0, atol=1e-10)
+    M = band_to_dense(mb)
+    np.testing.assert_allclose(normalised(lanczos_modes(kb, mb, R, MR, 2), M), dense, rtol=0, atol=1e-10)
 
 
 def test_smile_v1_modes_the_schedule_reproduces():

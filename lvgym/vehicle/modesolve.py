@@ -1,8 +1,9 @@
 """Eigen-solvers of the free-free beam of :mod:`.beam`: the first few elastic modes of ``K q = omega^2 M q``.
 
-``K`` [N/m, N, N m] and ``M`` [kg, kg m, kg m^2] are the banded (half-bandwidth 3) stiffness and consistent
-mass matrices on the DOFs ``(w_0, theta_0, w_1, ...)`` of ascending nodes; ``R`` (n_dof, 2) are the two
-rigid-body modes (translation, rotation) and ``MR = M R``. Both solvers return DOF vectors of the elastic
+``K`` [N/m, N, N m] and ``M`` [kg, kg m, kg m^2] are the stiffness and consistent mass matrices on the DOFs
+``(w_0, theta_0, w_1, ...)`` of ascending nodes, symmetric with half-bandwidth 3 and passed in LAPACK's upper
+banded storage ``ab[BANDWIDTH + i - j, j] = A[i, j]`` (4, n_dof); ``R`` (n_dof, 2) are the two rigid-body
+modes (translation, rotation) and ``MR = M R``. Both solvers return DOF vectors of the elastic
 modes, lowest first, in the subspace M-orthogonal to ``R``, neither normalised nor signed (:func:`.beam.modes`
 does both and takes the frequencies from :func:`bending_energy`).
 
@@ -21,32 +22,51 @@ off by up to 5e-10 relative in omega, the Rayleigh quotient of :func:`bending_en
 from __future__ import annotations
 
 import numpy as np
-from scipy.linalg import eigh, null_space, solve_triangular
-from scipy.linalg.lapack import dpbtrf, dpbtrs
+from scipy.linalg import eigh, null_space
+from scipy.linalg.blas import dtbmv
+from scipy.linalg.lapack import dpbtrf, dpbtrs, dtbtrs
 
-__all__ = ["BANDWIDTH", "bending_energy", "dense_modes", "lanczos_modes"]
+__all__ = ["BANDWIDTH", "band_matmul", "band_to_dense", "bending_energy", "dense_modes", "lanczos_modes"]
 
 #: half-bandwidth of K and M: the Hermite elements couple the DOFs of neighbouring nodes only
 BANDWIDTH = 3
 
 
-def upper_band(A: np.ndarray) -> np.ndarray:
-    """LAPACK's upper banded storage (``ab[BANDWIDTH + i - j, j] = A[i, j]``) of the symmetric band matrix
-    ``A``."""
-    ab = np.zeros((BANDWIDTH + 1, A.shape[0]))
-    for d in range(BANDWIDTH + 1):
-        ab[BANDWIDTH - d, d:] = np.diagonal(A, d)
-    return ab
-
-
-def band_to_upper(ab: np.ndarray) -> np.ndarray:
-    """The dense upper-triangular matrix of an upper banded storage ``ab``."""
+def band_to_dense(ab: np.ndarray) -> np.ndarray:
+    """The dense symmetric matrix of an upper banded storage ``ab``."""
     n = ab.shape[1]
     out = np.zeros((n, n))
-    for d in range(ab.shape[0]):
-        k = ab.shape[0] - 1 - d
-        out[np.arange(n - k), np.arange(k, n)] = ab[d, k:]
+    for d in range(BANDWIDTH + 1):
+        i = np.arange(n - d)
+        out[i, i + d] = out[i + d, i] = ab[BANDWIDTH - d, d:]
     return out
+
+
+def band_matmul(ab: np.ndarray, X: np.ndarray) -> np.ndarray:
+    """``A @ X`` for the symmetric band matrix ``A`` of upper banded storage ``ab`` and ``X`` (n,) or (n, K)."""
+    w = ab[:, :, None] if X.ndim == 2 else ab
+    out = w[BANDWIDTH] * X
+    for d in range(1, BANDWIDTH + 1):
+        out[:-d] += w[BANDWIDTH - d, d:] * X[d:]
+        out[d:] += w[BANDWIDTH - d, d:] * X[:-d]
+    return out
+
+
+def clamped_band(kb: np.ndarray, node: int) -> np.ndarray:
+    """The banded stiffness ``kb`` with the DOFs of ``node`` clamped: their rows and columns zero, their
+    diagonal 1, so that ``K_c u = f`` with ``f = 0`` at those DOFs gives ``u = 0`` there and the clamped
+    beam's deflection elsewhere (the Cholesky factor of the other DOFs is that of ``K`` without the rows
+    and columns, to the bit: the eliminations only subtract zeros)."""
+    ab = kb.copy()
+    n = ab.shape[1]
+    for dof in (2 * node, 2 * node + 1):
+        for d in range(BANDWIDTH + 1):
+            if dof + d < n:
+                ab[BANDWIDTH - d, dof + d] = 0.0             # row dof, column dof + d
+            if dof - d >= 0:
+                ab[BANDWIDTH - d, dof] = 0.0                 # row dof - d, column dof
+        ab[BANDWIDTH, dof] = 1.0
+    return ab
 
 
 def bending_energy(x: np.ndarray, ei: np.ndarray, q: np.ndarray) -> np.ndarray:
@@ -64,11 +84,12 @@ def bending_energy(x: np.ndarray, ei: np.ndarray, q: np.ndarray) -> np.ndarray:
     return ((ei[:, None] / h) * (mean * mean + 3.0 * skew * skew)).sum(axis=0)
 
 
-def dense_modes(K: np.ndarray, M: np.ndarray, R: np.ndarray, MR: np.ndarray, n_modes: int) -> np.ndarray:
+def dense_modes(kb: np.ndarray, mb: np.ndarray, R: np.ndarray, MR: np.ndarray, n_modes: int) -> np.ndarray:
     """DOF vectors (n_dof, n_modes) of the lowest elastic modes by a dense solve of the flexibility form
     ``M y = (1 / omega^2) K y`` on the subspace M-orthogonal to the rigid modes, whose largest eigenvalues
     are the lowest modes (found to a relative accuracy ``eps omega_k^2 / omega_1^2`` instead of the
     stiffness form's ``eps omega_max^2 / omega_k^2``)."""
+    K, M = band_to_dense(kb), band_to_dense(mb)
     T = null_space(MR.T)                     # (n_dof, n_dof - 2): M-orthogonal to both rigid modes
     Kr, Mr = T.T @ K @ T, T.T @ M @ T
     n_r = T.shape[1]
@@ -77,7 +98,7 @@ def dense_modes(K: np.ndarray, M: np.ndarray, R: np.ndarray, MR: np.ndarray, n_m
     return T @ y[:, ::-1]
 
 
-def lanczos_modes(K: np.ndarray, M: np.ndarray, R: np.ndarray, MR: np.ndarray, n_modes: int) -> np.ndarray:
+def lanczos_modes(kb: np.ndarray, mb: np.ndarray, R: np.ndarray, MR: np.ndarray, n_modes: int) -> np.ndarray:
     """DOF vectors (n_dof, n_modes) of the lowest elastic modes by Lanczos iteration on the beam's
     flexibility, without a dense factorisation.
 
@@ -93,30 +114,32 @@ def lanczos_modes(K: np.ndarray, M: np.ndarray, R: np.ndarray, MR: np.ndarray, n
     it not converge, :func:`dense_modes` answers instead."""
     from scipy.sparse.linalg import ArpackNoConvergence, LinearOperator, eigsh  # 20-30 ms to import
 
-    n = K.shape[0]
+    n = kb.shape[1]
     g = np.linalg.inv(R.T @ MR)                              # (2, 2): the rigid-body mass matrix, inverted
     x = R[0::2, 1]                                           # node stations [m]
     c = int(np.argmin(np.abs(x - (R[:, 0] @ MR[:, 1]) / (R[:, 0] @ MR[:, 0]))))   # the node nearest the CG
-    free = np.r_[0:2 * c, 2 * c + 2:n]                       # every DOF but that node's (K_c stays banded)
-    kc, info_k = dpbtrf(upper_band(K[np.ix_(free, free)]))
-    mc, info_m = dpbtrf(upper_band(M))
+    clamped = slice(2 * c, 2 * c + 2)
+    kc, info_k = dpbtrf(clamped_band(kb, c))
+    mc, info_m = dpbtrf(mb)                                  # M = U^T U, U upper banded
     if info_k or info_m:
         raise np.linalg.LinAlgError(f"banded Cholesky failed (clamped K: {info_k}, M: {info_m})")
-    U = band_to_upper(mc)
-    UR = U @ R
-    relief, clear = MR @ g, UR @ g                           # (n, 2) each
-    u = np.zeros(n)
+    UR = np.column_stack([dtbmv(BANDWIDTH, mc, r) for r in R.T])
+    relief = MR @ g                                          # (n, 2)
 
     def matvec(z: np.ndarray) -> np.ndarray:
         z = z.ravel()
-        f = U.T @ z - relief @ (UR.T @ z)                    # P^T U^T z: a self-equilibrated load
-        u[free] = dpbtrs(kc, f[free])[0]                     # the deflection, clamped at the CG node
-        return U @ u - clear @ (MR.T @ u)                    # U P u: without rigid-body motion
+        f = dtbmv(BANDWIDTH, mc, z, trans=1) - relief @ (UR.T @ z)   # P^T U^T z: a self-equilibrated load
+        f[clamped] = 0.0
+        u = dpbtrs(kc, f)[0]                                 # the deflection, clamped at the CG node
+        return dtbmv(BANDWIDTH, mc, u - R @ (g @ (MR.T @ u)))         # U P u: without rigid-body motion
 
     op = LinearOperator((n, n), matvec=matvec, dtype=float)
     v0 = np.random.default_rng(0).standard_normal(n)
     try:
         mu, z = eigsh(op, k=n_modes, which="LA", v0=v0, ncv=min(n - 2, 2 * n_modes + 8), tol=0.0)
     except ArpackNoConvergence:
-        return dense_modes(K, M, R, MR, n_modes)
-    return solve_triangular(U, z[:, np.argsort(mu)[::-1]], check_finite=False)
+        return dense_modes(kb, mb, R, MR, n_modes)
+    q, info = dtbtrs(mc, z[:, np.argsort(mu)[::-1]])        # q = U^-1 z
+    if info:
+        raise np.linalg.LinAlgError(f"banded triangular solve failed ({info})")
+    return q
