@@ -387,10 +387,9 @@ def mesh_stack(sections: Sequence[Section], point_masses: Sequence = (),
         raise ConfigError("element_length", element_length, "a finite element length > 0 m, or None")
     gap = MERGE_FRACTION * min(h, length)
     kept = [lo, hi]                              # ascending; a breakpoint is kept if no kept one is within gap
-    for b in [*bounds, *pm[:, 0].tolist(), *query.tolist()]:
-        b = float(b)
+    for b in [*map(float, bounds), *pm[:, 0].tolist(), *query.tolist()]:
         i = bisect.bisect_left(kept, b)          # the nearest kept ones are kept[i - 1] and kept[i]
-        if min(abs(b - kept[j]) for j in (i - 1, i) if 0 <= j < len(kept)) >= gap:
+        if (i == len(kept) or kept[i] - b >= gap) and (i == 0 or b - kept[i - 1] >= gap):
             kept.insert(i, b)
     kept = np.array(kept[::-1])
     x = _subdivide(kept, h)
