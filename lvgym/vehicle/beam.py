@@ -13,7 +13,7 @@ This module computes them for a beam of piecewise-constant sections with point m
   symmetric problem ``K q = omega^2 M q`` is solved on the subspace M-orthogonal to them (Lanczos on
   the banded factors of ``K`` and ``M``, :mod:`.modesolve`), so every elastic mode has zero linear and
   angular momentum. ``omega_k^2`` is the Rayleigh quotient of the computed shape, which is accurate to
-  about 1e-11 where the eigensolvers' eigenvalues are not (a few 1e-10).
+  about 1e-11 where the eigensolvers' eigenvalues are not (up to 2e-9).
 * Modes are mass-normalised, ``q_k^T M q_k = 1 kg``: ``phi`` is in 1/sqrt(kg), the modal coordinate
   ``eta`` in sqrt(kg) m, and the physical deflection is ``sum_k eta_k phi_k(x)``.
 * Reproducible: the linear algebra runs on one BLAS thread (``threadpoolctl``). Threaded BLAS sums in an
@@ -120,7 +120,7 @@ _BAND_ROW = BANDWIDTH + _UPPER_I - _UPPER_J
 
 def _assemble_band(x: np.ndarray, ei: np.ndarray, mpl: np.ndarray, pm: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Stiffness and consistent mass matrices of the beam on ascending nodes ``x`` [m] in LAPACK's upper
-    banded storage, ``ab[BANDWIDTH + i - j, j] = A[i, j]`` (:func:`.modesolve.upper_band`), each (4, 2n)."""
+    banded storage, ``ab[BANDWIDTH + i - j, j] = A[i, j]`` (as :mod:`.modesolve` takes them), each (4, 2n)."""
     n_dof = 2 * x.size
     h = np.diff(x)
     o = np.ones_like(h)
@@ -165,7 +165,6 @@ def assemble(stations, EI, mass_per_length, point_masses: Sequence = ()) -> tupl
         p = (2 * np.arange(x.size)[::-1, None] + np.arange(2)).ravel()
         K, M = K[np.ix_(p, p)], M[np.ix_(p, p)]
     return K, M
-
 
 
 
@@ -282,7 +281,7 @@ def _modes(stations, EI, mass_per_length, *, point_masses: Sequence = (), n_mode
         sign = np.where(np.abs(tip) > 1e-9 * np.abs(big), np.sign(tip), np.sign(big))
         q = q * sign
         # omega^2 from the Rayleigh quotient of the shape (q^T M q = 1), whose error is second order in
-        # the shape's: the eigensolvers' own eigenvalues are off by up to a few 1e-10 (see :mod:`.modesolve`)
+        # the shape's: the eigensolvers' own eigenvalues are off by up to 2e-9 (see :mod:`.modesolve`)
         omega = np.sqrt(bending_energy(x, ei, q))
     else:
         q, omega = np.zeros((n_dof, 0)), np.zeros(0)
