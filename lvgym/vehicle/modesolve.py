@@ -22,6 +22,9 @@ eigenvalues are off by up to 2e-9 relative in omega (5e-10 on SMILE v1), the Ray
 
 from __future__ import annotations
 
+import functools
+import inspect
+
 import numpy as np
 from scipy.linalg import eigh, null_space
 from scipy.linalg.blas import dtbmv
@@ -99,6 +102,13 @@ def dense_modes(kb: np.ndarray, mb: np.ndarray, R: np.ndarray, MR: np.ndarray, n
     return T @ y[:, ::-1]
 
 
+@functools.lru_cache(maxsize=1)
+def _eigsh_takes_rng() -> bool:
+    """Whether ``scipy.sparse.linalg.eigsh`` has an ``rng`` argument (SciPy >= 1.15), looked up once."""
+    from scipy.sparse.linalg import eigsh
+    return "rng" in inspect.signature(eigsh).parameters
+
+
 def lanczos_modes(kb: np.ndarray, mb: np.ndarray, R: np.ndarray, MR: np.ndarray, n_modes: int) -> np.ndarray:
     """DOF vectors (n_dof, n_modes) of the lowest elastic modes by Lanczos iteration on the beam's
     flexibility, without a dense factorisation.
@@ -135,10 +145,13 @@ def lanczos_modes(kb: np.ndarray, mb: np.ndarray, R: np.ndarray, MR: np.ndarray,
         return dtbmv(BANDWIDTH, mc, u - R @ (g @ (MR.T @ u)))         # U P u: without rigid-body motion
 
     op = LinearOperator((n, n), matvec=matvec, dtype=float)
-    rng = np.random.default_rng(0)               # passed on too: eigsh's own, from OS entropy, costs 0.2 ms
+    rng = np.random.default_rng(0)
+    # SciPy >= 1.15 takes the generator too (else it draws its own from OS entropy, 0.2 ms a call, unused
+    # as v0 is given); older ones have no rng argument. The start vector is v0 either way.
+    seeded = {"rng": rng} if _eigsh_takes_rng() else {}
     try:
         mu, z = eigsh(op, k=n_modes, which="LA", v0=rng.standard_normal(n), ncv=min(n - 2, 2 * n_modes + 8),
-                      tol=0.0, rng=rng)
+                      tol=0.0, **seeded)
     except ArpackNoConvergence:
         return dense_modes(kb, mb, R, MR, n_modes)
     q, info = dtbtrs(mc, z[:, np.argsort(mu)[::-1]])        # q = U^-1 z
