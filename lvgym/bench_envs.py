@@ -19,8 +19,8 @@ cache, so the mass and mode tables are built (a new or dispersed vehicle); **war
 again, the tables read back (:mod:`lvgym.simulator.cache`). Both read the vehicle file and build the
 aerodynamic tables. Cases: the rigid Stratos III simulator of the RocketPy validation (240 s, 4,803 table rows;
 :func:`lvgym.verify.rocketpy_case.lvgym_simulator`) and ``gymnasium.make`` plus ``reset`` of SmileAscent-v0
-(non-rigid, 1,224 rows, modes at lift-off and at the separation), SmileAscent-v1 (modes every 2 s: 37 beam
-eigen-solves) and SlenderAscent-v0 (10 s).
+(non-rigid, 1,224 rows, modes at lift-off and at the separation), SmileAscent-v1 (modes every 2 s: 33 beam
+eigen-solves), SlenderAscent-v0 (10 s) and SlenderAscent-v1 (6 eigen-solves).
 """
 
 from __future__ import annotations
@@ -116,7 +116,8 @@ def run(min_time: float = 2.0, batch: int = 1024) -> list[tuple[str, str, float,
 
 #: construction cases: label -> what to build (:func:`construction`)
 CONSTRUCTION = {"Simulator('stratos3', 'rigid'), 240 s": "stratos3", "lvgym/SmileAscent-v0": "lvgym/SmileAscent-v0",
-                "lvgym/SmileAscent-v1": "lvgym/SmileAscent-v1", "lvgym/SlenderAscent-v0": "lvgym/SlenderAscent-v0"}
+                "lvgym/SmileAscent-v1": "lvgym/SmileAscent-v1", "lvgym/SlenderAscent-v0": "lvgym/SlenderAscent-v0",
+                "lvgym/SlenderAscent-v1": "lvgym/SlenderAscent-v1"}
 
 
 def _start(what: str) -> None:

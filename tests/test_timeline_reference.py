@@ -4,8 +4,16 @@
 every 20th row and at the rows around each event (both sides of an event share its time), the full arrays
 of the changes of mode basis, and the events. It was written by the per-row ``build_timeline`` of commit
 2a7bc86 (``python tests/test_timeline_reference.py`` with that commit on the path); the array-wise build
-reproduces it to the last bit, so the tolerance below (1e-12 of each array's largest entry) only allows
-for a BLAS or LAPACK that rounds differently. Rewrite the file only when a change of the tables is meant.
+reproduced it to the last bit, so the tolerance (1e-12 of each array's largest entry) only allows for a
+BLAS or LAPACK that rounds differently. Rewrite the file only when a change of the tables is meant.
+
+The arrays that carry bending modes (:data:`MODAL`) get 1e-9 of their largest entry instead: the modes are
+now found by Lanczos on banded factors and their frequencies by Rayleigh quotients
+(:mod:`lvgym.vehicle.modesolve`), not by the dense ``eigh`` that wrote the file. Against eigenpairs of the
+same matrices refined in 40-digit arithmetic (``tests/test_beam.py``), the old frequencies were off by up
+to 2e-9 relative and the new ones by less than 2e-11; the shapes of either solver by 1e-11 ... 5e-10 of
+their largest entry, the float64 floor of this mesh. Measured differences from the file: 4e-10 of the
+largest entry (``mode_transfer`` of smile_v1), 2.4e-12 for ``params``, whose largest entries are not modal.
 """
 
 from __future__ import annotations
@@ -32,6 +40,8 @@ CASES = {
                                             mode_interval=2.0, mode_basis="projected", strips=True)),
 }
 _WHOLE = ("mode_change_t", "mode_transfer", "hold", "sensor_stations", "strip_stations")
+#: arrays with frequencies, shapes or slopes of the bending modes in them (see the module docstring)
+MODAL = ("params", "phi_sensor", "dphi_sensor", "phi_strip", "dphi_strip", "mode_transfer")
 
 
 def build(name: str):
@@ -81,7 +91,8 @@ def test_tables_equal_the_reference(name):
             continue
         scale = float(np.abs(want).max()) if want.size else 0.0
         worst[key] = float(np.abs(have - want).max() / scale) if scale > 0 else 0.0
-    assert max(worst.values()) <= 1e-12, worst
+    assert max(v for k, v in worst.items() if k not in MODAL) <= 1e-12, worst
+    assert max(v for k, v in worst.items() if k in MODAL) <= 1e-9, worst
 
 
 def write(path: Path = REFERENCE) -> None:

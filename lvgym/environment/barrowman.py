@@ -34,6 +34,7 @@ Stations are x_b positions from the nose tip [m] (<= 0), lengths in m.
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
@@ -153,17 +154,30 @@ def wave_ramp(mach: float, supersonic) -> float:
     return t * t * (3.0 - 2.0 * t) * supersonic(M_WAVE_FULL)
 
 
+@functools.lru_cache(maxsize=4)
+def _sine_table(n_terms: int, n_points: int = 4000) -> tuple[np.ndarray, np.ndarray]:
+    """Midpoints ``t`` (n_points,) of ``[0, pi]`` and ``sin(n t)`` (n_terms, n_points) for n = 1..n_terms:
+    constants of :func:`slender_body_wave_drag` (3-4 ms to compute, so computed once), read-only."""
+    t = (np.arange(n_points) + 0.5) * math.pi / n_points
+    n = np.arange(1, n_terms + 1)
+    table = np.sin(n[:, None] * t[None, :])
+    t.flags.writeable = table.flags.writeable = False
+    return t, table
+
+
 def slender_body_wave_drag(shape: str, length: float, radius: float, n_terms: int = 80) -> float:
     """Wave drag coefficient (per base area) of a pointed nose on a cylinder, slender-body theory:
     ``S'(x) = sum A_n sin(n t)``, ``x = L (1 - cos t) / 2``, ``D/q = pi/4 sum n A_n^2``
     (von Karman 1936). The von Karman nose gives ``4 (R/L)^2``. Not for the cone (slope jump)."""
-    t = (np.arange(4000) + 0.5) * math.pi / 4000
+    t, table = _sine_table(n_terms)
     x = 0.5 * length * (1.0 - np.cos(t))
     r = nose_radius(shape, x, length, radius)
     ds_dt = np.gradient(math.pi * r * r, t)
     ds_dx = ds_dt / (0.5 * length * np.sin(t))
     n = np.arange(1, n_terms + 1)
-    a_n = 2.0 / 4000 * (ds_dx[None, :] * np.sin(n[:, None] * t[None, :])).sum(axis=1)
+    # row by row in blocks (each row's sum as over the whole product), without a 2.6 MB temporary
+    a_n = np.concatenate([(ds_dx[None, :] * table[i:i + 8]).sum(axis=1) for i in range(0, n_terms, 8)])
+    a_n = 2.0 / 4000 * a_n
     return float(0.25 * math.pi * np.sum(n * a_n * a_n) / (math.pi * radius * radius))
 
 

@@ -10,8 +10,10 @@ This module computes them for a beam of piecewise-constant sections with point m
   element shape functions (they need not sit on nodes). No shear deformation and no rotary inertia
   of the sections (Euler-Bernoulli); the beam is free at both ends.
 * The two rigid-body modes (translation and rotation) are removed exactly: the generalised
-  symmetric problem ``K q = omega^2 M q`` is solved by ``scipy.linalg.eigh`` on the subspace
-  M-orthogonal to them, so every elastic mode has zero linear and angular momentum.
+  symmetric problem ``K q = omega^2 M q`` is solved on the subspace M-orthogonal to them (Lanczos on
+  the banded factors of ``K`` and ``M``, :mod:`.modesolve`), so every elastic mode has zero linear and
+  angular momentum. ``omega_k^2`` is the Rayleigh quotient of the computed shape, which is accurate to
+  about 1e-11 where the eigensolvers' eigenvalues are not (up to 2e-9).
 * Modes are mass-normalised, ``q_k^T M q_k = 1 kg``: ``phi`` is in 1/sqrt(kg), the modal coordinate
   ``eta`` in sqrt(kg) m, and the physical deflection is ``sum_k eta_k phi_k(x)``.
 * Reproducible: the linear algebra runs on one BLAS thread (``threadpoolctl``). Threaded BLAS sums in an
@@ -45,11 +47,11 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.linalg import eigh, null_space
 from threadpoolctl import ThreadpoolController
 
 from lvgym.errors import ConfigError
 
+from .modesolve import BANDWIDTH, band_matmul, band_to_dense, bending_energy, dense_modes, lanczos_modes
 from .sections import (MATERIALS, BeamMesh, DistributedMass, Material, PointMass, Section, frozen_array,
                        mesh_stack, per_element, point_mass_array, stations_on, tube)
 
@@ -110,33 +112,45 @@ def _check_beam(stations, EI, mass_per_length, point_masses):
     return x, ei, mpl, point_mass_array(point_masses, float(x[0]), float(x[-1])), flip
 
 
-def _assemble_sorted(x: np.ndarray, ei: np.ndarray, mpl: np.ndarray, pm: np.ndarray):
+#: the entries (i, j), i <= j, of a Hermite element's 4 x 4 matrices, and where they go in LAPACK's upper
+#: banded storage of the element's first DOF: row BANDWIDTH + i - j, column offset j
+_UPPER_I, _UPPER_J = np.triu_indices(4)
+_BAND_ROW = BANDWIDTH + _UPPER_I - _UPPER_J
+
+
+def _assemble_band(x: np.ndarray, ei: np.ndarray, mpl: np.ndarray, pm: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Stiffness and consistent mass matrices of the beam on ascending nodes ``x`` [m] in LAPACK's upper
+    banded storage, ``ab[BANDWIDTH + i - j, j] = A[i, j]`` (as :mod:`.modesolve` takes them), each (4, 2n)."""
     n_dof = 2 * x.size
     h = np.diff(x)
     o = np.ones_like(h)
-    kb = np.array([[12 * o, 6 * h, -12 * o, 6 * h], [6 * h, 4 * h * h, -6 * h, 2 * h * h],
-                   [-12 * o, -6 * h, 12 * o, -6 * h], [6 * h, 2 * h * h, -6 * h, 4 * h * h]])
-    mb = np.array([[156 * o, 22 * h, 54 * o, -13 * h], [22 * h, 4 * h * h, 13 * h, -3 * h * h],
-                   [54 * o, 13 * h, 156 * o, -22 * h], [-13 * h, -3 * h * h, -22 * h, 4 * h * h]])
-    ke = np.moveaxis(kb, -1, 0) * (ei / h**3)[:, None, None]         # (n_el, 4, 4)
-    me = np.moveaxis(mb, -1, 0) * (mpl * h / 420.0)[:, None, None]
-    K = np.zeros((n_dof, n_dof))
-    M = np.zeros((n_dof, n_dof))
+    hh = (4 * h * h, 2 * h * h, -3 * h * h)
+    # upper entries in the order of _UPPER_I, _UPPER_J: (0,0) (0,1) (0,2) (0,3) (1,1) (1,2) (1,3) (2,2) (2,3) (3,3)
+    ke = np.stack([12 * o, 6 * h, -12 * o, 6 * h, hh[0], -6 * h, hh[1], 12 * o, -6 * h, hh[0]], axis=-1)
+    me = np.stack([156 * o, 22 * h, 54 * o, -13 * h, hh[0], 13 * h, hh[2], 156 * o, -22 * h, hh[0]], axis=-1)
+    ke = ke * (ei / h**3)[:, None]                                  # (n_el, 10)
+    me = me * (mpl * h / 420.0)[:, None]
+    K = np.zeros((BANDWIDTH + 1, n_dof))
+    M = np.zeros((BANDWIDTH + 1, n_dof))
     # even elements, then odd ones: no two elements of a pass share a DOF, and an entry has at most two
     # terms (one per element), which add to the same sum in either order
     for first in (0, 1):
         e = np.arange(first, h.size, 2)
-        d = 2 * e[:, None] + np.arange(4)                              # (elements, 4)
-        K[d[:, :, None], d[:, None, :]] += ke[e]
-        M[d[:, :, None], d[:, None, :]] += me[e]
+        col = 2 * e[:, None] + _UPPER_J                             # (elements, 10)
+        K[_BAND_ROW, col] += ke[e]
+        M[_BAND_ROW, col] += me[e]
     if pm.size:                                  # point masses, in turn (several may share an element)
         e = np.minimum(np.searchsorted(x, pm[:, 0], side="right") - 1, h.size - 1)
         N, dN = _hermite((pm[:, 0] - x[e]) / h[e], h[e])              # (P, 4)
-        add = (pm[:, 1, None, None] * (N[:, :, None] * N[:, None, :])
-               + pm[:, 2, None, None] * (dN[:, :, None] * dN[:, None, :]))
-        d = 2 * e[:, None] + np.arange(4)
-        np.add.at(M, (d[:, :, None], d[:, None, :]), add)
+        add = (pm[:, 1, None] * (N[:, _UPPER_I] * N[:, _UPPER_J])
+               + pm[:, 2, None] * (dN[:, _UPPER_I] * dN[:, _UPPER_J]))
+        np.add.at(M, (np.broadcast_to(_BAND_ROW, add.shape), 2 * e[:, None] + _UPPER_J), add)
     return K, M
+
+
+def _assemble_sorted(x: np.ndarray, ei: np.ndarray, mpl: np.ndarray, pm: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Dense stiffness and mass matrices of the beam on ascending nodes ``x`` [m] (:func:`_assemble_band`)."""
+    return tuple(band_to_dense(ab) for ab in _assemble_band(x, ei, mpl, pm))
 
 
 def assemble(stations, EI, mass_per_length, point_masses: Sequence = ()) -> tuple[np.ndarray, np.ndarray]:
@@ -188,7 +202,7 @@ class BeamModes:
     inertia_cg: float
     _x: np.ndarray = field(repr=False)      # nodes, ascending [m]
     _q: np.ndarray = field(repr=False)      # DOF vectors on ascending nodes, (2n, K)
-    _m: np.ndarray = field(repr=False)      # consistent mass matrix on the DOFs of _q, (2n, 2n)
+    _mb: np.ndarray = field(repr=False)     # consistent mass matrix on the DOFs of _q, upper banded (4, 2n)
 
     @property
     def n_modes(self) -> int:
@@ -249,29 +263,26 @@ def _modes(stations, EI, mass_per_length, *, point_masses: Sequence = (), n_mode
     if isinstance(n_modes, bool) or not isinstance(n_modes, (int, np.integer)) or not 0 <= n_modes <= n_dof - 2:
         raise ConfigError("n_modes", n_modes, f"an integer in [0, {n_dof - 2}] (2 x nodes - 2 rigid modes)")
     query = stations_on(query_stations, float(x[0]), float(x[-1]), "query_stations")
-    K, M = _assemble_sorted(x, ei, mpl, pm)
+    kb, mb = _assemble_band(x, ei, mpl, pm)
     R = np.zeros((n_dof, 2))                     # rigid modes: translation; rotation about station 0
     R[0::2, 0] = 1.0
     R[0::2, 1] = x
     R[1::2, 1] = 1.0
-    MR = M @ R
+    MR = band_matmul(mb, R)
     mass, first, second = R[:, 0] @ MR[:, 0], R[:, 0] @ MR[:, 1], R[:, 1] @ MR[:, 1]
     cg = first / mass
     if n_modes:
-        T = null_space(MR.T)                     # (n_dof, n_dof - 2): M-orthogonal to both rigid modes
-        Kr, Mr = T.T @ K @ T, T.T @ M @ T
-        # the flexibility form M y = (1 / omega^2) K y: its largest eigenvalues are the lowest modes,
-        # found to a relative accuracy eps * omega_k^2 / omega_1^2 instead of eps * omega_max^2 / omega_k^2
-        n_r = n_dof - 2
-        mu, y = eigh(0.5 * (Mr + Mr.T), 0.5 * (Kr + Kr.T), subset_by_index=[n_r - n_modes, n_r - 1],
-                     overwrite_a=True, overwrite_b=True, check_finite=False)       # K, M checked finite
-        mu, y = mu[::-1], y[:, ::-1]
-        q = T @ (y / np.sqrt(np.einsum("ik,ij,jk->k", y, Mr, y)))        # q^T M q = 1
+        solve = lanczos_modes if n_dof - 2 >= 2 * n_modes + 20 else dense_modes
+        q = solve(kb, mb, R, MR, n_modes)
+        q = q - R @ np.linalg.solve(R.T @ MR, MR.T @ q)           # exactly no rigid-body motion
+        q = q / np.sqrt((q * band_matmul(mb, q)).sum(axis=0))      # q^T M q = 1
         tip = q[-2]
         big = q[np.argmax(np.abs(q[0::2]), axis=0) * 2, np.arange(n_modes)]
         sign = np.where(np.abs(tip) > 1e-9 * np.abs(big), np.sign(tip), np.sign(big))
         q = q * sign
-        omega = 1.0 / np.sqrt(mu)
+        # omega^2 from the Rayleigh quotient of the shape (q^T M q = 1), whose error is second order in
+        # the shape's: the eigensolvers' own eigenvalues are off by up to 2e-9 (see :mod:`.modesolve`)
+        omega = np.sqrt(bending_energy(x, ei, q))
     else:
         q, omega = np.zeros((n_dof, 0)), np.zeros(0)
     phi_q, dphi_q = _interpolate(x, q, query)
@@ -280,7 +291,7 @@ def _modes(stations, EI, mass_per_length, *, point_masses: Sequence = (), n_mode
     return BeamModes(omega=fa(omega), node_stations=fa(x[order]), phi_nodes=fa(q[0::2][order]),
                      dphi_nodes=fa(q[1::2][order]), query_stations=fa(query), phi=fa(phi_q), dphi=fa(dphi_q),
                      mass=float(mass), cg_station=float(cg), inertia_cg=float(second - mass * cg * cg),
-                     _x=fa(x), _q=fa(q), _m=fa(M))
+                     _x=fa(x), _q=fa(q), _mb=fa(mb))
 
 
 def stack_modes(sections: Sequence[Section], point_masses: Sequence = (),
@@ -310,7 +321,7 @@ def transfer(old: BeamModes, new: BeamModes) -> np.ndarray:
         w, theta = _interpolate(old._x, old._q, x)              # (n_new, K_old) each
         q_old = np.empty((2 * x.size, old.n_modes))
         q_old[0::2], q_old[1::2] = w, theta
-        return new._q.T @ (new._m @ q_old)
+        return new._q.T @ band_matmul(new._mb, q_old)
 
 
 # ---------------------------------------------------------------------------- thesis comparison

@@ -37,6 +37,7 @@ your own :class:`Material` then.
 
 from __future__ import annotations
 
+import bisect
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -248,6 +249,20 @@ def stations_on(s, lo: float, hi: float, key: str) -> np.ndarray:
 
 def point_mass_array(point_masses, lo: float, hi: float) -> np.ndarray:
     """(P, 3) array of station [m], mass [kg], rotary inertia [kg m^2]."""
+    if not isinstance(point_masses, (list, tuple)):
+        point_masses = list(point_masses)
+    if all(type(pm) is PointMass for pm in point_masses):    # checked as an array; the loop names a bad one
+        try:
+            a = np.array([(float(pm.station), float(pm.mass), float(pm.rotary_inertia)) for pm in point_masses],
+                         dtype=float).reshape(-1, 3)
+        except (TypeError, ValueError):
+            a = np.full((1, 3), np.nan)
+        tol = 1e-9 * max(1.0, hi - lo)
+        s = a[:, 0]
+        if np.isfinite(a).all() and (a[:, 1:] >= 0.0).all() and (s >= lo - tol).all() and (s <= hi + tol).all():
+            s = np.where(lo > s, lo, s)                      # min(max(station, lo), hi), as the loop's
+            a[:, 0] = np.where(hi < s, hi, s)
+            return a
     rows = []
     for i, pm in enumerate(point_masses):
         try:
@@ -371,11 +386,12 @@ def mesh_stack(sections: Sequence[Section], point_masses: Sequence = (),
     if not (math.isfinite(h) and h > 0.0):
         raise ConfigError("element_length", element_length, "a finite element length > 0 m, or None")
     gap = MERGE_FRACTION * min(h, length)
-    kept = [hi, lo]
-    for b in [*bounds, *pm[:, 0].tolist(), *query.tolist()]:
-        if min(abs(b - k) for k in kept) >= gap:
-            kept.append(float(b))
-    kept = np.sort(kept)[::-1]
+    kept = [lo, hi]                              # ascending; a breakpoint is kept if no kept one is within gap
+    for b in [*map(float, bounds), *pm[:, 0].tolist(), *query.tolist()]:
+        i = bisect.bisect_left(kept, b)          # the nearest kept ones are kept[i - 1] and kept[i]
+        if (i == len(kept) or kept[i] - b >= gap) and (i == 0 or b - kept[i - 1] >= gap):
+            kept.insert(i, b)
+    kept = np.array(kept[::-1])
     x = _subdivide(kept, h)
     h_el = -np.diff(x)
     mpl = -np.diff(_cumulative(x, mass)) / h_el
