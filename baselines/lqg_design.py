@@ -47,7 +47,7 @@ import argparse
 import math
 import sys
 import warnings
-from dataclasses import asdict, dataclass, fields
+from dataclasses import asdict, dataclass, fields, replace
 from pathlib import Path
 from typing import Any
 
@@ -328,8 +328,8 @@ class MarginTargets:
 
 #: the weights tried at every row (q_rate = 1; docs/lqg.md): integral, gimbal and mode-rate weights, gimbal
 #: and mode-rate process noise
-SEARCH_GRID = {"q_int": (10.0, 100.0), "r_gimbal": (3.0, 30.0), "w_gimbal": (1e-8, 1e-7),
-               "q_modes": (1e-5, 1e-4, 1e-3), "w_modes": (1e-5, 1e-4, 1e-3)}
+SEARCH_GRID = {"q_int": (10.0, 100.0), "r_gimbal": (1.0, 3.0, 10.0, 30.0, 300.0), "w_gimbal": (1e-8, 1e-7),
+               "q_modes": (1e-5, 1e-4, 1e-3), "w_modes": (1e-5, 1e-4, 1e-3, 1e-2)}
 _SEARCH_W = np.logspace(-5, math.log10(math.pi / 0.02 * 0.9999), 5000)
 
 
@@ -374,27 +374,62 @@ def shortfall(a: dict[str, Any], tg: MarginTargets) -> float:
     return s
 
 
-#: the frequency [rad/s] of the figure of merit: the rigid loop's gain there (the rigid-body band, where the
-#: wind acts: the higher, the smaller the rate error; the PID's loops have 10-20 dB there)
-MERIT_RADPS = 1.0
+def gust_response(d: RowDesign, op: OperatingPoint, plane: str) -> float:
+    """The figure of merit among designs that meet the targets: the H2 norm [rad/s per (m/s)] of the
+    closed loop (the row's compensator on the plant of ``op``) from a white disturbance of the lateral
+    velocity of the plane (``v_z`` pitch, ``v_y`` yaw: what a gust does to the angle of attack) to the
+    gyro rate; a lightly damped weathercock mode makes it large. The square root of
+    ``C_cl P C_cl^T`` with ``P = A_cl P A_cl^T + B_cl B_cl^T``."""
+    A, B, C, _ = delayed_plant(op, plane)
+    labels = plant_labels(op, plane)
+    Bd = np.zeros((A.shape[0], 1))
+    Bd[labels.index(PLANE_VELOCITY[plane]), 0] = 1.0
+    k = d.compensator()
+    Ac, Bc, Cc, Dc = (np.asarray(m, float) for m in (k.A, k.B, k.C, k.D))
+    Acl = np.block([[A + B @ Dc @ C, B @ Cc], [Bc @ C, Ac]])
+    Bcl = np.vstack([Bd, np.zeros((Ac.shape[0], 1))])
+    Ccl = np.hstack([C, np.zeros((1, Ac.shape[0]))])
+    if np.abs(np.linalg.eigvals(Acl)).max() >= 1.0:
+        return math.inf
+    P = sla.solve_discrete_lyapunov(Acl, Bcl @ Bcl.T)
+    return float(math.sqrt(max((Ccl @ P @ Ccl.T).item(), 0.0)))
 
 
-def merit(d: RowDesign, rigid: control.StateSpace) -> float:
-    """The rigid loop's gain [dB] at :data:`MERIT_RADPS` (the figure of merit among designs that meet
-    the targets)."""
-    return float(20.0 * np.log10(np.abs(frequency_response(open_loop(d.compensator(), rigid), [MERIT_RADPS]))[0]))
+#: the lateral velocity state of each plane (the gust's entry for :func:`gust_response`)
+PLANE_VELOCITY = {"pitch": "v_z", "yaw": "v_y"}
 
 
-def search_row(op_nonrigid: OperatingPoint, op_rigid: OperatingPoint, neighbours: list[OperatingPoint],
+def dispersed(op: OperatingPoint, frequency_scale: float, damping_scale: float) -> OperatingPoint:
+    """``op`` with its pendulums' frequencies scaled by ``frequency_scale`` (lengths / f^2 and the damper
+    frequency x f, as the env's ``slosh_frequency`` dispersion) and their damping ratios by
+    ``damping_scale`` (the ``slosh_damping`` dispersion)."""
+    lay = op.sim.dynamics.layout
+    p = op.p.copy()
+    for j in range(op.sim.dynamics.n_slosh):
+        p[lay.slosh_param(j, "length")] /= frequency_scale ** 2
+        p[lay.slosh_param(j, "omega")] *= frequency_scale
+        p[lay.slosh_param(j, "zeta")] *= damping_scale
+    return replace(op, p=p)
+
+
+#: the dispersed plants every row must stay stable on (:func:`dispersed`: slosh frequency, damping): the
+#: env's slosh-frequency dispersion at 2 sigma (x N(1, 5 %)) with the low end of its damping dispersion
+#: (x [0.5, 2])
+DISPERSED_SLOSH = ((0.9, 0.5), (1.1, 0.5))
+
+
+def search_row(op_nonrigid: OperatingPoint, op_rigid: OperatingPoint, neighbours: dict[str, OperatingPoint],
                plane: str, tg: MarginTargets = MarginTargets(), grid: dict = SEARCH_GRID,
                log=print) -> tuple[RowDesign, dict[str, Any], list[dict]]:
     """Every combination of the weights of ``grid`` at one row: among the designs whose loops are
-    stable on the rigid, the non-rigid and the ``neighbours``' non-rigid plants and meet ``tg``, the one of the highest rigid loop gain at 1 rad/s (:func:`merit`); if none meets them, the one
-    of smallest :func:`shortfall`. Returns the design, its assessment on the full frequency grid and the
+    stable on the rigid, the non-rigid and the ``neighbours``' non-rigid plants (name -> operating
+    point: the ends of the row's interval, the dispersed plants) and meet ``tg``, the one of the
+    smallest rigid gust response (:func:`gust_response`); if none meets them, the one of smallest
+    :func:`shortfall`. Returns the design, its assessment on the full frequency grid and the
     table of every candidate."""
     modes = mode_frequencies(op_nonrigid, plane)
     plants = {"rigid": flight_plant(op_rigid, plane), "nonrigid": flight_plant(op_nonrigid, plane)}
-    plants.update({f"t={op.t:.1f}": flight_plant(op, plane) for op in neighbours})
+    plants.update({name: flight_plant(op, plane) for name, op in neighbours.items()})
     responses = {k: response(g, _SEARCH_W) for k, g in plants.items()}
     table, cands = [], []
     keys = list(grid)
@@ -413,14 +448,15 @@ def search_row(op_nonrigid: OperatingPoint, op_rigid: OperatingPoint, neighbours
             continue
         a = assess(d, plants, modes, _SEARCH_W, responses)
         sf = shortfall(a, tg)
-        mer = merit(d, plants["rigid"])
-        table.append({**asdict(w), "shortfall": sf, "merit_db": mer})
-        cands.append((sf, -mer, len(cands), d, a))
+        h2 = gust_response(d, op_rigid, plane)
+        table.append({**asdict(w), "shortfall": sf, "gust_h2": h2})
+        cands.append((sf, h2, len(cands), d, a))
     if not cands:
         raise RuntimeError(f"no design of the grid could be computed at t = {op_nonrigid.t:g} s ({plane})")
     cands.sort(key=lambda c: (c[0] > 0, c[0] if c[0] > 0 else c[1], c[2]))
     d = cands[0][3]
     final = assess(d, plants, modes)
+    final["gust_h2"] = gust_response(d, op_rigid, plane)
     log(f"  {plane} t = {d.t:5.1f} s: q_int {d.weights.q_int:g}, r {d.weights.r_gimbal:g}, w {d.weights.w_gimbal:g}, "
         f"q_modes {d.weights.q_modes:g}, w_modes {d.weights.w_modes:g}: shortfall {shortfall(final, tg):.3f}, "
         f"{sum(1 for c in cands if c[0] == 0)} of {len(table)} designs meet the targets")
@@ -461,7 +497,8 @@ def design_schedule(vehicle: str = "smile", rows: tuple[float, ...] = SMILE_ROWS
                     phases: tuple[tuple[float, float], ...] = SMILE_PHASES_S, tg: MarginTargets = MarginTargets(),
                     grid: dict = SEARCH_GRID, planes: tuple[str, ...] = PLANE_NAMES, log=print) -> dict[str, Any]:
     """Design every row and plane (:func:`search_row`); the neighbours of a row are the non-rigid plants
-    at the ends of its interval (:func:`row_intervals`)."""
+    at the ends of its interval (:func:`row_intervals`) and at the row with its slosh dispersed
+    (:data:`DISPERSED_SLOSH`)."""
     if vehicle != "smile":
         raise ConfigError("vehicle", vehicle, "'smile' (the LQG schedule is designed for SMILE v1 only)")
     intervals = row_intervals(tuple(rows), phases)
@@ -470,7 +507,8 @@ def design_schedule(vehicle: str = "smile", rows: tuple[float, ...] = SMILE_ROWS
     for t, (lo, hi) in zip(rows, intervals):
         log(f"t = {t:g} s (used {lo:g}-{hi:g} s)")
         op_n, op_r = _op(vehicle, t, "nonrigid", upper_after), _op(vehicle, t, "rigid", upper_after)
-        near = [_op(vehicle, x, "nonrigid", upper_after) for x in (lo, hi) if abs(x - t) > 0.05]
+        near = {f"t={x:.1f}": _op(vehicle, x, "nonrigid", upper_after) for x in (lo, hi) if abs(x - t) > 0.05}
+        near.update({f"slosh f x{f:g} zeta x{z:g}": dispersed(op_n, f, z) for f, z in DISPERSED_SLOSH})
         entry: dict[str, Any] = {"time_s": float(op_n.t), "interval_s": [lo, hi]}
         chosen = None
         for plane in planes:                 # the first plane's search; the others fly its weights (axisymmetric)
@@ -507,23 +545,26 @@ def save_schedule(doc: dict[str, Any], path: Path) -> None:
 def _m(m: dict[str, Any]) -> str:
     st = "stable" if m["closed_loop_stable"] else "UNSTABLE"
     return (f"{m['gain_margin_db']:.1f} / {m['gain_reduction_margin_db']:.1f} / {m['phase_margin_deg']:.1f} at "
-            f"{m['gain_crossover_radps']:.2f} / {st}")
+            f"{m['gain_crossover_radps']:.3g} / {st}")
 
 
 def margin_table(doc: dict[str, Any]) -> str:
     """The margins per row and plane as a Markdown table."""
-    lines = ["| t [s] | plane | q_int, r, w | rigid GM / GRM [dB] / PM [deg] at [rad/s] / CL | "
-             "non-rigid GM / GRM / PM at / CL | slosh max dB | bending dB | interval ends (non-rigid) |",
-             "|---:|---|---|---|---|---:|---|---|"]
+    lines = ["| t [s] | plane | q_int, r_gimbal, w_gimbal, q_modes, w_modes | rigid GM / GRM [dB] / PM [deg] at [rad/s] / CL | "
+             "non-rigid GM / GRM / PM at / CL | slosh max dB | bending dB | gust H2 | robustness plants (non-rigid): interval ends, "
+             "slosh dispersed |",
+             "|---:|---|---|---|---|---:|---|---:|---|"]
     for r in doc["rows"]:
         for plane in PLANE_NAMES:
             if plane not in r:
                 continue
             d, a = r[plane]["design"], r[plane]["assessment"]
-            ends = "; ".join(f"{k}: {_m(v)}" for k, v in a.items() if k.startswith("t="))
-            lines.append(f"| {r['time_s']:g} | {plane} | {d.weights.q_int:g}, {d.weights.r_gimbal:g}, {d.weights.w_gimbal:g} "
+            ends = "; ".join(f"{k}: {_m(v)}" for k, v in a.items()
+                             if isinstance(v, dict) and k not in ("rigid", "nonrigid"))
+            wt = d.weights
+            lines.append(f"| {r['time_s']:g} | {plane} | {wt.q_int:g}, {wt.r_gimbal:g}, {wt.w_gimbal:g}, {wt.q_modes:g}, {wt.w_modes:g} "
                          f"| {_m(a['rigid'])} | {_m(a['nonrigid'])} | {max(a['slosh_db']):.1f} | "
-                         f"{', '.join(f'{x:.1f}' for x in a['bending_db'])} | {ends} |")
+                         f"{', '.join(f'{x:.1f}' for x in a['bending_db'])} | {a['gust_h2']:.4f} | {ends} |")
     return "\n".join(lines) + "\n"
 
 
