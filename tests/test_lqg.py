@@ -133,8 +133,9 @@ def test_yaw_plane_sign_matches_the_env():
 
 @pytest.mark.parametrize("model", ["rigid", "nonrigid"])
 def test_lqg_flies_smile_v1(model):
-    """One validation seed of the smile-v1 suite (turbulence, gust, every dispersion), 70 s: no failure
-    and a pitch + yaw rate error under 1.5 rad (gs-pid's test-seed means are 0.81 rigid, 1.58 non-rigid)."""
+    """The first validation seed of the smile-v1 suite (turbulence, gust, every dispersion), 70 s: no
+    failure and a pitch + yaw rate error under 1.0 rad (the shipped schedule flies 0.70 rigid and 0.84
+    non-rigid; gs-pid 0.76 and 3.67 on this seed)."""
     from lvgym.benchmark.registry import resolve_policy
     from lvgym.benchmark.runner import build_policy, play_episode
     from lvgym.benchmark.suites import SUITES
@@ -145,7 +146,7 @@ def test_lqg_flies_smile_v1(model):
     assert isinstance(policy, LQGPolicy)
     rec = play_episode(policy, env, SUITES["smile-v1"].seeds("validation", 1)[0])
     assert not rec["failed"], rec["failure_reason"]
-    assert rec["rate_error_rad"] < 1.5
+    assert rec["rate_error_rad"] < 1.0
 
 
 def test_bad_inputs_raise_clear_errors(tmp_path):
