@@ -1,6 +1,7 @@
 """The LQG baseline (baselines.lqg_design, baselines.lqg): its plant, its margins, its law and its flight."""
 
 import warnings
+from dataclasses import fields
 
 import control
 import gymnasium as gym
@@ -11,6 +12,7 @@ import lvgym  # noqa: F401
 from baselines import flightloop as F
 from baselines import linearize as L
 from baselines import lqg_design as D
+from baselines import lqg_row as R
 from baselines.lqg import LQGLaw, LQGPolicy, LQGRow, LQGSchedule, smile_lqg
 from lvgym.errors import ConfigError
 
@@ -29,24 +31,24 @@ def shipped():
     return LQGSchedule.load("smile_lqg")
 
 
-def _row_weights(t: float) -> D.LQGWeights:
+def _row_weights(t: float) -> R.LQGWeights:
     """The weights the shipped schedule chose at the row of flight time ``t`` [s]."""
     with np.load(D.SCHEDULES / "smile_lqg.npz") as z:
         i = int(np.argmin(np.abs(z["time_s"] - t)))
         vals = z[f"pitch_{i}_weights"]
-    return D.LQGWeights(**{f.name: float(v) for f, v in zip(D.fields(D.LQGWeights), vals)})
+    return R.LQGWeights(**{f.name: float(v) for f, v in zip(fields(R.LQGWeights), vals)})
 
 
 def test_delayed_plant_is_the_flight_plant(ops):
     """The delay written as a state leaves the plant as flight_plant builds it, and the state names
     count the servo, the vehicle, the gyro filters and the delay."""
     op = ops["nonrigid"]
-    A, B, C, Gw = D.delayed_plant(op)
+    A, B, C, Gw = R.delayed_plant(op)
     w = np.logspace(-1, np.log10(150.0), 200)
     ours = F.frequency_response(control.ss(A, B, C, 0.0, 0.02), w)
     ref = F.frequency_response(F.flight_plant(op), w)
     np.testing.assert_allclose(ours, ref, rtol=1e-9, atol=1e-12)
-    labels = D.plant_labels(op)
+    labels = R.plant_labels(op)
     assert len(labels) == A.shape[0] and labels[0] == "servo_position" and labels[-1] == "command_delay_0"
     assert "omega_y" in labels and "eta_dot_z0" in labels
     assert np.all(Gw[-1] == 0.0) and B[-1, 0] == 1.0              # the disturbance enters after the delay
@@ -62,18 +64,21 @@ def test_grid_margins_agree_with_linearize_margins_on_a_pid_loop(ops):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         Lp = charts.open_loop(ops["rigid"], (0.0491, 0.3526, 0.1196, 500.0))
-        ref, ours = L.margins(Lp), D.loop_margins(Lp)
+        ref, ours = L.margins(Lp), R.loop_margins(Lp)
     assert ours["phase_margin_deg"] == pytest.approx(ref["phase_margin_deg"], abs=0.05)
     assert ours["gain_crossover_radps"] == pytest.approx(ref["gain_crossover_radps"], rel=1e-3)
     assert ours["gain_margin_db"] == pytest.approx(ref["gain_margin_db"], abs=0.1)
     assert ours["closed_loop_stable"] == ref["closed_loop_stable"]
 
 
-def test_design_at_max_q_meets_its_margins(ops):
-    """The max-q row, designed with the shipped weights on the non-rigid plant: rigid and non-rigid loops
-    broken at the plant input stable with >= 6 dB and >= 30 deg, the second bending mode (aliased) below
-    -6 dB, and linearize.margins agrees that both closed loops are stable."""
-    d = D.design_row(ops["nonrigid"], "pitch", _row_weights(T0))
+def test_design_at_max_q_meets_its_margins(ops, shipped):
+    """The max-q row, designed with the shipped weights on the non-rigid plant, is the shipped row, and its
+    rigid and non-rigid loops broken at the plant input are stable with >= 6 dB and >= 30 deg, the second
+    bending mode (aliased) below -6 dB, and linearize.margins agrees that both closed loops are stable."""
+    d = R.design_row(ops["nonrigid"], "pitch", _row_weights(T0))
+    row = shipped.rows["pitch"][shipped.index(T0)]
+    np.testing.assert_allclose(d.Kx, row.Kx, rtol=1e-6, atol=1e-9 * np.abs(row.Kx).max())
+    np.testing.assert_allclose(d.M, row.M, rtol=1e-6, atol=1e-9 * np.abs(row.M).max())
     modes = F.mode_frequencies(ops["nonrigid"])
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
@@ -82,7 +87,7 @@ def test_design_at_max_q_meets_its_margins(ops):
         for m in ops:
             assert a[m]["closed_loop_stable"], m
             assert a[m]["gain_margin_db"] >= 6.0 and abs(a[m]["phase_margin_deg"]) >= 30.0, (m, a[m])
-            assert L.margins(D.open_loop(d.compensator(), plants[m]))["closed_loop_stable"], m
+            assert L.margins(R.open_loop(d.compensator(), plants[m]))["closed_loop_stable"], m
     assert max(a["bending_db"][1:]) <= -6.0
 
 
@@ -96,7 +101,7 @@ def test_law_equals_the_linear_compensator(shipped):
         law = LQGLaw(one.rows["pitch"], one, u_limit=1e6)
         y = 1e-3 * rng.standard_normal(200)
         u_law = np.array([law.update(v, r.time_s) for v in y])
-        d = D.RowDesign(r.time_s, "pitch", r.A, r.B, r.C, r.Kx, r.Ki, r.M, r.a, r.dt, D.LQGWeights(), r.labels)
+        d = R.RowDesign(r.time_s, "pitch", r.A, r.B, r.C, r.Kx, r.Ki, r.M, r.a, r.dt, R.LQGWeights(), r.labels)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             u_lin = np.ravel(control.forced_response(d.compensator(), U=y).outputs)
@@ -157,7 +162,7 @@ def test_bad_inputs_raise_clear_errors(tmp_path):
     with pytest.raises(ConfigError, match="vehicle"):
         D.design_schedule("stratos3")
     with pytest.raises(ConfigError, match="lqg.r_gimbal"):
-        D.LQGWeights(r_gimbal=0.0)
+        R.LQGWeights(r_gimbal=0.0)
     with pytest.raises(SystemExit):
         D.main(["--vehicle", "slender"])
     with pytest.raises(ConfigError, match="rows"):
