@@ -30,6 +30,8 @@ POLICIES: dict[str, PolicySpec] = {
     "pid-thesis": PolicySpec("pid-thesis", "baselines.pid:smile_single_pid"),
     "gs-pid-thesis": PolicySpec("gs-pid-thesis", "baselines.pid:smile_scheduled_pid",
                                 (("name", "gs-pid-thesis"), ("schedule", "smile_thesis"))),
+    # LQG on the non-rigid flight plant, scheduled over the flight (baselines.lqg_design, docs/lqg.md)
+    "lqg": PolicySpec("lqg", "baselines.lqg:smile_lqg", (("name", "lqg"),)),
     # the shipped learned policy (agents/trained/ppo_smile_ascent, docs/training.md)
     "ppo": PolicySpec("ppo", "agents.policy:shipped_policy"),
 }

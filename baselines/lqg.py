@@ -1,0 +1,223 @@
+"""LQG rate control of pitch and yaw, scheduled over the flight, as a benchmark policy.
+
+The compensators are designed by :mod:`.lqg_design` (``python -m baselines.lqg_design --vehicle smile``)
+on the flight computer's non-rigid plant at frozen flight times (the rows of
+``baselines/schedules/smile_lqg.npz``). Per plane and control period (the design's law, with the gyro
+sample ``y`` [rad/s] the observation's rate error, ``rate - reference``)::
+
+    x_f = x_p + M (y - C x_p)              measurement update (steady-state Kalman gain M)
+    v   = -K_x x_f - K_i xi                LQR on the filtered state and the rate-error integral
+    u   = clip(v, -limit, limit)           the gimbal command [rad]; the action is u / limit
+    x_p <- A x_f + B u                     time update with the command sent (the model's delay state
+                                           carries it to the plant one period later)
+    xi  <- a xi - dt y                     leaky integral of the rate error (held while the output is
+                                           clipped and the integral would push it further)
+
+Without clipping this is exactly :func:`.lqg_design.compensator` (checked in the tests).
+
+Scheduling: the row in use is the one whose interval (from the midpoints between the rows of a
+thrusting phase, :func:`.lqg_design.row_intervals`) holds ``info["time"]``; beyond the intervals the
+nearest row. The rows' state dimensions differ between the boost and the upper stage (other pendulums,
+no bending modes in the band), so at a switch the integral is carried and the estimate is carried state
+by state where the two rows name the same states, and set to zero where they do not.
+
+Off (the observation's ``controller_on`` below 0.5: before the controller starts and through the
+staging coast): the output is 0 and the estimate and the integral are frozen; at every engagement
+they restart from zero (a new flight phase: the upper stage's trim is not the boost's).
+
+Both planes fly their own design (pitch and yaw plants of the axisymmetric vehicle agree to 1e-9 in the
+boost, 1 % in the upper stage; :mod:`.lqg_design` uses the pitch weights for yaw). Signs: a positive
+pitch (yaw) gimbal gives a positive pitch (yaw) rate, as the plant models (checked against the env in
+the tests).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from lvgym.errors import ConfigError
+
+SCHEDULES = Path(__file__).resolve().parent / "schedules"
+PLANES = ("pitch", "yaw")
+
+
+@dataclass(frozen=True)
+class LQGRow:
+    """One row's compensator of one plane (the names of :class:`.lqg_design.RowDesign`)."""
+
+    time_s: float
+    interval_s: tuple[float, float]
+    A: np.ndarray
+    B: np.ndarray
+    C: np.ndarray
+    Kx: np.ndarray
+    Ki: float
+    M: np.ndarray
+    a: float
+    dt: float
+    labels: tuple[str, ...]
+
+    def __post_init__(self) -> None:
+        n = self.A.shape[0]
+        for key, shape in (("A", (n, n)), ("B", (n, 1)), ("C", (1, n)), ("Kx", (1, n)), ("M", (n, 1))):
+            if getattr(self, key).shape != shape:
+                raise ConfigError(f"row {self.time_s:g} s.{key}", getattr(self, key).shape, f"shape {shape}")
+        if len(self.labels) != n:
+            raise ConfigError(f"row {self.time_s:g} s.labels", len(self.labels), f"{n} state names")
+        if not (self.dt > 0 and 0.0 < self.a <= 1.0):
+            raise ConfigError(f"row {self.time_s:g} s.a", self.a, "an integrator factor in (0, 1] at dt > 0")
+
+
+@dataclass(frozen=True)
+class LQGSchedule:
+    """The rows of each plane (:data:`PLANES`), in flight-time order."""
+
+    rows: dict[str, tuple[LQGRow, ...]]
+    source: str = ""
+
+    def __post_init__(self) -> None:
+        for plane in PLANES:
+            if plane not in self.rows or not self.rows[plane]:
+                raise ConfigError(f"{self.source}: rows.{plane}", None, "at least one row per plane")
+        times = [r.time_s for r in self.rows["pitch"]]
+        if times != sorted(times) or [r.time_s for r in self.rows["yaw"]] != times:
+            raise ConfigError(f"{self.source}: time_s", times, "increasing and the same in both planes")
+
+    @property
+    def dt(self) -> float:
+        return self.rows["pitch"][0].dt
+
+    def index(self, t: float) -> int:
+        """The row in use at flight time ``t`` [s]: the one whose interval holds it, else the nearest."""
+        rows = self.rows["pitch"]
+        for i, r in enumerate(rows):
+            if r.interval_s[0] <= t < r.interval_s[1]:
+                return i
+        return int(np.argmin([min(abs(t - r.interval_s[0]), abs(t - r.interval_s[1])) for r in rows]))
+
+    @classmethod
+    def load(cls, path: str | Path = "smile_lqg") -> "LQGSchedule":
+        """A schedule written by :func:`.lqg_design.save_schedule` (a path, or a name in
+        ``baselines/schedules``)."""
+        p = Path(path)
+        if not p.exists():
+            p = SCHEDULES / (str(path) if str(path).endswith(".npz") else f"{path}.npz")
+        if not p.exists():
+            raise FileNotFoundError(f"LQG schedule {str(path)!r}: no such file (nor {p}); write one with "
+                                    "`python -m baselines.lqg_design --vehicle smile` (--overwrite to ship it)")
+        with np.load(p, allow_pickle=False) as z:
+            times, intervals = z["time_s"], z["interval_s"]
+            rows = {}
+            for plane in PLANES:
+                rows[plane] = tuple(LQGRow(
+                    float(t), (float(lo), float(hi)), *(np.asarray(z[f"{plane}_{i}_{k}"], float) for k in ("A", "B", "C", "Kx")),
+                    float(z[f"{plane}_{i}_Ki"]), np.asarray(z[f"{plane}_{i}_M"], float), float(z[f"{plane}_{i}_a"]),
+                    float(z[f"{plane}_{i}_dt"]), tuple(str(s) for s in z[f"{plane}_{i}_labels"]))
+                    for i, (t, (lo, hi)) in enumerate(zip(times, intervals)))
+        return cls(rows, str(p))
+
+
+class LQGLaw:
+    """One plane's law (module docstring): ``update(y, t, enabled) -> u`` [rad]."""
+
+    def __init__(self, rows: tuple[LQGRow, ...], schedule: LQGSchedule, u_limit: float) -> None:
+        if not u_limit > 0.0:
+            raise ConfigError("u_limit", u_limit, "a gimbal limit > 0 rad")
+        self.rows, self.schedule, self.u_limit = rows, schedule, float(u_limit)
+        self.reset()
+
+    def reset(self) -> None:
+        self.row: int | None = None
+        self.xp: np.ndarray | None = None
+        self.xi = 0.0
+        self.was_on = False
+        self.saturated = False
+
+    def _switch(self, i: int) -> None:
+        new = self.rows[i]
+        x = np.zeros(new.A.shape[0])
+        if self.row is not None and self.xp is not None:
+            old = self.rows[self.row]
+            if old.labels == new.labels:
+                x = self.xp.copy()
+            else:                                  # carry the states both rows name, zero the others
+                where = {name: k for k, name in enumerate(old.labels)}
+                for k, name in enumerate(new.labels):
+                    if name in where and new.labels.count(name) == 1:
+                        x[k] = self.xp[where[name]]
+        self.row, self.xp = i, x
+
+    def update(self, y: float, t: float, enabled: bool = True) -> float:
+        """The command [rad] for the gyro sample ``y`` [rad/s] at flight time ``t`` [s]."""
+        if not enabled:
+            self.was_on, self.saturated = False, False
+            return 0.0
+        if not self.was_on:                        # engagement: restart from zero
+            self.row, self.xp, self.xi = None, None, 0.0
+        self.was_on = True
+        i = self.schedule.index(t)
+        if i != self.row:
+            self._switch(i)
+        r = self.rows[self.row]
+        y = float(y)
+        xf = self.xp + r.M[:, 0] * (y - float(r.C[0] @ self.xp))
+        v = -float(r.Kx[0] @ xf) - r.Ki * self.xi
+        u = min(max(v, -self.u_limit), self.u_limit)
+        self.saturated = u != v
+        dxi = (r.a - 1.0) * self.xi - r.dt * y
+        if not (self.saturated and (v - u) * (-r.Ki * dxi) > 0.0):   # clamp: do not integrate into the limit
+            self.xi += dxi
+        self.xp = r.A @ xf + r.B[:, 0] * u
+        return u
+
+
+class LQGPolicy:
+    """Pitch and yaw LQG (module docstring) as a benchmark :class:`~lvgym.benchmark.policy.Policy` of
+    the TVC envs. ``env``: the lvgym env it flies (the gimbal limit, the control period, the delay and
+    the observation's layout come from it); ``schedule``: an :class:`LQGSchedule`, a path or a name in
+    ``baselines/schedules``. ``act`` needs ``info["time"]``."""
+
+    def __init__(self, *, env: Any, schedule: LQGSchedule | str | Path = "smile_lqg", name: str = "lqg") -> None:
+        task = env.unwrapped
+        self.name = name
+        self.schedule = schedule if isinstance(schedule, LQGSchedule) else LQGSchedule.load(schedule)
+        self.dt = float(task.task.control_dt_s)
+        if abs(self.dt - self.schedule.dt) > 1e-12:
+            raise ConfigError("env control_dt_s", self.dt, f"the schedule's control period {self.schedule.dt} s "
+                              f"({self.schedule.source})")
+        delay = int(getattr(task.task, "action_delay_steps", 0))
+        n_delay = sum(1 for s in self.schedule.rows["pitch"][0].labels if s.startswith("command_delay_"))
+        if delay != n_delay:
+            raise ConfigError("env action_delay_steps", delay, f"the schedule's {n_delay} ({self.schedule.source})")
+        self.limit = float(task.gimbal_limit)
+        lay = task.observation_layout
+        self._i_err = [lay.index("pitch_rate_error"), lay.index("yaw_rate_error")]
+        self._i_on = lay.index("controller_on")
+        self.axes = [LQGLaw(self.schedule.rows[p], self.schedule, self.limit) for p in PLANES]
+        self.last_gimbal = np.zeros(2)
+
+    def reset(self) -> None:
+        for law in self.axes:
+            law.reset()
+        self.last_gimbal = np.zeros(2)
+
+    def act(self, observation: np.ndarray, info: dict[str, Any]) -> np.ndarray:
+        obs = np.asarray(observation, dtype=float)
+        on = float(obs[self._i_on]) >= 0.5
+        t = float(info["time"])
+        self.last_gimbal = np.array([law.update(obs[i], t, on) for law, i in zip(self.axes, self._i_err)])
+        return np.clip(self.last_gimbal / self.limit, -1.0, 1.0).astype(np.float32)
+
+
+def smile_lqg(env: Any, name: str = "lqg", schedule: str = "smile_lqg") -> LQGPolicy:
+    """The LQG schedule designed for SMILE v1 (``baselines/schedules/smile_lqg.npz``) on ``env``; the env
+    must fly the ``smile_v1`` vehicle."""
+    vehicle = getattr(env.unwrapped.task, "vehicle", None)
+    if vehicle != "smile_v1":
+        raise ConfigError("env vehicle", vehicle, "'smile_v1' (the LQG schedule is designed for SMILE v1, "
+                          "lvgym/SmileAscent-v1)")
+    return LQGPolicy(env=env, schedule=schedule, name=name)
