@@ -11,12 +11,14 @@ gyro at the control period, with the servo, the bending slope at the IMU, the gy
 and the one-period computational delay, rigid and non-rigid. The controller is
 ``C(z) = PID(z) F(z)``: the backward-Euler PID of :mod:`.pid` (unfiltered derivative) times the
 :class:`.filters.StructuralFilter` chain (lead-lag, low-pass, a notch on the first bending mode when it
-lies below the Nyquist frequency). Its nine parameters minimise the energy of the rate's response to a
-disturbance at the plant input, ``sum |G / (1 + C G)|^2 dw`` over the frequency grid (the mean of the
-rigid and the non-rigid plant), under the constraints of :class:`Requirements` (penalties), by
-Nelder-Mead from the previous row's design and from seeded random starts. Every row is then checked
-exactly with :func:`.linearize.margins` on the python-control loops, in pitch and yaw, and the
-schedule, interpolated on mass as the policy flies it, is checked again at frozen times between rows.
+lies below the Nyquist frequency). Each row flies its own stretch of the flight, from the midpoint to the
+row before to the midpoint to the row after (the policy takes the nearest row on mass). Its nine
+parameters minimise the energy of the rate's response to a disturbance at the plant input,
+``sum |G / (1 + C G)|^2 dw`` over the frequency grid (the mean of the rigid and the non-rigid plant at
+the row's time), under the constraints of :class:`Requirements` on the plants at the row's time and at
+both ends of its stretch (penalties), by Nelder-Mead from the previous row's design and from seeded
+random starts. Every row is then checked exactly with :func:`.linearize.margins` on the
+python-control loops, in pitch and yaw, on all those plants.
 """
 
 from __future__ import annotations

@@ -161,7 +161,7 @@ class GainSchedule:
         return float(np.interp(value, x[order], np.asarray(column, float)[order]))
 
     def filter_at(self, value: float) -> StructuralFilter | None:
-        """The structural filter at ``value`` (each parameter interpolated linearly), or None."""
+        """The structural filter at ``value`` (each parameter read as the gains are), or None."""
         if self.filters is None:
             return None
         return StructuralFilter(**{k: self._interp(value, [getattr(f, k) for f in self.filters]) for k in FILTER_KEYS})
