@@ -132,6 +132,13 @@ def folded(w: float, dt: float) -> float:
     return abs(((w + 0.5 * ws) % ws) - 0.5 * ws)
 
 
+def notch_frequency(modes: dict[str, list[float]], dt: float) -> float | None:
+    """The notch's frequency [rad/s]: the first bending mode's, if below 0.9 times the Nyquist
+    frequency of ``dt`` [s]; else None (notch off)."""
+    bending = modes.get("bending", [])
+    return bending[0] if bending and bending[0] < 0.9 * math.pi / dt else None
+
+
 class RowProblem:
     """The design problem of one row: the discrete plants of the row's own flight time and of the ends
     of the stretch it flies (``cases``: the first is the row's own, whose disturbance response is the
@@ -150,8 +157,7 @@ class RowProblem:
         self.w = np.unique(np.concatenate([np.geomspace(1e-3, 0.999 * nyq, n_grid)] + dense))
         self.dw = np.gradient(self.w)                   # a log grid, and dense around every mode
         self.z = np.exp(1j * self.w * self.dt)
-        bending = cases[0][1].get("bending", [])
-        self.notch_radps = bending[0] if bending and bending[0] < 0.9 * nyq else None
+        self.notch_radps = notch_frequency(cases[0][1], self.dt)
         self.cases = []
         for plants, modes in cases:
             with warnings.catch_warnings():
@@ -349,12 +355,13 @@ def design_schedule(vehicle: str = "smile", times=None, req: Requirements | None
             skipped.append({"time_s": float(t), "reason": "coast"})
             warm, left = None, None
             continue
+        notch = notch_frequency(own[1], float(own[0]["pitch"]["rigid"].dt))
         cases = [(t, own)] + ([left] if left is not None else [])
         e = design_row(RowProblem([(c[0]["pitch"], c[1]) for _, c in cases], req), warm, rng, starts)
         right = None
         if k + 1 < len(times):
             t_r = 0.5 * (t + times[k + 1])
-            gains, filt = controller(e["values"], RowProblem([(own[0]["pitch"], own[1])], req).notch_radps)
+            gains, filt = controller(e["values"], notch)
             first = rows + [{"time_s": t, "mass_kg": own[2]["mass_kg"], "kp": gains[0], "ki": gains[1], "kd": gains[2],
                              "filter": filt.as_dict()}]
             try:
@@ -366,7 +373,6 @@ def design_schedule(vehicle: str = "smile", times=None, req: Requirements | None
             cases.append(right)
             e = design_row(RowProblem([(c[0]["pitch"], c[1]) for _, c in cases], req), e["values"], rng, starts=0)
         warm = e["values"]
-        notch = RowProblem([(own[0]["pitch"], own[1])], req).notch_radps
         gains, filt = controller(e["values"], notch)
         checks = [_checked(c, tc, gains, filt, req) for tc, c in cases]
         row = {"time_s": float(t), "mass_kg": round(own[2]["mass_kg"], 2), "kp": float(gains[0]),

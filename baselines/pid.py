@@ -283,6 +283,8 @@ class GainScheduledPIDPolicy(PIDPolicy):
             pid.set_gains(*g)
         if self.chains is not None:
             filt = self.schedule.filter_at(self.value)
+            if filt == self.chains[0].filter:             # unchanged (a nearest-row schedule, mostly)
+                return
             coeffs = filt.discrete(self.dt)               # the same filter on both axes
             for chain in self.chains:
                 chain.set_filter(filt, coeffs)
