@@ -9,7 +9,7 @@ from lvgym.environment.aeroelastic import resample_modes
 from lvgym.envs.spec import wind_spec
 from lvgym.errors import ConfigError
 from lvgym.simulator import Simulator, flight_loads
-from lvgym.simulator.layouts import CTX
+from lvgym.simulator.layouts import CTX, DS
 from lvgym.simulator.strips import N_STRIPS
 
 T_END = 3.0
@@ -112,6 +112,38 @@ def test_compiled_loads_agree_with_the_python_path(pair):
     np.testing.assert_allclose(lay.view(loads["on"], "loads", "f_eta").ravel(), f_eta, rtol=1e-12)
     assert np.all(lay.view(loads["off"], "loads", "f_eta") == 0.0)
     np.testing.assert_array_equal(lay.view(loads["on"], "loads", "thrust_b"), lay.view(loads["off"], "loads", "thrust_b"))
+
+
+def test_the_normal_force_dispersion_scales_the_strip_loads(pair):
+    # v1's ``aerodynamics`` draw multiplies the normal force: the strips' elastic force, moment and modal
+    # forces scale with it as the table's normal force does (both come from one CN-alpha distribution)
+    on, off = pair
+    rng = np.random.default_rng(7)
+    lay = on.layout
+    x = on.x.copy()
+    lay.view(x, "state", "eta")[:] = rng.normal(0, 0.02, (1, 2, on.dynamics.n_modes))
+    lay.view(x, "state", "eta_dot")[:] = rng.normal(0, 1.0, (1, 2, on.dynamics.n_modes))
+    lay.view(x, "state", "omega_bi_b")[:] = [0.01, 0.05, -0.03]
+    out = {}
+    for kn in (1.0, 1.2):
+        for name, sim in (("on", on), ("off", off)):
+            sim.x[:] = x
+            sim.c[0, CTX.dispersion + DS.normal_scale] = kn
+            sim.update_conditions()
+            u = lay.zeros_loads()
+            ctx = sim.c[0].copy()
+            _call_loads(flight_loads, float(sim.t[0] - ctx[CTX.time0]), x[0].copy(), sim.p[0].copy(), ctx, u)
+            out[name, kn] = (sim.conditions("f_aero_b")[0].copy(), sim.conditions("m_aero_b")[0].copy(),
+                             lay.view(u, "loads", "f_eta").ravel().copy())
+        for sim in (on, off):
+            sim.c[0, CTX.dispersion + DS.normal_scale] = 1.0
+    for i, what in enumerate(("force", "moment")):
+        base = out["on", 1.0][i] - out["off", 1.0][i]
+        assert np.abs(base[1:]).max() > 1.0, what
+        np.testing.assert_allclose(out["on", 1.2][i] - out["off", 1.2][i], 1.2 * base, rtol=1e-9,
+                                   atol=1e-9 * np.abs(out["off", 1.2][i]).max(), err_msg=what)
+    assert np.abs(out["on", 1.0][2]).max() > 1.0
+    np.testing.assert_allclose(out["on", 1.2][2], 1.2 * out["on", 1.0][2], rtol=1e-12)
 
 
 def test_the_flag_changes_the_slender_flight(pair):

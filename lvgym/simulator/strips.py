@@ -25,6 +25,11 @@ Per row of a batch, the context holds (layout :data:`.layouts.AEROELASTIC`, offs
 the mode shapes and slopes at the strips of the current piece (copied from the timeline's
 ``phi_strip``/``dphi_strip`` row in force, which changes as the modes are recomputed) and the scratch of
 the loads. The state's ``eta`` and ``eta_dot`` are read by the dynamics layout's offsets.
+
+The row's ``normal_scale`` dispersion (layout :data:`.layouts.DISPERSION`, the ``aerodynamics`` draw of v1)
+multiplies the strips' force, moment and modal forces as it multiplies the table's normal force: both come
+from the same CN-alpha distribution. ``cp_shift`` moves only the table's rigid normal force: the elastic
+increment acts where the bending puts it.
 """
 
 from __future__ import annotations
@@ -40,7 +45,7 @@ from lvgym.environment.aeroelastic import StripAeroelastic, strip_loads_k
 from lvgym.errors import ConfigError
 from lvgym.packing import at
 
-from .layouts import AEROELASTIC, AEL, CTX, STR, STRIPS, D
+from .layouts import AEROELASTIC, AEL, CTX, DS, STR, STRIPS, D
 
 __all__ = ["N_STRIPS", "StripSetup", "pack_strips", "strip_models", "strip_stations"]
 
@@ -152,6 +157,13 @@ def strip_loads_at(x, p_cg, ctx, cond, oc):
                   ctx[a + AEL.s_ref], ctx[op:op + K * n].reshape((K, n)), ctx[od:od + K * n].reshape((K, n)),
                   x[o_eta:o_eta + n_eta], x[o_etad:o_etad + n_eta], False, ctx[of:of + 3], ctx[omb:omb + 3],
                   ctx[oe:odf], ctx[odf:end].reshape((n, 2)))
+    kn = ctx[CTX.dispersion + DS.normal_scale]          # the normal-force dispersion scales every strip's CN-alpha
+    if kn != 1.0:
+        for i in range(3):
+            ctx[of + i] *= kn
+            ctx[omb + i] *= kn
+        for k in range(n_eta):
+            ctx[oe + k] *= kn
     for i in range(3):
         cond[oc + D.f_aero_b + i] += ctx[of + i]
         cond[oc + D.m_aero_b + i] += ctx[omb + i]
