@@ -13,7 +13,8 @@ The law, per axis ``i`` (pitch, yaw), every control period ``dt`` while the loop
     e_f      = LP_e(e_i)                                    first-order low-pass, Tustin (keeps bending out)
     e_d      = sign(e_f) max(|e_f| - e_dz, 0)               error dead zone [rad/s]
     y_i      = LP_s(HP_s(d_i)^2)                            spectral damper of the gimbal command sent [rad^2]
-    dk/dt    = a e_d^2 - b y (k - k_min) - c (k - 1)        error gain, spectral damper, leakage to 1
+    y_d      = max(y_i - y_dz, 0)                           its dead zone (ours; y_dz = 0: y_d = y_i)
+    dk/dt    = a e_d^2 - b y_d (k - k_min) - c (k - 1)      error gain, spectral damper, leakage to 1
     d_i      = clip(k_i u_i, -limit, limit)                 the command sent
 
 ``k`` is integrated exactly over the period with ``e_d`` and ``y`` held (zero-order hold): with
@@ -44,9 +45,9 @@ import numpy as np
 
 from lvgym.errors import ConfigError, check_bool, check_number
 
-from .pid import smile_scheduled_pid
+from .pid import flex_pid, smile_scheduled_pid
 
-__all__ = ["AACParams", "AdaptiveAugmentingPolicy", "AdaptiveGainLaw", "FirstOrderFilter", "smile_aac"]
+__all__ = ["AACParams", "AdaptiveAugmentingPolicy", "AdaptiveGainLaw", "FLEX_AAC", "FirstOrderFilter", "flex_aac", "smile_aac"]
 
 
 @dataclass(frozen=True)
@@ -68,6 +69,9 @@ class AACParams:
     error_lp_hz: float = 2.0
     #: b: spectral damper gain [1/s / rad^2 of high-passed gimbal command]
     damper_gain: float = 2.0e4
+    #: dead zone of the spectral damper [rad^2]: only the part of ``y`` above it lowers k_T (ours, not in the
+    #: papers: the flight's own high-frequency content, staging and gusts, then costs nothing; 0: off)
+    damper_deadzone_rad2: float = 0.0
     #: spectral damper high-pass [Hz]: about an octave above the loops' ~3.4 Hz crossover
     damper_hp_hz: float = 7.0
     #: spectral damper low-pass of the squared signal [Hz]: an octave below the high-pass
@@ -84,7 +88,8 @@ class AACParams:
     def __post_init__(self) -> None:
         number = {"k_min": (0.0, 1.0, False), "k_max": (1.0, 10.0, False), "error_gain": (0.0, 1e9, False),
                   "error_deadzone_radps": (0.0, 1.0, False), "error_lp_hz": (0.0, 1e3, True),
-                  "damper_gain": (0.0, 1e12, False), "damper_hp_hz": (0.0, 1e3, True),
+                  "damper_gain": (0.0, 1e12, False), "damper_deadzone_rad2": (0.0, 1.0, False),
+                  "damper_hp_hz": (0.0, 1e3, True),
                   "damper_lp_hz": (0.0, 1e3, True), "leak_rate": (0.0, 1e3, False),
                   "ref_model_radps": (0.0, 1e4, True)}
         for f in fields(self):
@@ -207,6 +212,8 @@ class AdaptiveGainLaw:
         e_f = self.e_lp.step(e)
         self.e = np.sign(e_f) * np.maximum(np.abs(e_f) - p.error_deadzone_radps, 0.0)
         e2, y = self.e ** 2, self.y
+        if p.damper_deadzone_rad2 > 0.0:
+            y = np.maximum(y - p.damper_deadzone_rad2, 0.0)
         if not p.per_axis:
             e2, y = np.array([e2.sum()]), np.array([y.sum()])
         self.k = self.gain_step(self.k, e2, y)
@@ -287,3 +294,20 @@ def smile_aac(env: Any, schedule: str = "smile", name: str = "aac", record: bool
             raise ConfigError(f"aac.{key}", value, f"not a parameter of the adaptive law; one of {sorted(known)}")
     base = smile_scheduled_pid(env, schedule, name=f"gs-pid-{schedule}")
     return AdaptiveAugmentingPolicy(base, env=env, params=AACParams(**params), name=name, record=record)
+
+
+#: the law's parameters on ``gs-pid-flex`` (docs/adaptive-control.md, "On gs-pid-flex"; tuned on smile-v1's
+#: validation seeds 0-9): the defaults with a spectral-damper dead zone, so that the flex design's own
+#: high-frequency content (its lead, staging, gusts) does not lower k_T
+FLEX_AAC = {"damper_deadzone_rad2": 3e-3}
+
+
+def flex_aac(env: Any, name: str = "aac", record: bool = False, **params: Any) -> AdaptiveAugmentingPolicy:
+    """``aac``: AAC on ``gs-pid-flex`` (:func:`.pid.flex_pid`, the vehicle's flex schedule) with
+    :data:`FLEX_AAC`; keywords of :class:`AACParams` override them."""
+    known = {f.name for f in fields(AACParams)}
+    for key, value in params.items():
+        if key not in known:
+            raise ConfigError(f"aac.{key}", value, f"not a parameter of the adaptive law; one of {sorted(known)}")
+    return AdaptiveAugmentingPolicy(flex_pid(env), env=env, params=AACParams(**{**FLEX_AAC, **params}), name=name,
+                                    record=record)

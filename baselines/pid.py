@@ -55,6 +55,8 @@ from typing import Any
 import numpy as np
 import yaml
 
+from lvgym.errors import ConfigError
+
 from .filters import FILTER_KEYS, FilterChain, StructuralFilter
 
 SCHEDULES = Path(__file__).resolve().parent / "schedules"
@@ -299,6 +301,21 @@ def smile_single_pid(env: Any, name: str = "pid-thesis") -> PIDPolicy:
 def smile_scheduled_pid(env: Any, schedule: str = "smile_thesis", name: str | None = None) -> GainScheduledPIDPolicy:
     """Gain-scheduled PID on SMILE's ``env``: ``smile_thesis`` (Table 6.10, on mass) or ``smile`` (our tuning)."""
     return GainScheduledPIDPolicy(schedule, env=env, name=name or f"gs-pid-{schedule}")
+
+
+#: the gs-pid-flex schedule (``baselines/schedules/<name>.yaml``, written by ``python -m baselines.flexdesign``)
+#: of each vehicle a v1 env flies, keyed by the env's ``task.vehicle``
+FLEX_SCHEDULES = {"smile_v1": "smile_flex", "stratos3": "stratos3_flex"}
+
+
+def flex_pid(env: Any, name: str = "gs-pid-flex") -> GainScheduledPIDPolicy:
+    """``gs-pid-flex``: the filtered gain-scheduled PID designed on the non-rigid v1 flight loop of the
+    vehicle ``env`` flies (:data:`FLEX_SCHEDULES`); a vehicle without a flex design is refused."""
+    vehicle = getattr(env.unwrapped.task, "vehicle", None)
+    if not isinstance(vehicle, str) or vehicle not in FLEX_SCHEDULES:
+        raise ConfigError("env vehicle", vehicle, f"one of {sorted(FLEX_SCHEDULES)}: the vehicles of a v1 env "
+                          "with a gs-pid-flex schedule (python -m baselines.flexdesign --vehicle ...)")
+    return GainScheduledPIDPolicy(FLEX_SCHEDULES[vehicle], env=env, name=name)
 
 
 def smile_tuned_pid(env: Any, schedule: str = "smile", t_design: float = 28.8, name: str = "pid") -> PIDPolicy:

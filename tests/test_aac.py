@@ -10,7 +10,9 @@ import numpy as np
 import pytest
 
 import lvgym  # noqa: F401
-from baselines.aac import AACParams, AdaptiveAugmentingPolicy, AdaptiveGainLaw, FirstOrderFilter, smile_aac
+from baselines.aac import (FLEX_AAC, AACParams, AdaptiveAugmentingPolicy, AdaptiveGainLaw, FirstOrderFilter, flex_aac,
+                          smile_aac)
+from baselines.pid import FLEX_SCHEDULES, flex_pid
 from lvgym.benchmark.policy import Policy
 from lvgym.envs.layouts import OBS_FLIGHT
 from lvgym.errors import ConfigError
@@ -218,3 +220,36 @@ def test_aac_flies_smile_v1_rigid(v1_rigid):
     p = pol.params
     assert tr["on"].any() and np.all((tr["k"] >= p.k_min) & (tr["k"] <= p.k_max))
     assert np.abs(tr["k"][tr["on"]] - 1.0).max() < 0.5
+
+
+def test_damper_dead_zone_acts_on_the_excess_only():
+    # y below the dead zone: the law is the leak and the error term alone; above: the damper sees y - y_dz
+    dz = 3e-3
+    plain, zoned = law(damper_gain=2.0e4), law(damper_gain=2.0e4, damper_deadzone_rad2=dz)
+    for y, y_seen in ((1e-3, 0.0), (5e-3, 5e-3 - dz)):
+        k0 = np.array([1.4, 1.4])
+        for lw in (plain, zoned):
+            lw.reset()
+            lw.on = True
+            lw.k[:] = k0
+            lw.y[:] = y
+        zoned.step(np.zeros(2), np.zeros(2), np.zeros(2), True)
+        expected = plain.gain_step(k0, np.zeros(2), np.full(2, y_seen))
+        np.testing.assert_allclose(zoned.gains(), expected, rtol=1e-12)
+    # default 0: the published law, y as it is
+    assert AACParams().damper_deadzone_rad2 == 0.0
+    with pytest.raises(ConfigError, match=r"aac.damper_deadzone_rad2 = -1"):
+        AACParams(damper_deadzone_rad2=-1)
+
+
+def test_flex_policies_follow_the_envs_vehicle(v1_rigid):
+    pol = flex_pid(v1_rigid)
+    assert pol.schedule.meta["vehicle"] == "smile" and FLEX_SCHEDULES["smile_v1"] == "smile_flex"
+    stratos = gym.make("lvgym/StratosIII-v1", mission_time_s=2.0)
+    assert flex_pid(stratos).schedule.meta["vehicle"] == "stratos3"
+    for env_id in ("lvgym/SmileAscent-v0", "lvgym/SlenderAscent-v1"):
+        with pytest.raises(ConfigError, match="env vehicle"):
+            flex_pid(gym.make(env_id))
+    aac = flex_aac(v1_rigid)
+    assert aac.params.damper_deadzone_rad2 == FLEX_AAC["damper_deadzone_rad2"] and aac.name == "aac"
+    assert flex_aac(v1_rigid, damper_deadzone_rad2=0.0).params.damper_deadzone_rad2 == 0.0

@@ -21,11 +21,10 @@ POLICIES: dict[str, PolicySpec] = {
     "pid": PolicySpec("pid", "baselines.pid:smile_tuned_pid"),
     "gs-pid": PolicySpec("gs-pid", "baselines.pid:smile_scheduled_pid", (("name", "gs-pid"), ("schedule", "smile"))),
     # designed on the non-rigid v1 flight loop (baselines.flexdesign, docs/flex-design.md): structural
-    # filters and gains scheduled on mass, for SmileAscent-v1
-    "gs-pid-flex": PolicySpec("gs-pid-flex", "baselines.pid:smile_scheduled_pid",
-                              (("name", "gs-pid-flex"), ("schedule", "smile_flex"))),
+    # filters and gains scheduled on mass, the schedule of the env's vehicle (baselines.pid.FLEX_SCHEDULES)
+    "gs-pid-flex": PolicySpec("gs-pid-flex", "baselines.pid:flex_pid", (("name", "gs-pid-flex"),)),
     # adaptive augmenting control on gs-pid-flex (baselines.aac, docs/adaptive-control.md)
-    "aac": PolicySpec("aac", "baselines.aac:smile_aac", (("name", "aac"), ("schedule", "smile_flex"))),
+    "aac": PolicySpec("aac", "baselines.aac:flex_aac", (("name", "aac"),)),
     # the thesis's gains (6.3.1) and its Table 6.10 schedule, as published
     "pid-thesis": PolicySpec("pid-thesis", "baselines.pid:smile_single_pid"),
     "gs-pid-thesis": PolicySpec("gs-pid-thesis", "baselines.pid:smile_scheduled_pid",
