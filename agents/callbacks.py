@@ -43,7 +43,7 @@ from lvgym.benchmark.runner import play_episode
 from lvgym.benchmark.results import atomic_path, atomic_write_text, json_text, remove_stale_temporaries
 from lvgym.benchmark.suites import Suite, get_suite
 
-from .policy import SB3Policy, copy_policy, policy_files
+from .policy import SB3Policy, adapt, copy_policy, policy_files
 
 _STEM = re.compile(r"^step_(\d{12})$")
 #: what a validation's ``score`` is: compared lexicographically, lower is better (older runs' checkpoints
@@ -150,6 +150,7 @@ class ValidationEvaluator:
         failure penalty for the mission left), so among equal failure rates a policy that fails late is
         not preferred for its shorter rate-error integral. ``policy``: a Policy, or a callable that builds
         one for a condition's env (e.g. a residual policy whose baseline needs the env)."""
+        self._built.clear()                          # a factory's policies live for this evaluation only
         records = [self.episode(self._policy(policy, c), c, s) for c in self.suite.conditions for s in self.seeds]
         rows = summarize(records, ("rate_error_rad", "score", "max_rate_radps", "effort_rad_s", "episode_return"))
         conds: dict[str, dict[str, float]] = {}
@@ -344,8 +345,9 @@ class CheckpointCallback(BaseCallback):
     def _validate(self, step: int) -> dict[str, Any]:
         assert self.evaluator is not None
         t0 = time.perf_counter()
-        policy = SB3Policy.from_model(self.model, self.vecnormalize, name=f"step_{step}")
-        result = {"num_timesteps": step, **self.evaluator.evaluate(policy),
+        policy = SB3Policy.from_model(self.model, self.vecnormalize, name=f"step_{step}", meta=self.meta)
+        flown = policy if "residual" not in self.meta else (lambda env: adapt(policy, env))
+        result = {"num_timesteps": step, **self.evaluator.evaluate(flown),
                   "wall_s": round(time.perf_counter() - t0, 3)}
         self.logger.record("eval/failure_rate", result["failure_rate"])
         self.logger.record("eval/rate_error_rad", result["rate_error_rad"])
