@@ -74,7 +74,7 @@ class Args:
     residual: str | None = None
     """fly residual on this registered baseline, e.g. gs-pid-flex (agents.residual; default: not residual)"""
     residual_scale: float = 0.2
-    """with --residual: gimbal units (fractions of the limit) per unit of learned action, in (0, 2]"""
+    """with --residual: gimbal units per unit of learned action, in (0, 2]"""
     total_timesteps: int | None = None
     """env steps of the whole run (default: n_timesteps of the hyperparameter file)"""
     seed: int = 0
@@ -190,8 +190,7 @@ def env_kwargs_of(args: Args) -> dict[str, Any]:
     elif r in ([], ["none"], ["false"], ["False"]):
         r = False
     out: dict[str, Any] = {"model": args.model, "wind": args.wind, "randomize": r, "observation": args.observation}
-    if args.history:                                 # only when on: a run without it records what it always did
-        out["history"] = int(args.history)
+    out.update({"history": int(args.history)} if args.history else {})   # when on only: old runs unchanged
     for item in args.env_kwargs:
         key, sep, text = item.partition("=")
         if not sep or not key.strip():
@@ -217,8 +216,10 @@ def check_options(args: Args) -> None:
     option_number("--torch-threads", args.torch_threads, 1, 1024, integer=True)
     option_number("--verbose", args.verbose, 0, 2, integer=True)
     option_number("--n-envs", args.n_envs, 1, 4096, integer=True)
+    from agents.residual import residual_options
+
     option_number("--history", args.history, 0, 64, integer=True)
-    residual_of(args)
+    residual_options(args.residual, args.residual_scale)
     known = set(RANDOMIZE) | {"all", "none", "true", "false", "True", "False"}
     for r in args.randomize:
         if r not in known:
@@ -228,19 +229,6 @@ def check_options(args: Args) -> None:
 
         if args.eval_suite not in SUITES:
             raise ConfigError("--eval-suite", args.eval_suite, f"one of {sorted(SUITES)} or 'none'")
-
-
-def residual_of(args: Args) -> dict[str, Any] | None:
-    """The run's residual set-up (``{"baseline", "scale"}``, checked) or None."""
-    if args.residual in (None, "none"):
-        return None
-    from agents.residual import ResidualConfig
-
-    try:
-        return ResidualConfig(args.residual, args.residual_scale).to_dict()
-    except ConfigError as exc:
-        raise ConfigError("--" + exc.key.replace(".", "-").replace("residual-baseline", "residual"), exc.value,
-                          exc.allowed) from None
 
 
 def provenance() -> dict[str, Any]:
@@ -294,12 +282,9 @@ def make_venv(env_id: str, n_envs: int, seed: int, env_kwargs: dict[str, Any], n
     import lvgym  # noqa: F401
     from lvgym.envs import make_sb3_vec_env
 
-    base = make_sb3_vec_env(env_id, num_envs=n_envs, seed=seed, **env_kwargs)
-    if residual is not None:
-        from agents.residual import ResidualConfig, ResidualVecEnv
+    from agents.residual import residual_venv
 
-        base = ResidualVecEnv(base, ResidualConfig(**residual))
-    venv = VecMonitor(base)
+    venv = VecMonitor(residual_venv(make_sb3_vec_env(env_id, num_envs=n_envs, seed=seed, **env_kwargs), residual))
     if stats is not None and stats.is_file():
         return VecNormalize.load(str(stats), venv)
     if norm.norm_obs or norm.norm_reward:
@@ -339,6 +324,7 @@ def prepare(args: Args, given: set[str]) -> tuple[Args, dict[str, Any], Path, bo
     """The run's arguments, its ``config.yaml`` content, its folder and whether it resumes: every option
     checked, nothing written (:func:`create_run` writes). Raises ConfigError or SystemExit (one line)."""
     from agents.config import build_config, load_config, parse_overrides
+    from agents.residual import residual_options
 
     check_options(args)
     if args.resume:
@@ -373,7 +359,7 @@ def prepare(args: Args, given: set[str]) -> tuple[Args, dict[str, Any], Path, bo
     config = {"name": name, "args": asdict(args), "algo": args.algo, "env_id": args.env_id, "env_kwargs": env_kwargs,
               "total_timesteps": int(args.total_timesteps or cfg.n_timesteps), "seed": args.seed,
               "eval_suite": suite, "eval_select": args.eval_select, "hyperparams": cfg.to_dict(),
-              **({"residual": residual_of(args)} if residual_of(args) else {}),
+              **({"residual": res} if (res := residual_options(args.residual, args.residual_scale)) else {}),
               "hyperparams_source": cfg.source,
               "created_utc": dt.datetime.now(dt.timezone.utc).isoformat(timespec="seconds"), **provenance()}
     return args, config, run_dir, False

@@ -30,7 +30,7 @@ from lvgym.benchmark.runner import build_policy
 from lvgym.errors import ConfigError, check_number
 
 __all__ = ["DEFAULT_BASELINE", "ResidualConfig", "ResidualEnv", "ResidualPolicy", "ResidualRows", "ResidualVecEnv",
-           "combine"]
+           "combine", "residual_options", "residual_venv"]
 
 DEFAULT_BASELINE = "gs-pid-flex"
 #: registered policies that cannot be a residual's baseline (learned ones: the residual is on a classical law)
@@ -60,6 +60,23 @@ class ResidualConfig:
         """The residual set-up a saved policy's sidecar records, or None for a plain policy."""
         r = meta.get("residual")
         return None if not r else cls(**r)
+
+
+def residual_options(baseline: str | None, scale: float) -> dict[str, Any] | None:
+    """``train.py``'s ``--residual`` and ``--residual-scale`` as a run records them (None: not residual);
+    a bad value is a ConfigError naming the option."""
+    if baseline in (None, "none"):
+        return None
+    try:
+        return ResidualConfig(baseline, scale).to_dict()
+    except ConfigError as exc:
+        raise ConfigError("--residual" if exc.key.endswith("baseline") else "--residual-scale", exc.value,
+                          exc.allowed) from None
+
+
+def residual_venv(venv: Any, residual: dict[str, Any] | None) -> Any:
+    """``venv`` (the batched lvgym SB3 VecEnv) wrapped residual as ``residual`` records, or itself."""
+    return venv if residual is None else ResidualVecEnv(venv, ResidualConfig(**residual))
 
 
 def combine(base: np.ndarray, learned: np.ndarray, scale: float) -> np.ndarray:

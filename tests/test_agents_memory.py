@@ -104,6 +104,24 @@ def test_a_residual_run_records_its_baseline_and_the_adapter_rebuilds_it(tmp_pat
         obs, _, term, trunc, info = env.step(a)
     r1, r2 = play_episode(policy, env, 2), play_episode(policy, env, 2)
     assert r1["score"] == r2["score"]
+    from lvgym.benchmark.registry import resolve_policy    # what evaluate.py does with a run folder
+    flown = build_policy(resolve_policy(str(run)), env)
+    assert isinstance(flown, ResidualPolicy) and play_episode(flown, env, 2)["score"] == r1["score"]
+
+
+def test_residual_and_history_combine_in_training_and_in_the_adapter(tmp_path):
+    run = TRAIN.train(_argv(tmp_path, "res-h", "--residual", "gs-pid-flex", "--history", "2"))
+    opts = dict(SHORT, observation="flight")
+    stacked, plain = gymnasium.make(ENV, history=2, **opts), gymnasium.make(ENV, **opts)
+    p_stacked, p_plain = load_policy(run, env=stacked), load_policy(run, env=plain)
+    hs, info_s = stacked.reset(seed=8)
+    ps, info_p = plain.reset(seed=8)
+    p_stacked.reset(), p_plain.reset()
+    for _ in range(60):        # the history records the applied (baseline + residual) action in both
+        a, b = p_stacked.act(hs, info_s), p_plain.act(ps, info_p)
+        assert np.array_equal(a, b) and np.array_equal(p_plain.learned._buf[0], hs)
+        hs, _, _, _, info_s = stacked.step(a)
+        ps, _, _, _, info_p = plain.step(b)
 
 
 # ------------------------------------------------------------------------------------------ recurrent PPO
