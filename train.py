@@ -1,9 +1,12 @@
-"""Train a TVC policy with stable-baselines3 (PPO, SAC or TD3) on the batched lvgym envs.
+"""Train a TVC policy with stable-baselines3 (PPO, SAC, TD3; sb3-contrib's RecurrentPPO) on the batched lvgym envs.
 
     python train.py                                            # PPO on SmileAscent-v0, agents/hyperparams/ppo.yaml
     python train.py --algo sac --model rigid --wind random --randomize all --total-timesteps 2e6 --name sac-rigid
     python train.py --hp algo.n_steps=128 policy.net_arch=[32,32] --env-kwargs mission_time_s=20
     python train.py --resume runs/sac-rigid                    # continue a stopped or killed run
+    python train.py --env-id lvgym/SmileAscent-v1 --history 4  # stack the last 4 samples and actions
+    python train.py --env-id lvgym/SmileAscent-v1 --algo recurrent-ppo --observation flight
+    python train.py --env-id lvgym/SmileAscent-v1 --residual gs-pid-flex --residual-scale 0.2
 
 A run lives in ``runs/<name>/``: ``config.yaml`` (every argument, the resolved hyperparameters and env
 keywords, lvgym version, git commit), ``segments.jsonl`` (one line per start or resume), ``tb/``
@@ -64,8 +67,14 @@ class Args:
     """state (ideal) or sensors (IMU)"""
     env_kwargs: list[str] = field(default_factory=list)
     """further env keywords KEY=VALUE (values in YAML), e.g. mission_time_s=20"""
+    history: int = 0
+    """observation history: the last K samples and actions stacked (lvgym.envs.history; 0: off)"""
     algo: str = "ppo"
-    """ppo, sac or td3"""
+    """ppo, sac, td3 or recurrent-ppo (sb3-contrib's RecurrentPPO with MlpLstmPolicy)"""
+    residual: str | None = None
+    """fly residual on this registered baseline, e.g. gs-pid-flex (agents.residual; default: not residual)"""
+    residual_scale: float = 0.2
+    """with --residual: gimbal units per unit of learned action, in (0, 2]"""
     total_timesteps: int | None = None
     """env steps of the whole run (default: n_timesteps of the hyperparameter file)"""
     seed: int = 0
@@ -142,9 +151,9 @@ def build_parser(suppress: bool = False) -> argparse.ArgumentParser:
             kw["nargs"] = "*"
         elif f.name in ("total_timesteps", "checkpoint_freq", "eval_freq"):
             kw["type"] = _number
-        elif f.name in ("seed", "n_envs", "keep_checkpoints", "eval_episodes", "torch_threads", "verbose"):
+        elif f.name in ("seed", "n_envs", "history", "keep_checkpoints", "eval_episodes", "torch_threads", "verbose"):
             kw["type"] = int
-        elif f.name in ("eval_mission_time_s", "checkpoint_interval_s"):
+        elif f.name in ("eval_mission_time_s", "checkpoint_interval_s", "residual_scale"):
             kw["type"] = float
         if f.name == "algo":
             from agents.config import ALGOS
@@ -181,6 +190,7 @@ def env_kwargs_of(args: Args) -> dict[str, Any]:
     elif r in ([], ["none"], ["false"], ["False"]):
         r = False
     out: dict[str, Any] = {"model": args.model, "wind": args.wind, "randomize": r, "observation": args.observation}
+    out.update({"history": int(args.history)} if args.history else {})   # when on only: old runs unchanged
     for item in args.env_kwargs:
         key, sep, text = item.partition("=")
         if not sep or not key.strip():
@@ -206,6 +216,10 @@ def check_options(args: Args) -> None:
     option_number("--torch-threads", args.torch_threads, 1, 1024, integer=True)
     option_number("--verbose", args.verbose, 0, 2, integer=True)
     option_number("--n-envs", args.n_envs, 1, 4096, integer=True)
+    from agents.residual import residual_options
+
+    option_number("--history", args.history, 0, 64, integer=True)
+    residual_options(args.residual, args.residual_scale)
     known = set(RANDOMIZE) | {"all", "none", "true", "false", "True", "False"}
     for r in args.randomize:
         if r not in known:
@@ -260,14 +274,17 @@ def training_seed(seed: int, step: int, n_envs: int) -> int:
 
 
 def make_venv(env_id: str, n_envs: int, seed: int, env_kwargs: dict[str, Any], norm: Any, gamma: float,
-              stats: Path | None) -> Any:
-    """Batched SB3 VecEnv -> VecMonitor (episode returns) -> VecNormalize (new, or loaded from ``stats``)."""
+              stats: Path | None, residual: dict[str, Any] | None = None) -> Any:
+    """Batched SB3 VecEnv (-> :class:`agents.residual.ResidualVecEnv` with ``residual``) -> VecMonitor
+    (episode returns) -> VecNormalize (new, or loaded from ``stats``)."""
     from stable_baselines3.common.vec_env import VecMonitor, VecNormalize
 
     import lvgym  # noqa: F401
     from lvgym.envs import make_sb3_vec_env
 
-    venv = VecMonitor(make_sb3_vec_env(env_id, num_envs=n_envs, seed=seed, **env_kwargs))
+    from agents.residual import residual_venv
+
+    venv = VecMonitor(residual_venv(make_sb3_vec_env(env_id, num_envs=n_envs, seed=seed, **env_kwargs), residual))
     if stats is not None and stats.is_file():
         return VecNormalize.load(str(stats), venv)
     if norm.norm_obs or norm.norm_reward:
@@ -307,6 +324,7 @@ def prepare(args: Args, given: set[str]) -> tuple[Args, dict[str, Any], Path, bo
     """The run's arguments, its ``config.yaml`` content, its folder and whether it resumes: every option
     checked, nothing written (:func:`create_run` writes). Raises ConfigError or SystemExit (one line)."""
     from agents.config import build_config, load_config, parse_overrides
+    from agents.residual import residual_options
 
     check_options(args)
     if args.resume:
@@ -341,6 +359,7 @@ def prepare(args: Args, given: set[str]) -> tuple[Args, dict[str, Any], Path, bo
     config = {"name": name, "args": asdict(args), "algo": args.algo, "env_id": args.env_id, "env_kwargs": env_kwargs,
               "total_timesteps": int(args.total_timesteps or cfg.n_timesteps), "seed": args.seed,
               "eval_suite": suite, "eval_select": args.eval_select, "hyperparams": cfg.to_dict(),
+              **({"residual": res} if (res := residual_options(args.residual, args.residual_scale)) else {}),
               "hyperparams_source": cfg.source,
               "created_utc": dt.datetime.now(dt.timezone.utc).isoformat(timespec="seconds"), **provenance()}
     return args, config, run_dir, False
@@ -374,12 +393,11 @@ def train(argv: list[str] | None = None) -> Path:
 
 
 def _train(args: Args, given: set[str], stop: Any) -> Path:
-    import stable_baselines3 as sb3
     import torch
 
     from agents.callbacks import (CheckpointCallback, ProgressBarCallback, ValidationEvaluator, clean_incomplete,
                                   latest_checkpoint, load_replay_buffer, load_rng)
-    from agents.config import ALGOS, build_config
+    from agents.config import ALGOS, algo_class, build_config
     from agents.policy import policy_files
 
     try:                                             # everything checked before the run folder is made
@@ -399,7 +417,7 @@ def _train(args: Args, given: set[str], stop: Any) -> Path:
         fail(PROG, exc)
     try:                                             # the env's keywords (--model, --wind, --env-kwargs, ...)
         venv = make_venv(config["env_id"], cfg.n_envs, seed, config["env_kwargs"], cfg.normalize, cfg.hyper.gamma,
-                         policy_files(stem)[1] if stem is not None else None)
+                         policy_files(stem)[1] if stem is not None else None, config.get("residual"))
     except (ConfigError, ValueError) as exc:
         fail(PROG, f"{config['env_id']} option {exc}")
     try:
@@ -409,7 +427,7 @@ def _train(args: Args, given: set[str], stop: Any) -> Path:
             clean_incomplete(ckpt_dir)
             print(_resume_note(run_dir, state, target), file=sys.stderr)
         torch.set_num_threads(max(1, args.torch_threads))
-        cls = getattr(sb3, ALGOS[config["algo"]])
+        cls = algo_class(config["algo"])
         if stem is not None:
             model = cls.load(str(policy_files(stem)[0]), env=venv, device="cpu")
             load_rng(stem.with_name(stem.name + "_rng.pkl"))
@@ -425,7 +443,8 @@ def _train(args: Args, given: set[str], stop: Any) -> Path:
                 n = venv.action_space.shape[0]
                 kw["action_noise"] = (NormalActionNoise if noise == "normal" else OrnsteinUhlenbeckActionNoise)(
                     np.zeros(n), sigma * np.ones(n))
-            model = cls("MlpPolicy", venv, seed=int(config["seed"]), device="cpu", verbose=0, **kw)
+            net = "MlpLstmPolicy" if config["algo"] == "recurrent-ppo" else "MlpPolicy"
+            model = cls(net, venv, seed=int(config["seed"]), device="cpu", verbose=0, **kw)
         model.set_logger(make_logger(run_dir, start, args.verbose))
         with open(run_dir / "segments.jsonl", "a", encoding="utf-8") as f:
             f.write(json.dumps({"start_step": start, "env_seed": seed, "target": target, "resumed": resumed,
@@ -441,7 +460,8 @@ def _train(args: Args, given: set[str], stop: Any) -> Path:
                                             select_on=config["env_kwargs"].get("model") if select == "trained" else None)
         meta = {"algo": ALGOS[config["algo"]], "env_id": config["env_id"], "env_kwargs": config["env_kwargs"],
                 "run": config["name"], "seed": config["seed"], "target_timesteps": target,
-                "git_commit": config.get("git_commit"), "lvgym_version": config.get("lvgym_version")}
+                "git_commit": config.get("git_commit"), "lvgym_version": config.get("lvgym_version"),
+                **({"residual": config["residual"]} if config.get("residual") else {})}
         checkpoint = CheckpointCallback(run_dir, args.checkpoint_freq, meta, venv if hasattr(venv, "obs_rms") else None,
                                         evaluator, args.eval_freq, args.keep_checkpoints, state, verbose=args.verbose,
                                         interval_s=args.checkpoint_interval_s, stop=stop)

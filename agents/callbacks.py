@@ -43,9 +43,12 @@ from lvgym.benchmark.runner import play_episode
 from lvgym.benchmark.results import atomic_path, atomic_write_text, json_text, remove_stale_temporaries
 from lvgym.benchmark.suites import Suite, get_suite
 
-from .policy import SB3Policy, copy_policy, policy_files
+from .policy import SB3Policy, adapt, copy_policy, policy_files
 
 _STEM = re.compile(r"^step_(\d{12})$")
+#: what a validation's ``score`` is: compared lexicographically, lower is better (older runs' checkpoints
+#: without this key ranked on ``[failure rate, rate error]``)
+SELECTION = "failure_rate, score"
 RNG_SUFFIX = "_rng.pkl"
 BUFFER_SUFFIX = "_replay_buffer.pkl"
 
@@ -128,6 +131,7 @@ class ValidationEvaluator:
         chosen = [c.name for c in self.suite.conditions if c.model == select_on]
         self.selected = chosen or [c.name for c in self.suite.conditions]
         self._envs: dict[Any, Any] = {}
+        self._built: dict[Any, Policy] = {}
 
     def episode(self, policy: Policy, condition: Any, seed: int) -> dict[str, Any]:
         """One episode's record (as ``lvgym.benchmark.runner.run_episode`` returns it), flown by the
@@ -139,11 +143,16 @@ class ValidationEvaluator:
                 **play_episode(policy, self._envs[condition], seed)}
 
     def evaluate(self, policy: Policy) -> dict[str, Any]:
-        """Per-condition means and failure rates, and the selection ``score``: ``[failure rate, rate
-        error]`` averaged over the selected conditions (``selected_on``), compared lexicographically (lower
-        is better; a failed episode's rate error stops at the failure, so failures must count first)."""
-        records = [self.episode(policy, c, s) for c in self.suite.conditions for s in self.seeds]
-        rows = summarize(records, ("rate_error_rad", "max_rate_radps", "effort_rad_s", "episode_return"))
+        """Per-condition means and failure rates, and the selection ``score``: ``[failure rate, score]``
+        averaged over the selected conditions (``selected_on``), compared lexicographically (lower is
+        better). The second entry is the episodes' failure-charged ``score`` of protocol v1
+        (:func:`lvgym.benchmark.scoring.flight_metrics`: the rate error plus, for a failed episode, the
+        failure penalty for the mission left), so among equal failure rates a policy that fails late is
+        not preferred for its shorter rate-error integral. ``policy``: a Policy, or a callable that builds
+        one for a condition's env (e.g. a residual policy whose baseline needs the env)."""
+        self._built.clear()                          # a factory's policies live for this evaluation only
+        records = [self.episode(self._policy(policy, c), c, s) for c in self.suite.conditions for s in self.seeds]
+        rows = summarize(records, ("rate_error_rad", "score", "max_rate_radps", "effort_rad_s", "episode_return"))
         conds: dict[str, dict[str, float]] = {}
         for r in rows:
             conds[r["condition"]] = {k: float(r[k]) for k in r if isinstance(r[k], (int, float))
@@ -151,14 +160,28 @@ class ValidationEvaluator:
         sel = [conds[name] for name in self.selected]
         fail = float(np.mean([c["failure_rate"] for c in sel]))
         err = float(np.mean([c["rate_error_rad_mean"] for c in sel]))
+        charged = float(np.mean([c["score_mean"] for c in sel]))
         return {"suite": self.suite.name, "version": self.suite.version, "seed_set": "validation",
                 "episodes": len(self.seeds), "conditions": conds, "selected_on": list(self.selected),
-                "failure_rate": fail, "rate_error_rad": err, "score": [fail, err]}
+                "failure_rate": fail, "rate_error_rad": err, "episode_score": charged, "score": [fail, charged],
+                "selection": SELECTION}
+
+    def _policy(self, policy: Any, condition: Any) -> Policy:
+        """``policy`` itself, or the one the factory ``policy`` builds for ``condition``'s env (cached)."""
+        if isinstance(policy, Policy):
+            return policy
+        if condition not in self._envs:
+            self._envs[condition] = condition.make_env()
+        key = ("policy", id(policy), condition)
+        if key not in self._built:
+            self._built[key] = policy(self._envs[condition])
+        return self._built[key]
 
     def close(self) -> None:
         for env in self._envs.values():
             env.close()
         self._envs.clear()
+        self._built.clear()
 
 
 # ------------------------------------------------------------------------------------------ signals
@@ -300,8 +323,9 @@ class CheckpointCallback(BaseCallback):
             result = self._validate(step)
             self.evaluations.append(result)
             self.last_eval = step
-            if self.best is None or result["score"] < self.best["score"]:
-                self.best, new_best = {"num_timesteps": step, "score": result["score"], "stem": stem.name}, True
+            if self.best is None or self.best.get("selection") != SELECTION or result["score"] < self.best["score"]:
+                self.best, new_best = {"num_timesteps": step, "score": result["score"], "stem": stem.name,
+                                       "selection": SELECTION}, True
         state = {**self.meta, "num_timesteps": step, "saved_utc": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
                  "train_wall_s": round(self.wall0 + time.monotonic() - self.t_start, 3),
                  "evaluations": self.evaluations, "best": self.best}
@@ -321,8 +345,9 @@ class CheckpointCallback(BaseCallback):
     def _validate(self, step: int) -> dict[str, Any]:
         assert self.evaluator is not None
         t0 = time.perf_counter()
-        policy = SB3Policy.from_model(self.model, self.vecnormalize, name=f"step_{step}")
-        result = {"num_timesteps": step, **self.evaluator.evaluate(policy),
+        policy = SB3Policy.from_model(self.model, self.vecnormalize, name=f"step_{step}", meta=self.meta)
+        flown = policy if "residual" not in self.meta else (lambda env: adapt(policy, env))
+        result = {"num_timesteps": step, **self.evaluator.evaluate(flown),
                   "wall_s": round(time.perf_counter() - t0, 3)}
         self.logger.record("eval/failure_rate", result["failure_rate"])
         self.logger.record("eval/rate_error_rad", result["rate_error_rad"])

@@ -31,10 +31,39 @@ from lvgym.errors import ConfigError, check_bool, check_choice, check_number
 
 HYPERPARAMS_DIR = Path(__file__).resolve().parent / "hyperparams"
 #: the algorithms train.py trains: name -> stable-baselines3 class (the one list of them)
-ALGOS = {"ppo": "PPO", "sac": "SAC", "td3": "TD3"}
+ALGOS = {"ppo": "PPO", "sac": "SAC", "td3": "TD3", "recurrent-ppo": "RecurrentPPO"}
+#: the algorithms of sb3-contrib (the others are stable-baselines3's)
+CONTRIB = ("RecurrentPPO",)
+#: the on-policy algorithms (their ``algo:`` keys are :class:`PPOConfig`'s)
+ON_POLICY = ("ppo", "recurrent-ppo")
 ACTIVATIONS = ("tanh", "relu", "elu", "leaky_relu")
 LR_SCHEDULES = ("constant", "linear")
 ACTION_NOISES = ("none", "normal", "ornstein_uhlenbeck")
+
+
+def algo_name(algo: str) -> str:
+    """The class name of ``algo`` (a key of :data:`ALGOS` or a class name, any case), e.g. ``RecurrentPPO``;
+    an unknown name comes back upper-cased."""
+    for key, name in ALGOS.items():
+        if algo.lower() in (key, name.lower()):
+            return name
+    return algo.upper()
+
+
+def algo_class(algo: str) -> type:
+    """The stable-baselines3 (or sb3-contrib) class of ``algo`` (``ValueError`` for an unknown one,
+    ``ImportError`` when sb3-contrib is missing)."""
+    name = algo_name(algo)
+    if name in CONTRIB:
+        import sb3_contrib
+
+        return getattr(sb3_contrib, name)
+    import stable_baselines3 as sb3
+
+    cls = getattr(sb3, name, None)
+    if cls is None:
+        raise ValueError(f"algo = {algo!r}: one of {sorted(ALGOS.values())}")
+    return cls
 
 
 # ------------------------------------------------------------------------------------------ validation
@@ -88,13 +117,20 @@ class NormalizeConfig:
 @dataclass(frozen=True)
 class PolicyConfig:
     """The networks. ``net_arch``: hidden layers of actor and critic (separate networks of this shape);
-    ``qf_arch`` (SAC/TD3): the critics' layers (None: ``net_arch``); ``log_std_init``, ``ortho_init``: PPO."""
+    ``qf_arch`` (SAC/TD3): the critics' layers (None: ``net_arch``); ``log_std_init``, ``ortho_init``: PPO.
+    Recurrent PPO only (sb3-contrib's ``MlpLstmPolicy``): ``lstm_hidden_size`` (units of the LSTM),
+    ``n_lstm_layers``, ``shared_lstm`` (actor and critic share one LSTM) and ``enable_critic_lstm`` (the
+    critic has its own LSTM; False with ``shared_lstm``: it then sees the observation only)."""
 
     net_arch: tuple[int, ...] = (64, 64)
     qf_arch: tuple[int, ...] | None = None
     activation: str = "tanh"
     log_std_init: float = 0.0
     ortho_init: bool = True
+    lstm_hidden_size: int | None = None
+    n_lstm_layers: int | None = None
+    shared_lstm: bool | None = None
+    enable_critic_lstm: bool | None = None
 
     def validate(self, src: str | None = None) -> PolicyConfig:
         object.__setattr__(self, "net_arch", _layers("policy.net_arch", self.net_arch, src))
@@ -103,7 +139,24 @@ class PolicyConfig:
         check_choice("policy.activation", self.activation, ACTIVATIONS, src)
         _num("policy.log_std_init", self.log_std_init, -10.0, 5.0, src=src)
         check_bool("policy.ortho_init", self.ortho_init, src)
+        if self.lstm_hidden_size is not None:
+            _num("policy.lstm_hidden_size", self.lstm_hidden_size, 1, 4096, integer=True, src=src)
+        if self.n_lstm_layers is not None:
+            _num("policy.n_lstm_layers", self.n_lstm_layers, 1, 16, integer=True, src=src)
+        for key in ("shared_lstm", "enable_critic_lstm"):
+            if getattr(self, key) is not None:
+                check_bool(f"policy.{key}", getattr(self, key), src)
+        if self.shared_lstm and self.enable_critic_lstm:
+            raise ConfigError("policy.enable_critic_lstm", True, "false with policy.shared_lstm: true (the critic "
+                              "then uses the shared LSTM)", src)
         return self
+
+    def lstm_kwargs(self) -> dict[str, Any]:
+        """The LSTM keywords of ``MlpLstmPolicy`` (defaults: 64 units, 1 layer, separate critic LSTM)."""
+        return {"lstm_hidden_size": self.lstm_hidden_size or 64, "n_lstm_layers": self.n_lstm_layers or 1,
+                "shared_lstm": bool(self.shared_lstm),
+                "enable_critic_lstm": not self.shared_lstm if self.enable_critic_lstm is None
+                else bool(self.enable_critic_lstm)}
 
     def sb3_kwargs(self, algo: str) -> dict[str, Any]:
         """``policy_kwargs`` of the SB3 model."""
@@ -111,9 +164,10 @@ class PolicyConfig:
 
         act = {"tanh": nn.Tanh, "relu": nn.ReLU, "elu": nn.ELU, "leaky_relu": nn.LeakyReLU}[self.activation]
         pi = list(self.net_arch)
-        if algo == "ppo":
-            return {"net_arch": {"pi": pi, "vf": pi}, "activation_fn": act, "log_std_init": self.log_std_init,
-                    "ortho_init": self.ortho_init}
+        if algo in ON_POLICY:
+            kw = {"net_arch": {"pi": pi, "vf": pi}, "activation_fn": act, "log_std_init": self.log_std_init,
+                  "ortho_init": self.ortho_init}
+            return {**kw, **self.lstm_kwargs()} if algo == "recurrent-ppo" else kw
         return {"net_arch": {"pi": pi, "qf": list(self.qf_arch or self.net_arch)}, "activation_fn": act}
 
 
@@ -222,7 +276,9 @@ class AgentConfig:
                "policy": {**d["policy"], "net_arch": list(self.policy.net_arch),
                           "qf_arch": None if self.policy.qf_arch is None else list(self.policy.qf_arch)},
                           "algo": d["hyper"]}
-        if self.algo == "ppo":
+        for key in _LSTM_KEYS if self.algo != "recurrent-ppo" else ():
+            out["policy"].pop(key)
+        if self.algo in ON_POLICY:
             out["policy"].pop("qf_arch")
         else:
             out["algo"] = {k: v for k, v in out["algo"].items() if k in _ALGO_KEYS[self.algo]}
@@ -234,7 +290,7 @@ class AgentConfig:
         lr, sched = h.pop("learning_rate"), h.pop("lr_schedule")
         kw: dict[str, Any] = {"learning_rate": linear_schedule(lr) if sched == "linear" else lr,
                               "policy_kwargs": self.policy.sb3_kwargs(self.algo)}
-        if self.algo != "ppo":
+        if self.algo not in ON_POLICY:
             noise, sigma = h.pop("action_noise"), h.pop("action_noise_sigma")
             h = {k: v for k, v in h.items() if k in _ALGO_KEYS[self.algo]}
             kw["train_freq"] = (h.pop("train_freq"), "step")
@@ -246,6 +302,7 @@ _COMMON = ("learning_rate", "lr_schedule", "buffer_size", "learning_starts", "ba
            "train_freq", "gradient_steps", "action_noise", "action_noise_sigma")
 _ALGO_KEYS = {"sac": _COMMON + ("ent_coef", "use_sde"),
               "td3": _COMMON + ("policy_delay", "target_policy_noise", "target_noise_clip")}
+_LSTM_KEYS = ("lstm_hidden_size", "n_lstm_layers", "shared_lstm", "enable_critic_lstm")
 _ENTRY_KEYS = ("n_envs", "n_timesteps", "normalize", "policy", "algo")
 
 
@@ -320,9 +377,13 @@ def build_config(algo: str, env_id: str, entry: Mapping[str, Any], source: str =
     for key, value in raw.items():
         if key not in _ENTRY_KEYS:
             raise ConfigError(key, value, _unknown(key, _ENTRY_KEYS), src)
-    hyper_cls: type = PPOConfig if algo == "ppo" else OffPolicyConfig
+    hyper_cls: type = PPOConfig if algo in ON_POLICY else OffPolicyConfig
     algo_raw = raw.get("algo", {}) or {}
-    if algo != "ppo":
+    if algo != "recurrent-ppo":
+        for key in _LSTM_KEYS:
+            if key in (raw.get("policy") or {}):
+                raise ConfigError(f"policy.{key}", raw["policy"][key], "only with --algo recurrent-ppo", src)
+    if algo not in ON_POLICY:
         _known("algo.", algo_raw, hyper_cls, src)
         allowed = _ALGO_KEYS[algo]
         for key, value in algo_raw.items():
@@ -359,6 +420,6 @@ def load_config(algo: str, env_id: str, overrides: Mapping[str, Any] | None = No
     return build_config(algo, env_id, entry, src, overrides)
 
 
-__all__ = ["ALGOS", "AgentConfig", "HYPERPARAMS_DIR", "LinearSchedule", "NormalizeConfig", "OffPolicyConfig",
+__all__ = ["ALGOS", "CONTRIB", "ON_POLICY", "AgentConfig", "algo_class", "algo_name", "HYPERPARAMS_DIR", "LinearSchedule", "NormalizeConfig", "OffPolicyConfig",
            "PPOConfig", "PolicyConfig", "build_config", "linear_schedule", "load_config", "parse_overrides",
            "read_entries"]

@@ -16,6 +16,7 @@ validation, else its final model, else its last checkpoint).
 from __future__ import annotations
 
 import argparse
+import functools
 import json
 import pickle
 import shutil
@@ -27,7 +28,7 @@ import numpy as np
 
 from lvgym.benchmark.results import atomic_path, atomic_write_text
 
-from .config import ALGOS
+from .config import ALGOS, algo_class, algo_name
 
 VECNORM_SUFFIX = "_vecnormalize.pkl"
 
@@ -51,7 +52,7 @@ def save_policy(model: Any, vecnormalize: Any, stem: str | Path, meta: dict[str,
     if vecnormalize is not None:
         with atomic_path(norm_path) as tmp:
             vecnormalize.save(tmp)
-    atomic_write_text(json_path, json.dumps({**meta, "algo": str(meta["algo"]).upper()}, indent=1, sort_keys=True))
+    atomic_write_text(json_path, json.dumps({**meta, "algo": algo_name(str(meta["algo"]))}, indent=1, sort_keys=True))
     return zip_path
 
 
@@ -94,7 +95,7 @@ def _sidecar_algo(path: Path) -> str | None:
     side = path.with_suffix(".json")
     if side.is_file():
         algo = json.loads(side.read_text(encoding="utf-8")).get("algo")
-        return str(algo).upper() if algo else None
+        return algo_name(str(algo)) if algo else None
     return None
 
 
@@ -106,7 +107,8 @@ def _guess_algo(path: Path) -> str | None:
         module = str(data.get("policy_class", {}).get("__module__", ""))
     except (KeyError, ValueError, zipfile.BadZipFile, AttributeError):
         return None
-    for key, algo in (("sac", "SAC"), ("td3", "TD3"), ("ddpg", "DDPG"), ("common.policies", "PPO")):
+    for key, algo in (("recurrent", "RecurrentPPO"), ("sac", "SAC"), ("td3", "TD3"), ("ddpg", "DDPG"),
+                      ("common.policies", "PPO")):
         if key in module:
             return algo
     return None
@@ -116,8 +118,6 @@ def guess_and_load(path: str | Path) -> Any:
     """The SB3 model at ``path`` when no sidecar names its algorithm: the algorithm suggested by the
     policy class stored in the zip first, then every algorithm train.py trains
     (:data:`agents.config.ALGOS`) in turn."""
-    import stable_baselines3 as sb3
-
     path = Path(path)
     if not path.is_file():
         raise FileNotFoundError(f"policy {str(path)!r}: no such SB3 model file")
@@ -126,9 +126,10 @@ def guess_and_load(path: str | Path) -> Any:
     order = [first] + [a for a in known if a != first] if first else known
     errors = []
     for algo in order:
-        cls = getattr(sb3, algo, None)
-        if cls is None:
-            errors.append(f"{algo}: not in stable_baselines3")
+        try:
+            cls = algo_class(algo)
+        except (ImportError, ValueError) as exc:
+            errors.append(f"{algo}: {exc}")
             continue
         try:
             return cls.load(str(path), device="cpu")
@@ -147,15 +148,13 @@ def read_meta(zip_path: str | Path) -> dict[str, Any]:
 def load_model(zip_path: str | Path, algo: str | None = None) -> Any:
     """The SB3 model at ``zip_path`` on the CPU: class from ``algo``, else from the sidecar JSON, else
     guessed by :func:`guess_and_load` (policies saved by other tools)."""
-    import stable_baselines3 as sb3
-
     algo = algo or read_meta(zip_path).get("algo")
     if algo is None:
         return guess_and_load(zip_path)
-    name = ALGOS.get(str(algo).lower(), str(algo).upper())
-    cls = getattr(sb3, name, None)
-    if cls is None:
-        raise ValueError(f"{str(zip_path)!r}: algo = {algo!r}: one of {sorted(ALGOS.values())}")
+    try:
+        cls = algo_class(str(algo))
+    except ValueError:
+        raise ValueError(f"{str(zip_path)!r}: algo = {algo!r}: one of {sorted(ALGOS.values())}") from None
     return cls.load(str(zip_path), device="cpu")
 
 
@@ -186,14 +185,16 @@ class SB3Policy:
         self.deterministic = bool(deterministic)
         p = Path(path)
         self.name = name or (p.resolve().name if p.is_dir() else zip_path.stem)
+        self._setup()
 
     @classmethod
     def from_model(cls, model: Any, normalizer: Any = None, name: str = "agent",
-                   deterministic: bool = True) -> SB3Policy:
+                   deterministic: bool = True, meta: dict[str, Any] | None = None) -> SB3Policy:
         """A live model (and a VecNormalize whose statistics it was trained with) as a policy. The
-        statistics are copied and frozen: later training does not change this policy."""
+        statistics are copied and frozen: later training does not change this policy. ``meta``: the
+        run's sidecar fields (its ``env_kwargs`` say whether the observation has a ``history``)."""
         self = cls.__new__(cls)
-        self.path, self.meta, self.model, self.name = "", {}, model, name
+        self.path, self.meta, self.model, self.name = "", dict(meta or {}), model, name
         self.deterministic = bool(deterministic)
         self.normalizer = None
         if normalizer is not None:
@@ -202,19 +203,90 @@ class SB3Policy:
             self.normalizer = copy.copy(normalizer)
             self.normalizer.obs_rms = copy.deepcopy(normalizer.obs_rms)
             self.normalizer.training = False
+        self._setup()
         return self
 
+    def _setup(self) -> None:
+        """What the model needs besides its weights: the observation history of its training env
+        (``env_kwargs["history"]``: k samples and actions, stacked here from a plain observation with the
+        env's own :class:`lvgym.envs.history.HistoryStack`) and, for a recurrent model, its LSTM state."""
+        self.recurrent = algo_name(type(self.model).__name__) == "RecurrentPPO"
+        self.history = int((self.meta.get("env_kwargs") or {}).get("history", 0) or 0)
+        self._stack: Any = None
+        self._buf = np.zeros((1, 0), np.float32)
+        self._last = np.zeros(0, np.float32)
+        self.reset()
+
     def reset(self) -> None:
-        """Nothing to reset (feed-forward networks)."""
+        """A new episode: the LSTM state (recurrent models) and the stacked history start afresh."""
+        self._lstm: Any = None
+        self._starts = np.ones(1, dtype=bool)
+        self._fresh = True
+
+    def note_applied(self, action: np.ndarray) -> None:
+        """The action the env got this step (a residual policy's mix): the history records it."""
+        self._last = np.asarray(action, dtype=np.float32)
+
+    def _stacked(self, obs: np.ndarray) -> np.ndarray:
+        """``obs`` as the model saw it in training: itself, or (a plain observation of a model trained with
+        ``history``) the stack of the last samples and actions."""
+        expected = self.model.observation_space.shape
+        if obs.shape == expected or not self.history:
+            return obs
+        if self._stack is None:
+            from lvgym.envs.history import HistoryStack
+            from lvgym.envs.layouts import ACTIONS
+
+            base = _plain_layout(int(obs.shape[0]))
+            stack = HistoryStack(base, ACTIONS["tvc"], self.history)
+            if (stack.size,) != expected:
+                raise ValueError(f"policy {self.name!r}: observation of shape {obs.shape} with history "
+                                 f"{self.history} stacks to ({stack.size},), trained on {expected}")
+            self._stack, self._buf = stack, stack.zeros(1)
+        if self._fresh:
+            self._stack.reset(self._buf, [0], obs[None])
+        else:
+            from lvgym.envs.history import recorded_action
+
+            self._stack.push(self._buf, obs[None], recorded_action("tvc", self._last[None]))
+        return self._buf[0].copy()
 
     def act(self, observation: np.ndarray, info: dict[str, Any]) -> np.ndarray:
-        """The action for one observation of the env's observation space."""
-        obs = np.asarray(observation, dtype=np.float32)
+        """The action for one observation of the env's observation space (or, for a model trained with
+        ``history``, of the plain observation: the history is stacked here)."""
+        obs = self._stacked(np.asarray(observation, dtype=np.float32))
+        self._fresh = False
         expected = self.model.observation_space.shape
         if obs.shape != expected:
             raise ValueError(f"policy {self.name!r}: observation of shape {obs.shape}, trained on {expected}")
+        action = self._predict(obs)
+        self._last = np.asarray(action, dtype=np.float32)
+        return action
+
+    def act_batch(self, observations: np.ndarray, episode_start: np.ndarray) -> np.ndarray:
+        """Actions (B, n_a) for the observations (B, n_obs) of B env rows (a batched env's, with the
+        model's own observation: a ``history`` env stacks natively); ``episode_start`` (B,) bool marks the
+        rows whose episode begins with this observation (their LSTM state restarts)."""
+        obs = np.asarray(observations, dtype=np.float32)
         if self.normalizer is not None and getattr(self.normalizer, "norm_obs", True):
             obs = np.asarray(self.normalizer.normalize_obs(obs), dtype=np.float32)
+        starts = np.asarray(episode_start, dtype=bool)
+        if not self.recurrent:
+            return np.asarray(self.model.predict(obs, deterministic=self.deterministic)[0])
+        if self._lstm is not None and np.shape(self._lstm[0])[1] != obs.shape[0]:
+            self._lstm = None
+        action, self._lstm = self.model.predict(obs, state=self._lstm, episode_start=starts,
+                                                deterministic=self.deterministic)
+        return np.asarray(action)
+
+    def _predict(self, obs: np.ndarray) -> np.ndarray:
+        if self.normalizer is not None and getattr(self.normalizer, "norm_obs", True):
+            obs = np.asarray(self.normalizer.normalize_obs(obs), dtype=np.float32)
+        if self.recurrent:                         # the LSTM state goes on, restarted at an episode's start
+            action, self._lstm = self.model.predict(obs[None], state=self._lstm, episode_start=self._starts,
+                                                    deterministic=self.deterministic)
+            self._starts = np.zeros(1, dtype=bool)
+            return np.asarray(action)[0]
         fast = self._fast_path()
         if fast is None:
             action, _ = self.model.predict(obs, deterministic=self.deterministic)
@@ -237,7 +309,8 @@ class SB3Policy:
             pol = getattr(m, "policy", None)
             ok = (pol is not None and isinstance(m.action_space, spaces.Box)
                   and isinstance(m.observation_space, spaces.Box) and len(m.observation_space.shape) == 1
-                  and not getattr(pol, "squash_output", False) and str(getattr(m, "device", "cpu")) == "cpu")
+                  and not getattr(pol, "squash_output", False) and str(getattr(m, "device", "cpu")) == "cpu"
+                  and not self.recurrent)
             if ok:
                 pol.set_training_mode(False)
             self._fast = (pol, m.action_space.low, m.action_space.high) if ok else None
@@ -256,10 +329,32 @@ def shipped_policy(name: str = "ppo") -> SB3Policy:
     return SB3Policy(SHIPPED, name)
 
 
-def load_policy(path: str | Path, name: str | None = None) -> SB3Policy:
-    """``SB3Policy(path, name)``: a factory for ``lvgym.benchmark.PolicySpec("...", "agents.policy:load_policy",
-    (("path", ...),))``."""
-    return SB3Policy(path, name)
+def load_policy(path: str | Path, name: str | None = None, env: Any = None) -> Any:
+    """``SB3Policy(path, name)``, or for a run trained residual on a baseline (its sidecar's ``residual``)
+    the :class:`~agents.residual.ResidualPolicy` of it on that baseline, rebuilt on ``env``: a factory for
+    ``lvgym.benchmark.PolicySpec("...", "agents.policy:load_policy", (("path", ...),))``."""
+    return adapt(SB3Policy(path, name), env)
+
+
+def adapt(policy: SB3Policy, env: Any) -> Any:
+    """``policy`` as the env flies it: on its baseline when its meta records a residual run (built on
+    ``env``, which must then be given), else itself."""
+    from .residual import ResidualConfig, ResidualPolicy
+
+    residual = ResidualConfig.from_meta(policy.meta)
+    if residual is None:
+        return policy
+    if env is None:
+        raise ValueError(f"policy {policy.name!r} is residual on {residual.baseline!r}: its baseline needs the env")
+    return ResidualPolicy(policy, residual, env)
+
+
+@functools.lru_cache(maxsize=8)
+def _plain_layout(n: int) -> Any:
+    """A layout of ``n`` unnamed observation entries (what the adapter stacks without the env's names)."""
+    from lvgym.packing import Field, Packed
+
+    return Packed("observation", [Field("entry", n, "-", "observation entries")], interface=True)
 
 
 def _export(args: argparse.Namespace) -> None:
@@ -283,5 +378,5 @@ if __name__ == "__main__":
     main()
 
 
-__all__ = ["SB3Policy", "copy_policy", "load_model", "load_policy", "load_vecnormalize", "policy_files",
+__all__ = ["SB3Policy", "adapt", "copy_policy", "load_model", "load_policy", "load_vecnormalize", "policy_files",
            "read_meta", "resolve_model_path", "save_policy"]

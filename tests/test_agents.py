@@ -113,7 +113,7 @@ def test_train_saves_resumes_and_reloads_as_a_policy(tmp_path):
     for e in state0["evaluations"]:
         (name,) = e["selected_on"]
         assert name.endswith("/nonrigid")
-        assert e["score"] == [e["conditions"][name]["failure_rate"], e["conditions"][name]["rate_error_rad_mean"]]
+        assert e["score"] == [e["conditions"][name]["failure_rate"], e["conditions"][name]["score_mean"]]
     assert load_model(zip0).num_timesteps == s0
     count0 = _vecnorm(zip0.with_suffix("")).obs_rms.count
 
@@ -226,6 +226,42 @@ def test_validation_selects_on_the_training_model_or_on_every_condition():
     names = {m: ValidationEvaluator("smile-windy", 1, select_on=m).selected for m in ("rigid", "nonrigid", "flex", None)}
     assert names["rigid"] == ["smile-windy/rigid"] and names["nonrigid"] == ["smile-windy/nonrigid"]
     assert names["flex"] == names[None] == ["smile-windy/rigid", "smile-windy/nonrigid"]   # not flown: all
+
+
+def test_validation_ranks_on_failure_rate_then_the_failure_charged_score():
+    """Two policies with equal failure rates: the one whose failures come late has the smaller rate error
+    (its integral stops at the failure) but the larger failure-charged score; selection takes the score."""
+    from agents.callbacks import ValidationEvaluator
+
+    ev = ValidationEvaluator("smile-windy", 2, select_on="nonrigid")
+    table = {"early": [(True, 0.5, 3.5), (False, 1.0, 1.0)], "late": [(True, 0.9, 1.4), (False, 1.0, 1.0)]}
+
+    class Fake:
+        def __init__(self, name):
+            self.name = name
+
+        def reset(self):
+            pass
+
+        def act(self, observation, info):
+            return np.zeros(2, np.float32)
+
+    def episode(policy, condition, seed):
+        failed, err, score = table[policy.name][ev.seeds.index(seed)]
+        return {"suite": ev.suite.name, "condition": condition.name, "group": condition.group, "policy": policy.name,
+                "model": condition.model, "seed": seed, "failed": failed, "failure_reason": "x" if failed else "",
+                "rate_error_rad": err, "score": score, "max_rate_radps": 0.0, "effort_rad_s": 0.0,
+                "episode_return": -score}
+
+    ev.episode = episode
+    early, late = ev.evaluate(Fake("early")), ev.evaluate(Fake("late"))
+    assert early["failure_rate"] == late["failure_rate"] == 0.5
+    assert early["rate_error_rad"] < late["rate_error_rad"]                  # the old key would pick "early"
+    assert early["score"] == [0.5, 2.25] and late["score"] == [0.5, 1.2] and late["score"] < early["score"]
+    assert late["selection"] == "failure_rate, score"
+    built = []
+    ev.evaluate(lambda env: built.append(env) or Fake("late"))            # a factory: built once per condition
+    assert len(built) == len(ev.suite.conditions)
 
 
 def test_the_fast_action_path_equals_predict():

@@ -13,7 +13,10 @@ vehicle, a research option: no flight computer has its rates, attitude and angle
 what a flight computer samples, every entry a flight-computer signal: the IMU's gyros with bandwidth,
 anti-aliasing, drifting bias and angle random walk, the attitude of their strapdown integration, the
 accelerometers with lever arm and bending; see :mod:`lvgym.envs.flightcomputer` and docs/sensors.md); the
-table is :data:`lvgym.envs.layouts.OBSERVATIONS` (``env.unwrapped.observation_layout`` names the entries)::
+table is :data:`lvgym.envs.layouts.OBSERVATIONS` (``env.unwrapped.observation_layout`` names the entries;
+with ``history=k`` the observation is the last k samples and the last k actions, oldest first, zero-padded
+at a reset, the newest sample under the names below and the older ones as ``<name>_lag<j>``: see
+:mod:`lvgym.envs.history`)::
 
 %(observation)s
 
@@ -154,7 +157,7 @@ class AscentEnv(gym.Env):
         self._bind()
         self._rates = []
         info = _row(self.func.state_info(self.state), 0)
-        return self.state.task.obs[0].copy(), info
+        return self.func.observation(self.state)[0], info
 
     def step(self, action):
         if self.state is None:
@@ -168,7 +171,7 @@ class AscentEnv(gym.Env):
         self._rates.append((row["time"], float(w[0]), float(w[1]), float(w[2])))
         if self.render_mode == "human":
             self.render()
-        return ts.obs[0].copy(), float(ts.reward[0]), bool(ts.reason[0] != 0), bool(ts.truncated[0]), row
+        return func.observation(self.state)[0], float(ts.reward[0]), bool(ts.reason[0] != 0), bool(ts.truncated[0]), row
 
     # ------------------------------------------------------------------------------ state as data
     def get_state(self) -> EpisodeState:

@@ -47,7 +47,8 @@ from lvgym.vehicle import MassModel, Vehicle, load_vehicle
 from lvgym.vehicle.slender import slender_vehicle
 
 from .coast import coast_moment
-from .layouts import FLIGHT_DRAWS, NAV, OBSERVATIONS, REASONS, REWARD, REWARD_TERMS, SENSOR_NOISE, TASK
+from .history import HistoryStack, recorded_action
+from .layouts import ACTIONS, FLIGHT_DRAWS, NAV, OBSERVATIONS, REASONS, REWARD, REWARD_TERMS, SENSOR_NOISE, TASK
 from .signals import TaskData, reset_signals, step_signals_range
 from .spec import TaskSpec, wind_spec
 
@@ -103,8 +104,10 @@ class AscentFuncEnv(FuncEnv):
     """The ascent task of one :class:`~.spec.TaskSpec` as pure functions of an explicit state (see the
     module docstring). Attributes: ``spec``, ``vehicle``, ``timeline``, ``sim`` (the
     :class:`~lvgym.simulator.Simulator` whose constants it flies; its own ``data`` is unused unless an
-    adapter binds it), ``gimbal_limit`` [rad], ``imu`` station [m], ``n_steps``, ``observation_layout``
-    (:data:`.layouts.OBSERVATIONS` of the observation mode), ``action_space``, ``observation_space``
+    adapter binds it), ``gimbal_limit`` [rad], ``imu`` station [m], ``n_steps``, ``sample_layout``
+    (:data:`.layouts.OBSERVATIONS` of the observation mode), ``observation_layout`` (the same, or with
+    ``history`` the stacked one of :mod:`.history`), ``history`` (its :class:`~.history.HistoryStack` or
+    None), ``action_space``, ``observation_space``
     (of one row)."""
 
     def __init__(self, spec: TaskSpec) -> None:
@@ -126,7 +129,10 @@ class AscentFuncEnv(FuncEnv):
                              aeroelastic=s.aeroelastic, mode_basis=s.mode_basis, slosh_frequency=s.slosh_frequency,
                              imu=imu)
         self.n_steps = int(round(s.mission_time_s / s.control_dt_s))
-        self.observation_layout = OBSERVATIONS[s.observation]
+        #: the layout of one sample of the observation mode (the observation itself without ``history``)
+        self.sample_layout = OBSERVATIONS[s.observation]
+        self.history = HistoryStack(self.sample_layout, ACTIONS[s.control], s.history) if s.history else None
+        self.observation_layout = self.history.layout if self.history else self.sample_layout
         self.action_space = (spaces.Box(-1.0, 1.0, (2,), np.float32) if s.control == "tvc" else spaces.MultiDiscrete([3]))
         self.observation_space = spaces.Box(-np.inf, np.inf, (self.observation_layout.size,), np.float32)
         self._noisy = s.observation == "sensors" and "sensor_noise" in s.randomize
@@ -142,8 +148,8 @@ class AscentFuncEnv(FuncEnv):
                                                          0.0 if f.name == "bias_step" else sigmas[f.name])
                                                  for f in FLIGHT_DRAWS.fields])      # no bias step at a reset
         self._neutral = 0.0 if s.control == "tvc" else 1.0        # the action that commands nothing
-        self._noise = [(getattr(s, key), self.observation_layout.slice(names[0]).start, len(names), per)
-                       for key, names, per in SENSOR_NOISE if names[0] in self.observation_layout]
+        self._noise = [(getattr(s, key), self.sample_layout.slice(names[0]).start, len(names), per)
+                       for key, names, per in SENSOR_NOISE if names[0] in self.sample_layout]
         lay = self.sim.layout
         self._i_mb, self._i_J = lay.params["m_b"], lay.params["J_b"]
         self._i_cg, self._i_om = lay.params["r_cg"], lay.params["omega_modes"]
@@ -173,7 +179,7 @@ class AscentFuncEnv(FuncEnv):
     # ------------------------------------------------------------------------------ state
     def new_state(self, batch: int) -> AscentState:
         """Zeroed rows for ``batch`` episodes (reset them with :meth:`reset` before stepping)."""
-        B, n_obs = int(batch), self.observation_layout.size
+        B, n_obs = int(batch), self.sample_layout.size
         task = TaskData(steps=np.zeros(B, dtype=np.int64), on=np.zeros(B, dtype=bool), on_step=np.zeros(B, dtype=bool),
                         axis_ref_i=np.zeros((B, 3)), cum_error=np.zeros((B, 3)), rate_error=np.zeros((B, 3)),
                         gyro_bias=np.zeros((B, 3)), obs=np.zeros((B, n_obs), dtype=np.float32), att=np.zeros((B, 2)),
@@ -182,7 +188,8 @@ class AscentFuncEnv(FuncEnv):
                         stage=np.zeros(B, dtype=np.int64),
                         pending=np.full((B, max(self.spec.action_delay_steps, 1), self.action_space.shape[0]),
                                         self._neutral),
-                        nav=NAV.zeros(B), draws=FLIGHT_DRAWS.zeros(B))
+                        nav=NAV.zeros(B), draws=FLIGHT_DRAWS.zeros(B),
+                        history=self.history.zeros(B) if self.history else np.zeros((B, 0), np.float32))
         return AscentState(sim=self.sim.new_data(B), task=task, events=[[] for _ in range(B)])
 
     @staticmethod
@@ -250,6 +257,8 @@ class AscentFuncEnv(FuncEnv):
         self._draw_flight(sim, ts, rows, rngs, self._draw_sigma_reset)
         reset_signals(rows, params.task, params.setup, sim, ts, params.tables)
         self._add_noise(sim, ts, rows, rngs)
+        if self.history:
+            self.history.reset(ts.history, rows, ts.obs[rows])
         events = list(state.events)
         for b in rows:
             events[b] = []
@@ -267,7 +276,7 @@ class AscentFuncEnv(FuncEnv):
         a = np.asarray(action) if checked else self.check_action(action, B)
         st = state if inplace else self.take(state)
         s, sim, ts = self.spec, st.sim, st.task
-        on = ts.on
+        on, sampled = ts.on, a
         if s.action_delay_steps:                      # the oldest sampled action acts; this one waits
             q = ts.pending
             now = q[:, 0].copy()
@@ -291,6 +300,8 @@ class AscentFuncEnv(FuncEnv):
         self.sim.run_rows(_SIGNALS, B, params.task, params.setup, sim, ts, params.tables)
         if self._noisy:
             self._add_noise(sim, ts, range(B), rng)
+        if self.history:
+            self.history.push(ts.history, ts.obs, recorded_action(s.control, sampled))
         return AscentState(sim=sim, task=ts, events=events)
 
     def _coast(self, sim: SimData, ts: TaskData) -> tuple[np.ndarray | None, np.ndarray | None]:
@@ -339,8 +350,9 @@ class AscentFuncEnv(FuncEnv):
         return a
 
     def observation(self, state: AscentState, rng: Any = None, params: AscentParams | None = None) -> np.ndarray:
-        """The observation (B, n_obs) float32 of every row: what the flight computer sampled (noise included)."""
-        return state.task.obs.copy()
+        """The observation (B, n_obs) float32 of every row: what the flight computer sampled (noise
+        included), or with ``history`` the stacked samples and actions (:mod:`.history`)."""
+        return (state.task.history if self.history else state.task.obs).copy()
 
     def reward(self, state: AscentState | None, action: Any, next_state: AscentState, rng: Any = None,
                params: AscentParams | None = None) -> np.ndarray:

@@ -18,7 +18,7 @@ from __future__ import annotations
 
 from lvgym.packing import Field, Packed, rst_table
 
-__all__ = ["FLIGHT_DRAWS", "FLIGHT_SOURCE", "G0", "NAV", "OBSERVATIONS", "OBS_FLIGHT", "OBS_SENSORS", "OBS_STATE",
+__all__ = ["ACTIONS", "FLIGHT_DRAWS", "FLIGHT_SOURCE", "G0", "NAV", "OBSERVATIONS", "OBS_FLIGHT", "OBS_SENSORS", "OBS_STATE",
            "REASONS", "REWARD", "REWARD_TERMS", "SENSOR_NOISE",
            "TASK", "FD", "NV", "O", "OF", "OS", "RW", "T", "observation_table"]
 
@@ -96,6 +96,15 @@ OBS_FLIGHT = Packed("observation (flight)", [
     Field("accel_y", 1, "g0", "the same along body y"),
 ] + _COMMON_TAIL, interface=True)
 OBSERVATIONS = {"state": OBS_STATE, "sensors": OBS_SENSORS, "flight": OBS_FLIGHT}
+#: the action as an observation with ``history`` records it (:mod:`.history`), per ``control``: the TVC
+#: command clipped to [-1, 1] (what the flight computer sent, before the controller-off gating and the
+#: ``action_delay_steps`` queue), the RCS pulse as the action minus 1 (so that the zero of a reset is "no pulse")
+ACTIONS = {"tvc": Packed("action (tvc)", [
+    Field("action_pitch", 1, "-", "gimbal pitch command over the gimbal limit, clipped to [-1, 1]"),
+    Field("action_yaw", 1, "-", "gimbal yaw command over the gimbal limit, clipped to [-1, 1]"),
+], interface=True), "rcs": Packed("action (rcs)", [
+    Field("action_roll", 1, "-", "roll pulse: -1 negative, 0 none, +1 positive (the action minus 1)"),
+], interface=True)}
 #: where a flight computer gets each entry of the ``sensors`` and ``flight`` modes (the ``state`` mode's
 #: entries 0-6 are the ideal state: no flight computer has them)
 FLIGHT_SOURCE = {

@@ -2,7 +2,8 @@
 
 It follows stable-baselines3's conventions: a finished row resets at once, its last observation is in
 ``infos[i]["terminal_observation"]`` and ``infos[i]["TimeLimit.truncated"]`` says whether the mission
-time ended it. Row ``i`` seeded with ``seed + i`` is step for step the single env seeded with ``seed + i``.
+time ended it; ``reset_infos[i]`` is the info of row ``i``'s latest reset (as the single env's
+``reset`` returns it). Row ``i`` seeded with ``seed + i`` is step for step the single env seeded with ``seed + i``.
 ``lvgym.envs.make_sb3_vec_env(env_id, num_envs, seed, **options)`` builds one by env id.
 """
 
@@ -40,12 +41,23 @@ class AscentSB3VecEnv(VecEnv):
         """The :class:`~lvgym.simulator.Simulator` (its ``data`` is this env's rows)."""
         return self.func.sim
 
+    @property
+    def observation_layout(self):
+        """The :class:`~lvgym.packing.Packed` layout of one row's observation."""
+        return self.func.observation_layout
+
+    @property
+    def gimbal_limit(self) -> float:
+        """Gimbal limit [rad]: a TVC action of 1 commands this angle."""
+        return self.func.gimbal_limit
+
     def reset(self) -> np.ndarray:
         if self._seed is not None:
             self._rngs = [gym.utils.seeding.np_random(self._seed + i)[0] for i in range(self.num_envs)]
             self._seed = None
         self.state = self.func.initial(self._rngs)
         self.func.sim.data = self.state.sim
+        self.reset_infos = _rows(self.func.state_info(self.state), self.num_envs)
         return self.func.observation(self.state)
 
     def step_async(self, actions: np.ndarray) -> None:
@@ -70,7 +82,10 @@ class AscentSB3VecEnv(VecEnv):
             rows = np.flatnonzero(done)
             self.state = func.reset(self.state, rows, [self._rngs[b] for b in rows])
             self.func.sim.data = self.state.sim
-            obs[rows] = self.state.task.obs[rows]
+            obs[rows] = func.observation(self.state)[rows]
+            fresh = _rows(func.state_info(self.state), self.num_envs)
+            for b in rows:
+                self.reset_infos[b] = fresh[b]
         return obs, reward.astype(np.float32), done, infos
 
     def seed(self, seed: int | None = None):

@@ -100,7 +100,8 @@ class TaskSpec:
     propellant stays settled against the drag (0: none); aeroelastic: the strip-theory
     aeroelastic loads (True, False, None: the vehicle file's flag; False in v0); mode_interval_s, mode_basis,
     slosh_frequency: the Simulator's ``mode_interval`` (None: the vehicle's), ``mode_basis`` (``held`` v0,
-    ``projected``) and ``slosh_frequency`` (``vacuum_thrust`` v0, ``specific_force``).
+    ``projected``) and ``slosh_frequency`` (``vacuum_thrust`` v0, ``specific_force``); history: the
+    observation is the last ``history`` samples and actions (:mod:`.history`; 0: off, the sample alone).
 
     Sensors. ``sensors`` adds, with ``sensor_noise`` randomised, a constant gyro bias
     N(0, ``gyro_bias_radps``) and white noise ``gyro_noise_radps``, ``attitude_noise_rad``,
@@ -172,6 +173,7 @@ class TaskSpec:
     antialias_hz: float = 20.0
     gyro_arw_rad_per_sqrt_s: float = 4.4e-5
     gyro_bias_rw_radps_per_sqrt_s: float = 1.5e-6
+    history: int = 0
 
     def __post_init__(self) -> None:
         check_choice("model", self.model, MODELS)
@@ -180,6 +182,7 @@ class TaskSpec:
         check_choice("reference", self.reference, REFERENCES)
         check_choice("reference_velocity", self.reference_velocity, REFERENCE_VELOCITIES)
         check_number("action_delay_steps", self.action_delay_steps, 0, 50, integer=True)
+        check_number("history", self.history, 0, 64, integer=True)
         check_choice("control", self.control, CONTROLS)
         check_bool("coast_control", self.coast_control)
         check_choice("mode_basis", self.mode_basis, MODE_BASES)

@@ -65,6 +65,16 @@ class AscentVectorEnv(VectorEnv):
         """The :class:`~lvgym.simulator.Simulator` (its ``data`` is this env's rows)."""
         return self.func.sim
 
+    @property
+    def observation_layout(self):
+        """The :class:`~lvgym.packing.Packed` layout of one row's observation."""
+        return self.func.observation_layout
+
+    @property
+    def gimbal_limit(self) -> float:
+        """Gimbal limit [rad]: a TVC action of 1 commands this angle."""
+        return self.func.gimbal_limit
+
     def reset(self, *, seed: int | list[int | None] | None = None, options: dict[str, Any] | None = None):
         if seed is None or isinstance(seed, int):
             seeds = [None if seed is None else seed + i for i in range(self.num_envs)]
