@@ -1,7 +1,7 @@
 """Compare TVC policies on the frozen benchmark protocol (``lvgym.benchmark``).
 
     python evaluate.py                                   # the default comparison (see DEFAULT_*)
-    python evaluate.py --policies zero pid gs-pid runs/ppo_smile.zip --suites smile-windy --episodes 50
+    python evaluate.py --policies zero pid gs-pid runs/ppo_smile.zip --suites smile-windy --episodes 50   # v0
     python evaluate.py --executor ray --workers 4        # Ray (pip install 'lvgym[ray]'): a local Ray
     RAY_ADDRESS=auto python evaluate.py --executor ray    # ... or the running cluster (``ray start``)
 
@@ -45,10 +45,12 @@ from lvgym.cli import fail, one_line_errors
 from lvgym.errors import ConfigError
 from lvgym.parallel import TaskFailed, exit_on_sigterm
 
-DEFAULT_POLICIES = ["zero", "pid", "gs-pid", "ppo"]
-DEFAULT_SUITES = ["smile-windy"]
-#: episodes per condition and policy of the default run (2 conditions x 4 policies x 50 = 400 episodes of 60 s:
-#: 118 s of episodes on 2 cores with the four default policies, 2026-12-02)
+#: the default comparison (issue 17): no control, the rigid-designed gs-pid (the thesis's question), the
+#: designs for the flexible vehicle (gs-pid-flex, lqg, aac) and the shipped learned policy
+DEFAULT_POLICIES = ["zero", "gs-pid", "gs-pid-flex", "lqg", "aac", "ppo"]
+#: the main suite of protocol v1 (``smile-windy`` is v0's)
+DEFAULT_SUITES = ["smile-v1"]
+#: episodes per condition and policy of the default run (2 conditions x 6 policies x 50 = 600 episodes of 70 s)
 DEFAULT_EPISODES = 50
 #: the longest episode an env takes (``lvgym.envs.TaskSpec.mission_time_s``) [s]
 MAX_MISSION_TIME_S = 3600.0

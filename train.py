@@ -46,7 +46,8 @@ from lvgym.errors import ConfigError
 from lvgym.parallel import exit_on_sigterm
 
 ROOT = Path(__file__).resolve().parent
-DEFAULT_EVAL_SUITES = {"lvgym/SmileAscent-v0": "smile-windy", "lvgym/SlenderAscent-v0": "slender-ld30"}
+DEFAULT_EVAL_SUITES = {"lvgym/SmileAscent-v0": "smile-windy", "lvgym/SlenderAscent-v0": "slender-ld30",
+                       "lvgym/SmileAscent-v1": "smile-v1", "lvgym/SlenderAscent-v1": "slender-v1"}
 RESUME_OVERRIDABLE = ("resume", "progress", "torch_threads", "verbose", "total_timesteps", "checkpoint_interval_s")
 PROG = "train.py"
 
@@ -100,7 +101,7 @@ class Args:
     eval_episodes: int = 10
     """validation seeds per condition of the eval suite"""
     eval_suite: str | None = None
-    """protocol suite of the validation (default: smile-windy or slender-ld30 by env; 'none': no validation)"""
+    """protocol suite of the validation (default by env: DEFAULT_EVAL_SUITES; 'none': no validation)"""
     eval_mission_time_s: float | None = None
     """shorten validation episodes (smoke tests only)"""
     eval_select: str = "trained"

@@ -332,7 +332,8 @@ def test_registry_names_what_is_missing(monkeypatch):
         ev.resolve_policy("not-a-policy")
     assert ev.resolve_policy("zero") == ZERO
     args = ev.parse_args([])
-    assert args.policies == ["zero", "pid", "gs-pid", "ppo"] and args.suites == ["smile-windy"] and args.executor == "local"
+    assert args.policies == ["zero", "gs-pid", "gs-pid-flex", "lqg", "aac", "ppo"] and args.suites == ["smile-v1"]
+    assert args.executor == "local"
     assert args.reference is None and ev.parse_args(["--reference", "pid"]).reference == "pid"
     with pytest.raises(SystemExit, match="--reference = 'ghost'"):          # refused before any episode runs
         ev.main(["--policies", "zero", "--reference", "ghost", "--no-progress"])
@@ -340,7 +341,8 @@ def test_registry_names_what_is_missing(monkeypatch):
 
 def test_cli_end_to_end(tmp_path, tiny_sb3):
     out = tmp_path / "res"
-    proc = subprocess.run(_evaluate_cmd(out, "--policies", "zero", str(tiny_sb3), "--episodes", "2", "--workers", "2"),
+    proc = subprocess.run(_evaluate_cmd(out, "--policies", "zero", str(tiny_sb3), "--suites", "smile-windy", "--episodes", "2",
+                                          "--workers", "2"),
                           cwd=ROOT, capture_output=True, text=True, timeout=120)
     assert proc.returncode == 0, proc.stderr
     assert "| rigid | zero |" in proc.stdout and "| nonrigid | tiny |" in proc.stdout

@@ -57,7 +57,8 @@ N_VALIDATION_SEEDS = 10_000
 TEST_SEED0 = 10_000
 N_TEST_SEEDS = 10_000
 SEED_SETS = ("test", "validation")
-DEFAULT_SUITE = "smile-windy"
+#: the main suite (evaluate.py's default): protocol v1's SMILE ascent
+DEFAULT_SUITE = "smile-v1"
 
 
 def _freeze(options: Mapping[str, Any]) -> tuple[tuple[str, Any], ...]:
