@@ -27,7 +27,7 @@ RANDOMIZE = RANDOMIZE_V0 + ("aerodynamics", "thrust_level", "slosh_mass", "slosh
 #: mode shapes at ``IMU_STATION_INTERVALS`` + 1 evenly spaced stations over the +-3 sigma range (the
 #: nominal one among them) and a row interpolates linearly between them
 IMU_STATION_SIGMA = 0.005
-IMU_STATION_INTERVALS = 12
+IMU_STATION_INTERVALS = 24
 OBSERVATIONS = ("state", "sensors", "flight")
 REFERENCES = ("zero_rate", "gravity_turn")
 REFERENCE_VELOCITIES = ("inertial", "earth")
