@@ -89,9 +89,9 @@ def _cascade(first: tuple, second: tuple) -> tuple[np.ndarray, np.ndarray, np.nd
 class Imu:
     """An IMU at station ``station_m`` [m] (``sensor``: its index among the timeline's sensor stations,
     where the mode shapes and slopes are tabulated; ``probes``: the indices of further sensor stations
-    around it between which a dispersed station interpolates, see :meth:`placement`) with the gyro's bandwidth ``gyro_bandwidth_hz``
-    [Hz] and damping ``gyro_damping`` [-] and an anti-aliasing Butterworth low-pass at
-    ``antialias_hz`` [Hz] before sampling (see the module docstring)."""
+    around it between which a dispersed station interpolates, see :meth:`placement`) with the gyro's
+    bandwidth ``gyro_bandwidth_hz`` [Hz] and damping ``gyro_damping`` [-] and an anti-aliasing
+    Butterworth low-pass at ``antialias_hz`` [Hz] before sampling (see the module docstring)."""
 
     station_m: float
     sensor: int = 0

@@ -30,7 +30,8 @@ from lvgym.environment.atmosphere import AIR
 from lvgym.packing import Field, Packed
 
 __all__ = ["ACCEL_ORDER", "ACTUATOR", "AERO", "AEROELASTIC", "CONDITIONS", "CONTEXT", "DISPERSION", "GYRO_ORDER", "IMU",
-           "IMU_STATE", "IMU_STATION", "RAIL", "RAIL_STATE", "SERVO", "STRIPS", "TRIG", "A", "AEL", "CTX", "D", "DS", "IM", "IS", "RL", "RS",
+           "IMU_STATE",
+           "IMU_STATION", "RAIL", "RAIL_STATE", "SERVO", "STRIPS", "TRIG", "A", "AEL", "CTX", "D", "DS", "IM", "IS", "RL", "RS",
            "SV", "TG", "AE", "STR"]
 
 #: flight conditions of one state at one time
