@@ -165,6 +165,11 @@ def test_imu_station_draw_law_and_determinism():
     around = np.sort(np.append(st[list(func.sim.imu.probes)], st[0])) - func.imu
     assert around[0] == pytest.approx(-3.0 * sigma) and around[-1] == pytest.approx(3.0 * sigma)
     np.testing.assert_allclose(np.diff(around), 6.0 * sigma / 24, rtol=1e-9)
+    # a draw clipped at the range's end lands on the last tabulated station (not outside by round-off)
+    ends = func.sim.imu.placement(np.array([-3.0 * sigma, 3.0 * sigma]), st)
+    from lvgym.simulator.layouts import IMU_STATION
+    lo = IMU_STATION.view(ends, "station_lo")[:, 0].astype(int)
+    np.testing.assert_allclose(st[lo], func.imu + np.array([-3.0, 3.0]) * sigma, atol=1e-9)
 
 
 def test_imu_station_switched_off_or_without_an_imu_is_nominal():

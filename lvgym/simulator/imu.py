@@ -115,7 +115,8 @@ class Imu:
         the two tabulated stations (``sensor`` and ``probes`` of ``sensor_stations`` [m]) around each
         row's station and the linear weight of the forward one. A shift of 0 gives ``lo = hi = sensor``
         and weight 0; a station on a tabulated one, that one with weight 0. A station outside the
-        tabulated ones raises ``ValueError``."""
+        tabulated ones by more than round-off (1e-9 m; a draw clipped at the range's end) raises
+        ``ValueError``."""
         shift = np.atleast_1d(np.asarray(shift, dtype=float))
         idx = np.array([self.sensor, *self.probes], dtype=int)
         xs = np.asarray(sensor_stations, dtype=float)[idx]
@@ -129,9 +130,10 @@ class Imu:
             if d == 0.0:
                 continue
             x = self.station_m + d
-            if not xs[0] <= x <= xs[-1]:
+            if not xs[0] - 1e-9 <= x <= xs[-1] + 1e-9:
                 raise ValueError(f"IMU station shift {d!r} m: the station {x!r} m lies outside the tabulated "
                                  f"[{xs[0]!r}, {xs[-1]!r}] m")
+            x = min(max(x, xs[0]), xs[-1])
             i = int(np.searchsorted(xs, x, side="right")) - 1
             if xs[i] == x or i == xs.size - 1:
                 v("station_lo")[r] = v("station_hi")[r] = idx[i]
