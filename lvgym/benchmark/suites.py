@@ -174,7 +174,7 @@ SMILE_V1 = "lvgym/SmileAscent-v1"
 #: every randomisation of v1 (v0's and the Monte Carlo dispersions of docs/benchmark.md)
 V1_DISPERSIONS = ("wind", "thrust_misalignment", "mass", "slosh_damping", "bending_frequency", "sensor_noise",
                   "aerodynamics", "thrust_level", "slosh_mass", "slosh_frequency", "bending_damping", "servo_bandwidth",
-                  "servo_delay")
+                  "servo_delay", "imu_station")
 
 #: the suites of protocol v1 (a draft: they may still change until the version is frozen)
 SUITES_V1: dict[str, Suite] = {s.name: s for s in (

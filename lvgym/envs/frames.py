@@ -8,6 +8,7 @@ import numpy as np
 
 from lvgym.simulator.core import dcm_batch
 
+from .functional import RENDER_STATIONS
 from .render import HumanViewer, Renderer, RenderFrame
 
 
@@ -16,10 +17,11 @@ def make_frame(env: Any) -> RenderFrame:
     sim, tl = env.sim, env.timeline
     t = float(sim.t[0])
     length = float(env.vehicle.length)
-    stations = tl.sensor_stations[1:]                       # station 0 is the IMU
+    render = slice(1, 1 + RENDER_STATIONS)                  # station 0 is the IMU, its probes follow these
+    stations = tl.sensor_stations[render]
     deflection = np.zeros_like(stations)
     if sim.dynamics.n_modes:
-        phi = tl.left("phi_sensor", sim.t)[0, 1:]           # (S, K) shapes of the modes in force
+        phi = tl.left("phi_sensor", sim.t)[0, render]       # (S, K) shapes of the modes in force
         deflection = phi @ sim.state("eta")[0, 1]           # pitch-plane (z) deflection [m]
     C_ib = dcm_batch(sim.state("q_bi")[:1])[0]
     up = -sim.conditions("g_i")[0] / np.linalg.norm(sim.conditions("g_i")[0])

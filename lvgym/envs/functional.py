@@ -50,9 +50,10 @@ from .coast import coast_moment
 from .history import HistoryStack, recorded_action
 from .layouts import ACTIONS, FLIGHT_DRAWS, NAV, OBSERVATIONS, REASONS, REWARD, REWARD_TERMS, SENSOR_NOISE, TASK
 from .signals import TaskData, reset_signals, step_signals_range
-from .spec import TaskSpec, wind_spec
+from .spec import IMU_STATION_INTERVALS, IMU_STATION_SIGMA, TaskSpec, wind_spec
 
-__all__ = ["AscentFuncEnv", "AscentParams", "AscentState", "RENDER_STATIONS", "cached_timeline", "cached_vehicle"]
+__all__ = ["AscentFuncEnv", "AscentParams", "AscentState", "RENDER_STATIONS", "cached_timeline", "cached_vehicle",
+           "imu_probe_offsets"]
 
 #: an episode's (or a batch of episodes') whole state: the simulator's rows (:class:`~lvgym.simulator.SimData`),
 #: the task's rows (:data:`~.signals.TaskData`) and the events of the last step (one list per row)
@@ -80,13 +81,25 @@ def cached_vehicle(key: Any) -> Vehicle:
 @functools.lru_cache(maxsize=32)
 def cached_timeline(key: Any, model: str, t_end: float, physics_dt: float, n_modes: int | None,
                     imu: float, aeroelastic: bool | None = False, mode_interval: float | None = None,
-                    mode_basis: str = "held") -> Timeline:
-    """Timelines are shared between the envs of a process (they are read-only)."""
+                    mode_basis: str = "held", imu_probes: tuple[float, ...] = ()) -> Timeline:
+    """Timelines are shared between the envs of a process (they are read-only). Sensor stations: the IMU
+    (index 0), the ``RENDER_STATIONS`` of the rendered view, then the ``imu_probes`` [m] (stations around
+    the IMU a dispersed station interpolates between; read off the beam, not meshed, so the others'
+    shapes do not change with them)."""
     vehicle = cached_vehicle(key)
     stations = [imu, *np.linspace(0.0, -vehicle.length, RENDER_STATIONS).tolist()]
     return build_timeline(MassModel(vehicle), model, t_end, 0.05, n_modes, stations, 0.5 / physics_dt,
                           strip_stations=aeroelastic_strips(vehicle, aeroelastic=aeroelastic),
-                          mode_interval=mode_interval, mode_basis=mode_basis)
+                          mode_interval=mode_interval, mode_basis=mode_basis, sensor_probes=imu_probes)
+
+
+def imu_probe_offsets(length: float) -> np.ndarray:
+    """Offsets [m] from the nominal IMU station of the stations tabulated for the ``imu_station``
+    dispersion of a vehicle of ``length`` [m]: ``IMU_STATION_INTERVALS`` + 1 evenly spaced over
+    +-3 ``IMU_STATION_SIGMA`` ``length``, the nominal (0) left out (it is the IMU's own station)."""
+    n = IMU_STATION_INTERVALS // 2
+    step = 3.0 * IMU_STATION_SIGMA * length / n
+    return np.array([k * step for k in range(-n, n + 1) if k != 0])
 
 
 def _shown(action: Any) -> str:
@@ -115,15 +128,20 @@ class AscentFuncEnv(FuncEnv):
         key = tuple(s.vehicle) if isinstance(s.vehicle, (list, tuple)) else str(s.vehicle)
         self.vehicle = vehicle = cached_vehicle(key)
         self.imu = s.imu_station_m if s.imu_station_m is not None else -0.25 * vehicle.length
+        # the imu_station dispersion acts on the flight observation's IMU (the others have no IMU dynamics)
+        self._imu_sigma = (IMU_STATION_SIGMA * vehicle.length if "imu_station" in s.randomize and
+                           s.observation == "flight" else 0.0)
+        probes = tuple((self.imu + imu_probe_offsets(vehicle.length)).tolist()) if self._imu_sigma else ()
         self.timeline = tl = cached_timeline(key, s.model, s.mission_time_s + 1.0, s.physics_dt_s, s.n_modes, self.imu,
-                                             s.aeroelastic, s.mode_interval_s, s.mode_basis)
+                                             s.aeroelastic, s.mode_interval_s, s.mode_basis, probes)
         limits = [math.degrees(e.gimbal_limit) for e in vehicle.stages[0].engines if e.gimbal_limit is not None]
         self.gimbal_limit = math.radians(s.gimbal_limit_deg if s.gimbal_limit_deg is not None
                                          else (min(limits) if limits else 5.0))
         servo = Servo(s.actuator_frequency, s.actuator_damping, self.gimbal_limit, math.radians(s.gimbal_rate_limit_degps))
-        # the IMU is the timeline's first sensor station (cached_timeline)
-        imu = (Imu(self.imu, 0, s.gyro_bandwidth_hz, s.gyro_damping, s.antialias_hz) if s.observation == "flight"
-               else None)
+        # the IMU is the timeline's first sensor station, its probes the last ones (cached_timeline)
+        n_s = tl.sensor_stations.size
+        imu = (Imu(self.imu, 0, s.gyro_bandwidth_hz, s.gyro_damping, s.antialias_hz,
+                   probes=tuple(range(n_s - len(probes), n_s))) if s.observation == "flight" else None)
         self.sim = Simulator(vehicle, s.model, site=s.site, elevation_deg=s.elevation_deg,
                              rail_length=s.rail_length_m, physics_dt=s.physics_dt_s, timeline=tl, servo=servo,
                              aeroelastic=s.aeroelastic, mode_basis=s.mode_basis, slosh_frequency=s.slosh_frequency,
@@ -230,13 +248,14 @@ class AscentFuncEnv(FuncEnv):
         rngs = list(rng)
         if len(rngs) != rows.size:
             raise ValueError(f"{len(rngs)} generators for {rows.size} rows")
-        winds, scales, offsets, mis, loads, servos = [], [], [], [], [], []
+        winds, scales, offsets, mis, loads, servos, stations = [], [], [], [], [], [], []
         ts = state.task
         for b, g in zip(rows, rngs):
             wind_rng = g if "wind" in s.randomize else np.random.default_rng(12345)
             winds.append((wind_spec(s.wind, s.mission_time_s), wind_rng))
-            sc, of, m, ld, sv = self.dispersions(g)
+            sc, of, m, ld, sv, st = self.dispersions(g)
             servos.append(sv)
+            stations.append(st)
             scales.append(sc)
             offsets.append(of)
             mis.append(m)
@@ -244,7 +263,8 @@ class AscentFuncEnv(FuncEnv):
             ts.gyro_bias[b] = g.normal(0.0, s.gyro_bias_radps, 3) if "sensor_noise" in s.randomize else np.zeros(3)
         sim = self.sim.reset_rows(rows, [w[1] for w in winds], [w[0] for w in winds], np.array(mis), np.array(scales),
                                   np.array(offsets), data=state.sim, dispersion=np.array(loads),
-                                  servo_dispersion=np.array(servos))
+                                  servo_dispersion=np.array(servos),
+                                  imu_station=np.array(stations) if self._imu_sigma else None)
         ts.cum_error[rows] = 0.0
         ts.rate_error[rows] = 0.0
         ts.steps[rows] = 0
@@ -401,10 +421,11 @@ class AscentFuncEnv(FuncEnv):
         return state.sim.actuator[:, ACTUATOR.index("effort")].copy()
 
     def dispersions(self, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray,
-                                                             np.ndarray]:
+                                                             np.ndarray, float]:
         """Parameter scale and offset, thrust misalignment, load dispersions (layout
-        :data:`~lvgym.simulator.layouts.DISPERSION`) and servo dispersion (frequency factor, delay in
-        physics steps) of one row, drawn from ``rng`` in this order; every normal draw is clipped at 3 sigma.
+        :data:`~lvgym.simulator.layouts.DISPERSION`), servo dispersion (frequency factor, delay in
+        physics steps) and IMU station shift [m] along +x_b of one row, drawn from ``rng`` in this order;
+        every normal draw is clipped at 3 sigma.
 
         Protocol v0's: mass: body mass x N(1, 1 %), CG station + N(0, 2 cm), inertia x N(1, 3 %);
         slosh_damping: ratios x log-uniform [0.5, 2]; bending_frequency: x N(1, 5 %); thrust_misalignment:
@@ -414,7 +435,9 @@ class AscentFuncEnv(FuncEnv):
         slosh_frequency: x N(1, 5 %) (pendulum lengths / f^2, and the tabulated damper frequency x f; with
         ``slosh_frequency="specific_force"`` the damper's frequency follows from the dispersed length);
         bending_damping: ratios x log-uniform [0.5, 2]; servo_bandwidth: natural frequency x N(1, 10 %);
-        servo_delay: 0 or 1 physics step (0 or 10 ms at the default step) with equal chances."""
+        servo_delay: 0 or 1 physics step (0 or 10 ms at the default step) with equal chances; imu_station:
+        the station + N(0, ``IMU_STATION_SIGMA`` x the vehicle's length) (0.5 %: 8.3 cm on SMILE), drawn
+        only with the ``flight`` observation (the others have no IMU dynamics; 0 otherwise)."""
         n_p = self.sim.layout.n_p
         scale, offset, mis = np.ones(n_p), np.zeros(n_p), np.zeros(2)
         loads = DISPERSION.pack({"thrust_scale": 1.0, "normal_scale": 1.0, "axial_scale": 1.0})
@@ -461,7 +484,8 @@ class AscentFuncEnv(FuncEnv):
             servo[0] = 1.0 + normal(0.1, 0.3)
         if "servo_delay" in r:
             servo[1] = float(rng.integers(0, 2))
-        return scale, offset, mis, loads, servo
+        station = float(normal(self._imu_sigma, 3.0 * self._imu_sigma)) if self._imu_sigma else 0.0
+        return scale, offset, mis, loads, servo, station
 
     def _draw_flight(self, sim: SimData, ts: TaskData, rows: Any, rngs: Sequence[np.random.Generator | None],
                      sigma: np.ndarray) -> None:

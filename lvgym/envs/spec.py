@@ -21,7 +21,13 @@ MAXQ_GUST_ONSET_M = (8000.0, 11500.0)
 RANDOMIZE_V0 = ("wind", "thrust_misalignment", "mass", "slosh_damping", "bending_frequency", "sensor_noise")
 #: every randomisation by name (``lvgym.envs.functional.AscentFuncEnv.dispersions`` draws them)
 RANDOMIZE = RANDOMIZE_V0 + ("aerodynamics", "thrust_level", "slosh_mass", "slosh_frequency", "bending_damping",
-                            "servo_bandwidth", "servo_delay")
+                            "servo_bandwidth", "servo_delay", "imu_station")
+#: the ``imu_station`` dispersion: the IMU station shifted along x_b by N(0, sigma) with sigma this fraction
+#: of the vehicle's length, clipped at 3 sigma (docs/benchmark.md "Dispersions"); the timeline tabulates the
+#: mode shapes at ``IMU_STATION_INTERVALS`` + 1 evenly spaced stations over the +-3 sigma range (the
+#: nominal one among them) and a row interpolates linearly between them
+IMU_STATION_SIGMA = 0.005
+IMU_STATION_INTERVALS = 24
 OBSERVATIONS = ("state", "sensors", "flight")
 REFERENCES = ("zero_rate", "gravity_turn")
 REFERENCE_VELOCITIES = ("inertial", "earth")

@@ -51,7 +51,7 @@ from .advance import StepSetup, advance_range, conditions_rows, constrain_k, slo
 from .data import SimData
 from .flight import flight_loads, pack_context, stack_contexts
 from .imu import IMU_OFF, Imu
-from .layouts import ACTUATOR, CONDITIONS, CONTEXT, DISPERSION, RAIL, RAIL_STATE, RS
+from .layouts import ACTUATOR, CONDITIONS, CONTEXT, DISPERSION, IMU_STATE, RAIL, RAIL_STATE, RS
 from .piece import SLOSH_FREQUENCIES
 from .servo import DIRECT, Servo
 from .strips import StripSetup, strip_models, strip_stations
@@ -201,9 +201,9 @@ class Simulator:
         self.rail = self._rail_vector()
         self.servo = servo
         self.imu = imu
-        if imu is not None and not 0 <= imu.sensor < self.timeline.sensor_stations.size:
-            raise ValueError(f"imu.sensor = {imu.sensor}: the timeline has {self.timeline.sensor_stations.size} "
-                             "sensor stations")
+        if imu is not None and not all(0 <= i < self.timeline.sensor_stations.size for i in (imu.sensor, *imu.probes)):
+            raise ValueError(f"imu.sensor = {imu.sensor}, imu.probes = {imu.probes}: the timeline has "
+                             f"{self.timeline.sensor_stations.size} sensor stations")
         self.threads = int(threads) if threads is not None else default_threads()
         if self.threads < 1:
             raise ValueError(f"threads = {threads!r}: at least 1")
@@ -248,19 +248,20 @@ class Simulator:
     def reset(self, batch: int = 1, rng: np.random.Generator | None = None, winds: Sequence[Any] | None = None,
               misalignment: np.ndarray | None = None, param_scale: np.ndarray | None = None,
               param_offset: np.ndarray | None = None, dispersion: np.ndarray | None = None,
-              servo_dispersion: np.ndarray | None = None) -> None:
+              servo_dispersion: np.ndarray | None = None, imu_station: np.ndarray | None = None) -> None:
         """Put ``batch`` vehicles on the pad at t = 0 (see :meth:`reset_rows` for the options)."""
         B = int(batch)
         if B < 1:
             raise ValueError(f"batch = {batch!r}: at least one vehicle")
         self.data = self.reset_rows(np.arange(B), rng, winds, misalignment, param_scale, param_offset,
-                                    data=self.new_data(B), dispersion=dispersion, servo_dispersion=servo_dispersion)
+                                    data=self.new_data(B), dispersion=dispersion, servo_dispersion=servo_dispersion,
+                                    imu_station=imu_station)
 
     def reset_rows(self, rows: Any, rng: np.random.Generator | Sequence[np.random.Generator] | None = None,
                    winds: Sequence[Any] | None = None, misalignment: np.ndarray | None = None,
                    param_scale: np.ndarray | None = None, param_offset: np.ndarray | None = None,
                    data: SimData | None = None, dispersion: np.ndarray | None = None,
-                   servo_dispersion: np.ndarray | None = None) -> SimData:
+                   servo_dispersion: np.ndarray | None = None, imu_station: np.ndarray | None = None) -> SimData:
         """Put the vehicles ``rows`` back on the pad at t = 0; the others are untouched.
 
         ``rng``: one generator, or one per row, for whatever is random (the wind models' ``reset``);
@@ -269,7 +270,9 @@ class Simulator:
         ``param_offset`` (R, n_p): a row flies ``timeline params * scale + offset`` (dispersions of mass,
         CG, inertia, slosh damping, bending frequencies); ``dispersion`` (R, n) the rows' load dispersions
         (layout :data:`.layouts.DISPERSION`; default neutral); ``servo_dispersion`` (R, 2) the rows' servo
-        natural-frequency factor [-] and delay [physics steps] (default 1 and 0). ``data``: the rows to reset (default
+        natural-frequency factor [-] and delay [physics steps] (default 1 and 0); ``imu_station`` (R,) [m] the
+        rows' IMU station shifts along +x_b (default 0: the nominal station; with an IMU only, within the
+        stations its ``probes`` tabulate, :meth:`.imu.Imu.placement`). ``data``: the rows to reset (default
         :attr:`data`, which is then updated); returns them (a new value when the context widened)."""
         own = data is None
         if own and self.batch == 0:
@@ -319,6 +322,10 @@ class Simulator:
         self.update_conditions(rows, d)
         if self.imu is not None:
             d.imu[rows] = self._imu_at_rest(rows, d)
+            shift = np.zeros(R) if imu_station is None else np.broadcast_to(np.asarray(imu_station, float), (R,))
+            IMU_STATE.view(d.imu, "station")[rows] = self.imu.placement(shift, self.timeline.sensor_stations)
+        elif imu_station is not None and np.any(np.asarray(imu_station) != 0.0):
+            raise ValueError("imu_station: a shifted IMU station needs a simulator with an IMU (imu=)")
         if own:
             self.data = d
         return d

@@ -32,6 +32,14 @@ and exact at any step, whatever ``w h``. Their parameters are the block :data:`.
 simulator's step set-up; each row's filter states the field ``imu`` of its :class:`~.data.SimData`
 (layout :data:`.layouts.IMU_STATE`), started at rest on the pad (:meth:`Imu.rest_state`). Noise, bias
 and sampling belong to the flight computer that reads the filters' outputs (:mod:`lvgym.envs.flightcomputer`).
+
+Dispersed station. A row's IMU may sit ``station_shift`` [m] from the nominal station (the ``imu_station``
+dispersion; block :data:`.layouts.IMU_STATION` of the row's IMU state, written by :meth:`Imu.placement`).
+The timeline then tabulates the mode shapes and slopes also at a few stations around the nominal one
+(``probes``, read off the solved beam, not meshed); the row takes them linearly in station between the two
+tabulated stations around its own (``(1 - weight) lo + weight hi``; weight 0 copies ``lo``'s exactly), and
+its accelerometers' lever arm from its own station. A shift of zero reproduces the flight of an
+undispersed IMU bit for bit.
 """
 
 from __future__ import annotations
@@ -47,12 +55,11 @@ from lvgym.dynamics.layout import PARAMS, STATE, X
 from lvgym.packing import at
 from lvgym.rotations import quat_to_dcm
 
-from .layouts import ACCEL_ORDER, CTX, D, GYRO_ORDER, IM, IMU, IMU_STATE, IS
+from .layouts import ACCEL_ORDER, CTX, D, GYRO_ORDER, IM, IMU, IMU_STATE, IMU_STATION, IS
 from .timeline import locate_k
 
 __all__ = ["IMU_OFF", "Imu", "ImuWork", "imu_begin_k", "imu_end_k", "imu_output_k", "imu_shift_k", "lti_step_k",
-           "make_imu_work",
-           "specific_force_k"]
+           "make_imu_work", "specific_force_k", "station_modes_k"]
 
 XF, PF = STATE.fixed, PARAMS.fixed
 #: no IMU: the filters are not advanced (the simulator of protocol v0)
@@ -81,15 +88,17 @@ def _cascade(first: tuple, second: tuple) -> tuple[np.ndarray, np.ndarray, np.nd
 @dataclass(frozen=True)
 class Imu:
     """An IMU at station ``station_m`` [m] (``sensor``: its index among the timeline's sensor stations,
-    where the mode shapes and slopes are tabulated) with the gyro's bandwidth ``gyro_bandwidth_hz``
-    [Hz] and damping ``gyro_damping`` [-] and an anti-aliasing Butterworth low-pass at
-    ``antialias_hz`` [Hz] before sampling (see the module docstring)."""
+    where the mode shapes and slopes are tabulated; ``probes``: the indices of further sensor stations
+    around it between which a dispersed station interpolates, see :meth:`placement`) with the gyro's
+    bandwidth ``gyro_bandwidth_hz`` [Hz] and damping ``gyro_damping`` [-] and an anti-aliasing
+    Butterworth low-pass at ``antialias_hz`` [Hz] before sampling (see the module docstring)."""
 
     station_m: float
     sensor: int = 0
     gyro_bandwidth_hz: float = 80.0
     gyro_damping: float = 0.7
     antialias_hz: float = 20.0
+    probes: tuple[int, ...] = ()
 
     def __post_init__(self) -> None:
         for key in ("gyro_bandwidth_hz", "gyro_damping", "antialias_hz"):
@@ -98,6 +107,40 @@ class Imu:
                 raise ValueError(f"imu.{key} = {v!r}: a finite number > 0")
         if not (isinstance(self.sensor, int) and self.sensor >= 0):
             raise ValueError(f"imu.sensor = {self.sensor!r}: an index >= 0")
+        if not all(isinstance(i, int) and i >= 0 and i != self.sensor for i in self.probes):
+            raise ValueError(f"imu.probes = {self.probes!r}: sensor indices >= 0 other than sensor")
+
+    def placement(self, shift: np.ndarray, sensor_stations: np.ndarray) -> np.ndarray:
+        """The rows' station blocks (R, IMU_STATION.size) for station shifts ``shift`` (R,) [m] along +x_b:
+        the two tabulated stations (``sensor`` and ``probes`` of ``sensor_stations`` [m]) around each
+        row's station and the linear weight of the forward one. A shift of 0 gives ``lo = hi = sensor``
+        and weight 0; a station on a tabulated one, that one with weight 0. A station outside the
+        tabulated ones by more than round-off (1e-9 m; a draw clipped at the range's end) raises
+        ``ValueError``."""
+        shift = np.atleast_1d(np.asarray(shift, dtype=float))
+        idx = np.array([self.sensor, *self.probes], dtype=int)
+        xs = np.asarray(sensor_stations, dtype=float)[idx]
+        order = np.argsort(xs, kind="stable")
+        idx, xs = idx[order], xs[order]
+        out = IMU_STATION.zeros(shift.size)
+        v = lambda name: IMU_STATION.view(out, name)[:, 0]          # noqa: E731
+        v("station_shift")[:] = shift
+        v("station_lo")[:] = v("station_hi")[:] = self.sensor
+        for r, d in enumerate(shift):
+            if d == 0.0:
+                continue
+            x = self.station_m + d
+            if not xs[0] - 1e-9 <= x <= xs[-1] + 1e-9:
+                raise ValueError(f"IMU station shift {d!r} m: the station {x!r} m lies outside the tabulated "
+                                 f"[{xs[0]!r}, {xs[-1]!r}] m")
+            x = min(max(x, xs[0]), xs[-1])
+            i = int(np.searchsorted(xs, x, side="right")) - 1
+            if xs[i] == x or i == xs.size - 1:
+                v("station_lo")[r] = v("station_hi")[r] = idx[i]
+                continue
+            v("station_lo")[r], v("station_hi")[r] = idx[i], idx[i + 1]
+            v("station_weight")[r] = (x - xs[i]) / (xs[i + 1] - xs[i])
+        return out
 
     def continuous(self) -> dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]]:
         """The continuous filters ``(A, B, C)`` of the gyro (sensor bandwidth, then anti-aliasing) and
@@ -138,16 +181,18 @@ class Imu:
 #: scratch of one row's IMU step: ``omega0`` (3) [rad/s], ``v0`` (3) [m/s] (less the CG's travel),
 #: ``C0`` (3, 3) ``C_ib`` at the start of the step, ``C1`` at its end, ``eta_dot0`` (2K) modal rates at
 #: the start, ``omega1`` (3), ``a_i`` (3) [m/s^2] the CG's mean acceleration, ``g_i`` (3) gravity, ``r`` (3) [m]
-#: the IMU from the CG of B, ``u`` (3) the gyro inputs, ``f`` (3) [m/s^2] the specific force, ``tmp`` (4) scratch
+#: the IMU from the CG of B, ``u`` (3) the gyro inputs, ``f`` (3) [m/s^2] the specific force, ``tmp`` (4) scratch,
+#: ``phi`` (K) and ``dphi`` (K) the mode shapes and slopes at the row's station
 ImuWork = namedtuple("ImuWork", ["omega0", "omega1", "v0", "a_i", "g_i", "r", "C0", "C1", "eta_dot0", "u", "f",
-                                 "tmp"])
+                                 "tmp", "phi", "dphi"])
 
 
 @nb.njit(cache=True, nogil=True)
 def make_imu_work(n_modes):
     """The scratch of :func:`imu_begin_k` / :func:`imu_end_k` for ``n_modes`` modes per plane."""
     return ImuWork(np.zeros(3), np.zeros(3), np.zeros(3), np.zeros(3), np.zeros(3), np.zeros(3), np.zeros((3, 3)),
-                   np.zeros((3, 3)), np.zeros(2 * n_modes), np.zeros(3), np.zeros(3), np.zeros(_GO))
+                   np.zeros((3, 3)), np.zeros(2 * n_modes), np.zeros(3), np.zeros(3), np.zeros(_GO), np.zeros(n_modes),
+                   np.zeros(n_modes))
 
 
 @nb.njit(cache=True, nogil=True, inline="always")
@@ -206,18 +251,36 @@ def imu_shift_k(x, w, sign):
         w.v0[i] += sign * x[ov + i]
 
 
+@nb.njit(cache=True, nogil=True, inline="always")
+def station_modes_k(st, tables, j, phi, dphi):
+    """Mode shapes ``phi`` and slopes ``dphi`` (K,) at a row's IMU station (its block IMU_STATION in the
+    row's IMU state ``st``) in the timeline's row ``j``: linear between the tabulated stations ``lo`` and
+    ``hi``; a weight of 0 copies ``lo``'s (exactly)."""
+    lo, hi, wt = int(st[IS.station_lo]), int(st[IS.station_hi]), st[IS.station_weight]
+    p0, d0 = tables.phi_sensor[j, lo], tables.dphi_sensor[j, lo]
+    if wt == 0.0:
+        for k in range(phi.size):
+            phi[k], dphi[k] = p0[k], d0[k]
+        return
+    p1, d1 = tables.phi_sensor[j, hi], tables.dphi_sensor[j, hi]
+    for k in range(phi.size):
+        phi[k] = (1.0 - wt) * p0[k] + wt * p1[k]
+        dphi[k] = (1.0 - wt) * d0[k] + wt * d1[k]
+
+
 @nb.njit(cache=True, nogil=True)
 def imu_end_k(prm, st, x, p, ctx, tables, t, h, w, n_slosh, n_modes):
     """Advance a row's IMU filters ``st`` (layout IMU_STATE) over the physics step of ``h`` [s] that
     ended at ``t`` [s] with the state ``x`` and parameters ``p`` (its start kept in ``w`` by
     :func:`imu_begin_k`); ``prm`` the IMU block (layout IMU), ``ctx`` the row's context (gravity of
-    the latest RK4 stage), ``tables`` the timeline's (mode shapes and slopes at the IMU)."""
+    the latest RK4 stage), ``tables`` the timeline's (mode shapes and slopes at the sensor stations, taken
+    at the row's station by :func:`station_modes_k`)."""
     ow, ov, oq, oc = XF.omega_bi_b, XF.v_zw_i, XF.q_bi, PF.r_cg
     K = n_modes
     i, wt = locate_k(tables.t, t)
     j = i + 1 if wt >= 1.0 else i
-    s = int(prm[IM.sensor])
-    phi, dphi = tables.phi_sensor[j, s], tables.dphi_sensor[j, s]
+    phi, dphi = w.phi, w.dphi
+    station_modes_k(st, tables, j, phi, dphi)
     o_etad = at(X.eta_dot, n_modes, n_slosh)
     u = w.u
     for a in range(3):                               # gyro: mean body rate + mean slope rate at the IMU
@@ -237,7 +300,7 @@ def imu_end_k(prm, st, x, p, ctx, tables, t, h, w, n_slosh, n_modes):
         w.a_i[a] = (x[ov + a] - w.v0[a]) / h
         w.g_i[a] = ctx[og + a]
         w.omega1[a] = x[ow + a]
-    w.r[0] = prm[IM.station] - p[oc]
+    w.r[0] = (prm[IM.station] + st[IS.station_shift]) - p[oc]
     w.r[1], w.r[2] = -p[oc + 1], -p[oc + 2]
     specific_force_k(w.a_i, w.g_i, w.C0, w.C1, w.omega0, w.omega1, h, w.r, w.f)
     for k in range(K):

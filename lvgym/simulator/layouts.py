@@ -19,7 +19,8 @@ these layouts; the compiled functions read their offsets from the ``.at`` namedt
 - :data:`RAIL` the launch rail (one per simulator), :data:`RAIL_STATE` the row's motion along it.
 - :data:`SERVO` the gimbal servo's parameters, :data:`ACTUATOR` the row's command, gimbal and effort.
 - :data:`IMU` the inertial measurement unit's parameters (one per simulator; discrete filters of
-  :mod:`.imu`), :data:`IMU_STATE` the row's gyro and accelerometer filter states.
+  :mod:`.imu`), :data:`IMU_STATE` the row's gyro and accelerometer filter states and its station
+  (:data:`IMU_STATION`, the ``imu_station`` dispersion).
 """
 
 from __future__ import annotations
@@ -29,7 +30,8 @@ from lvgym.environment.atmosphere import AIR
 from lvgym.packing import Field, Packed
 
 __all__ = ["ACCEL_ORDER", "ACTUATOR", "AERO", "AEROELASTIC", "CONDITIONS", "CONTEXT", "DISPERSION", "GYRO_ORDER", "IMU",
-           "IMU_STATE", "RAIL", "RAIL_STATE", "SERVO", "STRIPS", "TRIG", "A", "AEL", "CTX", "D", "DS", "IM", "IS", "RL", "RS",
+           "IMU_STATE",
+           "IMU_STATION", "RAIL", "RAIL_STATE", "SERVO", "STRIPS", "TRIG", "A", "AEL", "CTX", "D", "DS", "IM", "IS", "RL", "RS",
            "SV", "TG", "AE", "STR"]
 
 #: flight conditions of one state at one time
@@ -192,12 +194,23 @@ IMU = Packed("imu parameters", [
     Field("accel_c", ACCEL_ORDER, "-", "accelerometer filter: output vector (the sampled specific force)"),
 ])
 
-#: a row's IMU filter states (zero and unused without an IMU)
+#: a row's IMU station (dispersion ``imu_station``): its shift from the nominal station and where it lies
+#: between two of the timeline's sensor stations, whose mode shapes and slopes the row interpolates linearly
+#: (``(1 - weight) lo + weight hi``); nominal: shift 0, ``lo = hi`` the IMU's own sensor index, weight 0
+IMU_STATION = Packed("imu station", [
+    Field("station_shift", 1, "m", "the row's IMU station minus the nominal one, along +x_b (towards the nose)"),
+    Field("station_lo", 1, "-", "index of the tabulated sensor station at or aft of the row's station"),
+    Field("station_hi", 1, "-", "index of the next tabulated sensor station forward of it (lo when the weight is 0)"),
+    Field("station_weight", 1, "-", "linear weight of station_hi, in [0, 1)"),
+])
+
+#: a row's IMU: filter states (zero and unused without an IMU) and its station
 IMU_STATE = Packed("imu state", [
     Field("gyro", 3 * GYRO_ORDER, "rad/s", "gyro filter states per body axis (x, y, z): sensor bandwidth "
           "(output, its rate), then anti-aliasing (output, its rate)", shape=(3, GYRO_ORDER)),
     Field("accel", 2 * ACCEL_ORDER, "m/s^2", "accelerometer anti-aliasing states per lateral body axis (y, z): "
           "output, its rate", shape=(2, ACCEL_ORDER)),
+    Field("station", IMU_STATION.size, "-", "the row's IMU station (layout IMU_STATION)", sub=IMU_STATION),
 ])
 
 #: offsets for compiled code
@@ -210,7 +223,7 @@ IM, IS = IMU.at, IMU_STATE.at
 def _doc() -> str:
     return "\n\n".join(f"``{lay.title}`` ({lay.size} entries):\n\n{lay.table()}" for lay in
                        (CONTEXT, AERO, TRIG, DISPERSION, AEROELASTIC, STRIPS, CONDITIONS, RAIL, RAIL_STATE, SERVO,
-                        ACTUATOR, IMU, IMU_STATE))
+                        ACTUATOR, IMU, IMU_STATION, IMU_STATE))
 
 
 __doc__ = (__doc__ or "") + "\n" + _doc()

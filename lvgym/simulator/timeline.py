@@ -260,7 +260,7 @@ def _grid(mm: MassModel, t_end: float, dt: float) -> tuple[list[float], list[tup
 def build_timeline(mass_model: MassModel, model: str, t_end: float, dt: float = 0.05,
                    n_modes: int | None = None, sensor_stations=(), mode_cutoff_hz: float = np.inf,
                    cache: bool = True, strip_stations=None, *, mode_interval: float | None = None,
-                   mode_basis: str = "held") -> Timeline:
+                   mode_basis: str = "held", sensor_probes=()) -> Timeline:
     """Tabulate ``mass_model``'s vehicle from lift-off to ``t_end`` [s] for the dynamics ``model``
     (one of ``MODELS``) every ``dt`` [s] (and at every event and thrust-table breakpoint), with
     ``n_modes`` bending modes per plane (default: the vehicle file's; 0 for rigid and slosh) and
@@ -277,7 +277,11 @@ def build_timeline(mass_model: MassModel, model: str, t_end: float, dt: float = 
     modes are those of a timeline without strips), decoupled modes zero.
     ``mode_interval`` [s]: recompute the modes also every so many seconds of flight (None: the vehicle
     file's ``structure.recompute_interval``, else at separations only); ``mode_basis``: ``held`` or
-    ``projected``, see the module docstring.
+    ``projected``, see the module docstring. ``sensor_probes`` [m]: further sensor stations, appended to
+    ``sensor_stations`` in the timeline's ``sensor_stations``, ``phi_sensor`` and ``dphi_sensor``, read off
+    each solved beam with its element shape functions and not added to its mesh (the meshed stations'
+    shapes and the modes are bit for bit those of a timeline without them): the stations a dispersed IMU
+    interpolates between.
 
     ``cache``: look the timeline up in the on-disk cache first and store it there (:mod:`.cache`: keyed by
     the vehicle's whole content, these arguments and the source of the code that builds it)."""
@@ -291,14 +295,18 @@ def build_timeline(mass_model: MassModel, model: str, t_end: float, dt: float = 
     if cache:
         from .cache import cached
         strips_key = None if strip_stations is None else np.asarray(strip_stations, float).tolist()
+        probes_key = tuple(np.ravel(sensor_probes).tolist())
         return cached(mass_model, (model, float(t_end), float(dt), n_modes, tuple(np.ravel(sensor_stations).tolist()),
-                                   float(mode_cutoff_hz), strips_key, mode_interval, mode_basis),
+                                   float(mode_cutoff_hz), strips_key, mode_interval, mode_basis)
+                      + ((probes_key,) if probes_key else ()),
                       lambda: build_timeline(mass_model, model, t_end, dt, n_modes, sensor_stations, mode_cutoff_hz,
                                              cache=False, strip_stations=strip_stations, mode_interval=mode_interval,
-                                             mode_basis=mode_basis))
+                                             mode_basis=mode_basis, sensor_probes=sensor_probes))
     mm = mass_model
     vehicle = mm.vehicle
-    sensors = np.asarray(sensor_stations, dtype=float).reshape(-1)
+    meshed = np.asarray(sensor_stations, dtype=float).reshape(-1)
+    probes = np.asarray(sensor_probes, dtype=float).reshape(-1)
+    sensors = np.concatenate([meshed, probes])
     strips = np.zeros((len(vehicle.stages), 0)) if strip_stations is None else np.asarray(strip_stations, float)
     if strips.ndim != 2 or strips.shape[0] != len(vehicle.stages):
         raise ValueError(f"strip_stations of shape {strips.shape}: expected ({len(vehicle.stages)}, n), one row per stage")
@@ -307,7 +315,8 @@ def build_timeline(mass_model: MassModel, model: str, t_end: float, dt: float = 
     with_slosh = model in ("slosh", "nonrigid")
     N = mm.n_slosh if with_slosh else 0
     dyn = NonRigidModel(N, K)
-    schedule = ModeSchedule(mm, n_modes=K, recompute_interval=mode_interval, sensor_stations=sensors) if K > 0 else None
+    schedule = (ModeSchedule(mm, n_modes=K, recompute_interval=mode_interval, sensor_stations=meshed,
+                             probe_stations=probes) if K > 0 else None)
     times, events = _grid(mm, t_end, dt)
     cols: dict[str, list] = {k: [] for k in ("t", "T0", "Ae", "burn", "stage", "modes", "m_b", "r_cg", "J_b",
                                              "gimbal", "m", "cg", "J", "ms", "L", "hinge", "zeta")}

@@ -152,19 +152,25 @@ def _stack_modes(sections: list[Section], points: list[PointMass], spread: list[
 
 def vehicle_modes(vehicle: Vehicle, state: MassState, props: MassProperties, n_modes: int | None = None,
                   sensor_stations=None, ei_factor: float | None = None,
-                  solved: dict[bytes, BeamModes] | None = None) -> VehicleModes:
+                  solved: dict[bytes, BeamModes] | None = None, probe_stations=()) -> VehicleModes:
     """First ``n_modes`` (default: the vehicle file's) bending modes of the stack in ``state``;
     ``ei_factor`` multiplies every EI (default :func:`stiffness_factor`). ``solved``: the beams solved so
     far by the caller (a dict it keeps), so that a stack whose masses have not changed (a coast between
-    burnout and separation while the modes are recomputed every few seconds) is not solved again."""
+    burnout and separation while the modes are recomputed every few seconds) is not solved again.
+    ``probe_stations`` [m]: further stations appended to the sensor stations whose shapes and slopes are
+    read off the solved beam with its element shape functions (:meth:`~.beam.BeamModes.shape_at`) and
+    are not nodes of its mesh, so the modes, and the shapes at every other station, are those without
+    them (a dispersed IMU station interpolates between such probes)."""
     opts = vehicle.structure
     K = opts.n_modes if n_modes is None else int(n_modes)
     sensors = np.asarray(opts.sensor_stations if sensor_stations is None else sensor_stations, float).reshape(-1)
+    probes = np.asarray(probe_stations, float).reshape(-1)
     N = props.slosh_mass.size
     if K == 0:
         z = np.zeros(0)
-        return VehicleModes(props.t, z, z, z, z, np.zeros((N, 0)), sensors, np.zeros((sensors.size, 0)),
-                            np.zeros((sensors.size, 0)), None)
+        S = sensors.size + probes.size
+        return VehicleModes(props.t, z, z, z, z, np.zeros((N, 0)), np.concatenate([sensors, probes]), np.zeros((S, 0)),
+                            np.zeros((S, 0)), None)
     attached = [si for si, ph in enumerate(state.phase) if ph != SEPARATED]
     sections = _stiffness(vehicle, attached)
     top, bottom = max(s.top for s in sections), min(s.bottom for s in sections)
@@ -176,10 +182,14 @@ def vehicle_modes(vehicle: Vehicle, state: MassState, props: MassProperties, n_m
     if factor != 1.0:
         sections = [Section(sec.top, sec.bottom, sec.EI * factor, sec.mass_per_length) for sec in sections]
     beam = _stack_modes(sections, points, spread, K, query, solved)
+    phi_s, dphi_s = beam.phi[1 + N:].copy(), beam.dphi[1 + N:].copy()
+    if probes.size:
+        phi_p, dphi_p = beam.shape_at(np.clip(probes, bottom, top))
+        phi_s, dphi_s = np.vstack([phi_s, phi_p]), np.vstack([dphi_s, dphi_p])
     return VehicleModes(t=props.t, omega=beam.omega.copy(), zeta=np.full(K, opts.damping),
                         phi_gimbal=beam.phi[0].copy(), dphi_gimbal=beam.dphi[0].copy(),
-                        phi_hinge=beam.phi[1:1 + N].copy(), sensor_stations=sensors,
-                        phi_sensor=beam.phi[1 + N:].copy(), dphi_sensor=beam.dphi[1 + N:].copy(), beam=beam)
+                        phi_hinge=beam.phi[1:1 + N].copy(), sensor_stations=np.concatenate([sensors, probes]),
+                        phi_sensor=phi_s, dphi_sensor=dphi_s, beam=beam)
 
 
 def mode_transfer(old: VehicleModes, new: VehicleModes) -> np.ndarray:
@@ -197,12 +207,13 @@ class ModeSchedule:
     also every ``recompute_interval`` seconds of flight (``None``: the vehicle file's setting)."""
 
     def __init__(self, mass_model: MassModel, n_modes: int | None = None, recompute_interval: float | None = None,
-                 sensor_stations=None):
+                 sensor_stations=None, probe_stations=()):
         self.mass_model = mass_model
         self.n_modes = n_modes
         self.interval = mass_model.vehicle.structure.recompute_interval if recompute_interval is None \
             else recompute_interval
         self.sensor_stations = sensor_stations
+        self.probe_stations = probe_stations          # read off the beam, not meshed (:func:`vehicle_modes`)
         self.ei_factor = stiffness_factor(mass_model.vehicle, mass_model.cg_convention)
         self._solved: dict[bytes, BeamModes] = {}                # the beams of this schedule, by their inputs
         self._key: tuple | None = None
@@ -221,7 +232,7 @@ class ModeSchedule:
         if self._due(state.t, attached):
             props = props if props is not None else self.mass_model.properties(state)
             self._modes = vehicle_modes(self.mass_model.vehicle, state, props, self.n_modes, self.sensor_stations,
-                                        self.ei_factor, self._solved)
+                                        self.ei_factor, self._solved, self.probe_stations)
             self._key = attached
         return self._modes
 
@@ -233,7 +244,7 @@ class ModeSchedule:
         for i, t in enumerate(state.t.tolist()):
             if self._due(t, attached):
                 self._modes = vehicle_modes(self.mass_model.vehicle, state.row(i), props.row(i), self.n_modes,
-                                            self.sensor_stations, self.ei_factor, self._solved)
+                                            self.sensor_stations, self.ei_factor, self._solved, self.probe_stations)
                 self._key = attached
             out.append(self._modes)
         return out
