@@ -45,7 +45,7 @@ from lvgym.vehicle.slender import slender_mapping
 
 __all__ = ["Beam", "Lift", "FlightCondition", "vehicle_beam", "vehicle_lift", "uniform_beam_check",
            "static_stiffness", "elastic_moment_ratio", "divergence_qbar", "dynamic_matrix", "growth_rate",
-           "pinned_operating_point", "lvgym_poles"]
+           "pinned_operating_point", "lvgym_poles", "pitch_stiffness", "divergence_qbar_flight"]
 
 
 @dataclass
