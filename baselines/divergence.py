@@ -45,7 +45,7 @@ from lvgym.vehicle.slender import slender_mapping
 
 __all__ = ["Beam", "Lift", "FlightCondition", "vehicle_beam", "vehicle_lift", "uniform_beam_check",
            "static_stiffness", "elastic_moment_ratio", "divergence_qbar", "dynamic_matrix", "growth_rate",
-           "pinned_operating_point", "lvgym_poles", "pitch_stiffness", "divergence_qbar_flight"]
+           "pinned_operating_point", "lvgym_poles", "pitch_stiffness", "divergence_qbar_flight", "stabilisability"]
 
 
 @dataclass
@@ -401,3 +401,38 @@ def divergence_qbar_flight(beam: Beam, lift: Lift, fc: FlightCondition, hi: floa
         if fa > 0 >= fb:
             return float(optimize.brentq(f, a, b, xtol=10.0))
     return math.inf
+
+
+def stabilisability(op: Any, plane: str = "pitch") -> dict[str, float]:
+    """What limits a TVC loop at ``op`` (docs/aerodynamics.md): the flight plant's unstable real pole
+    ``p`` [1/s] and real right-half-plane zero ``z`` [1/s] (continuous equivalents of
+    :func:`.flightloop.flight_plant`, gimbal command to sampled gyro), the pure delay ``theta`` [s]
+    (the computational delay plus half a control period for the hold), the servo's equivalent lag
+    ``2 zeta / omega`` [s], and the lower bounds on the closed loop's peak complementary sensitivity of
+    any linear controller, ``Mt >= exp(p theta) (z + p) / (z - p)`` (with the delay alone: ``mt_delay``;
+    with the servo counted as delay: ``mt_servo``); the TVC moment per gimbal radian ``T l`` [N m/rad]."""
+    import control
+
+    from .flightloop import control_timing, flight_plant
+
+    G = flight_plant(op, plane)
+    dt = float(G.dt)
+    poles = np.asarray(control.poles(G), complex)
+    zeros = np.asarray(control.zeros(G), complex)
+    pc = np.log(poles[np.abs(poles) > 1e-12]) / dt
+    zc = np.log(zeros[np.abs(zeros) > 1e-12]) / dt
+    p = float(pc[np.abs(pc.imag) < 1e-9].real.max())
+    rz = zc[(np.abs(zc.imag) < 1e-9) & (zc.real > 1e-3)].real
+    z = float(rz.min()) if rz.size else math.inf
+    _, steps = control_timing(op)
+    theta = steps * dt + 0.5 * dt
+    s = op.sim.servo
+    lag = 2.0 * float(s.damping) / float(s.frequency)
+    ratio = (z + p) / (z - p) if math.isfinite(z) and z > p else (1.0 if not math.isfinite(z) else math.inf)
+    tl = op.sim.timeline
+    cg = float(np.ravel(tl.interp("cg", [op.t])[0])[0])
+    arm = cg - float(op.p[op.sim.layout.params["r_gimbal"]][0])
+    return {"p": p, "z": z, "theta": theta, "servo_lag": lag, "p_tau": p * (theta + lag),
+            "mt_delay": math.exp(p * theta) * ratio, "mt_servo": math.exp(p * (theta + lag)) * ratio,
+            "tvc_moment_per_rad": float(op.sim.conditions("thrust")[0]) * arm,
+            "servo_radps": float(s.frequency)}

@@ -80,3 +80,20 @@ def test_slope_sign_is_the_destabilising_one(lift):
     assert dv.elastic_moment_ratio(st, 300e3) < -0.5
     flipped = {**st, "e": -st["e"], "A": -st["A"]}
     assert dv.elastic_moment_ratio(flipped, 300e3) > 0.0
+
+
+def test_no_tvc_loop_with_margins_from_6s(lvgym_points):
+    """From 6 s the divergence outruns the loop: the unstable pole nears the 15 rad/s servo (above it from 7 s), p times
+    the loop's lag (delay, hold, servo) exceeds 1, and even a controller that inverted the servo exactly
+    cannot keep the peak complementary sensitivity below 2 (6 dB / 29 deg disk margins need ~1.5).
+    Measured: p 7.31 / 13.69 1/s at 5 / 6 s, RHP zero 64.8 / 64.1 1/s, Mt >= 1.56 / 2.33 (delay alone),
+    3.1 / 8.4 (servo as lag)."""
+    op6 = dv.pinned_operating_point(6.0)
+    s6 = dv.stabilisability(op6)
+    assert s6["p"] == pytest.approx(lvgym_points[6.0]["max_real"], rel=1e-6)
+    assert s6["p"] > 0.9 * s6["servo_radps"]             # 13.7 against 15 rad/s (16.3 at 7 s)
+    assert s6["p_tau"] > 1.0
+    assert s6["mt_delay"] > 2.0
+    assert 30.0 < s6["z"] < 120.0                      # the gyro sees a real RHP zero below the bending mode
+    s5 = dv.stabilisability(dv.pinned_operating_point(5.0))
+    assert s5["mt_servo"] > 2.5 and s5["p_tau"] > 0.5
