@@ -45,7 +45,7 @@ from lvgym.vehicle.slender import slender_mapping
 
 __all__ = ["Beam", "Lift", "FlightCondition", "vehicle_beam", "vehicle_lift", "uniform_beam_check",
            "static_stiffness", "elastic_moment_ratio", "divergence_qbar", "dynamic_matrix", "growth_rate",
-           "pinned_operating_point", "lvgym_poles", "pitch_stiffness", "divergence_qbar_flight", "stabilisability"]
+           "pinned_operating_point", "lvgym_poles", "pitch_stiffness", "divergence_qbar_flight", "stabilisability", "lqg_sensitivity_sweep"]
 
 
 @dataclass
@@ -436,3 +436,45 @@ def stabilisability(op: Any, plane: str = "pitch") -> dict[str, float]:
             "mt_delay": math.exp(p * theta) * ratio, "mt_servo": math.exp(p * (theta + lag)) * ratio,
             "tvc_moment_per_rad": float(op.sim.conditions("thrust")[0]) * arm,
             "servo_radps": float(s.frequency)}
+
+
+def lqg_sensitivity_sweep(op: Any, plane: str = "pitch", rhos: Any = None, noises: Any = None) -> dict[str, float]:
+    """The smallest peak sensitivity ``Ms`` [-] that a sweep of discrete LQG controllers reaches on the
+    flight plant at ``op`` (:func:`.flightloop.flight_plant`): an output-weighted LQR (``rho C^T C``,
+    unit input weight) with a predictor Kalman observer (process noise ``noise`` at the plant input, unit
+    measurement noise), over ``rhos`` x ``noises`` (default 15 x 9 log-spaced); only closed-loop stable
+    designs count. Returns ``ms``, its ``rho``, ``noise`` and the disk margins it implies."""
+    import warnings
+
+    import control
+
+    from .flightloop import flight_plant
+
+    G = control.ss(flight_plant(op, plane))
+    A, B, C = (np.asarray(m, float) for m in (G.A, G.B, G.C))
+    n, dt = A.shape[0], float(G.dt)
+    z = np.exp(1j * np.geomspace(0.1, 0.999 * math.pi / dt, 500) * dt)
+    rhos = np.geomspace(1e-2, 1e5, 15) if rhos is None else rhos
+    noises = np.geomspace(1e-4, 1e4, 9) if noises is None else noises
+    best = (math.inf, math.nan, math.nan)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        for rho in rhos:
+            for qn in noises:
+                try:
+                    K, _, _ = control.dlqr(A, B, rho * C.T @ C + 1e-8 * np.eye(n), 1.0)
+                    L, _, _ = control.dlqe(A, B, C, qn, 1.0)
+                except Exception:                                   # noqa: BLE001 (a failed Riccati solve)
+                    continue
+                Kc = control.ss(A - B @ K - L @ C, L, K, 0.0, dt)      # u = -Kc y
+                loop_ = control.series(Kc, G)
+                if np.abs(np.linalg.eigvals(np.asarray(control.ss(control.feedback(loop_, 1)).A))).max() >= 1.0:
+                    continue
+                ms = float(np.abs(1.0 / (1.0 + np.asarray(loop_(z), complex).ravel())).max())
+                if ms < best[0]:
+                    best = (ms, float(rho), float(qn))
+    ms = best[0]
+    return {"ms": ms, "rho": best[1], "noise": best[2],
+            "disk_gm_up_db": 20 * math.log10(ms / (ms - 1)) if ms > 1 else math.inf,
+            "disk_gm_down_db": 20 * math.log10(ms / (ms + 1)),
+            "disk_pm_deg": math.degrees(2 * math.asin(min(1.0, 1 / (2 * ms))))}
