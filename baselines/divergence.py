@@ -328,8 +328,11 @@ def growth_rate(A: np.ndarray) -> float:
 
 
 # ------------------------------------------------------------------ lvgym's side of the comparison
-def pinned_operating_point(t: float, diameter: float = 0.2833, length: float = 8.5) -> Any:
-    """An operating point of ``SlenderAscent-v1`` (non-rigid, calm, gimbal at zero) at ``t`` [s] whose
+def pinned_operating_point(t: float, diameter: float = 0.2833, length: float = 8.5,
+                           wall_thickness: float = 0.002) -> Any:
+    """An operating point of ``SlenderAscent-v1`` with a tube wall of ``wall_thickness`` [m] (default the
+    thesis's 2 mm, the tube this module checks; the env's own default is 4.5 mm) (non-rigid, calm, gimbal
+    at zero) at ``t`` [s] whose
     state is that of the same flight without the aeroelastic loads (which lasts the 10 s), and whose
     simulator, parameters and context are the aeroelastic env's: the flight with the loads diverges
     after 4 s, so its own state is no operating point beyond that. Both envs are stepped together and
@@ -339,7 +342,8 @@ def pinned_operating_point(t: float, diameter: float = 0.2833, length: float = 8
     import lvgym  # noqa: F401
     from .linearize import OperatingPoint
 
-    opts = {"model": "nonrigid", "wind": "none", "diameter": diameter, "length": length}
+    opts = {"model": "nonrigid", "wind": "none", "diameter": diameter, "length": length,
+            "wall_thickness_m": wall_thickness}
     on = gym.make("lvgym/SlenderAscent-v1", **opts)
     off = gym.make("lvgym/SlenderAscent-v1", aeroelastic=False, **opts)
     on.reset(seed=0)

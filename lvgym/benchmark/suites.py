@@ -184,8 +184,8 @@ SUITES_V1: dict[str, Suite] = {s.name: s for s in (
     Suite("stratos-tvc-v1", "Stratos III with TVC (StratosIII-v1), 30 s, turbulence drawn per seed; thrust "
           "misalignment, mass, aerodynamics, thrust level and the slosh and bending dispersions",
           _pair("stratos-tvc-v1", "lvgym/StratosIII-v1", "turbulence", V1_DISPERSIONS), version=PROTOCOL_V1),
-    Suite("slender-v1", "Slender vehicle L/D = 30 (SlenderAscent-v1: aeroelastic strip loads), 10 s, turbulence, "
-          "every dispersion (provisional: no slender baseline yet, issue 17)",
+    Suite("slender-v1", "Slender vehicle L/D = 30 (SlenderAscent-v1: aeroelastic strip loads, 4.5 mm wall), 10 s, "
+          "turbulence, every dispersion (provisional: no slender baseline yet, issue 17)",
           _pair("slender-v1", "lvgym/SlenderAscent-v1", "turbulence", V1_DISPERSIONS, length=8.5, diameter=0.2833),
           version=PROTOCOL_V1),
     Suite("smile-v1-maxq-gust", "SMILE v1 through max q, 35 s: a random jet stream and a random 1-cosine gust in "

@@ -281,22 +281,28 @@ class SlenderAscentEnv(AscentEnv):
     ``aero_mach`` became 2.0 (it flew the full tables, which no policy survives)."""
 
     DEFAULTS = {"site": "andoya", "mission_time_s": 10.0, "rate_weights": (0.0, 1.0, 1.0)}
+    #: the tube's wall [m] when ``wall_thickness_m`` is not given (None: the thesis's 2 mm)
+    WALL_THICKNESS_M: float | None = None
 
     def __init__(self, render_mode: str | None = None, length: float = 8.5, diameter: Any = 0.3,
-                 aero_mach: float | None = DEFAULT_AERO_MACH, **options: Any) -> None:
+                 aero_mach: float | None = DEFAULT_AERO_MACH, wall_thickness_m: float | None = None,
+                 **options: Any) -> None:
         d = np.atleast_1d(np.asarray(diameter, dtype=float))
         if d.size not in (1, 2) or np.any(d <= 0):
             raise ValueError(f"diameter = {diameter!r}: a diameter [m] > 0 or a (low, high) pair")
         self.diameters = tuple(np.linspace(d[0], d[-1], 4 if d.size == 2 else 1).tolist())
         self.length = float(length)
         self.aero_mach = None if aero_mach is None else float(aero_mach)
-        super().__init__(render_mode, vehicles=[slender_key(self.length, dia, self.aero_mach) for dia in self.diameters],
-                         **options)
+        self.wall_thickness_m = self.WALL_THICKNESS_M if wall_thickness_m is None else float(wall_thickness_m)
+        super().__init__(render_mode, vehicles=[slender_key(self.length, dia, self.aero_mach, self.wall_thickness_m)
+                                                for dia in self.diameters], **options)
 
 
-def slender_key(length: float, diameter: float, aero_mach: float | None) -> tuple:
-    """The vehicle key of :func:`~.functional.cached_vehicle` of one slender vehicle [m, m, -]."""
-    return ("slender", float(length), float(diameter), aero_mach)
+def slender_key(length: float, diameter: float, aero_mach: float | None, wall_thickness_m: float | None = None) -> tuple:
+    """The vehicle key of :func:`~.functional.cached_vehicle` of one slender vehicle [m, m, -, m] (no wall:
+    the thesis's 2 mm, and the key v0 always had)."""
+    key = ("slender", float(length), float(diameter), aero_mach)
+    return key if wall_thickness_m is None else key + (float(wall_thickness_m),)
 
 
 class StratosIIIV1Env(StratosIIIEnv):
@@ -311,8 +317,14 @@ class StratosIIIV1Env(StratosIIIEnv):
 class SlenderAscentV1Env(SlenderAscentEnv):
     """``lvgym/SlenderAscent-v1``: the slender vehicle with protocol v1's physics and timing (a draft):
     one control period of delay, modes recomputed every 2 s and projected, slosh dampers on the specific
-    force, and the strip-theory aeroelastic loads its vehicle file asks for. With them the bent vehicle
-    loses its static stability near 350-450 kPa (docs/aerodynamics.md): the gimbal at zero fails on
-    q-alpha at 4.1-4.7 s of the 10 s flight (test seeds 10000-10002 of the slender-ld30 options)."""
+    force, and the strip-theory aeroelastic loads its vehicle file asks for.
+
+    Its tube's wall is 4.5 mm (``wall_thickness_m``), not the thesis's 2 mm: with the strip loads the
+    2 mm tube diverges statically at 370-400 kPa, reached at 4.2-4.4 s, and from 6 s its unstable pole
+    (13.7-18.5 1/s, beyond the 15 rad/s servo, with 30 ms of delay and hold) admits no TVC loop with
+    useful margins; the 4.5 mm tube (+42 kg) diverges only above 1.6 times the flight's dynamic pressure
+    and keeps its first mode at 13.6 Hz (docs/aerodynamics.md, "Aeroelastic divergence";
+    ``baselines/divergence.py`` checks it independently). ``wall_thickness_m=0.002`` flies the thesis's tube."""
 
     DEFAULTS = {**SlenderAscentEnv.DEFAULTS, **V1_OPTIONS}
+    WALL_THICKNESS_M = 0.0045

@@ -69,13 +69,17 @@ _SIGNALS = Kernel(step_signals_range)      # row ranges on the simulator's threa
 
 @functools.lru_cache(maxsize=32)
 def cached_vehicle(key: Any) -> Vehicle:
-    """A shipped vehicle by name or path, or ``("slender", length, diameter[, aero_mach])`` for the
-    parametric one (``aero_mach``: Mach number its aerodynamic tables are frozen at, None: full tables)."""
-    if isinstance(key, tuple) and len(key) in (3, 4) and key[0] == "slender":
-        return slender_vehicle(length=float(key[1]), diameter=float(key[2]), aero_mach=key[3] if len(key) == 4 else None)
+    """A shipped vehicle by name or path, or ``("slender", length, diameter[, aero_mach[, wall_thickness]])``
+    for the parametric one (``aero_mach``: Mach number its aerodynamic tables are frozen at, None: full
+    tables; ``wall_thickness`` [m]: its tube's wall, default the thesis's 2 mm)."""
+    if isinstance(key, tuple) and len(key) in (3, 4, 5) and key[0] == "slender":
+        extra = {"wall_thickness": float(key[4])} if len(key) == 5 else {}
+        return slender_vehicle(length=float(key[1]), diameter=float(key[2]), aero_mach=key[3] if len(key) >= 4 else None,
+                               **extra)
     if isinstance(key, str):
         return load_vehicle(key)
-    raise ValueError(f"vehicle = {key!r}: a shipped name, a YAML path or ('slender', length, diameter[, aero_mach])")
+    raise ValueError(f"vehicle = {key!r}: a shipped name, a YAML path or ('slender', length, diameter[, aero_mach"
+                     "[, wall_thickness]])")
 
 
 @functools.lru_cache(maxsize=32)

@@ -31,8 +31,10 @@ def batch_task(env_cls: type, options: dict[str, Any]) -> TaskSpec:
             raise ValueError("diameter ranges are drawn per episode by the single SlenderAscent env only; "
                              "a vector env flies one geometry (make one vector env per diameter)")
         aero_mach = options.pop("aero_mach", DEFAULT_AERO_MACH)
+        wall = options.pop("wall_thickness_m", None)
         options["vehicle"] = slender_key(length, float(np.ravel(diameter)[0]),
-                                         None if aero_mach is None else float(aero_mach))
+                                         None if aero_mach is None else float(aero_mach),
+                                         env_cls.WALL_THICKNESS_M if wall is None else float(wall))
     return TaskSpec.build(env_cls.DEFAULTS, options)
 
 
