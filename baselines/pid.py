@@ -304,16 +304,17 @@ def smile_scheduled_pid(env: Any, schedule: str = "smile_thesis", name: str | No
 
 
 #: the gs-pid-flex schedule (``baselines/schedules/<name>.yaml``, written by ``python -m baselines.flexdesign``)
-#: of each vehicle a v1 env flies, keyed by the env's ``task.vehicle``
-FLEX_SCHEDULES = {"smile_v1": "smile_flex", "stratos3": "stratos3_flex"}
+#: of each vehicle a v1 env flies, keyed by the env's ``task.vehicle`` (a name, or the slender vehicle's key
+#: tuple; the slender vehicle has none yet: docs/flex-design.md)
+FLEX_SCHEDULES: dict = {"smile_v1": "smile_flex", "stratos3": "stratos3_flex"}
 
 
 def flex_pid(env: Any, name: str = "gs-pid-flex") -> GainScheduledPIDPolicy:
     """``gs-pid-flex``: the filtered gain-scheduled PID designed on the non-rigid v1 flight loop of the
     vehicle ``env`` flies (:data:`FLEX_SCHEDULES`); a vehicle without a flex design is refused."""
     vehicle = getattr(env.unwrapped.task, "vehicle", None)
-    if not isinstance(vehicle, str) or vehicle not in FLEX_SCHEDULES:
-        raise ConfigError("env vehicle", vehicle, f"one of {sorted(FLEX_SCHEDULES)}: the vehicles of a v1 env "
+    if not isinstance(vehicle, (str, tuple)) or vehicle not in FLEX_SCHEDULES:
+        raise ConfigError("env vehicle", vehicle, f"one of {list(FLEX_SCHEDULES)}: the vehicles of a v1 env "
                           "with a gs-pid-flex schedule (python -m baselines.flexdesign --vehicle ...)")
     return GainScheduledPIDPolicy(FLEX_SCHEDULES[vehicle], env=env, name=name)
 

@@ -328,3 +328,11 @@ class SlenderAscentV1Env(SlenderAscentEnv):
 
     DEFAULTS = {**SlenderAscentEnv.DEFAULTS, **V1_OPTIONS}
     WALL_THICKNESS_M = 0.0045
+
+    def __init__(self, render_mode: str | None = None, length: float = 8.5, diameter: Any = 0.2833,
+                 aero_mach: float | None = DEFAULT_AERO_MACH, wall_thickness_m: float | None = None,
+                 **options: Any) -> None:
+        """As :class:`SlenderAscentEnv`, with the ``slender-v1`` suite's geometry by default (L/D 30:
+        8.5 m, 0.2833 m)."""
+        super().__init__(render_mode, length=length, diameter=diameter, aero_mach=aero_mach,
+                         wall_thickness_m=wall_thickness_m, **options)

@@ -9,6 +9,8 @@ after an episode's end resets that row, ignores its action and returns reward 0)
 
 from __future__ import annotations
 
+import inspect
+
 from typing import Any
 
 import gymnasium as gym
@@ -26,7 +28,9 @@ def batch_task(env_cls: type, options: dict[str, Any]) -> TaskSpec:
     """The task of ``num_envs`` rows of ``env_cls`` with ``options`` (one vehicle for all rows)."""
     options = dict(options)
     if issubclass(env_cls, SlenderAscentEnv):
-        length, diameter = options.pop("length", 8.5), options.pop("diameter", 0.3)
+        defaults = inspect.signature(env_cls.__init__).parameters     # the env class's own geometry defaults
+        length = options.pop("length", defaults["length"].default)
+        diameter = options.pop("diameter", defaults["diameter"].default)
         if np.size(diameter) != 1:
             raise ValueError("diameter ranges are drawn per episode by the single SlenderAscent env only; "
                              "a vector env flies one geometry (make one vector env per diameter)")
