@@ -18,7 +18,7 @@ suite              env                    conditions (each flown ``rigid`` and `
 =================  =====================  ==========================================================
 smile-calm         SmileAscent-v0         no wind; thrust misalignment and mass dispersed
 smile-windy        SmileAscent-v0         moderate Dryden turbulence over a 10 m/s wind (drawn per
-                                          seed); thrust misalignment dispersed. The default suite.
+                                          seed); thrust misalignment dispersed. v0's main suite.
 smile-dispersed    SmileAscent-v0         random jet stream + turbulence, every randomisation (mass,
                                           slosh damping, bending frequency, sensor noise), IMU sensors
 slender-ld30       SlenderAscent-v0       L/D = 30 (8.5 m x 0.2833 m); turbulence drawn per seed,
@@ -28,7 +28,7 @@ slender-ld30       SlenderAscent-v0       L/D = 30 (8.5 m x 0.2833 m); turbulenc
 Protocol v1 (a draft, version ``v1-draft``, until issue 16 freezes it) adds, on ``SmileAscent-v1``:
 
 ==================  ===============================================================================
-smile-v1            70 s, v0's turbulence plus a random 1-cosine gust, every dispersion (``V1_DISPERSIONS``)
+smile-v1            70 s, v0's turbulence plus a random 1-cosine gust, every dispersion (``V1_DISPERSIONS``), the default
 smile-v1-maxq-gust  35 s, a random jet stream plus a random gust in the max-q region, every dispersion
 stratos-tvc-v1      Stratos III with TVC (StratosIII-v1), 30 s, turbulence, every dispersion
 slender-v1          the L/D 30 slender vehicle with its aeroelastic loads (SlenderAscent-v1), 10 s, turbulence,
