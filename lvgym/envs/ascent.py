@@ -50,6 +50,7 @@ from .functional import AscentFuncEnv, AscentState
 from .layouts import observation_table
 from .snapshot import EpisodeState, rng_state, set_rng_state
 from .spec import FLIGHT_DEFAULTS, TaskSpec
+from .views import FuncViews
 
 __doc__ = __doc__ % {"observation": "\n".join("    " + line for line in observation_table().splitlines())}
 
@@ -89,7 +90,7 @@ def _rows(info: dict[str, Any], batch: int) -> list[dict[str, Any]]:
     return [dict(zip(keys, vals)) for vals in zip(*columns.values())] if keys else [{} for _ in range(batch)]
 
 
-class AscentEnv(gym.Env):
+class AscentEnv(FuncViews, gym.Env):
     """Base of the ascent envs: one row of an :class:`~.functional.AscentFuncEnv`. Subclasses set
     ``DEFAULTS``. ``vehicles``: several vehicles (keys of :func:`~.functional.cached_vehicle`) of which
     each reset draws one from the env's generator (the episode's *variant*, part of its state)."""
@@ -124,29 +125,7 @@ class AscentEnv(gym.Env):
         """Point the simulator's read-outs (``env.unwrapped.sim.x``, ``.conditions(...)``) at the state."""
         self.func.sim.data = self.state.sim
 
-    # ------------------------------------------------------------------------------ facts of the task
-    @property
-    def sim(self):
-        """The :class:`~lvgym.simulator.Simulator` of the current variant (its ``data`` is this env's rows)."""
-        return self.func.sim
-
-    @property
-    def timeline(self):
-        return self.func.timeline
-
-    @property
-    def vehicle(self):
-        return self.func.vehicle
-
-    @property
-    def observation_layout(self):
-        """The :class:`~lvgym.packing.Packed` layout of the observation (names, indices, units)."""
-        return self.func.observation_layout
-
-    @property
-    def gimbal_limit(self) -> float:
-        """Gimbal limit [rad]: a TVC action of 1 commands this angle."""
-        return self.func.gimbal_limit
+    # facts of the task (sim, timeline, vehicle, observation_layout, gimbal_limit): .views.FuncViews
 
     # ------------------------------------------------------------------------------ Gymnasium
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):

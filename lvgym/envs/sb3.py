@@ -18,11 +18,12 @@ from stable_baselines3.common.vec_env.base_vec_env import VecEnv
 from .ascent import _rows
 from .functional import AscentFuncEnv, AscentState
 from .vector import batch_task
+from .views import FuncViews
 
 __all__ = ["AscentSB3VecEnv"]
 
 
-class AscentSB3VecEnv(VecEnv):
+class AscentSB3VecEnv(FuncViews, VecEnv):
     """``num_envs`` rows of an ascent env class (``env_cls``) with the same options, seeded ``seed + i``."""
 
     def __init__(self, env_cls: type, num_envs: int = 1, seed: int | None = None, **options: Any) -> None:
@@ -35,21 +36,6 @@ class AscentSB3VecEnv(VecEnv):
         self._actions: np.ndarray | None = None
         self._rngs = [np.random.default_rng(None if seed is None else seed + i) for i in range(self.num_envs)]
         self.state: AscentState | None = None
-
-    @property
-    def sim(self):
-        """The :class:`~lvgym.simulator.Simulator` (its ``data`` is this env's rows)."""
-        return self.func.sim
-
-    @property
-    def observation_layout(self):
-        """The :class:`~lvgym.packing.Packed` layout of one row's observation."""
-        return self.func.observation_layout
-
-    @property
-    def gimbal_limit(self) -> float:
-        """Gimbal limit [rad]: a TVC action of 1 commands this angle."""
-        return self.func.gimbal_limit
 
     def reset(self) -> np.ndarray:
         if self._seed is not None:

@@ -22,6 +22,7 @@ from .ascent import DEFAULT_AERO_MACH, SlenderAscentEnv, slender_key
 from .functional import AscentFuncEnv, AscentState
 from .snapshot import EpisodeState, rng_state, set_rng_state
 from .spec import TaskSpec
+from .views import FuncViews
 
 
 def batch_task(env_cls: type, options: dict[str, Any]) -> TaskSpec:
@@ -49,7 +50,7 @@ def _select(rows: Any, n: int) -> np.ndarray:
     return idx
 
 
-class AscentVectorEnv(VectorEnv):
+class AscentVectorEnv(FuncViews, VectorEnv):
     """``num_envs`` rows of an ascent env class (``env_cls``) with the same options."""
 
     metadata = {"autoreset_mode": AutoresetMode.NEXT_STEP, "render_modes": []}
@@ -65,21 +66,6 @@ class AscentVectorEnv(VectorEnv):
         self.state: AscentState | None = None
         self._rngs: list[np.random.Generator] = []
         self._needs_reset = np.zeros(self.num_envs, dtype=bool)
-
-    @property
-    def sim(self):
-        """The :class:`~lvgym.simulator.Simulator` (its ``data`` is this env's rows)."""
-        return self.func.sim
-
-    @property
-    def observation_layout(self):
-        """The :class:`~lvgym.packing.Packed` layout of one row's observation."""
-        return self.func.observation_layout
-
-    @property
-    def gimbal_limit(self) -> float:
-        """Gimbal limit [rad]: a TVC action of 1 commands this angle."""
-        return self.func.gimbal_limit
 
     def reset(self, *, seed: int | list[int | None] | None = None, options: dict[str, Any] | None = None):
         if seed is None or isinstance(seed, int):
