@@ -75,16 +75,22 @@ def test_strip_modes_are_the_beam_modes_at_the_strips():
     assert np.abs(phi).max() > 0.05 and np.abs(dphi).max() > 0.01
 
 
+def _bent_state(sim, seed):
+    """The simulator's state with large random modal deflections and rates and a body rate."""
+    rng = np.random.default_rng(seed)
+    x = sim.x.copy()
+    sim.layout.view(x, "state", "eta")[:] = rng.normal(0, 0.02, (1, 2, sim.dynamics.n_modes))
+    sim.layout.view(x, "state", "eta_dot")[:] = rng.normal(0, 1.0, (1, 2, sim.dynamics.n_modes))
+    sim.layout.view(x, "state", "omega_bi_b")[:] = [0.01, 0.05, -0.03]
+    return x
+
+
 def test_compiled_loads_agree_with_the_python_path(pair):
     # a state with large modal deflections, rates and body rates: the conditions' force and moment gain
     # exactly the strips' elastic increment, and the loads' f_eta are the strips' modal forces
     on, off = pair
-    rng = np.random.default_rng(5)
     lay = on.layout
-    x = on.x.copy()
-    lay.view(x, "state", "eta")[:] = rng.normal(0, 0.02, (1, 2, on.dynamics.n_modes))
-    lay.view(x, "state", "eta_dot")[:] = rng.normal(0, 1.0, (1, 2, on.dynamics.n_modes))
-    lay.view(x, "state", "omega_bi_b")[:] = [0.01, 0.05, -0.03]
+    x = _bent_state(on, 5)
     for sim in (on, off):
         sim.x[:] = x
         sim.update_conditions()
@@ -118,12 +124,8 @@ def test_the_normal_force_dispersion_scales_the_strip_loads(pair):
     # v1's ``aerodynamics`` draw multiplies the normal force: the strips' elastic force, moment and modal
     # forces scale with it as the table's normal force does (both come from one CN-alpha distribution)
     on, off = pair
-    rng = np.random.default_rng(7)
     lay = on.layout
-    x = on.x.copy()
-    lay.view(x, "state", "eta")[:] = rng.normal(0, 0.02, (1, 2, on.dynamics.n_modes))
-    lay.view(x, "state", "eta_dot")[:] = rng.normal(0, 1.0, (1, 2, on.dynamics.n_modes))
-    lay.view(x, "state", "omega_bi_b")[:] = [0.01, 0.05, -0.03]
+    x = _bent_state(on, 7)
     out = {}
     for kn in (1.0, 1.2):
         for name, sim in (("on", on), ("off", off)):
