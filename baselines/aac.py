@@ -283,15 +283,20 @@ class AdaptiveAugmentingPolicy:
 
 
 # ---------------------------------------------------------------------------- presets
+def _check_keywords(params: dict[str, Any]) -> None:
+    """Refuse a keyword that is not a field of :class:`AACParams`, naming it and the allowed ones."""
+    known = {f.name for f in fields(AACParams)}
+    for key, value in params.items():
+        if key not in known:
+            raise ConfigError(f"aac.{key}", value, f"not a parameter of the adaptive law; one of {sorted(known)}")
+
+
 def smile_aac(env: Any, schedule: str = "smile", name: str = "aac", record: bool = False,
               **params: Any) -> AdaptiveAugmentingPolicy:
     """AAC on the gain-scheduled PID of ``baselines/schedules/<schedule>.yaml`` (``gs-pid``: ``smile``)
     flying ``env``; keywords of :class:`AACParams` override the defaults. One PolicySpec line wires it:
     ``PolicySpec("aac", "baselines.aac:smile_aac", (("name", "aac"), ("schedule", "smile")))``."""
-    known = {f.name for f in fields(AACParams)}
-    for key, value in params.items():
-        if key not in known:
-            raise ConfigError(f"aac.{key}", value, f"not a parameter of the adaptive law; one of {sorted(known)}")
+    _check_keywords(params)
     base = smile_scheduled_pid(env, schedule, name=f"gs-pid-{schedule}")
     return AdaptiveAugmentingPolicy(base, env=env, params=AACParams(**params), name=name, record=record)
 
@@ -305,9 +310,6 @@ FLEX_AAC = {"damper_deadzone_rad2": 3e-3}
 def flex_aac(env: Any, name: str = "aac", record: bool = False, **params: Any) -> AdaptiveAugmentingPolicy:
     """``aac``: AAC on ``gs-pid-flex`` (:func:`.pid.flex_pid`, the vehicle's flex schedule) with
     :data:`FLEX_AAC`; keywords of :class:`AACParams` override them."""
-    known = {f.name for f in fields(AACParams)}
-    for key, value in params.items():
-        if key not in known:
-            raise ConfigError(f"aac.{key}", value, f"not a parameter of the adaptive law; one of {sorted(known)}")
+    _check_keywords(params)
     return AdaptiveAugmentingPolicy(flex_pid(env), env=env, params=AACParams(**{**FLEX_AAC, **params}), name=name,
                                     record=record)

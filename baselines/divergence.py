@@ -245,15 +245,19 @@ def elastic_moment_ratio(st: dict[str, Any], qbar: float) -> float:
     return float(-(st["e"] @ eta) / st["m0"])
 
 
-def divergence_qbar(st: dict[str, Any], hi: float = 5e6) -> float:
-    """Dynamic pressure [Pa] where the inertia-relieved pitch stiffness passes zero (ratio -1)."""
-    f = lambda q: elastic_moment_ratio(st, q) + 1.0
-    grid = np.geomspace(1e3, hi, 200)
+def _first_sign_change(f: Any, grid: np.ndarray, xtol: float) -> float:
+    """The first ``q`` of ``grid`` [Pa] where ``f`` goes from positive to non-positive, refined by Brent's
+    method to ``xtol`` [Pa]; ``inf`` if it never does."""
     vals = [f(q) for q in grid]
     for a, b, fa, fb in zip(grid[:-1], grid[1:], vals[:-1], vals[1:]):
         if fa > 0 >= fb:
-            return float(optimize.brentq(f, a, b, xtol=1.0))
+            return float(optimize.brentq(f, a, b, xtol=xtol))
     return math.inf
+
+
+def divergence_qbar(st: dict[str, Any], hi: float = 5e6) -> float:
+    """Dynamic pressure [Pa] where the inertia-relieved pitch stiffness passes zero (ratio -1)."""
+    return _first_sign_change(lambda q: elastic_moment_ratio(st, q) + 1.0, np.geomspace(1e3, hi, 200), 1.0)
 
 
 @dataclass
@@ -399,12 +403,7 @@ def divergence_qbar_flight(beam: Beam, lift: Lift, fc: FlightCondition, hi: floa
         c = FlightCondition(q, fc.airspeed, fc.thrust, ca * q)
         return pitch_stiffness(dynamic_matrix(beam, lift, c, **options))[0]
 
-    grid = np.geomspace(1e4, hi, 120)
-    vals = [f(q) for q in grid]
-    for a, b, fa, fb in zip(grid[:-1], grid[1:], vals[:-1], vals[1:]):
-        if fa > 0 >= fb:
-            return float(optimize.brentq(f, a, b, xtol=10.0))
-    return math.inf
+    return _first_sign_change(f, np.geomspace(1e4, hi, 120), 10.0)
 
 
 def stabilisability(op: Any, plane: str = "pitch") -> dict[str, float]:
