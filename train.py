@@ -62,10 +62,12 @@ class Args:
     """flight model: rigid, slosh, flex or nonrigid"""
     wind: str = "turbulence"
     """wind tier: none, profile, gust, turbulence or random"""
-    randomize: list[str] = field(default_factory=lambda: ["wind", "thrust_misalignment"])
-    """names drawn per episode (lvgym.envs.RANDOMIZE), or 'all' / 'none'"""
-    observation: str = "state"
-    """state (ideal) or sensors (IMU)"""
+    randomize: list[str] = field(default_factory=lambda: ["protocol"])
+    """names drawn per episode (lvgym.envs.RANDOMIZE), 'all', 'none' or 'protocol': the env's protocol
+    (wind thrust_misalignment for v0 ids; every dispersion of protocol v1, V1_DISPERSIONS, for v1 ids)"""
+    observation: str = "env"
+    """state (ideal), sensors (IMU), flight (v1's flight computer) or env: the env's own (state for v0
+    ids, flight for v1 ids)"""
     env_kwargs: list[str] = field(default_factory=list)
     """further env keywords KEY=VALUE (values in YAML), e.g. mission_time_s=20"""
     history: int = 0
@@ -173,7 +175,7 @@ def _choices() -> dict[str, tuple[str, ...]]:
     from lvgym.envs.spec import OBSERVATIONS, WIND_TIERS
     from lvgym.simulator import MODELS
 
-    return {"env_id": tuple(lvgym.ENV_IDS), "model": tuple(MODELS), "wind": WIND_TIERS, "observation": OBSERVATIONS}
+    return {"env_id": tuple(lvgym.ENV_IDS), "model": tuple(MODELS), "wind": WIND_TIERS, "observation": ("env", *OBSERVATIONS)}
 
 
 def parse_args(argv: list[str] | None = None) -> tuple[Args, set[str]]:
@@ -183,14 +185,27 @@ def parse_args(argv: list[str] | None = None) -> tuple[Args, set[str]]:
 
 
 # ------------------------------------------------------------------------------------------ helpers
+def protocol_randomize(env_id: str) -> list[str]:
+    """What ``--randomize protocol`` draws for ``env_id``: protocol v1's dispersions for a v1 id
+    (:data:`lvgym.benchmark.suites.V1_DISPERSIONS`, what its suites fly), v0's training default (wind and
+    thrust misalignment) otherwise."""
+    if env_id.endswith("-v1"):
+        from lvgym.benchmark.suites import V1_DISPERSIONS
+        return list(V1_DISPERSIONS)
+    return ["wind", "thrust_misalignment"]
+
+
 def env_kwargs_of(args: Args) -> dict[str, Any]:
     """The env keywords of a run: model, wind, randomisation, observation and the ``--env-kwargs``."""
     r: Any = list(args.randomize)
-    if r in (["all"], ["true"], ["True"]):
+    if r == ["protocol"]:
+        r = protocol_randomize(args.env_id)
+    elif r in (["all"], ["true"], ["True"]):
         r = True
     elif r in ([], ["none"], ["false"], ["False"]):
         r = False
-    out: dict[str, Any] = {"model": args.model, "wind": args.wind, "randomize": r, "observation": args.observation}
+    out: dict[str, Any] = {"model": args.model, "wind": args.wind, "randomize": r}
+    out.update({} if args.observation == "env" else {"observation": args.observation})
     out.update({"history": int(args.history)} if args.history else {})   # when on only: old runs unchanged
     for item in args.env_kwargs:
         key, sep, text = item.partition("=")
@@ -221,10 +236,12 @@ def check_options(args: Args) -> None:
 
     option_number("--history", args.history, 0, 64, integer=True)
     residual_options(args.residual, args.residual_scale)
-    known = set(RANDOMIZE) | {"all", "none", "true", "false", "True", "False"}
+    known = set(RANDOMIZE) | {"all", "none", "protocol", "true", "false", "True", "False"}
     for r in args.randomize:
         if r not in known:
-            raise ConfigError("--randomize", r, f"names of {list(RANDOMIZE)}, or 'all' or 'none'")
+            raise ConfigError("--randomize", r, f"names of {list(RANDOMIZE)}, or 'all', 'none' or 'protocol'")
+    if "protocol" in args.randomize and len(args.randomize) > 1:
+        raise ConfigError("--randomize", " ".join(args.randomize), "'protocol' alone, or names without it")
     if args.eval_suite not in (None, "none"):
         from lvgym.benchmark.suites import SUITES
 

@@ -10,6 +10,15 @@ that fails every episode no longer looks robust); the rate error stops at a fail
     python -m agents.robustness --dry-run                 # print the commands
     python -m agents.robustness                           # train 2 models x 3 seeds, then evaluate
     python -m agents.robustness --seeds 0 --total-timesteps 2e6 --episodes 10   # a smaller version
+    python -m agents.robustness --tag res-lqg --train-args "--residual lqg"    # residual on the LQG
+
+By default the experiment is protocol v1's: ``lvgym/SmileAscent-v1`` trained with its flight sensors,
+delay and every v1 dispersion (``train.py``'s ``--randomize protocol``), evaluated on ``smile-v1`` beside
+the flex-designed ``gs-pid-flex`` and ``lqg``. v0's experiment (2026-11) was ``--env-id
+lvgym/SmileAscent-v0 --randomize wind thrust_misalignment mass --suites smile-calm smile-windy
+smile-dispersed --baselines pid gs-pid``. ``--train-args`` passes further ``train.py`` options to every
+run (``--residual``, ``--history``, ``--hp``, ...); ``--tag`` names the configuration in the run names
+(``robust-<tag>-<model>-s<seed>``, default the algorithm).
 
 Every step is restartable: a run with ``final_model.json`` is done and skipped, a run folder without it
 is continued with ``train.py --resume``, so the command can simply be run again after an interruption.
@@ -26,20 +35,21 @@ import sys
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-MODELS = ("rigid", "nonrigid")
+MODELS = ("nonrigid", "rigid")   # non-rigid first: the policy to ship, if time runs short
 
 
-def run_name(algo: str, model: str, seed: int) -> str:
-    return f"robust-{algo}-{model}-s{seed}"
+def run_name(tag: str, model: str, seed: int) -> str:
+    return f"robust-{tag}-{model}-s{seed}"
 
 
 def train_command(args: argparse.Namespace, model: str, seed: int) -> list[str]:
     """The train.py command of one run (``--resume`` if its folder exists)."""
-    folder = Path(args.runs_dir) / run_name(args.algo, model, seed)
+    folder = Path(args.runs_dir) / run_name(args.tag or args.algo, model, seed)
     if (folder / "config.yaml").is_file():
         return [sys.executable, str(ROOT / "train.py"), "--resume", str(folder)]
-    cmd = [sys.executable, str(ROOT / "train.py"), "--algo", args.algo, "--model", model, "--seed", str(seed),
-           "--wind", args.wind, "--randomize", *args.randomize, "--name", folder.name, "--runs-dir", args.runs_dir]
+    cmd = [sys.executable, str(ROOT / "train.py"), "--env-id", args.env_id, "--algo", args.algo, "--model", model,
+           "--seed", str(seed), "--wind", args.wind, "--randomize", *args.randomize, "--name", folder.name,
+           "--runs-dir", args.runs_dir, *shlex.split(args.train_args)]
     if args.total_timesteps:
         cmd += ["--total-timesteps", str(int(float(args.total_timesteps)))]
     return cmd
@@ -51,7 +61,7 @@ def commands(args: argparse.Namespace) -> list[list[str]]:
     exported: list[str] = []
     for model in MODELS:
         for seed in args.seeds:
-            name = run_name(args.algo, model, seed)
+            name = run_name(args.tag or args.algo, model, seed)
             folder = Path(args.runs_dir) / name
             if not (folder / "final_model.json").is_file():
                 out.append(train_command(args, model, seed))
@@ -65,14 +75,18 @@ def commands(args: argparse.Namespace) -> list[list[str]]:
 
 def main(argv: list[str] | None = None) -> None:
     p = argparse.ArgumentParser(prog="python -m agents.robustness", description=__doc__.split("\n\n")[0])
-    p.add_argument("--algo", default="ppo", choices=("ppo", "sac", "td3"))
+    p.add_argument("--env-id", default="lvgym/SmileAscent-v1", help="training env (default lvgym/SmileAscent-v1)")
+    p.add_argument("--algo", default="ppo", choices=("ppo", "sac", "td3", "recurrent-ppo"))
+    p.add_argument("--tag", default=None, help="configuration name in the run names (default: the algorithm)")
+    p.add_argument("--train-args", default="", help='further train.py options for every run, e.g. "--residual lqg"')
     p.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2])
     p.add_argument("--total-timesteps", default=None, help="per run (default: the hyperparameter file's)")
     p.add_argument("--wind", default="turbulence", help="training wind tier (default turbulence)")
-    p.add_argument("--randomize", nargs="+", default=["wind", "thrust_misalignment", "mass"],
-                   help="training randomisation (default: wind thrust_misalignment mass)")
-    p.add_argument("--suites", nargs="+", default=["smile-calm", "smile-windy", "smile-dispersed"])
-    p.add_argument("--baselines", nargs="*", default=["pid", "gs-pid"], help="evaluate.py policy names beside the agents")
+    p.add_argument("--randomize", nargs="+", default=["protocol"],
+                   help="training randomisation (default protocol: the env's own, every dispersion for v1)")
+    p.add_argument("--suites", nargs="+", default=["smile-v1"])
+    p.add_argument("--baselines", nargs="*", default=["gs-pid-flex", "lqg"],
+                   help="evaluate.py policy names beside the agents")
     p.add_argument("--episodes", type=int, default=50, help="test seeds per condition and policy")
     p.add_argument("--runs-dir", default="runs")
     p.add_argument("--out", default="results/robustness")

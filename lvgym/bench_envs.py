@@ -20,7 +20,9 @@ again, the tables read back (:mod:`lvgym.simulator.cache`). Both read the vehicl
 aerodynamic tables. Cases: the rigid Stratos III simulator of the RocketPy validation (240 s, 4,803 table rows;
 :func:`lvgym.verify.rocketpy_case.lvgym_simulator`) and ``gymnasium.make`` plus ``reset`` of SmileAscent-v0
 (non-rigid, 1,224 rows, modes at lift-off and at the separation), SmileAscent-v1 (modes every 2 s: 33 beam
-eigen-solves), SlenderAscent-v0 (10 s) and SlenderAscent-v1 (6 eigen-solves).
+eigen-solves), SlenderAscent-v0 (10 s) and SlenderAscent-v1 (6 eigen-solves). A third column, **new
+process**, times a fresh interpreter's ``import lvgym`` and the same start with the tables cached
+(:func:`first_start`): what a script or a worker process pays before its first step.
 """
 
 from __future__ import annotations
@@ -134,6 +136,22 @@ def _start(what: str) -> None:
         gym.make(what).reset(seed=0)
 
 
+def first_start(what: str, repeats: int = 3) -> float:
+    """Median wall time [s] of a new Python process's ``import lvgym`` plus the start of a
+    :data:`CONSTRUCTION` case, the tables taken from the user's cache (what a script or a worker pays
+    before its first step; the interpreter's own start is not counted)."""
+    import subprocess
+    import sys
+
+    code = ("import time, warnings; t = time.perf_counter(); warnings.simplefilter('ignore')\n"
+            "import gymnasium as gym, lvgym\nfrom lvgym.bench_envs import _start\n"
+            f"_start({what!r}); print(time.perf_counter() - t)")
+    subprocess.run([sys.executable, "-c", code], check=True, capture_output=True)      # fills the cache
+    times = [float(subprocess.run([sys.executable, "-c", code], check=True, capture_output=True,
+                                  text=True).stdout.split()[-1]) for _ in range(repeats)]
+    return float(np.median(times))
+
+
 def construction(repeats: int = 5) -> list[tuple[str, float, float]]:
     """``(case, cold [s], warm [s])`` medians of ``repeats`` runs (see the module docstring)."""
     import tempfile
@@ -188,10 +206,11 @@ def main() -> None:
             print(f"| {model} | {how} | {rate:,.0f} | {ratio:.1f} |")
     if args.only != "steps":
         print(f"\n# construction: starting a simulator [s], median of {args.repeats} ({cpu_name()})\n")
-        print("| case | cold (tables built) | warm (tables from the cache) |")
-        print("|---|---|---|")
+        print("| case | cold (tables built) | warm (tables from the cache) | new process (imports, cached tables) |")
+        print("|---|---|---|---|")
         for label, cold, warm in construction(args.repeats):
-            print(f"| construction, {label} | {cold:.3f} | {warm:.3f} |")
+            first = first_start(CONSTRUCTION[label], max(1, args.repeats // 2))
+            print(f"| construction, {label} | {cold:.3f} | {warm:.3f} | {first:.3f} |")
 
 
 if __name__ == "__main__":

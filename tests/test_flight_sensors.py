@@ -61,6 +61,26 @@ def test_discrete_filters_are_the_continuous_ones_sampled():
     assert abs(g[0]) == pytest.approx(abs(aa) / (2 * 0.6), rel=1e-9)
 
 
+def test_discrete_filters_are_scipys_zero_order_hold_to_the_bit():
+    imu = Imu(-3.0, gyro_bandwidth_hz=50.0, gyro_damping=0.6, antialias_hz=20.0)
+    for h in (1e-3, H, 0.02):
+        disc = imu.discrete(h)
+        for name, (a, b, c) in imu.continuous().items():
+            ad, bd, cd, _, _ = signal.cont2discrete((a, b, c, np.zeros((1, 1))), h, method="zoh")
+            for mine, theirs in zip(disc[name], (ad, bd[:, 0], cd[0])):
+                np.testing.assert_array_equal(mine, theirs)
+
+
+def test_an_env_does_not_import_scipy_signal():
+    import subprocess
+    import sys
+
+    code = ("import sys, gymnasium as gym, lvgym; e = gym.make('lvgym/SmileAscent-v1'); e.reset(seed=0); "
+            "print('scipy.signal' in sys.modules)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip().splitlines()[-1] == "False", out.stdout + out.stderr
+
+
 def test_discrete_filters_stay_stable_whatever_the_step():
     for h in (1e-4, 0.01, 0.05):
         for ad, _, _ in Imu(-1.0, gyro_bandwidth_hz=500.0, antialias_hz=200.0).discrete(h).values():

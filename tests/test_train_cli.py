@@ -120,3 +120,25 @@ def test_a_signal_writes_a_checkpoint_before_the_run_exits(tmp_path, signum):
     (step, _), = list_checkpoints(tmp_path / "sig" / "checkpoints")
     assert step >= 2 * 4 * 32                              # at least the two logged rollouts of 4 x 32 steps
     assert not (tmp_path / "sig" / "final_model.json").exists()    # the run is not finished
+
+
+def test_the_default_observation_and_randomisation_are_the_env_protocols():
+    from lvgym.benchmark.suites import V1_DISPERSIONS
+
+    v0 = TRAIN.env_kwargs_of(TRAIN.Args())
+    assert v0["randomize"] == ["wind", "thrust_misalignment"] and "observation" not in v0   # v0's own: state
+    v1 = TRAIN.env_kwargs_of(TRAIN.Args(env_id="lvgym/SmileAscent-v1"))
+    assert v1["randomize"] == list(V1_DISPERSIONS) and "observation" not in v1               # v1's own: flight
+    import lvgym.envs as envs
+
+    assert envs.ENVS["lvgym/SmileAscent-v0"].DEFAULTS.get("observation", "state") == "state"
+    assert envs.ENVS["lvgym/SmileAscent-v1"].DEFAULTS["observation"] == "flight"
+    assert TRAIN.env_kwargs_of(TRAIN.Args(observation="state", randomize=["mass"])) == {
+        "model": "nonrigid", "wind": "turbulence", "randomize": ["mass"], "observation": "state"}
+
+
+def test_protocol_randomisation_is_alone(tmp_path, capsys):
+    with pytest.raises(SystemExit) as exit_:
+        TRAIN.train([*_argv(tmp_path, "mixed", steps=128), "--randomize", "protocol", "mass"])
+    text = exit_.value.code if isinstance(exit_.value.code, str) else capsys.readouterr().err
+    assert "--randomize = 'protocol mass': 'protocol' alone" in text and not list(tmp_path.iterdir())
