@@ -293,16 +293,19 @@ def training_seed(seed: int, step: int, n_envs: int) -> int:
 
 def make_venv(env_id: str, n_envs: int, seed: int, env_kwargs: dict[str, Any], norm: Any, gamma: float,
               stats: Path | None, residual: dict[str, Any] | None = None) -> Any:
-    """Batched SB3 VecEnv (-> :class:`agents.residual.ResidualVecEnv` with ``residual``) -> VecMonitor
-    (episode returns) -> VecNormalize (new, or loaded from ``stats``)."""
+    """Batched SB3 VecEnv (-> :class:`agents.residual.ResidualVecEnv` with ``residual``) -> EnvClock (the
+    env's wall time, :mod:`agents.timing`) -> VecMonitor (episode returns) -> VecNormalize (new, or
+    loaded from ``stats``)."""
     from stable_baselines3.common.vec_env import VecMonitor, VecNormalize
 
     import lvgym  # noqa: F401
     from lvgym.envs import make_sb3_vec_env
 
     from agents.residual import residual_venv
+    from agents.timing import EnvClock
 
-    venv = VecMonitor(residual_venv(make_sb3_vec_env(env_id, num_envs=n_envs, seed=seed, **env_kwargs), residual))
+    venv = VecMonitor(EnvClock(residual_venv(make_sb3_vec_env(env_id, num_envs=n_envs, seed=seed, **env_kwargs),
+                                             residual)))
     if stats is not None and stats.is_file():
         return VecNormalize.load(str(stats), venv)
     if norm.norm_obs or norm.norm_reward:

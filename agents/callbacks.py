@@ -266,10 +266,17 @@ class CheckpointCallback(BaseCallback):
         self.stop = stop
         self.wall0 = float(state.get("train_wall_s", 0.0))
         self.t_start = self.last_save_time = time.monotonic()
+        self.clock = None                            # the venv's EnvClock (agents.timing), found at the start
+        self.env0 = float(state.get("env_wall_s", 0.0))
+        self.env_at_start = 0.0
 
     def _init_callback(self) -> None:
+        from agents.timing import find_clock
+
         self.folder.mkdir(parents=True, exist_ok=True)
         self.t_start = self.last_save_time = time.monotonic()
+        self.clock = find_clock(self.training_env)
+        self.env_at_start = self.clock.env_s if self.clock is not None else 0.0
         if self.last_save < 0:
             self.last_save = self.last_step_save = self.num_timesteps
         if self.best is not None:                   # a resumed run: best_model.* as of its checkpoint
@@ -281,6 +288,26 @@ class CheckpointCallback(BaseCallback):
 
     def _on_step(self) -> bool:
         return not self.stopping                    # False ends model.learn (then _on_training_end)
+
+    def train_wall_s(self) -> float:
+        """Wall time [s] of the run so far, every segment of a resumed run included."""
+        return self.wall0 + time.monotonic() - self.t_start
+
+    def timing(self) -> dict[str, float]:
+        """``train_wall_s`` and, with an :class:`agents.timing.EnvClock` in the venv, ``env_wall_s`` [s]."""
+        out = {"train_wall_s": round(self.train_wall_s(), 3)}
+        if self.clock is not None:
+            out["env_wall_s"] = round(self.env_wall_s(), 3)
+        return out
+
+    def env_wall_s(self) -> float:
+        """Wall time [s] spent in the env since learning started, every segment included."""
+        return self.env0 + (self.clock.env_s - self.env_at_start if self.clock is not None else 0.0)
+
+    def _on_rollout_end(self) -> None:
+        if self.clock is not None:
+            self.logger.record("time/env_share", self.env_wall_s() / max(self.train_wall_s(), 1e-9))
+            self.logger.record("time/train_wall_s", self.train_wall_s())
 
     def _on_rollout_start(self) -> None:
         by_steps = self.num_timesteps - self.last_step_save >= self.save_freq     # the same steps on every run
@@ -320,15 +347,14 @@ class CheckpointCallback(BaseCallback):
                     pickle.dump(self.model.replay_buffer, f, protocol=pickle.HIGHEST_PROTOCOL)
         new_best = False
         if evaluate:
-            result = self._validate(step)
+            result = {**self._validate(step), **self.timing()}
             self.evaluations.append(result)
             self.last_eval = step
             if self.best is None or self.best.get("selection") != SELECTION or result["score"] < self.best["score"]:
                 self.best, new_best = {"num_timesteps": step, "score": result["score"], "stem": stem.name,
                                        "selection": SELECTION}, True
         state = {**self.meta, "num_timesteps": step, "saved_utc": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
-                 "train_wall_s": round(self.wall0 + time.monotonic() - self.t_start, 3),
-                 "evaluations": self.evaluations, "best": self.best}
+                 **self.timing(), "evaluations": self.evaluations, "best": self.best}
         atomic_write_text(json_path, json_text(state))            # the commit: the checkpoint now exists
         self.last_save = step
         self.last_save_time = time.monotonic()

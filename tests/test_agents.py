@@ -130,6 +130,17 @@ def test_train_saves_resumes_and_reloads_as_a_policy(tmp_path):
     assert steps[:len(state0["evaluations"])] == [e["num_timesteps"] for e in state0["evaluations"]]
     assert steps == sorted(set(steps))
     assert json.loads((run / "final_model.json").read_text())["num_timesteps"] == s1
+    # where the wall time went (agents.timing): the env's seconds within the run's, carried across the resume
+    for state in (state0, state1):
+        assert 0.0 < state["env_wall_s"] < state["train_wall_s"]
+    assert state1["env_wall_s"] > state0["env_wall_s"] and state1["train_wall_s"] > state0["train_wall_s"]
+    walls = [(e["train_wall_s"], e["env_wall_s"]) for e in state1["evaluations"]]
+    assert walls == sorted(walls) and all(0.0 < env_s < wall for wall, env_s in walls)
+    import csv
+
+    with open(next(run.glob("progress_000000000000.csv")), encoding="utf-8") as f:
+        shares = [float(r["time/env_share"]) for r in csv.DictReader(f) if r.get("time/env_share")]
+    assert shares and all(0.0 < x < 1.0 for x in shares)
 
     env = gymnasium.make("lvgym/SmileAscent-v0", mission_time_s=0.5)
     for source in (run, run / "final_model.zip", run / "best_model.zip"):
