@@ -49,6 +49,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from functools import cached_property
 from pathlib import Path
 from typing import Any
 
@@ -155,22 +156,40 @@ class GainSchedule:
         if self.filters is not None and len(self.filters) != m:
             raise ValueError(f"filters has {len(self.filters)} entries for {m} breakpoints")
 
-    def _interp(self, value: float, column) -> float:
+    @cached_property
+    def _table(self) -> tuple[np.ndarray, np.ndarray, dict[str, np.ndarray]]:
+        """Breakpoints, the same sorted ascending, and every column (gains, filter keys) in that order:
+        built once, so a lookup is one ``argmin`` or one ``np.interp`` per column (the same numbers)."""
         x = np.asarray(self.points, float)
-        if self.interpolation == "nearest":
-            return float(np.asarray(column, float)[int(np.argmin(np.abs(x - value)))])
         order = np.argsort(x)
-        return float(np.interp(value, x[order], np.asarray(column, float)[order]))
+        cols = {k: np.asarray(getattr(self, k), float)[order] for k in ("kp", "ki", "kd", "n")}
+        if self.filters is not None:
+            cols.update({k: np.array([getattr(f, k) for f in self.filters], float)[order] for k in FILTER_KEYS})
+        return x, x[order], cols
+
+    def _nearest(self, value: float) -> int:
+        """Index (in :attr:`points` order) of the breakpoint nearest ``value``."""
+        return int(np.argmin(np.abs(self._table[0] - value)))
+
+    def _lookup(self, value: float, keys: tuple[str, ...]) -> list[float]:
+        x, x_sorted, cols = self._table
+        if self.interpolation == "nearest":
+            i = self._nearest(value)
+            return [float(getattr(self, k)[i]) if k in ("kp", "ki", "kd", "n") else float(getattr(self.filters[i], k))
+                    for k in keys]
+        return [float(np.interp(value, x_sorted, cols[k])) for k in keys]
 
     def filter_at(self, value: float) -> StructuralFilter | None:
         """The structural filter at ``value`` (each parameter read as the gains are), or None."""
         if self.filters is None:
             return None
-        return StructuralFilter(**{k: self._interp(value, [getattr(f, k) for f in self.filters]) for k in FILTER_KEYS})
+        if self.interpolation == "nearest":
+            return self.filters[self._nearest(value)]
+        return StructuralFilter(**dict(zip(FILTER_KEYS, self._lookup(value, FILTER_KEYS))))
 
     def gains(self, value: float) -> tuple[float, float, float, float]:
         """(kp, ki, kd, n) at ``value`` of the scheduling variable."""
-        return tuple(self._interp(value, getattr(self, k)) for k in ("kp", "ki", "kd", "n"))
+        return tuple(self._lookup(value, ("kp", "ki", "kd", "n")))
 
     # ------------------------------------------------------------------ files
     @classmethod
