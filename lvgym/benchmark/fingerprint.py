@@ -1,0 +1,146 @@
+"""A protocol's fingerprint: what a frozen protocol must go on giving.
+
+A protocol version, once frozen, never changes: the same suite, seed and policy fly the same episode.
+The fingerprint is that promise made checkable. For every suite of a protocol version, both conditions,
+the first ``seeds`` test seeds, it flies two policies that no design work can change: the zero policy (the
+gimbal at zero: the plant, the winds, the dispersions and the sensors alone) and an open-loop gimbal probe
+(:class:`ProbePolicy`: the servo, the delay and the bending it excites), and records per episode the score,
+the rate error, the failure and its reason, the flight time, the largest q-alpha and a digest of the first
+and last observation. ``tests/test_protocol_fingerprint.py`` compares a fresh run with the stored file.
+
+    python -m lvgym.benchmark.fingerprint --version v1 --check     # compare with the stored file
+    python -m lvgym.benchmark.fingerprint --version v1 --write     # (re)write it: only when freezing
+
+Reproducibility: on one machine and one set of library versions the episodes are the same to the bit;
+across CPUs and BLAS builds the floating-point sums can round differently, so the numbers are compared to
+a relative ``1e-6`` and the failure and its reason exactly.
+"""
+
+from __future__ import annotations
+
+import argparse
+import hashlib
+import json
+import sys
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .runner import play_episode, zero_policy
+from .suites import SUITES, Suite
+
+__all__ = ["FINGERPRINTS", "POLICIES", "RTOL", "ProbePolicy", "compare", "fingerprint", "stored"]
+
+#: where the stored fingerprints live, per protocol version
+FINGERPRINTS = Path(__file__).resolve().parent / "data"
+#: relative tolerance on the numbers across machines (exact on one machine)
+RTOL = 1e-6
+NUMBERS = ("score", "rate_error_rad", "max_qalpha_pa_deg", "duration_s")
+EXACT = ("failed", "failure_reason")
+
+
+def _suites(version: str) -> list[Suite]:
+    out = [s for s in SUITES.values() if s.version == version]
+    if not out:
+        raise ValueError(f"version = {version!r}: no suite carries it; known: {sorted({s.version for s in SUITES.values()})}")
+    return out
+
+
+def _digest(obs: np.ndarray) -> str:
+    """The observation rounded to 6 significant digits (float32 noise across machines stays below)."""
+    text = np.array2string(np.asarray(obs, dtype=np.float64), precision=6, floatmode="maxprec", threshold=10**6)
+    return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
+class ProbePolicy:
+    """An open-loop gimbal probe of the action path (servo, delay, the bending it excites): pitch
+    ``0.05 sin(2 pi 0.5 t)``, yaw ``0.04 cos(2 pi 1.3 t)`` of the gimbal limit, ``t`` = ``info["time"]`` [s]
+    (a roll-only RCS task gets the middle action)."""
+
+    name = "probe"
+
+    def __init__(self, env: Any) -> None:
+        self.space = env.action_space
+
+    def reset(self) -> None:
+        """Nothing to reset: the probe is a function of time."""
+
+    def act(self, observation: np.ndarray, info: dict[str, Any]) -> np.ndarray:
+        if not hasattr(self.space, "low"):
+            return np.asarray(self.space.nvec, dtype=np.int64) // 2
+        t = float(info["time"])
+        return np.array([0.05 * np.sin(2 * np.pi * 0.5 * t), 0.04 * np.cos(2 * np.pi * 1.3 * t)], dtype=np.float32)
+
+
+#: the fingerprint's policies: the plant alone, and the action path
+POLICIES = {"zero": zero_policy, "probe": ProbePolicy}
+
+
+def _episode(suite: Suite, condition: Any, seed: int, policy: str) -> dict[str, Any]:
+    env = condition.make_env()
+    obs0, _ = env.reset(seed=int(seed))
+    first = _digest(obs0)
+    m = play_episode(POLICIES[policy](env), env, seed)
+    reason = m.get("failure_reason") or ""
+    return {"suite": suite.name, "condition": condition.name, "seed": int(seed), "policy": policy, "first_obs": first,
+            "score": float(m["score"]), "rate_error_rad": float(m["rate_error_rad"]),
+            "max_qalpha_pa_deg": float(m["max_qalpha_pa_deg"]), "failed": bool(m["failed"]),
+            "failure_reason": str(reason), "duration_s": float(m["duration_s"])}
+
+
+def fingerprint(version: str, seeds: int = 1) -> list[dict[str, Any]]:
+    """The fingerprint records of protocol ``version``: every suite, condition and first ``seeds`` test seeds."""
+    return [_episode(suite, cond, seed, policy) for suite in _suites(version) for cond in suite.conditions
+            for seed in suite.seeds("test", seeds) for policy in POLICIES]
+
+
+def stored(version: str) -> list[dict[str, Any]]:
+    """The stored fingerprint of ``version`` (``FileNotFoundError`` if it has none)."""
+    return json.loads((FINGERPRINTS / f"{version}.json").read_text(encoding="utf-8"))["episodes"]
+
+
+def compare(fresh: list[dict[str, Any]], reference: list[dict[str, Any]], rtol: float = RTOL) -> list[str]:
+    """The differences between two fingerprints, one line each (empty: the same)."""
+    key = lambda r: (r["suite"], r["condition"], r["seed"], r["policy"])           # noqa: E731
+    ref = {key(r): r for r in reference}
+    out = [f"{k}: not in the fresh run" for k in ref if k not in {key(r) for r in fresh}]
+    for r in fresh:
+        old = ref.get(key(r))
+        if old is None:
+            out.append(f"{key(r)}: not in the stored fingerprint")
+            continue
+        out += [f"{key(r)} {f}: {r[f]!r} against {old[f]!r}" for f in (*EXACT, "first_obs") if r[f] != old[f]]
+        out += [f"{key(r)} {f}: {r[f]!r} against {old[f]!r}" for f in NUMBERS
+                if not np.isclose(r[f], old[f], rtol=rtol, atol=0.0)]
+    return out
+
+
+def main(argv: list[str] | None = None) -> None:
+    p = argparse.ArgumentParser(prog="python -m lvgym.benchmark.fingerprint", description=__doc__.split("\n\n")[0])
+    p.add_argument("--version", default="v1", help="protocol version (default v1)")
+    p.add_argument("--seeds", type=int, default=1, help="test seeds per condition (default 1)")
+    mode = p.add_mutually_exclusive_group(required=True)
+    mode.add_argument("--check", action="store_true", help="compare a fresh run with the stored fingerprint")
+    mode.add_argument("--write", action="store_true", help="write the stored fingerprint (when freezing)")
+    args = p.parse_args(argv)
+    try:
+        fresh = fingerprint(args.version, args.seeds)
+    except ValueError as exc:
+        p.exit(2, f"{p.prog}: {exc}\n")
+    path = FINGERPRINTS / f"{args.version}.json"
+    if args.write:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(json.dumps({"version": args.version, "policies": list(POLICIES), "seeds": args.seeds,
+                                    "episodes": fresh}, indent=1) + "\n", encoding="utf-8")
+        print(f"{len(fresh)} episodes written to {path}")
+        return
+    diffs = compare(fresh, stored(args.version))
+    for line in diffs:
+        print(line)
+    print(f"{len(fresh)} episodes: " + ("the same" if not diffs else f"{len(diffs)} differences"))
+    sys.exit(1 if diffs else 0)
+
+
+if __name__ == "__main__":
+    main()
