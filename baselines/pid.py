@@ -65,6 +65,7 @@ from typing import Any
 import numpy as np
 import yaml
 
+from lvgym.envs.ascent import DEFAULT_AERO_MACH, SlenderAscentV1Env, slender_key
 from lvgym.envs.layouts import G0
 from lvgym.errors import ConfigError
 
@@ -351,8 +352,9 @@ def smile_scheduled_pid(env: Any, schedule: str = "smile_thesis", name: str | No
 
 #: the gs-pid-flex schedule (``baselines/schedules/<name>.yaml``, written by ``python -m baselines.flexdesign``)
 #: of each vehicle a v1 env flies, keyed by the env's ``task.vehicle`` (a name, or the slender vehicle's key
-#: tuple; the slender vehicle has none yet: docs/flex-design.md)
-FLEX_SCHEDULES: dict = {"smile_v1": "smile_flex", "stratos3": "stratos3_flex"}
+#: tuple: ``SlenderAscent-v1``'s default 8.5 m x 0.2833 m, 4.5 mm tube, with load relief; docs/flex-design.md)
+FLEX_SCHEDULES: dict = {"smile_v1": "smile_flex", "stratos3": "stratos3_flex",
+                        slender_key(8.5, 0.2833, DEFAULT_AERO_MACH, SlenderAscentV1Env.WALL_THICKNESS_M): "slender_flex"}
 
 
 def flex_pid(env: Any, name: str = "gs-pid-flex") -> GainScheduledPIDPolicy:
