@@ -107,3 +107,41 @@ def min_peak_qalpha(models: dict[str, np.ndarray], time_s: np.ndarray, qbar_pa: 
     return {"peak_pa_deg": float(res.x[-1]), "delta_rad": delta, "alpha_rad": alpha,
             "zero_peak_pa_deg": float(np.max(np.abs(q_deg[rows] * h[rows]))),
             "t_peak_s": float(t[rows][int(np.argmax(np.abs(q_deg[rows] * alpha[rows])))])}
+
+
+#: the frozen times [s] of :func:`main`'s rigid models (the slender vehicle burns out just after 8.9 s)
+SLENDER_TIMES = (1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 8.9)
+
+
+def main(argv: list[str] | None = None) -> int:
+    """``python -m baselines.loadbound --seeds 10``: the bound per plane on ``slender-v1``'s rigid
+    validation seeds, in the wind of each seed's flight with the gimbal at zero (q-alpha limit lifted)."""
+    import argparse
+    import math
+
+    from lvgym.benchmark.runner import ZERO
+    from lvgym.benchmark.suites import get_suite
+
+    from .qalpha_floor import fly
+
+    ap = argparse.ArgumentParser(prog="python -m baselines.loadbound", description=__doc__.split("\n\n")[0])
+    ap.add_argument("--seeds", type=int, default=10, help="validation seeds 0 .. n-1")
+    ap.add_argument("--gimbal-deg", type=float, default=5.0, help="gimbal limit per plane [deg]")
+    a = ap.parse_args(argv)
+    models = rigid_models(SLENDER_TIMES)
+    cond = get_suite("slender-v1").conditions[0].with_options(qalpha_limit_pa_deg=1e9)
+    for seed in range(a.seeds):
+        r = fly(ZERO, cond, seed)
+        t = r["time"]
+        sel = (t >= SLENDER_TIMES[0] - 1e-9) & (t <= SLENDER_TIMES[-1] + 1e-9)
+        res = [min_peak_qalpha(models, t[sel], r["qbar"][sel], r["airspeed"][sel], r["wind_ne"][sel, j],
+                               math.radians(a.gimbal_deg), math.radians(30.0)) for j in range(2)]
+        print(f"seed {seed}: bound north {res[0]['peak_pa_deg'] / 1e3:5.1f}, east {res[1]['peak_pa_deg'] / 1e3:5.1f} "
+              f"kPa deg; the model's gimbal at zero {res[0]['zero_peak_pa_deg'] / 1e3:5.1f}, "
+              f"{res[1]['zero_peak_pa_deg'] / 1e3:5.1f}; flown at zero (total) {r['qalpha'][sel & (t >= 2.0)].max() / 1e3:5.1f}; "
+              f"largest gimbal {max(np.abs(x['delta_rad']).max() for x in res) * 180 / math.pi:.2f} deg", flush=True)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -32,6 +32,8 @@ from typing import Any
 
 import numpy as np
 
+from lvgym.vehicle.sections import MATERIALS, tube_area, tube_second_moment
+
 from .divergence import Beam, Lift, vehicle_beam, vehicle_lift
 
 __all__ = ["YIELD_STRESS_PA", "FACTOR_OF_SAFETY_YIELD", "lumped_masses", "bending_moment_per_qsa",
@@ -94,8 +96,7 @@ def qalpha_limit_pa_deg(moment_per_qsa_m: float, s_ref_m2: float, diameter_m: fl
     """q-alpha [Pa deg] at which the wall's stress (bending plus the compression ``axial_n`` [N]) reaches
     ``allowable_pa`` [Pa]; ``moment_per_qsa_m`` [m]: the largest bending moment per unit ``q S alpha``."""
     D, t = float(diameter_m), float(wall_m)
-    inertia = math.pi * (D**4 - (D - 2 * t) ** 4) / 64.0
-    area = math.pi * (D * D - (D - 2 * t) ** 2) / 4.0
+    inertia, area = tube_second_moment(D, t), tube_area(D, t)
     per_q_alpha = abs(moment_per_qsa_m) * s_ref_m2 * (D / 2.0) / inertia      # stress [Pa] per Pa rad
     left = allowable_pa - axial_n / area
     if left <= 0.0:
@@ -125,7 +126,32 @@ def slender_v1_qalpha_limit(t: float = 8.0, thrust_n: float | None = None, drag_
         lim = qalpha_limit_pa_deg(m[k], lift.s_ref, diameter, wall, allowable, axial)
         out[case] = {"moment_per_qsa_m": float(m[k]), "station_m": float(xi[k]), "axial_n": axial, "limit_pa_deg": lim}
         worst = min(worst, lim)
-    from lvgym.vehicle.sections import MATERIALS
-    out["buckling_pa"] = buckling_stress_pa(MATERIALS["al_ansys"].youngs_modulus, diameter / 2.0, wall)
+    out["buckling_pa"] = buckling_stress_pa(MATERIALS[material if material in MATERIALS else "al_ansys"].youngs_modulus,
+                                            diameter / 2.0, wall)
     out["limit_pa_deg"] = worst
     return out
+
+
+def main(argv: list[str] | None = None) -> int:
+    """``python -m baselines.structural_limit [times...]``: the limit at flight times [s] of
+    ``SlenderAscent-v1`` (default 4, 6, 8 s), with the thrust and axial drag of its calm flight there."""
+    from .linearize import aero_slopes, operating_point
+
+    times = [float(v) for v in (argv if argv is not None else __import__("sys").argv[1:])] or [4.0, 6.0, 8.0]
+    print("| t [s] | mass [kg] | thrust / drag [kN] | bending moment per q S alpha, free / trimmed [m] | station [m] "
+          "| compression [kN] | q-alpha limit [MPa deg] |\n|---:|---:|---|---|---:|---:|---:|")
+    for t in times:
+        op = operating_point("slender", t, "rigid", protocol="v1")
+        thrust, drag = float(op.sim.conditions("thrust")[0]), float(aero_slopes(op)[3])
+        r = slender_v1_qalpha_limit(t, thrust_n=thrust, drag_n=drag)
+        worst = min(("free", "trimmed"), key=lambda c: r[c]["limit_pa_deg"])
+        print(f"| {t:g} | {r['mass_kg']:.0f} | {thrust / 1e3:.1f} / {drag / 1e3:.1f} | {r['free']['moment_per_qsa_m']:.2f} / "
+              f"{r['trimmed']['moment_per_qsa_m']:.2f} | {r[worst]['station_m']:.2f} | {r[worst]['axial_n'] / 1e3:.1f} "
+              f"| {r['limit_pa_deg'] / 1e6:.2f} |")
+    print(f"allowable {r['allowable_pa'] / 1e6:.0f} MPa (yield / {FACTOR_OF_SAFETY_YIELD}), local buckling "
+          f"{r['buckling_pa'] / 1e9:.2f} GPa")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
