@@ -3,12 +3,13 @@ the load a perfect attitude hold would carry in the same wind (docs/flex-design.
 
 For every episode :func:`fly` records, at every control step, the time [s], the dynamic pressure ``q``
 [Pa], the total angle of attack [rad], the env's q-alpha [Pa deg], the horizontal wind (its size and its
-north and east components) [m/s] and the airspeed [m/s]. Its summary (:func:`summary`) gives the failure (time, q, alpha, q-alpha), the peak
-q-alpha and the **attitude-hold estimate**: the vehicle flies vertically with the body held on the
-reference axis (the vertical), so its angle of attack is the wind's, ``alpha_hold = atan(|w_h| / V)``
-(``w_h`` the horizontal wind, ``V`` the airspeed), and the hold carries ``q alpha_hold`` [Pa deg];
-its peak over the flight says whether any controller that holds the attitude could meet the limit.
-The rest is :mod:`.loadbound`'s (what a controller that turns into the wind could do).
+north and east components) [m/s] and the airspeed [m/s]. Its summary (:func:`summary`) gives the
+failure (time, q, alpha, q-alpha), the peak q-alpha and the **attitude-hold estimate**: the vehicle
+flies vertically with the body held on the reference axis (the vertical), so its angle of attack is the
+wind's, ``alpha_hold = atan(|w_h| / V)`` (``w_h`` the horizontal wind, ``V`` the airspeed), and the hold
+carries ``q alpha_hold`` [Pa deg]; its peak over the flight says whether any controller that holds the
+attitude could meet the limit. What a controller that turns into the wind could do is
+:mod:`.loadbound`'s.
 
 ``python -m baselines.qalpha_floor --policies zero gs-pid-flex --seeds 10`` (validation seeds 0-9 of
 ``slender-v1``) prints one line per episode and the summary.

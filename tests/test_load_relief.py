@@ -15,7 +15,6 @@ from baselines.divergence import Lift, free_free_beam
 from baselines.loadbound import min_peak_qalpha
 from baselines.pid import ACCEL_SIGNS, FLEX_SCHEDULES, GainSchedule, GainScheduledPIDPolicy, flex_pid
 from baselines.structural_limit import bending_moment_per_qsa, buckling_stress_pa, qalpha_limit_pa_deg
-from lvgym.envs.layouts import G0
 from lvgym.errors import ConfigError
 
 
