@@ -80,7 +80,7 @@ INTERPOLATIONS = ("linear", "nearest")
 #: ``+z_b``) gives a normal force and so a specific force along ``-z_b``; a negative pitch rate turns
 #: the nose towards ``+z_b``, so pitch takes ``+accel_z``; yaw: ``+beta`` gives a force along ``-y_b`` and
 #: a positive yaw rate turns the nose towards ``+y_b``, so yaw takes ``-accel_y``
-#: (``tests/test_load_relief.py`` checks both in a crosswind)
+#: (``tests/test_load_relief.py`` checks both in a gust)
 ACCEL_SIGNS = (1.0, -1.0)
 #: the thesis's single gain set (6.3.1), tuned on the rigid SMILE at 28.8 s; N as Table 6.10's 28.8 s row
 THESIS_SINGLE = {"kp": 8.98, "ki": 3.92, "kd": 4.57, "n": 500.0}
