@@ -334,14 +334,23 @@ def _checked(case: tuple, t: float, gains, filt: StructuralFilter, req: Requirem
             "margins": {k: _rounded(v) for k, v in chk.items() if k not in ("modes", "meets")}, "modes": chk["modes"]}
 
 
+def relieved(gains: tuple[float, float, float], relief: tuple[float, float] | None) -> tuple[float, float, float]:
+    """The gains of a load-relief row: ``relief = (ki_scale, accel_gain)`` scales the integral (the
+    attitude hold that fights the weathercocking; :mod:`.pid`, "Load relief"); None: unchanged."""
+    return gains if relief is None else (gains[0], gains[1] * relief[0], gains[2])
+
+
 def design_schedule(vehicle: str = "smile", times=None, req: Requirements | None = None, starts: int = 2,
-                    seed: int = 0, log=print) -> dict[str, Any]:
+                    seed: int = 0, log=print, relief: tuple[float, float] | None = None) -> dict[str, Any]:
     """Design every row of ``vehicle``'s schedule in time order. Each row flies the stretch between the
     midpoints to its neighbours in the same burn (the policy switches rows at the mass midpoints,
     ``interpolation: nearest``), and is designed to meet the requirements at its own time and at both
     ends of its stretch; the end's plants are flown to with the rows before it (the right end: with
     a first design of the row from its time and left end, which the final design then starts from).
-    Returns the schedule document."""
+    ``relief = (ki_scale, accel_gain)``: every row, once designed, flies with its integral gain scaled
+    and the load-relief gain ``accel_gain`` [rad/s per m/s^2] (the later rows are flown to so), and is
+    checked so (the rate loop's margins; the accelerometer path is not in the linear plant). Returns the
+    schedule document."""
     req = req or Requirements()
     times = tuple(sorted(FLEX_TIMES[vehicle] if times is None else times))
     rng = np.random.default_rng(seed)
@@ -362,8 +371,9 @@ def design_schedule(vehicle: str = "smile", times=None, req: Requirements | None
         if k + 1 < len(times):
             t_r = 0.5 * (t + times[k + 1])
             gains, filt = controller(e["values"], notch)
+            gains = relieved(gains, relief)
             first = rows + [{"time_s": t, "mass_kg": own[2]["mass_kg"], "kp": gains[0], "ki": gains[1], "kd": gains[2],
-                             "filter": filt.as_dict()}]
+                             "filter": filt.as_dict(), **({} if relief is None else {"accel_gain": relief[1]})}]
             try:
                 case = row_plants(vehicle, t_r, schedule_policy(first))
                 right = (t_r, case) if case[2]["thrust_n"] > 0.0 else None
@@ -374,9 +384,11 @@ def design_schedule(vehicle: str = "smile", times=None, req: Requirements | None
             e = design_row(RowProblem([(c[0]["pitch"], c[1]) for _, c in cases], req), e["values"], rng, starts=0)
         warm = e["values"]
         gains, filt = controller(e["values"], notch)
+        gains = relieved(gains, relief)
         checks = [_checked(c, tc, gains, filt, req) for tc, c in cases]
         row = {"time_s": float(t), "mass_kg": round(own[2]["mass_kg"], 2), "kp": float(gains[0]),
                "ki": float(gains[1]), "kd": float(gains[2]), "filter": filt.as_dict(),
+               **({} if relief is None else {"accel_gain": float(relief[1])}),
                "meets": all(c["meets"] for c in checks), "objective": round(float(e["J"]), 4),
                "stretch_s": [round(min(tc for tc, _ in cases), 3), round(max(tc for tc, _ in cases), 3)],
                "margins": checks[0]["margins"], "modes": checks[0]["modes"], "ends": checks[1:]}
@@ -386,7 +398,9 @@ def design_schedule(vehicle: str = "smile", times=None, req: Requirements | None
     return {"vehicle": vehicle, "protocol": "v1",
             "source": "python -m baselines.flexdesign (non-rigid v1 flight loop, discrete)",
             "variable": "mass", "interpolation": "nearest", "requirements": asdict(req),
-            "design": {"starts": starts, "seed": seed}, "rows": rows, "skipped": skipped}
+            "design": {"starts": starts, "seed": seed, **({} if relief is None else
+                                                          {"ki_scale": relief[0], "accel_gain": relief[1]})},
+            "rows": rows, "skipped": skipped}
 
 
 def _worst(row: dict[str, Any], model: str) -> dict[str, float]:
@@ -462,20 +476,28 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--times", type=float, nargs="*", default=None, help="flight times of the rows [s]")
     ap.add_argument("--starts", type=int, default=2, help="random starts of the optimiser per row (besides the warm one)")
     ap.add_argument("--seed", type=int, default=0, help="seed of the random starts")
+    ap.add_argument("--load-relief", type=float, nargs=2, default=None, metavar=("KI_SCALE", "ACCEL_GAIN"),
+                    help="load relief: scale every row's integral gain by KI_SCALE and add ACCEL_GAIN [rad/s per m/s^2]")
     a = ap.parse_args(argv)
     try:
         out = output_path(a.vehicle, a.out, a.overwrite, stem=f"{a.vehicle}_flex")
         option_number("--starts", a.starts, 0, 100)
         for t in a.times or ():
             option_number("--times", t, 0.0, 3600.0, lo_open=True)
+        if a.load_relief is not None:
+            option_number("--load-relief KI_SCALE", a.load_relief[0], 0.0, 1.0)
+            option_number("--load-relief ACCEL_GAIN", a.load_relief[1], 0.0, 1.0)
     except ConfigError as exc:
         fail(ap.prog, exc)
-    doc = design_schedule(a.vehicle, a.times, starts=a.starts, seed=a.seed)
+    doc = design_schedule(a.vehicle, a.times, starts=a.starts, seed=a.seed,
+                          relief=None if a.load_relief is None else tuple(a.load_relief))
     if not doc["rows"]:
         print(f"no flight time of {a.vehicle} could be designed; nothing written", file=sys.stderr)
         return 1
     shipped = out.parent.resolve() == SCHEDULES.resolve()
-    again = f"python -m baselines.flexdesign --vehicle {a.vehicle}" + (" --overwrite" if shipped else f" --out {out}")
+    again = (f"python -m baselines.flexdesign --vehicle {a.vehicle} --starts {a.starts}"
+             + ("" if a.load_relief is None else " --load-relief {:g} {:g}".format(*a.load_relief))
+             + (" --overwrite" if shipped else f" --out {out}"))
     out.parent.mkdir(parents=True, exist_ok=True)
     atomic_write_text(out, f"# gs-pid-flex schedule of {a.vehicle}, regenerated by: {again}\n"
                       "# Gains: rad of gimbal per rad/s of filtered rate error (kp), per rad (ki), per rad/s^2 (kd); "

@@ -43,6 +43,16 @@ Structural filters (``gs-pid-flex``, :mod:`.flexdesign`): a schedule whose rows 
 (:class:`.filters.StructuralFilter`, its parameters interpolated like the gains) filters each axis's
 error before the PID, ``u = PID(F(e))``; the filter starts in the steady state of the error whenever
 the controller switches on.
+
+Load relief (:data:`ACCEL_SIGNS`): a schedule whose rows carry ``accel_gain`` ``k_a`` [rad/s of rate
+command per m/s^2 of lateral specific force] adds the IMU's accelerometers to each axis's error,
+``e = -(rate error) + k_a s_axis f_axis`` (``f`` [m/s^2] the observation's ``accel_z`` for pitch and
+``accel_y`` for yaw, times g0; ``s_axis`` the sign that makes the commanded rate turn the nose into the
+relative wind), before the structural filter and the PID. The rate loop then tracks a turn into the wind
+proportional to the sensed normal load, and its integral, which otherwise holds the attitude, settles
+where the lateral specific force is zero: the vehicle weathercocks at low frequency and the rate loop
+still damps it at high frequency (the accelerometer load relief of the max-q region:
+docs/flex-design.md, "The slender vehicle").
 """
 
 from __future__ import annotations
@@ -56,6 +66,8 @@ from typing import Any
 import numpy as np
 import yaml
 
+from lvgym.envs.ascent import DEFAULT_AERO_MACH, SlenderAscentV1Env, slender_key
+from lvgym.envs.layouts import G0
 from lvgym.errors import ConfigError
 
 from .filters import FILTER_KEYS, FilterChain, StructuralFilter
@@ -64,6 +76,13 @@ SCHEDULES = Path(__file__).resolve().parent / "schedules"
 VARIABLES = ("mass", "time", "mach")
 #: how a schedule reads between breakpoints: linearly, or the nearest row (switching at the midpoints)
 INTERPOLATIONS = ("linear", "nearest")
+#: per axis (pitch, yaw): the sign ``s_axis`` of the load-relief term, so that ``+k_a s f`` commands the
+#: body rate that turns the nose into the relative wind. A positive angle of attack (the air from below,
+#: ``+z_b``) gives a normal force and so a specific force along ``-z_b``; a negative pitch rate turns
+#: the nose towards ``+z_b``, so pitch takes ``+accel_z``; yaw: ``+beta`` gives a force along ``-y_b`` and
+#: a positive yaw rate turns the nose towards ``+y_b``, so yaw takes ``-accel_y``
+#: (``tests/test_load_relief.py`` checks both in a gust)
+ACCEL_SIGNS = (1.0, -1.0)
 #: the thesis's single gain set (6.3.1), tuned on the rigid SMILE at 28.8 s; N as Table 6.10's 28.8 s row
 THESIS_SINGLE = {"kp": 8.98, "ki": 3.92, "kd": 4.57, "n": 500.0}
 
@@ -132,6 +151,8 @@ class GainSchedule:
     meta: dict = field(default_factory=dict, compare=False)
     filters: tuple[StructuralFilter, ...] | None = None
     interpolation: str = "linear"
+    #: load-relief gain per row [rad/s per m/s^2] (None: no accelerometer feedback)
+    accel_gain: tuple[float, ...] | None = None
 
     def __post_init__(self) -> None:
         if self.variable not in VARIABLES:
@@ -155,6 +176,9 @@ class GainSchedule:
             raise ValueError(f"interpolation = {self.interpolation!r}: one of {INTERPOLATIONS}")
         if self.filters is not None and len(self.filters) != m:
             raise ValueError(f"filters has {len(self.filters)} entries for {m} breakpoints")
+        if self.accel_gain is not None and (len(self.accel_gain) != m or
+                                            any(not (math.isfinite(v) and v >= 0) for v in self.accel_gain)):
+            raise ConfigError("accel_gain", list(self.accel_gain), f"{m} finite gains >= 0 [rad/s per m/s^2], one per row")
 
     @cached_property
     def _table(self) -> tuple[np.ndarray, np.ndarray, dict[str, np.ndarray]]:
@@ -187,6 +211,10 @@ class GainSchedule:
             return self.filters[self._nearest(value)]
         return StructuralFilter(**dict(zip(FILTER_KEYS, self._lookup(value, FILTER_KEYS))))
 
+    def accel_gain_at(self, value: float) -> float:
+        """The load-relief gain [rad/s per m/s^2] at ``value`` (0 without one)."""
+        return 0.0 if self.accel_gain is None else self._interp(value, self.accel_gain)
+
     def gains(self, value: float) -> tuple[float, float, float, float]:
         """(kp, ki, kd, n) at ``value`` of the scheduling variable."""
         return tuple(self._lookup(value, ("kp", "ki", "kd", "n")))
@@ -204,8 +232,12 @@ class GainSchedule:
         if any(with_filter) and not all(with_filter):
             raise ValueError(f"rows {[i for i, f in enumerate(with_filter) if not f]} have no 'filter': every row or none")
         filters = tuple(StructuralFilter.from_dict(r["filter"]) for r in rows) if all(with_filter) and rows else None
+        with_accel = [("accel_gain" in r) for r in rows]
+        if any(with_accel) and not all(with_accel):
+            raise ConfigError("accel_gain", [i for i, f in enumerate(with_accel) if not f], "in every row or none")
+        accel = get("accel_gain") if all(with_accel) and rows else None
         return cls(var, get(key), get("kp"), get("ki"), get("kd"), get("n", math.inf), meta, filters,
-                   data.get("interpolation", "linear"))
+                   data.get("interpolation", "linear"), accel)
 
     @classmethod
     def load(cls, path: str | Path) -> "GainSchedule":
@@ -238,6 +270,9 @@ class PIDPolicy:
         self._i_err = [lay.index("pitch_rate_error"), lay.index("yaw_rate_error")]
         self._i_on, self._i_mach = lay.index("controller_on"), lay.index("mach_over_10")
         self.axes = [DiscretePID(kp, ki, kd, n, self.dt, -self.limit, self.limit) for _ in range(2)]
+        #: the accelerometers (pitch: accel_z, yaw: accel_y) where the observation has them
+        self._i_acc = [lay.index("accel_z"), lay.index("accel_y")] if "accel_z" in lay.names else None
+        self.accel_gain = 0.0                             # load relief [rad/s per m/s^2], see the module docstring
         self.chains: list[FilterChain] | None = None      # structural filters of the error, per axis
         self._filtering = False
         self.last_gimbal = np.zeros(2)
@@ -267,11 +302,19 @@ class PIDPolicy:
     def schedule_gains(self, observation: np.ndarray, info: dict[str, Any]) -> None:
         """Hook for gain scheduling (nothing for fixed gains)."""
 
+    def errors(self, obs: np.ndarray) -> np.ndarray:
+        """The loop's errors [rad/s], pitch and yaw: reference - rate, plus the load-relief rate command
+        ``k_a s_axis f_axis`` when ``accel_gain`` is not zero (module docstring)."""
+        e = -obs[self._i_err]
+        if self.accel_gain != 0.0:
+            e = e + self.accel_gain * G0 * np.asarray(ACCEL_SIGNS) * obs[self._i_acc]
+        return e
+
     def act(self, observation: np.ndarray, info: dict[str, Any]) -> np.ndarray:
         obs = np.asarray(observation, dtype=float)
         on = self.enabled(obs)
         self.schedule_gains(obs, info)
-        errors = self.filtered(-obs[self._i_err], on)   # reference - rate, pitch and yaw
+        errors = self.filtered(self.errors(obs), on)
         self.last_gimbal = np.array([pid.update(e, on) for pid, e in zip(self.axes, errors)])
         return np.clip(self.last_gimbal / self.limit, -1.0, 1.0).astype(np.float32)
 
@@ -284,6 +327,9 @@ class GainScheduledPIDPolicy(PIDPolicy):
         self.schedule = schedule if isinstance(schedule, GainSchedule) else GainSchedule.load(schedule)
         g = self.schedule.gains(self.schedule.points[0])
         super().__init__(*g, env=env, name=name)
+        if self.schedule.accel_gain is not None and self._i_acc is None:
+            raise ConfigError("accel_gain", list(self.schedule.accel_gain), "a schedule without load relief: the "
+                              "env's observation has no accelerometers (observation 'sensors' or 'flight')")
         if self.schedule.filters is not None:
             f0 = self.schedule.filter_at(self.schedule.points[0])
             self.chains = [FilterChain(f0, self.dt) for _ in self.axes]
@@ -302,6 +348,7 @@ class GainScheduledPIDPolicy(PIDPolicy):
         g = self.schedule.gains(self.value)
         for pid in self.axes:
             pid.set_gains(*g)
+        self.accel_gain = self.schedule.accel_gain_at(self.value)
         if self.chains is not None:
             filt = self.schedule.filter_at(self.value)
             if filt == self.chains[0].filter:             # unchanged (a nearest-row schedule, mostly)
@@ -324,8 +371,9 @@ def smile_scheduled_pid(env: Any, schedule: str = "smile_thesis", name: str | No
 
 #: the gs-pid-flex schedule (``baselines/schedules/<name>.yaml``, written by ``python -m baselines.flexdesign``)
 #: of each vehicle a v1 env flies, keyed by the env's ``task.vehicle`` (a name, or the slender vehicle's key
-#: tuple; the slender vehicle has none yet: docs/flex-design.md)
-FLEX_SCHEDULES: dict = {"smile_v1": "smile_flex", "stratos3": "stratos3_flex"}
+#: tuple: ``SlenderAscent-v1``'s default 8.5 m x 0.2833 m, 4.5 mm tube, with load relief; docs/flex-design.md)
+FLEX_SCHEDULES: dict = {"smile_v1": "smile_flex", "stratos3": "stratos3_flex",
+                        slender_key(8.5, 0.2833, DEFAULT_AERO_MACH, SlenderAscentV1Env.WALL_THICKNESS_M): "slender_flex"}
 
 
 def flex_pid(env: Any, name: str = "gs-pid-flex") -> GainScheduledPIDPolicy:

@@ -247,9 +247,11 @@ def test_flex_policies_follow_the_envs_vehicle(v1_rigid):
     assert pol.schedule.meta["vehicle"] == "smile" and FLEX_SCHEDULES["smile_v1"] == "smile_flex"
     stratos = gym.make("lvgym/StratosIII-v1", mission_time_s=2.0)
     assert flex_pid(stratos).schedule.meta["vehicle"] == "stratos3"
-    for env_id in ("lvgym/SmileAscent-v0", "lvgym/SlenderAscent-v1"):
+    assert flex_pid(gym.make("lvgym/SlenderAscent-v1", mission_time_s=2.0)).schedule.meta["vehicle"] == "slender"
+    for env_id, opts in (("lvgym/SmileAscent-v0", {}), ("lvgym/SlenderAscent-v0", {}),
+                         ("lvgym/SlenderAscent-v1", {"wall_thickness_m": 0.002})):   # the thesis's tube: no design
         with pytest.raises(ConfigError, match="env vehicle"):
-            flex_pid(gym.make(env_id))
+            flex_pid(gym.make(env_id, **opts))
     aac = flex_aac(v1_rigid)
     assert aac.params.damper_deadzone_rad2 == FLEX_AAC["damper_deadzone_rad2"] and aac.name == "aac"
     assert flex_aac(v1_rigid, damper_deadzone_rad2=0.0).params.damper_deadzone_rad2 == 0.0

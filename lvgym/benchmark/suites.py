@@ -32,8 +32,8 @@ smile-v1            70 s, v0's turbulence plus a random 1-cosine gust, every dis
 smile-v1-maxq-gust  35 s, a random jet stream plus a random gust in the max-q region, every dispersion
 stratos-tvc-v1      Stratos III with TVC (StratosIII-v1), 30 s, turbulence, every dispersion
 slender-v1          the L/D 30 slender vehicle with its aeroelastic loads (SlenderAscent-v1), 10 s, turbulence,
-                    every dispersion; provisional until it has a baseline (the gimbal at zero fails on
-                    q-alpha at 4.1-4.7 s)
+                    every dispersion; its baseline is gs-pid-flex with load relief (docs/flex-design.md:
+                    on validation seeds 0-9 the gimbal at zero fails 2/10 rigid and 4/10 non-rigid on q-alpha)
 ==================  ===============================================================================
 
 ``slender-ld30`` is provisional: there is no slender baseline yet. SlenderAscent-v0 freezes the vehicle's
@@ -185,7 +185,7 @@ SUITES_V1: dict[str, Suite] = {s.name: s for s in (
           "misalignment, mass, aerodynamics, thrust level and the slosh and bending dispersions",
           _pair("stratos-tvc-v1", "lvgym/StratosIII-v1", "turbulence", V1_DISPERSIONS), version=PROTOCOL_V1),
     Suite("slender-v1", "Slender vehicle L/D = 30 (SlenderAscent-v1: aeroelastic strip loads, 4.5 mm wall), 10 s, "
-          "turbulence, every dispersion (provisional: no slender baseline yet, issue 17)",
+          "turbulence, every dispersion (baseline: gs-pid-flex with load relief, docs/flex-design.md)",
           _pair("slender-v1", "lvgym/SlenderAscent-v1", "turbulence", V1_DISPERSIONS, length=8.5, diameter=0.2833),
           version=PROTOCOL_V1),
     Suite("smile-v1-maxq-gust", "SMILE v1 through max q, 35 s: a random jet stream and a random 1-cosine gust in "

@@ -1,0 +1,165 @@
+"""The load relief of the gain-scheduled PID (baselines.pid, ``accel_gain``), the slender vehicle's
+gs-pid-flex schedule, the tube's structural q-alpha limit (baselines.structural_limit) and the
+linear-programme bound on the q-alpha of any gimbal history (baselines.loadbound)."""
+
+from __future__ import annotations
+
+import math
+
+import gymnasium as gym
+import numpy as np
+import pytest
+
+import lvgym  # noqa: F401
+from baselines.divergence import Lift, free_free_beam
+from baselines.loadbound import min_peak_qalpha
+from baselines.pid import ACCEL_SIGNS, FLEX_SCHEDULES, GainSchedule, GainScheduledPIDPolicy, flex_pid
+from baselines.structural_limit import bending_moment_per_qsa, buckling_stress_pa, qalpha_limit_pa_deg
+from lvgym.errors import ConfigError
+
+
+@pytest.fixture(scope="module")
+def slender_env():
+    env = gym.make("lvgym/SlenderAscent-v1", model="rigid")
+    yield env
+    env.close()
+
+
+def _one_row(accel_gain: float | None) -> GainSchedule:
+    row = {"mass_kg": 300.0, "kp": 0.1, "ki": 0.0, "kd": 0.0}
+    if accel_gain is not None:
+        row["accel_gain"] = accel_gain
+    return GainSchedule.from_dict({"variable": "mass", "rows": [row]})
+
+
+def test_load_relief_law_against_hand_numbers(slender_env):
+    pol = GainScheduledPIDPolicy(_one_row(0.002), env=slender_env)
+    lay = slender_env.unwrapped.observation_layout
+    obs = np.zeros(lay.size)
+    obs[lay.index("pitch_rate_error")] = 0.01       # rad/s
+    obs[lay.index("accel_z")] = 0.5                 # g0
+    obs[lay.index("accel_y")] = -0.2
+    obs[lay.index("controller_on")] = 1.0
+    pol.reset()
+    action = pol.act(obs, {"mass": 300.0, "time": 3.0})
+    # pitch: e = -0.01 + 0.002 * 9.80665 * (+1) * 0.5 = -0.01 + 0.00980665 = -1.9335e-4 rad/s
+    # yaw:   e = 0 + 0.002 * 9.80665 * (-1) * (-0.2) = 3.92266e-3 rad/s; gimbal = kp e (no filter, ki = kd = 0)
+    assert ACCEL_SIGNS == (1.0, -1.0)
+    np.testing.assert_allclose(pol.last_gimbal, [0.1 * -1.9335e-4, 0.1 * 3.92266e-3], rtol=1e-4)
+    np.testing.assert_allclose(action, pol.last_gimbal / slender_env.unwrapped.gimbal_limit, rtol=1e-5)
+    # without the row key: the error alone, and no accelerometer term
+    plain = GainScheduledPIDPolicy(_one_row(None), env=slender_env)
+    plain.reset()
+    plain.act(obs, {"mass": 300.0, "time": 3.0})
+    np.testing.assert_allclose(plain.last_gimbal, [0.1 * -0.01, 0.0], atol=1e-12)
+
+
+def test_load_relief_needs_every_row_and_accelerometers():
+    rows = [{"mass_kg": 300.0, "kp": 0.1, "ki": 0.0, "kd": 0.0, "accel_gain": 0.001},
+            {"mass_kg": 200.0, "kp": 0.1, "ki": 0.0, "kd": 0.0}]
+    with pytest.raises(ConfigError, match="accel_gain"):
+        GainSchedule.from_dict({"variable": "mass", "rows": rows})
+    env = gym.make("lvgym/SlenderAscent-v1", model="rigid", observation="state")
+    with pytest.raises(ConfigError, match="accelerometers"):
+        GainScheduledPIDPolicy(_one_row(0.001), env=env)
+    env.close()
+
+
+def test_accelerometer_signs_in_a_crosswind():
+    """The frame facts behind ACCEL_SIGNS: in a steady crosswind with the gimbal at zero, the lateral
+    specific force is opposite to the air's body component (pitch: +v_air_z gives -accel_z; yaw:
+    +v_air_y gives -accel_y), and a positive pitch (yaw) rate raises (lowers) v_air_z (v_air_y). The
+    ``gust`` tier (a 1-cosine gust): in the steady ``profile`` wind the weathercock's oscillation puts
+    the IMU's lever-arm acceleration on top and the correlation is weaker (-0.24 / -0.34 when measured)."""
+    env = gym.make("lvgym/SlenderAscent-v1", model="rigid", wind="gust", mission_time_s=6.0)
+    lay = env.unwrapped.observation_layout
+    obs, info = env.reset(seed=0)
+    rows = []
+    while True:
+        obs, _, term, trunc, info = env.step(np.zeros(2, np.float32))
+        va = env.unwrapped.sim.conditions("v_air_b")[0]
+        w = env.unwrapped.sim.x[0, env.unwrapped.sim.layout.state["omega_bi_b"]]
+        rows.append([info["time"], va[2] / va[0], va[1] / va[0], obs[lay.index("accel_z")], obs[lay.index("accel_y")],
+                     w[1], w[2]])
+        if term or trunc:
+            break
+    env.close()
+    a = np.array(rows)
+    a = a[a[:, 0] >= 2.0]
+    assert np.corrcoef(a[:, 1], a[:, 3])[0, 1] < -0.8
+    assert np.corrcoef(a[:, 2], a[:, 4])[0, 1] < -0.8
+    dt = a[1, 0] - a[0, 0]
+    rate_p, rate_y = np.gradient(a[:, 1], dt), np.gradient(a[:, 2], dt)
+    assert np.corrcoef(rate_p, a[:, 5])[0, 1] > 0.5
+    assert np.corrcoef(rate_y, a[:, 6])[0, 1] < -0.5
+
+
+def test_gs_pid_flex_flies_the_slender_schedule(slender_env):
+    key = slender_env.unwrapped.task.vehicle
+    assert FLEX_SCHEDULES[key] == "slender_flex"
+    pol = flex_pid(slender_env)
+    assert pol.schedule.accel_gain is not None and all(k > 0 for k in pol.schedule.accel_gain)
+    assert pol.schedule.meta["design"]["ki_scale"] < 1.0
+    assert pol.schedule.filters is not None
+
+
+def test_short_slender_v1_flight_with_load_relief():
+    env = gym.make("lvgym/SlenderAscent-v1", model="nonrigid", wind="turbulence", mission_time_s=4.0)
+    pol = flex_pid(env)
+    obs, info = env.reset(seed=0)
+    pol.reset()
+    gains = []
+    while True:
+        obs, _, term, trunc, info = env.step(pol.act(obs, info))
+        gains.append(pol.accel_gain)
+        if term or trunc:
+            break
+    env.close()
+    assert trunc and not term and info["time"] == pytest.approx(4.0)
+    assert max(gains) > 0.0 and np.all(np.isfinite(pol.last_gimbal))
+
+
+def test_bending_moment_of_a_uniform_free_beam_against_hand_numbers():
+    """A uniform 1 m, 1 kg free beam with a unit lateral force at 0.25 m behind the nose (gimbal at zero):
+    a = 1, theta_ddot = 0.25 / (1/12) = 3; M(x) = (x - 0.25)+ - int_0^x (1 + 3 (0.5 - s)) (x - s) ds,
+    so M(0.25) = -(1.75 * 0.25^2 / 2 + 0.25^3) = -0.0703125 and M(0.5) = 0.25 - (0.5^2 / 2 + 0.5^3) = 0."""
+    beam = free_free_beam(1.0, 1.0, lambda x: np.ones_like(x), [], n_el=400, gimbal=1.0)
+    lift = Lift(np.array([0.25]), np.array([1.0]), 1.0)
+    xi, m = bending_moment_per_qsa(beam, lift, "free")
+    at = lambda x: float(np.interp(x, xi, m))  # noqa: E731
+    assert at(0.25) == pytest.approx(-0.0703125, abs=2e-3)
+    assert at(0.5) == pytest.approx(0.0, abs=2e-3)
+    assert abs(m[-1]) < 1e-9 and abs(m[0]) < 1e-12                # free ends carry no moment
+    # trimmed: the side force at the tail F_g = -0.25 / (0.5 - 1.0) = 0.5, a = 1.5, no rotation:
+    # M(0.5) = 0.25 - 1.5 * 0.5^2 / 2 = 0.0625
+    xi, m = bending_moment_per_qsa(beam, lift, "trimmed")
+    assert float(np.interp(0.5, xi, m)) == pytest.approx(0.0625, abs=2e-3)
+
+
+def test_qalpha_limit_against_hand_numbers():
+    """D 0.2833 m, t 4.5 mm: I = pi/64 (D^4 - d^4) = 3.8306e-5 m^4, A = 3.9414e-3 m^2. A bending moment of
+    5 m per unit q S alpha on S = 0.063 m^2 stresses the wall by 5 * 0.063 * 0.14165 / 3.8306e-5 = 1164.8 Pa
+    per Pa rad; 40 kN of compression takes 10.149 MPa of the 224 MPa allowable, leaving 213.85 MPa:
+    q alpha = 213.85e6 / 1164.8 = 1.8359e5 Pa rad = 10.519e6 Pa deg."""
+    assert qalpha_limit_pa_deg(5.0, 0.063, 0.2833, 0.0045, 224e6, 40000.0) == pytest.approx(10.519e6, rel=1e-3)
+    assert qalpha_limit_pa_deg(5.0, 0.063, 0.2833, 0.0045, 224e6, 1e7) == 0.0
+    # SP-8007's knockdown at R/t = 31.5: phi = sqrt(31.5)/16 = 0.3508, gamma = 1 - 0.901 (1 - e^-phi) = 0.7335;
+    # 0.605 * 71 GPa / 31.5 * 0.7335 = 1.0003 GPa
+    assert buckling_stress_pa(71e9, 0.14165, 0.0045) == pytest.approx(1.0003e9, rel=1e-3)
+
+
+def test_load_bound_on_a_frozen_model():
+    """A model whose gimbal drives the angle of attack directly can null a constant wind angle (bound 0);
+    with no gimbal the bound is the wind's own q-alpha."""
+    t = np.arange(0.0, 1.0, 0.02)
+    V = np.full(t.size, 100.0)
+    q = np.full(t.size, 1e5)
+    wind = np.full(t.size, 1.0)                    # 0.01 rad of wind angle
+    A = np.zeros((1, 3, 3))
+    models = {"t": np.array([0.0]), "A": A, "B": np.array([[0.0, 0.0, 0.0]]), "E": np.zeros((1, 3))}
+    free = min_peak_qalpha(models, t, q, V, wind, 0.0, 1.0, on_after_s=0.0)
+    assert free["peak_pa_deg"] == pytest.approx(1e5 * math.degrees(0.01), rel=1e-6)
+    assert free["zero_peak_pa_deg"] == pytest.approx(free["peak_pa_deg"], rel=1e-9)
+    models["B"] = np.array([[0.0, 1.0, 0.0]])      # theta_dot = delta: the gimbal turns the body
+    held = min_peak_qalpha(models, t, q, V, wind, 0.1, 10.0, on_after_s=0.0, count_after_s=0.2)
+    assert held["peak_pa_deg"] < 1e-6 * free["peak_pa_deg"] + 1e-6
