@@ -83,6 +83,8 @@ INTERPOLATIONS = ("linear", "nearest")
 #: a positive yaw rate turns the nose towards ``+y_b``, so yaw takes ``-accel_y``
 #: (``tests/test_load_relief.py`` checks both in a gust)
 ACCEL_SIGNS = (1.0, -1.0)
+#: a schedule's columns of one number per row (the filters' parameters are the other columns)
+ROW_COLUMNS = ("kp", "ki", "kd", "n", "accel_gain")
 #: the thesis's single gain set (6.3.1), tuned on the rigid SMILE at 28.8 s; N as Table 6.10's 28.8 s row
 THESIS_SINGLE = {"kp": 8.98, "ki": 3.92, "kd": 4.57, "n": 500.0}
 
@@ -186,7 +188,7 @@ class GainSchedule:
         built once, so a lookup is one ``argmin`` or one ``np.interp`` per column (the same numbers)."""
         x = np.asarray(self.points, float)
         order = np.argsort(x)
-        cols = {k: np.asarray(getattr(self, k), float)[order] for k in ("kp", "ki", "kd", "n")}
+        cols = {k: np.asarray(getattr(self, k), float)[order] for k in ROW_COLUMNS if getattr(self, k) is not None}
         if self.filters is not None:
             cols.update({k: np.array([getattr(f, k) for f in self.filters], float)[order] for k in FILTER_KEYS})
         return x, x[order], cols
@@ -199,8 +201,7 @@ class GainSchedule:
         x, x_sorted, cols = self._table
         if self.interpolation == "nearest":
             i = self._nearest(value)
-            return [float(getattr(self, k)[i]) if k in ("kp", "ki", "kd", "n") else float(getattr(self.filters[i], k))
-                    for k in keys]
+            return [float(getattr(self, k)[i]) if k in ROW_COLUMNS else float(getattr(self.filters[i], k)) for k in keys]
         return [float(np.interp(value, x_sorted, cols[k])) for k in keys]
 
     def filter_at(self, value: float) -> StructuralFilter | None:
@@ -213,7 +214,7 @@ class GainSchedule:
 
     def accel_gain_at(self, value: float) -> float:
         """The load-relief gain [rad/s per m/s^2] at ``value`` (0 without one)."""
-        return 0.0 if self.accel_gain is None else self._interp(value, self.accel_gain)
+        return 0.0 if self.accel_gain is None else self._lookup(value, ("accel_gain",))[0]
 
     def gains(self, value: float) -> tuple[float, float, float, float]:
         """(kp, ki, kd, n) at ``value`` of the scheduling variable."""
