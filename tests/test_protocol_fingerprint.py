@@ -38,3 +38,11 @@ def test_the_probe_is_a_function_of_time_and_unknown_versions_are_refused():
     assert env.action_space.contains(a)
     with pytest.raises(ValueError, match="no suite carries it"):
         fp.fingerprint("v9")
+
+
+@pytest.mark.parametrize("version", ["v0", "v1"])
+def test_a_frozen_protocol_flies_its_stored_episodes(version):
+    stored = fp.stored(version)
+    assert {r["suite"] for r in stored} == {s.name for s in fp._suites(version)}
+    assert len(stored) == 2 * 2 * len({r["suite"] for r in stored})      # 2 conditions x 2 policies, 1 seed
+    assert fp.compare(fp.fingerprint(version), stored) == []

@@ -25,7 +25,8 @@ slender-ld30       SlenderAscent-v0       L/D = 30 (8.5 m x 0.2833 m); turbulenc
                                           thrust misalignment and bending frequency dispersed
 =================  =====================  ==========================================================
 
-Protocol v1 (a draft, version ``v1-draft``, until issue 16 freezes it) adds, on ``SmileAscent-v1``:
+Protocol v1 (version ``v1``, frozen on 2026-12-02; :mod:`.fingerprint` holds it to its episodes) adds, on
+``SmileAscent-v1``:
 
 ==================  ===============================================================================
 smile-v1            70 s, v0's turbulence plus a random 1-cosine gust, every dispersion (``V1_DISPERSIONS``), the default
@@ -167,16 +168,17 @@ SUITES: dict[str, Suite] = {s.name: s for s in (
 )}
 
 
-#: protocol v1 while issue 16 builds it: results carry this version and are not protocol numbers until
-#: the version is frozen as ``v1``
-PROTOCOL_V1 = "v1-draft"
+#: protocol v1, frozen on 2026-12-02 (results before that carry ``v1-draft``: an earlier draft's numbers);
+#: ``lvgym/benchmark/data/v1.json`` is its fingerprint (:mod:`.fingerprint`), tests/test_protocol_fingerprint.py
+#: holds every later version of the code to it
+PROTOCOL_V1 = "v1"
 SMILE_V1 = "lvgym/SmileAscent-v1"
 #: every randomisation of v1 (v0's and the Monte Carlo dispersions of docs/benchmark.md)
 V1_DISPERSIONS = ("wind", "thrust_misalignment", "mass", "slosh_damping", "bending_frequency", "sensor_noise",
                   "aerodynamics", "thrust_level", "slosh_mass", "slosh_frequency", "bending_damping", "servo_bandwidth",
                   "servo_delay", "imu_station")
 
-#: the suites of protocol v1 (a draft: they may still change until the version is frozen)
+#: the suites of protocol v1 (frozen: a change of their definitions or of what they fly is a new version)
 SUITES_V1: dict[str, Suite] = {s.name: s for s in (
     Suite("smile-v1", "SMILE v1 (own upper-stage aerodynamics, staging at 1.8 kPa, coast control, one period of "
           "delay), 70 s, turbulence and a random 1-cosine gust, every dispersion",

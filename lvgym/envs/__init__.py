@@ -1,11 +1,11 @@
 """Gymnasium environments of lvgym, registered on ``import lvgym``:
 
 - ``lvgym/SmileAscent-v0`` (:class:`~.ascent.SmileAscentEnv`): SMILE's first-stage flight, TVC;
-- ``lvgym/SmileAscent-v1`` (:class:`~.ascent.SmileAscentV1Env`): SMILE as protocol v1 flies it (draft);
+- ``lvgym/SmileAscent-v1`` (:class:`~.ascent.SmileAscentV1Env`): SMILE as protocol v1 flies it;
 - ``lvgym/StratosIII-v0`` (:class:`~.ascent.StratosIIIEnv`): Stratos III through its thrust drop, roll RCS;
 - ``lvgym/SlenderAscent-v0`` (:class:`~.ascent.SlenderAscentEnv`): the parametric L/D vehicle;
 - ``lvgym/StratosIII-v1``, ``lvgym/SlenderAscent-v1``: Stratos III with TVC and the slender vehicle with
-  protocol v1's physics and timing (drafts).
+  protocol v1's physics and timing.
 
 Each is a thin adapter over the functional env :class:`~.functional.AscentFuncEnv` (explicit state and
 parameters, batched over rows); each has a native batched ``VectorEnv`` as its ``vector_entry_point``

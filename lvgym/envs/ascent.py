@@ -206,7 +206,7 @@ V1_OPTIONS = {**FLIGHT_DEFAULTS, "reference_velocity": "earth", "action_delay_st
 
 
 class SmileAscentV1Env(SmileAscentEnv):
-    """``lvgym/SmileAscent-v1``: SMILE as protocol v1 flies it (a draft until issue 16 freezes it).
+    """``lvgym/SmileAscent-v1``: SMILE as protocol v1 flies it (frozen 2026-12-02).
 
     The vehicle ``smile_v1`` (lvgym/vehicles/smile_v1.yaml): the upper stack flies its own, finless
     aerodynamics after separation, which comes 10 s after the 43 s burnout at about 1.8 kPa (the finned
@@ -286,15 +286,14 @@ def slender_key(length: float, diameter: float, aero_mach: float | None, wall_th
 
 class StratosIIIV1Env(StratosIIIEnv):
     """``lvgym/StratosIII-v1``: Stratos III with thrust-vector control (the hypothetical TVC of
-    ``StratosIII-v0``'s ``control="tvc"``) and protocol v1's physics and timing (a draft until issue 16
-    freezes it): one control period of delay, modes recomputed every 2 s and projected, slosh dampers on
+    ``StratosIII-v0``'s ``control="tvc"``) and protocol v1's physics and timing (frozen 2026-12-02): one control period of delay, modes recomputed every 2 s and projected, slosh dampers on
     the specific force. Reward weights pitch and yaw; roll is left to the vehicle."""
 
     DEFAULTS = {**StratosIIIEnv.DEFAULTS, **V1_OPTIONS, "control": "tvc", "rate_weights": (0.0, 1.0, 1.0)}
 
 
 class SlenderAscentV1Env(SlenderAscentEnv):
-    """``lvgym/SlenderAscent-v1``: the slender vehicle with protocol v1's physics and timing (a draft):
+    """``lvgym/SlenderAscent-v1``: the slender vehicle with protocol v1's physics and timing (frozen):
     one control period of delay, modes recomputed every 2 s and projected, slosh dampers on the specific
     force, and the strip-theory aeroelastic loads its vehicle file asks for.
 
