@@ -60,8 +60,9 @@ class Args:
     """registered lvgym env id"""
     model: str = "nonrigid"
     """flight model: rigid, slosh, flex or nonrigid"""
-    wind: str = "turbulence"
-    """wind tier: none, profile, gust, turbulence or random"""
+    wind: str = "protocol"
+    """wind tier (lvgym.envs.WIND_TIERS), or protocol: the env's protocol (turbulence for v0 ids; the wind of
+    the id's v1 suite for v1 ids, turbulence_gust for SmileAscent-v1)"""
     randomize: list[str] = field(default_factory=lambda: ["protocol"])
     """names drawn per episode (lvgym.envs.RANDOMIZE), 'all', 'none' or 'protocol': the env's protocol
     (wind thrust_misalignment for v0 ids; every dispersion of protocol v1, V1_DISPERSIONS, for v1 ids)"""
@@ -175,7 +176,8 @@ def _choices() -> dict[str, tuple[str, ...]]:
     from lvgym.envs.spec import OBSERVATIONS, WIND_TIERS
     from lvgym.simulator import MODELS
 
-    return {"env_id": tuple(lvgym.ENV_IDS), "model": tuple(MODELS), "wind": WIND_TIERS, "observation": ("env", *OBSERVATIONS)}
+    return {"env_id": tuple(lvgym.ENV_IDS), "model": tuple(MODELS), "wind": ("protocol", *WIND_TIERS),
+            "observation": ("env", *OBSERVATIONS)}
 
 
 def parse_args(argv: list[str] | None = None) -> tuple[Args, set[str]]:
@@ -185,26 +187,30 @@ def parse_args(argv: list[str] | None = None) -> tuple[Args, set[str]]:
 
 
 # ------------------------------------------------------------------------------------------ helpers
-def protocol_randomize(env_id: str) -> list[str]:
-    """What ``--randomize protocol`` draws for ``env_id``: protocol v1's dispersions for a v1 id
-    (:data:`lvgym.benchmark.suites.V1_DISPERSIONS`, what its suites fly), v0's training default (wind and
-    thrust misalignment) otherwise."""
-    if env_id.endswith("-v1"):
-        from lvgym.benchmark.suites import V1_DISPERSIONS
-        return list(V1_DISPERSIONS)
-    return ["wind", "thrust_misalignment"]
+def protocol_training(env_id: str) -> tuple[str, list[str]]:
+    """The wind and the randomisation that ``--wind protocol`` and ``--randomize protocol`` mean for
+    ``env_id``: for a v1 id those of its v1 suite (:data:`DEFAULT_EVAL_SUITES`: the distribution it is
+    validated and tested on, with training seeds), v0's training defaults otherwise (turbulence; wind and
+    thrust misalignment drawn)."""
+    suite = DEFAULT_EVAL_SUITES.get(env_id)
+    if env_id.endswith("-v1") and suite is not None:
+        from lvgym.benchmark.suites import get_suite
+        condition = get_suite(suite).conditions[0]
+        return condition.wind, list(condition.randomize)
+    return "turbulence", ["wind", "thrust_misalignment"]
 
 
 def env_kwargs_of(args: Args) -> dict[str, Any]:
     """The env keywords of a run: model, wind, randomisation, observation and the ``--env-kwargs``."""
     r: Any = list(args.randomize)
+    wind, protocol_r = protocol_training(args.env_id)
     if r == ["protocol"]:
-        r = protocol_randomize(args.env_id)
+        r = protocol_r
     elif r in (["all"], ["true"], ["True"]):
         r = True
     elif r in ([], ["none"], ["false"], ["False"]):
         r = False
-    out: dict[str, Any] = {"model": args.model, "wind": args.wind, "randomize": r}
+    out: dict[str, Any] = {"model": args.model, "wind": wind if args.wind == "protocol" else args.wind, "randomize": r}
     out.update({} if args.observation == "env" else {"observation": args.observation})
     out.update({"history": int(args.history)} if args.history else {})   # when on only: old runs unchanged
     for item in args.env_kwargs:

@@ -81,7 +81,7 @@ def main(argv: list[str] | None = None) -> None:
     p.add_argument("--train-args", default="", help='further train.py options for every run, e.g. "--residual lqg"')
     p.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2])
     p.add_argument("--total-timesteps", default=None, help="per run (default: the hyperparameter file's)")
-    p.add_argument("--wind", default="turbulence", help="training wind tier (default turbulence)")
+    p.add_argument("--wind", default="protocol", help="training wind tier (default protocol: the env's own, the suite's for v1)")
     p.add_argument("--randomize", nargs="+", default=["protocol"],
                    help="training randomisation (default protocol: the env's own, every dispersion for v1)")
     p.add_argument("--suites", nargs="+", default=["smile-v1"])

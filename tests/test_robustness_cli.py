@@ -10,7 +10,7 @@ from agents import robustness
 
 def _args(**kw) -> Namespace:
     base = dict(env_id="lvgym/SmileAscent-v1", algo="ppo", tag=None, train_args="", seeds=[0, 1], total_timesteps=None,
-                wind="turbulence", randomize=["protocol"], suites=["smile-v1"], baselines=["gs-pid-flex", "lqg"],
+                wind="protocol", randomize=["protocol"], suites=["smile-v1"], baselines=["gs-pid-flex", "lqg"],
                 episodes=50, runs_dir="/nonexistent-runs", out="results/robustness", dry_run=True)
     return Namespace(**{**base, **kw})
 

@@ -127,13 +127,16 @@ def test_the_default_observation_and_randomisation_are_the_env_protocols():
 
     v0 = TRAIN.env_kwargs_of(TRAIN.Args())
     assert v0["randomize"] == ["wind", "thrust_misalignment"] and "observation" not in v0   # v0's own: state
+    assert v0["wind"] == "turbulence"
     v1 = TRAIN.env_kwargs_of(TRAIN.Args(env_id="lvgym/SmileAscent-v1"))
-    assert v1["randomize"] == list(V1_DISPERSIONS) and "observation" not in v1               # v1's own: flight
+    assert sorted(v1["randomize"]) == sorted(V1_DISPERSIONS) and "observation" not in v1     # v1's own: flight
+    assert v1["wind"] == "turbulence_gust"                                                  # smile-v1's wind
+    assert TRAIN.env_kwargs_of(TRAIN.Args(env_id="lvgym/SlenderAscent-v1"))["wind"] == "turbulence"
     import lvgym.envs as envs
 
     assert envs.ENVS["lvgym/SmileAscent-v0"].DEFAULTS.get("observation", "state") == "state"
     assert envs.ENVS["lvgym/SmileAscent-v1"].DEFAULTS["observation"] == "flight"
-    assert TRAIN.env_kwargs_of(TRAIN.Args(observation="state", randomize=["mass"])) == {
+    assert TRAIN.env_kwargs_of(TRAIN.Args(observation="state", randomize=["mass"], wind="turbulence")) == {
         "model": "nonrigid", "wind": "turbulence", "randomize": ["mass"], "observation": "state"}
 
 
