@@ -317,16 +317,20 @@ class SB3Policy:
         return self._fast
 
 
-#: the policy shipped for ``lvgym/SmileAscent-v0`` (its sidecar JSON holds the training set-up; the command
-#: that reproduces it is in docs/training.md)
-SHIPPED = Path(__file__).resolve().parent / "trained" / "ppo_smile_ascent.zip"
+#: the folder of the shipped policies (each ``<file>.zip`` beside its ``_vecnormalize.pkl`` and its sidecar
+#: JSON, which holds the training set-up; the commands that reproduce them are in docs/training.md)
+TRAINED = Path(__file__).resolve().parent / "trained"
+#: the policy shipped for ``lvgym/SmileAscent-v0``
+SHIPPED = TRAINED / "ppo_smile_ascent.zip"
 
 
-def shipped_policy(name: str = "ppo") -> SB3Policy:
-    """The shipped PPO policy of ``lvgym/SmileAscent-v0`` (``agents/trained/ppo_smile_ascent``)."""
-    if not SHIPPED.is_file():
-        raise FileNotFoundError(f"the shipped policy {str(SHIPPED)!r} is missing (see docs/training.md)")
-    return SB3Policy(SHIPPED, name)
+def shipped_policy(name: str = "ppo", file: str = "ppo_smile_ascent", env: Any = None) -> Any:
+    """A shipped policy, ``agents/trained/<file>.zip`` (default: the PPO of ``lvgym/SmileAscent-v0``), as
+    :func:`load_policy` makes it: on its baseline, built on ``env``, when it was trained residual."""
+    path = TRAINED / f"{file}.zip"
+    if not path.is_file():
+        raise FileNotFoundError(f"the shipped policy {str(path)!r} is missing (see docs/training.md)")
+    return load_policy(path, name, env)
 
 
 def load_policy(path: str | Path, name: str | None = None, env: Any = None) -> Any:
