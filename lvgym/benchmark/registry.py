@@ -31,8 +31,11 @@ POLICIES: dict[str, PolicySpec] = {
                                 (("name", "gs-pid-thesis"), ("schedule", "smile_thesis"))),
     # LQG on the non-rigid flight plant, scheduled over the flight (baselines.lqg_design, docs/lqg.md)
     "lqg": PolicySpec("lqg", "baselines.lqg:smile_lqg", (("name", "lqg"),)),
-    # the shipped learned policy (agents/trained/ppo_smile_ascent, docs/training.md)
+    # the shipped learned policies (agents/trained, docs/training.md): PPO of SmileAscent-v0 (the ideal state
+    # observation), and protocol v1's: PPO residual on lqg, flight sensors, a 4-sample history
     "ppo": PolicySpec("ppo", "agents.policy:shipped_policy"),
+    "ppo-res-lqg": PolicySpec("ppo-res-lqg", "agents.policy:shipped_policy",
+                              (("file", "ppo_res_lqg_smile_v1"), ("name", "ppo-res-lqg"))),
 }
 
 
