@@ -10,7 +10,7 @@ from lvgym.benchmark import fingerprint as fp
 
 
 def _record(**kw):
-    base = {"suite": "s", "condition": "s/rigid", "seed": 10000, "policy": "zero", "first_obs": "ab", "score": 1.0,
+    base = {"suite": "s", "condition": "s/rigid", "seed": 10000, "policy": "zero", "first_obs": [1.0, 2.0], "score": 1.0,
             "rate_error_rad": 1.0, "max_qalpha_pa_deg": 1e5, "duration_s": 10.0, "failed": False, "failure_reason": ""}
     return {**base, **kw}
 
@@ -18,11 +18,11 @@ def _record(**kw):
 def test_compare_names_every_difference_and_tolerates_round_off():
     ref = [_record(), _record(policy="probe")]
     assert fp.compare([dict(r) for r in ref], ref) == []
-    assert fp.compare([_record(score=1.0 + 5e-7), _record(policy="probe")], ref) == []     # within 1e-6
-    diffs = fp.compare([_record(score=1.01, failed=True), _record(policy="probe", first_obs="cd")], ref)
+    assert fp.compare([_record(score=1.0 + 5e-4), _record(policy="probe")], ref) == []     # within RTOL
+    diffs = fp.compare([_record(score=1.01, failed=True), _record(policy="probe", first_obs=[1.0, 2.1])], ref)
     assert any("failed: True against False" in d for d in diffs)
     assert any("score: 1.01 against 1.0" in d for d in diffs)
-    assert any("first_obs: 'cd' against 'ab'" in d for d in diffs)
+    assert any("first_obs: differs (largest difference 0.1" in d for d in diffs)
     assert fp.compare([_record()], ref) == ["('s', 's/rigid', 10000, 'probe'): not in the fresh run"]
 
 

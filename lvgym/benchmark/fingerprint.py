@@ -5,21 +5,20 @@ The fingerprint is that promise made checkable. For every suite of a protocol ve
 the first ``seeds`` test seeds, it flies two policies that no design work can change: the zero policy (the
 gimbal at zero: the plant, the winds, the dispersions and the sensors alone) and an open-loop gimbal probe
 (:class:`ProbePolicy`: the servo, the delay and the bending it excites), and records per episode the score,
-the rate error, the failure and its reason, the flight time, the largest q-alpha and a digest of the first
-and last observation. ``tests/test_protocol_fingerprint.py`` compares a fresh run with the stored file.
+the rate error, the failure and its reason, the flight time, the largest q-alpha and the first
+observation. ``tests/test_protocol_fingerprint.py`` compares a fresh run with the stored file.
 
     python -m lvgym.benchmark.fingerprint --version v1 --check     # compare with the stored file
     python -m lvgym.benchmark.fingerprint --version v1 --write     # (re)write it: only when freezing
 
 Reproducibility: on one machine and one set of library versions the episodes are the same to the bit;
 across CPUs and BLAS builds the floating-point sums can round differently, so the numbers are compared to
-a relative ``1e-6`` and the failure and its reason exactly.
+a relative ``RTOL`` (1e-3) and the failure and its reason exactly.
 """
 
 from __future__ import annotations
 
 import argparse
-import hashlib
 import json
 import sys
 from pathlib import Path
@@ -34,8 +33,10 @@ __all__ = ["FINGERPRINTS", "POLICIES", "RTOL", "ProbePolicy", "compare", "finger
 
 #: where the stored fingerprints live, per protocol version
 FINGERPRINTS = Path(__file__).resolve().parent / "data"
-#: relative tolerance on the numbers across machines (exact on one machine)
-RTOL = 1e-6
+#: relative tolerance on the numbers across machines (exact on one machine). Another CPU moved a 50-seed
+#: mean of a policy that fails 14 % of its episodes by 1e-3 (README, reproducibility), and a failing
+#: episode's end can move by a control step; a protocol change moves these episodes by more
+RTOL = 1e-3
 NUMBERS = ("score", "rate_error_rad", "max_qalpha_pa_deg", "duration_s")
 EXACT = ("failed", "failure_reason")
 
@@ -47,10 +48,10 @@ def _suites(version: str) -> list[Suite]:
     return out
 
 
-def _digest(obs: np.ndarray) -> str:
-    """The observation rounded to 6 significant digits (float32 noise across machines stays below)."""
-    text = np.array2string(np.asarray(obs, dtype=np.float64), precision=6, floatmode="maxprec", threshold=10**6)
-    return hashlib.sha256(text.encode()).hexdigest()[:16]
+def _first(obs: np.ndarray) -> list[float]:
+    """The first observation as plain floats (compared to ``RTOL``, not digested: a digest would turn a
+    last-bit difference across CPUs into a mismatch)."""
+    return [float(x) for x in np.asarray(obs, dtype=np.float64).ravel()]
 
 
 class ProbePolicy:
@@ -80,7 +81,7 @@ POLICIES = {"zero": zero_policy, "probe": ProbePolicy}
 def _episode(suite: Suite, condition: Any, seed: int, policy: str) -> dict[str, Any]:
     env = condition.make_env()
     obs0, _ = env.reset(seed=int(seed))
-    first = _digest(obs0)
+    first = _first(obs0)
     m = play_episode(POLICIES[policy](env), env, seed)
     reason = m.get("failure_reason") or ""
     return {"suite": suite.name, "condition": condition.name, "seed": int(seed), "policy": policy, "first_obs": first,
@@ -110,7 +111,11 @@ def compare(fresh: list[dict[str, Any]], reference: list[dict[str, Any]], rtol: 
         if old is None:
             out.append(f"{key(r)}: not in the stored fingerprint")
             continue
-        out += [f"{key(r)} {f}: {r[f]!r} against {old[f]!r}" for f in (*EXACT, "first_obs") if r[f] != old[f]]
+        out += [f"{key(r)} {f}: {r[f]!r} against {old[f]!r}" for f in EXACT if r[f] != old[f]]
+        a, b = np.asarray(r["first_obs"], float), np.asarray(old["first_obs"], float)
+        if a.shape != b.shape or not np.allclose(a, b, rtol=rtol, atol=1e-9):
+            out.append(f"{key(r)} first_obs: differs (largest difference "
+                       f"{np.max(np.abs(a - b)) if a.shape == b.shape else 'in shape'})")
         out += [f"{key(r)} {f}: {r[f]!r} against {old[f]!r}" for f in NUMBERS
                 if not np.isclose(r[f], old[f], rtol=rtol, atol=0.0)]
     return out
