@@ -28,26 +28,21 @@ class EnvClock(VecEnvWrapper):
         super().__init__(venv)
         self.env_s = 0.0
 
-    def reset(self) -> Any:
+    def _timed(self, call: Any, *args: Any) -> Any:
         t0 = time.perf_counter()
         try:
-            return self.venv.reset()
+            return call(*args)
         finally:
             self.env_s += time.perf_counter() - t0
+
+    def reset(self) -> Any:
+        return self._timed(self.venv.reset)
 
     def step_async(self, actions: Any) -> None:
-        t0 = time.perf_counter()
-        try:
-            self.venv.step_async(actions)
-        finally:
-            self.env_s += time.perf_counter() - t0
+        self._timed(self.venv.step_async, actions)
 
     def step_wait(self) -> Any:
-        t0 = time.perf_counter()
-        try:
-            return self.venv.step_wait()
-        finally:
-            self.env_s += time.perf_counter() - t0
+        return self._timed(self.venv.step_wait)
 
 
 def find_clock(venv: Any) -> EnvClock | None:

@@ -274,6 +274,7 @@ class PIDPolicy:
         #: the accelerometers (pitch: accel_z, yaw: accel_y) where the observation has them
         self._i_acc = [lay.index("accel_z"), lay.index("accel_y")] if "accel_z" in lay.names else None
         self.accel_gain = 0.0                             # load relief [rad/s per m/s^2], see the module docstring
+        self.accel_signs = np.asarray(ACCEL_SIGNS)        # s_axis of the load-relief term, per axis
         self.chains: list[FilterChain] | None = None      # structural filters of the error, per axis
         self._filtering = False
         self.last_gimbal = np.zeros(2)
@@ -308,7 +309,7 @@ class PIDPolicy:
         ``k_a s_axis f_axis`` when ``accel_gain`` is not zero (module docstring)."""
         e = -obs[self._i_err]
         if self.accel_gain != 0.0:
-            e = e + self.accel_gain * G0 * np.asarray(ACCEL_SIGNS) * obs[self._i_acc]
+            e = e + self.accel_gain * G0 * self.accel_signs * obs[self._i_acc]
         return e
 
     def act(self, observation: np.ndarray, info: dict[str, Any]) -> np.ndarray:

@@ -3,7 +3,7 @@ docs/flex-design.md, "The slender vehicle").
 
 A variant scales each row's integral gain (``ki_scale``, one number or one per row), its proportional and
 derivative gains (``kp_scale``) and sets its accelerometer gain (``accel_gain`` [rad/s per m/s^2], one
-number or one per row; :mod:`.pid`, "Load relief"); ``signs`` replaces :data:`.pid.ACCEL_SIGNS` (to check
+number or one per row; :mod:`.pid`, "Load relief"); ``signs`` replaces the policies' :data:`.pid.ACCEL_SIGNS` (to check
 the sign). :func:`evaluate` flies it on every condition of the suite and returns, per flight model, the
 failures, the mean score [rad], the largest and the median peak q-alpha [kPa deg].
 
@@ -22,7 +22,6 @@ import yaml
 from lvgym.benchmark.runner import play_episode
 from lvgym.benchmark.suites import get_suite
 
-from . import pid
 from .pid import GainSchedule, GainScheduledPIDPolicy
 
 __all__ = ["variant", "evaluate"]
@@ -51,19 +50,26 @@ def evaluate(doc: dict[str, Any], suite: str = "slender-v1", seeds: int = 10, si
     conds = get_suite(suite).conditions
     envs = envs if envs is not None else {c.model: c.make_env() for c in conds}
     sched = variant(doc, **changes)
-    saved = pid.ACCEL_SIGNS
-    pid.ACCEL_SIGNS = saved if signs is None else tuple(signs)
-    try:
-        out = {}
-        for model, env in envs.items():
-            policy = GainScheduledPIDPolicy(sched, env=env)
-            recs = [play_episode(policy, env, s) for s in range(seeds)]
-            peaks = [r["max_qalpha_pa_deg"] / 1e3 for r in recs]
-            out[model] = (sum(r["failed"] for r in recs), float(np.mean([r["score"] for r in recs])),
-                          float(np.max(peaks)), float(np.median(peaks)))
-    finally:
-        pid.ACCEL_SIGNS = saved
+    out = {}
+    for model, env in envs.items():
+        policy = GainScheduledPIDPolicy(sched, env=env)
+        if signs is not None:
+            policy.accel_signs = np.asarray(signs, dtype=float)
+        recs = [play_episode(policy, env, s) for s in range(seeds)]
+        peaks = [r["max_qalpha_pa_deg"] / 1e3 for r in recs]
+        out[model] = (sum(r["failed"] for r in recs), float(np.mean([r["score"] for r in recs])),
+                      float(np.max(peaks)), float(np.median(peaks)))
     return out
+
+
+def _keywords(spec: str) -> dict[str, Any]:
+    """``"ki_scale=0.05, accel_gain=[0.001, 0.002]"`` as keywords: literals only (``ast.literal_eval``)."""
+    import ast
+
+    call = ast.parse(f"f({spec})", mode="eval").body
+    if not isinstance(call, ast.Call) or call.args or any(k.arg is None for k in call.keywords):
+        raise SystemExit(f"python -m baselines.relief_sweep: variant {spec!r}: KEY=LITERAL, ... only")
+    return {k.arg: ast.literal_eval(k.value) for k in call.keywords}
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -79,7 +85,7 @@ def main(argv: list[str] | None = None) -> int:
         doc = yaml.safe_load(f)
     envs = {c.model: c.make_env() for c in get_suite(a.suite).conditions}
     for spec in a.variants:
-        changes = eval(f"dict({spec})", {"__builtins__": {}, "dict": dict})   # keyword=literal, ... only
+        changes = _keywords(spec)
         res = evaluate(doc, a.suite, a.seeds, envs=envs, **changes)
         print(spec, "  ".join(f"{m}: {f}/{a.seeds} failed, score {s:.3f}, peak q-alpha max {mx:.1f} median {md:.1f} kPa deg"
                               for m, (f, s, mx, md) in res.items()), flush=True)
