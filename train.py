@@ -79,6 +79,10 @@ class Args:
     """fly residual on this registered baseline, e.g. gs-pid-flex (agents.residual; default: not residual)"""
     residual_scale: float = 0.2
     """with --residual: gimbal units per unit of learned action, in (0, 2]"""
+    loop_gain_db: float = 0.0
+    """train with the loop gain drawn per episode uniformly in +-this many dB (agents.loop_dispersion; 0: off)"""
+    loop_delay_periods: int = 0
+    """train with an extra loop delay drawn per episode from 0 to this many control periods (0: off)"""
     total_timesteps: int | None = None
     """env steps of the whole run (default: n_timesteps of the hyperparameter file)"""
     seed: int = 0
@@ -155,9 +159,10 @@ def build_parser(suppress: bool = False) -> argparse.ArgumentParser:
             kw["nargs"] = "*"
         elif f.name in ("total_timesteps", "checkpoint_freq", "eval_freq"):
             kw["type"] = _number
-        elif f.name in ("seed", "n_envs", "history", "keep_checkpoints", "eval_episodes", "torch_threads", "verbose"):
+        elif f.name in ("seed", "n_envs", "history", "keep_checkpoints", "eval_episodes", "torch_threads", "verbose",
+                        "loop_delay_periods"):
             kw["type"] = int
-        elif f.name in ("eval_mission_time_s", "checkpoint_interval_s", "residual_scale"):
+        elif f.name in ("eval_mission_time_s", "checkpoint_interval_s", "residual_scale", "loop_gain_db"):
             kw["type"] = float
         if f.name == "algo":
             from agents.config import ALGOS
@@ -242,6 +247,9 @@ def check_options(args: Args) -> None:
 
     option_number("--history", args.history, 0, 64, integer=True)
     residual_options(args.residual, args.residual_scale)
+    from agents.loop_dispersion import loop_dispersion_options
+
+    loop_dispersion_options(args.loop_gain_db, args.loop_delay_periods)
     known = set(RANDOMIZE) | {"all", "none", "protocol", "true", "false", "True", "False"}
     for r in args.randomize:
         if r not in known:
@@ -298,20 +306,21 @@ def training_seed(seed: int, step: int, n_envs: int) -> int:
 
 
 def make_venv(env_id: str, n_envs: int, seed: int, env_kwargs: dict[str, Any], norm: Any, gamma: float,
-              stats: Path | None, residual: dict[str, Any] | None = None) -> Any:
-    """Batched SB3 VecEnv (-> :class:`agents.residual.ResidualVecEnv` with ``residual``) -> EnvClock (the
-    env's wall time, :mod:`agents.timing`) -> VecMonitor (episode returns) -> VecNormalize (new, or
-    loaded from ``stats``)."""
+              stats: Path | None, residual: dict[str, Any] | None = None, loop: dict[str, Any] | None = None) -> Any:
+    """Batched SB3 VecEnv (-> :class:`agents.loop_dispersion.LoopDispersedVecEnv` with ``loop`` ->
+    :class:`agents.residual.ResidualVecEnv` with ``residual``) -> EnvClock (the env's wall time,
+    :mod:`agents.timing`) -> VecMonitor (episode returns) -> VecNormalize (new, or loaded from ``stats``)."""
     from stable_baselines3.common.vec_env import VecMonitor, VecNormalize
 
     import lvgym  # noqa: F401
     from lvgym.envs import make_sb3_vec_env
 
+    from agents.loop_dispersion import loop_venv
     from agents.residual import residual_venv
     from agents.timing import EnvClock
 
-    venv = VecMonitor(EnvClock(residual_venv(make_sb3_vec_env(env_id, num_envs=n_envs, seed=seed, **env_kwargs),
-                                             residual)))
+    base = loop_venv(make_sb3_vec_env(env_id, num_envs=n_envs, seed=seed, **env_kwargs), loop, seed)
+    venv = VecMonitor(EnvClock(residual_venv(base, residual)))
     if stats is not None and stats.is_file():
         return VecNormalize.load(str(stats), venv)
     if norm.norm_obs or norm.norm_reward:
@@ -351,6 +360,7 @@ def prepare(args: Args, given: set[str]) -> tuple[Args, dict[str, Any], Path, bo
     """The run's arguments, its ``config.yaml`` content, its folder and whether it resumes: every option
     checked, nothing written (:func:`create_run` writes). Raises ConfigError or SystemExit (one line)."""
     from agents.config import build_config, load_config, parse_overrides
+    from agents.loop_dispersion import loop_dispersion_options
     from agents.residual import residual_options
 
     check_options(args)
@@ -387,6 +397,8 @@ def prepare(args: Args, given: set[str]) -> tuple[Args, dict[str, Any], Path, bo
               "total_timesteps": int(args.total_timesteps or cfg.n_timesteps), "seed": args.seed,
               "eval_suite": suite, "eval_select": args.eval_select, "hyperparams": cfg.to_dict(),
               **({"residual": res} if (res := residual_options(args.residual, args.residual_scale)) else {}),
+              **({"loop_dispersion": loop} if (loop := loop_dispersion_options(args.loop_gain_db,
+                                                                                 args.loop_delay_periods)) else {}),
               "hyperparams_source": cfg.source,
               "created_utc": dt.datetime.now(dt.timezone.utc).isoformat(timespec="seconds"), **provenance()}
     return args, config, run_dir, False
@@ -444,7 +456,8 @@ def _train(args: Args, given: set[str], stop: Any) -> Path:
         fail(PROG, exc)
     try:                                             # the env's keywords (--model, --wind, --env-kwargs, ...)
         venv = make_venv(config["env_id"], cfg.n_envs, seed, config["env_kwargs"], cfg.normalize, cfg.hyper.gamma,
-                         policy_files(stem)[1] if stem is not None else None, config.get("residual"))
+                         policy_files(stem)[1] if stem is not None else None, config.get("residual"),
+                         config.get("loop_dispersion"))
     except (ConfigError, ValueError) as exc:
         fail(PROG, f"{config['env_id']} option {exc}")
     try:
