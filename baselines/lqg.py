@@ -41,6 +41,8 @@ import numpy as np
 
 from lvgym.errors import ConfigError
 
+from .filecache import read_once
+
 SCHEDULES = Path(__file__).resolve().parent / "schedules"
 PLANES = ("pitch", "yaw")
 
@@ -109,16 +111,29 @@ class LQGSchedule:
         if not p.exists():
             raise FileNotFoundError(f"LQG schedule {str(path)!r}: no such file (nor {p}); write one with "
                                     "`python -m baselines.lqg_design --vehicle smile` (--overwrite to ship it)")
+        return read_once(p, cls._read, "LQGSchedule")              # read once per process
+
+    @classmethod
+    def _read(cls, p: Path) -> "LQGSchedule":
+        """The schedule in the file ``p`` (an ``.npz`` of :func:`.lqg_design.save_schedule`)."""
         with np.load(p, allow_pickle=False) as z:
             times, intervals = z["time_s"], z["interval_s"]
             rows = {}
             for plane in PLANES:
                 rows[plane] = tuple(LQGRow(
-                    float(t), (float(lo), float(hi)), *(np.asarray(z[f"{plane}_{i}_{k}"], float) for k in ("A", "B", "C", "Kx")),
-                    float(z[f"{plane}_{i}_Ki"]), np.asarray(z[f"{plane}_{i}_M"], float), float(z[f"{plane}_{i}_a"]),
+                    float(t), (float(lo), float(hi)), *(_read_only(z[f"{plane}_{i}_{k}"]) for k in ("A", "B", "C", "Kx")),
+                    float(z[f"{plane}_{i}_Ki"]), _read_only(z[f"{plane}_{i}_M"]), float(z[f"{plane}_{i}_a"]),
                     float(z[f"{plane}_{i}_dt"]), tuple(str(s) for s in z[f"{plane}_{i}_labels"]))
                     for i, (t, (lo, hi)) in enumerate(zip(times, intervals)))
         return cls(rows, str(p))
+
+
+def _read_only(a: np.ndarray) -> np.ndarray:
+    """``a`` as a float array that cannot be written (the schedule is shared by every policy built from
+    it, :func:`.filecache.read_once`)."""
+    out = np.array(a, dtype=float)
+    out.setflags(write=False)
+    return out
 
 
 class LQGLaw:

@@ -64,12 +64,12 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import yaml
 
 from lvgym.envs.ascent import DEFAULT_AERO_MACH, SlenderAscentV1Env, slender_key
 from lvgym.envs.layouts import G0
 from lvgym.errors import ConfigError
 
+from .filecache import read_once, safe_load_fast
 from .filters import FILTER_KEYS, FilterChain, StructuralFilter
 
 SCHEDULES = Path(__file__).resolve().parent / "schedules"
@@ -246,8 +246,12 @@ class GainSchedule:
         p = Path(path)
         if not p.exists():
             p = SCHEDULES / (str(path) if str(path).endswith(".yaml") else f"{path}.yaml")
-        with open(p) as f:
-            return cls.from_dict(yaml.safe_load(f))
+
+        def read(q: Path) -> "GainSchedule":
+            with open(q) as f:
+                return cls.from_dict(safe_load_fast(f))
+
+        return read_once(p, read, "GainSchedule")                  # parsed once per process
 
 
 class PIDPolicy:
