@@ -33,12 +33,13 @@ import numpy as np
 from scipy import optimize, signal
 
 from .filters import StructuralFilter
+from .flextable import margin_table, row_line
 from .flightloop import flight_plant, frequency_response, mode_frequencies
 from .linearize import margins, operating_point, pid_tf
 
 #: the flight times of the schedule per vehicle [s]: SMILE v1 boost (burnout 43 s) and upper stage
 #: (ignition 54 s, mission 70 s); Stratos III (30 s); the slender vehicle (10 s)
-FLEX_TIMES = {"smile": (3.0, 10.0, 20.0, 28.8, 36.0, 42.5, 54.1, 62.0, 69.5),
+FLEX_TIMES = {"smile": (3.0, 10.0, 15.0, 20.0, 24.4, 28.8, 32.4, 36.0, 42.5, 54.1, 62.0, 69.5),
               "stratos3": (2.0, 6.0, 10.0, 14.0, 18.0, 24.0, 29.0),
               "slender": (1.0, 3.0, 5.0, 7.0, 9.0)}
 
@@ -341,7 +342,8 @@ def relieved(gains: tuple[float, float, float], relief: tuple[float, float] | No
 
 
 def design_schedule(vehicle: str = "smile", times=None, req: Requirements | None = None, starts: int = 2,
-                    seed: int = 0, log=print, relief: tuple[float, float] | None = None) -> dict[str, Any]:
+                    seed: int = 0, log=print, relief: tuple[float, float] | None = None,
+                    planes: tuple[str, ...] = ("pitch",)) -> dict[str, Any]:
     """Design every row of ``vehicle``'s schedule in time order. Each row flies the stretch between the
     midpoints to its neighbours in the same burn (the policy switches rows at the mass midpoints,
     ``interpolation: nearest``), and is designed to meet the requirements at its own time and at both
@@ -349,8 +351,11 @@ def design_schedule(vehicle: str = "smile", times=None, req: Requirements | None
     a first design of the row from its time and left end, which the final design then starts from).
     ``relief = (ki_scale, accel_gain)``: every row, once designed, flies with its integral gain scaled
     and the load-relief gain ``accel_gain`` [rad/s per m/s^2] (the later rows are flown to so), and is
-    checked so (the rate loop's margins; the accelerometer path is not in the linear plant). Returns the
-    schedule document."""
+    checked so (the rate loop's margins; the accelerometer path is not in the linear plant). ``planes``:
+    the planes whose loops the optimiser holds to the requirements (the pitch loop's disturbance response
+    is the objective; every row is checked in both planes whatever it is). Returns the schedule document."""
+    if not planes or any(p not in ("pitch", "yaw") for p in planes) or planes[0] != "pitch":
+        raise ValueError(f"planes = {planes!r}: ('pitch',) or ('pitch', 'yaw')")
     req = req or Requirements()
     times = tuple(sorted(FLEX_TIMES[vehicle] if times is None else times))
     rng = np.random.default_rng(seed)
@@ -366,7 +371,7 @@ def design_schedule(vehicle: str = "smile", times=None, req: Requirements | None
             continue
         notch = notch_frequency(own[1], float(own[0]["pitch"]["rigid"].dt))
         cases = [(t, own)] + ([left] if left is not None else [])
-        e = design_row(RowProblem([(c[0]["pitch"], c[1]) for _, c in cases], req), warm, rng, starts)
+        e = design_row(RowProblem([(c[0][p], c[1]) for _, c in cases for p in planes], req), warm, rng, starts)
         right = None
         if k + 1 < len(times):
             t_r = 0.5 * (t + times[k + 1])
@@ -381,7 +386,8 @@ def design_schedule(vehicle: str = "smile", times=None, req: Requirements | None
                 log(f"t = {t_r:g} s: not reached ({exc}); the row is designed without its right end")
         if right is not None:
             cases.append(right)
-            e = design_row(RowProblem([(c[0]["pitch"], c[1]) for _, c in cases], req), e["values"], rng, starts=0)
+            e = design_row(RowProblem([(c[0][p], c[1]) for _, c in cases for p in planes], req), e["values"], rng,
+                           starts=0)
         warm = e["values"]
         gains, filt = controller(e["values"], notch)
         gains = relieved(gains, relief)
@@ -393,66 +399,14 @@ def design_schedule(vehicle: str = "smile", times=None, req: Requirements | None
                "stretch_s": [round(min(tc for tc, _ in cases), 3), round(max(tc for tc, _ in cases), 3)],
                "margins": checks[0]["margins"], "modes": checks[0]["modes"], "ends": checks[1:]}
         rows.append(row)
-        log(_row_line(row) + "".join(f"\n    end {_row_line(c)}" for c in checks[1:]))
+        log(row_line(row) + "".join(f"\n    end {row_line(c)}" for c in checks[1:]))
         left = right
     return {"vehicle": vehicle, "protocol": "v1",
             "source": "python -m baselines.flexdesign (non-rigid v1 flight loop, discrete)",
             "variable": "mass", "interpolation": "nearest", "requirements": asdict(req),
-            "design": {"starts": starts, "seed": seed, **({} if relief is None else
+            "design": {"starts": starts, "seed": seed, "planes": list(planes), **({} if relief is None else
                                                           {"ki_scale": relief[0], "accel_gain": relief[1]})},
             "rows": rows, "skipped": skipped}
-
-
-def _worst(row: dict[str, Any], model: str) -> dict[str, float]:
-    """The worse of the pitch and yaw margins of ``model`` in a row."""
-    ms = [row["margins"][f"{model}_{p}"] for p in ("pitch", "yaw")]
-    return {"gm": min(m["gain_margin_db"] for m in ms), "gm_down": max(m["gain_reduction_margin_db"] for m in ms),
-            "pm": min(abs(m["phase_margin_deg"]) for m in ms), "growth": max(m["max_pole_real_per_s"] for m in ms)}
-
-
-def _mode_summary(row: dict[str, Any]) -> tuple[str, str, str]:
-    slosh = [m["loop_gain_db"] for m in row["modes"] if m["mode"] == "slosh"]
-    bend = [m for m in row["modes"] if m["mode"] == "bending"]
-    s = f"{min(slosh):.1f} to {max(slosh):.1f}" if slosh else "-"
-    b1 = f"{bend[0]['loop_gain_db']:.1f} ({bend[0]['stabilised']})" if bend else "-"
-    hi = f"{max(m['loop_gain_db'] for m in bend[1:]):.1f}" if len(bend) > 1 else "-"
-    return s, b1, hi
-
-
-def _row_line(row: dict[str, Any]) -> str:
-    r, n = _worst(row, "rigid"), _worst(row, "nonrigid")
-    s, b1, hi = _mode_summary(row)
-    return (f"t = {row['time_s']:5.1f} s  m = {row['mass_kg']:8.1f} kg  rigid GM {r['gm']:.1f}/{r['gm_down']:.1f} dB "
-            f"PM {r['pm']:.1f} deg  non-rigid GM {n['gm']:.1f}/{n['gm_down']:.1f} dB PM {n['pm']:.1f} deg  "
-            f"slosh {s} dB  bending 1 {b1} dB  higher {hi} dB  growth {max(r['growth'], n['growth']):.3f} 1/s  "
-            f"meets {row['meets']}")
-
-
-def margin_table(doc: dict[str, Any]) -> str:
-    """The schedule's margins as a Markdown table (worse of pitch and yaw per row)."""
-    def fmt(x: float) -> str:
-        return "none" if not math.isfinite(x) or abs(x) >= 99 else f"{x:.1f}"
-
-    lines = [f"# gs-pid-flex margins: {doc['vehicle']} (protocol {doc['protocol']})", "",
-             f"Requirements: {doc['requirements']}. Each row's controller flies from the midpoint to the row "
-             "before to the midpoint to the row after (its 'end' lines: the same controller on the plants there). "
-             "Margins are the worse of pitch and yaw; 'down' is the gain "
-             "reduction that destabilises a conditionally stable loop; mode columns are the non-rigid pitch loop's "
-             "gain [dB] at the mode ('gain': at least the attenuation below 0 dB; 'phase': inside the loop, held by "
-             "the non-rigid margins).", "",
-             "| t [s] | mass [kg] | kp | ki | kd | rigid GM up/down [dB] | rigid PM [deg] | non-rigid GM up/down [dB] "
-             "| non-rigid PM [deg] | slosh gain [dB] | bending 1 [dB] | higher bending [dB] | meets |",
-             "|---:|---:|---:|---:|---:|---|---:|---|---:|---|---|---:|---|"]
-    for line in doc["rows"]:
-        for kind, row in [("row", line)] + [("end", e) for e in line.get("ends", [])]:
-            r, n = _worst(row, "rigid"), _worst(row, "nonrigid")
-            s, b1, hi = _mode_summary(row)
-            t = f"{row['time_s']:.1f}" + (" (end)" if kind == "end" else "")
-            gains = (f"{row['kp']:.4f} | {row['ki']:.4f} | {row['kd']:.5f}" if kind == "row" else "same | | ")
-            lines.append(f"| {t} | {row['mass_kg']:.0f} | {gains} | {fmt(r['gm'])} / {fmt(r['gm_down'])} | {fmt(r['pm'])} "
-                         f"| {fmt(n['gm'])} / {fmt(n['gm_down'])} | {fmt(n['pm'])} | {s} | {b1} | {hi} | "
-                         f"{'yes' if row['meets'] else 'NO'} |")
-    return "\n".join(lines) + "\n"
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -478,6 +432,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--seed", type=int, default=0, help="seed of the random starts")
     ap.add_argument("--load-relief", type=float, nargs=2, default=None, metavar=("KI_SCALE", "ACCEL_GAIN"),
                     help="load relief: scale every row's integral gain by KI_SCALE and add ACCEL_GAIN [rad/s per m/s^2]")
+    ap.add_argument("--planes", nargs="+", choices=("pitch", "yaw"), default=["pitch"],
+                    help="planes the optimiser holds to the requirements: pitch (default) or pitch yaw")
     a = ap.parse_args(argv)
     try:
         out = output_path(a.vehicle, a.out, a.overwrite, stem=f"{a.vehicle}_flex")
@@ -490,13 +446,16 @@ def main(argv: list[str] | None = None) -> int:
     except ConfigError as exc:
         fail(ap.prog, exc)
     doc = design_schedule(a.vehicle, a.times, starts=a.starts, seed=a.seed,
-                          relief=None if a.load_relief is None else tuple(a.load_relief))
+                          relief=None if a.load_relief is None else tuple(a.load_relief), planes=tuple(dict.fromkeys(
+                              ["pitch", *a.planes])))
     if not doc["rows"]:
         print(f"no flight time of {a.vehicle} could be designed; nothing written", file=sys.stderr)
         return 1
     shipped = out.parent.resolve() == SCHEDULES.resolve()
     again = (f"python -m baselines.flexdesign --vehicle {a.vehicle} --starts {a.starts}"
              + ("" if a.load_relief is None else " --load-relief {:g} {:g}".format(*a.load_relief))
+             + ("" if not a.times else " --times " + " ".join(f"{t:g}" for t in a.times))
+             + ("" if a.planes == ["pitch"] else " --planes " + " ".join(dict.fromkeys(["pitch", *a.planes])))
              + (" --overwrite" if shipped else f" --out {out}"))
     out.parent.mkdir(parents=True, exist_ok=True)
     atomic_write_text(out, f"# gs-pid-flex schedule of {a.vehicle}, regenerated by: {again}\n"
