@@ -5,7 +5,7 @@ the compiled step that applies them row by row."""
 import numpy as np
 import pytest
 
-from lvgym.simulator import Simulator, build_timeline
+from lvgym.simulator import Simulator, build_timeline, cache
 from lvgym.vehicle import MassModel, load_vehicle
 from lvgym.vehicle.structure import mode_transfer, stiffness_factor, vehicle_modes
 
@@ -126,7 +126,7 @@ def test_held_timelines_have_no_changes_and_the_cache_keeps_the_options(tmp_path
     np.testing.assert_allclose(proj.mode_change_t, [2.0, 4.0, 6.0, 8.0, 10.0])
     assert proj.mode_basis == "projected" and proj.mode_interval == 2.0
     again = build_timeline(mm, **kw, mode_interval=2.0, mode_basis="projected")     # from the cache
-    assert len(list((tmp_path / "timelines").glob("*.npz"))) == 2
+    assert len(list((tmp_path / "timelines").glob("*" + cache.SUFFIX))) == 2
     np.testing.assert_array_equal(again.mode_transfer, proj.mode_transfer)
     assert again.mode_interval == 2.0 and again.mode_basis == "projected"
     np.testing.assert_array_equal(held.params, proj.params)       # the same modes in force, only carried

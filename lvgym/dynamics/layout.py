@@ -18,6 +18,7 @@ their offsets from them (``at(X.eta_dot, K, N)``, see :mod:`lvgym.packing`).
 
 from __future__ import annotations
 
+import functools
 from collections import namedtuple
 from dataclasses import dataclass, field
 
@@ -141,6 +142,18 @@ RK4_ROWS = Packed("rk4 rows", [
 ])
 
 
+@functools.lru_cache(maxsize=None)
+def _resolved(n: int, k: int) -> tuple[dict[str, Packed], dict[str, dict[str, slice]]]:
+    """The :class:`~lvgym.packing.Packed` layouts (state, params, loads, slosh) for ``n`` pendulums and ``k``
+    modes per plane and the state, params and loads slices by name: resolved once per process (a resolve
+    makes four offset namedtuple classes, about 0.25 ms), shared by every :class:`Layout` of that size."""
+    packed = {kind: lin.resolve(k, n) for kind, lin in (("state", STATE), ("params", PARAMS),
+                                                          ("loads", LOADS), ("slosh", SLOSH))}
+    slices = {kind: {name: packed[kind].slice(name) for name in packed[kind].names}
+              for kind in ("state", "params", "loads")}
+    return packed, slices
+
+
 @dataclass(frozen=True)
 class Layout:
     """Index map of state, parameter and load vectors for N slosh pendulums and K modes per plane
@@ -163,12 +176,10 @@ class Layout:
             value = getattr(self, key)
             if not isinstance(value, (int, np.integer)) or value < 0:
                 raise ValueError(f"Layout.{key} = {value!r}: must be an integer >= 0")
-        n, k = int(self.n_slosh), int(self.n_modes)
-        packed = {kind: lin.resolve(k, n) for kind, lin in (("state", STATE), ("params", PARAMS),
-                                                              ("loads", LOADS), ("slosh", SLOSH))}
-        object.__setattr__(self, "packed", packed)
+        packed, slices = _resolved(int(self.n_slosh), int(self.n_modes))
+        object.__setattr__(self, "packed", dict(packed))
         for kind in ("state", "params", "loads"):
-            object.__setattr__(self, kind, {name: packed[kind].slice(name) for name in packed[kind].names})
+            object.__setattr__(self, kind, dict(slices[kind]))
         for name, kind in (("n_x", "state"), ("n_p", "params"), ("n_u", "loads")):
             object.__setattr__(self, name, packed[kind].size)
 

@@ -19,6 +19,7 @@ poles are regular, and no factorials, so it stays stable to high degree.
 
 from __future__ import annotations
 
+import functools
 import math
 from pathlib import Path
 from typing import Any
@@ -327,9 +328,17 @@ class HarmonicGravity(GravityModel):
 
 def load_egm2008(path: Path = DATA_FILE) -> tuple[np.ndarray, np.ndarray, float, float]:
     """Fully normalised EGM2008 coefficients ``C``, ``S`` (square arrays up to the shipped degree),
-    ``gm`` [m^3/s^2] and ``radius`` [m] read from the data file (header lines ``# key = value``)."""
+    ``gm`` [m^3/s^2] and ``radius`` [m] read from the data file (header lines ``# key = value``); the file
+    is parsed once per process and content (each call gets its own arrays)."""
+    C, S, gm, radius = _parsed_egm2008(Path(path).read_bytes())
+    return C.copy(), S.copy(), gm, radius
+
+
+@functools.lru_cache(maxsize=4)
+def _parsed_egm2008(content: bytes) -> tuple[np.ndarray, np.ndarray, float, float]:
+    """:func:`load_egm2008` of a file's ``content`` (read-only arrays)."""
     header, rows = {}, []
-    for line in path.read_text().splitlines():
+    for line in content.decode("utf-8").splitlines():
         if line.startswith("#"):
             k, _, v = line[1:].partition("=")
             if k.strip() in ("gm", "radius"):
@@ -341,6 +350,7 @@ def load_egm2008(path: Path = DATA_FILE) -> tuple[np.ndarray, np.ndarray, float,
     C, S = np.zeros((n_max + 1, n_max + 1)), np.zeros((n_max + 1, n_max + 1))
     for n, m, c, s in rows:
         C[int(n), int(m)], S[int(n), int(m)] = c, s
+    C.flags.writeable = S.flags.writeable = False
     return C, S, header["gm"], header["radius"]
 
 

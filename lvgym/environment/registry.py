@@ -8,6 +8,7 @@ as ``{"model": "exponential", "scale_height": 7200.0}``; unknown names and unkno
 
 from __future__ import annotations
 
+import functools
 import inspect
 from collections.abc import Callable, Mapping
 from typing import Any, TypeVar
@@ -60,8 +61,7 @@ def make(kind: str, spec: str | Mapping[str, Any], *, key: str | None = None, **
         raise ConfigError(f"{key}.model", name, f"one of {list(names(kind))}")
     options.update(overrides)
     cls = models[name]
-    accepted = inspect.signature(cls).parameters
-    takes_any = any(p.kind is inspect.Parameter.VAR_KEYWORD for p in accepted.values())
+    accepted, takes_any = _options(cls)
     for option in options:
         if option not in accepted and not takes_any:
             raise ConfigError(f"{key}.{option}", options[option],
@@ -72,6 +72,13 @@ def make(kind: str, spec: str | Mapping[str, Any], *, key: str | None = None, **
         if key == kind or not err.key.startswith(f"{kind}."):
             raise
         raise ConfigError(key + err.key[len(kind):], err.value, err.allowed, err.source) from None
+
+
+@functools.lru_cache(maxsize=None)
+def _options(cls: type) -> tuple[Any, bool]:
+    """The parameters of ``cls``'s constructor and whether it takes any keyword (read once per class)."""
+    accepted = inspect.signature(cls).parameters
+    return accepted, any(p.kind is inspect.Parameter.VAR_KEYWORD for p in accepted.values())
 
 
 def names_of_kinds() -> list[str]:

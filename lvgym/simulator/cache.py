@@ -7,7 +7,8 @@ CG convention, the timeline's arguments, whether layouts are padded, and the sou
 builds a timeline (the vehicle layer, the beam, the dynamics layout and parameter builder, the mode
 resampling at the aeroelastic strips, this package's timeline), so an edited vehicle file or an edited
 mass model never reads a stale entry. The folder is ``$LVGYM_CACHE_DIR`` (default
-``~/.cache/lvgym``), its ``timelines/`` subfolder one ``.npz`` file per entry, written atomically; ``off``
+``~/.cache/lvgym``), its ``timelines/`` subfolder one file per entry (``SUFFIX``; a JSON header and the raw arrays,
+read back in one call), written atomically; ``off``
 (or an unwritable folder) switches the cache off. A file that cannot be read is rebuilt.
 """
 
@@ -16,6 +17,7 @@ from __future__ import annotations
 import dataclasses
 import functools
 import hashlib
+import json
 import os
 import pickle
 import tempfile
@@ -28,7 +30,7 @@ import numpy as np
 
 from lvgym import packing
 
-__all__ = ["cache_dir", "cached", "key", "using"]
+__all__ = ["SUFFIX", "cache_dir", "cached", "key", "using"]
 
 _ARRAYS = ("t", "params", "hold", "thrust0", "exit_area", "mass", "cg", "inertia", "slosh_mass", "burning", "stage",
            "sensor_stations", "phi_sensor", "dphi_sensor", "strip_stations", "phi_strip", "dphi_strip", "mode_change_t",
@@ -81,37 +83,74 @@ def key(mass_model: Any, args: tuple) -> str:
     return h.hexdigest()[:40]
 
 
+#: the first 8 bytes of an entry; then the header's length and the arrays' start (8 bytes each,
+#: little-endian), the header (JSON: the arrays' names, dtypes, shapes and offsets from that start, and the
+#: timeline's other fields), and from the start (a multiple of :data:`_ALIGN`) the arrays' bytes, each
+#: block padded to a multiple of :data:`_ALIGN`
+_MAGIC = b"LVGYMTL1"
+_ALIGN = 64
+#: the entries' file name suffix
+SUFFIX = ".lvtl"
+
+
+def _padded(n: int) -> int:
+    return -(-n // _ALIGN) * _ALIGN
+
+
 def _load(path: Path) -> Any:
+    """The timeline stored at ``path`` by :func:`_store`: one read, the arrays views of one aligned,
+    writable buffer (``np.load`` of a ``.npz`` took 3-5 ms for it: a zip member and a parsed header per array)."""
     from lvgym.dynamics import NonRigidModel
 
     from .timeline import Timeline
-    with np.load(path, allow_pickle=False) as f:
-        arrays = {k: f[k] for k in _ARRAYS}
-        meta = [str(x) for x in f["meta"]]
-        n_slosh, n_modes = (int(v) for v in f["sizes"])
-        event_t = f["event_t"]
-        interval = float(f["mode_interval"])
-        basis = str(f["mode_basis"])
-    model, n_stage = meta[0], int(meta[1])
-    stage_names, rest = tuple(meta[2:2 + n_stage]), meta[2 + n_stage:]
-    n_names = int(rest[0])
-    slosh_names, event_text = tuple(rest[1:1 + n_names]), rest[1 + n_names:]
-    return Timeline(model=model, dynamics=NonRigidModel(n_slosh, n_modes), stage_names=stage_names,
-                    slosh_names=slosh_names, events=tuple((float(t), e) for t, e in zip(event_t, event_text)),
-                    mode_interval=None if np.isnan(interval) else interval, mode_basis=basis, **arrays)
+    with open(path, "rb") as f:
+        size = os.fstat(f.fileno()).st_size
+        buf = np.empty(size, dtype=np.uint8)
+        if f.readinto(memoryview(buf)) != size:
+            raise ValueError(f"{path}: short read")
+    if size < 24 or bytes(buf[:8]) != _MAGIC:
+        raise ValueError(f"{path}: not a timeline entry")
+    n_head, start = int.from_bytes(bytes(buf[8:16]), "little"), int.from_bytes(bytes(buf[16:24]), "little")
+    head = json.loads(bytes(buf[24:24 + n_head]).decode("utf-8"))
+    arrays = {}
+    for name, dtype, shape, offset in head["arrays"]:
+        dt = np.dtype(dtype)
+        lo = start + offset
+        hi = lo + int(np.prod(shape, dtype=np.int64)) * dt.itemsize
+        if lo % _ALIGN or hi > size:
+            raise ValueError(f"{path}: array {name!r} outside the file")
+        arrays[name] = buf[lo:hi].view(dt).reshape(shape)
+    if set(arrays) != set(_ARRAYS):
+        raise ValueError(f"{path}: arrays {sorted(arrays)}")
+    interval = head["mode_interval"]
+    return Timeline(model=head["model"], dynamics=NonRigidModel(*head["sizes"]), stage_names=tuple(head["stage_names"]),
+                    slosh_names=tuple(head["slosh_names"]), events=tuple((float(t), e) for t, e in head["events"]),
+                    mode_interval=None if interval is None else float(interval), mode_basis=head["mode_basis"],
+                    **arrays)
 
 
 def _store(path: Path, tl: Any) -> None:
-    meta = [tl.model, str(len(tl.stage_names)), *tl.stage_names, str(len(tl.slosh_names)), *tl.slosh_names,
-            *(e for _, e in tl.events)]
+    """Write ``tl`` to ``path`` (see :data:`_MAGIC`), atomically: a temporary file renamed."""
+    blocks, entries, offset = [], [], 0
+    for name in _ARRAYS:
+        a = np.ascontiguousarray(getattr(tl, name))
+        blocks.append(a)
+        entries.append([name, a.dtype.str, list(a.shape), offset])
+        offset += _padded(a.nbytes)
+    head = {"model": tl.model, "sizes": [tl.dynamics.n_slosh, tl.dynamics.n_modes],
+            "stage_names": list(tl.stage_names), "slosh_names": list(tl.slosh_names),
+            "events": [[float(t), str(e)] for t, e in tl.events], "mode_basis": tl.mode_basis,
+            "mode_interval": None if tl.mode_interval is None else float(tl.mode_interval), "arrays": entries}
+    text = json.dumps(head).encode("utf-8")       # floats as their shortest repr: read back to the bit
+    start = _padded(24 + len(text))
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".tmp")
     try:
         with os.fdopen(fd, "wb") as f:
-            np.savez(f, meta=np.array(meta), sizes=np.array([tl.dynamics.n_slosh, tl.dynamics.n_modes]),
-                     event_t=np.array([t for t, _ in tl.events], dtype=float),
-                     mode_interval=np.nan if tl.mode_interval is None else tl.mode_interval,
-                     mode_basis=np.array(tl.mode_basis), **{k: getattr(tl, k) for k in _ARRAYS})
+            f.write(_MAGIC + len(text).to_bytes(8, "little") + start.to_bytes(8, "little") + text
+                    + bytes(start - 24 - len(text)))
+            for a in blocks:
+                f.write(a.tobytes() + bytes(_padded(a.nbytes) - a.nbytes))
         os.replace(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
@@ -123,7 +162,7 @@ def cached(mass_model: Any, args: tuple, build: Callable[[], Any]) -> Any:
     folder = cache_dir()
     if folder is None:
         return build()
-    path = folder / f"{key(mass_model, args)}.npz"
+    path = folder / f"{key(mass_model, args)}{SUFFIX}"
     if path.is_file():
         try:
             return _load(path)
