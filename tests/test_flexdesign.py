@@ -167,7 +167,22 @@ def test_shipped_schedule_record():
                 assert chk["margins"][f"nonrigid_{plane}"]["max_pole_real_per_s"] < 0.025
         if row["meets"]:
             assert all(c["meets"] for c in row["ends"])
-    assert sum(r["meets"] for r in sched.meta["rows"]) >= 7
+    assert all(r["meets"] for r in sched.meta["rows"])           # the 12-row schedule meets at every row
+
+
+def test_stratos3_schedule_was_designed_and_meets_in_both_planes():
+    """The shipped Stratos III schedule was designed with the yaw loops in the optimiser
+    (``--planes pitch yaw``) and records every row and stretch end meeting the requirements in pitch
+    and yaw; a plane list without pitch first is refused."""
+    sched = GainSchedule.load("stratos3_flex")
+    assert sched.meta["design"]["planes"] == ["pitch", "yaw"]
+    for row in sched.meta["rows"]:
+        assert row["meets"] and all(c["meets"] for c in row["ends"]), row["time_s"]
+        for chk in [row] + row["ends"]:
+            for key, m in chk["margins"].items():
+                assert m["gain_margin_db"] >= 5.95 and abs(m["phase_margin_deg"]) >= 29.5, (row["time_s"], key, m)
+    with pytest.raises(ValueError, match="planes"):
+        FD.design_schedule("stratos3", times=(2.0,), planes=("yaw",))
 
 
 def test_gs_pid_flex_flies_the_nonrigid_v1_vehicle():
