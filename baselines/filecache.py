@@ -14,21 +14,10 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any, TypeVar
 
-import yaml
-
-__all__ = ["read_once", "safe_load_fast"]
+__all__ = ["read_once"]
 
 T = TypeVar("T")
 _CACHE: dict[tuple[str, str, int, int], Any] = {}
-
-#: libyaml's parser with the safe constructor where PyYAML was built with it (the same values)
-_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
-
-
-def safe_load_fast(stream: Any) -> Any:
-    """``yaml.safe_load`` through libyaml's parser when it is there (the same safe constructor, so the
-    same values; about 10 times faster)."""
-    return yaml.load(stream, Loader=_LOADER)  # noqa: S506 - a safe loader
 
 
 def read_once(path: str | Path, reader: Callable[[Path], T], kind: str) -> T:

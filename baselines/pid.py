@@ -68,8 +68,9 @@ import numpy as np
 from lvgym.envs.ascent import DEFAULT_AERO_MACH, SlenderAscentV1Env, slender_key
 from lvgym.envs.layouts import G0
 from lvgym.errors import ConfigError
+from lvgym.vehicle.yamlfile import read_yaml
 
-from .filecache import read_once, safe_load_fast
+from .filecache import read_once
 from .filters import FILTER_KEYS, FilterChain, StructuralFilter
 
 SCHEDULES = Path(__file__).resolve().parent / "schedules"
@@ -248,8 +249,7 @@ class GainSchedule:
             p = SCHEDULES / (str(path) if str(path).endswith(".yaml") else f"{path}.yaml")
 
         def read(q: Path) -> "GainSchedule":
-            with open(q) as f:
-                return cls.from_dict(safe_load_fast(f))
+            return cls.from_dict(read_yaml(q)[0])            # libyaml, duplicate keys refused, errors name the file
 
         return read_once(p, read, "GainSchedule")                  # parsed once per process
 
