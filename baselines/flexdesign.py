@@ -36,6 +36,7 @@ from .filters import StructuralFilter
 from .flextable import margin_table, row_line
 from .flightloop import flight_plant, frequency_response, mode_frequencies
 from .linearize import margins, operating_point, pid_tf
+from .noise import command_noise, gyro_noise, noise_fraction_on_grid
 
 #: the flight times of the schedule per vehicle [s]: SMILE v1 boost (burnout 43 s) and upper stage
 #: (ignition 54 s, mission 70 s); Stratos III (30 s); the slender vehicle (10 s)
@@ -59,7 +60,10 @@ class Requirements:
     ``bending1``: how the first bending mode must be stabilised, ``"gain"`` (the default: v1's suites
     disperse the servo delay by 0 or 10 ms, 41 deg of phase at 71 rad/s, and the bending frequency by
     5 %, so the mode's phase is not known well enough to phase-stabilise it) or ``"phase"`` (inside
-    the loop, held by the non-rigid margins, as Ares I's first stage did)."""
+    the loop, held by the non-rigid margins, as Ares I's first stage did);
+    ``noise_fraction``: the largest RMS of the gimbal command's response to the flight gyro's white
+    noise, as a fraction of the gimbal limit (:mod:`.noise`; rigid and non-rigid loops), so that the
+    actuator's travel and rate are not spent on sensor noise."""
 
     rigid_gm_db: float = 6.0
     rigid_pm_deg: float = 30.0
@@ -68,6 +72,7 @@ class Requirements:
     attenuation_db: float = 6.0
     drift_per_s: float = 0.02
     bending1: str = "gain"
+    noise_fraction: float = 0.02
 
     def __post_init__(self) -> None:
         for k, v in asdict(self).items():
@@ -144,11 +149,14 @@ class RowProblem:
     """The design problem of one row: the discrete plants of the row's own flight time and of the ends
     of the stretch it flies (``cases``: the first is the row's own, whose disturbance response is the
     objective; the requirements hold on all), their responses on a frequency grid, and the bands the
-    mode constraints look at."""
+    mode constraints look at; ``noise``: the gyro's noise per sample [rad/s] and the gimbal limit [rad]
+    (:func:`.noise.gyro_noise`; a zero noise leaves the noise requirement out)."""
 
     def __init__(self, cases: list[tuple[dict[str, control.StateSpace], dict[str, list[float]]]], req: Requirements,
-                 n_grid: int = 3000, slack: tuple[float, float] = (0.5, 2.0)) -> None:
+                 n_grid: int = 3000, slack: tuple[float, float] = (0.5, 2.0),
+                 noise: tuple[float, float] = (0.0, 1.0)) -> None:
         self.req = req
+        self.noise = (float(noise[0]), float(noise[1]))
         self.slack_db, self.slack_deg = slack           # designed beyond the requirements by this much (the
         #                                               # grid's margins are a little optimistic)
         self.dt = float(cases[0][0]["rigid"].dt)
@@ -204,14 +212,17 @@ class RowProblem:
 
     def evaluate(self, values: dict[str, float]) -> dict[str, Any]:
         """Worst margins over the cases per model (gain up, gain down, phase, growth), the modes' part of
-        the loop at its peak over the gain-stabilised bands [dB], and the objective ``J``."""
+        the loop at its peak over the gain-stabilised bands [dB], the command's noise as a fraction of the
+        gimbal limit (``noise``, the largest over the cases and models), and the objective ``J``."""
         gains, filt = controller(values, self.notch_radps)
         b, a = _controller_poly(gains, filt, self.dt)
         C = np.polyval(b, self.z) / np.polyval(a, self.z)
-        out: dict[str, Any] = {"values": values, "higher_db": -99.0}
+        out: dict[str, Any] = {"values": values, "higher_db": -99.0, "noise": 0.0}
         for i, (G, band, _) in enumerate(self.cases):
             for model, g in G.items():
                 L = C * g
+                if self.noise[0] > 0.0:
+                    out["noise"] = max(out["noise"], noise_fraction_on_grid(C, g, self.w, self.dt, *self.noise))
                 m = self.grid_margins(L) + (self.growth(b, a, model, i),)
                 w = out.get(model)
                 out[model] = m if w is None else (min(w[0], m[0]), max(w[1], m[1]), min(w[2], m[2]), max(w[3], m[3]))
@@ -231,6 +242,8 @@ class RowProblem:
             v += [max(0.0, gm - up), max(0.0, gm + down) if down > -99 else 0.0, max(0.0, pm - phase) / 5.0,
                   100.0 * max(0.0, growth - 0.8 * r.drift_per_s)]
         v.append(max(0.0, e["higher_db"] + r.attenuation_db + sdb))
+        if self.noise[0] > 0.0:                        # relative, designed 10 % below the requirement
+            v.append(5.0 * max(0.0, e["noise"] / max(r.noise_fraction, 1e-12) - 0.9))
         return v
 
     def cost(self, u: np.ndarray) -> float:
@@ -263,7 +276,8 @@ def design_row(problem: RowProblem, warm: dict[str, float] | None, rng: np.rando
 
 def row_plants(vehicle: str, t: float, policy: Callable | None) -> tuple[dict, dict, dict]:
     """Pitch and yaw ``flight_plant`` of the rigid and non-rigid v1 vehicle at ``t`` [s], flown there
-    with ``policy`` (None: the zero action), and the non-rigid modes."""
+    with ``policy`` (None: the zero action), the non-rigid modes, and the thrust [N], the mass [kg] and
+    the gyro's noise with the gimbal limit (:func:`.noise.gyro_noise`) there."""
     plants: dict[str, dict[str, control.StateSpace]] = {"pitch": {}, "yaw": {}}
     thrust = None
     for model in ("rigid", "nonrigid"):
@@ -274,16 +288,20 @@ def row_plants(vehicle: str, t: float, policy: Callable | None) -> tuple[dict, d
         if model == "nonrigid":
             modes = mode_frequencies(op)
             mass = float(op.sim.timeline.interp("mass", [op.t])[0])
-    return plants, modes, {"thrust_n": thrust, "mass_kg": mass}
+            noise = gyro_noise(op)
+    return plants, modes, {"thrust_n": thrust, "mass_kg": mass, "noise": noise}
 
 
 def check_loops(plants: dict[str, dict[str, control.StateSpace]], gains, filt: StructuralFilter,
-                modes: dict[str, list[float]], req: Requirements) -> dict[str, Any]:
+                modes: dict[str, list[float]], req: Requirements,
+                noise: tuple[float, float] | None = None) -> dict[str, Any]:
     """Exact margins (:func:`.linearize.margins`) of ``C(z) G(z)`` for every plane and model; for each
     slosh and bending mode the peak of the modes' part of the pitch loop, ``C (G_nonrigid - G_rigid)``,
     near the frequency at which the sampler sees it (+-3 % for slosh, +-15 % for bending), and so how
     it is stabilised ('gain': at least ``req.attenuation_db`` below 0 dB; 'phase': held by the
-    non-rigid margins); and whether the row meets ``req``."""
+    non-rigid margins); with ``noise`` (the gyro's noise per sample [rad/s], the gimbal limit [rad]) the
+    command's noise as a fraction of the limit per loop (``noise_fraction``, :func:`.noise.command_noise`);
+    and whether the row meets ``req``."""
     dt = float(plants["pitch"]["rigid"].dt)
     C = control.ss(controller_tf(gains, filt, dt))
     out: dict[str, Any] = {}
@@ -296,6 +314,9 @@ def check_loops(plants: dict[str, dict[str, control.StateSpace]], gains, filt: S
                 gm, pm = (req.rigid_gm_db, req.rigid_pm_deg) if model == "rigid" else (req.flex_gm_db, req.flex_pm_deg)
                 m["meets"] = bool(m["max_pole_real_per_s"] < req.drift_per_s and m["gain_margin_db"] >= gm - 0.05
                                   and m["gain_reduction_margin_db"] <= -gm + 0.05 and abs(m["phase_margin_deg"]) >= pm - 0.5)
+                if noise is not None and noise[0] > 0.0:
+                    m["noise_fraction"] = command_noise(C, g, *noise)
+                    m["meets"] = bool(m["meets"] and m["noise_fraction"] <= req.noise_fraction * 1.005)
                 ok &= m["meets"]
                 out[f"{model}_{plane}"] = m
         modal = control.series(plants["pitch"]["nonrigid"] - plants["pitch"]["rigid"], C)   # the modes' part
@@ -317,7 +338,8 @@ def check_loops(plants: dict[str, dict[str, control.StateSpace]], gains, filt: S
 
 
 def _rounded(m: dict) -> dict:
-    return {k: (round(v, 5 if k.startswith("max_pole") else 2) if isinstance(v, float) else v) for k, v in m.items()}
+    return {k: (round(v, 5 if k.startswith(("max_pole", "noise")) else 2) if isinstance(v, float) else v)
+            for k, v in m.items()}
 
 
 def schedule_policy(rows: list[dict[str, Any]]) -> Callable:
@@ -330,7 +352,7 @@ def schedule_policy(rows: list[dict[str, Any]]) -> Callable:
 
 def _checked(case: tuple, t: float, gains, filt: StructuralFilter, req: Requirements) -> dict[str, Any]:
     plants, modes, info = case
-    chk = check_loops(plants, gains, filt, modes, req)
+    chk = check_loops(plants, gains, filt, modes, req, info.get("noise"))
     return {"time_s": float(t), "mass_kg": round(info["mass_kg"], 2), "meets": chk["meets"],
             "margins": {k: _rounded(v) for k, v in chk.items() if k not in ("modes", "meets")}, "modes": chk["modes"]}
 
@@ -371,7 +393,9 @@ def design_schedule(vehicle: str = "smile", times=None, req: Requirements | None
             continue
         notch = notch_frequency(own[1], float(own[0]["pitch"]["rigid"].dt))
         cases = [(t, own)] + ([left] if left is not None else [])
-        e = design_row(RowProblem([(c[0][p], c[1]) for _, c in cases for p in planes], req), warm, rng, starts)
+        noise = own[2]["noise"]
+        e = design_row(RowProblem([(c[0][p], c[1]) for _, c in cases for p in planes], req, noise=noise), warm, rng,
+                       starts)
         right = None
         if k + 1 < len(times):
             t_r = 0.5 * (t + times[k + 1])
@@ -386,8 +410,8 @@ def design_schedule(vehicle: str = "smile", times=None, req: Requirements | None
                 log(f"t = {t_r:g} s: not reached ({exc}); the row is designed without its right end")
         if right is not None:
             cases.append(right)
-            e = design_row(RowProblem([(c[0][p], c[1]) for _, c in cases for p in planes], req), e["values"], rng,
-                           starts=0)
+            e = design_row(RowProblem([(c[0][p], c[1]) for _, c in cases for p in planes], req, noise=noise),
+                           e["values"], rng, starts=0)
         warm = e["values"]
         gains, filt = controller(e["values"], notch)
         gains = relieved(gains, relief)
