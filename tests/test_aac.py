@@ -255,3 +255,34 @@ def test_flex_policies_follow_the_envs_vehicle(v1_rigid):
     aac = flex_aac(v1_rigid)
     assert aac.params.damper_deadzone_rad2 == FLEX_AAC["damper_deadzone_rad2"] and aac.name == "aac"
     assert flex_aac(v1_rigid, damper_deadzone_rad2=0.0).params.damper_deadzone_rad2 == 0.0
+
+
+def test_aac_sweep_variants_and_the_scaled_base():
+    """The tuning command's variants are AACParams keywords (a typo is a ConfigError naming it), 'none' is
+    the base alone, and a scaled base scales both its action and the ``last_gimbal`` the law reads."""
+    from baselines.aac_sweep import ScaledBase, parse_variant
+    from lvgym.errors import ConfigError
+
+    assert parse_variant("none") is None
+    assert parse_variant("damper_gain=1e3, damper_deadzone_rad2=0") == {"damper_gain": 1000.0,
+                                                                         "damper_deadzone_rad2": 0}
+    with pytest.raises(ConfigError, match="damper_gian"):
+        parse_variant("damper_gian=1")
+    with pytest.raises(ConfigError, match="key=value"):
+        parse_variant("damper_gain")
+
+    class Base:
+        name, dt, limit = "base", 0.02, 0.1
+
+        def reset(self):
+            self.last_gimbal = np.zeros(2)
+
+        def act(self, observation, info):
+            self.last_gimbal = np.array([0.02, -0.05])
+            return (self.last_gimbal / self.limit).astype(np.float32)
+
+    b = ScaledBase(Base(), 2.0)
+    b.reset()
+    np.testing.assert_allclose(b.act(np.zeros(3), {}), [0.4, -1.0], rtol=1e-6)
+    np.testing.assert_allclose(b.last_gimbal, [0.04, -0.1])
+    assert (b.dt, b.limit, b.name) == (0.02, 0.1, "base*2")
