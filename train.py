@@ -155,8 +155,10 @@ def build_parser(suppress: bool = False) -> argparse.ArgumentParser:
         if f.name == "progress":
             p.add_argument("--no-progress", dest="progress", action="store_false", help="hide the progress bar")
             continue
-        if isinstance(default, list):
-            kw["nargs"] = "*"
+        if isinstance(default, list):                  # --hp, --env-kwargs: a repeated flag adds to the list;
+            kw["nargs"] = "*"                          # --randomize (a default of its own) is replaced
+            if not default:
+                kw["action"] = "extend"
         elif f.name in ("total_timesteps", "checkpoint_freq", "eval_freq"):
             kw["type"] = _number
         elif f.name in ("seed", "n_envs", "history", "keep_checkpoints", "eval_episodes", "torch_threads", "verbose",

@@ -145,3 +145,15 @@ def test_protocol_randomisation_is_alone(tmp_path, capsys):
         TRAIN.train([*_argv(tmp_path, "mixed", steps=128), "--randomize", "protocol", "mass"])
     text = exit_.value.code if isinstance(exit_.value.code, str) else capsys.readouterr().err
     assert "--randomize = 'protocol mass': 'protocol' alone" in text and not list(tmp_path.iterdir())
+
+
+def test_repeated_list_options_add_up_and_randomize_replaces_its_default():
+    """``--hp a=1 --hp b=2`` keeps both overrides (argparse's default would keep the last only), as does a
+    repeated ``--env-kwargs``; ``--randomize`` replaces its default ``protocol``."""
+    args, _ = TRAIN.parse_args(["--hp", "algo.n_steps=128", "--hp", "algo.n_epochs=2", "policy.net_arch=[8]",
+                                "--env-kwargs", "mission_time_s=20", "--env-kwargs", "n_modes=1",
+                                "--randomize", "wind"])
+    assert args.hp == ["algo.n_steps=128", "algo.n_epochs=2", "policy.net_arch=[8]"]
+    assert args.env_kwargs == ["mission_time_s=20", "n_modes=1"]
+    assert args.randomize == ["wind"]
+    assert TRAIN.parse_args([])[0].hp == [] and TRAIN.parse_args([])[0].randomize == ["protocol"]
