@@ -26,13 +26,20 @@ def _mode_summary(row: dict[str, Any]) -> tuple[str, str, str]:
     return s, b1, hi
 
 
+def _meets(row: dict[str, Any]) -> str:
+    """'yes', or 'NO' and the requirements missed (where the record lists them)."""
+    if row["meets"]:
+        return "yes"
+    return "NO" + (f" ({', '.join(row['misses'])})" if row.get("misses") else "")
+
+
 def row_line(row: dict[str, Any]) -> str:
     r, n = _worst(row, "rigid"), _worst(row, "nonrigid")
     s, b1, hi = _mode_summary(row)
     return (f"t = {row['time_s']:5.1f} s  m = {row['mass_kg']:8.1f} kg  rigid GM {r['gm']:.1f}/{r['gm_down']:.1f} dB "
             f"PM {r['pm']:.1f} deg  non-rigid GM {n['gm']:.1f}/{n['gm_down']:.1f} dB PM {n['pm']:.1f} deg  "
             f"slosh {s} dB  bending 1 {b1} dB  higher {hi} dB  growth {max(r['growth'], n['growth']):.3f} 1/s  "
-            f"meets {row['meets']}")
+            f"meets: {_meets(row)}")
 
 
 def margin_table(doc: dict[str, Any]) -> str:
@@ -46,7 +53,7 @@ def margin_table(doc: dict[str, Any]) -> str:
              "Margins are the worse of pitch and yaw; 'down' is the gain "
              "reduction that destabilises a conditionally stable loop; mode columns are the non-rigid pitch loop's "
              "gain [dB] at the mode ('gain': at least the attenuation below 0 dB; 'phase': inside the loop, held by "
-             "the non-rigid margins).", "",
+             "the non-rigid margins); 'meets': yes, or NO and the requirements missed.", "",
              "| t [s] | mass [kg] | kp | ki | kd | rigid GM up/down [dB] | rigid PM [deg] | non-rigid GM up/down [dB] "
              "| non-rigid PM [deg] | slosh gain [dB] | bending 1 [dB] | higher bending [dB] | meets |",
              "|---:|---:|---:|---:|---:|---|---:|---|---:|---|---|---:|---|"]
@@ -58,5 +65,5 @@ def margin_table(doc: dict[str, Any]) -> str:
             gains = (f"{row['kp']:.4f} | {row['ki']:.4f} | {row['kd']:.5f}" if kind == "row" else "same | | ")
             lines.append(f"| {t} | {row['mass_kg']:.0f} | {gains} | {fmt(r['gm'])} / {fmt(r['gm_down'])} | {fmt(r['pm'])} "
                          f"| {fmt(n['gm'])} / {fmt(n['gm_down'])} | {fmt(n['pm'])} | {s} | {b1} | {hi} | "
-                         f"{'yes' if row['meets'] else 'NO'} |")
+                         f"{_meets(row)} |")
     return "\n".join(lines) + "\n"
