@@ -145,6 +145,22 @@ def relief_row(problem_cases: list, req: Requirements, plain: dict[str, Any], ki
     return design_row(problem, [dict(w, ki=ki) for w in [plain["values"], *also]], np.random.default_rng(0), starts=0)
 
 
+def plain_schedule(schedule: Any) -> Any:
+    """The :class:`.pid.GainSchedule` of the plain designs (integral kept, no accelerometer term) that the
+    rows of a load-relief :class:`.pid.GainSchedule` ``schedule`` record under ``plain``
+    (:func:`design_schedule`), scheduled as ``schedule`` is."""
+    from .pid import GainSchedule
+
+    rows = schedule.meta.get("rows", [])
+    missing = [r.get("time_s") for r in rows if "plain" not in r]
+    if missing or not rows:
+        raise ValueError(f"rows at t = {missing} s have no 'plain' entry: a load-relief schedule written by "
+                         "python -m baselines.flexdesign --load-relief records one in every row")
+    return GainSchedule.from_dict({"variable": schedule.variable, "interpolation": schedule.interpolation, "rows": [
+        {"time_s": r["time_s"], "mass_kg": r["mass_kg"], **{k: r["plain"][k] for k in ("kp", "ki", "kd", "filter")}}
+        for r in rows]})
+
+
 def design_schedule(vehicle: str = "smile", times=None, req: Requirements | None = None, starts: int = 2,
                     seed: int = 0, log=print, relief: tuple[float, float] | None = None,
                     planes: tuple[str, ...] = ("pitch",)) -> dict[str, Any]:
