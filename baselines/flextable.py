@@ -33,13 +33,20 @@ def _noise(r: dict[str, float], n: dict[str, float]) -> str:
     return f"{100 * x:.1f}" if math.isfinite(x) else "-"
 
 
+def _meets(row: dict[str, Any]) -> str:
+    """'yes', or 'NO' and the requirements missed (where the record lists them)."""
+    if row["meets"]:
+        return "yes"
+    return "NO" + (f" ({', '.join(row['misses'])})" if row.get("misses") else "")
+
+
 def row_line(row: dict[str, Any]) -> str:
     r, n = _worst(row, "rigid"), _worst(row, "nonrigid")
     s, b1, hi = _mode_summary(row)
     return (f"t = {row['time_s']:5.1f} s  m = {row['mass_kg']:8.1f} kg  rigid GM {r['gm']:.1f}/{r['gm_down']:.1f} dB "
             f"PM {r['pm']:.1f} deg  non-rigid GM {n['gm']:.1f}/{n['gm_down']:.1f} dB PM {n['pm']:.1f} deg  "
             f"slosh {s} dB  bending 1 {b1} dB  higher {hi} dB  growth {max(r['growth'], n['growth']):.3f} 1/s  "
-            f"noise {_noise(r, n)} %  meets {row['meets']}")
+            f"noise {_noise(r, n)} %  meets: {_meets(row)}")
 
 
 def margin_table(doc: dict[str, Any]) -> str:
@@ -54,7 +61,8 @@ def margin_table(doc: dict[str, Any]) -> str:
              "reduction that destabilises a conditionally stable loop; mode columns are the non-rigid pitch loop's "
              "gain [dB] at the mode ('gain': at least the attenuation below 0 dB; 'phase': inside the loop, held by "
              "the non-rigid margins); noise: the RMS of the command's response to the flight gyro's white noise "
-             "[% of the gimbal limit], the worse loop (baselines/noise.py).", "",
+             "[% of the gimbal limit], the worse loop (baselines/noise.py); 'meets': yes, or NO and the requirements "
+             "missed.", "",
              "| t [s] | mass [kg] | kp | ki | kd | rigid GM up/down [dB] | rigid PM [deg] | non-rigid GM up/down [dB] "
              "| non-rigid PM [deg] | slosh gain [dB] | bending 1 [dB] | higher bending [dB] | noise [%] | meets |",
              "|---:|---:|---:|---:|---:|---|---:|---|---:|---|---|---:|---:|---|"]
@@ -66,5 +74,5 @@ def margin_table(doc: dict[str, Any]) -> str:
             gains = (f"{row['kp']:.4f} | {row['ki']:.4f} | {row['kd']:.5f}" if kind == "row" else "same | | ")
             lines.append(f"| {t} | {row['mass_kg']:.0f} | {gains} | {fmt(r['gm'])} / {fmt(r['gm_down'])} | {fmt(r['pm'])} "
                          f"| {fmt(n['gm'])} / {fmt(n['gm_down'])} | {fmt(n['pm'])} | {s} | {b1} | {hi} | {_noise(r, n)} | "
-                         f"{'yes' if row['meets'] else 'NO'} |")
+                         f"{_meets(row)} |")
     return "\n".join(lines) + "\n"

@@ -12,7 +12,8 @@ attitude could meet the limit. What a controller that turns into the wind could 
 :mod:`.loadbound`'s.
 
 ``python -m baselines.qalpha_floor --policies zero gs-pid-flex --seeds 10`` (validation seeds 0-9 of
-``slender-v1``) prints one line per episode and the summary.
+``slender-v1``) prints one line per episode and the summary; ``--plain baselines/schedules/slender_flex.yaml``
+also flies the plain designs (integral kept) the load-relief schedule's rows record.
 """
 
 from __future__ import annotations
@@ -75,12 +76,18 @@ def main(argv: list[str] | None = None) -> int:
 
     from lvgym.benchmark.registry import resolve_policy
 
+    from .flexdesign import plain_schedule
+    from .pid import GainSchedule
+
     ap = argparse.ArgumentParser(prog="python -m baselines.qalpha_floor", description=__doc__.split("\n\n")[0])
     ap.add_argument("--policies", nargs="+", default=["zero"])
     ap.add_argument("--suite", default="slender-v1")
     ap.add_argument("--seeds", type=int, default=10, help="validation seeds 0 .. n-1")
     ap.add_argument("--schedule", action="append", default=[], metavar="YAML",
                     help="also fly the gain-scheduled PID of this schedule file (repeatable)")
+    ap.add_argument("--plain", action="append", default=[], metavar="YAML",
+                    help="also fly the plain designs (integral kept) that this load-relief schedule's rows record "
+                    "(repeatable)")
     ap.add_argument("--unlimited", action="store_true", help="lift the q-alpha limit (1e9 Pa deg): every flight "
                     "goes to the mission's end, so the peaks are those of the whole flight")
     a = ap.parse_args(argv)
@@ -88,6 +95,9 @@ def main(argv: list[str] | None = None) -> int:
     specs = [(n, resolve_policy(n, "python -m baselines.qalpha_floor")) for n in a.policies]
     specs += [(f"file:{i}", PolicySpec(f"file:{i}", "baselines.pid:GainScheduledPIDPolicy", (("schedule", p),)))
               for i, p in enumerate(a.schedule)]
+    specs += [(f"plain:{i}", PolicySpec(f"plain:{i}", "baselines.pid:GainScheduledPIDPolicy",
+                                        (("schedule", plain_schedule(GainSchedule.load(p))),)))
+              for i, p in enumerate(a.plain)]
     for name, spec in specs:
         for cond in suite.conditions:
             cond = cond.with_options(qalpha_limit_pa_deg=1e9) if a.unlimited else cond

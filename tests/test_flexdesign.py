@@ -108,6 +108,36 @@ def test_folded_frequency_by_hand():
     assert FD.folded(561.6, DT) == pytest.approx(2 * 2 * math.pi / DT - 561.6)
 
 
+def test_row_problem_with_a_fixed_integral_and_the_vehicle_drift():
+    """A first-order plant ``0.02 / (z - 1.01)`` (rigid and non-rigid alike, no modes) grows by
+    ln(1.01) / 0.02 = 0.49752 1/s with the gimbal held (:func:`open_loop_growth`). With
+    ``drift="vehicle"`` the drift penalty allows exactly that growth, with ``"requirement"`` 0.8 times
+    0.02 = 0.016 1/s. A fixed integral stays out of the optimiser's vector and in every parameter set it
+    gives; a fixed name or value outside the parameters is refused, naming it."""
+    g = control.ss(control.tf([0.02], [1.0, -1.01], DT))
+    cases = [({"rigid": g, "nonrigid": g}, {})]
+    assert FD.open_loop_growth(g.A, DT) == pytest.approx(math.log(1.01) / DT, rel=1e-12)
+    assert FD.open_loop_growth(np.diag([1.0, 0.5]), DT) == pytest.approx(math.log(0.5) / DT)   # z = 1 left out
+    free = FD.RowProblem(cases, FD.Requirements(), n_grid=200)
+    held = FD.RowProblem(cases, FD.Requirements(), n_grid=200, fixed={"ki": 0.0384}, drift="vehicle")
+    assert free.allowed_growth == [{"rigid": pytest.approx(0.016), "nonrigid": pytest.approx(0.016)}]
+    assert held.allowed_growth[0]["rigid"] == pytest.approx(0.49752, abs=1e-5)
+    assert len(free.params) == 9 and len(held.params) == 8 and "ki" not in [p[0] for p in held.params]
+    v = held.values(held.to_unit(FD.START))
+    assert v["ki"] == 0.0384 and v["kp"] == pytest.approx(FD.START["kp"], rel=1e-9)
+    # the same loop's drift excess against the two allowances differs by exactly their difference
+    e_free, e_held = free.evaluate(dict(FD.START, ki=0.0384)), held.evaluate(v)
+    for m in ("rigid", "nonrigid"):
+        assert e_free[m][3] == pytest.approx(e_held[m][3], rel=1e-9)
+        assert e_free["drift_excess"][m] - e_held["drift_excess"][m] == pytest.approx(0.49752 - 0.016, abs=1e-5)
+    with pytest.raises(ValueError, match="'kq'"):
+        FD.RowProblem(cases, FD.Requirements(), fixed={"kq": 1.0})
+    with pytest.raises(ValueError, match="ki = -1"):
+        FD.RowProblem(cases, FD.Requirements(), fixed={"ki": -1.0})
+    with pytest.raises(ValueError, match="drift"):
+        FD.RowProblem(cases, FD.Requirements(), drift="none")
+
+
 @pytest.fixture(scope="module")
 def row288():
     plants, modes, info = FD.row_plants("smile", 28.8, None)

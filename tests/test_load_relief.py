@@ -1,6 +1,7 @@
 """The load relief of the gain-scheduled PID (baselines.pid, ``accel_gain``), the slender vehicle's
-gs-pid-flex schedule, the tube's structural q-alpha limit (baselines.structural_limit) and the
-linear-programme bound on the q-alpha of any gimbal history (baselines.loadbound)."""
+gs-pid-flex schedule and its drift requirement against the q-alpha limit, the tube's structural q-alpha
+limit (baselines.structural_limit) and the linear-programme bound on the q-alpha of any gimbal history
+(baselines.loadbound)."""
 
 from __future__ import annotations
 
@@ -11,10 +12,17 @@ import numpy as np
 import pytest
 
 import lvgym  # noqa: F401
+from baselines import flexdesign as FD
 from baselines.divergence import Lift, free_free_beam
+from baselines.filters import StructuralFilter
 from baselines.loadbound import min_peak_qalpha
 from baselines.pid import ACCEL_SIGNS, FLEX_SCHEDULES, GainSchedule, GainScheduledPIDPolicy, flex_pid
+from baselines.qalpha_floor import fly, summary
 from baselines.structural_limit import bending_moment_per_qsa, buckling_stress_pa, qalpha_limit_pa_deg
+from lvgym.benchmark.registry import POLICIES
+from lvgym.benchmark.runner import PolicySpec
+from lvgym.benchmark.suites import get_suite
+from lvgym.envs.layouts import REASONS
 from lvgym.errors import ConfigError
 
 
@@ -101,6 +109,82 @@ def test_gs_pid_flex_flies_the_slender_schedule(slender_env):
     assert pol.schedule.accel_gain is not None and all(k > 0 for k in pol.schedule.accel_gain)
     assert pol.schedule.meta["design"]["ki_scale"] < 1.0
     assert pol.schedule.filters is not None
+
+
+def test_slender_rows_meet_every_requirement_but_the_drift():
+    """The shipped load-relief schedule's record: every row, at its time and at both ends of its stretch,
+    in pitch and yaw, rigid and non-rigid, meets the 6 dB / 30 deg margins and attenuates every bending
+    mode by at least 6 dB, and misses the drift requirement only: its slowest divergence (0.14-0.50 1/s)
+    is above 0.02 1/s and below the vehicle's own with the gimbal held (0.16-0.95 1/s). Its integral is
+    ``ki_scale`` (0.05) times the plain design's it records."""
+    meta = GainSchedule.load("slender_flex").meta
+    assert meta["design"]["ki_scale"] == 0.05 and meta["design"]["accel_gain"] == 0.001
+    assert [r["time_s"] for r in meta["rows"]] == [1.0, 3.0, 5.0, 7.0]
+    for row in meta["rows"]:
+        assert row["misses"] == ["drift"] and not row["meets"], (row["time_s"], row["misses"])
+        assert row["ki"] == pytest.approx(0.05 * row["plain"]["ki"], rel=1e-12)
+        assert row["accel_gain"] == 0.001
+        for chk in [row] + row["ends"]:
+            assert chk["misses"] == ["drift"], (row["time_s"], chk["time_s"], chk["misses"])
+            for key, m in chk["margins"].items():
+                assert m["gain_margin_db"] >= 5.95 and abs(m["phase_margin_deg"]) >= 29.5, (row["time_s"], key, m)
+                assert 0.02 < m["max_pole_real_per_s"] < m["open_loop_pole_per_s"], (row["time_s"], key, m)
+            assert all(x["loop_gain_db"] <= -6.0 for x in chk["modes"] if x["mode"] == "bending"), chk["modes"]
+
+
+def test_slender_first_row_on_fresh_plants():
+    """The 1 s row (which missed the gain margin before it was designed on the relieved loop: rigid
+    5.4-5.8, non-rigid 4.3-4.7 dB) checked again on freshly built pitch plants at 1 s (flown there with the
+    gimbal at zero, as the design flew them): the record's numbers side by side, rigid / non-rigid gain
+    margin 6.69 / 6.93 dB, phase margin 54.0 / 54.2 deg, bending modes 6.5 dB down, slowest divergence
+    0.50 1/s against the vehicle's own 0.95 1/s."""
+    plants, modes, _ = FD.row_plants("slender", 1.0, None)
+    row = GainSchedule.load("slender_flex").meta["rows"][0]
+    chk = FD.check_loops({"pitch": plants["pitch"]}, (row["kp"], row["ki"], row["kd"]),
+                         StructuralFilter.from_dict(row["filter"]), modes, FD.Requirements())
+    assert chk["misses"] == ["drift"]
+    for key in ("rigid_pitch", "nonrigid_pitch"):
+        rec, m = row["margins"][key], chk[key]
+        assert m["gain_margin_db"] == pytest.approx(rec["gain_margin_db"], abs=0.01) and m["gain_margin_db"] >= 6.0
+        assert m["phase_margin_deg"] == pytest.approx(rec["phase_margin_deg"], abs=0.05)
+        assert m["max_pole_real_per_s"] == pytest.approx(rec["max_pole_real_per_s"], abs=1e-4)
+        assert m["open_loop_pole_per_s"] == pytest.approx(rec["open_loop_pole_per_s"], abs=1e-4)
+    assert chk["rigid_pitch"]["max_pole_real_per_s"] == pytest.approx(0.502, abs=1e-3)
+    assert chk["rigid_pitch"]["open_loop_pole_per_s"] == pytest.approx(0.953, abs=1e-3)
+    assert [m["loop_gain_db"] for m in chk["modes"]] == [x["loop_gain_db"] for x in row["modes"]]
+
+
+def test_the_drift_requirement_contradicts_the_qalpha_limit():
+    """Issue 17 asks every row for a slowest divergence of 0.02 1/s; slender-v1 asks for a q-alpha below
+    250 kPa deg. On this vehicle they contradict each other. The plain designs the load-relief rows
+    record (integral 0.56-0.78 rad of gimbal per rad, no accelerometer) come as close to the drift
+    requirement as the optimiser got (0.008-0.025 1/s; the relief rows: 0.14-0.50 1/s); flown on
+    validation seeds where the load-relief schedule stays far under the limit (rigid seed 5: 163.8 kPa deg;
+    non-rigid seed 3: 174.3), they break it (270.1 at 5.42 s; 271.1 at 5.18 s). And a perfect attitude hold
+    in the same winds would carry 455.6 and 441.8 kPa deg (the wind's angle times q; 409-489 on all ten
+    seeds of either model when measured): no loop that holds the attitude can meet 250."""
+    sched = GainSchedule.load("slender_flex")
+    meta = sched.meta
+    plain_growth = [r["plain"]["max_pole_real_per_s"] for r in meta["rows"]]
+    assert max(plain_growth) < 0.026 and min(plain_growth) < 0.02
+    assert min(m["max_pole_real_per_s"] for r in meta["rows"] for m in r["margins"].values()) > 0.15
+    assert all(0.5 < r["plain"]["ki"] < 0.8 for r in meta["rows"])
+    suite = get_suite("slender-v1")
+    seeds = suite.seeds("validation", 10)
+    plain = PolicySpec("plain", "baselines.pid:GainScheduledPIDPolicy", (("schedule", FD.plain_schedule(sched)),))
+    for cond in suite.conditions:
+        seed = {"rigid": seeds[5], "nonrigid": seeds[3]}[cond.model]
+        held = summary(fly(plain, cond, seed))
+        relieved = summary(fly(POLICIES["gs-pid-flex"], cond, seed))
+        assert held["failed"] and held["reason"] == REASONS[2], (cond.model, held)
+        assert held["qalpha_peak_kpa_deg"] > 260.0, (cond.model, held)
+        assert not relieved["failed"] and relieved["qalpha_peak_kpa_deg"] < 180.0, (cond.model, relieved)
+        assert relieved["hold_peak_kpa_deg"] > 440.0, (cond.model, relieved)
+
+
+def test_plain_schedule_needs_the_record():
+    with pytest.raises(ValueError, match="plain"):
+        FD.plain_schedule(GainSchedule.load("smile_flex"))
 
 
 def test_short_slender_v1_flight_with_load_relief():
