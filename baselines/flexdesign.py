@@ -40,7 +40,7 @@ from .noise import command_noise, gyro_noise
 
 #: the flight times of the schedule per vehicle [s]: SMILE v1 boost (burnout 43 s) and upper stage
 #: (ignition 54 s, mission 70 s); Stratos III (30 s); the slender vehicle (10 s)
-FLEX_TIMES = {"smile": (3.0, 10.0, 15.0, 20.0, 24.4, 28.8, 32.4, 36.0, 42.5, 54.1, 62.0, 69.5),
+FLEX_TIMES = {"smile": (3.0, 10.0, 15.0, 20.0, 24.4, 28.8, 32.4, 36.0, 39.25, 42.5, 54.1, 62.0, 69.5),
               "stratos3": (2.0, 6.0, 10.0, 14.0, 18.0, 24.0, 29.0),
               "slender": (1.0, 3.0, 5.0, 7.0, 9.0)}
 

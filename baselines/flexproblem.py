@@ -63,7 +63,7 @@ class Requirements:
     attenuation_db: float = 6.0
     drift_per_s: float = 0.02
     bending1: str = "gain"
-    noise_fraction: float = 0.02
+    noise_fraction: float = 0.05
 
     def __post_init__(self) -> None:
         for k, v in asdict(self).items():
