@@ -41,6 +41,7 @@ from lvgym.dynamics import NonRigidModel
 from lvgym.environment.aeroelastic import resample_modes
 from lvgym.errors import check_choice, check_number
 from lvgym.vehicle import MassModel
+from lvgym.vehicle.beam import one_blas_thread
 from lvgym.vehicle.massmodel import BURNING, SEPARATED, MassState
 from lvgym.vehicle.structure import ModeSchedule, mode_transfer
 
@@ -302,7 +303,15 @@ def build_timeline(mass_model: MassModel, model: str, t_end: float, dt: float = 
                       lambda: build_timeline(mass_model, model, t_end, dt, n_modes, sensor_stations, mode_cutoff_hz,
                                              cache=False, strip_stations=strip_stations, mode_interval=mode_interval,
                                              mode_basis=mode_basis, sensor_probes=sensor_probes))
-    mm = mass_model
+    with one_blas_thread():          # once for all the beam solves and mode transfers of the build
+        return _tabulate(mass_model, model, t_end, dt, n_modes, sensor_stations, mode_cutoff_hz, strip_stations,
+                         mode_interval, mode_basis, sensor_probes)
+
+
+def _tabulate(mm: MassModel, model: str, t_end: float, dt: float, n_modes: int | None, sensor_stations,
+              mode_cutoff_hz: float, strip_stations, mode_interval: float | None, mode_basis: str,
+              sensor_probes) -> Timeline:
+    """The work of :func:`build_timeline` (arguments checked, no cache)."""
     vehicle = mm.vehicle
     meshed = np.asarray(sensor_stations, dtype=float).reshape(-1)
     probes = np.asarray(sensor_probes, dtype=float).reshape(-1)

@@ -43,8 +43,11 @@ from __future__ import annotations
 
 import functools
 import math
-from collections.abc import Sequence
+import threading
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 from threadpoolctl import ThreadpoolController
@@ -66,19 +69,45 @@ def _blas() -> ThreadpoolController:
     return ThreadpoolController()
 
 
-def one_blas_thread():
-    """A context in which BLAS runs on one thread (reproducible sums, see the module docstring)."""
-    return _blas().limit(limits=1, user_api="blas")
+_one_thread_lock = threading.Lock()
+_one_thread_depth = 0
+_one_thread_limiter: Any = None
+
+
+@contextmanager
+def one_blas_thread() -> Iterator[None]:
+    """A context in which BLAS runs on one thread (reproducible sums, see the module docstring). Nested
+    contexts (a timeline's solves inside its build, :func:`lvgym.simulator.build_timeline`) cost nothing:
+    the outermost one limits the threads and restores them at its end (about 20 us each)."""
+    global _one_thread_depth, _one_thread_limiter
+    with _one_thread_lock:
+        if _one_thread_depth == 0:
+            _one_thread_limiter = _blas().limit(limits=1, user_api="blas")
+        _one_thread_depth += 1
+    try:
+        yield
+    finally:
+        with _one_thread_lock:
+            _one_thread_depth -= 1
+            if _one_thread_depth == 0:
+                _one_thread_limiter.restore_original_limits()
+                _one_thread_limiter = None
 
 
 def _hermite(xi: np.ndarray, h: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Hermite cubic shape functions ``N`` and their x-derivatives ``dN`` (shape (..., 4)) at the local
     coordinate ``xi`` in [0, 1] of elements of length ``h`` [m]; DOF order (w1, theta1, w2, theta2)."""
     xi2, xi3 = xi * xi, xi * xi * xi
-    N = np.stack([1.0 - 3.0 * xi2 + 2.0 * xi3, h * (xi - 2.0 * xi2 + xi3), 3.0 * xi2 - 2.0 * xi3,
-                  h * (xi3 - xi2)], axis=-1)
-    dN = np.stack([(6.0 * xi2 - 6.0 * xi) / h, 1.0 - 4.0 * xi + 3.0 * xi2, (6.0 * xi - 6.0 * xi2) / h,
-                   3.0 * xi2 - 2.0 * xi], axis=-1)
+    shape = np.broadcast_shapes(np.shape(xi), np.shape(h)) + (4,)
+    N, dN = np.empty(shape), np.empty(shape)
+    N[..., 0] = 1.0 - 3.0 * xi2 + 2.0 * xi3
+    N[..., 1] = h * (xi - 2.0 * xi2 + xi3)
+    N[..., 2] = 3.0 * xi2 - 2.0 * xi3
+    N[..., 3] = h * (xi3 - xi2)
+    dN[..., 0] = (6.0 * xi2 - 6.0 * xi) / h
+    dN[..., 1] = 1.0 - 4.0 * xi + 3.0 * xi2
+    dN[..., 2] = (6.0 * xi - 6.0 * xi2) / h
+    dN[..., 3] = 3.0 * xi2 - 2.0 * xi
     return N, dN
 
 
@@ -116,6 +145,11 @@ def _check_beam(stations, EI, mass_per_length, point_masses):
 #: banded storage of the element's first DOF: row BANDWIDTH + i - j, column offset j
 _UPPER_I, _UPPER_J = np.triu_indices(4)
 _BAND_ROW = BANDWIDTH + _UPPER_I - _UPPER_J
+#: those entries of a Hermite element's stiffness (times h^3 / EI) and consistent mass (times 420 / (m' h))
+#: matrices: coefficients ``c`` of ``c``, ``c h`` or ``(c h) h`` (the columns ``_H0``, the others, ``_H2``)
+_K_COEF = np.array([12.0, 6.0, -12.0, 6.0, 4.0, -6.0, 2.0, 12.0, -6.0, 4.0])
+_M_COEF = np.array([156.0, 22.0, 54.0, -13.0, 4.0, 13.0, -3.0, 156.0, -22.0, 4.0])
+_H0, _H2 = np.array([0, 2, 7]), np.array([4, 6, 9])
 
 
 def _assemble_band(x: np.ndarray, ei: np.ndarray, mpl: np.ndarray, pm: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -123,13 +157,13 @@ def _assemble_band(x: np.ndarray, ei: np.ndarray, mpl: np.ndarray, pm: np.ndarra
     banded storage, ``ab[BANDWIDTH + i - j, j] = A[i, j]`` (as :mod:`.modesolve` takes them), each (4, 2n)."""
     n_dof = 2 * x.size
     h = np.diff(x)
-    o = np.ones_like(h)
-    hh = (4 * h * h, 2 * h * h, -3 * h * h)
     # upper entries in the order of _UPPER_I, _UPPER_J: (0,0) (0,1) (0,2) (0,3) (1,1) (1,2) (1,3) (2,2) (2,3) (3,3)
-    ke = np.stack([12 * o, 6 * h, -12 * o, 6 * h, hh[0], -6 * h, hh[1], 12 * o, -6 * h, hh[0]], axis=-1)
-    me = np.stack([156 * o, 22 * h, 54 * o, -13 * h, hh[0], 13 * h, hh[2], 156 * o, -22 * h, hh[0]], axis=-1)
-    ke = ke * (ei / h**3)[:, None]                                  # (n_el, 10)
-    me = me * (mpl * h / 420.0)[:, None]
+    ke, me = _K_COEF * h[:, None], _M_COEF * h[:, None]          # c h, then (c h) h and c by the power of h
+    ke[:, _H2] *= h[:, None]
+    me[:, _H2] *= h[:, None]
+    ke[:, _H0], me[:, _H0] = _K_COEF[_H0], _M_COEF[_H0]
+    ke *= (ei / h**3)[:, None]                                      # (n_el, 10)
+    me *= (mpl * h / 420.0)[:, None]
     K = np.zeros((BANDWIDTH + 1, n_dof))
     M = np.zeros((BANDWIDTH + 1, n_dof))
     # even elements, then odd ones: no two elements of a pass share a DOF, and an entry has at most two
@@ -144,7 +178,9 @@ def _assemble_band(x: np.ndarray, ei: np.ndarray, mpl: np.ndarray, pm: np.ndarra
         N, dN = _hermite((pm[:, 0] - x[e]) / h[e], h[e])              # (P, 4)
         add = (pm[:, 1, None] * (N[:, _UPPER_I] * N[:, _UPPER_J])
                + pm[:, 2, None] * (dN[:, _UPPER_I] * dN[:, _UPPER_J]))
-        np.add.at(M, (np.broadcast_to(_BAND_ROW, add.shape), 2 * e[:, None] + _UPPER_J), add)
+        cols = 2 * e[:, None] + _UPPER_J
+        for p in range(add.shape[0]):            # in order (as np.add.at): neighbours share a node's entries
+            M[_BAND_ROW, cols[p]] += add[p]
     return K, M
 
 

@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import functools
 import inspect
+from typing import Any
 
 import numpy as np
 from scipy.linalg import eigh, null_space
@@ -103,6 +104,27 @@ def dense_modes(kb: np.ndarray, mb: np.ndarray, R: np.ndarray, MR: np.ndarray, n
 
 
 @functools.lru_cache(maxsize=1)
+def _flexibility_operator() -> type:
+    """A ``LinearOperator`` whose ``matvec`` is the given function itself, without the checks and
+    reshapes of the generic one (ARPACK passes a 1-D vector of the right size 13 times a solve), defined
+    at first use (``scipy.sparse.linalg`` takes 20-30 ms to import)."""
+    from scipy.sparse.linalg import LinearOperator
+
+    class Flexibility(LinearOperator):
+        def __init__(self, shape: tuple[int, int], matvec: Any, dtype: Any) -> None:
+            super().__init__(dtype=np.dtype(dtype), shape=shape)
+            self._apply = matvec
+
+        def _matvec(self, x: np.ndarray) -> np.ndarray:
+            return self._apply(x)
+
+        def matvec(self, x: np.ndarray) -> np.ndarray:
+            return self._apply(x)
+
+    return Flexibility
+
+
+@functools.lru_cache(maxsize=1)
 def _eigsh_takes_rng() -> bool:
     """Whether ``scipy.sparse.linalg.eigsh`` has an ``rng`` argument (SciPy >= 1.15), looked up once."""
     from scipy.sparse.linalg import eigsh
@@ -123,7 +145,7 @@ def lanczos_modes(kb: np.ndarray, mb: np.ndarray, R: np.ndarray, MR: np.ndarray,
     ``1 / omega_k^2`` of the lowest modes and ``q = U^-1 z`` their shapes. ARPACK (``eigsh``, to machine
     precision, ``tol = 0``) from a fixed start vector: the result depends on ``K`` and ``M`` only. Should
     it not converge, :func:`dense_modes` answers instead."""
-    from scipy.sparse.linalg import ArpackNoConvergence, LinearOperator, eigsh  # 20-30 ms to import
+    from scipy.sparse.linalg import ArpackNoConvergence, eigsh  # 20-30 ms to import
 
     n = kb.shape[1]
     g = np.linalg.inv(R.T @ MR)                              # (2, 2): the rigid-body mass matrix, inverted
@@ -144,7 +166,7 @@ def lanczos_modes(kb: np.ndarray, mb: np.ndarray, R: np.ndarray, MR: np.ndarray,
         u = dpbtrs(kc, f)[0]                                 # the deflection, clamped at the CG node
         return dtbmv(BANDWIDTH, mc, u - R @ (g @ (MR.T @ u)))         # U P u: without rigid-body motion
 
-    op = LinearOperator((n, n), matvec=matvec, dtype=float)
+    op = _flexibility_operator()((n, n), matvec, float)
     rng = np.random.default_rng(0)
     # SciPy >= 1.15 takes the generator too (else it draws its own from OS entropy, 0.2 ms a call, unused
     # as v0 is given); older ones have no rng argument. The start vector is v0 either way.
