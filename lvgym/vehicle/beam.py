@@ -54,6 +54,7 @@ from threadpoolctl import ThreadpoolController
 
 from lvgym.errors import ConfigError
 
+from .beamkernels import H_POWER, K_COEF, M_COEF, UPPER_I, UPPER_J, assemble_band_k, hermite_k
 from .modesolve import BANDWIDTH, band_matmul, band_to_dense, bending_energy, dense_modes, lanczos_modes
 from .sections import (MATERIALS, BeamMesh, DistributedMass, Material, PointMass, Section, frozen_array,
                        mesh_stack, per_element, point_mass_array, stations_on, tube)
@@ -95,19 +96,12 @@ def one_blas_thread() -> Iterator[None]:
 
 
 def _hermite(xi: np.ndarray, h: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Hermite cubic shape functions ``N`` and their x-derivatives ``dN`` (shape (..., 4)) at the local
-    coordinate ``xi`` in [0, 1] of elements of length ``h`` [m]; DOF order (w1, theta1, w2, theta2)."""
-    xi2, xi3 = xi * xi, xi * xi * xi
-    shape = np.broadcast_shapes(np.shape(xi), np.shape(h)) + (4,)
-    N, dN = np.empty(shape), np.empty(shape)
-    N[..., 0] = 1.0 - 3.0 * xi2 + 2.0 * xi3
-    N[..., 1] = h * (xi - 2.0 * xi2 + xi3)
-    N[..., 2] = 3.0 * xi2 - 2.0 * xi3
-    N[..., 3] = h * (xi3 - xi2)
-    dN[..., 0] = (6.0 * xi2 - 6.0 * xi) / h
-    dN[..., 1] = 1.0 - 4.0 * xi + 3.0 * xi2
-    dN[..., 2] = (6.0 * xi - 6.0 * xi2) / h
-    dN[..., 3] = 3.0 * xi2 - 2.0 * xi
+    """Hermite cubic shape functions ``N`` and their x-derivatives ``dN`` (shape (P, 4)) at the local
+    coordinates ``xi`` (P,) in [0, 1] of elements of lengths ``h`` (P,) [m]; DOF order (w1, theta1, w2,
+    theta2) (:func:`.beamkernels.hermite_k`)."""
+    xi = np.ascontiguousarray(xi, dtype=float)
+    N, dN = np.empty((xi.size, 4)), np.empty((xi.size, 4))
+    hermite_k(xi, np.ascontiguousarray(np.broadcast_to(h, xi.shape), dtype=float), N, dN)
     return N, dN
 
 
@@ -141,46 +135,20 @@ def _check_beam(stations, EI, mass_per_length, point_masses):
     return x, ei, mpl, point_mass_array(point_masses, float(x[0]), float(x[-1])), flip
 
 
-#: the entries (i, j), i <= j, of a Hermite element's 4 x 4 matrices, and where they go in LAPACK's upper
-#: banded storage of the element's first DOF: row BANDWIDTH + i - j, column offset j
-_UPPER_I, _UPPER_J = np.triu_indices(4)
-_BAND_ROW = BANDWIDTH + _UPPER_I - _UPPER_J
-#: those entries of a Hermite element's stiffness (times h^3 / EI) and consistent mass (times 420 / (m' h))
-#: matrices: coefficients ``c`` of ``c``, ``c h`` or ``(c h) h`` (the columns ``_H0``, the others, ``_H2``)
-_K_COEF = np.array([12.0, 6.0, -12.0, 6.0, 4.0, -6.0, 2.0, 12.0, -6.0, 4.0])
-_M_COEF = np.array([156.0, 22.0, 54.0, -13.0, 4.0, 13.0, -3.0, 156.0, -22.0, 4.0])
-_H0, _H2 = np.array([0, 2, 7]), np.array([4, 6, 9])
-
-
 def _assemble_band(x: np.ndarray, ei: np.ndarray, mpl: np.ndarray, pm: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Stiffness and consistent mass matrices of the beam on ascending nodes ``x`` [m] in LAPACK's upper
-    banded storage, ``ab[BANDWIDTH + i - j, j] = A[i, j]`` (as :mod:`.modesolve` takes them), each (4, 2n)."""
+    banded storage, ``ab[BANDWIDTH + i - j, j] = A[i, j]`` (as :mod:`.modesolve` takes them), each (4, 2n):
+    each entry the sum of its elements' terms, then the point masses added one after the other
+    (:func:`.beamkernels.assemble_band_k`)."""
     n_dof = 2 * x.size
     h = np.diff(x)
-    # upper entries in the order of _UPPER_I, _UPPER_J: (0,0) (0,1) (0,2) (0,3) (1,1) (1,2) (1,3) (2,2) (2,3) (3,3)
-    ke, me = _K_COEF * h[:, None], _M_COEF * h[:, None]          # c h, then (c h) h and c by the power of h
-    ke[:, _H2] *= h[:, None]
-    me[:, _H2] *= h[:, None]
-    ke[:, _H0], me[:, _H0] = _K_COEF[_H0], _M_COEF[_H0]
-    ke *= (ei / h**3)[:, None]                                      # (n_el, 10)
-    me *= (mpl * h / 420.0)[:, None]
     K = np.zeros((BANDWIDTH + 1, n_dof))
     M = np.zeros((BANDWIDTH + 1, n_dof))
-    # even elements, then odd ones: no two elements of a pass share a DOF, and an entry has at most two
-    # terms (one per element), which add to the same sum in either order
-    for first in (0, 1):
-        e = np.arange(first, h.size, 2)
-        col = 2 * e[:, None] + _UPPER_J                             # (elements, 10)
-        K[_BAND_ROW, col] += ke[e]
-        M[_BAND_ROW, col] += me[e]
-    if pm.size:                                  # point masses, in turn (several may share an element)
-        e = np.minimum(np.searchsorted(x, pm[:, 0], side="right") - 1, h.size - 1)
-        N, dN = _hermite((pm[:, 0] - x[e]) / h[e], h[e])              # (P, 4)
-        add = (pm[:, 1, None] * (N[:, _UPPER_I] * N[:, _UPPER_J])
-               + pm[:, 2, None] * (dN[:, _UPPER_I] * dN[:, _UPPER_J]))
-        cols = 2 * e[:, None] + _UPPER_J
-        for p in range(add.shape[0]):            # in order (as np.add.at): neighbours share a node's entries
-            M[_BAND_ROW, cols[p]] += add[p]
+    pm = np.ascontiguousarray(pm, dtype=float).reshape(-1, 3)
+    element = np.minimum(np.searchsorted(x, pm[:, 0], side="right") - 1, h.size - 1)
+    assemble_band_k(np.ascontiguousarray(x, dtype=float), np.ascontiguousarray(ei / h**3, dtype=float),
+                    np.ascontiguousarray(mpl * h / 420.0, dtype=float), pm, element, K, M, UPPER_I, UPPER_J,
+                    K_COEF, M_COEF, H_POWER)
     return K, M
 
 

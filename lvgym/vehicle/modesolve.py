@@ -31,6 +31,8 @@ from scipy.linalg import eigh, null_space
 from scipy.linalg.blas import dtbmv
 from scipy.linalg.lapack import dpbtrf, dpbtrs, dtbtrs
 
+from .beamkernels import band_matmul_k
+
 __all__ = ["BANDWIDTH", "band_matmul", "band_to_dense", "bending_energy", "dense_modes", "lanczos_modes"]
 
 #: half-bandwidth of K and M: the Hermite elements couple the DOFs of neighbouring nodes only
@@ -48,13 +50,14 @@ def band_to_dense(ab: np.ndarray) -> np.ndarray:
 
 
 def band_matmul(ab: np.ndarray, X: np.ndarray) -> np.ndarray:
-    """``A @ X`` for the symmetric band matrix ``A`` of upper banded storage ``ab`` and ``X`` (n,) or (n, K)."""
-    w = ab[:, :, None] if X.ndim == 2 else ab
-    out = w[BANDWIDTH] * X
-    for d in range(1, BANDWIDTH + 1):
-        out[:-d] += w[BANDWIDTH - d, d:] * X[d:]
-        out[d:] += w[BANDWIDTH - d, d:] * X[:-d]
-    return out
+    """``A @ X`` for the symmetric band matrix ``A`` of upper banded storage ``ab`` and ``X`` (n,) or (n, K):
+    ``A[i, i] X[i]``, then for d = 1 .. 3 the terms ``A[i, i + d] X[i + d]`` and then ``A[i, i - d] X[i - d]``
+    added in turn (:func:`.beamkernels.band_matmul_k`)."""
+    X = np.asarray(X, dtype=float)
+    X2 = np.ascontiguousarray(X.reshape(X.shape[0], -1))
+    out = np.empty_like(X2)
+    band_matmul_k(np.ascontiguousarray(ab, dtype=float), X2, out)
+    return out.reshape(X.shape)
 
 
 def clamped_band(kb: np.ndarray, node: int) -> np.ndarray:

@@ -1,0 +1,101 @@
+"""Start-up work (issue 19): the compiled beam assembly against the array formulation it replaced, and the
+caches of built models (a hit gives the same objects or arrays, another input misses)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from lvgym.vehicle.beam import _assemble_band, _hermite
+
+_UPPER_I, _UPPER_J = np.triu_indices(4)
+_BAND_ROW = 3 + _UPPER_I - _UPPER_J
+
+
+def _hermite_arrays(xi, h):
+    """The former array formulation of the Hermite shape functions."""
+    xi2, xi3 = xi * xi, xi * xi * xi
+    N = np.stack([1.0 - 3.0 * xi2 + 2.0 * xi3, h * (xi - 2.0 * xi2 + xi3), 3.0 * xi2 - 2.0 * xi3,
+                  h * (xi3 - xi2)], axis=-1)
+    dN = np.stack([(6.0 * xi2 - 6.0 * xi) / h, 1.0 - 4.0 * xi + 3.0 * xi2, (6.0 * xi - 6.0 * xi2) / h,
+                   3.0 * xi2 - 2.0 * xi], axis=-1)
+    return N, dN
+
+
+def _assemble_arrays(x, ei, mpl, pm):
+    """The former array formulation of :func:`lvgym.vehicle.beam._assemble_band`."""
+    n_dof = 2 * x.size
+    h = np.diff(x)
+    o = np.ones_like(h)
+    hh = (4 * h * h, 2 * h * h, -3 * h * h)
+    ke = np.stack([12 * o, 6 * h, -12 * o, 6 * h, hh[0], -6 * h, hh[1], 12 * o, -6 * h, hh[0]], axis=-1)
+    me = np.stack([156 * o, 22 * h, 54 * o, -13 * h, hh[0], 13 * h, hh[2], 156 * o, -22 * h, hh[0]], axis=-1)
+    ke = ke * (ei / h**3)[:, None]
+    me = me * (mpl * h / 420.0)[:, None]
+    K = np.zeros((4, n_dof))
+    M = np.zeros((4, n_dof))
+    for first in (0, 1):
+        e = np.arange(first, h.size, 2)
+        col = 2 * e[:, None] + _UPPER_J
+        K[_BAND_ROW, col] += ke[e]
+        M[_BAND_ROW, col] += me[e]
+    if pm.size:
+        e = np.minimum(np.searchsorted(x, pm[:, 0], side="right") - 1, h.size - 1)
+        N, dN = _hermite_arrays((pm[:, 0] - x[e]) / h[e], h[e])
+        add = (pm[:, 1, None] * (N[:, _UPPER_I] * N[:, _UPPER_J])
+               + pm[:, 2, None] * (dN[:, _UPPER_I] * dN[:, _UPPER_J]))
+        np.add.at(M, (np.broadcast_to(_BAND_ROW, add.shape), 2 * e[:, None] + _UPPER_J), add)
+    return K, M
+
+
+@pytest.mark.parametrize("seed", range(40))
+def test_assembly_is_the_array_formulation_to_the_bit(seed):
+    rng = np.random.default_rng(seed)
+    n = int(rng.integers(2, 120))
+    x = np.sort(-rng.uniform(0.0, 30.0, n))
+    x = np.unique(x)
+    if x.size < 2:
+        x = np.array([-1.0, 0.0])
+    ei = rng.uniform(1e3, 1e9, x.size - 1)
+    mpl = rng.uniform(0.1, 500.0, x.size - 1)
+    P = int(rng.integers(0, 9))
+    stations = np.concatenate([rng.uniform(x[0], x[-1], P), rng.choice(x, min(3, x.size)),  # on nodes too
+                               np.repeat(rng.uniform(x[0], x[-1], 1), 2)])                   # two in one place
+    pm = np.column_stack([stations, rng.uniform(0.0, 300.0, stations.size),
+                          np.where(rng.random(stations.size) < 0.3, 0.0, rng.uniform(0.0, 5.0, stations.size))])
+    K, M = _assemble_band(x, ei, mpl, pm)
+    K0, M0 = _assemble_arrays(x, ei, mpl, pm)
+    assert K.tobytes() == K0.tobytes() and M.tobytes() == M0.tobytes()
+    K, M = _assemble_band(x, ei, mpl, np.zeros((0, 3)))
+    K0, M0 = _assemble_arrays(x, ei, mpl, np.zeros((0, 3)))
+    assert K.tobytes() == K0.tobytes() and M.tobytes() == M0.tobytes()
+
+
+def test_hermite_is_the_array_formulation_to_the_bit():
+    rng = np.random.default_rng(1)
+    xi = np.concatenate([rng.random(500), [0.0, 1.0, 0.5]])
+    h = rng.uniform(1e-3, 3.0, xi.size)
+    for got, want in zip(_hermite(xi, h), _hermite_arrays(xi, h)):
+        assert got.tobytes() == want.tobytes()
+
+
+def _band_matmul_arrays(ab, X):
+    """The former array formulation of :func:`lvgym.vehicle.modesolve.band_matmul`."""
+    w = ab[:, :, None] if X.ndim == 2 else ab
+    out = w[3] * X
+    for d in range(1, 4):
+        out[:-d] += w[3 - d, d:] * X[d:]
+        out[d:] += w[3 - d, d:] * X[:-d]
+    return out
+
+
+@pytest.mark.parametrize("seed", range(20))
+def test_band_matmul_is_the_array_formulation_to_the_bit(seed):
+    from lvgym.vehicle.modesolve import band_matmul
+
+    rng = np.random.default_rng(seed)
+    n = int(rng.integers(4, 300))
+    ab = rng.normal(size=(4, n)) * 10.0 ** rng.integers(-3, 6)
+    for X in (rng.normal(size=n), rng.normal(size=(n, int(rng.integers(1, 5)))), rng.normal(size=(2, n)).T):
+        got, want = band_matmul(ab, X), _band_matmul_arrays(ab, X)
+        assert got.shape == want.shape and got.tobytes() == np.ascontiguousarray(want).tobytes()
