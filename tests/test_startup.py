@@ -99,3 +99,26 @@ def test_band_matmul_is_the_array_formulation_to_the_bit(seed):
     for X in (rng.normal(size=n), rng.normal(size=(n, int(rng.integers(1, 5)))), rng.normal(size=(2, n)).T):
         got, want = band_matmul(ab, X), _band_matmul_arrays(ab, X)
         assert got.shape == want.shape and got.tobytes() == np.ascontiguousarray(want).tobytes()
+
+
+def _subdivide_arrays(kept, h):
+    """The former array formulation of :func:`lvgym.vehicle.sections._subdivide`."""
+    a, b = kept[:-1], kept[1:]
+    n = np.ceil((a - b) / h - 1e-9).astype(np.int64)
+    span = np.repeat(np.arange(a.size), n)
+    i = np.arange(span.size) - np.repeat(np.cumsum(n) - n, n) + 1
+    x = i * ((b - a) / n)[span] + a[span]
+    x[(np.cumsum(n) - 1)[n > 0]] = b[n > 0]
+    return np.concatenate([kept[:1], x])
+
+
+@pytest.mark.parametrize("seed", range(30))
+def test_subdivide_is_the_array_formulation_to_the_bit(seed):
+    from lvgym.vehicle.sections import _subdivide
+
+    rng = np.random.default_rng(seed)
+    length = rng.uniform(0.5, 60.0)
+    kept = np.unique(np.concatenate([[0.0, -length], -rng.uniform(0.0, length, int(rng.integers(0, 30)))]))[::-1]
+    h = length / rng.integers(5, 200)
+    got, want = _subdivide(kept, h), _subdivide_arrays(kept, h)
+    assert got.tobytes() == want.tobytes()

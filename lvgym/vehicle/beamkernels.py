@@ -8,10 +8,12 @@ array operations, which for a beam of 80-100 nodes cost more than their arithmet
 
 from __future__ import annotations
 
+import math
+
 import numba as nb
 import numpy as np
 
-__all__ = ["assemble_band_k", "hermite_k"]
+__all__ = ["assemble_band_k", "band_matmul_k", "hermite_k", "subdivide_k"]
 
 #: the entries (i, j), i <= j, of a Hermite element's 4 x 4 matrices in the order (0,0) (0,1) (0,2) (0,3)
 #: (1,1) (1,2) (1,3) (2,2) (2,3) (3,3); an entry goes to LAPACK's upper banded storage at row
@@ -98,3 +100,30 @@ def band_matmul_k(ab, X, out):
         for i in range(d, n):
             for k in range(K):
                 out[i, k] += ab[3 - d, i] * X[i - d, k]
+
+
+@nb.njit(cache=True, nogil=True)
+def subdivide_k(kept, h):
+    """Nodes [m] from the descending breakpoints ``kept`` (k,): each span cut into the fewest equal elements
+    no longer than ``h`` [m], node i of a span of n at ``i ((b - a) / n) + a`` and its last node exactly
+    ``b`` (as :func:`.sections._subdivide` formulated it with arrays)."""
+    k = kept.size
+    counts = np.empty(k - 1, dtype=np.int64)
+    total = 1
+    for s in range(k - 1):
+        counts[s] = math.ceil((kept[s] - kept[s + 1]) / h - 1e-9)
+        total += max(counts[s], 0)
+    x = np.empty(total)
+    x[0] = kept[0]
+    j = 1
+    for s in range(k - 1):
+        a, b, n = kept[s], kept[s + 1], counts[s]
+        if n <= 0:
+            continue
+        step = (b - a) / n
+        for i in range(1, n):
+            x[j] = i * step + a
+            j += 1
+        x[j] = b
+        j += 1
+    return x

@@ -46,6 +46,8 @@ import numpy as np
 
 from lvgym.errors import ConfigError
 
+from .beamkernels import subdivide_k
+
 __all__ = ["Material", "MATERIALS", "quasi_isotropic_modulus", "tube_area", "tube_second_moment",
            "tube_second_moment_thin", "tube", "PointMass", "Section", "DistributedMass", "BeamMesh",
            "mesh_stack"]
@@ -323,13 +325,7 @@ def _cumulative(s: np.ndarray, pieces: list[tuple[float, float, float]]) -> np.n
 def _subdivide(kept: np.ndarray, h: float) -> np.ndarray:
     """Nodes [m] from the descending breakpoints ``kept``: each span cut into the fewest equal elements no
     longer than ``h`` [m], as ``np.linspace`` places them (``a + i (b - a) / n``, the span's end exact)."""
-    a, b = kept[:-1], kept[1:]
-    n = np.ceil((a - b) / h - 1e-9).astype(np.int64)              # elements per span, >= 1
-    span = np.repeat(np.arange(a.size), n)
-    i = np.arange(span.size) - np.repeat(np.cumsum(n) - n, n) + 1  # 1..n within each span
-    x = i * ((b - a) / n)[span] + a[span]
-    x[(np.cumsum(n) - 1)[n > 0]] = b[n > 0]
-    return np.concatenate([kept[:1], x])
+    return subdivide_k(np.ascontiguousarray(kept, dtype=float), float(h))
 
 
 def mesh_stack(sections: Sequence[Section], point_masses: Sequence = (),
