@@ -122,3 +122,32 @@ def test_subdivide_is_the_array_formulation_to_the_bit(seed):
     h = length / rng.integers(5, 200)
     got, want = _subdivide(kept, h), _subdivide_arrays(kept, h)
     assert got.tobytes() == want.tobytes()
+
+
+def test_mass_property_rows_are_the_generic_rows():
+    """``MassProperties.row`` and ``TankProperties.row`` name their fields once; every field is taken, and
+    each row equals the field-by-field one."""
+    from dataclasses import fields
+
+    from lvgym.vehicle import MassModel, load_vehicle
+    from lvgym.vehicle.massmodel import _PROPS_ARRAYS, _PROPS_FLOATS, MassProperties
+    from lvgym.vehicle.tanks import _TANK_FLOATS, TankProperties
+
+    assert [f.name for f in fields(TankProperties)] == [*_TANK_FLOATS, "fixed_inertia"]
+    assert {f.name for f in fields(MassProperties)} == {*_PROPS_FLOATS, *_PROPS_ARRAYS, "slosh_names", "stages",
+                                                         "tanks"}
+    mm = MassModel(load_vehicle("smile"))
+    stretches, _ = mm.history(np.linspace(0.0, 20.0, 9))
+    props = mm.properties(stretches[0])
+    for i in (0, 3, -1):
+        row = props.row(i)
+        for f in fields(MassProperties):
+            got, batch = getattr(row, f.name), getattr(props, f.name)
+            if f.name in _PROPS_FLOATS:
+                assert type(got) is float and got == float(batch[i])
+            elif f.name in _PROPS_ARRAYS:
+                assert got.tobytes() == batch[i].tobytes()
+        for tp_row, tp in zip(row.tanks, props.tanks):
+            if tp is not None:
+                for f in fields(TankProperties):
+                    assert np.array_equal(getattr(tp_row, f.name), getattr(tp, f.name)[i])

@@ -24,7 +24,7 @@ The first stage ignites at lift-off, t = 0.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, fields, replace
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -99,14 +99,17 @@ class MassProperties:
 
     def row(self, i: int) -> MassProperties:
         """Instant ``i`` of a batch."""
-        out = {f.name: getattr(self, f.name) for f in fields(self)}
-        for name in ("t", "m_b", "mass", "mass_flow"):
-            out[name] = float(out[name][i])
-        for name in ("r_cg_b", "J_b", "slosh_mass", "pendulum_length", "hinge", "slosh_rest", "slosh_damping",
-                     "cg", "inertia", "gimbal"):
-            out[name] = out[name][i].copy()
-        out["tanks"] = tuple(None if tp is None else tp.row(i) for tp in self.tanks)
-        return MassProperties(**out)
+        g = self.__getattribute__
+        return MassProperties(**{name: float(g(name)[i]) for name in _PROPS_FLOATS},
+                              **{name: g(name)[i].copy() for name in _PROPS_ARRAYS},
+                              slosh_names=self.slosh_names, stages=self.stages,
+                              tanks=tuple(None if tp is None else tp.row(i) for tp in self.tanks))
+
+
+#: the fields of :class:`MassProperties` that are floats of one instant, arrays of one instant
+_PROPS_FLOATS = ("t", "m_b", "mass", "mass_flow")
+_PROPS_ARRAYS = ("r_cg_b", "J_b", "slosh_mass", "pendulum_length", "hinge", "slosh_rest", "slosh_damping", "cg",
+                 "inertia", "gimbal")
 
 
 def combine(parts: list[tuple]) -> tuple:
