@@ -101,13 +101,14 @@ def _hermite(xi: np.ndarray, h: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     theta2) (:func:`.beamkernels.hermite_k`)."""
     xi = np.ascontiguousarray(xi, dtype=float)
     N, dN = np.empty((xi.size, 4)), np.empty((xi.size, 4))
-    hermite_k(xi, np.ascontiguousarray(np.broadcast_to(h, xi.shape), dtype=float), N, dN)
+    h = np.asarray(h, dtype=float)
+    hermite_k(xi, np.ascontiguousarray(h if h.shape == xi.shape else np.broadcast_to(h, xi.shape)), N, dN)
     return N, dN
 
 
 def _interpolate(x: np.ndarray, q: np.ndarray, s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Value and x-slope at stations ``s`` (q,) of DOF vectors ``q`` (2n, K) on ascending nodes ``x``."""
-    e = np.clip(np.searchsorted(x, s, side="right") - 1, 0, len(x) - 2)
+    e = np.minimum(np.maximum(np.searchsorted(x, s, side="right") - 1, 0), len(x) - 2)
     h = x[e + 1] - x[e]
     N, dN = _hermite((s - x[e]) / h, h)
     qe = q[2 * e[:, None] + np.arange(4)]                        # (q, 4, K)
