@@ -151,3 +151,81 @@ def test_mass_property_rows_are_the_generic_rows():
             if tp is not None:
                 for f in fields(TankProperties):
                     assert np.array_equal(getattr(tp_row, f.name), getattr(tp, f.name)[i])
+
+
+def test_stage_aerodynamics_built_once_per_vehicle_object():
+    """A hit gives the same models (the timeline's strips and the simulator share one Barrowman build);
+    another vehicle object, even of equal content, builds its own, with equal tables; a model given by name
+    is built at each call; the entry goes with the vehicle object."""
+    import gc
+
+    from lvgym.simulator import vehicleaero
+    from lvgym.simulator.vehicleaero import aeroelastic_strips, stage_aerodynamics, vehicle_strips
+    from lvgym.vehicle.slender import slender_vehicle
+
+    v = slender_vehicle(wall_thickness=0.0045, diameter=0.2833, aero_mach=2.0)
+    first = stage_aerodynamics(v)
+    assert all(a is b for a, b in zip(first, stage_aerodynamics(v)))
+    strips = vehicle_strips(v, first)
+    assert all(a is b for a, b in zip(strips, vehicle_strips(v, stage_aerodynamics(v))))
+    stations = aeroelastic_strips(v, aeroelastic=True)
+    assert np.array_equal(stations, np.array([m.x_strip for m in strips]))
+    twin = slender_vehicle(wall_thickness=0.0045, diameter=0.2833, aero_mach=2.0)
+    other = stage_aerodynamics(twin)
+    assert other[0] is not first[0]
+    for name in ("grid", "table", "params"):
+        assert getattr(other[0], name).tobytes() == getattr(first[0], name).tobytes()
+    by_name = stage_aerodynamics(v, v.aerodynamics)           # a mapping: built at each call
+    assert by_name[0] is not first[0] and by_name[0].table.tobytes() == first[0].table.tobytes()
+    assert vehicle_strips(v, by_name)[0] is not strips[0]   # not the vehicle's own models: not kept
+    key = id(twin)
+    del twin, other
+    gc.collect()
+    assert key not in vehicleaero._BUILT
+
+
+def test_process_constants_are_copies_of_one_computation():
+    """The EGM2008 factors, the IMU filters' discretisation and a site's frames are computed once per
+    process and input; each caller gets its own arrays, equal to a new computation; another input misses."""
+    from lvgym.environment.earth import C_ne, LaunchSite, geodetic_to_ecef
+    from lvgym.environment.gravity import _harmonic_factors, harmonic_factors
+    from lvgym.simulator.imu import Imu
+
+    a = harmonic_factors(4)
+    a[:] = 0.0                                               # the caller's own array
+    b = harmonic_factors(4)
+    assert b.tobytes() == _harmonic_factors.__wrapped__(4).tobytes() and b.any()
+    assert harmonic_factors(3).size != b.size
+
+    imu = Imu(-1.0, gyro_bandwidth_hz=80.0, gyro_damping=0.7, antialias_hz=20.0)
+    d1 = imu.discrete(0.01)
+    d1["gyro"][0][:] = 0.0
+    d2 = Imu(-2.0, 0, 80.0, 0.7, 20.0).discrete(0.01)         # another station: the same filters
+    assert d2["gyro"][0].any()
+    from scipy.linalg import expm
+    for name, (a_c, b_c, c_c) in imu.continuous().items():
+        n = a_c.shape[0]
+        em = np.zeros((n + 1, n + 1))
+        em[:n, :n], em[:n, n:] = a_c, b_c
+        ms = expm(0.01 * em)[:n, :]
+        assert d2[name][0].tobytes() == ms[:, :n].tobytes() and d2[name][1].tobytes() == ms[:, n].tobytes()
+    assert not np.array_equal(Imu(-1.0, 0, 60.0, 0.7, 20.0).discrete(0.01)["gyro"][0], d2["gyro"][0])
+
+    site = LaunchSite(latitude_deg=69.2943, longitude_deg=16.0205, altitude_m=10.0, azimuth_deg=0.0)
+    r = site.r_pad_e
+    r[:] = 0.0
+    assert site.r_pad_e.tobytes() == geodetic_to_ecef(site.latitude, site.longitude, 10.0).tobytes()
+    assert site.C_ne.tobytes() == C_ne(site.latitude, site.longitude).tobytes()
+    assert site.C_le is not site.C_le and np.array_equal(site.C_le, site.C_le)
+
+
+def test_nested_one_blas_thread_limits_once():
+    from lvgym.vehicle.beam import _blas, one_blas_thread
+
+    blas = [lc for lc in _blas().lib_controllers if lc.user_api == "blas"]
+    before = [lc.get_num_threads() for lc in blas]
+    with one_blas_thread():
+        with one_blas_thread():
+            assert all(lc.get_num_threads() == 1 for lc in blas)
+        assert all(lc.get_num_threads() == 1 for lc in blas)
+    assert [lc.get_num_threads() for lc in blas] == before
