@@ -229,3 +229,28 @@ def test_nested_one_blas_thread_limits_once():
             assert all(lc.get_num_threads() == 1 for lc in blas)
         assert all(lc.get_num_threads() == 1 for lc in blas)
     assert [lc.get_num_threads() for lc in blas] == before
+
+
+@pytest.mark.parametrize("seed", range(20))
+def test_combine_rows_is_combine_to_the_bit(seed):
+    from lvgym.vehicle.massmodel import combine, combine_rows
+
+    rng = np.random.default_rng(seed)
+    B = int(rng.integers(1, 40))
+    parts = []
+    for _ in range(int(rng.integers(1, 7))):
+        batched = rng.random() < 0.5
+        m = rng.uniform(0.0, 500.0, B) if batched else float(rng.uniform(0.0, 500.0))
+        if batched and rng.random() < 0.3:
+            m[rng.random(B) < 0.3] = 0.0                         # emptied tanks
+        c = -rng.uniform(0.0, 20.0, (B, 3) if batched else 3) * np.array([1.0, 0.01, 0.01])
+        J = rng.normal(size=(B, 3, 3) if batched else (3, 3))
+        parts.append((m, c, J))
+    parts.append((np.zeros(B), np.zeros((B, 3)), np.zeros((3, 3))))
+    want = [np.broadcast_to(a, s) for a, s in zip(combine(parts), ((B,), (B, 3), (B, 3, 3)))]
+    got = combine_rows(parts, B)
+    for g, w in zip(got, want):
+        assert g.shape == w.shape and g.tobytes() == np.ascontiguousarray(w).tobytes()
+    zero = [(np.zeros(B), np.zeros((B, 3)), np.zeros((B, 3, 3)))] * 2          # no mass at all: zeros
+    for g, w in zip(combine_rows(zero, B), combine(zero)):
+        assert g.tobytes() == w.tobytes()
