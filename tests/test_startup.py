@@ -254,3 +254,27 @@ def test_combine_rows_is_combine_to_the_bit(seed):
     zero = [(np.zeros(B), np.zeros((B, 3)), np.zeros((B, 3, 3)))] * 2          # no mass at all: zeros
     for g, w in zip(combine_rows(zero, B), combine(zero)):
         assert g.tobytes() == w.tobytes()
+
+
+@pytest.mark.parametrize("short", [None, 0, 5, 64, 100, 10**9])
+def test_timeline_entry_written_whole_after_a_short_gathered_write(tmp_path, monkeypatch, short):
+    """The entry's buffers go out in one gathered write; a short one (or none) is completed in order."""
+    import os
+
+    from lvgym.simulator import cache
+
+    rng = np.random.default_rng(3)
+    parts = [b"head" * 5, memoryview(rng.normal(size=13)).cast("B"), bytes(7),
+             memoryview(np.arange(6, dtype=np.int64)).cast("B"), b"tail"]
+    want = b"".join(bytes(p) for p in parts)
+    if short is None:
+        monkeypatch.delattr(os, "writev", raising=False)
+    else:
+        def writev(fd, bufs):
+            data = b"".join(bytes(b) for b in bufs)[:short]
+            return os.write(fd, data)
+        monkeypatch.setattr(os, "writev", writev)
+    path = tmp_path / "entry"
+    with open(path, "wb") as f:
+        cache._write_all(f, parts)
+    assert path.read_bytes() == want
