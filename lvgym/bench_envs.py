@@ -22,7 +22,15 @@ aerodynamic tables. Cases: the rigid Stratos III simulator of the RocketPy valid
 (non-rigid, 1,224 rows, modes at lift-off and at the separation), SmileAscent-v1 (modes every 2 s: 33 beam
 eigen-solves), SlenderAscent-v0 (10 s) and SlenderAscent-v1 (6 eigen-solves). A third column, **new
 process**, times a fresh interpreter's ``import lvgym`` and the same start with the tables cached
-(:func:`first_start`): what a script or a worker process pays before its first step.
+(:func:`first_start`): what a script or a worker process pays before its first step. Each cold and warm
+time is given as wall time and as CPU time of the process (``time.process_time``; much less sensitive to
+other jobs on the machine than the wall time, though not immune to them).
+
+``--against DIR`` (construction only) compares with another checkout of lvgym (``DIR`` holds its ``lvgym``
+package, e.g. a ``git worktree`` of an older commit) in the same sitting: ``--rounds`` rounds, each a new
+process of that checkout and one of this, in turn (the order alternating), each timing ``--repeats`` cold and
+warm starts after a warm-up (:data:`CHILD`, code that runs on either); it prints the medians over the
+processes of their medians and the ratios (``DIR`` / this: how many times faster this one starts).
 """
 
 from __future__ import annotations
@@ -152,8 +160,9 @@ def first_start(what: str, repeats: int = 3) -> float:
     return float(np.median(times))
 
 
-def construction(repeats: int = 5) -> list[tuple[str, float, float]]:
-    """``(case, cold [s], warm [s])`` medians of ``repeats`` runs (see the module docstring)."""
+def construction(repeats: int = 5) -> list[tuple[str, float, float, float, float]]:
+    """``(case, cold [s], warm [s], cold CPU [s], warm CPU [s])`` medians of ``repeats`` runs (see the
+    module docstring)."""
     import tempfile
     import warnings
 
@@ -165,15 +174,79 @@ def construction(repeats: int = 5) -> list[tuple[str, float, float]]:
         for label, what in CONSTRUCTION.items():
             with using(os.path.join(root, f"{what.replace('/', '_')}-warm-up")):
                 _start(what)
-            cold, warm = [], []
+            times: dict[str, list[float]] = {"cold": [], "warm": [], "cold_cpu": [], "warm_cpu": []}
             for k in range(repeats):
                 with using(os.path.join(root, f"{what.replace('/', '_')}-{k}")):
-                    for times in (cold, warm):
-                        start = time.perf_counter()
+                    for kind in ("cold", "warm"):
+                        wall, cpu = time.perf_counter(), time.process_time()
                         _start(what)
-                        times.append(time.perf_counter() - start)
-            rows.append((label, float(np.median(cold)), float(np.median(warm))))
+                        times[kind + "_cpu"].append(time.process_time() - cpu)
+                        times[kind].append(time.perf_counter() - wall)
+            rows.append((label, *(float(np.median(times[k])) for k in ("cold", "warm", "cold_cpu", "warm_cpu"))))
     return rows
+
+
+#: the construction timing of one case in a new process, for either checkout of :func:`compare` (it uses
+#: only what the per-row code of 2026-11 had too): argv ``what repeats``; prints one JSON line of the medians
+CHILD = """
+import json, os, sys, tempfile, time, warnings
+warnings.simplefilter("ignore")
+import numpy as np, gymnasium as gym, lvgym
+from lvgym.envs import functional
+what, repeats = sys.argv[1], int(sys.argv[2])
+def start():
+    functional.cached_vehicle.cache_clear()
+    functional.cached_timeline.cache_clear()
+    if what == "stratos3":
+        from lvgym.verify.rocketpy_case import lvgym_simulator
+        lvgym_simulator().reset()
+    else:
+        gym.make(what).reset(seed=0)
+root = tempfile.mkdtemp(prefix="lvgym-bench-")
+os.environ["LVGYM_CACHE_DIR"] = os.path.join(root, "warm-up")
+start()
+start()
+times = {"cold": [], "warm": [], "cold_cpu": [], "warm_cpu": []}
+for k in range(repeats):
+    os.environ["LVGYM_CACHE_DIR"] = os.path.join(root, str(k))
+    for kind in ("cold", "warm"):
+        wall, cpu = time.perf_counter(), time.process_time()
+        start()
+        times[kind + "_cpu"].append(time.process_time() - cpu)
+        times[kind].append(time.perf_counter() - wall)
+print(json.dumps({k: float(np.median(v)) for k, v in times.items()} | {"lvgym": lvgym.__file__}))
+"""
+
+
+def compare(other: str, rounds: int = 3, repeats: int = 7, cases: dict[str, str] | None = None
+            ) -> list[tuple[str, str, float, float]]:
+    """``(case, measure, other [s], this [s])``: medians over ``rounds`` processes of each checkout of the
+    :data:`CHILD` medians (``measure``: cold, cold_cpu, warm, warm_cpu), the checkouts in turn (see the
+    module docstring). ``other``: a folder holding another checkout's ``lvgym`` package."""
+    import json
+    import subprocess
+    import sys
+    import tempfile
+
+    import lvgym as this_lvgym
+
+    trees = {"other": os.path.abspath(other), "this": os.path.dirname(os.path.dirname(this_lvgym.__file__))}
+    results: dict[tuple[str, str, str], list[float]] = {}
+    with tempfile.TemporaryDirectory(prefix="lvgym-bench-cwd-") as cwd:     # no checkout on sys.path's ''
+        for r in range(rounds):
+            for label, what in (cases or CONSTRUCTION).items():
+                for tree in (("other", "this") if r % 2 == 0 else ("this", "other")):
+                    env = dict(os.environ, PYTHONPATH=trees[tree])
+                    out = subprocess.run([sys.executable, "-c", CHILD, what, str(repeats)], cwd=cwd, env=env,
+                                         check=True, capture_output=True, text=True).stdout
+                    got = json.loads(out.strip().splitlines()[-1])
+                    if not got["lvgym"].startswith(trees[tree]):
+                        raise RuntimeError(f"{tree}: imported {got['lvgym']}, not from {trees[tree]}")
+                    for measure in ("cold", "cold_cpu", "warm", "warm_cpu"):
+                        results.setdefault((label, measure, tree), []).append(got[measure])
+    return [(label, measure, float(np.median(results[label, measure, "other"])),
+             float(np.median(results[label, measure, "this"])))
+            for label in (cases or CONSTRUCTION) for measure in ("cold", "cold_cpu", "warm", "warm_cpu")]
 
 
 def cpu_name() -> str:
@@ -188,13 +261,37 @@ def cpu_name() -> str:
     return platform.processor() or platform.machine()
 
 
+def load_average() -> str:
+    """The 1, 5 and 15 minute load averages (``/proc/loadavg``), or ``?``."""
+    try:
+        with open("/proc/loadavg", encoding="utf-8") as f:
+            return " ".join(f.read().split()[:3])
+    except OSError:
+        return "?"
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--min-time", type=float, default=2.0, help="seconds per measurement")
     parser.add_argument("--batch", type=int, default=1024, help="rows of the batched envs")
     parser.add_argument("--repeats", type=int, default=5, help="runs per construction case")
     parser.add_argument("--only", choices=("steps", "construction"), help="one of the two tables")
+    parser.add_argument("--against", metavar="DIR", help="construction: compare with the checkout whose lvgym "
+                        "package is in DIR, process by process in turn (see the module docstring)")
+    parser.add_argument("--rounds", type=int, default=3, help="--against: processes of each checkout per case")
+    parser.add_argument("--case", action="append", choices=sorted(CONSTRUCTION.values()),
+                        help="--against: only these construction cases (repeatable)")
     args = parser.parse_args()
+    if args.against:
+        cases = {k: v for k, v in CONSTRUCTION.items() if not args.case or v in args.case}
+        rows = compare(args.against, args.rounds, args.repeats, cases)
+        print(f"# construction [s], {args.against} against this checkout: medians over {args.rounds} processes "
+              f"each of the medians of {args.repeats} runs, in turn ({cpu_name()}, load {load_average()})\n")
+        print("| case | measure | other | this | other / this |")
+        print("|---|---|---:|---:|---:|")
+        for label, measure, other, this in rows:
+            print(f"| {label} | {measure.replace('_cpu', ', CPU')} | {other:.4f} | {this:.4f} | {other / this:.1f} |")
+        return
     from lvgym.simulator.threads import default_threads
     if args.only != "construction":
         rows = run(args.min_time, args.batch)
@@ -206,11 +303,12 @@ def main() -> None:
             print(f"| {model} | {how} | {rate:,.0f} | {ratio:.1f} |")
     if args.only != "steps":
         print(f"\n# construction: starting a simulator [s], median of {args.repeats} ({cpu_name()})\n")
-        print("| case | cold (tables built) | warm (tables from the cache) | new process (imports, cached tables) |")
-        print("|---|---|---|---|")
-        for label, cold, warm in construction(args.repeats):
+        print("| case | cold (tables built) | warm (tables from the cache) | cold, CPU | warm, CPU "
+              "| new process (imports, cached tables) |")
+        print("|---|---|---|---|---|---|")
+        for label, cold, warm, cold_cpu, warm_cpu in construction(args.repeats):
             first = first_start(CONSTRUCTION[label], max(1, args.repeats // 2))
-            print(f"| construction, {label} | {cold:.3f} | {warm:.3f} | {first:.3f} |")
+            print(f"| construction, {label} | {cold:.4f} | {warm:.4f} | {cold_cpu:.4f} | {warm_cpu:.4f} | {first:.3f} |")
 
 
 if __name__ == "__main__":

@@ -36,6 +36,7 @@ from __future__ import annotations
 
 import functools
 import math
+import threading
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -155,28 +156,42 @@ def wave_ramp(mach: float, supersonic) -> float:
 
 
 @functools.lru_cache(maxsize=4)
-def _sine_table(n_terms: int, n_points: int = 4000) -> tuple[np.ndarray, np.ndarray]:
-    """Midpoints ``t`` (n_points,) of ``[0, pi]`` and ``sin(n t)`` (n_terms, n_points) for n = 1..n_terms:
-    constants of :func:`slender_body_wave_drag` (3-4 ms to compute, so computed once), read-only."""
+def _sine_table(n_terms: int, n_points: int = 4000) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Midpoints ``t`` (n_points,) of ``[0, pi]``, ``sin(n t)`` (n_terms, n_points) for n = 1..n_terms,
+    ``cos t`` and ``sin t`` (n_points,): constants of :func:`slender_body_wave_drag` (3-4 ms to compute, so
+    computed once), read-only."""
     t = (np.arange(n_points) + 0.5) * math.pi / n_points
     n = np.arange(1, n_terms + 1)
     table = np.sin(n[:, None] * t[None, :])
-    t.flags.writeable = table.flags.writeable = False
-    return t, table
+    cos_t, sin_t = np.cos(t), np.sin(t)
+    for a in (t, table, cos_t, sin_t):
+        a.flags.writeable = False
+    return t, table, cos_t, sin_t
+
+
+_SCRATCH = threading.local()
+
+
+def _wave_scratch(shape: tuple[int, ...]) -> np.ndarray:
+    """A scratch array of ``shape`` kept per thread (the products of :func:`slender_body_wave_drag`)."""
+    buf = getattr(_SCRATCH, "wave", None)
+    if buf is None or buf.shape != shape:
+        buf = _SCRATCH.wave = np.empty(shape)
+    return buf
 
 
 def slender_body_wave_drag(shape: str, length: float, radius: float, n_terms: int = 80) -> float:
     """Wave drag coefficient (per base area) of a pointed nose on a cylinder, slender-body theory:
     ``S'(x) = sum A_n sin(n t)``, ``x = L (1 - cos t) / 2``, ``D/q = pi/4 sum n A_n^2``
     (von Karman 1936). The von Karman nose gives ``4 (R/L)^2``. Not for the cone (slope jump)."""
-    t, table = _sine_table(n_terms)
-    x = 0.5 * length * (1.0 - np.cos(t))
+    t, table, cos_t, sin_t = _sine_table(n_terms)
+    x = 0.5 * length * (1.0 - cos_t)
     r = nose_radius(shape, x, length, radius)
     ds_dt = np.gradient(math.pi * r * r, t)
-    ds_dx = ds_dt / (0.5 * length * np.sin(t))
+    ds_dx = ds_dt / (0.5 * length * sin_t)
     n = np.arange(1, n_terms + 1)
-    # row by row in blocks (each row's sum as over the whole product), without a 2.6 MB temporary
-    a_n = np.concatenate([(ds_dx[None, :] * table[i:i + 8]).sum(axis=1) for i in range(0, n_terms, 8)])
+    # the products into the process's scratch block (no new 2.6 MB temporary), each row summed alone
+    a_n = np.multiply(table, ds_dx[None, :], out=_wave_scratch(table.shape)).sum(axis=1)
     a_n = 2.0 / 4000 * a_n
     return float(0.25 * math.pi * np.sum(n * a_n * a_n) / (math.pi * radius * radius))
 

@@ -360,23 +360,32 @@ class LaunchSite:
         """Launch azimuth [rad], clockwise from north."""
         return math.radians(self.azimuth_deg)
 
+    @cached_property
+    def _pad(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``r_pad_e``, ``C_ne`` and ``C_le`` computed once per site (read-only; the properties copy)."""
+        r = geodetic_to_ecef(self.latitude, self.longitude, float(self.altitude_m))
+        n = C_ne(self.latitude, self.longitude)
+        up = -n[2]
+        downrange = math.cos(self.azimuth) * n[0] + math.sin(self.azimuth) * n[1]
+        le = np.array([up, np.cross(downrange, up), downrange])
+        for a in (r, n, le):
+            a.flags.writeable = False
+        return r, n, le
+
     @property
     def r_pad_e(self) -> np.ndarray:
         """Pad position in the Earth-fixed frame [m]."""
-        return geodetic_to_ecef(self.latitude, self.longitude, float(self.altitude_m))
+        return self._pad[0].copy()
 
     @property
     def C_ne(self) -> np.ndarray:
         """Earth-fixed -> NED DCM at the pad."""
-        return C_ne(self.latitude, self.longitude)
+        return self._pad[1].copy()
 
     @property
     def C_le(self) -> np.ndarray:
         """Earth-fixed -> launch frame DCM (rows: up, right of the azimuth, downrange)."""
-        n = self.C_ne
-        up = -n[2]
-        downrange = math.cos(self.azimuth) * n[0] + math.sin(self.azimuth) * n[1]
-        return np.array([up, np.cross(downrange, up), downrange])
+        return self._pad[2].copy()
 
     @cached_property
     def params(self) -> np.ndarray:

@@ -50,7 +50,14 @@ _u = nb.uint64                  # an unsigned array index: no negative-index wra
 def harmonic_factors(N: int) -> np.ndarray:
     """Recursion and gradient factors of the fully normalised harmonics up to degree N, as six
     (N+2, N+2) blocks end to end (``F_*`` order): the column recursion ``a``, ``b`` and the gradient
-    factors ``fz``, ``f0`` (m = 0), ``fa``, ``fb``, so the kernel takes no square root."""
+    factors ``fz``, ``f0`` (m = 0), ``fa``, ``fb``, so the kernel takes no square root. Computed once per
+    process and degree (each call gets its own array)."""
+    return _harmonic_factors(int(N)).copy()
+
+
+@functools.lru_cache(maxsize=8)
+def _harmonic_factors(N: int) -> np.ndarray:
+    """:func:`harmonic_factors` (read-only)."""
     n2 = N + 2
     F = np.zeros((6, n2, n2))
     for m in range(n2):
@@ -66,7 +73,9 @@ def harmonic_factors(N: int) -> np.ndarray:
             F[F_FA, n, m] = math.sqrt((2.0 * n + 1.0) * (n + m + 1.0) * (n + m + 2.0) / (2.0 * n + 3.0))
             F[F_FB, n, m] = math.sqrt((2.0 if m == 1 else 1.0) * (2.0 * n + 1.0) * (n - m + 1.0)
                                       * (n - m + 2.0) / (2.0 * n + 3.0))
-    return F.ravel()
+    F = F.ravel()
+    F.flags.writeable = False
+    return F
 
 
 def harmonics_work(p: np.ndarray) -> int:

@@ -143,18 +143,38 @@ def _store(path: Path, tl: Any) -> None:
             "mode_interval": None if tl.mode_interval is None else float(tl.mode_interval), "arrays": entries}
     text = json.dumps(head).encode("utf-8")       # floats as their shortest repr: read back to the bit
     start = _padded(24 + len(text))
+    parts: list[Any] = [_MAGIC + len(text).to_bytes(8, "little") + start.to_bytes(8, "little") + text
+                        + bytes(start - 24 - len(text))]
+    for a in blocks:                              # the arrays' own (contiguous) bytes, then their padding
+        if a.nbytes:
+            parts.append(memoryview(a).cast("B"))
+        if _padded(a.nbytes) > a.nbytes:
+            parts.append(bytes(_padded(a.nbytes) - a.nbytes))
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".tmp")
     try:
         with os.fdopen(fd, "wb") as f:
-            f.write(_MAGIC + len(text).to_bytes(8, "little") + start.to_bytes(8, "little") + text
-                    + bytes(start - 24 - len(text)))
-            for a in blocks:
-                f.write(a.tobytes() + bytes(_padded(a.nbytes) - a.nbytes))
+            _write_all(f, parts)
         os.replace(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
+
+
+def _write_all(f: Any, parts: list[Any]) -> None:
+    """Write the buffers ``parts`` to the binary file ``f`` in order: one gathered write where the system
+    has it (``os.writev``), the rest of a short write and any other system by ``f.write``."""
+    done = 0
+    if hasattr(os, "writev") and len(parts) <= 512:
+        f.flush()
+        done = os.writev(f.fileno(), parts)
+    for part in parts:
+        n = len(part) if isinstance(part, bytes) else part.nbytes
+        if done >= n:
+            done -= n
+            continue
+        f.write(part[done:] if done else part)
+        done = 0
 
 
 def cached(mass_model: Any, args: tuple, build: Callable[[], Any]) -> Any:

@@ -54,9 +54,10 @@ from .imu import IMU_OFF, Imu
 from .layouts import ACTUATOR, CONDITIONS, CONTEXT, DISPERSION, IMU_STATE, RAIL, RAIL_STATE, RS
 from .piece import SLOSH_FREQUENCIES
 from .servo import DIRECT, Servo
-from .strips import StripSetup, strip_models, strip_stations
+from .strips import StripSetup, strip_stations
 from .threads import ROWS_PER_THREAD, Kernel, default_threads, pool
 from .timeline import MODELS, Timeline, build_timeline
+from .vehicleaero import aeroelastic_strips, stage_aerodynamics, vehicle_strips
 
 _ADVANCE, _SLOSH = Kernel(advance_range), Kernel(slosh_angles_range)
 
@@ -67,30 +68,6 @@ SITES = {
     "el_arenosillo": LaunchSite(latitude_deg=37.0970, longitude_deg=-6.7350, altitude_m=20.0, azimuth_deg=225.0),
     "flat": LaunchSite(latitude_deg=0.0, longitude_deg=0.0, altitude_m=0.0, azimuth_deg=90.0, flat_earth=True),
 }
-
-
-def stage_aerodynamics(vehicle: Vehicle, aerodynamics: Any = "vehicle") -> list[Any]:
-    """The aerodynamic model of each stage (in force while it is the lowest attached one; all None
-    without aerodynamics): ``"vehicle"`` gives the vehicle file's ``aerodynamics`` and each stage's own
-    where it has one, else the stack's before it; a name, mapping or model flies the whole flight."""
-    from_vehicle = isinstance(aerodynamics, str) and aerodynamics == "vehicle"
-    if from_vehicle:
-        aerodynamics = vehicle.aerodynamics or None
-    first = make("aerodynamics", aerodynamics) if isinstance(aerodynamics, (str, dict)) else aerodynamics
-    out = [first]
-    for stage in vehicle.stages[1:]:
-        own = stage.aerodynamics if from_vehicle and first is not None else None
-        out.append(make("aerodynamics", own) if own else out[-1])
-    return out
-
-
-def aeroelastic_strips(vehicle: Vehicle, aerodynamics: Any = "vehicle", aeroelastic: bool | None = None
-                       ) -> np.ndarray | None:
-    """The strip stations (n_stages, n) [m] a timeline needs for a simulator of ``vehicle`` with these
-    options (None: no aeroelastic loads), for :func:`.timeline.build_timeline`'s ``strip_stations``."""
-    on = vehicle.structure.aeroelastic if aeroelastic is None else aeroelastic
-    stages = stage_aerodynamics(vehicle, aerodynamics) if on else [None]
-    return None if stages[0] is None else strip_stations(strip_models(stages))
 
 
 def dcm_batch(q: np.ndarray) -> np.ndarray:
@@ -165,8 +142,8 @@ class Simulator:
         if aeroelastic not in (None, True, False):
             raise ValueError(f"aeroelastic = {aeroelastic!r}: True, False or None (the vehicle file's)")
         self.aeroelastic = bool(self.vehicle.structure.aeroelastic if aeroelastic is None else aeroelastic)
-        strips = (strip_models(self.stage_aerodynamics) if self.aeroelastic and self.aerodynamics is not None
-                  else None)
+        strips = (vehicle_strips(self.vehicle, self.stage_aerodynamics)
+                  if self.aeroelastic and self.aerodynamics is not None else None)
         stations = None if strips is None else strip_stations(strips)
         self.physics_dt = float(physics_dt)
         self.elevation = math.radians(elevation_deg)

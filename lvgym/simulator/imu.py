@@ -44,6 +44,7 @@ undispersed IMU bit for bit.
 
 from __future__ import annotations
 
+import functools
 import math
 from collections import namedtuple
 from dataclasses import dataclass
@@ -83,6 +84,24 @@ def _cascade(first: tuple, second: tuple) -> tuple[np.ndarray, np.ndarray, np.nd
     a = np.zeros((n1 + n2, n1 + n2))
     a[:n1, :n1], a[n1:, :n1], a[n1:, n1:] = a1, b2 @ c1, a2
     return a, np.vstack([b1, np.zeros((n2, 1))]), np.hstack([np.zeros((1, n1)), c2])
+
+
+@functools.lru_cache(maxsize=32)
+def _discrete(gyro_bandwidth_hz: float, gyro_damping: float, antialias_hz: float, h: float
+              ) -> dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]]:
+    """:meth:`Imu.discrete` of the filters with these constants [Hz, -, Hz] for steps of ``h`` [s],
+    computed once per process and constants (read-only arrays; the station does not enter)."""
+    from scipy.linalg import expm
+    out = {}
+    for name, (a, b, c) in Imu(0.0, 0, gyro_bandwidth_hz, gyro_damping, antialias_hz).continuous().items():
+        n = a.shape[0]
+        em = np.zeros((n + 1, n + 1))
+        em[:n, :n], em[:n, n:] = a, b
+        ms = expm(float(h) * em)[:n, :]
+        out[name] = (ms[:, :n], ms[:, n], np.asarray(c, dtype=float)[0])
+        for arr in out[name]:
+            arr.flags.writeable = False
+    return out
 
 
 @dataclass(frozen=True)
@@ -154,15 +173,8 @@ class Imu:
         ``expm(h [[A, B], [0, 0]]) = [[Ad, Bd], [0, 1]]``, the matrix exponential ``scipy.signal.cont2discrete``
         takes for ``method="zoh"`` (the same numbers; ``scipy.signal`` itself is not imported, which costs
         1-2.5 s on the first v1 env of a process)."""
-        from scipy.linalg import expm
-        out = {}
-        for name, (a, b, c) in self.continuous().items():
-            n = a.shape[0]
-            em = np.zeros((n + 1, n + 1))
-            em[:n, :n], em[:n, n:] = a, b
-            ms = expm(float(h) * em)[:n, :]
-            out[name] = (ms[:, :n], ms[:, n], np.asarray(c, dtype=float)[0])
-        return out
+        held = _discrete(self.gyro_bandwidth_hz, self.gyro_damping, self.antialias_hz, float(h))
+        return {name: tuple(a.copy() for a in abc) for name, abc in held.items()}
 
     def params(self, h: float) -> np.ndarray:
         """The parameter block (layout :data:`.layouts.IMU`) for physics steps of ``h`` [s]."""

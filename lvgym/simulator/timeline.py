@@ -41,6 +41,7 @@ from lvgym.dynamics import NonRigidModel
 from lvgym.environment.aeroelastic import resample_modes
 from lvgym.errors import check_choice, check_number
 from lvgym.vehicle import MassModel
+from lvgym.vehicle.beam import one_blas_thread
 from lvgym.vehicle.massmodel import BURNING, SEPARATED, MassState
 from lvgym.vehicle.structure import ModeSchedule, mode_transfer
 
@@ -302,7 +303,15 @@ def build_timeline(mass_model: MassModel, model: str, t_end: float, dt: float = 
                       lambda: build_timeline(mass_model, model, t_end, dt, n_modes, sensor_stations, mode_cutoff_hz,
                                              cache=False, strip_stations=strip_stations, mode_interval=mode_interval,
                                              mode_basis=mode_basis, sensor_probes=sensor_probes))
-    mm = mass_model
+    with one_blas_thread():          # once for all the beam solves and mode transfers of the build
+        return _tabulate(mass_model, model, t_end, dt, n_modes, sensor_stations, mode_cutoff_hz, strip_stations,
+                         mode_interval, mode_basis, sensor_probes)
+
+
+def _tabulate(mm: MassModel, model: str, t_end: float, dt: float, n_modes: int | None, sensor_stations,
+              mode_cutoff_hz: float, strip_stations, mode_interval: float | None, mode_basis: str,
+              sensor_probes) -> Timeline:
+    """The work of :func:`build_timeline` (arguments checked, no cache)."""
     vehicle = mm.vehicle
     meshed = np.asarray(sensor_stations, dtype=float).reshape(-1)
     probes = np.asarray(sensor_probes, dtype=float).reshape(-1)
@@ -405,8 +414,12 @@ def _mode_rows(modes_rows: list, K: int, N: int, S: int, strips: np.ndarray, sta
     cut: dict[int, tuple] = {}                          # id of the modes: (modes, its decoupled version)
     on_strips: dict[tuple[int, int], tuple[np.ndarray, np.ndarray]] = {}
     changes: list[tuple[float, np.ndarray]] = []
+    stages = stage.tolist()
+    # the rows where the modes or the stage change (within a run of rows nothing new happens)
+    starts = [0] + [i for i in range(1, n) if modes_rows[i] is not modes_rows[i - 1] or stages[i] != stages[i - 1]]
     last = None
-    for i, modes in enumerate(modes_rows):
+    for i in starts:
+        modes = modes_rows[i]
         if id(modes) not in cut:
             cut[id(modes)] = (modes, _cut(modes, cutoff_hz))
         if projected and last is not None and modes is not last:
@@ -415,12 +428,13 @@ def _mode_rows(modes_rows: list, K: int, N: int, S: int, strips: np.ndarray, sta
                 T = T @ changes.pop()[1]
             changes.append((float(t[i]), T))
         last = modes
-        if n_strip and (id(modes), int(stage[i])) not in on_strips:
+        if n_strip and (id(modes), int(stages[i])) not in on_strips:
             beam, keep = modes.beam, _kept(modes, cutoff_hz)
-            phi, dphi = resample_modes(strips[int(stage[i])], beam.node_stations, beam.phi_nodes.T, beam.dphi_nodes.T)
-            on_strips[id(modes), int(stage[i])] = (phi * keep[:, None], dphi * keep[:, None])
+            phi, dphi = resample_modes(strips[int(stages[i])], beam.node_stations, beam.phi_nodes.T, beam.dphi_nodes.T)
+            on_strips[id(modes), int(stages[i])] = (phi * keep[:, None], dphi * keep[:, None])
     which = {key: u for u, key in enumerate(cut)}
-    index = np.array([which[id(m)] for m in modes_rows])
+    lengths = np.diff([*starts, n])
+    index = np.repeat([which[id(modes_rows[i])] for i in starts], lengths)
     unique = [c for _, c in cut.values()]
     for key in ("omega", "zeta", "phi_gimbal", "dphi_gimbal", "phi_sensor", "dphi_sensor"):
         out[key] = np.array([getattr(m, key) for m in unique]).reshape((len(unique),) + out[key].shape[1:])[index]
@@ -428,7 +442,7 @@ def _mode_rows(modes_rows: list, K: int, N: int, S: int, strips: np.ndarray, sta
     if n_strip:
         keys = list(on_strips)
         pair = {k: u for u, k in enumerate(keys)}
-        at = np.array([pair[id(m), int(s)] for m, s in zip(modes_rows, stage)])
+        at = np.repeat([pair[id(modes_rows[i]), int(stages[i])] for i in starts], lengths)
         out["phi_strip"] = np.array([on_strips[k][0] for k in keys])[at]
         out["dphi_strip"] = np.array([on_strips[k][1] for k in keys])[at]
     out["changes"] = changes

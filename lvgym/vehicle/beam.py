@@ -43,14 +43,18 @@ from __future__ import annotations
 
 import functools
 import math
-from collections.abc import Sequence
+import threading
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 from threadpoolctl import ThreadpoolController
 
 from lvgym.errors import ConfigError
 
+from .beamkernels import H_POWER, K_COEF, M_COEF, UPPER_I, UPPER_J, assemble_band_k, hermite_k
 from .modesolve import BANDWIDTH, band_matmul, band_to_dense, bending_energy, dense_modes, lanczos_modes
 from .sections import (MATERIALS, BeamMesh, DistributedMass, Material, PointMass, Section, frozen_array,
                        mesh_stack, per_element, point_mass_array, stations_on, tube)
@@ -66,25 +70,45 @@ def _blas() -> ThreadpoolController:
     return ThreadpoolController()
 
 
-def one_blas_thread():
-    """A context in which BLAS runs on one thread (reproducible sums, see the module docstring)."""
-    return _blas().limit(limits=1, user_api="blas")
+_one_thread_lock = threading.Lock()
+_one_thread_depth = 0
+_one_thread_limiter: Any = None
+
+
+@contextmanager
+def one_blas_thread() -> Iterator[None]:
+    """A context in which BLAS runs on one thread (reproducible sums, see the module docstring). Nested
+    contexts (a timeline's solves inside its build, :func:`lvgym.simulator.build_timeline`) cost nothing:
+    the outermost one limits the threads and restores them at its end (about 20 us each)."""
+    global _one_thread_depth, _one_thread_limiter
+    with _one_thread_lock:
+        if _one_thread_depth == 0:
+            _one_thread_limiter = _blas().limit(limits=1, user_api="blas")
+        _one_thread_depth += 1
+    try:
+        yield
+    finally:
+        with _one_thread_lock:
+            _one_thread_depth -= 1
+            if _one_thread_depth == 0:
+                _one_thread_limiter.restore_original_limits()
+                _one_thread_limiter = None
 
 
 def _hermite(xi: np.ndarray, h: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Hermite cubic shape functions ``N`` and their x-derivatives ``dN`` (shape (..., 4)) at the local
-    coordinate ``xi`` in [0, 1] of elements of length ``h`` [m]; DOF order (w1, theta1, w2, theta2)."""
-    xi2, xi3 = xi * xi, xi * xi * xi
-    N = np.stack([1.0 - 3.0 * xi2 + 2.0 * xi3, h * (xi - 2.0 * xi2 + xi3), 3.0 * xi2 - 2.0 * xi3,
-                  h * (xi3 - xi2)], axis=-1)
-    dN = np.stack([(6.0 * xi2 - 6.0 * xi) / h, 1.0 - 4.0 * xi + 3.0 * xi2, (6.0 * xi - 6.0 * xi2) / h,
-                   3.0 * xi2 - 2.0 * xi], axis=-1)
+    """Hermite cubic shape functions ``N`` and their x-derivatives ``dN`` (shape (P, 4)) at the local
+    coordinates ``xi`` (P,) in [0, 1] of elements of lengths ``h`` (P,) [m]; DOF order (w1, theta1, w2,
+    theta2) (:func:`.beamkernels.hermite_k`)."""
+    xi = np.ascontiguousarray(xi, dtype=float)
+    N, dN = np.empty((xi.size, 4)), np.empty((xi.size, 4))
+    h = np.asarray(h, dtype=float)
+    hermite_k(xi, np.ascontiguousarray(h if h.shape == xi.shape else np.broadcast_to(h, xi.shape)), N, dN)
     return N, dN
 
 
 def _interpolate(x: np.ndarray, q: np.ndarray, s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Value and x-slope at stations ``s`` (q,) of DOF vectors ``q`` (2n, K) on ascending nodes ``x``."""
-    e = np.clip(np.searchsorted(x, s, side="right") - 1, 0, len(x) - 2)
+    e = np.minimum(np.maximum(np.searchsorted(x, s, side="right") - 1, 0), len(x) - 2)
     h = x[e + 1] - x[e]
     N, dN = _hermite((s - x[e]) / h, h)
     qe = q[2 * e[:, None] + np.arange(4)]                        # (q, 4, K)
@@ -112,39 +136,20 @@ def _check_beam(stations, EI, mass_per_length, point_masses):
     return x, ei, mpl, point_mass_array(point_masses, float(x[0]), float(x[-1])), flip
 
 
-#: the entries (i, j), i <= j, of a Hermite element's 4 x 4 matrices, and where they go in LAPACK's upper
-#: banded storage of the element's first DOF: row BANDWIDTH + i - j, column offset j
-_UPPER_I, _UPPER_J = np.triu_indices(4)
-_BAND_ROW = BANDWIDTH + _UPPER_I - _UPPER_J
-
-
 def _assemble_band(x: np.ndarray, ei: np.ndarray, mpl: np.ndarray, pm: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Stiffness and consistent mass matrices of the beam on ascending nodes ``x`` [m] in LAPACK's upper
-    banded storage, ``ab[BANDWIDTH + i - j, j] = A[i, j]`` (as :mod:`.modesolve` takes them), each (4, 2n)."""
+    banded storage, ``ab[BANDWIDTH + i - j, j] = A[i, j]`` (as :mod:`.modesolve` takes them), each (4, 2n):
+    each entry the sum of its elements' terms, then the point masses added one after the other
+    (:func:`.beamkernels.assemble_band_k`)."""
     n_dof = 2 * x.size
     h = np.diff(x)
-    o = np.ones_like(h)
-    hh = (4 * h * h, 2 * h * h, -3 * h * h)
-    # upper entries in the order of _UPPER_I, _UPPER_J: (0,0) (0,1) (0,2) (0,3) (1,1) (1,2) (1,3) (2,2) (2,3) (3,3)
-    ke = np.stack([12 * o, 6 * h, -12 * o, 6 * h, hh[0], -6 * h, hh[1], 12 * o, -6 * h, hh[0]], axis=-1)
-    me = np.stack([156 * o, 22 * h, 54 * o, -13 * h, hh[0], 13 * h, hh[2], 156 * o, -22 * h, hh[0]], axis=-1)
-    ke = ke * (ei / h**3)[:, None]                                  # (n_el, 10)
-    me = me * (mpl * h / 420.0)[:, None]
     K = np.zeros((BANDWIDTH + 1, n_dof))
     M = np.zeros((BANDWIDTH + 1, n_dof))
-    # even elements, then odd ones: no two elements of a pass share a DOF, and an entry has at most two
-    # terms (one per element), which add to the same sum in either order
-    for first in (0, 1):
-        e = np.arange(first, h.size, 2)
-        col = 2 * e[:, None] + _UPPER_J                             # (elements, 10)
-        K[_BAND_ROW, col] += ke[e]
-        M[_BAND_ROW, col] += me[e]
-    if pm.size:                                  # point masses, in turn (several may share an element)
-        e = np.minimum(np.searchsorted(x, pm[:, 0], side="right") - 1, h.size - 1)
-        N, dN = _hermite((pm[:, 0] - x[e]) / h[e], h[e])              # (P, 4)
-        add = (pm[:, 1, None] * (N[:, _UPPER_I] * N[:, _UPPER_J])
-               + pm[:, 2, None] * (dN[:, _UPPER_I] * dN[:, _UPPER_J]))
-        np.add.at(M, (np.broadcast_to(_BAND_ROW, add.shape), 2 * e[:, None] + _UPPER_J), add)
+    pm = np.ascontiguousarray(pm, dtype=float).reshape(-1, 3)
+    element = np.minimum(np.searchsorted(x, pm[:, 0], side="right") - 1, h.size - 1)
+    assemble_band_k(np.ascontiguousarray(x, dtype=float), np.ascontiguousarray(ei / h**3, dtype=float),
+                    np.ascontiguousarray(mpl * h / 420.0, dtype=float), pm, element, K, M, UPPER_I, UPPER_J,
+                    K_COEF, M_COEF, H_POWER)
     return K, M
 
 

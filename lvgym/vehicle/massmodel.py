@@ -24,8 +24,9 @@ The first stage ignites at lift-off, t = 0.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, fields, replace
+from dataclasses import dataclass, replace
 
+import numba as nb
 import numpy as np
 
 from .config import Vehicle
@@ -99,14 +100,17 @@ class MassProperties:
 
     def row(self, i: int) -> MassProperties:
         """Instant ``i`` of a batch."""
-        out = {f.name: getattr(self, f.name) for f in fields(self)}
-        for name in ("t", "m_b", "mass", "mass_flow"):
-            out[name] = float(out[name][i])
-        for name in ("r_cg_b", "J_b", "slosh_mass", "pendulum_length", "hinge", "slosh_rest", "slosh_damping",
-                     "cg", "inertia", "gimbal"):
-            out[name] = out[name][i].copy()
-        out["tanks"] = tuple(None if tp is None else tp.row(i) for tp in self.tanks)
-        return MassProperties(**out)
+        g = self.__getattribute__
+        return MassProperties(**{name: float(g(name)[i]) for name in _PROPS_FLOATS},
+                              **{name: g(name)[i].copy() for name in _PROPS_ARRAYS},
+                              slosh_names=self.slosh_names, stages=self.stages,
+                              tanks=tuple(None if tp is None else tp.row(i) for tp in self.tanks))
+
+
+#: the fields of :class:`MassProperties` that are floats of one instant, arrays of one instant
+_PROPS_FLOATS = ("t", "m_b", "mass", "mass_flow")
+_PROPS_ARRAYS = ("r_cg_b", "J_b", "slosh_mass", "pendulum_length", "hinge", "slosh_rest", "slosh_damping", "cg",
+                 "inertia", "gimbal")
 
 
 def combine(parts: list[tuple]) -> tuple:
@@ -132,6 +136,53 @@ def combine(parts: list[tuple]) -> tuple:
     cg = np.where(some[..., None], cg, 0.0) + np.zeros(m.shape + (3,))
     J = np.where(some[..., None, None], J, 0.0) + np.zeros(m.shape + (3, 3))
     return (float(m) if m.ndim == 0 else m), cg, J
+
+
+def combine_rows(parts: list[tuple], batch: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`combine` of parts for a batch of ``batch`` instants (each part's ``m``, ``cg``, ``J`` a
+    number or a (3,), (3, 3) array, or with the leading axis): the same numbers, term by term in the same
+    order, in one compiled loop (:func:`_combine_k`); ``m`` (B,), ``cg`` (B, 3), ``J`` (B, 3, 3)."""
+    P = len(parts)
+    m, c, J = np.empty((P, batch)), np.empty((P, batch, 3)), np.empty((P, batch, 3, 3))
+    for p, (mi, ci, Ji) in enumerate(parts):
+        m[p], c[p], J[p] = mi, ci, Ji
+    out = np.empty(batch), np.empty((batch, 3)), np.empty((batch, 3, 3))
+    _combine_k(m, c, J, *out)
+    return out
+
+
+@nb.njit(cache=True, nogil=True)
+def _combine_k(m, c, J, out_m, out_cg, out_J):
+    """:func:`combine_rows` of parts ``m`` (P, B) [kg], ``c`` (P, B, 3) [m], ``J`` (P, B, 3, 3) [kg m^2]."""
+    P, B = m.shape
+    Jacc = np.empty((3, 3))
+    r = np.empty(3)
+    cg = np.empty(3)
+    for b in range(B):
+        total = 0.0
+        for p in range(P):
+            total = total + m[p, b]
+        some = total > 0.0
+        denom = total if some else 1.0
+        for k in range(3):
+            first = 0.0
+            for p in range(P):
+                first = first + m[p, b] * c[p, b, k]
+            cg[k] = first / denom
+        Jacc[:, :] = 0.0
+        for p in range(P):
+            for k in range(3):
+                r[k] = c[p, b, k] - cg[k]
+            rr = r[0] * r[0] + r[1] * r[1] + r[2] * r[2]
+            for i in range(3):
+                for j in range(3):
+                    eye = 1.0 if i == j else 0.0
+                    Jacc[i, j] = Jacc[i, j] + (J[p, b, i, j] + m[p, b] * (rr * eye - r[i] * r[j]))
+        out_m[b] = total
+        for i in range(3):
+            out_cg[b, i] = (cg[i] if some else 0.0) + 0.0
+            for j in range(3):
+                out_J[b, i, j] = (Jacc[i, j] if some else 0.0) + 0.0
 
 
 class MassModel:
@@ -360,8 +411,7 @@ class MassModel:
         for part, on in ((v.payload, True), (v.fairing, state.fairing)):
             if part is not None and on:
                 parts.append((part.mass, part.cg, part.inertia))
-        m_b, r_cg_b, J_b = combine(parts)
-        m_b = np.broadcast_to(m_b, (B,))
+        m_b, r_cg_b, J_b = combine_rows(parts, B)
         n = self.n_slosh
         m_s, L = np.zeros((B, n)), np.zeros((B, n))
         zeta = np.tile([self.tanks[k].slosh_damping for k in self.slosh_tanks], (B, 1)).reshape(B, n)
@@ -373,7 +423,7 @@ class MassModel:
                 continue
             m_s[:, j], L[:, j] = tp.slosh_mass, tp.pendulum_length
             hinge[:, j, 0], rest[:, j, 0] = tp.hinge_station, tp.slosh_station
-        mass, cg, inertia = combine(parts + [(m_s[:, j], rest[:, j], np.zeros((3, 3))) for j in range(n)])
+        mass, cg, inertia = combine_rows(parts + [(m_s[:, j], rest[:, j], np.zeros((3, 3))) for j in range(n)], B)
         return MassProperties(t=state.t, m_b=m_b, r_cg_b=r_cg_b, J_b=J_b, slosh_names=self.slosh_names,
                               slosh_mass=m_s, pendulum_length=L, hinge=hinge, slosh_rest=rest, slosh_damping=zeta,
                               mass=np.broadcast_to(mass, (B,)), cg=cg, inertia=inertia,

@@ -24,11 +24,14 @@ from __future__ import annotations
 
 import functools
 import inspect
+from typing import Any
 
 import numpy as np
 from scipy.linalg import eigh, null_space
 from scipy.linalg.blas import dtbmv
 from scipy.linalg.lapack import dpbtrf, dpbtrs, dtbtrs
+
+from .beamkernels import band_matmul_k
 
 __all__ = ["BANDWIDTH", "band_matmul", "band_to_dense", "bending_energy", "dense_modes", "lanczos_modes"]
 
@@ -47,13 +50,14 @@ def band_to_dense(ab: np.ndarray) -> np.ndarray:
 
 
 def band_matmul(ab: np.ndarray, X: np.ndarray) -> np.ndarray:
-    """``A @ X`` for the symmetric band matrix ``A`` of upper banded storage ``ab`` and ``X`` (n,) or (n, K)."""
-    w = ab[:, :, None] if X.ndim == 2 else ab
-    out = w[BANDWIDTH] * X
-    for d in range(1, BANDWIDTH + 1):
-        out[:-d] += w[BANDWIDTH - d, d:] * X[d:]
-        out[d:] += w[BANDWIDTH - d, d:] * X[:-d]
-    return out
+    """``A @ X`` for the symmetric band matrix ``A`` of upper banded storage ``ab`` and ``X`` (n,) or (n, K):
+    ``A[i, i] X[i]``, then for d = 1 .. 3 the terms ``A[i, i + d] X[i + d]`` and then ``A[i, i - d] X[i - d]``
+    added in turn (:func:`.beamkernels.band_matmul_k`)."""
+    X = np.asarray(X, dtype=float)
+    X2 = np.ascontiguousarray(X.reshape(X.shape[0], -1))
+    out = np.empty_like(X2)
+    band_matmul_k(np.ascontiguousarray(ab, dtype=float), X2, out)
+    return out.reshape(X.shape)
 
 
 def clamped_band(kb: np.ndarray, node: int) -> np.ndarray:
@@ -103,6 +107,27 @@ def dense_modes(kb: np.ndarray, mb: np.ndarray, R: np.ndarray, MR: np.ndarray, n
 
 
 @functools.lru_cache(maxsize=1)
+def _flexibility_operator() -> type:
+    """A ``LinearOperator`` whose ``matvec`` is the given function itself, without the checks and
+    reshapes of the generic one (ARPACK passes a 1-D vector of the right size 13 times a solve), defined
+    at first use (``scipy.sparse.linalg`` takes 20-30 ms to import)."""
+    from scipy.sparse.linalg import LinearOperator
+
+    class Flexibility(LinearOperator):
+        def __init__(self, shape: tuple[int, int], matvec: Any, dtype: Any) -> None:
+            super().__init__(dtype=np.dtype(dtype), shape=shape)
+            self._apply = matvec
+
+        def _matvec(self, x: np.ndarray) -> np.ndarray:
+            return self._apply(x)
+
+        def matvec(self, x: np.ndarray) -> np.ndarray:
+            return self._apply(x)
+
+    return Flexibility
+
+
+@functools.lru_cache(maxsize=1)
 def _eigsh_takes_rng() -> bool:
     """Whether ``scipy.sparse.linalg.eigsh`` has an ``rng`` argument (SciPy >= 1.15), looked up once."""
     from scipy.sparse.linalg import eigsh
@@ -123,7 +148,7 @@ def lanczos_modes(kb: np.ndarray, mb: np.ndarray, R: np.ndarray, MR: np.ndarray,
     ``1 / omega_k^2`` of the lowest modes and ``q = U^-1 z`` their shapes. ARPACK (``eigsh``, to machine
     precision, ``tol = 0``) from a fixed start vector: the result depends on ``K`` and ``M`` only. Should
     it not converge, :func:`dense_modes` answers instead."""
-    from scipy.sparse.linalg import ArpackNoConvergence, LinearOperator, eigsh  # 20-30 ms to import
+    from scipy.sparse.linalg import ArpackNoConvergence, eigsh  # 20-30 ms to import
 
     n = kb.shape[1]
     g = np.linalg.inv(R.T @ MR)                              # (2, 2): the rigid-body mass matrix, inverted
@@ -144,7 +169,7 @@ def lanczos_modes(kb: np.ndarray, mb: np.ndarray, R: np.ndarray, MR: np.ndarray,
         u = dpbtrs(kc, f)[0]                                 # the deflection, clamped at the CG node
         return dtbmv(BANDWIDTH, mc, u - R @ (g @ (MR.T @ u)))         # U P u: without rigid-body motion
 
-    op = LinearOperator((n, n), matvec=matvec, dtype=float)
+    op = _flexibility_operator()((n, n), matvec, float)
     rng = np.random.default_rng(0)
     # SciPy >= 1.15 takes the generator too (else it draws its own from OS entropy, 0.2 ms a call, unused
     # as v0 is given); older ones have no rng argument. The start vector is v0 either way.

@@ -148,16 +148,17 @@ class Reader:
         if value is None:
             return value
         flat = self._floats(name, value, None)
-        if flat.size == 3:
+        if flat.size == 3:                       # diagonal: symmetric, its moments the diagonal sorted
             J = np.diag(flat)
+            moments = np.sort(flat)
         elif flat.size == 9:
             J = flat.reshape(3, 3)
+            if not np.allclose(J, J.T, rtol=0.0, atol=1e-9 * max(1.0, np.abs(J).max())):
+                raise self.error(name, value, "must be symmetric")
+            moments = np.linalg.eigvalsh(J)
         else:
             raise self.error(name, value, "must be [Ixx, Iyy, Izz] or a 3x3 matrix")
-        if not np.allclose(J, J.T, rtol=0.0, atol=1e-9 * max(1.0, np.abs(J).max())):
-            raise self.error(name, value, "must be symmetric")
         tol = 1e-9 * max(1.0, np.abs(J).max())
-        moments = np.linalg.eigvalsh(J)
         if moments.min() < -tol:
             raise self.error(name, value, "must be positive semi-definite (no negative moments of inertia)")
         if moments[0] + moments[1] < moments[2] - max(tol, 1e-6 * moments[2]):

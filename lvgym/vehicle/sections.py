@@ -46,6 +46,8 @@ import numpy as np
 
 from lvgym.errors import ConfigError
 
+from .beamkernels import subdivide_k
+
 __all__ = ["Material", "MATERIALS", "quasi_isotropic_modulus", "tube_area", "tube_second_moment",
            "tube_second_moment_thin", "tube", "PointMass", "Section", "DistributedMass", "BeamMesh",
            "mesh_stack"]
@@ -227,6 +229,8 @@ def per_element(value, n_el: int, key: str, allow_zero: bool = False) -> np.ndar
         np.asarray(value, dtype=float)
     if a.shape != (n_el,):
         raise ConfigError(key, value, f"a number or one value per element ({n_el})")
+    if a.size and (a.min() >= 0.0 if allow_zero else a.min() > 0.0) and a.max() < math.inf:
+        return a                                     # all finite and positive (NaN fails the min test)
     bad = ~np.isfinite(a) | ((a < 0.0) if allow_zero else (a <= 0.0))
     if bad.any():
         i = int(np.argmax(bad))
@@ -240,8 +244,8 @@ def stations_on(s, lo: float, hi: float, key: str) -> np.ndarray:
     if a.ndim != 1:
         raise ConfigError(key, s, "a sequence of stations [m]")
     tol = 1e-9 * max(1.0, hi - lo)
-    bad = ~np.isfinite(a) | (a < lo - tol) | (a > hi + tol)
-    if bad.any():
+    if a.size and not (a.min() >= lo - tol and a.max() <= hi + tol):     # NaN fails the test too
+        bad = ~np.isfinite(a) | (a < lo - tol) | (a > hi + tol)
         i = int(np.argmax(bad))
         raise ConfigError(f"{key}[{i}]", float(a[i]), f"must lie on the beam, in [{lo}, {hi}] m")
     return np.clip(a, lo, hi)
@@ -251,18 +255,14 @@ def point_mass_array(point_masses, lo: float, hi: float) -> np.ndarray:
     """(P, 3) array of station [m], mass [kg], rotary inertia [kg m^2]."""
     if not isinstance(point_masses, (list, tuple)):
         point_masses = list(point_masses)
-    if all(type(pm) is PointMass for pm in point_masses):    # checked as an array; the loop names a bad one
+    if all(type(pm) is PointMass for pm in point_masses):    # checked as floats; the loop names a bad one
         try:
-            a = np.array([(float(pm.station), float(pm.mass), float(pm.rotary_inertia)) for pm in point_masses],
-                         dtype=float).reshape(-1, 3)
+            rows = [(float(pm.station), float(pm.mass), float(pm.rotary_inertia)) for pm in point_masses]
         except (TypeError, ValueError):
-            a = np.full((1, 3), np.nan)
+            rows = [(math.nan, math.nan, math.nan)]
         tol = 1e-9 * max(1.0, hi - lo)
-        s = a[:, 0]
-        if np.isfinite(a).all() and (a[:, 1:] >= 0.0).all() and (s >= lo - tol).all() and (s <= hi + tol).all():
-            s = np.where(lo > s, lo, s)                      # min(max(station, lo), hi), as the loop's
-            a[:, 0] = np.where(hi < s, hi, s)
-            return a
+        if all(lo - tol <= st <= hi + tol and 0.0 <= m < math.inf and 0.0 <= j < math.inf for st, m, j in rows):
+            return np.array([(min(max(st, lo), hi), m, j) for st, m, j in rows], dtype=float).reshape(-1, 3)
     rows = []
     for i, pm in enumerate(point_masses):
         try:
@@ -323,13 +323,7 @@ def _cumulative(s: np.ndarray, pieces: list[tuple[float, float, float]]) -> np.n
 def _subdivide(kept: np.ndarray, h: float) -> np.ndarray:
     """Nodes [m] from the descending breakpoints ``kept``: each span cut into the fewest equal elements no
     longer than ``h`` [m], as ``np.linspace`` places them (``a + i (b - a) / n``, the span's end exact)."""
-    a, b = kept[:-1], kept[1:]
-    n = np.ceil((a - b) / h - 1e-9).astype(np.int64)              # elements per span, >= 1
-    span = np.repeat(np.arange(a.size), n)
-    i = np.arange(span.size) - np.repeat(np.cumsum(n) - n, n) + 1  # 1..n within each span
-    x = i * ((b - a) / n)[span] + a[span]
-    x[(np.cumsum(n) - 1)[n > 0]] = b[n > 0]
-    return np.concatenate([kept[:1], x])
+    return subdivide_k(np.ascontiguousarray(kept, dtype=float), float(h))
 
 
 def mesh_stack(sections: Sequence[Section], point_masses: Sequence = (),

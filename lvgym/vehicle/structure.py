@@ -144,7 +144,8 @@ def _stack_modes(sections: list[Section], points: list[PointMass], spread: list[
     bits of their inputs, so the result is the same arrays a new solve gives), and stored there."""
     if solved is None:
         return stack_modes(sections, points, spread, n_modes=n_modes, query_stations=query)
-    key = pickle.dumps((sections, points, spread, n_modes, query), protocol=4)
+    query = np.ascontiguousarray(query, dtype=float)
+    key = pickle.dumps((sections, points, spread, n_modes, query.shape, query.tobytes()), protocol=4)
     if key not in solved:
         solved[key] = stack_modes(sections, points, spread, n_modes=n_modes, query_stations=query)
     return solved[key]

@@ -20,7 +20,7 @@ inactive (mass 0) and the liquid is all fixed mass (DESIGN.md note 4).
 
 from __future__ import annotations
 
-from dataclasses import dataclass, fields
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -59,8 +59,13 @@ class TankProperties:
 
     def row(self, i: int) -> TankProperties:
         """Instant ``i`` of a batch (floats and a (3, 3) inertia)."""
-        return TankProperties(**{f.name: (getattr(self, f.name)[i].copy() if f.name == "fixed_inertia"
-                                          else float(getattr(self, f.name)[i])) for f in fields(self)})
+        g = self.__getattribute__
+        return TankProperties(*(float(g(name)[i]) for name in _TANK_FLOATS), self.fixed_inertia[i].copy())
+
+
+#: the fields of :class:`TankProperties` before ``fixed_inertia``, in order (floats of one instant)
+_TANK_FLOATS = ("liquid_mass", "height", "liquid_cg", "slosh_mass", "pendulum_length", "pendulum_length_roberts",
+                "slosh_station", "hinge_station", "fixed_mass", "fixed_cg")
 
 
 def slosh_fraction(kappa):
