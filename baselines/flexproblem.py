@@ -30,7 +30,7 @@ from scipy import optimize, signal
 from .filters import StructuralFilter
 from .flightloop import frequency_response
 from .linearize import pid_tf
-from .noise import noise_fraction_on_grid
+from .noise import noise_rate_on_grid
 
 __all__ = ["Requirements", "PARAMETERS", "DRIFT_MODES", "START", "RowProblem", "controller", "controller_tf",
            "design_row", "folded", "notch_frequency", "open_loop_growth"]
@@ -52,9 +52,9 @@ class Requirements:
     disperse the servo delay by 0 or 10 ms, 41 deg of phase at 71 rad/s, and the bending frequency by
     5 %, so the mode's phase is not known well enough to phase-stabilise it) or ``"phase"`` (inside
     the loop, held by the non-rigid margins, as Ares I's first stage did);
-    ``noise_fraction``: the largest RMS of the gimbal command's response to the flight gyro's white
-    noise, as a fraction of the gimbal limit (:mod:`.noise`; rigid and non-rigid loops), so that the
-    actuator's travel and rate are not spent on sensor noise."""
+    ``noise_rate_fraction``: None (the default: not required, only reported), or the largest RMS of the
+    gimbal rate the flight gyro's white noise may command, as a fraction of the servo's rate limit
+    (:mod:`.noise`; rigid and non-rigid loops; docs/flex-design.md, "Sensor noise in the command")."""
 
     rigid_gm_db: float = 6.0
     rigid_pm_deg: float = 30.0
@@ -63,13 +63,15 @@ class Requirements:
     attenuation_db: float = 6.0
     drift_per_s: float = 0.02
     bending1: str = "gain"
-    noise_fraction: float = 0.05
+    noise_rate_fraction: float | None = None
 
     def __post_init__(self) -> None:
         for k, v in asdict(self).items():
             if k == "bending1":
                 if v not in ("gain", "phase"):
                     raise ValueError(f"bending1 = {v!r}: 'gain' or 'phase'")
+            elif k == "noise_rate_fraction" and v is None:
+                continue
             elif not (isinstance(v, (int, float)) and math.isfinite(v) and v >= 0.0):
                 raise ValueError(f"{k} = {v!r}: a finite number >= 0")
 
@@ -160,8 +162,9 @@ class RowProblem:
 
     ``fixed``: parameters of :data:`PARAMETERS` held at these values (in their units) and not optimised;
     ``drift``: one of :data:`DRIFT_MODES`; ``noise``: the gyro's white noise per sample [rad/s] and the
-    gimbal limit [rad] (:func:`.noise.gyro_noise`; a zero noise leaves ``Requirements.noise_fraction``
-    out). The optimiser's vector holds the other parameters (:meth:`values`, :meth:`to_unit`)."""
+    servo's rate limit [rad/s] (:func:`.noise.gyro_noise`; held to ``Requirements.noise_rate_fraction``
+    when that is set and the noise is not zero). The optimiser's vector holds the other parameters
+    (:meth:`values`, :meth:`to_unit`)."""
 
     def __init__(self, cases: list[tuple[dict[str, control.StateSpace], dict[str, list[float]]]], req: Requirements,
                  n_grid: int = 3000, slack: tuple[float, float] = (0.5, 2.0), fixed: dict[str, float] | None = None,
@@ -179,6 +182,7 @@ class RowProblem:
         self.drift = drift
         self.req = req
         self.noise = (float(noise[0]), float(noise[1]))
+        self._noise_held = self.noise[0] > 0.0 and req.noise_rate_fraction is not None
         self.slack_db, self.slack_deg = slack           # designed beyond the requirements by this much (the
         #                                               # grid's margins are a little optimistic)
         self.dt = float(cases[0][0]["rigid"].dt)
@@ -246,8 +250,9 @@ class RowProblem:
     def evaluate(self, values: dict[str, float]) -> dict[str, Any]:
         """Worst margins over the cases per model (gain up, gain down, phase, growth), the modes' part of
         the loop at its peak over the gain-stabilised bands [dB], the objective ``J`` and, per model, the
-        largest excess of the growth over the allowed one (``drift_excess`` [1/s]); ``noise``: the command's
-        response to the gyro's noise as a fraction of the gimbal limit, the largest over cases and models."""
+        largest excess of the growth over the allowed one (``drift_excess`` [1/s]); ``noise``: the gimbal rate
+        the gyro's noise commands as a fraction of the rate limit, the largest over cases and models
+        (computed only when the requirement is set)."""
         gains, filt = controller(values, self.notch_radps)
         b, a = _controller_poly(gains, filt, self.dt)
         C = np.polyval(b, self.z) / np.polyval(a, self.z)
@@ -255,8 +260,8 @@ class RowProblem:
         for i, (G, band, _) in enumerate(self.cases):
             for model, g in G.items():
                 L = C * g
-                if self.noise[0] > 0.0:
-                    out["noise"] = max(out["noise"], noise_fraction_on_grid(C, g, self.w, self.dt, *self.noise))
+                if self._noise_held:
+                    out["noise"] = max(out["noise"], noise_rate_on_grid(C, g, self.w, self.dt, *self.noise))
                 m = self.grid_margins(L) + (self.growth(b, a, model, i),)
                 w = out.get(model)
                 out[model] = m if w is None else (min(w[0], m[0]), max(w[1], m[1]), min(w[2], m[2]), max(w[3], m[3]))
@@ -278,8 +283,8 @@ class RowProblem:
             v += [max(0.0, gm - up), max(0.0, gm + down) if down > -99 else 0.0, max(0.0, pm - phase) / 5.0,
                   100.0 * max(0.0, e["drift_excess"][model])]
         v.append(max(0.0, e["higher_db"] + r.attenuation_db + sdb))
-        if self.noise[0] > 0.0:                        # relative, designed 10 % below the requirement
-            v.append(5.0 * max(0.0, e["noise"] / max(r.noise_fraction, 1e-12) - 0.9))
+        if self._noise_held:                           # relative, designed 10 % below the requirement
+            v.append(5.0 * max(0.0, e["noise"] / max(r.noise_rate_fraction, 1e-12) - 0.9))
         return v
 
     def cost(self, u: np.ndarray) -> float:

@@ -15,7 +15,7 @@ def _worst(row: dict[str, Any], model: str) -> dict[str, float]:
     ms = [row["margins"][f"{model}_{p}"] for p in ("pitch", "yaw")]
     return {"gm": min(m["gain_margin_db"] for m in ms), "gm_down": max(m["gain_reduction_margin_db"] for m in ms),
             "pm": min(abs(m["phase_margin_deg"]) for m in ms), "growth": max(m["max_pole_real_per_s"] for m in ms),
-            "noise": max((m["noise_fraction"] for m in ms if "noise_fraction" in m), default=float("nan"))}
+            "noise": max((m["noise_rate_fraction"] for m in ms if "noise_rate_fraction" in m), default=float("nan"))}
 
 
 def _mode_summary(row: dict[str, Any]) -> tuple[str, str, str]:
@@ -28,7 +28,8 @@ def _mode_summary(row: dict[str, Any]) -> tuple[str, str, str]:
 
 
 def _noise(r: dict[str, float], n: dict[str, float]) -> str:
-    """The command's noise [% of the gimbal limit RMS], the worse loop, or '-' where not computed."""
+    """The gimbal rate the gyro's noise commands [% of the rate limit, RMS], the worse loop, or '-' where
+    not computed."""
     x = max(r["noise"], n["noise"]) if math.isfinite(r["noise"]) and math.isfinite(n["noise"]) else float("nan")
     return f"{100 * x:.1f}" if math.isfinite(x) else "-"
 
@@ -60,9 +61,9 @@ def margin_table(doc: dict[str, Any]) -> str:
              "Margins are the worse of pitch and yaw; 'down' is the gain "
              "reduction that destabilises a conditionally stable loop; mode columns are the non-rigid pitch loop's "
              "gain [dB] at the mode ('gain': at least the attenuation below 0 dB; 'phase': inside the loop, held by "
-             "the non-rigid margins); noise: the RMS of the command's response to the flight gyro's white noise "
-             "[% of the gimbal limit], the worse loop (baselines/noise.py); 'meets': yes, or NO and the requirements "
-             "missed.", "",
+             "the non-rigid margins); noise: the RMS of the gimbal rate the flight gyro's white noise commands "
+             "[% of the servo's rate limit], the worse loop (baselines/noise.py); 'meets': yes, or NO and the "
+             "requirements missed.", "",
              "| t [s] | mass [kg] | kp | ki | kd | rigid GM up/down [dB] | rigid PM [deg] | non-rigid GM up/down [dB] "
              "| non-rigid PM [deg] | slosh gain [dB] | bending 1 [dB] | higher bending [dB] | noise [%] | meets |",
              "|---:|---:|---:|---:|---:|---|---:|---|---:|---|---|---:|---:|---|"]

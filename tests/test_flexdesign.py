@@ -244,3 +244,35 @@ def test_design_command_never_overwrites_the_shipped_schedule(tmp_path):
         output_path("smile", str(SCHEDULES / "smile.yaml"), False)
     with pytest.raises(SystemExit):
         FD.main(["--vehicle", "smile", "--starts", "-1", "--out", str(tmp_path / "x.yaml")])
+
+
+def test_the_noise_requirement_is_reported_and_held_when_asked(row288):
+    """check_loops reports the gimbal rate the gyro's noise commands on every loop (baselines.noise); by
+    default it is not a requirement (the shipped 28.8 s row commands about six times the servo's rate limit
+    from the noise, docs/flex-design.md), with ``noise_rate_fraction`` set it is one, and the design
+    problem then penalises it (its violations get one more entry, positive here)."""
+    from baselines.noise import command_noise_rate
+
+    plants, modes, info = row288
+    r = min(GainSchedule.load("smile_flex").meta["rows"], key=lambda r: abs(r["time_s"] - 28.8))
+    gains, filt = (r["kp"], r["ki"], r["kd"]), StructuralFilter.from_dict(r["filter"])
+    chk = FD.check_loops(plants, gains, filt, modes, FD.Requirements(), info["noise"])
+    assert chk["meets"]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        C = control.ss(FD.controller_tf(gains, filt, DT))
+        for key in ("rigid_pitch", "nonrigid_yaw"):
+            plane = key.split("_")[1]
+            expected = command_noise_rate(C, plants[plane][key.split("_")[0]], *info["noise"])
+            assert chk[key]["noise_rate_fraction"] == pytest.approx(expected, rel=1e-12)
+    assert 4.0 < chk["rigid_pitch"]["noise_rate_fraction"] < 8.0
+    held = FD.check_loops(plants, gains, filt, modes, FD.Requirements(noise_rate_fraction=0.2), info["noise"])
+    assert held["misses"] == ["sensor noise"] and not held["meets"]
+    values = {"kp": r["kp"], "ki": r["ki"], "kd": r["kd"], "lead_zero_radps": r["filter"]["lead_zero_radps"],
+              "lead_ratio": r["filter"]["lead_pole_radps"] / r["filter"]["lead_zero_radps"],
+              "lowpass_radps": r["filter"]["lowpass_radps"], "lowpass_damping": r["filter"]["lowpass_damping"],
+              "notch_damping": r["filter"]["notch_damping"], "notch_depth": r["filter"]["notch_depth"]}
+    loose = FD.RowProblem([(plants["pitch"], modes)], FD.Requirements(), noise=info["noise"])
+    tight = FD.RowProblem([(plants["pitch"], modes)], FD.Requirements(noise_rate_fraction=0.2), noise=info["noise"])
+    v_loose, v_tight = loose.violations(loose.evaluate(values)), tight.violations(tight.evaluate(values))
+    assert len(v_tight) == len(v_loose) + 1 and v_tight[-1] > 1.0 and v_tight[:-1] == v_loose

@@ -1,4 +1,5 @@
-"""How much of a policy's gimbal command is the flight gyro's noise, measured in the nonlinear simulation.
+"""How much gimbal rate the flight gyro's noise commands through a policy, measured in the nonlinear
+simulation.
 
     python -m lvgym.benchmark.cmdnoise                               # the default policies, smile-v1, 3 test seeds
     python -m lvgym.benchmark.cmdnoise --policies gs-pid-flex lqg --seeds 5 --seed-set validation
@@ -7,13 +8,14 @@ Each episode is flown twice on the same seed: as the protocol flies it, and with
 walk set to zero (``gyro_arw_rad_per_sqrt_s = 0``; the env still draws the same random numbers, so the
 wind, the dispersions and the bias are those of the first flight). The difference of the two command
 histories is the command's response to the gyro's white noise, plus whatever that noise changes in the
-flight. Reported per policy and condition, over the seeds: its RMS while the controller is on, as a
-fraction of the gimbal limit (the action's unit), for the whole flight and per thrusting phase, and the
-gimbal rate's RMS [deg/s] of both flights (what the servo makes of it).
+flight; its change per control period over the period is the gimbal rate the noise commands. Reported per
+policy and condition, over the seeds: that rate's RMS while the controller is on, as a fraction of the
+servo's rate limit, for the whole flight and per thrusting phase, and the RMS of the gimbal's own rate
+[deg/s] in both flights (what the servo makes of it).
 
-A linear loop's value at a frozen time is :func:`baselines.noise.command_noise` (the design requirement of
-``gs-pid-flex``, docs/flex-design.md); this measures it for any policy, learned ones included, as
-:mod:`.margins` measures the gain and delay margins.
+A linear loop's value at a frozen time is :func:`baselines.noise.command_noise_rate` (the design
+requirement of ``gs-pid-flex``, docs/flex-design.md); this measures it for any policy, learned ones
+included, as :mod:`.margins` measures the gain and delay margins.
 """
 
 from __future__ import annotations
@@ -52,7 +54,7 @@ class NoiseTask:
     seed: int
 
 
-def _fly(spec: PolicySpec, condition: Condition, seed: int) -> dict[str, np.ndarray]:
+def _fly(spec: PolicySpec, condition: Condition, seed: int) -> dict[str, Any]:
     env = condition.make_env()
     policy = build_policy(spec, env)
     obs, info = env.reset(seed=int(seed))
@@ -68,7 +70,10 @@ def _fly(spec: PolicySpec, condition: Condition, seed: int) -> dict[str, np.ndar
         rate.append(np.degrees(np.abs(np.asarray(info["gimbal_rate"], float))))
         if terminated or truncated:
             break
-    return {"t": np.array(t), "action": np.array(a), "rate": np.array(rate), "on": np.array(on)}
+    u = env.unwrapped
+    return {"t": np.array(t), "action": np.array(a), "rate": np.array(rate), "on": np.array(on),
+            "dt": float(u.task.control_dt_s), "limit": float(u.gimbal_limit),
+            "rate_limit": float(u.sim.servo.rate_limit)}
 
 
 def _rms(x: np.ndarray) -> float:
@@ -76,22 +81,30 @@ def _rms(x: np.ndarray) -> float:
 
 
 def command_noise_episode(task: NoiseTask) -> dict[str, Any]:
-    """The two flights of ``task`` and their difference: ``noise`` (RMS of the command difference over
-    the samples where the controller is on in both, [gimbal limit]; per phase ``noise_<phase>``),
-    ``rate_deg_s`` and ``rate_quiet_deg_s`` (RMS gimbal rate of the flight and of the noiseless one
-    while on [deg/s]) and ``samples`` (how many samples both flights share)."""
+    """The two flights of ``task`` and their difference ``d`` (the commands' difference [rad]): ``noise``
+    (RMS of the commanded rate ``(d[k] - d[k-1]) / dt`` over the samples where the controller is on in
+    both flights at both steps, as a fraction of the servo's rate limit; per phase ``noise_<phase>``),
+    ``noise_deg_s`` (the same in deg/s), ``rate_deg_s`` and ``rate_quiet_deg_s`` (RMS gimbal rate of the
+    flight and of the noiseless one while on [deg/s]) and ``samples`` (how many samples both share)."""
     loud = _fly(task.policy, task.condition, task.seed)
     quiet = _fly(task.policy, task.condition.with_options(gyro_arw_rad_per_sqrt_s=0.0), task.seed)
     n = min(len(loud["t"]), len(quiet["t"]))
     on = loud["on"][:n] & quiet["on"][:n]
-    diff = loud["action"][:n] - quiet["action"][:n]
+    d = (loud["action"][:n] - quiet["action"][:n]) * loud["limit"]
+    rate = np.zeros_like(d)
+    rate[1:] = (d[1:] - d[:-1]) / loud["dt"]                 # the commanded rate the noise adds [rad/s]
+    both = on.copy()
+    both[1:] &= on[:-1]
+    both[0] = False
+    scale = 1.0 / loud["rate_limit"]
     out = {"policy": task.policy.name, "condition": task.condition.name, "model": task.condition.model,
-           "seed": int(task.seed), "samples": int(n), "noise": _rms(diff[on]),
+           "seed": int(task.seed), "samples": int(n), "noise": scale * _rms(rate[both]),
+           "noise_deg_s": math.degrees(_rms(rate[both])),
            "rate_deg_s": _rms(loud["rate"][:n][on]), "rate_quiet_deg_s": _rms(quiet["rate"][:n][on])}
     t = loud["t"][:n]
     for name, (lo, hi) in PHASES.items():
-        m = on & (t > lo) & (t <= hi)
-        out[f"noise_{name}"] = _rms(diff[m])
+        m = both & (t > lo) & (t <= hi)
+        out[f"noise_{name}"] = scale * _rms(rate[m])
     return out
 
 
@@ -108,21 +121,22 @@ def run_command_noise(policies: Sequence[PolicySpec], suite: str = "smile-v1", s
 
 def noise_table(records: Sequence[dict[str, Any]]) -> str:
     """A Markdown table: per policy and condition, the mean over the seeds of each record's RMS values
-    (noise in % of the gimbal limit; gimbal rate in deg/s) and their range."""
+    (the commanded rate the noise adds in % of the servo's rate limit and in deg/s; the gimbal's rate in
+    deg/s) and the range of the first."""
     keys: dict[tuple[str, str], list[dict[str, Any]]] = {}
     for r in records:
         keys.setdefault((r["policy"], r["condition"]), []).append(r)
-    lines = ["| policy | condition | seeds | command noise, on [% of limit] | boost [%] | upper stage [%] "
-             "| gimbal rate [deg/s] | gimbal rate without the noise [deg/s] |",
-             "|---|---|---:|---|---:|---:|---:|---:|"]
+    lines = ["| policy | condition | seeds | gimbal rate commanded by the gyro noise [% of the rate limit] "
+             "| [deg/s] | boost [%] | upper stage [%] | gimbal rate [deg/s] | gimbal rate without the noise [deg/s] |",
+             "|---|---|---:|---|---:|---:|---:|---:|---:|"]
     for (pol, cond), rs in keys.items():
         def mean(k: str, scale: float = 1.0) -> str:
             v = [scale * r[k] for r in rs if math.isfinite(r[k])]
             return f"{np.mean(v):.2f}" if v else "-"
         noise = [100 * r["noise"] for r in rs]
         lines.append(f"| {pol} | {cond} | {len(rs)} | {np.mean(noise):.2f} ({min(noise):.2f}-{max(noise):.2f}) "
-                     f"| {mean('noise_boost', 100)} | {mean('noise_upper', 100)} | {mean('rate_deg_s')} "
-                     f"| {mean('rate_quiet_deg_s')} |")
+                     f"| {mean('noise_deg_s')} | {mean('noise_boost', 100)} | {mean('noise_upper', 100)} "
+                     f"| {mean('rate_deg_s')} | {mean('rate_quiet_deg_s')} |")
     return "\n".join(lines) + "\n"
 
 
