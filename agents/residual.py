@@ -87,25 +87,41 @@ def combine(base: np.ndarray, learned: np.ndarray, scale: float) -> np.ndarray:
 
 class ResidualRows:
     """One baseline per env row (built by its registry factory on ``env``, a single or batched lvgym env)
-    and the baseline action of each row for its coming step (:attr:`base`, (rows, n_a) float32)."""
+    and the baseline action of each row for its coming step (:attr:`base`, (rows, n_a) float32). A baseline
+    whose policy has ``batch(n)`` (``lqg``: :class:`baselines.lqg.LQGBatch`) flies every row in one object,
+    stepped together; the others, one policy per row."""
 
     def __init__(self, config: ResidualConfig, env: Any, rows: int) -> None:
         if not hasattr(env.action_space, "low"):
             raise ValueError("a residual policy needs a Box (TVC) action space")
         self.config = config
         spec = POLICIES[config.baseline]
-        self.policies: list[Policy] = [build_policy(spec, env) for _ in range(int(rows))]
+        first = build_policy(spec, env)
+        self.batch = first.batch(int(rows)) if hasattr(first, "batch") else None
+        self.policies: list[Policy] = [] if self.batch is not None else [first] + [
+            build_policy(spec, env) for _ in range(int(rows) - 1)]
         n_a = int(np.prod(env.action_space.shape[-1:]))
         self.base = np.zeros((int(rows), n_a), np.float32)
 
     def reset(self, rows: Any, obs: np.ndarray, infos: list[dict[str, Any]]) -> None:
         """Rows ``rows`` start an episode whose first observation is ``obs[b]`` and info ``infos[b]``."""
+        if self.batch is not None:
+            rows = np.asarray(list(rows), dtype=int)
+            if rows.size:
+                self.batch.reset(rows)
+                self.base[rows] = self.batch.act(rows, obs[rows], [infos[b] for b in rows])
+            return
         for b in rows:
             self.policies[b].reset()
             self.base[b] = self.policies[b].act(obs[b], infos[b])
 
     def advance(self, rows: Any, obs: np.ndarray, infos: list[dict[str, Any]]) -> None:
         """Rows ``rows`` went one step on: their baselines act on the new observation."""
+        if self.batch is not None:
+            rows = np.asarray(list(rows), dtype=int)
+            if rows.size:
+                self.base[rows] = self.batch.act(rows, obs[rows], [infos[b] for b in rows])
+            return
         for b in rows:
             self.base[b] = self.policies[b].act(obs[b], infos[b])
 

@@ -101,6 +101,14 @@ class LQGSchedule:
                 return i
         return int(np.argmin([min(abs(t - r.interval_s[0]), abs(t - r.interval_s[1])) for r in rows]))
 
+    def index_many(self, t: Any) -> np.ndarray:
+        """:meth:`index` of every flight time of the array ``t`` [s]."""
+        t = np.asarray(t, float).reshape(-1, 1)
+        iv = np.array([r.interval_s for r in self.rows["pitch"]])
+        inside = (iv[:, 0] <= t) & (t < iv[:, 1])
+        near = np.argmin(np.minimum(np.abs(t - iv[:, 0]), np.abs(t - iv[:, 1])), axis=1)
+        return np.where(inside.any(axis=1), np.argmax(inside, axis=1), near)
+
     @classmethod
     def load(cls, path: str | Path = "smile_lqg") -> "LQGSchedule":
         """A schedule written by :func:`.lqg_design.save_schedule` (a path, or a name in
@@ -137,56 +145,74 @@ def _read_only(a: np.ndarray) -> np.ndarray:
 
 
 class LQGLaw:
-    """One plane's law (module docstring): ``update(y, t, enabled) -> u`` [rad]."""
+    """One plane's law (module docstring) for ``n`` independent rows (episodes) of one schedule:
+    ``update(y, t, on, which) -> u`` [rad] steps the rows ``which`` with their gyro samples ``y`` [rad/s],
+    flight times ``t`` [s] and switches ``on``. One row is :class:`LQGPolicy`; many are a residual
+    policy's baselines in training (:meth:`LQGPolicy.batch`). The rows in use at the same schedule row are
+    stepped together, as matrix products over the rows."""
 
-    def __init__(self, rows: tuple[LQGRow, ...], schedule: LQGSchedule, u_limit: float) -> None:
+    def __init__(self, rows: tuple[LQGRow, ...], schedule: LQGSchedule, u_limit: float, n: int = 1) -> None:
         if not u_limit > 0.0:
             raise ConfigError("u_limit", u_limit, "a gimbal limit > 0 rad")
-        self.rows, self.schedule, self.u_limit = rows, schedule, float(u_limit)
-        self.reset()
+        if int(n) < 1:
+            raise ConfigError("n", n, "at least one row")
+        self.rows, self.schedule, self.u_limit, self.n = rows, schedule, float(u_limit), int(n)
+        self.n_states = max(r.A.shape[0] for r in rows)
+        self.row = np.full(self.n, -1)                  # the schedule row in use (-1: none since engagement)
+        self.x = np.zeros((self.n, self.n_states))     # the predicted state x_p, the row's first states
+        self.xi = np.zeros(self.n)
+        self.was_on = np.zeros(self.n, bool)
+        self.saturated = np.zeros(self.n, bool)
 
-    def reset(self) -> None:
-        self.row: int | None = None
-        self.xp: np.ndarray | None = None
-        self.xi = 0.0
-        self.was_on = False
-        self.saturated = False
+    def reset(self, which: Any = None) -> None:
+        """Restart the rows ``which`` (None: all) as at the start of an episode."""
+        w = slice(None) if which is None else np.asarray(which, dtype=int)
+        self.row[w], self.x[w], self.xi[w], self.was_on[w], self.saturated[w] = -1, 0.0, 0.0, False, False
 
-    def _switch(self, i: int) -> None:
+    def _switch(self, b: int, i: int) -> None:
         new = self.rows[i]
-        x = np.zeros(new.A.shape[0])
-        if self.row is not None and self.xp is not None:
-            old = self.rows[self.row]
+        x = np.zeros(self.n_states)
+        if self.row[b] >= 0:
+            old = self.rows[self.row[b]]
             if old.labels == new.labels:
-                x = self.xp.copy()
+                x[:new.A.shape[0]] = self.x[b, :new.A.shape[0]]
             else:                                  # carry the states both rows name, zero the others
                 where = {name: k for k, name in enumerate(old.labels)}
                 for k, name in enumerate(new.labels):
                     if name in where and new.labels.count(name) == 1:
-                        x[k] = self.xp[where[name]]
-        self.row, self.xp = i, x
+                        x[k] = self.x[b, where[name]]
+        self.row[b], self.x[b] = i, x
 
-    def update(self, y: float, t: float, enabled: bool = True) -> float:
-        """The command [rad] for the gyro sample ``y`` [rad/s] at flight time ``t`` [s]."""
-        if not enabled:
-            self.was_on, self.saturated = False, False
-            return 0.0
-        if not self.was_on:                        # engagement: restart from zero
-            self.row, self.xp, self.xi = None, None, 0.0
-        self.was_on = True
-        i = self.schedule.index(t)
-        if i != self.row:
-            self._switch(i)
-        r = self.rows[self.row]
-        y = float(y)
-        xf = self.xp + r.M[:, 0] * (y - float(r.C[0] @ self.xp))
-        v = -float(r.Kx[0] @ xf) - r.Ki * self.xi
-        u = min(max(v, -self.u_limit), self.u_limit)
-        self.saturated = u != v
-        dxi = (r.a - 1.0) * self.xi - r.dt * y
-        if not (self.saturated and (v - u) * (-r.Ki * dxi) > 0.0):   # clamp: do not integrate into the limit
-            self.xi += dxi
-        self.xp = r.A @ xf + r.B[:, 0] * u
+    def update(self, y: Any, t: Any, on: Any, which: Any = None) -> np.ndarray:
+        """The commands [rad] of the rows ``which`` (None: all) for their gyro samples ``y`` [rad/s] at
+        flight times ``t`` [s], the law on where ``on``."""
+        which = np.arange(self.n) if which is None else np.asarray(which, dtype=int)
+        y, t = np.asarray(y, float).reshape(-1), np.asarray(t, float).reshape(-1)
+        on = np.asarray(on, bool).reshape(-1)
+        u = np.zeros(which.size)
+        off = which[~on]
+        self.was_on[off], self.saturated[off] = False, False
+        engaged = which[on & ~self.was_on[which]]      # engagement: restart from zero
+        self.row[engaged], self.x[engaged], self.xi[engaged] = -1, 0.0, 0.0
+        self.was_on[which[on]] = True
+        idx = self.schedule.index_many(t)
+        for k in np.flatnonzero(on & (idx != self.row[which])):
+            self._switch(int(which[k]), int(idx[k]))
+        for i in np.unique(idx[on]):
+            k = np.flatnonzero(on & (idx == i))
+            b, r = which[k], self.rows[i]
+            m = r.A.shape[0]
+            yy, xp, xi = y[k], self.x[b, :m], self.xi[b]
+            xf = xp + (yy - xp @ r.C[0])[:, None] * r.M[:, 0]
+            v = -(xf @ r.Kx[0]) - r.Ki * xi
+            uu = np.clip(v, -self.u_limit, self.u_limit)
+            sat = uu != v
+            dxi = (r.a - 1.0) * xi - r.dt * yy
+            hold = sat & ((v - uu) * (-r.Ki * dxi) > 0.0)   # clamp: do not integrate into the limit
+            self.xi[b] = np.where(hold, xi, xi + dxi)
+            self.x[b, :m] = xf @ r.A.T + uu[:, None] * r.B[:, 0]
+            self.saturated[b] = sat
+            u[k] = uu
         return u
 
 
@@ -224,8 +250,37 @@ class LQGPolicy:
         obs = np.asarray(observation, dtype=float)
         on = float(obs[self._i_on]) >= 0.5
         t = float(info["time"])
-        self.last_gimbal = np.array([law.update(obs[i], t, on) for law, i in zip(self.axes, self._i_err)])
+        self.last_gimbal = np.array([law.update(obs[i], t, on)[0] for law, i in zip(self.axes, self._i_err)])
         return np.clip(self.last_gimbal / self.limit, -1.0, 1.0).astype(np.float32)
+
+    def batch(self, n: int) -> "LQGBatch":
+        """The same law for ``n`` independent rows of a batched env, stepped together (:class:`LQGBatch`)."""
+        return LQGBatch(self, n)
+
+
+class LQGBatch:
+    """``n`` independent copies of an :class:`LQGPolicy` (one per env row), stepped together: ``act(rows,
+    observations, infos)`` gives the actions of the rows ``rows`` (an :class:`LQGPolicy` per row would give
+    the same, each in its own Python call; ``agents.residual`` uses this for a residual's baselines)."""
+
+    def __init__(self, policy: LQGPolicy, n: int) -> None:
+        self.name, self.limit = policy.name, policy.limit
+        self._i_err, self._i_on = policy._i_err, policy._i_on
+        self.axes = [LQGLaw(policy.schedule.rows[p], policy.schedule, policy.limit, n) for p in PLANES]
+
+    def reset(self, rows: Any) -> None:
+        """Rows ``rows`` start an episode."""
+        for law in self.axes:
+            law.reset(rows)
+
+    def act(self, rows: Any, observations: np.ndarray, infos: list[dict[str, Any]]) -> np.ndarray:
+        """Actions (len(rows), 2) float32 of the rows ``rows`` for their observations (len(rows), n_obs) and
+        infos (each with ``time``)."""
+        obs = np.asarray(observations, dtype=float).reshape(len(infos), -1)
+        on = obs[:, self._i_on] >= 0.5
+        t = np.array([float(i["time"]) for i in infos])
+        u = np.stack([law.update(obs[:, i], t, on, rows) for law, i in zip(self.axes, self._i_err)], axis=1)
+        return np.clip(u / self.limit, -1.0, 1.0).astype(np.float32)
 
 
 def smile_lqg(env: Any, name: str = "lqg", schedule: str = "smile_lqg") -> LQGPolicy:

@@ -100,7 +100,7 @@ def test_law_equals_the_linear_compensator(shipped):
         one = LQGSchedule({p: (r,) for p in ("pitch", "yaw")}, "one row")
         law = LQGLaw(one.rows["pitch"], one, u_limit=1e6)
         y = 1e-3 * rng.standard_normal(200)
-        u_law = np.array([law.update(v, r.time_s) for v in y])
+        u_law = np.array([law.update(v, r.time_s, True)[0] for v in y])
         d = R.RowDesign(r.time_s, "pitch", r.A, r.B, r.C, r.Kx, r.Ki, r.M, r.a, r.dt, R.LQGWeights(), r.labels)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
@@ -170,3 +170,36 @@ def test_bad_inputs_raise_clear_errors(tmp_path):
     r = LQGSchedule.load("smile_lqg").rows["pitch"][0]
     with pytest.raises(ConfigError, match="Kx"):
         LQGRow(r.time_s, r.interval_s, r.A, r.B, r.C, r.Kx[:, :-1], r.Ki, r.M, r.a, r.dt, r.labels)
+
+
+def test_a_batch_of_rows_is_the_policy_of_each_row():
+    """LQGBatch steps n rows together (what a residual's baselines in training use); each row's actions
+    equal an LQGPolicy's flying the same inputs to the bit, with the rows at different flight times
+    (other schedule rows, the boost and the upper stage at once), switched off through a coast, reset at
+    different steps and stepped in changing subsets."""
+    env = gym.make("lvgym/SmileAscent-v1", model="nonrigid")
+    obs0, _ = env.reset(seed=0)
+    lay = env.unwrapped.observation_layout
+    n = 6
+    single = [smile_lqg(env) for _ in range(n)]
+    batch = smile_lqg(env).batch(n)
+    rng = np.random.default_rng(5)
+    t = np.array([2.0, 9.0, 20.0, 41.9, 50.0, 54.0])          # the last two: coast, then ignition
+    batch.reset(np.arange(n))
+    for p in single:
+        p.reset()
+    for step in range(400):
+        rows = np.flatnonzero(rng.random(n) < 0.8)              # the rows stepped this time
+        obs = np.tile(obs0, (n, 1)).astype(float)
+        obs[:, lay.index("pitch_rate_error")] = 2e-3 * rng.standard_normal(n)
+        obs[:, lay.index("yaw_rate_error")] = 2e-3 * rng.standard_normal(n)
+        obs[:, lay.index("controller_on")] = ((t < 43.0) | (t > 54.5)).astype(float)
+        infos = [{"time": float(x)} for x in t]
+        got = batch.act(rows, obs[rows], [infos[b] for b in rows])
+        want = np.array([single[b].act(obs[b], infos[b]) for b in rows]).reshape(-1, 2)
+        np.testing.assert_array_equal(got, want)
+        t[rows] += 0.02
+        if step == 200:                                         # a row starts a new episode
+            batch.reset([3])
+            single[3].reset()
+            t[3] = 2.0
