@@ -46,7 +46,8 @@ TRAIN = _train_module()
 
 
 def _argv(tmp: Path, name: str, algo: str = "ppo", steps: int = 384, seed: int = 0, extra: tuple = ()) -> list[str]:
-    return ["--algo", algo, "--name", name, "--runs-dir", str(tmp), "--total-timesteps", str(steps),
+    return ["--env-id", "lvgym/SmileAscent-v0", "--algo", algo, "--name", name, "--runs-dir", str(tmp),
+            "--total-timesteps", str(steps),
             "--seed", str(seed), "--n-envs", "4", "--hp", *TINY[algo], "--env-kwargs", *ENV_KW,
             "--checkpoint-freq", "128", "--eval-freq", "256", "--eval-episodes", "1", "--eval-mission-time-s", "0.5",
             "--no-progress", *extra]

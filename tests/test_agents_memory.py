@@ -40,7 +40,8 @@ TRAIN = _train_module()
 
 def _argv(tmp: Path, name: str, *extra: str, algo: str = "ppo", steps: int = 256) -> list[str]:
     hp = TINY + (["policy.lstm_hidden_size=8"] if algo == "recurrent-ppo" else [])
-    return ["--env-id", ENV, "--observation", "flight", "--algo", algo, "--name", name, "--runs-dir", str(tmp),
+    return ["--env-id", ENV, "--observation", "flight", "--residual", "none", "--history", "0", "--algo", algo,
+            "--name", name, "--runs-dir", str(tmp),
             "--total-timesteps", str(steps), "--seed", "0", "--n-envs", "4", "--hp", *hp, "--env-kwargs", *ENV_KW,
             "--checkpoint-freq", "128", "--eval-suite", "smile-v1", "--eval-freq", "128", "--eval-episodes", "1",
             "--eval-mission-time-s", "0.5", "--no-progress", *extra]

@@ -125,7 +125,7 @@ def test_a_signal_writes_a_checkpoint_before_the_run_exits(tmp_path, signum):
 def test_the_default_observation_and_randomisation_are_the_env_protocols():
     from lvgym.benchmark.suites import V1_DISPERSIONS
 
-    v0 = TRAIN.env_kwargs_of(TRAIN.Args())
+    v0 = TRAIN.env_kwargs_of(TRAIN.Args(env_id="lvgym/SmileAscent-v0"))
     assert v0["randomize"] == ["wind", "thrust_misalignment"] and "observation" not in v0   # v0's own: state
     assert v0["wind"] == "turbulence"
     v1 = TRAIN.env_kwargs_of(TRAIN.Args(env_id="lvgym/SmileAscent-v1"))
@@ -157,3 +157,22 @@ def test_repeated_list_options_add_up_and_randomize_replaces_its_default():
     assert args.env_kwargs == ["mission_time_s=20", "n_modes=1"]
     assert args.randomize == ["wind"]
     assert TRAIN.parse_args([])[0].hp == [] and TRAIN.parse_args([])[0].randomize == ["protocol"]
+
+
+def test_the_default_run_is_the_v1_recipe_and_given_options_win(tmp_path):
+    """``python train.py`` trains SmileAscent-v1 with its recipe (train.RECIPES: residual on lqg at 5 %,
+    a 4-sample history, turbulence without the gust), recorded in the run's config; an option on the
+    command line wins over the recipe; a v0 id has none. Nothing is written by prepare()."""
+    base = ["--runs-dir", str(tmp_path), "--name", "r"]
+    args, config, _, _ = TRAIN.prepare(*TRAIN.parse_args(base))
+    assert args.env_id == "lvgym/SmileAscent-v1"
+    assert config["residual"] == {"baseline": "lqg", "scale": 0.05}
+    assert config["env_kwargs"]["history"] == 4 and config["env_kwargs"]["wind"] == "turbulence"
+    assert config["args"]["residual"] == "lqg" and config["args"]["history"] == 4
+    args, config, _, _ = TRAIN.prepare(*TRAIN.parse_args(base + ["--residual", "none", "--history", "0",
+                                                                 "--wind", "protocol"]))
+    assert "residual" not in config and "history" not in config["env_kwargs"]
+    assert config["env_kwargs"]["wind"] == "turbulence_gust"
+    args, config, _, _ = TRAIN.prepare(*TRAIN.parse_args(base + ["--env-id", "lvgym/SmileAscent-v0"]))
+    assert args.residual is None and "history" not in config["env_kwargs"]
+    assert not (tmp_path / "r").exists()
