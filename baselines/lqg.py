@@ -34,6 +34,7 @@ the tests).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 from pathlib import Path
 from typing import Any
 
@@ -42,6 +43,7 @@ import numpy as np
 from lvgym.errors import ConfigError
 
 from .filecache import read_once
+from .lqgkernel import LQGState, LQGTables, lqg_step_k, lqg_tables
 
 SCHEDULES = Path(__file__).resolve().parent / "schedules"
 PLANES = ("pitch", "yaw")
@@ -101,13 +103,17 @@ class LQGSchedule:
                 return i
         return int(np.argmin([min(abs(t - r.interval_s[0]), abs(t - r.interval_s[1])) for r in rows]))
 
-    def index_many(self, t: Any) -> np.ndarray:
-        """:meth:`index` of every flight time of the array ``t`` [s]."""
-        t = np.asarray(t, float).reshape(-1, 1)
-        iv = np.array([r.interval_s for r in self.rows["pitch"]])
-        inside = (iv[:, 0] <= t) & (t < iv[:, 1])
-        near = np.argmin(np.minimum(np.abs(t - iv[:, 0]), np.abs(t - iv[:, 1])), axis=1)
-        return np.where(inside.any(axis=1), np.argmax(inside, axis=1), near)
+    @cached_property
+    def _tables(self) -> dict[int, LQGTables]:
+        return {}
+
+    def tables(self, rows: tuple[LQGRow, ...]) -> LQGTables:
+        """The stacked tables of ``rows`` (one plane's, :func:`.lqgkernel.lqg_tables`), built once per
+        schedule object and plane."""
+        key = id(rows)
+        if key not in self._tables:
+            self._tables[key] = lqg_tables(rows)
+        return self._tables[key]
 
     @classmethod
     def load(cls, path: str | Path = "smile_lqg") -> "LQGSchedule":
@@ -148,8 +154,8 @@ class LQGLaw:
     """One plane's law (module docstring) for ``n`` independent rows (episodes) of one schedule:
     ``update(y, t, on, which) -> u`` [rad] steps the rows ``which`` with their gyro samples ``y`` [rad/s],
     flight times ``t`` [s] and switches ``on``. One row is :class:`LQGPolicy`; many are a residual
-    policy's baselines in training (:meth:`LQGPolicy.batch`). The rows in use at the same schedule row are
-    stepped together, as matrix products over the rows."""
+    policy's baselines in training (:meth:`LQGPolicy.batch`). Both run the compiled step
+    :func:`.lqgkernel.lqg_step_k` on the schedule's stacked tables."""
 
     def __init__(self, rows: tuple[LQGRow, ...], schedule: LQGSchedule, u_limit: float, n: int = 1) -> None:
         if not u_limit > 0.0:
@@ -157,62 +163,32 @@ class LQGLaw:
         if int(n) < 1:
             raise ConfigError("n", n, "at least one row")
         self.rows, self.schedule, self.u_limit, self.n = rows, schedule, float(u_limit), int(n)
-        self.n_states = max(r.A.shape[0] for r in rows)
-        self.row = np.full(self.n, -1)                  # the schedule row in use (-1: none since engagement)
-        self.x = np.zeros((self.n, self.n_states))     # the predicted state x_p, the row's first states
-        self.xi = np.zeros(self.n)
-        self.was_on = np.zeros(self.n, bool)
-        self.saturated = np.zeros(self.n, bool)
+        self.tables = schedule.tables(rows)
+        N = self.tables.A.shape[1]
+        self.state = LQGState(np.zeros((self.n, N)), np.zeros(self.n), np.full(self.n, -1, dtype=np.int64),
+                              np.zeros(self.n, bool), np.zeros(self.n, bool))
+        self._all = np.arange(self.n, dtype=np.int64)
+
+    @property
+    def saturated(self) -> np.ndarray:
+        """Whether each row's last command was clipped."""
+        return self.state.saturated
 
     def reset(self, which: Any = None) -> None:
         """Restart the rows ``which`` (None: all) as at the start of an episode."""
-        w = slice(None) if which is None else np.asarray(which, dtype=int)
-        self.row[w], self.x[w], self.xi[w], self.was_on[w], self.saturated[w] = -1, 0.0, 0.0, False, False
-
-    def _switch(self, b: int, i: int) -> None:
-        new = self.rows[i]
-        x = np.zeros(self.n_states)
-        if self.row[b] >= 0:
-            old = self.rows[self.row[b]]
-            if old.labels == new.labels:
-                x[:new.A.shape[0]] = self.x[b, :new.A.shape[0]]
-            else:                                  # carry the states both rows name, zero the others
-                where = {name: k for k, name in enumerate(old.labels)}
-                for k, name in enumerate(new.labels):
-                    if name in where and new.labels.count(name) == 1:
-                        x[k] = self.x[b, where[name]]
-        self.row[b], self.x[b] = i, x
+        w = slice(None) if which is None else np.asarray(which, dtype=np.int64)
+        st = self.state
+        st.row[w], st.x[w], st.xi[w], st.was_on[w], st.saturated[w] = -1, 0.0, 0.0, False, False
 
     def update(self, y: Any, t: Any, on: Any, which: Any = None) -> np.ndarray:
         """The commands [rad] of the rows ``which`` (None: all) for their gyro samples ``y`` [rad/s] at
         flight times ``t`` [s], the law on where ``on``."""
-        which = np.arange(self.n) if which is None else np.asarray(which, dtype=int)
-        y, t = np.asarray(y, float).reshape(-1), np.asarray(t, float).reshape(-1)
-        on = np.asarray(on, bool).reshape(-1)
-        u = np.zeros(which.size)
-        off = which[~on]
-        self.was_on[off], self.saturated[off] = False, False
-        engaged = which[on & ~self.was_on[which]]      # engagement: restart from zero
-        self.row[engaged], self.x[engaged], self.xi[engaged] = -1, 0.0, 0.0
-        self.was_on[which[on]] = True
-        idx = self.schedule.index_many(t)
-        for k in np.flatnonzero(on & (idx != self.row[which])):
-            self._switch(int(which[k]), int(idx[k]))
-        for i in np.unique(idx[on]):
-            k = np.flatnonzero(on & (idx == i))
-            b, r = which[k], self.rows[i]
-            m = r.A.shape[0]
-            yy, xp, xi = y[k], self.x[b, :m], self.xi[b]
-            xf = xp + (yy - xp @ r.C[0])[:, None] * r.M[:, 0]
-            v = -(xf @ r.Kx[0]) - r.Ki * xi
-            uu = np.clip(v, -self.u_limit, self.u_limit)
-            sat = uu != v
-            dxi = (r.a - 1.0) * xi - r.dt * yy
-            hold = sat & ((v - uu) * (-r.Ki * dxi) > 0.0)   # clamp: do not integrate into the limit
-            self.xi[b] = np.where(hold, xi, xi + dxi)
-            self.x[b, :m] = xf @ r.A.T + uu[:, None] * r.B[:, 0]
-            self.saturated[b] = sat
-            u[k] = uu
+        which = self._all if which is None else np.asarray(which, dtype=np.int64).reshape(-1)
+        y = np.asarray(y, dtype=float).reshape(-1)
+        t = np.asarray(t, dtype=float).reshape(-1)
+        on = np.asarray(on, dtype=bool).reshape(-1)
+        u = np.empty(which.size)
+        lqg_step_k(self.tables, self.state, which, y, t, on, self.u_limit, u)
         return u
 
 

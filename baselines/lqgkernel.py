@@ -1,0 +1,143 @@
+"""The compiled step of the LQG law (:mod:`.lqg`) for any number of rows: one row for a benchmark policy,
+all the env rows of a residual policy's baselines in training. One code path for both.
+
+The schedule's rows are stacked, zero-padded to the largest state (:class:`LQGTables`, built once per
+schedule and plane by :func:`lqg_tables`); a law's state is :class:`LQGState` (``x``: the predicted
+state ``x_p`` per row in the first ``dim`` entries of the row in use; ``xi``: the rate error's leaky
+integral; ``row``: the schedule row in use, -1 since the last engagement; ``was_on``; ``saturated``).
+:func:`lqg_step_k` is the module docstring of :mod:`.lqg` row by row::
+
+    x_f = x_p + M (y - C x_p);  v = -K_x x_f - K_i xi;  u = clip(v);  xi <- a xi - dt y (held while clipped
+    and pushing further);  x_p <- A x_f + B u
+
+with the engagement restart, the schedule row chosen by flight time (the row whose interval holds it,
+else the nearest) and, at a switch, the states both rows name carried (``carry``) and the others zeroed.
+"""
+
+from __future__ import annotations
+
+from typing import Any, NamedTuple
+
+import numba as nb
+import numpy as np
+
+__all__ = ["LQGState", "LQGTables", "lqg_step_k", "lqg_tables"]
+
+
+class LQGTables(NamedTuple):
+    """One plane's schedule, R rows padded to N states: ``A`` (R, N, N), ``B``, ``C``, ``Kx``, ``M`` (R, N),
+    ``Ki``, ``a``, ``dt`` (R,), ``dim`` (R,) the row's own state count, ``lo``, ``hi`` (R,) its interval [s],
+    ``carry`` (R, R, N): at a switch from row ``o`` to row ``i`` the new state ``k`` takes the old state
+    ``carry[o, i, k]`` (-1: zero)."""
+
+    A: np.ndarray
+    B: np.ndarray
+    C: np.ndarray
+    Kx: np.ndarray
+    M: np.ndarray
+    Ki: np.ndarray
+    a: np.ndarray
+    dt: np.ndarray
+    dim: np.ndarray
+    lo: np.ndarray
+    hi: np.ndarray
+    carry: np.ndarray
+
+
+class LQGState(NamedTuple):
+    """The state of ``n`` rows of one plane's law (module docstring)."""
+
+    x: np.ndarray
+    xi: np.ndarray
+    row: np.ndarray
+    was_on: np.ndarray
+    saturated: np.ndarray
+
+
+def lqg_tables(rows: Any) -> LQGTables:
+    """The stacked tables of a plane's :class:`.lqg.LQGRow` sequence (carry maps from the state labels:
+    identical labels carry every state; otherwise a state named once in the new row takes the old state
+    of that name)."""
+    R, N = len(rows), max(r.A.shape[0] for r in rows)
+    A, (B, C, Kx, M) = np.zeros((R, N, N)), (np.zeros((R, N)) for _ in range(4))
+    carry = np.full((R, R, N), -1, dtype=np.int64)
+    for i, r in enumerate(rows):
+        m = r.A.shape[0]
+        A[i, :m, :m], B[i, :m], C[i, :m], Kx[i, :m], M[i, :m] = r.A, r.B[:, 0], r.C[0], r.Kx[0], r.M[:, 0]
+        for o, old in enumerate(rows):
+            if old.labels == r.labels:
+                carry[o, i, :m] = np.arange(m)
+                continue
+            where = {name: k for k, name in enumerate(old.labels)}
+            for k, name in enumerate(r.labels):
+                if name in where and r.labels.count(name) == 1:
+                    carry[o, i, k] = where[name]
+    return LQGTables(A, B, C, Kx, M, np.array([r.Ki for r in rows]), np.array([r.a for r in rows]),
+                     np.array([r.dt for r in rows]), np.array([r.A.shape[0] for r in rows], dtype=np.int64),
+                     np.array([r.interval_s[0] for r in rows]), np.array([r.interval_s[1] for r in rows]), carry)
+
+
+@nb.njit(cache=True)
+def _row_index(tb, t):
+    best, dist = 0, np.inf
+    for i in range(tb.lo.size):
+        if tb.lo[i] <= t < tb.hi[i]:
+            return i
+        d = min(abs(t - tb.lo[i]), abs(t - tb.hi[i]))
+        if d < dist:
+            best, dist = i, d
+    return best
+
+
+@nb.njit(cache=True)
+def lqg_step_k(tb, st, which, y, t, on, u_limit, u):
+    """Step the rows ``which`` (k,) of the law ``st`` (:class:`LQGState`) with the gyro samples ``y`` (k,)
+    [rad/s] at flight times ``t`` (k,) [s], the law on where ``on`` (k,); their commands [rad] into ``u``
+    (k,). ``tb``: :class:`LQGTables`; ``u_limit``: the gimbal limit [rad]."""
+    N = tb.A.shape[1]
+    xf = np.empty(N)
+    old = np.empty(N)
+    for j in range(which.size):
+        b = which[j]
+        if not on[j]:
+            st.was_on[b] = False
+            st.saturated[b] = False
+            u[j] = 0.0
+            continue
+        if not st.was_on[b]:                      # engagement: restart from zero
+            st.row[b] = -1
+            st.x[b, :] = 0.0
+            st.xi[b] = 0.0
+        st.was_on[b] = True
+        i = _row_index(tb, t[j])
+        if i != st.row[b]:
+            o = st.row[b]
+            old[:] = st.x[b, :]
+            for k in range(N):
+                src = tb.carry[o, i, k] if o >= 0 else -1
+                st.x[b, k] = old[src] if src >= 0 else 0.0
+            st.row[b] = i
+        m = tb.dim[i]
+        cx = 0.0
+        for k in range(m):
+            cx += tb.C[i, k] * st.x[b, k]
+        innov = y[j] - cx
+        kx = 0.0
+        for k in range(m):
+            xf[k] = st.x[b, k] + tb.M[i, k] * innov
+            kx += tb.Kx[i, k] * xf[k]
+        v = -kx - tb.Ki[i] * st.xi[b]
+        uu = min(max(v, -u_limit), u_limit)
+        sat = uu != v
+        dxi = (tb.a[i] - 1.0) * st.xi[b] - tb.dt[i] * y[j]
+        if not (sat and (v - uu) * (-tb.Ki[i] * dxi) > 0.0):   # clamp: do not integrate into the limit
+            st.xi[b] += dxi
+        for r in range(m):
+            acc = 0.0
+            for k in range(m):
+                acc += tb.A[i, r, k] * xf[k]
+            st.x[b, r] = acc + tb.B[i, r] * uu
+        for r in range(m, N):
+            st.x[b, r] = 0.0
+        st.saturated[b] = sat
+        u[j] = uu
