@@ -100,7 +100,8 @@ def compare_agents(values: dict[tuple[str, str, str], dict[int, float]], conditi
     (``runs``, ``episodes``, ``mean``, ``iqm``, ``iqm_ci_low``, ``iqm_ci_high``) in the order of the IQM,
     then one ``p_improvement`` row per pair, the agent of the lower IQM over the other (``agent`` over
     ``other``: ``p``, ``ci_low``, ``ci_high``; the other way round is ``1 - p``). rliable's bootstrap of
-    the probability of improvement is slow: about 30 s per pair of 3 x 50 matrices with ``reps`` 2000."""
+    the probability of improvement is slow: about a minute per pair of 3 x 50 matrices with ``reps`` 2000
+    on 2 shared cores (lower ``reps`` for a first look)."""
     keys = sorted({(s, c) for s, c, _ in values if conditions is None or c.split("/")[-1] in conditions or c in conditions})
     if not keys:
         raise ConfigError("--condition", list(conditions or []), "conditions of the results: " + ", ".join(
