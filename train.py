@@ -32,8 +32,6 @@ import argparse
 import datetime as dt
 import json
 import os
-import platform
-import subprocess
 import sys
 import time
 from dataclasses import asdict, dataclass, field, fields, replace
@@ -42,11 +40,11 @@ from typing import Any
 
 import yaml
 
+from agents.runfolder import create_run, make_logger, provenance
 from lvgym.cli import fail, one_line_errors, option_number
 from lvgym.errors import ConfigError
 from lvgym.parallel import exit_on_sigterm
 
-ROOT = Path(__file__).resolve().parent
 DEFAULT_EVAL_SUITES = {"lvgym/SmileAscent-v0": "smile-windy", "lvgym/SlenderAscent-v0": "slender-ld30",
                        "lvgym/SmileAscent-v1": "smile-v1", "lvgym/SlenderAscent-v1": "slender-v1"}
 RESUME_OVERRIDABLE = ("resume", "progress", "torch_threads", "verbose", "total_timesteps", "checkpoint_interval_s")
@@ -275,33 +273,6 @@ def check_options(args: Args) -> None:
             raise ConfigError("--eval-suite", args.eval_suite, f"one of {sorted(SUITES)} or 'none'")
 
 
-def provenance() -> dict[str, Any]:
-    """Versions, git commit and whether the work tree had changes."""
-    import gymnasium
-    import stable_baselines3
-    import torch
-
-    import lvgym
-
-    def git(*cmd: str) -> str:
-        try:
-            return subprocess.run(["git", *cmd], cwd=ROOT, capture_output=True, text=True, timeout=10).stdout.strip()
-        except (OSError, subprocess.SubprocessError):
-            return ""
-
-    try:
-        from importlib.metadata import version
-
-        lv = version("lvgym")
-    except Exception:  # noqa: BLE001
-        lv = getattr(lvgym, "__version__", "unknown")
-    return {"lvgym_version": lv, "git_commit": git("rev-parse", "HEAD") or None,
-            "git_dirty": bool(git("status", "--porcelain", "--untracked-files=no")),
-            "stable_baselines3": stable_baselines3.__version__, "torch": torch.__version__,
-            "gymnasium": gymnasium.__version__, "python": platform.python_version(),
-            "host": platform.node(), "command": [sys.executable, *sys.argv]}
-
-
 def training_seed(seed: int, step: int, n_envs: int) -> int:
     """Seed of env row 0 for a run segment starting at ``step`` (rows get ``+ i``): ``seed`` at the
     start, a fresh draw on resume; always a validation seed (the test seeds stay unseen)."""
@@ -339,32 +310,6 @@ def make_venv(env_id: str, n_envs: int, seed: int, env_kwargs: dict[str, Any], n
         return VecNormalize(venv, norm_obs=norm.norm_obs, norm_reward=norm.norm_reward, clip_obs=norm.clip_obs,
                             clip_reward=norm.clip_reward, epsilon=norm.epsilon, gamma=gamma)
     return venv
-
-
-def make_logger(run_dir: Path, start: int, verbose: int) -> Any:
-    from stable_baselines3.common.logger import CSVOutputFormat, HumanOutputFormat, Logger, TensorBoardOutputFormat
-
-    formats: list[Any] = [TensorBoardOutputFormat(str(run_dir / "tb")),
-                          CSVOutputFormat(str(run_dir / f"progress_{start:012d}.csv"))]
-    if verbose:
-        formats.append(HumanOutputFormat(sys.stdout))
-    return Logger(str(run_dir), formats)
-
-
-def _plain(x: Any) -> Any:
-    if isinstance(x, dict):
-        return {k: _plain(v) for k, v in x.items()}
-    if isinstance(x, (list, tuple)):
-        return [_plain(v) for v in x]
-    if isinstance(x, str):
-        return str(x)
-    return x
-
-
-def _write_yaml(path: Path, data: dict[str, Any]) -> None:
-    from lvgym.benchmark.results import atomic_write_text
-
-    atomic_write_text(path, yaml.safe_dump(_plain(data), sort_keys=False, width=120))
 
 
 # ------------------------------------------------------------------------------------------ main
@@ -416,12 +361,6 @@ def prepare(args: Args, given: set[str]) -> tuple[Args, dict[str, Any], Path, bo
               "hyperparams_source": cfg.source,
               "created_utc": dt.datetime.now(dt.timezone.utc).isoformat(timespec="seconds"), **provenance()}
     return args, config, run_dir, False
-
-
-def create_run(config: dict[str, Any], run_dir: Path) -> None:
-    """Write the run's ``config.yaml`` (a new run: make its folder; a resumed one: its new target)."""
-    run_dir.mkdir(parents=True, exist_ok=True)
-    _write_yaml(run_dir / "config.yaml", config)
 
 
 def _resume_note(run_dir: Path, state: dict[str, Any] | None, target: int) -> str:
