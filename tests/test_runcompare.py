@@ -72,6 +72,8 @@ def test_bad_inputs_name_what_is_allowed(tmp_path):
         runcompare.read_episodes(tmp_path / "missing")
     with pytest.raises(ConfigError, match="--metric.*rate_error_rad"):
         runcompare.read_episodes(a, "effort")
+    with pytest.raises(ConfigError, match="--metric.*a numeric column.*'smile-v1'"):
+        runcompare.read_episodes(a, "suite")
     with pytest.raises(ConfigError, match="--condition.*smile-v1/nonrigid"):
         runcompare.compare_agents(runcompare.merge([a]), ["rigid"])
 

@@ -37,7 +37,7 @@ from ..errors import ConfigError
 from .compare import RUN_LABEL
 from .stats import REPS, iqm, probability_of_improvement
 
-__all__ = ["read_episodes", "agent_matrices", "compare_agents", "table"]
+__all__ = ["read_episodes", "merge", "agent_matrices", "compare_agents", "table"]
 
 PROG = "python -m lvgym.benchmark.runcompare"
 
@@ -54,7 +54,11 @@ def read_episodes(folder: str | Path, metric: str = "score") -> dict[tuple[str, 
         if metric not in (reader.fieldnames or []):
             raise ConfigError("--metric", metric, f"a column of {path}: {', '.join(reader.fieldnames or [])}")
         for row in reader:
-            out.setdefault((row["suite"], row["condition"], row["policy"]), {})[int(row["seed"])] = float(row[metric])
+            try:
+                value = float(row[metric])
+            except ValueError:
+                raise ConfigError("--metric", metric, f"a numeric column of {path} (it holds {row[metric]!r})") from None
+            out.setdefault((row["suite"], row["condition"], row["policy"]), {})[int(row["seed"])] = value
     return out
 
 
