@@ -105,15 +105,13 @@ class ResidualRows:
 
     def reset(self, rows: Any, obs: np.ndarray, infos: list[dict[str, Any]]) -> None:
         """Rows ``rows`` start an episode whose first observation is ``obs[b]`` and info ``infos[b]``."""
+        rows = np.asarray(list(rows), dtype=int)
         if self.batch is not None:
-            rows = np.asarray(list(rows), dtype=int)
-            if rows.size:
-                self.batch.reset(rows)
-                self.base[rows] = self.batch.act(rows, obs[rows], [infos[b] for b in rows])
-            return
-        for b in rows:
-            self.policies[b].reset()
-            self.base[b] = self.policies[b].act(obs[b], infos[b])
+            self.batch.reset(rows)
+        else:
+            for b in rows:
+                self.policies[b].reset()
+        self.advance(rows, obs, infos)
 
     def advance(self, rows: Any, obs: np.ndarray, infos: list[dict[str, Any]]) -> None:
         """Rows ``rows`` went one step on: their baselines act on the new observation."""

@@ -43,7 +43,7 @@ import numpy as np
 from lvgym.errors import ConfigError
 
 from .filecache import read_once
-from .lqgkernel import LQGState, LQGTables, lqg_step_k, lqg_tables
+from .lqgkernel import LQGState, LQGTables, lqg_step_k, lqg_tables, row_index
 
 SCHEDULES = Path(__file__).resolve().parent / "schedules"
 PLANES = ("pitch", "yaw")
@@ -96,12 +96,9 @@ class LQGSchedule:
         return self.rows["pitch"][0].dt
 
     def index(self, t: float) -> int:
-        """The row in use at flight time ``t`` [s]: the one whose interval holds it, else the nearest."""
-        rows = self.rows["pitch"]
-        for i, r in enumerate(rows):
-            if r.interval_s[0] <= t < r.interval_s[1]:
-                return i
-        return int(np.argmin([min(abs(t - r.interval_s[0]), abs(t - r.interval_s[1])) for r in rows]))
+        """The row in use at flight time ``t`` [s]: the one whose interval holds it, else the nearest (the
+        law's own choice, :func:`.lqgkernel.row_index`)."""
+        return int(row_index(self.tables(self.rows["pitch"]), float(t)))
 
     @cached_property
     def _tables(self) -> dict[int, LQGTables]:

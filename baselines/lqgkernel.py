@@ -21,7 +21,7 @@ from typing import Any, NamedTuple
 import numba as nb
 import numpy as np
 
-__all__ = ["LQGState", "LQGTables", "lqg_step_k", "lqg_tables"]
+__all__ = ["LQGState", "LQGTables", "lqg_step_k", "lqg_tables", "row_index"]
 
 
 class LQGTables(NamedTuple):
@@ -78,7 +78,9 @@ def lqg_tables(rows: Any) -> LQGTables:
 
 
 @nb.njit(cache=True)
-def _row_index(tb, t):
+def row_index(tb, t):
+    """The schedule row in use at flight time ``t`` [s]: the one whose interval ``[lo, hi)`` holds it,
+    else the one with the nearest interval end."""
     best, dist = 0, np.inf
     for i in range(tb.lo.size):
         if tb.lo[i] <= t < tb.hi[i]:
@@ -109,7 +111,7 @@ def lqg_step_k(tb, st, which, y, t, on, u_limit, u):
             st.x[b, :] = 0.0
             st.xi[b] = 0.0
         st.was_on[b] = True
-        i = _row_index(tb, t[j])
+        i = row_index(tb, t[j])
         if i != st.row[b]:
             o = st.row[b]
             old[:] = st.x[b, :]

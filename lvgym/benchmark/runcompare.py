@@ -35,6 +35,7 @@ import numpy as np
 from ..cli import fail, one_line_errors
 from ..errors import ConfigError
 from .compare import RUN_LABEL
+from .metrics import per_seed
 from .stats import REPS, iqm, probability_of_improvement
 
 __all__ = ["read_episodes", "merge", "agent_matrices", "compare_agents", "table"]
@@ -48,18 +49,24 @@ def read_episodes(folder: str | Path, metric: str = "score") -> dict[tuple[str, 
     path = Path(folder) / "episodes.csv"
     if not path.is_file():
         raise ConfigError("results folder", str(folder), "a folder written by evaluate.py (holding episodes.csv)")
-    out: dict[tuple[str, str, str], dict[int, float]] = {}
     with open(path, newline="") as f:
         reader = csv.DictReader(f)
         if metric not in (reader.fieldnames or []):
             raise ConfigError("--metric", metric, f"a column of {path}: {', '.join(reader.fieldnames or [])}")
-        for row in reader:
-            try:
-                value = float(row[metric])
-            except ValueError:
-                raise ConfigError("--metric", metric, f"a numeric column of {path} (it holds {row[metric]!r})") from None
-            out.setdefault((row["suite"], row["condition"], row["policy"]), {})[int(row["seed"])] = value
-    return out
+        rows = list(reader)
+    try:
+        return per_seed(rows, metric)
+    except ValueError:
+        bad = next(r[metric] for r in rows if not _is_number(r[metric]))
+        raise ConfigError("--metric", metric, f"a numeric column of {path} (it holds {bad!r})") from None
+
+
+def _is_number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
 
 
 def merge(folders: Sequence[str | Path], metric: str = "score") -> dict[tuple[str, str, str], dict[int, float]]:
