@@ -12,7 +12,7 @@ from __future__ import annotations
 import argparse
 from typing import Any, NoReturn
 
-from .errors import check_number
+from .errors import ConfigError, check_number
 
 __all__ = ["fail", "one_line_errors", "option_number"]
 
@@ -35,6 +35,22 @@ def option_number(option: str, value: Any, lo: float, hi: float, *, integer: boo
     if value is None:
         return None
     return check_number(option, value, lo, hi, integer=integer, lo_open=lo_open)
+
+
+def parse_number(text: Any, option: str = "") -> Any:
+    """A command-line number as int or float (None passes); a non-number raises ``ConfigError`` naming
+    ``option`` if given, else is left for the range check to refuse."""
+    if text is None or isinstance(text, (int, float)):
+        return text
+    try:
+        return int(text)
+    except ValueError:
+        try:
+            return float(text)
+        except ValueError:
+            if option:
+                raise ConfigError(option, text, "a number") from None
+            return text
 
 
 def fail(prog: str, exc: BaseException | str) -> NoReturn:

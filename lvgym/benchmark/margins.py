@@ -38,7 +38,7 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any
 
-from lvgym.cli import fail, one_line_errors, option_number
+from lvgym.cli import fail, one_line_errors, option_number, parse_number
 from lvgym.errors import ConfigError, check_number
 from lvgym.parallel import EXECUTORS, TaskFailed, check_workers, exit_on_sigterm, run_map
 
@@ -412,14 +412,14 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     p.add_argument("--no-progress", dest="progress", action="store_false", help="hide the progress bar")
     ns = p.parse_args(argv)
     try:
-        ns.seeds = option_number("--seeds", _number(ns.seeds), 1, 10_000, integer=True)
-        ns.workers = check_workers(_number(ns.workers), "--workers")
-        ns.physics_dt_s = option_number("--physics-dt-s", _number(ns.physics_dt_s), 0.0, 0.05, lo_open=True)
-        ns.mission_time_s = option_number("--mission-time-s", _number(ns.mission_time_s), 0.0, 3600.0, lo_open=True)
+        ns.seeds = option_number("--seeds", parse_number(ns.seeds), 1, 10_000, integer=True)
+        ns.workers = check_workers(parse_number(ns.workers), "--workers")
+        ns.physics_dt_s = option_number("--physics-dt-s", parse_number(ns.physics_dt_s), 0.0, 0.05, lo_open=True)
+        ns.mission_time_s = option_number("--mission-time-s", parse_number(ns.mission_time_s), 0.0, 3600.0, lo_open=True)
         names = ("error_ratio", "rate_limit_ratio", "gain_max_db", "gain_min_db", "gain_tol_db", "gain_step_db",
                  "delay_max_s")
         for key in names:
-            setattr(ns, key, _number(getattr(ns, key), f"--{key.replace('_', '-')}"))
+            setattr(ns, key, parse_number(getattr(ns, key), f"--{key.replace('_', '-')}"))
         try:
             ns.options = MarginOptions(**{k: getattr(ns, k) for k in names})
         except ConfigError as exc:
@@ -429,19 +429,6 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     return ns
 
 
-def _number(text: Any, option: str = "") -> Any:
-    """A command-line number as int or float (None passes); a non-number is left for the check to refuse."""
-    if text is None or isinstance(text, (int, float)):
-        return text
-    try:
-        return int(text)
-    except ValueError:
-        try:
-            return float(text)
-        except ValueError:
-            if option:
-                raise ConfigError(option, text, "a number") from None
-            return text
 
 
 def main(argv: list[str] | None = None) -> list[dict[str, Any]]:

@@ -14,7 +14,7 @@ from lvgym.errors import ConfigError, check_bool, check_choice, check_number
 from lvgym.simulator import MODE_BASES, MODELS, SLOSH_FREQUENCIES
 
 #: protocol v0's wind tiers, then v1's
-WIND_TIERS = ("none", "profile", "gust", "turbulence", "random", "turbulence_gust", "maxq_gust")
+WIND_TIERS = ("none", "profile", "gust", "turbulence", "random", "turbulence_gust", "maxq_gust", "random_gust")
 #: the onset altitudes [m] of the ``maxq_gust`` tier's gust: SMILE's max q is at 9.8 km (docs/vehicles.md)
 MAXQ_GUST_ONSET_M = (8000.0, 11500.0)
 #: protocol v0's randomisations (what ``randomize=True`` means)
@@ -42,7 +42,8 @@ def wind_spec(tier: str, mission_time: float) -> Any:
     10 m/s west wind; ``random``: a random jet-stream profile plus moderate Dryden turbulence.
     Protocol v1's: ``turbulence_gust``: ``turbulence`` plus a random 1-cosine gust (``random_gust``: 5-15 m/s,
     30-300 m, from any direction, onset 1-15 km); ``maxq_gust``: a random jet-stream profile plus a random
-    gust whose onset lies in the max-q region (``MAXQ_GUST_ONSET_M``)."""
+    gust whose onset lies in the max-q region (``MAXQ_GUST_ONSET_M``); ``random_gust``: the random gust of
+    ``turbulence_gust`` alone (``lvgym.benchmark.budget`` flies it to share out the error)."""
     profile = {"model": "profile", "altitude_m": [0.0, 1000.0, 10000.0, 100000.0],
                "speed": [5.0, 12.0, 20.0, 20.0], "direction_deg": [270.0, 270.0, 270.0, 270.0]}
     if tier == "none":
@@ -59,6 +60,8 @@ def wind_spec(tier: str, mission_time: float) -> Any:
         return {"model": "sum", "models": [{"model": "jet_stream"}, {"model": "dryden", "intensity": "moderate"}]}
     if tier == "turbulence_gust":
         return {"model": "sum", "models": [*wind_spec("turbulence", mission_time)["models"], {"model": "random_gust"}]}
+    if tier == "random_gust":
+        return {"model": "sum", "models": [{"model": "random_gust"}]}
     if tier == "maxq_gust":
         return {"model": "sum", "models": [{"model": "jet_stream"},
                                            {"model": "random_gust", "onset_m": list(MAXQ_GUST_ONSET_M)}]}
