@@ -1,0 +1,108 @@
+"""The linear headroom study (baselines.headroom): the Dryden filter against the specification's spectrum, the
+delay margin against hand numbers, the shipped lqg row designed again, and the trade at the 10 s row."""
+
+from __future__ import annotations
+
+import math
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from baselines import headroom as hr
+from lvgym.environment.turbulence import dryden_psd
+
+
+def discrete_psd(A, Q, C, dt, w):
+    """One-sided PSD [(m/s)^2 per rad/s] of y = C x, x_{k+1} = A x_k + noise of covariance Q, sampled at dt
+    (its integral over 0 .. pi / dt is the variance)."""
+    out = []
+    for wi in w:
+        z = np.exp(1j * wi * dt)
+        H = C @ np.linalg.inv(z * np.eye(A.shape[0]) - A)
+        out.append(dt / math.pi * (H @ Q @ H.conj().T).real.item())
+    return np.array(out)
+
+
+def test_dryden_filter_has_the_specified_variance_and_spectrum():
+    turb = hr.Turbulence(sigma=3.2, length=533.4, speed=286.0, altitude=1400.0)
+    A, Q, C = hr.dryden_filter(turb, 0.02)
+    import scipy.linalg as sla
+    var = (C @ sla.solve_discrete_lyapunov(A, Q) @ C.T).item()
+    assert var == pytest.approx(3.2 ** 2, rel=1e-9)
+    w = np.array([0.05, 0.5, 3.0])                     # rad/s, far below the 157 rad/s Nyquist frequency
+    spec = dryden_psd(w / turb.speed, turb.sigma, turb.length, "v") / turb.speed   # MIL-F-8785C, per rad/s
+    np.testing.assert_allclose(discrete_psd(A, Q, C, 0.02, w), spec, rtol=0.01)
+
+
+def test_delay_margin_of_a_hand_loop():
+    """L = (wc / w) exp(-j (pi/2 + w tau0)): crossover at wc with phase margin pi/2 - wc tau0, so the delay
+    margin is (pi/2) / wc - tau0; a crossover of negative phase margin counts the lag to -540 deg."""
+    w = np.logspace(-2, 2, 20001)
+    r = (2.0 / w) * np.exp(-1j * (math.pi / 2 + w * 0.1))
+    assert hr.delay_margin_s(r, w) == pytest.approx(math.pi / 4 - 0.1, rel=1e-4)            # 0.685 s
+    r2 = (2.0 / w) * np.exp(-1j * math.radians(200.0)) * np.ones_like(w)                    # PM -20 deg at 2 rad/s
+    assert hr.delay_margin_s(r2, w) == pytest.approx(math.radians(340.0) / 2.0, rel=1e-4)
+    assert hr.delay_margin_s(0.5 * np.ones_like(w, dtype=complex), w) == math.inf
+
+
+def test_candidates_keep_the_weights_not_varied():
+    row = hr.shipped_row(10.0)
+    cands = hr.candidates({"q_int": (1.0, 2.0), "wind_noise": (0.0, 0.5)}, row.weights)
+    assert [(c[0].q_int, c[1]) for c in cands] == [(1.0, 0.0), (1.0, 0.5), (2.0, 0.0), (2.0, 0.5)]
+    assert all(c[0].r_gimbal == row.weights.r_gimbal and c[0].w_modes == row.weights.w_modes for c in cands)
+
+
+def test_no_worse_counts_every_margin():
+    base = {"gm_nonrigid": 6.0, "gm_rigid": 9.0, "grm_nonrigid": -10.0, "dm_nonrigid_ms": 150.0, "dm_rigid_ms": 150.0}
+    assert hr.no_worse(dict(base), base)
+    assert not hr.no_worse({**base, "grm_nonrigid": -9.0}, base)            # closer to 0 dB: worse
+    assert hr.no_worse({**base, "grm_nonrigid": -12.0, "gm_rigid": 10.0}, base)
+    assert not hr.no_worse({**base, "dm_rigid_ms": 149.0}, base)
+
+
+@pytest.fixture(scope="module")
+def row10():
+    return hr.headroom(10.0, hr.GRIDS["small"], log=lambda s: None)
+
+
+def test_shipped_weights_give_the_shipped_row(row10):
+    """The shipped weights designed again on today's plant are the shipped row (the study compares like with like)."""
+    w = hr.shipped_row(10.0).weights
+    same = [d for d in row10["designs"] if d["wind_noise"] == 0.0 and d["q_int"] == w.q_int and d["r_gimbal"] == w.r_gimbal]
+    assert len(same) == 1
+    assert same[0]["ratio_nonrigid"] == pytest.approx(1.0, rel=1e-6)
+    for k in hr.MARGINS:
+        assert same[0][k] == pytest.approx(row10["base"][k], rel=1e-6)
+    assert row10["base"]["shortfall"] == 0.0                                # the shipped row meets its targets
+
+
+def test_the_10_s_row_trades_rate_error_for_margin(row10):
+    """At the 10 s row (boost), under the v1 turbulence (3.2 m/s at 1.4 km): the shipped row's body-rate RMS is
+    0.0145 rad/s, no design of the small grid lowers it without losing a margin, and the designs that take it
+    30 % lower keep at most 4.9 dB of non-rigid gain margin (shipped 6.2) and 74 ms of delay margin (152)."""
+    b = row10["base"]
+    assert b["rate_rms_nonrigid"] == pytest.approx(0.0145, abs=5e-4)
+    assert row10["best_no_worse"]["ratio_nonrigid"] == pytest.approx(1.0, rel=1e-6)
+    kept = row10["kept_at_target"]
+    assert row10["n_at_target"] >= 1
+    assert kept["gm_nonrigid"] < b["gm_nonrigid"] - 1.0
+    assert kept["dm_nonrigid_ms"] < 0.6 * b["dm_nonrigid_ms"]
+
+
+@pytest.mark.slow
+def test_full_grid_at_10_s():
+    """The study's grid (512 designs, several minutes): at the 10 s row no design with every margin no worse than
+    the shipped row's is 5 % better, and none of those 30 % better keeps the shipped non-rigid gain margin."""
+    r = hr.headroom(10.0, hr.GRIDS["full"], log=lambda s: None)
+    assert r["best_no_worse"]["ratio_nonrigid"] > 0.95
+    assert r["kept_at_target"]["gm_nonrigid"] < r["base"]["gm_nonrigid"]
+
+
+def test_command_line_refuses_a_time_that_is_not_a_row():
+    out = subprocess.run([sys.executable, "-m", "baselines.headroom", "--rows", "11"], capture_output=True, text=True,
+                         timeout=120)
+    assert out.returncode != 0
+    lines = out.stderr.strip().splitlines()
+    assert len(lines) == 1 and "--rows = 11" in lines[0], out.stderr
