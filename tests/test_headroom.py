@@ -60,6 +60,10 @@ def test_no_worse_counts_every_margin():
     assert not hr.no_worse({**base, "grm_nonrigid": -9.0}, base)            # closer to 0 dB: worse
     assert hr.no_worse({**base, "grm_nonrigid": -12.0, "gm_rigid": 10.0}, base)
     assert not hr.no_worse({**base, "dm_rigid_ms": 149.0}, base)
+    worse = {**base, "gm_nonrigid": 5.0, "grm_nonrigid": -9.0, "dm_nonrigid_ms": 90.0}
+    assert hr.no_worse(worse, base, slack_db=1.0, dm_fraction=0.6)
+    assert not hr.no_worse(worse, base, slack_db=0.9, dm_fraction=0.6)
+    assert not hr.no_worse(worse, base, slack_db=1.0, dm_fraction=0.61)
 
 
 @pytest.fixture(scope="module")
@@ -80,24 +84,31 @@ def test_shipped_weights_give_the_shipped_row(row10):
 
 def test_the_10_s_row_trades_rate_error_for_margin(row10):
     """At the 10 s row (boost), under the v1 turbulence (3.2 m/s at 1.4 km): the shipped row's body-rate RMS is
-    0.0145 rad/s, no design of the small grid lowers it without losing a margin, and the designs that take it
-    30 % lower keep at most 4.9 dB of non-rigid gain margin (shipped 6.2) and 74 ms of delay margin (152)."""
+    0.0145 rad/s; no design of the small grid lowers it without losing a margin, and with 2 dB of gain margin
+    and 40 % of the delay margin given up it falls by 18 % (q_int 1000, r 30: 5.0 dB non-rigid gain margin
+    against 6.2, 115 ms of delay margin against 152), no further at 3 dB and 60 %."""
     b = row10["base"]
     assert b["rate_rms_nonrigid"] == pytest.approx(0.0145, abs=5e-4)
-    assert row10["best_no_worse"]["ratio_nonrigid"] == pytest.approx(1.0, rel=1e-6)
-    kept = row10["kept_at_target"]
-    assert row10["n_at_target"] >= 1
-    assert kept["gm_nonrigid"] < b["gm_nonrigid"] - 1.0
-    assert kept["dm_nonrigid_ms"] < 0.6 * b["dm_nonrigid_ms"]
+    ratios = {(s["slack_db"], s["dm_fraction"]): s["design"]["ratio_nonrigid"] for s in row10["best"] if s["design"]}
+    assert ratios[(0.0, 1.0)] == pytest.approx(1.0, rel=1e-6)
+    assert min(r for (db, _), r in ratios.items() if db <= 2.0) > 0.7
+    assert ratios[(3.0, 0.4)] == pytest.approx(0.815, abs=0.005)
+    assert "| 10 | 0.0145; 6.2 / 9.0 / -10.6; 152 / 151 | 6 | 1.000 (q_int 100, r 10, wind 0) |" in hr.headroom_table([row10])
 
 
 @pytest.mark.slow
-def test_full_grid_at_10_s():
-    """The study's grid (512 designs, several minutes): at the 10 s row no design with every margin no worse than
-    the shipped row's is 5 % better, and none of those 30 % better keeps the shipped non-rigid gain margin."""
-    r = hr.headroom(10.0, hr.GRIDS["full"], log=lambda s: None)
-    assert r["best_no_worse"]["ratio_nonrigid"] > 0.95
-    assert r["kept_at_target"]["gm_nonrigid"] < r["base"]["gm_nonrigid"]
+def test_full_grid():
+    """The study's grid (1,073 designs at four rows, 20 minutes): with every margin no worse than the shipped
+    row's, the turbulence's rate RMS falls by at most 5 % (10 s) and not at all at 20 and 28.8 s; with 2 dB and
+    40 % of the delay margin given up, by at most 19 %; at 20 and 28.8 s not by 30 % even at 3 dB and 60 %."""
+    best = {}
+    for t in (10.0, 20.0, 28.8):
+        r = hr.headroom(t, hr.GRIDS["full"], log=lambda s: None)
+        best[t] = {(s["slack_db"], s["dm_fraction"]): s["design"]["ratio_nonrigid"] for s in r["best"]}
+    assert best[10.0][(0.0, 1.0)] == pytest.approx(0.954, abs=0.005)
+    assert best[20.0][(0.0, 1.0)] == pytest.approx(1.0, abs=1e-6) and best[28.8][(0.0, 1.0)] == pytest.approx(1.0, abs=1e-6)
+    assert min(b[(2.0, 0.6)] for b in best.values()) > 0.8
+    assert best[20.0][(3.0, 0.4)] > 0.8 and best[28.8][(3.0, 0.4)] > 0.75
 
 
 def test_command_line_refuses_a_time_that_is_not_a_row():
