@@ -7,7 +7,8 @@
 
 Policies are names of :data:`POLICIES` (``zero``, ``pid``, ``gs-pid``: our rigid tuning; ``pid-thesis``,
 ``gs-pid-thesis``: the thesis's gains and Table 6.10; ``gs-pid-flex``, ``lqg``, ``aac``: designed for the
-flexible vehicle; ``ppo``: the learned policy shipped for v0, ``ppo-res-lqg``: the one shipped for v1) or
+flexible vehicle; ``lqg-front``: ``lqg`` traded to the learned policy's margins (``baselines.headroom``);
+``ppo``: the learned policy shipped for v0, ``ppo-res-lqg``: the one shipped for v1) or
 paths of saved stable-baselines3 models (``.zip``; an optional ``<stem>_vecnormalize.pkl`` next to it
 normalises the observations) or of ``train.py`` run folders. Suites are names of ``lvgym.benchmark.SUITES``. Episodes run on a local process pool
 by default; the Markdown table is printed, and CSV, JSON, the table and PNG plots go to ``--out``
@@ -47,8 +48,8 @@ from lvgym.errors import ConfigError
 from lvgym.parallel import TaskFailed, exit_on_sigterm
 
 #: the default comparison (issue 17): no control, the rigid-designed gs-pid (the thesis's question), the
-#: designs for the flexible vehicle (gs-pid-flex, lqg, aac) and the shipped learned policy
-DEFAULT_POLICIES = ["zero", "gs-pid", "gs-pid-flex", "lqg", "aac", "ppo-res-lqg"]
+#: designs for the flexible vehicle (gs-pid-flex, lqg, lqg-front, aac) and the shipped learned policy
+DEFAULT_POLICIES = ["zero", "gs-pid", "gs-pid-flex", "lqg", "lqg-front", "aac", "ppo-res-lqg"]
 #: the main suite of protocol v1 (``smile-windy`` is v0's)
 DEFAULT_SUITES = ["smile-v1"]
 #: episodes per condition and policy of the default run (2 conditions x 6 policies x 50 = 600 episodes of 70 s)

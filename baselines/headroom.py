@@ -1,7 +1,8 @@
 """How much of the turbulence's rate error a linear design can still remove, and what that costs in margins.
 
-    python -m baselines.headroom                        # rows 10, 20 and 28.8 s of the lqg schedule, full grid
+    python -m baselines.headroom                        # rows 10, 20, 28.8 and 36 s of the lqg schedule, full grid
     python -m baselines.headroom --rows 10 --grid small
+    python -m baselines.headroom --write-schedule baselines/schedules/smile_lqg_front.npz --slack 2 0.6
 
 The Dryden turbulence causes most of `smile-v1`'s score (``python -m lvgym.benchmark.budget``). At a row
 of the ``lqg`` schedule (its frozen flight time, the pitch plane; the yaw plane is the same vehicle), this
@@ -30,7 +31,9 @@ margin is no worse than the shipped row's, and how much lower does it get when t
 little (:data:`SLACKS`: gain margins up and down by ``slack_db``, delay margins to ``dm_fraction`` of the
 shipped row's)? The family samples the LQG designs, which hold the optimal linear controller of every
 quadratic cost of this linear plant under Gaussian turbulence and noise; it is a sample, not a bound over
-every controller. docs/training.md ("How far 30 % is") gives the numbers.
+every controller. ``--write-schedule`` writes the shipped schedule with each studied row replaced, in
+both planes, by the design of lowest RMS within one margin loss (``--slack``; :func:`front_schedule`):
+the ``lqg-front`` policy flies it.docs/training.md ("How far 30 % is") gives the numbers.
 """
 
 from __future__ import annotations
@@ -41,6 +44,7 @@ import math
 import sys
 import time
 from dataclasses import asdict, dataclass, fields, replace
+from pathlib import Path
 from typing import Any
 
 import control
@@ -67,7 +71,9 @@ GRIDS: dict[str, dict[str, tuple[float, ...]]] = {
              "q_modes": (1e-5, 1e-4), "w_modes": (1e-3, 1e-2), "wind_noise": (0.0, 0.01, 0.1, 1.0)},
     "small": {"q_int": (100.0, 1000.0), "r_gimbal": (10.0, 30.0), "wind_noise": (0.0, 0.1)},
 }
-DEFAULT_ROWS = (10.0, 20.0, 28.8)
+DEFAULT_ROWS = (10.0, 20.0, 28.8, 36.0)
+#: the margin loss of ``--write-schedule``'s designs
+DEFAULT_SLACK = (2.0, 0.6)
 #: margin losses allowed: (gain margins [dB], delay margins kept as a fraction of the shipped row's)
 SLACKS = ((0.0, 1.0), (0.5, 0.9), (1.0, 0.8), (2.0, 0.6), (3.0, 0.4))
 MARGINS = ("gm_nonrigid", "gm_rigid", "grm_nonrigid", "dm_nonrigid_ms", "dm_rigid_ms")
@@ -325,15 +331,52 @@ def headroom_table(results: list[dict[str, Any]]) -> str:
     return "\n".join(lines)
 
 
+def front_schedule(results: list[dict[str, Any]], slack_db: float, dm_fraction: float, path: str | Path,
+                   schedule: str = "smile_lqg") -> dict[float, dict[str, Any]]:
+    """Write (``.npz``, as :func:`.lqg_design.save_schedule`) the shipped ``schedule`` with the row of every
+    :func:`headroom` result replaced, in both planes, by its design of lowest non-rigid ``rate_rms`` whose
+    margins are within ``slack_db`` / ``dm_fraction`` of the shipped row's (the yaw plane designed with the
+    same weights on its own plant); the other rows as shipped. Returns the chosen design of each row."""
+    sched = LQGSchedule.load(schedule)
+    with np.load(sched.source) as z:
+        arrays = {k: z[k] for k in z.files}
+    times = [float(x) for x in arrays["time_s"]]
+    chosen: dict[float, dict[str, Any]] = {}
+    for r in results:
+        within = [d for d in r["designs"] if no_worse(d, r["base"], slack_db, dm_fraction)]
+        best = min(within, key=lambda d: d["ratio_nonrigid"])          # the shipped row's own weights are within
+        w = LQGWeights(**{f.name: best[f.name] for f in fields(LQGWeights)})
+        i = int(np.argmin([abs(x - r["t"]) for x in times]))
+        loops_op = _op("smile", r["t"], "nonrigid", SMILE_PHASES_S[0][1] + 0.5)
+        for plane in arrays["planes"]:
+            d = wind_design(loops_op, str(plane), w, best["wind_noise"], row_turbulence(loops_op))
+            pre = f"{plane}_{i}_"
+            arrays.update({pre + k: getattr(d, k) for k in ("A", "B", "C", "Kx", "M")})
+            arrays.update({pre + "Ki": np.array(d.Ki), pre + "a": np.array(d.a), pre + "dt": np.array(d.dt),
+                           pre + "labels": np.array(d.state_labels),
+                           pre + "weights": np.array([getattr(w, f.name) for f in fields(LQGWeights)])})
+        chosen[r["t"]] = best
+    Path(path).parent.mkdir(parents=True, exist_ok=True)
+    np.savez(path, **arrays)
+    return chosen
+
+
 def main(argv: list[str] | None = None) -> list[dict[str, Any]]:
     p = one_line_errors(argparse.ArgumentParser(prog=PROG, description=__doc__.split("\n\n")[0]))
     p.add_argument("--rows", nargs="+", default=list(DEFAULT_ROWS), metavar="T",
                    help=f"rows of the lqg schedule [s] (default {' '.join(f'{x:g}' for x in DEFAULT_ROWS)})")
     p.add_argument("--grid", choices=sorted(GRIDS), default="full")
     p.add_argument("--out", default=None, help="write the designs of every row as JSON here")
+    p.add_argument("--write-schedule", default=None, metavar="PATH",
+                   help="write the schedule with each row's best design within --slack here (.npz)")
+    p.add_argument("--slack", nargs=2, default=list(DEFAULT_SLACK), metavar=("DB", "FRACTION"),
+                   help="the margin loss of --write-schedule: gain margins [dB], delay margins kept "
+                        f"(default {DEFAULT_SLACK[0]:g} {DEFAULT_SLACK[1]:g})")
     args = p.parse_args(argv)
     try:
         rows = [float(option_number("--rows", parse_number(x, "--rows"), 0.0, 100.0)) for x in args.rows]
+        slack_db = float(option_number("--slack", parse_number(args.slack[0], "--slack"), 0.0, 40.0))
+        dm_fraction = float(option_number("--slack", parse_number(args.slack[1], "--slack"), 0.0, 1.0))
         for t in rows:
             if t not in SMILE_ROWS_S:
                 raise ConfigError("--rows", t, f"rows of the lqg schedule {list(SMILE_ROWS_S)}")
@@ -346,6 +389,13 @@ def main(argv: list[str] | None = None) -> list[dict[str, Any]]:
     if args.out:
         from lvgym.benchmark.results import atomic_write_text, json_text
         atomic_write_text(args.out, json_text(results))
+    if args.write_schedule:
+        chosen = front_schedule(results, slack_db, dm_fraction, args.write_schedule)
+        for t, d in chosen.items():
+            print(f"{t:g} s: q_int {d['q_int']:g}, r_gimbal {d['r_gimbal']:g}, w_gimbal {d['w_gimbal']:g}, q_modes "
+                  f"{d['q_modes']:g}, w_modes {d['w_modes']:g}, wind_noise {d['wind_noise']:g}: RMS x "
+                  f"{d['ratio_nonrigid']:.3f}", file=sys.stderr)
+        print(f"schedule written to {args.write_schedule}", file=sys.stderr)
     return results
 
 

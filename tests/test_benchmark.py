@@ -332,7 +332,7 @@ def test_registry_names_what_is_missing(monkeypatch):
         ev.resolve_policy("not-a-policy")
     assert ev.resolve_policy("zero") == ZERO
     args = ev.parse_args([])
-    assert args.policies == ["zero", "gs-pid", "gs-pid-flex", "lqg", "aac", "ppo-res-lqg"] and args.suites == ["smile-v1"]
+    assert args.policies == ["zero", "gs-pid", "gs-pid-flex", "lqg", "lqg-front", "aac", "ppo-res-lqg"] and args.suites == ["smile-v1"]
     assert args.executor == "local"
     assert args.reference is None and ev.parse_args(["--reference", "pid"]).reference == "pid"
     with pytest.raises(SystemExit, match="--reference = 'ghost'"):          # refused before any episode runs

@@ -56,7 +56,7 @@ EXPERIMENTS = ("gain_up", "gain_down", "delay")
 UNITS = {"gain_up": "dB", "gain_down": "dB", "delay": "ms"}
 DEFAULT_SUITE = "smile-v1"
 #: every default policy of evaluate.py that has a loop to perturb (zero has none)
-DEFAULT_POLICIES = ["gs-pid", "gs-pid-flex", "lqg", "aac", "ppo-res-lqg"]
+DEFAULT_POLICIES = ["gs-pid", "gs-pid-flex", "lqg", "lqg-front", "aac", "ppo-res-lqg"]
 DEFAULT_SEEDS = 5
 PROG = "python -m lvgym.benchmark.margins"
 #: the nominal time at the gimbal rate limit counts as at least this in the rate-limit bound [s]
