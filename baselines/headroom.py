@@ -57,8 +57,8 @@ from lvgym.errors import ConfigError
 
 from .flightloop import flight_plant, mode_frequencies
 from .lqg import LQGSchedule
-from .lqg_design import (_SEARCH_W, DISPERSED_SLOSH, PLANE_VELOCITY, SMILE_PHASES_S, SMILE_ROWS_S, MarginTargets,
-                         _op, assess, dispersed, row_intervals, shortfall)
+from .lqg_design import (_SEARCH_W, PLANE_VELOCITY, SMILE_PHASES_S, SMILE_ROWS_S, MarginTargets, _op, assess,
+                         row_intervals, row_neighbours, shortfall)
 from .lqg_row import (GYRO_ARW_RAD_PER_SQRT_S, LQGWeights, RowDesign, _mode_rates, closed_loop_growth, compensator,
                       delayed_plant, design_row, open_loop, plant_labels, regulator, response)
 
@@ -151,8 +151,9 @@ def wind_design(op: Any, plane: str, w: LQGWeights, wind_noise: float, turb: Tur
 
 
 def turbulence_rms(d: Any, op: Any, plane: str, turb: Turbulence, noise: bool = True) -> float:
-    """RMS body rate [rad/s] of the row's compensator ``d`` (a :class:`.lqg_row.RowDesign`) on the plant of ``op`` under the turbulence ``turb`` and, with ``noise``, the
-    gyro's white noise (its angle random walk over a control period); inf if the loop is unstable."""
+    """RMS body rate [rad/s] of the row's compensator ``d`` (a :class:`.lqg_row.RowDesign`) on the plant of
+    ``op`` under the turbulence ``turb`` and, with ``noise``, the gyro's white noise (its angle random walk
+    over a control period); inf if the loop is unstable."""
     A, B, C, _ = delayed_plant(op, plane)
     labels = plant_labels(op, plane)
     Aw, Qw, Cw = dryden_filter(turb, d.dt)
@@ -210,17 +211,16 @@ def row_loops(t: float, plane: str = "pitch") -> RowLoops:
     if t not in SMILE_ROWS_S:
         raise ConfigError("rows", t, f"a row of the lqg schedule {list(SMILE_ROWS_S)}")
     upper_after = SMILE_PHASES_S[0][1] + 0.5
-    lo, hi = dict(zip(SMILE_ROWS_S, row_intervals(SMILE_ROWS_S, SMILE_PHASES_S)))[t]
+    interval = dict(zip(SMILE_ROWS_S, row_intervals(SMILE_ROWS_S, SMILE_PHASES_S)))[t]
     op_n, op_r = _op("smile", t, "nonrigid", upper_after), _op("smile", t, "rigid", upper_after)
-    ops = {"rigid": op_r, "nonrigid": op_n}
-    ops.update({f"t={x:.1f}": _op("smile", x, "nonrigid", upper_after) for x in (lo, hi) if abs(x - t) > 0.05})
-    ops.update({f"slosh f x{f:g} zeta x{z:g}": dispersed(op_n, f, z) for f, z in DISPERSED_SLOSH})
+    ops = {"rigid": op_r, "nonrigid": op_n, **row_neighbours("smile", t, interval, op_n, upper_after)}
     plants = {k: flight_plant(o, plane) for k, o in ops.items()}
     return RowLoops(t, op_r, op_n, plants, {k: response(g, _SEARCH_W) for k, g in plants.items()},
                     mode_frequencies(op_n, plane), row_turbulence(op_n))
 
 
-def loop_summary(d: Any, loops: RowLoops, plane: str = "pitch", tg: MarginTargets = MarginTargets()) -> dict[str, Any] | None:
+def loop_summary(d: Any, loops: RowLoops, plane: str = "pitch",
+                 tg: MarginTargets = MarginTargets()) -> dict[str, Any] | None:
     """Margins, targets' shortfall and turbulence RMS of the compensator ``d`` on the row's plants; None
     if a loop is unstable."""
     comp = compensator(d)

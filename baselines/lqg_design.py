@@ -226,6 +226,16 @@ def _op(vehicle: str, t: float, model: str, upper_after_s: float) -> OperatingPo
     return operating_point(vehicle, t, model, protocol="v1")
 
 
+def row_neighbours(vehicle: str, t: float, interval: tuple[float, float], op_nonrigid: OperatingPoint,
+                   upper_after_s: float) -> dict[str, OperatingPoint]:
+    """The robustness plants a row must stay stable on: the non-rigid points at the ends of its
+    ``interval`` [s] (those more than 0.05 s from ``t``) and the row's own with its slosh dispersed
+    (:data:`DISPERSED_SLOSH`)."""
+    near = {f"t={x:.1f}": _op(vehicle, x, "nonrigid", upper_after_s) for x in interval if abs(x - t) > 0.05}
+    near.update({f"slosh f x{f:g} zeta x{z:g}": dispersed(op_nonrigid, f, z) for f, z in DISPERSED_SLOSH})
+    return near
+
+
 def design_schedule(vehicle: str = "smile", rows: tuple[float, ...] = SMILE_ROWS_S,
                     phases: tuple[tuple[float, float], ...] = SMILE_PHASES_S, tg: MarginTargets = MarginTargets(),
                     grid: dict = SEARCH_GRID, planes: tuple[str, ...] = PLANE_NAMES, log=print) -> dict[str, Any]:
@@ -240,8 +250,7 @@ def design_schedule(vehicle: str = "smile", rows: tuple[float, ...] = SMILE_ROWS
     for t, (lo, hi) in zip(rows, intervals):
         log(f"t = {t:g} s (used {lo:g}-{hi:g} s)")
         op_n, op_r = _op(vehicle, t, "nonrigid", upper_after), _op(vehicle, t, "rigid", upper_after)
-        near = {f"t={x:.1f}": _op(vehicle, x, "nonrigid", upper_after) for x in (lo, hi) if abs(x - t) > 0.05}
-        near.update({f"slosh f x{f:g} zeta x{z:g}": dispersed(op_n, f, z) for f, z in DISPERSED_SLOSH})
+        near = row_neighbours(vehicle, t, (lo, hi), op_n, upper_after)
         entry: dict[str, Any] = {"time_s": float(op_n.t), "interval_s": [lo, hi]}
         chosen = None
         for plane in planes:                 # the first plane's search; the others fly its weights (axisymmetric)

@@ -14,7 +14,7 @@ from typing import Any, NoReturn
 
 from .errors import ConfigError, check_number
 
-__all__ = ["fail", "one_line_errors", "option_number"]
+__all__ = ["fail", "one_line_errors", "option_number", "parse_number"]
 
 
 def one_line_errors(parser: argparse.ArgumentParser) -> argparse.ArgumentParser:

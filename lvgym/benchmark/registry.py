@@ -33,7 +33,8 @@ POLICIES: dict[str, PolicySpec] = {
     "lqg": PolicySpec("lqg", "baselines.lqg:smile_lqg", (("name", "lqg"),)),
     # lqg with its boost and max-q rows moved along the turbulence-against-margin trade: the design of lowest
     # turbulence rate error within 2 dB of gain margin and 60 % of the delay margin (baselines.headroom)
-    "lqg-front": PolicySpec("lqg-front", "baselines.lqg:smile_lqg", (("name", "lqg-front"), ("schedule", "smile_lqg_front"))),
+    "lqg-front": PolicySpec("lqg-front", "baselines.lqg:smile_lqg",
+                            (("name", "lqg-front"), ("schedule", "smile_lqg_front"))),
     # the shipped learned policies (agents/trained, docs/training.md): PPO of SmileAscent-v0 (the ideal state
     # observation), and protocol v1's: PPO residual on lqg, flight sensors, a 4-sample history
     "ppo": PolicySpec("ppo", "agents.policy:shipped_policy"),

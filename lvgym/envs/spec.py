@@ -13,7 +13,7 @@ from typing import Any
 from lvgym.errors import ConfigError, check_bool, check_choice, check_number
 from lvgym.simulator import MODE_BASES, MODELS, SLOSH_FREQUENCIES
 
-#: protocol v0's wind tiers, then v1's
+#: protocol v0's wind tiers, then v1's, then ``random_gust`` (v1's gust alone, for the error budget)
 WIND_TIERS = ("none", "profile", "gust", "turbulence", "random", "turbulence_gust", "maxq_gust", "random_gust")
 #: the onset altitudes [m] of the ``maxq_gust`` tier's gust: SMILE's max q is at 9.8 km (docs/vehicles.md)
 MAXQ_GUST_ONSET_M = (8000.0, 11500.0)
