@@ -59,8 +59,9 @@ from .flightloop import flight_plant, mode_frequencies
 from .lqg import LQGSchedule
 from .lqg_design import (_SEARCH_W, PLANE_VELOCITY, SMILE_PHASES_S, SMILE_ROWS_S, MarginTargets, _op, assess,
                          row_intervals, row_neighbours, shortfall)
-from .lqg_row import (GYRO_ARW_RAD_PER_SQRT_S, LQGWeights, RowDesign, _mode_rates, closed_loop_growth, compensator,
-                      delayed_plant, design_row, open_loop, plant_labels, regulator, response)
+from .lqg_row import (GYRO_ARW_RAD_PER_SQRT_S, LQGWeights, RowDesign, closed_loop_growth, compensator, delayed_plant,
+                      design_row, kalman_gain, open_loop, plant_labels, regulator, response)
+from .noise import gyro_noise
 
 PROG = "python -m baselines.headroom"
 #: the body rate of each plane (what the score integrates)
@@ -139,14 +140,10 @@ def wind_design(op: Any, plane: str, w: LQGWeights, wind_noise: float, turb: Tur
     Ba, Ca = np.vstack([B, np.zeros((nw, 1))]), np.hstack([C, np.zeros((1, nw))])
     labels_a = tuple(labels) + tuple(f"wind_{i}" for i in range(nw))
     Kx, Ki, a = regulator(Aa, Ba, Ca, w, dt, labels_a)
-    Ga = np.vstack([Gw, np.zeros((nw, 1))])
-    W = w.w_gimbal * Ga @ Ga.T
-    for i in _mode_rates(labels_a):
-        W[i, i] += w.w_modes
-    W[n:, n:] += wind_noise * Qw
-    V = np.array([[float(getattr(op.task, "gyro_arw_rad_per_sqrt_s", GYRO_ARW_RAD_PER_SQRT_S)) ** 2 / dt]])
-    P = sla.solve_discrete_are(Aa.T, Ca.T, W + 1e-14 * np.eye(n + nw), V)
-    M = P @ Ca.T / (Ca @ P @ Ca.T + V).item()
+    extra = np.zeros((n + nw, n + nw))
+    extra[n:, n:] = wind_noise * Qw
+    arw = float(getattr(op.task, "gyro_arw_rad_per_sqrt_s", GYRO_ARW_RAD_PER_SQRT_S))
+    M = kalman_gain(Aa, Ca, np.vstack([Gw, np.zeros((nw, 1))]), w, dt, labels_a, arw, extra)
     return RowDesign(float(op.t), plane, Aa, Ba, Ca, Kx, Ki, M, a, dt, w, labels_a)
 
 
@@ -168,7 +165,7 @@ def turbulence_rms(d: Any, op: Any, plane: str, turb: Turbulence, noise: bool = 
     Q = np.zeros_like(Acl)
     Q[n:n + nw, n:n + nw] = Qw
     if noise:
-        sigma = float(getattr(op.task, "gyro_arw_rad_per_sqrt_s", GYRO_ARW_RAD_PER_SQRT_S)) / math.sqrt(d.dt)
+        sigma = gyro_noise(op)[0]
         Bn = np.vstack([B @ Dk, np.zeros((nw, 1)), Bk]) * sigma
         Q = Q + Bn @ Bn.T
     P = sla.solve_discrete_lyapunov(Acl, Q)

@@ -180,16 +180,20 @@ def regulator(A: np.ndarray, B: np.ndarray, C: np.ndarray, w: LQGWeights, dt: fl
 
 
 def kalman_gain(A: np.ndarray, C: np.ndarray, Gw: np.ndarray, w: LQGWeights, dt: float,
-                labels: tuple[str, ...], arw: float = GYRO_ARW_RAD_PER_SQRT_S) -> np.ndarray:
+                labels: tuple[str, ...], arw: float = GYRO_ARW_RAD_PER_SQRT_S,
+                extra_noise: np.ndarray | None = None) -> np.ndarray:
     """Steady-state current-estimator gain ``M`` (n, 1) (module docstring); ``w_modes`` acts on the
     states named ``eta_dot_*`` (bending rates) and ``omega_s_*`` (pendulum rates) of ``labels``: the
     modes' uncertainty, which keeps the filter following a mode whose frequency is not the model's.
-    ``arw``: the gyro's angle random walk [rad/sqrt(s)]."""
+    ``arw``: the gyro's angle random walk [rad/sqrt(s)]; ``extra_noise``: a further process noise
+    covariance (n, n) per control period (e.g. a disturbance model's states, ``baselines.headroom``)."""
     n = A.shape[0]
     V = np.array([[arw ** 2 / dt]])
     W = w.w_gimbal * Gw @ Gw.T
     for i in _mode_rates(labels):
         W[i, i] += w.w_modes
+    if extra_noise is not None:
+        W = W + extra_noise
     W = W + 1e-14 * np.eye(n)                          # keeps the Riccati equation regular on the delay state
     P = sla.solve_discrete_are(A.T, C.T, W, V)
     return P @ C.T / (C @ P @ C.T + V).item()

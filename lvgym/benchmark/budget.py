@@ -44,6 +44,7 @@ from lvgym.parallel import EXECUTORS, check_workers, exit_on_sigterm
 
 from .results import atomic_write_text, csv_text, json_text
 from .runner import PolicySpec, evaluate
+from .scoring import PHASES
 from .stats import bootstrap_ci, paired
 from .suites import SEED_SETS, SUITES, Condition, Suite, get_suite
 
@@ -58,7 +59,6 @@ _PART_TIERS = {frozenset(parts): tier for tier, parts in WIND_PARTS.items()}
 DISTURBANCES = ("thrust_misalignment", "sensor_noise")
 #: ``randomize`` names that are not a source: ``wind`` only says where the wind's draws come from
 NOT_SOURCES = ("wind",)
-PHASES = ("boost", "max_q", "coast", "upper")
 DEFAULT_POLICIES = ["lqg", "ppo-res-lqg"]
 DEFAULT_SUITE = "smile-v1"
 DEFAULT_EPISODES = 10
