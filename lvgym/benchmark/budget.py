@@ -46,7 +46,7 @@ from .results import atomic_write_text, csv_text, json_text
 from .runner import PolicySpec, evaluate
 from .scoring import PHASES
 from .stats import bootstrap_ci, paired
-from .suites import SEED_SETS, SUITES, Condition, Suite, get_suite
+from .suites import SEED_SETS, SUITES, Condition, Suite
 
 __all__ = ["DISTURBANCES", "PHASES", "WIND_PARTS", "budget_rows", "budget_table", "run_budget", "sources",
            "variants"]
@@ -215,23 +215,12 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
 
 def main(argv: list[str] | None = None) -> list[dict[str, Any]]:
     """Fly, print the table, write ``episodes.csv``, ``budget.csv`` and ``budget.json``; returns the rows."""
-    from .registry import resolve_policy
+    from .registry import resolve_flights
 
     args = parse_args(argv)
     exit_on_sigterm()
-    policies = [resolve_policy(n, PROG) for n in args.policies]
-    if len({p.name for p in policies}) != len(policies):
-        fail(PROG, f"--policies {' '.join(args.policies)}: each label must be distinct")
-    try:
-        suite = get_suite(args.suite)
-    except ValueError as exc:
-        fail(PROG, exc)
-    if args.mission_time_s is not None:
-        suite = suite.with_options(mission_time_s=args.mission_time_s)
-    conds = [c for c in suite.conditions if c.model in args.models]
-    if not conds:
-        fail(PROG, f"--models {' '.join(args.models)}: suite {suite.name!r} has "
-                   f"{sorted({c.model for c in suite.conditions})}")
+    policies, suite, conds = resolve_flights(PROG, args.policies, args.suite, args.models,
+                                             mission_time_s=args.mission_time_s)
     t0 = time.perf_counter()
     records = run_budget(policies, conds, suite, args.episodes, args.seed_set, args.executor, args.workers,
                          args.progress)

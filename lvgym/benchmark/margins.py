@@ -45,7 +45,7 @@ from lvgym.parallel import EXECUTORS, TaskFailed, check_workers, exit_on_sigterm
 from .perturb import db_to_gain, find_threshold, fly
 from .results import atomic_write_text, csv_text, json_text
 from .runner import PolicySpec, episode_objects
-from .suites import SEED_SETS, SUITES, Condition, Suite, get_suite
+from .suites import SEED_SETS, SUITES, Condition, Suite
 
 __all__ = ["EXPERIMENTS", "MarginOptions", "MarginTask", "RATE_ERROR_FLOOR_RADPS", "RATE_LIMIT_FLOOR_S", "bounds",
            "margin_rows", "margins_table", "run_margin_task",
@@ -429,28 +429,14 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     return ns
 
 
-
-
 def main(argv: list[str] | None = None) -> list[dict[str, Any]]:
     """Measure, print the table, write the result files; returns the results."""
-    from .registry import resolve_policy
+    from .registry import resolve_flights
 
     args = parse_args(argv)
     exit_on_sigterm()
-    policies = [resolve_policy(n, PROG) for n in args.policies]
-    if len({p.name for p in policies}) != len(policies):
-        fail(PROG, f"--policies {' '.join(args.policies)}: each label must be distinct")
-    try:
-        suite = get_suite(args.suite)
-    except ValueError as exc:
-        fail(PROG, exc)
-    overrides = {k: v for k, v in (("mission_time_s", args.mission_time_s), ("physics_dt_s", args.physics_dt_s))
-                 if v is not None}
-    suite = suite.with_options(**overrides)
-    conds = [c for c in suite.conditions if args.models is None or c.model in args.models]
-    if not conds:
-        fail(PROG, f"--models {' '.join(args.models)}: suite {suite.name!r} has "
-                   f"{sorted({c.model for c in suite.conditions})}")
+    policies, suite, conds = resolve_flights(PROG, args.policies, args.suite, args.models,
+                                             mission_time_s=args.mission_time_s, physics_dt_s=args.physics_dt_s)
     if args.physics_dt_s is not None:
         for c in conds:
             n = _control_dt_s(c) / args.physics_dt_s

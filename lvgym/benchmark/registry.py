@@ -8,11 +8,14 @@ of DESIGN.md: the benchmark sits below the controllers and the agents).
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from pathlib import Path
+from typing import Any
 
 from .runner import ZERO, PolicySpec
+from .suites import Condition, Suite, get_suite
 
-__all__ = ["POLICIES", "resolve_policy"]
+__all__ = ["POLICIES", "resolve_flights", "resolve_policy"]
 
 #: policy names -> how a worker builds them (factories are imported lazily, in the workers)
 POLICIES: dict[str, PolicySpec] = {
@@ -65,3 +68,25 @@ def resolve_policy(name: str, prog: str = "evaluate.py") -> PolicySpec:
         return PolicySpec(path.stem, "agents.policy:load_policy", (("path", str(path.resolve())),))
     raise SystemExit(f"{prog}: policy {name!r}: one of {sorted(POLICIES)}, a path to an SB3 .zip model or a "
                      "train.py run folder")
+
+
+def resolve_flights(prog: str, policy_names: Sequence[str], suite_name: str, models: Sequence[str] | None = None,
+                    **overrides: Any) -> tuple[list[PolicySpec], Suite, list[Condition]]:
+    """A command line's policies (:func:`resolve_policy`, distinct labels), its suite with the env
+    ``overrides`` that are not None (:meth:`~.suites.Suite.with_options`) and the suite's conditions of the
+    flight ``models`` (None: all); a bad value exits with a one-line message starting ``prog:``."""
+    from lvgym.cli import fail
+
+    policies = [resolve_policy(n, prog) for n in policy_names]
+    if len({p.name for p in policies}) != len(policies):
+        fail(prog, f"--policies {' '.join(policy_names)}: each label must be distinct")
+    try:
+        suite = get_suite(suite_name)
+    except ValueError as exc:
+        fail(prog, exc)
+    suite = suite.with_options(**{k: v for k, v in overrides.items() if v is not None})
+    conds = [c for c in suite.conditions if models is None or c.model in models]
+    if not conds:
+        fail(prog, f"--models {' '.join(models or ())}: suite {suite.name!r} has "
+                   f"{sorted({c.model for c in suite.conditions})}")
+    return policies, suite, conds
