@@ -38,7 +38,7 @@ from typing import Any
 
 import numpy as np
 
-from lvgym.cli import fail, one_line_errors, option_number, parse_number
+from lvgym.cli import fail, option_number, parse_number
 from lvgym.errors import ConfigError
 from lvgym.parallel import EXECUTORS, check_workers, exit_on_sigterm
 
@@ -46,7 +46,7 @@ from .results import atomic_write_text, csv_text, json_text
 from .runner import PolicySpec, evaluate
 from .scoring import PHASES
 from .stats import bootstrap_ci, paired
-from .suites import SEED_SETS, SUITES, Condition, Suite
+from .suites import SEED_SETS, Condition, Suite
 
 __all__ = ["DISTURBANCES", "PHASES", "WIND_PARTS", "budget_rows", "budget_table", "run_budget", "sources",
            "variants"]
@@ -184,15 +184,9 @@ def run_budget(policies: Sequence[PolicySpec], conditions: Sequence[Condition], 
 
 def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     """The command line, every value checked before any worker starts."""
-    from .registry import POLICIES
+    from .registry import flight_parser
 
-    p = one_line_errors(argparse.ArgumentParser(prog=PROG, description=__doc__.split("\n\n")[0],
-                                                epilog=__doc__.split("\n\n", 2)[2],
-                                                formatter_class=argparse.RawDescriptionHelpFormatter))
-    p.add_argument("--policies", nargs="+", default=DEFAULT_POLICIES, metavar="POLICY",
-                   help=f"names {sorted(POLICIES)}, SB3 .zip paths or train.py run folders "
-                        f"(default: {' '.join(DEFAULT_POLICIES)})")
-    p.add_argument("--suite", default=DEFAULT_SUITE, help=f"of {sorted(SUITES)} (default {DEFAULT_SUITE})")
+    p = flight_parser(PROG, __doc__, DEFAULT_POLICIES, DEFAULT_SUITE)
     p.add_argument("--models", nargs="+", default=["nonrigid"], metavar="MODEL",
                    help="the suite's conditions of these flight models (default: nonrigid)")
     p.add_argument("--episodes", default=DEFAULT_EPISODES, help=f"seeds per variant (default {DEFAULT_EPISODES})")

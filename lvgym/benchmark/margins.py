@@ -38,7 +38,7 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any
 
-from lvgym.cli import fail, one_line_errors, option_number, parse_number
+from lvgym.cli import fail, option_number, parse_number
 from lvgym.errors import ConfigError, check_number
 from lvgym.parallel import EXECUTORS, TaskFailed, check_workers, exit_on_sigterm, run_map
 
@@ -376,16 +376,10 @@ def _control_dt_s(condition: Condition) -> float:
 
 def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     """The command line, every value checked before any worker starts."""
-    from .registry import POLICIES
+    from .registry import flight_parser
 
     d = MarginOptions()
-    p = one_line_errors(argparse.ArgumentParser(prog=PROG, description=__doc__.split("\n\n")[0],
-                                                epilog=__doc__.split("\n\n", 2)[2],
-                                                formatter_class=argparse.RawDescriptionHelpFormatter))
-    p.add_argument("--policies", nargs="+", default=DEFAULT_POLICIES, metavar="POLICY",
-                   help=f"names {sorted(POLICIES)}, SB3 .zip paths or train.py run folders "
-                        f"(default: {' '.join(DEFAULT_POLICIES)})")
-    p.add_argument("--suite", default=DEFAULT_SUITE, help=f"of {sorted(SUITES)} (default {DEFAULT_SUITE})")
+    p = flight_parser(PROG, __doc__, DEFAULT_POLICIES, DEFAULT_SUITE)
     p.add_argument("--models", nargs="+", default=None, metavar="MODEL",
                    help="only the suite's conditions of these flight models (default: all, e.g. rigid and nonrigid)")
     p.add_argument("--seeds", default=DEFAULT_SEEDS, help=f"seeds per condition (default {DEFAULT_SEEDS})")

@@ -8,14 +8,15 @@ of DESIGN.md: the benchmark sits below the controllers and the agents).
 
 from __future__ import annotations
 
+import argparse
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
 from .runner import ZERO, PolicySpec
-from .suites import Condition, Suite, get_suite
+from .suites import SUITES, Condition, Suite, get_suite
 
-__all__ = ["POLICIES", "resolve_flights", "resolve_policy"]
+__all__ = ["POLICIES", "flight_parser", "resolve_flights", "resolve_policy"]
 
 #: policy names -> how a worker builds them (factories are imported lazily, in the workers)
 POLICIES: dict[str, PolicySpec] = {
@@ -68,6 +69,21 @@ def resolve_policy(name: str, prog: str = "evaluate.py") -> PolicySpec:
         return PolicySpec(path.stem, "agents.policy:load_policy", (("path", str(path.resolve())),))
     raise SystemExit(f"{prog}: policy {name!r}: one of {sorted(POLICIES)}, a path to an SB3 .zip model or a "
                      "train.py run folder")
+
+
+def flight_parser(prog: str, doc: str, default_policies: Sequence[str], default_suite: str) -> argparse.ArgumentParser:
+    """A benchmark command's parser (one-line errors; ``doc``'s first paragraph as its description, from its
+    third on as its epilog) with ``--policies`` and ``--suite``, which :func:`resolve_flights` resolves."""
+    from lvgym.cli import one_line_errors
+
+    p = one_line_errors(argparse.ArgumentParser(prog=prog, description=doc.split("\n\n")[0],
+                                                epilog=doc.split("\n\n", 2)[2],
+                                                formatter_class=argparse.RawDescriptionHelpFormatter))
+    p.add_argument("--policies", nargs="+", default=list(default_policies), metavar="POLICY",
+                   help=f"names {sorted(POLICIES)}, SB3 .zip paths or train.py run folders "
+                        f"(default: {' '.join(default_policies)})")
+    p.add_argument("--suite", default=default_suite, help=f"of {sorted(SUITES)} (default {default_suite})")
+    return p
 
 
 def resolve_flights(prog: str, policy_names: Sequence[str], suite_name: str, models: Sequence[str] | None = None,
