@@ -40,7 +40,7 @@ import numpy as np
 
 from lvgym.cli import fail, option_number, parse_number
 from lvgym.errors import ConfigError
-from lvgym.parallel import EXECUTORS, check_workers, exit_on_sigterm
+from lvgym.parallel import check_workers, exit_on_sigterm
 
 from .results import atomic_write_text, csv_text, json_text
 from .runner import PolicySpec, evaluate
@@ -186,16 +186,11 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     """The command line, every value checked before any worker starts."""
     from .registry import flight_parser
 
-    p = flight_parser(PROG, __doc__, DEFAULT_POLICIES, DEFAULT_SUITE)
+    p = flight_parser(PROG, __doc__, DEFAULT_POLICIES, DEFAULT_SUITE, "results/budget")
     p.add_argument("--models", nargs="+", default=["nonrigid"], metavar="MODEL",
                    help="the suite's conditions of these flight models (default: nonrigid)")
     p.add_argument("--episodes", default=DEFAULT_EPISODES, help=f"seeds per variant (default {DEFAULT_EPISODES})")
     p.add_argument("--seed-set", choices=SEED_SETS, default="validation", help="default: validation (a diagnosis)")
-    p.add_argument("--mission-time-s", default=None, help="shorten every episode (smoke tests only)")
-    p.add_argument("--executor", choices=EXECUTORS, default="local", help="default: local process pool")
-    p.add_argument("--workers", default=None, help="default: the CPUs available")
-    p.add_argument("--out", default="results/budget", help="results folder (default results/budget/)")
-    p.add_argument("--no-progress", dest="progress", action="store_false", help="hide the progress bar")
     ns = p.parse_args(argv)
     try:
         ns.episodes = option_number("--episodes", parse_number(ns.episodes, "--episodes"), 2, 10_000, integer=True)

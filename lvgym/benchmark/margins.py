@@ -40,7 +40,7 @@ from typing import Any
 
 from lvgym.cli import fail, option_number, parse_number
 from lvgym.errors import ConfigError, check_number
-from lvgym.parallel import EXECUTORS, TaskFailed, check_workers, exit_on_sigterm, run_map
+from lvgym.parallel import TaskFailed, check_workers, exit_on_sigterm, run_map
 
 from .perturb import db_to_gain, find_threshold, fly
 from .results import atomic_write_text, csv_text, json_text
@@ -379,7 +379,7 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     from .registry import flight_parser
 
     d = MarginOptions()
-    p = flight_parser(PROG, __doc__, DEFAULT_POLICIES, DEFAULT_SUITE)
+    p = flight_parser(PROG, __doc__, DEFAULT_POLICIES, DEFAULT_SUITE, "results/margins")
     p.add_argument("--models", nargs="+", default=None, metavar="MODEL",
                    help="only the suite's conditions of these flight models (default: all, e.g. rigid and nonrigid)")
     p.add_argument("--seeds", default=DEFAULT_SEEDS, help=f"seeds per condition (default {DEFAULT_SEEDS})")
@@ -399,11 +399,6 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     p.add_argument("--physics-dt-s", default=None,
                    help="physics step [s], the delay's resolution (default: the env's, 0.01; it also changes the "
                         "integration step and the servo_delay dispersion's quantum)")
-    p.add_argument("--mission-time-s", default=None, help="shorten every episode (smoke tests only)")
-    p.add_argument("--executor", choices=EXECUTORS, default="local", help="default: local process pool")
-    p.add_argument("--workers", default=None, help="default: the CPUs available")
-    p.add_argument("--out", default="results/margins", help="results folder (default results/margins/)")
-    p.add_argument("--no-progress", dest="progress", action="store_false", help="hide the progress bar")
     ns = p.parse_args(argv)
     try:
         ns.seeds = option_number("--seeds", parse_number(ns.seeds), 1, 10_000, integer=True)

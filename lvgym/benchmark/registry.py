@@ -71,10 +71,14 @@ def resolve_policy(name: str, prog: str = "evaluate.py") -> PolicySpec:
                      "train.py run folder")
 
 
-def flight_parser(prog: str, doc: str, default_policies: Sequence[str], default_suite: str) -> argparse.ArgumentParser:
+def flight_parser(prog: str, doc: str, default_policies: Sequence[str], default_suite: str,
+                  default_out: str) -> argparse.ArgumentParser:
     """A benchmark command's parser (one-line errors; ``doc``'s first paragraph as its description, from its
-    third on as its epilog) with ``--policies`` and ``--suite``, which :func:`resolve_flights` resolves."""
+    third on as its epilog) with ``--policies`` and ``--suite`` (which :func:`resolve_flights` resolves),
+    ``--mission-time-s``, ``--executor``, ``--workers`` (checked by the command), ``--out`` (default
+    ``default_out``) and ``--no-progress``."""
     from lvgym.cli import one_line_errors
+    from lvgym.parallel import EXECUTORS
 
     p = one_line_errors(argparse.ArgumentParser(prog=prog, description=doc.split("\n\n")[0],
                                                 epilog=doc.split("\n\n", 2)[2],
@@ -83,6 +87,11 @@ def flight_parser(prog: str, doc: str, default_policies: Sequence[str], default_
                    help=f"names {sorted(POLICIES)}, SB3 .zip paths or train.py run folders "
                         f"(default: {' '.join(default_policies)})")
     p.add_argument("--suite", default=default_suite, help=f"of {sorted(SUITES)} (default {default_suite})")
+    p.add_argument("--mission-time-s", default=None, help="shorten every episode (smoke tests only)")
+    p.add_argument("--executor", choices=EXECUTORS, default="local", help="default: local process pool")
+    p.add_argument("--workers", default=None, help="default: the CPUs available")
+    p.add_argument("--out", default=default_out, help=f"results folder (default {default_out}/)")
+    p.add_argument("--no-progress", dest="progress", action="store_false", help="hide the progress bar")
     return p
 
 
