@@ -6,7 +6,7 @@
 
 The Dryden turbulence causes most of `smile-v1`'s score (``python -m lvgym.benchmark.budget``). At a row
 of the ``lqg`` schedule (its frozen flight time, the pitch plane; the yaw plane is the same vehicle), this
-module flies a family of LQG designs on the row's linear flight loop (:mod:`.lqg_row`: servo, vehicle,
+module closes a family of LQG designs around the row's linear flight loop (:mod:`.lqg_row`: servo, vehicle,
 gyro chain, one period of delay) and measures for each:
 
 - ``rate_rms``: the RMS body pitch rate [rad/s] under the v1 turbulence at the row (transverse Dryden
@@ -33,7 +33,8 @@ shipped row's)? The family samples the LQG designs, which hold the optimal linea
 quadratic cost of this linear plant under Gaussian turbulence and noise; it is a sample, not a bound over
 every controller. ``--write-schedule`` writes the shipped schedule with each studied row replaced, in
 both planes, by the design of lowest RMS within one margin loss (``--slack``; :func:`front_schedule`):
-the ``lqg-front`` policy flies it.docs/training.md ("How far 30 % is") gives the numbers.
+the ``lqg-front`` policy flies it. docs/training.md ("The turbulence against the margins") gives the
+numbers.
 """
 
 from __future__ import annotations
