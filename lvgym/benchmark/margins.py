@@ -404,7 +404,8 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
         ns.seeds = option_number("--seeds", parse_number(ns.seeds), 1, 10_000, integer=True)
         ns.workers = check_workers(parse_number(ns.workers), "--workers")
         ns.physics_dt_s = option_number("--physics-dt-s", parse_number(ns.physics_dt_s), 0.0, 0.05, lo_open=True)
-        ns.mission_time_s = option_number("--mission-time-s", parse_number(ns.mission_time_s), 0.0, 3600.0, lo_open=True)
+        ns.mission_time_s = option_number("--mission-time-s", parse_number(ns.mission_time_s), 0.0, 3600.0,
+                                          lo_open=True)
         names = ("error_ratio", "rate_limit_ratio", "gain_max_db", "gain_min_db", "gain_tol_db", "gain_step_db",
                  "delay_max_s")
         for key in names:

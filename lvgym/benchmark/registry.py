@@ -1,5 +1,7 @@
 """The policies the benchmark's command lines know by name (``evaluate.py``, ``python -m
-lvgym.benchmark.margins``), and how a name or a saved model's path becomes a :class:`~.runner.PolicySpec`.
+lvgym.benchmark.margins``, ``... budget``), how a name or a saved model's path becomes a
+:class:`~.runner.PolicySpec`, and the options and checks those commands share (:func:`flight_parser`,
+:func:`resolve_flights`).
 
 A spec holds an import path as a string (``"baselines.pid:smile_tuned_pid"``); the factory is imported in
 the worker that flies the policy, so this module imports neither ``baselines`` nor ``agents`` (the layers
