@@ -60,8 +60,8 @@ from .flightloop import flight_plant, mode_frequencies
 from .lqg import LQGSchedule
 from .lqg_design import (_SEARCH_W, PLANE_VELOCITY, SMILE_PHASES_S, SMILE_ROWS_S, MarginTargets, _op, assess,
                          row_intervals, row_neighbours, shortfall)
-from .lqg_row import (GYRO_ARW_RAD_PER_SQRT_S, LQGWeights, RowDesign, closed_loop_growth, compensator, delayed_plant,
-                      design_row, kalman_gain, open_loop, plant_labels, regulator, response)
+from .lqg_row import (GYRO_ARW_RAD_PER_SQRT_S, LQGWeights, RowDesign, closed_loop, closed_loop_growth, compensator,
+                      delayed_plant, design_row, kalman_gain, open_loop, plant_labels, regulator, response)
 from .noise import gyro_noise
 
 PROG = "python -m baselines.headroom"
@@ -155,19 +155,16 @@ def turbulence_rms(d: Any, op: Any, plane: str, turb: Turbulence, noise: bool = 
     A, B, C, _ = delayed_plant(op, plane)
     labels = plant_labels(op, plane)
     Aw, Qw, Cw = dryden_filter(turb, d.dt)
-    k = compensator(d)
-    Ak, Bk, Ck, Dk = (np.asarray(m, float) for m in (k.A, k.B, k.C, k.D))
-    n, nw, nk = A.shape[0], Aw.shape[0], Ak.shape[0]
-    Acl = np.block([[A + B @ Dk @ C, wind_input(A, labels, plane) @ Cw, B @ Ck],
-                    [np.zeros((nw, n)), Aw, np.zeros((nw, nk))],
-                    [Bk @ C, np.zeros((nk, nw)), Ak]])
+    Alk, By = closed_loop(A, B, C, compensator(d))           # the plant's states, then the compensator's
+    n, nlk, nw = A.shape[0], Alk.shape[0], Aw.shape[0]
+    Bw = np.vstack([wind_input(A, labels, plane), np.zeros((nlk - n, 1))])
+    Acl = np.block([[Alk, Bw @ Cw], [np.zeros((nw, nlk)), Aw]])   # the wind filter's states last
     if np.abs(np.linalg.eigvals(Acl)).max() >= 1.0:
         return math.inf
     Q = np.zeros_like(Acl)
-    Q[n:n + nw, n:n + nw] = Qw
+    Q[nlk:, nlk:] = Qw
     if noise:
-        sigma = gyro_noise(op)[0]
-        Bn = np.vstack([B @ Dk, np.zeros((nw, 1)), Bk]) * sigma
+        Bn = np.vstack([By, np.zeros((nw, 1))]) * gyro_noise(op)[0]
         Q = Q + Bn @ Bn.T
     P = sla.solve_discrete_lyapunov(Acl, Q)
     i = labels.index(PLANE_RATE[plane])

@@ -29,8 +29,8 @@ from lvgym.errors import ConfigError, check_number
 
 from .flightloop import flight_plant, mode_frequencies
 from .linearize import OperatingPoint, operating_point
-from .lqg_row import (LQGWeights, RowDesign, closed_loop_growth, delayed_plant, design_row, frequency_grid,
-                      gain_at, margins_from_response, open_loop, plant_labels, response)
+from .lqg_row import (LQGWeights, RowDesign, closed_loop, closed_loop_growth, delayed_plant, design_row,
+                      frequency_grid, gain_at, margins_from_response, open_loop, plant_labels, response)
 
 SCHEDULES = Path(__file__).resolve().parent / "schedules"
 #: the schedule rows [s] of SMILE v1: the boost (burnout 43 s) and the upper stage (ignition 54 s)
@@ -117,11 +117,10 @@ def gust_response(d: RowDesign, op: OperatingPoint, plane: str) -> float:
     labels = plant_labels(op, plane)
     Bd = np.zeros((A.shape[0], 1))
     Bd[labels.index(PLANE_VELOCITY[plane]), 0] = 1.0
-    k = d.compensator()
-    Ac, Bc, Cc, Dc = (np.asarray(m, float) for m in (k.A, k.B, k.C, k.D))
-    Acl = np.block([[A + B @ Dc @ C, B @ Cc], [Bc @ C, Ac]])
-    Bcl = np.vstack([Bd, np.zeros((Ac.shape[0], 1))])
-    Ccl = np.hstack([C, np.zeros((1, Ac.shape[0]))])
+    Acl, _ = closed_loop(A, B, C, d.compensator())
+    nk = Acl.shape[0] - A.shape[0]
+    Bcl = np.vstack([Bd, np.zeros((nk, 1))])
+    Ccl = np.hstack([C, np.zeros((1, nk))])
     if np.abs(np.linalg.eigvals(Acl)).max() >= 1.0:
         return math.inf
     P = sla.solve_discrete_lyapunov(Acl, Bcl @ Bcl.T)

@@ -225,6 +225,15 @@ def compensator(d: RowDesign) -> control.StateSpace:
     return control.ss(Ac, Bc, Cc, Dc, d.dt, inputs=["gyro"], outputs=["command"])
 
 
+def closed_loop(A: np.ndarray, B: np.ndarray, C: np.ndarray,
+                comp: control.StateSpace) -> tuple[np.ndarray, np.ndarray]:
+    """The sampled plant ``(A, B, C)`` closed by the compensator ``comp`` (gyro sample ``y`` -> command
+    ``u``, :func:`compensator`): ``A_cl`` over the plant's states, then the compensator's, and ``B_y``, the
+    input matrix of a noise added to the sample ``y``."""
+    Ak, Bk, Ck, Dk = (np.asarray(m, float) for m in (comp.A, comp.B, comp.C, comp.D))
+    return np.block([[A + B @ Dk @ C, B @ Ck], [Bk @ C, Ak]]), np.vstack([B @ Dk, Bk])
+
+
 def open_loop(comp: control.StateSpace, plant: control.StateSpace) -> control.StateSpace:
     """``L = -K(z) G(z)``: the loop broken at the plant input, for negative feedback."""
     return control.ss(control.series(plant, -comp))

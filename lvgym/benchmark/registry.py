@@ -15,6 +15,9 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
+from lvgym.cli import fail, one_line_errors
+from lvgym.parallel import EXECUTORS
+
 from .runner import ZERO, PolicySpec
 from .suites import SUITES, Condition, Suite, get_suite
 
@@ -79,9 +82,6 @@ def flight_parser(prog: str, doc: str, default_policies: Sequence[str], default_
     third on as its epilog) with ``--policies`` and ``--suite`` (which :func:`resolve_flights` resolves),
     ``--mission-time-s``, ``--executor``, ``--workers`` (checked by the command), ``--out`` (default
     ``default_out``) and ``--no-progress``."""
-    from lvgym.cli import one_line_errors
-    from lvgym.parallel import EXECUTORS
-
     p = one_line_errors(argparse.ArgumentParser(prog=prog, description=doc.split("\n\n")[0],
                                                 epilog=doc.split("\n\n", 2)[2],
                                                 formatter_class=argparse.RawDescriptionHelpFormatter))
@@ -102,8 +102,6 @@ def resolve_flights(prog: str, policy_names: Sequence[str], suite_name: str, mod
     """A command line's policies (:func:`resolve_policy`, distinct labels), its suite with the env
     ``overrides`` that are not None (:meth:`~.suites.Suite.with_options`) and the suite's conditions of the
     flight ``models`` (None: all); a bad value exits with a one-line message starting ``prog:``."""
-    from lvgym.cli import fail
-
     policies = [resolve_policy(n, prog) for n in policy_names]
     if len({p.name for p in policies}) != len(policies):
         fail(prog, f"--policies {' '.join(policy_names)}: each label must be distinct")
