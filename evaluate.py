@@ -7,7 +7,7 @@
 
 Policies are names of :data:`POLICIES` (``zero``, ``pid``, ``gs-pid``: our rigid tuning; ``pid-thesis``,
 ``gs-pid-thesis``: the thesis's gains and Table 6.10; ``gs-pid-flex``, ``lqg``, ``aac``: designed for the
-flexible vehicle; ``lqg-front``: ``lqg`` traded to the learned policy's margins (``baselines.headroom``);
+flexible vehicle; ``lqg-front``: ``lqg`` traded to the learned policy's margins (``experiments.lqg_headroom.headroom``);
 ``ppo``: the learned policy shipped for v0, ``ppo-res-lqg``: the one shipped for v1) or
 paths of saved stable-baselines3 models (``.zip``; an optional ``<stem>_vecnormalize.pkl`` next to it
 normalises the observations) or of ``train.py`` run folders. Suites are names of ``lvgym.benchmark.SUITES``. Episodes run on a local process pool

@@ -14,7 +14,7 @@ keywords, lvgym version, git commit), ``segments.jsonl`` (one line per start or 
 (TensorBoard: ``tensorboard --logdir runs``), ``progress_<step>.csv``, ``checkpoints/`` (model,
 VecNormalize statistics, generator states, replay buffer; see ``agents/callbacks.py``),
 ``evaluations.json`` (validation on the benchmark protocol's validation seeds), ``best_model.*`` and
-``final_model.*`` (load with ``agents.policy.SB3Policy`` or pass the ``.zip`` to ``evaluate.py``).
+``final_model.*`` (load with ``lvgym.agents.policy.SB3Policy`` or pass the ``.zip`` to ``evaluate.py``).
 ``--resume`` restarts from the newest complete checkpoint with the run's own configuration, the same
 target step count, the normalisation statistics and the step counter (``reset_num_timesteps=False``),
 and says what it resumed from (or that there was no checkpoint yet).
@@ -40,7 +40,7 @@ from typing import Any
 
 import yaml
 
-from agents.runfolder import create_run, make_logger, provenance
+from lvgym.agents.runfolder import create_run, make_logger, provenance
 from lvgym.cli import fail, one_line_errors, option_number
 from lvgym.errors import ConfigError
 from lvgym.parallel import exit_on_sigterm
@@ -84,11 +84,11 @@ class Args:
     algo: str = "ppo"
     """ppo, sac, td3 or recurrent-ppo (sb3-contrib's RecurrentPPO with MlpLstmPolicy)"""
     residual: str | None = None
-    """fly residual on this registered baseline, e.g. gs-pid-flex (agents.residual; default: not residual)"""
+    """fly residual on this registered baseline, e.g. gs-pid-flex (lvgym.agents.residual; default: not residual)"""
     residual_scale: float = 0.2
     """with --residual: gimbal units per unit of learned action, in (0, 2]"""
     loop_gain_db: float = 0.0
-    """train with the loop gain drawn per episode uniformly in +-this many dB (agents.loop_dispersion; 0: off)"""
+    """train with the loop gain drawn per episode uniformly in +-this many dB (lvgym.agents.loop_dispersion; 0: off)"""
     loop_delay_periods: int = 0
     """train with an extra loop delay drawn per episode from 0 to this many control periods (0: off)"""
     total_timesteps: int | None = None
@@ -175,7 +175,7 @@ def build_parser(suppress: bool = False) -> argparse.ArgumentParser:
         elif f.name in ("eval_mission_time_s", "checkpoint_interval_s", "residual_scale", "loop_gain_db"):
             kw["type"] = float
         if f.name == "algo":
-            from agents.config import ALGOS
+            from lvgym.agents.config import ALGOS
             kw["choices"] = tuple(ALGOS)
         if f.name in choices:
             kw["choices"] = choices[f.name]
@@ -253,11 +253,11 @@ def check_options(args: Args) -> None:
     option_number("--torch-threads", args.torch_threads, 1, 1024, integer=True)
     option_number("--verbose", args.verbose, 0, 2, integer=True)
     option_number("--n-envs", args.n_envs, 1, 4096, integer=True)
-    from agents.residual import residual_options
+    from lvgym.agents.residual import residual_options
 
     option_number("--history", args.history, 0, 64, integer=True)
     residual_options(args.residual, args.residual_scale)
-    from agents.loop_dispersion import loop_dispersion_options
+    from lvgym.agents.loop_dispersion import loop_dispersion_options
 
     loop_dispersion_options(args.loop_gain_db, args.loop_delay_periods)
     known = set(RANDOMIZE) | {"all", "none", "protocol", "true", "false", "True", "False"}
@@ -290,17 +290,17 @@ def training_seed(seed: int, step: int, n_envs: int) -> int:
 
 def make_venv(env_id: str, n_envs: int, seed: int, env_kwargs: dict[str, Any], norm: Any, gamma: float,
               stats: Path | None, residual: dict[str, Any] | None = None, loop: dict[str, Any] | None = None) -> Any:
-    """Batched SB3 VecEnv (-> :class:`agents.loop_dispersion.LoopDispersedVecEnv` with ``loop`` ->
-    :class:`agents.residual.ResidualVecEnv` with ``residual``) -> EnvClock (the env's wall time,
-    :mod:`agents.timing`) -> VecMonitor (episode returns) -> VecNormalize (new, or loaded from ``stats``)."""
+    """Batched SB3 VecEnv (-> :class:`lvgym.agents.loop_dispersion.LoopDispersedVecEnv` with ``loop`` ->
+    :class:`lvgym.agents.residual.ResidualVecEnv` with ``residual``) -> EnvClock (the env's wall time,
+    :mod:`lvgym.agents.timing`) -> VecMonitor (episode returns) -> VecNormalize (new, or loaded from ``stats``)."""
     from stable_baselines3.common.vec_env import VecMonitor, VecNormalize
 
     import lvgym  # noqa: F401
     from lvgym.envs import make_sb3_vec_env
 
-    from agents.loop_dispersion import loop_venv
-    from agents.residual import residual_venv
-    from agents.timing import EnvClock
+    from lvgym.agents.loop_dispersion import loop_venv
+    from lvgym.agents.residual import residual_venv
+    from lvgym.agents.timing import EnvClock
 
     base = loop_venv(make_sb3_vec_env(env_id, num_envs=n_envs, seed=seed, **env_kwargs), loop, seed)
     venv = VecMonitor(EnvClock(residual_venv(base, residual)))
@@ -316,9 +316,9 @@ def make_venv(env_id: str, n_envs: int, seed: int, env_kwargs: dict[str, Any], n
 def prepare(args: Args, given: set[str]) -> tuple[Args, dict[str, Any], Path, bool]:
     """The run's arguments, its ``config.yaml`` content, its folder and whether it resumes: every option
     checked, nothing written (:func:`create_run` writes). Raises ConfigError or SystemExit (one line)."""
-    from agents.config import build_config, load_config, parse_overrides
-    from agents.loop_dispersion import loop_dispersion_options
-    from agents.residual import residual_options
+    from lvgym.agents.config import build_config, load_config, parse_overrides
+    from lvgym.agents.loop_dispersion import loop_dispersion_options
+    from lvgym.agents.residual import residual_options
 
     check_options(args)
     if args.resume:
@@ -376,7 +376,7 @@ def _resume_note(run_dir: Path, state: dict[str, Any] | None, target: int) -> st
 def train(argv: list[str] | None = None) -> Path:
     """Run (or resume) a training run; returns its folder. SIGTERM and SIGINT write a checkpoint and
     then exit with ``SystemExit(128 + signal)``."""
-    from agents.callbacks import SignalStop
+    from lvgym.agents.callbacks import SignalStop
 
     args, given = parse_args(argv)
     stop = SignalStop()
@@ -387,10 +387,10 @@ def train(argv: list[str] | None = None) -> Path:
 def _train(args: Args, given: set[str], stop: Any) -> Path:
     import torch
 
-    from agents.callbacks import (CheckpointCallback, ProgressBarCallback, ValidationEvaluator, clean_incomplete,
+    from lvgym.agents.callbacks import (CheckpointCallback, ProgressBarCallback, ValidationEvaluator, clean_incomplete,
                                   latest_checkpoint, load_replay_buffer, load_rng)
-    from agents.config import ALGOS, algo_class, build_config
-    from agents.policy import policy_files
+    from lvgym.agents.config import ALGOS, algo_class, build_config
+    from lvgym.agents.policy import policy_files
 
     try:                                             # everything checked before the run folder is made
         args, config, run_dir, resumed = prepare(args, given)

@@ -1,11 +1,11 @@
 """Learned TVC policies with stable-baselines3 (PPO, SAC, TD3) and sb3-contrib (RecurrentPPO) on the batched
 lvgym envs.
 
-- :mod:`agents.config`: per-env hyperparameters (``agents/hyperparams/<algo>.yaml``) as validated dataclasses;
-- :mod:`agents.callbacks`: crash-safe checkpoints, validation on the protocol's validation seeds, progress;
-- :mod:`agents.policy`: :class:`~agents.policy.SB3Policy`, a trained model behind the benchmark Policy interface;
-- :mod:`agents.residual`: residual policies on a classical baseline (training wrapper and adapter);
-- :mod:`agents.robustness`: the rigid-trained vs nonrigid-trained experiment.
+- :mod:`lvgym.agents.config`: per-env hyperparameters (``agents/hyperparams/<algo>.yaml``) as validated dataclasses;
+- :mod:`lvgym.agents.callbacks`: crash-safe checkpoints, validation on the protocol's validation seeds, progress;
+- :mod:`lvgym.agents.policy`: :class:`~lvgym.agents.policy.SB3Policy`, a trained model behind the benchmark Policy interface;
+- :mod:`lvgym.agents.residual`: residual policies on a classical baseline (training wrapper and adapter);
+- :mod:`experiments.rigid_vs_nonrigid_training.robustness`: the rigid-trained vs nonrigid-trained experiment.
 
 Training itself is ``train.py`` at the repository root (``docs/training.md``). Nothing in ``lvgym`` imports this
 package; importing it does not import stable-baselines3 (the submodules do).

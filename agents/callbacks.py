@@ -17,7 +17,7 @@ Checkpoints are taken at rollout boundaries (after a PPO update, before the next
 the optimiser, the step counter and the statistics agree. Validation (when due) runs at a checkpoint, on
 the checkpointed model, with the protocol's validation seeds; its result is part of the checkpoint's JSON,
 so the evaluation history and the best model are restored with it. ``best_model.*`` and ``final_model.*``
-next to ``checkpoints/`` are copies in the :mod:`agents.policy` layout (loadable by ``evaluate.py``).
+next to ``checkpoints/`` are copies in the :mod:`lvgym.agents.policy` layout (loadable by ``evaluate.py``).
 """
 
 from __future__ import annotations
@@ -266,12 +266,12 @@ class CheckpointCallback(BaseCallback):
         self.stop = stop
         self.wall0 = float(state.get("train_wall_s", 0.0))
         self.t_start = self.last_save_time = time.monotonic()
-        self.clock = None                            # the venv's EnvClock (agents.timing), found at the start
+        self.clock = None                            # the venv's EnvClock (lvgym.agents.timing), found at the start
         self.env0 = float(state.get("env_wall_s", 0.0))
         self.env_at_start = 0.0
 
     def _init_callback(self) -> None:
-        from agents.timing import find_clock
+        from lvgym.agents.timing import find_clock
 
         self.folder.mkdir(parents=True, exist_ok=True)
         self.t_start = self.last_save_time = time.monotonic()
@@ -294,7 +294,7 @@ class CheckpointCallback(BaseCallback):
         return self.wall0 + time.monotonic() - self.t_start
 
     def timing(self) -> dict[str, float]:
-        """``train_wall_s`` and, with an :class:`agents.timing.EnvClock` in the venv, ``env_wall_s`` [s]."""
+        """``train_wall_s`` and, with an :class:`lvgym.agents.timing.EnvClock` in the venv, ``env_wall_s`` [s]."""
         out = {"train_wall_s": round(self.train_wall_s(), 3)}
         if self.clock is not None:
             out["env_wall_s"] = round(self.env_wall_s(), 3)

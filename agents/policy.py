@@ -10,7 +10,7 @@ A saved policy is three files with one stem::
 ``evaluate.py`` loads saved models through :func:`load_policy`. :class:`SB3Policy` accepts such a ``.zip``, its stem, or a run folder of ``train.py`` (``runs/<name>``: its best model by
 validation, else its final model, else its last checkpoint).
 
-    python -m agents.policy export runs/ppo-smile agents/trained/ppo_smile_ascent   # copy a run's policy
+    python -m lvgym.agents.policy export runs/ppo-smile agents/trained/ppo_smile_ascent   # copy a run's policy
 """
 
 from __future__ import annotations
@@ -75,7 +75,7 @@ def resolve_model_path(path: str | Path) -> Path:
     model, its final model or its latest checkpoint (``FileNotFoundError`` otherwise)."""
     p = Path(path)
     if p.is_dir():
-        from agents.callbacks import latest_checkpoint
+        from lvgym.agents.callbacks import latest_checkpoint
 
         for stem in ("best_model", "final_model"):
             if (p / f"{stem}.zip").is_file() and (p / f"{stem}.json").is_file():
@@ -117,7 +117,7 @@ def _guess_algo(path: Path) -> str | None:
 def guess_and_load(path: str | Path) -> Any:
     """The SB3 model at ``path`` when no sidecar names its algorithm: the algorithm suggested by the
     policy class stored in the zip first, then every algorithm train.py trains
-    (:data:`agents.config.ALGOS`) in turn."""
+    (:data:`lvgym.agents.config.ALGOS`) in turn."""
     path = Path(path)
     if not path.is_file():
         raise FileNotFoundError(f"policy {str(path)!r}: no such SB3 model file")
@@ -335,8 +335,8 @@ def shipped_policy(name: str = "ppo", file: str = "ppo_smile_ascent", env: Any =
 
 def load_policy(path: str | Path, name: str | None = None, env: Any = None) -> Any:
     """``SB3Policy(path, name)``, or for a run trained residual on a baseline (its sidecar's ``residual``)
-    the :class:`~agents.residual.ResidualPolicy` of it on that baseline, rebuilt on ``env``: a factory for
-    ``lvgym.benchmark.PolicySpec("...", "agents.policy:load_policy", (("path", ...),))``."""
+    the :class:`~lvgym.agents.residual.ResidualPolicy` of it on that baseline, rebuilt on ``env``: a factory for
+    ``lvgym.benchmark.PolicySpec("...", "lvgym.agents.policy:load_policy", (("path", ...),))``."""
     return adapt(SB3Policy(path, name), env)
 
 
@@ -368,8 +368,8 @@ def _export(args: argparse.Namespace) -> None:
 
 
 def main(argv: list[str] | None = None) -> None:
-    """``python -m agents.policy export RUN STEM``: copy a run's policy (best, else final, else latest)."""
-    p = argparse.ArgumentParser(prog="python -m agents.policy", description=main.__doc__)
+    """``python -m lvgym.agents.policy export RUN STEM``: copy a run's policy (best, else final, else latest)."""
+    p = argparse.ArgumentParser(prog="python -m lvgym.agents.policy", description=main.__doc__)
     sub = p.add_subparsers(dest="cmd", required=True)
     e = sub.add_parser("export", help="copy a run's policy to STEM.zip, STEM_vecnormalize.pkl, STEM.json")
     e.add_argument("run", help="run folder (runs/<name>) or a .zip")

@@ -2,7 +2,7 @@
 
 The action the env gets is ``clip(baseline(obs, info) + residual_scale * learned, -1, 1)``: the baseline's
 action (a policy of :data:`lvgym.benchmark.registry.POLICIES`, by default ``gs-pid-flex``, the PID
-designed on the non-rigid v1 flight loop, ``baselines.pid:smile_scheduled_pid`` with schedule
+designed on the non-rigid v1 flight loop, ``lvgym.baselines.pid:smile_scheduled_pid`` with schedule
 ``smile_flex``) plus the learned action in [-1, 1] scaled by ``residual_scale`` (gimbal units: a scale of
 0.2 lets the learned part move the gimbal by at most 20 % of its limit), clipped to the action space.
 So a learned policy that outputs zero flies the baseline's episode exactly.
@@ -10,7 +10,7 @@ So a learned policy that outputs zero flies the baseline's episode exactly.
 One code path for training and evaluation: :class:`ResidualRows` holds one baseline per env row and
 mixes the actions (:func:`combine`); :class:`ResidualVecEnv` (an SB3 ``VecEnvWrapper`` over the batched
 lvgym ``VecEnv``, what ``train.py --residual`` trains on), :class:`ResidualEnv` (a Gymnasium wrapper of a
-single env) and :class:`ResidualPolicy` (the saved policy's adapter, :func:`agents.policy.load_policy`)
+single env) and :class:`ResidualPolicy` (the saved policy's adapter, :func:`lvgym.agents.policy.load_policy`)
 all use it. The baseline sees the env's own observation (with ``history`` it reads the newest sample by
 name); the learned policy sees the same observation.
 """
@@ -88,7 +88,7 @@ def combine(base: np.ndarray, learned: np.ndarray, scale: float) -> np.ndarray:
 class ResidualRows:
     """One baseline per env row (built by its registry factory on ``env``, a single or batched lvgym env)
     and the baseline action of each row for its coming step (:attr:`base`, (rows, n_a) float32). A baseline
-    whose policy has ``batch(n)`` (``lqg``: :class:`baselines.lqg.LQGBatch`) flies every row in one object,
+    whose policy has ``batch(n)`` (``lqg``: :class:`lvgym.baselines.lqg.LQGBatch`) flies every row in one object,
     stepped together; the others, one policy per row."""
 
     def __init__(self, config: ResidualConfig, env: Any, rows: int) -> None:
@@ -172,7 +172,7 @@ class ResidualEnv(gym.Wrapper):
 class ResidualPolicy:
     """A learned policy on a baseline, as a benchmark Policy: ``act`` returns ``baseline + scale *
     learned`` (:class:`ResidualRows`, one row, built on ``env``). ``learned``: a Policy whose actions are
-    the residual's (an :class:`agents.policy.SB3Policy`); if it has ``note_applied``, it is told the action
+    the residual's (an :class:`lvgym.agents.policy.SB3Policy`); if it has ``note_applied``, it is told the action
     the env gets (its observation history records that one, as the env's does)."""
 
     def __init__(self, learned: Any, config: ResidualConfig, env: Any, name: str | None = None) -> None:

@@ -228,7 +228,7 @@ class AdaptiveGainLaw:
 
 class AdaptiveAugmentingPolicy:
     """AAC around a PID-type baseline policy ``base`` (a benchmark Policy with ``last_gimbal`` [rad] per
-    axis after ``act``, ``dt`` [s] and ``limit`` [rad], as :class:`baselines.pid.PIDPolicy` and its
+    axis after ``act``, ``dt`` [s] and ``limit`` [rad], as :class:`lvgym.baselines.pid.PIDPolicy` and its
     subclasses): the base flies as designed and its command is multiplied by ``k_T`` per axis.
 
     ``env``: the lvgym env (its observation layout: ``pitch_rate_error``, ``yaw_rate_error``,
@@ -295,7 +295,7 @@ def smile_aac(env: Any, schedule: str = "smile", name: str = "aac", record: bool
               **params: Any) -> AdaptiveAugmentingPolicy:
     """AAC on the gain-scheduled PID of ``baselines/schedules/<schedule>.yaml`` (``gs-pid``: ``smile``)
     flying ``env``; keywords of :class:`AACParams` override the defaults. One PolicySpec line wires it:
-    ``PolicySpec("aac", "baselines.aac:smile_aac", (("name", "aac"), ("schedule", "smile")))``."""
+    ``PolicySpec("aac", "lvgym.baselines.aac:smile_aac", (("name", "aac"), ("schedule", "smile")))``."""
     _check_keywords(params)
     base = smile_scheduled_pid(env, schedule, name=f"gs-pid-{schedule}")
     return AdaptiveAugmentingPolicy(base, env=env, params=AACParams(**params), name=name, record=record)

@@ -21,8 +21,8 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, fields
+from typing import Any
 
-import control
 import numpy as np
 
 __all__ = ["StructuralFilter", "FilterChain", "FILTER_KEYS"]
@@ -86,8 +86,11 @@ class StructuralFilter:
             out.append((bz / az[0], az / az[0]))
         return out
 
-    def tf(self, dt: float) -> control.TransferFunction:
-        """The discrete filter chain as a python-control transfer function at ``dt`` [s]."""
+    def tf(self, dt: float) -> Any:
+        """The discrete filter chain as a python-control transfer function at ``dt`` [s] (a design tool's
+        view: needs python-control, ``pip install 'lvgym[control]'``; flying the filter does not)."""
+        import control
+
         g = control.tf([1.0], [1.0], dt)
         for b, a in self.discrete(dt):
             g = g * control.tf(b, a, dt)

@@ -1,6 +1,6 @@
 """LQG rate control of pitch and yaw, scheduled over the flight, as a benchmark policy.
 
-The compensators are designed by :mod:`.lqg_design` (``python -m baselines.lqg_design --vehicle smile``)
+The compensators are designed by :mod:`.lqg_design` (``python -m lvgym.baselines.design.lqg_design --vehicle smile``)
 on the flight computer's non-rigid plant at frozen flight times (the rows of
 ``baselines/schedules/smile_lqg.npz``). Per plane and control period (the design's law, with the gyro
 sample ``y`` [rad/s] the observation's rate error, ``rate - reference``)::
@@ -121,7 +121,7 @@ class LQGSchedule:
             p = SCHEDULES / (str(path) if str(path).endswith(".npz") else f"{path}.npz")
         if not p.exists():
             raise FileNotFoundError(f"LQG schedule {str(path)!r}: no such file (nor {p}); write one with "
-                                    "`python -m baselines.lqg_design --vehicle smile` (--overwrite to ship it)")
+                                    "`python -m lvgym.baselines.design.lqg_design --vehicle smile` (--overwrite to ship it)")
         return read_once(p, cls._read, "LQGSchedule")              # read once per process
 
     @classmethod
@@ -234,7 +234,7 @@ class LQGPolicy:
 class LQGBatch:
     """``n`` independent copies of an :class:`LQGPolicy` (one per env row), stepped together: ``act(rows,
     observations, infos)`` gives the actions of the rows ``rows`` (an :class:`LQGPolicy` per row would give
-    the same, each in its own Python call; ``agents.residual`` uses this for a residual's baselines)."""
+    the same, each in its own Python call; ``lvgym.agents.residual`` uses this for a residual's baselines)."""
 
     def __init__(self, policy: LQGPolicy, n: int) -> None:
         self.name, self.limit = policy.name, policy.limit

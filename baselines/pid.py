@@ -375,7 +375,7 @@ def smile_scheduled_pid(env: Any, schedule: str = "smile_thesis", name: str | No
     return GainScheduledPIDPolicy(schedule, env=env, name=name or f"gs-pid-{schedule}")
 
 
-#: the gs-pid-flex schedule (``baselines/schedules/<name>.yaml``, written by ``python -m baselines.flexdesign``)
+#: the gs-pid-flex schedule (``baselines/schedules/<name>.yaml``, written by ``python -m lvgym.baselines.design.flexdesign``)
 #: of each vehicle a v1 env flies, keyed by the env's ``task.vehicle`` (a name, or the slender vehicle's key
 #: tuple: ``SlenderAscent-v1``'s default 8.5 m x 0.2833 m, 4.5 mm tube, with load relief; docs/flex-design.md)
 FLEX_SCHEDULES: dict = {"smile_v1": "smile_flex", "stratos3": "stratos3_flex",
@@ -388,7 +388,7 @@ def flex_pid(env: Any, name: str = "gs-pid-flex") -> GainScheduledPIDPolicy:
     vehicle = getattr(env.unwrapped.task, "vehicle", None)
     if not isinstance(vehicle, (str, tuple)) or vehicle not in FLEX_SCHEDULES:
         raise ConfigError("env vehicle", vehicle, f"one of {list(FLEX_SCHEDULES)}: the vehicles of a v1 env "
-                          "with a gs-pid-flex schedule (python -m baselines.flexdesign --vehicle ...)")
+                          "with a gs-pid-flex schedule (python -m lvgym.baselines.design.flexdesign --vehicle ...)")
     return GainScheduledPIDPolicy(FLEX_SCHEDULES[vehicle], env=env, name=name)
 
 

@@ -1,5 +1,5 @@
-"""The old name of :mod:`baselines`, kept so that ``baselines_pid.*`` imports and ``python -m
-baselines_pid.tune`` keep working; new code imports :mod:`baselines`."""
+"""The old name of :mod:`lvgym.baselines`, kept in the repository (not installed) so that a checkout's
+``baselines_pid.*`` imports keep working; new code imports :mod:`lvgym.baselines`."""
 
-from baselines import *  # noqa: F401,F403
-from baselines import __all__  # noqa: F401
+from lvgym.baselines import *  # noqa: F401,F403
+from lvgym.baselines import __all__  # noqa: F401

@@ -1,3 +1,4 @@
-"""The old name of :mod:`baselines.bangbang` (the package is ``baselines`` since it holds more than PID loops)."""
+"""The old name of :mod:`lvgym.baselines.bangbang`, kept in the repository (not installed) so that a checkout's
+``baselines_pid.*`` imports keep working; new code imports :mod:`lvgym.baselines.bangbang`."""
 
-from baselines.bangbang import *  # noqa: F401,F403
+from lvgym.baselines.bangbang import *  # noqa: F401,F403

@@ -1,3 +1,4 @@
-"""The old name of :mod:`baselines.linearize` (the package is ``baselines`` since it holds more than PID loops)."""
+"""The old name of :mod:`lvgym.baselines.design.linearize`, kept in the repository (not installed) so that a
+checkout's ``baselines_pid.*`` imports keep working; new code imports :mod:`lvgym.baselines.design.linearize`."""
 
-from baselines.linearize import *  # noqa: F401,F403
+from lvgym.baselines.design.linearize import *  # noqa: F401,F403

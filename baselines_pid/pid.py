@@ -1,3 +1,4 @@
-"""The old name of :mod:`baselines.pid` (the package is ``baselines`` since it holds more than PID loops)."""
+"""The old name of :mod:`lvgym.baselines.pid`, kept in the repository (not installed) so that a checkout's
+``baselines_pid.*`` imports keep working; new code imports :mod:`lvgym.baselines.pid`."""
 
-from baselines.pid import *  # noqa: F401,F403
+from lvgym.baselines.pid import *  # noqa: F401,F403

@@ -10,9 +10,9 @@ import numpy as np
 import pytest
 
 import lvgym  # noqa: F401
-from baselines.aac import (FLEX_AAC, AACParams, AdaptiveAugmentingPolicy, AdaptiveGainLaw, FirstOrderFilter, flex_aac,
+from lvgym.baselines.aac import (FLEX_AAC, AACParams, AdaptiveAugmentingPolicy, AdaptiveGainLaw, FirstOrderFilter, flex_aac,
                           smile_aac)
-from baselines.pid import FLEX_SCHEDULES, flex_pid
+from lvgym.baselines.pid import FLEX_SCHEDULES, flex_pid
 from lvgym.benchmark.policy import Policy
 from lvgym.envs.layouts import OBS_FLIGHT
 from lvgym.errors import ConfigError
@@ -260,7 +260,7 @@ def test_flex_policies_follow_the_envs_vehicle(v1_rigid):
 def test_aac_sweep_variants_and_the_scaled_base():
     """The tuning command's variants are AACParams keywords (a typo is a ConfigError naming it), 'none' is
     the base alone, and a scaled base scales both its action and the ``last_gimbal`` the law reads."""
-    from baselines.aac_sweep import ScaledBase, parse_variant
+    from experiments.aac_tuning.aac_sweep import ScaledBase, parse_variant
     from lvgym.errors import ConfigError
 
     assert parse_variant("none") is None

@@ -20,9 +20,9 @@ import pytest
 import torch
 
 import lvgym  # noqa: F401
-from agents.callbacks import latest_checkpoint, list_checkpoints
-from agents.config import ALGOS, load_config, read_entries
-from agents.policy import SB3Policy, load_model
+from lvgym.agents.callbacks import latest_checkpoint, list_checkpoints
+from lvgym.agents.config import ALGOS, load_config, read_entries
+from lvgym.agents.policy import SB3Policy, load_model
 from lvgym.benchmark.policy import Policy
 from lvgym.errors import ConfigError
 
@@ -131,7 +131,7 @@ def test_train_saves_resumes_and_reloads_as_a_policy(tmp_path):
     assert steps[:len(state0["evaluations"])] == [e["num_timesteps"] for e in state0["evaluations"]]
     assert steps == sorted(set(steps))
     assert json.loads((run / "final_model.json").read_text())["num_timesteps"] == s1
-    # where the wall time went (agents.timing): the env's seconds within the run's, carried across the resume
+    # where the wall time went (lvgym.agents.timing): the env's seconds within the run's, carried across the resume
     for state in (state0, state1):
         assert 0.0 < state["env_wall_s"] < state["train_wall_s"]
     assert state1["env_wall_s"] > state0["env_wall_s"] and state1["train_wall_s"] > state0["train_wall_s"]
@@ -215,7 +215,7 @@ def test_resume_refuses_arguments_that_would_change_the_run(tmp_path):
 
 
 def test_shipped_checkpoint_loads_and_acts():
-    from agents.policy import shipped_policy
+    from lvgym.agents.policy import shipped_policy
 
     assert SHIPPED.is_file(), f"the shipped checkpoint {SHIPPED.relative_to(ROOT)} is missing"
     policy = shipped_policy()
@@ -233,7 +233,7 @@ def test_shipped_checkpoint_loads_and_acts():
 
 
 def test_validation_selects_on_the_training_model_or_on_every_condition():
-    from agents.callbacks import ValidationEvaluator
+    from lvgym.agents.callbacks import ValidationEvaluator
 
     names = {m: ValidationEvaluator("smile-windy", 1, select_on=m).selected for m in ("rigid", "nonrigid", "flex", None)}
     assert names["rigid"] == ["smile-windy/rigid"] and names["nonrigid"] == ["smile-windy/nonrigid"]
@@ -243,7 +243,7 @@ def test_validation_selects_on_the_training_model_or_on_every_condition():
 def test_validation_ranks_on_failure_rate_then_the_failure_charged_score():
     """Two policies with equal failure rates: the one whose failures come late has the smaller rate error
     (its integral stops at the failure) but the larger failure-charged score; selection takes the score."""
-    from agents.callbacks import ValidationEvaluator
+    from lvgym.agents.callbacks import ValidationEvaluator
 
     ev = ValidationEvaluator("smile-windy", 2, select_on="nonrigid")
     table = {"early": [(True, 0.5, 3.5), (False, 1.0, 1.0)], "late": [(True, 0.9, 1.4), (False, 1.0, 1.0)]}
@@ -279,7 +279,7 @@ def test_validation_ranks_on_failure_rate_then_the_failure_charged_score():
 def test_the_fast_action_path_equals_predict():
     """SB3Policy.act skips model.predict's per-call checks for a flat Box observation; the action must be
     exactly predict's."""
-    from agents.policy import shipped_policy
+    from lvgym.agents.policy import shipped_policy
     p = shipped_policy()
     assert p._fast_path() is not None
     rng = np.random.default_rng(3)

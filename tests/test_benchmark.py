@@ -303,14 +303,14 @@ def tiny_sb3(tmp_path_factory):
 
 
 def test_sb3_model_acts_as_a_policy(tiny_sb3):
-    from agents.policy import SB3Policy
+    from lvgym.agents.policy import SB3Policy
 
     p = SB3Policy(str(tiny_sb3))
     assert p.name == "tiny" and p.normalizer is not None
     p.reset()
     a = p.act(np.zeros(14, dtype=np.float32), {})
     assert a.shape == (2,) and np.all(np.abs(a) <= 1.0)
-    spec = PolicySpec("tiny", "agents.policy:load_policy", (("path", str(tiny_sb3)),))
+    spec = PolicySpec("tiny", "lvgym.agents.policy:load_policy", (("path", str(tiny_sb3)),))
     r = run_episode(spec, short_suite().conditions[0], 10_000)
     assert r["policy"] == "tiny" and r["duration_s"] == pytest.approx(SHORT)
 
@@ -365,7 +365,7 @@ def test_v0_effort_metric_stays_the_sampled_one():
     the frozen v0 metric keeps its definition; protocol v1 reads the env's integral."""
     import gymnasium as gym
 
-    from baselines.pid import smile_tuned_pid
+    from lvgym.baselines.pid import smile_tuned_pid
     from lvgym.benchmark.runner import play_episode
     env = gym.make("lvgym/SmileAscent-v0", model="nonrigid", wind="turbulence", randomize=["wind"],
                    mission_time_s=20.0)

@@ -1,4 +1,4 @@
-"""The error budget (lvgym.benchmark.budget): the variants by hand, the shares against hand numbers, and a short
+"""The error budget (experiments.error_budget.budget): the variants by hand, the shares against hand numbers, and a short
 flight whose nominal row equals the runner's episodes of the same condition."""
 
 from __future__ import annotations
@@ -127,7 +127,7 @@ def test_short_budget_matches_the_runner(tmp_path):
     (["--models", "wobbly"], "--models wobbly: suite 'smile-v1' has ['nonrigid', 'rigid']"),
 ])
 def test_command_line_errors_are_one_line(args, message):
-    out = subprocess.run([sys.executable, "-m", "lvgym.benchmark.budget", *args, "--no-progress"],
+    out = subprocess.run([sys.executable, "-m", "experiments.error_budget.budget", *args, "--no-progress"],
                          capture_output=True, text=True, timeout=120)
     assert out.returncode != 0
     lines = out.stderr.strip().splitlines()

@@ -1,5 +1,5 @@
 """Command-line values are checked before any worker starts, in one line naming the option, the value and
-what is allowed (issue 19): evaluate.py, ``python -m lvgym.studies``, ``python -m baselines.tune``;
+what is allowed (issue 19): evaluate.py, ``python -m lvgym.studies``, ``python -m lvgym.baselines.design.tune``;
 and the tuning command never overwrites a shipped gain schedule unless asked."""
 
 from __future__ import annotations
@@ -88,8 +88,8 @@ def test_study_values_are_checked_in_the_library_too():
 
 # ------------------------------------------------------------------------------------------ tuning
 def test_tune_never_overwrites_a_shipped_schedule_unless_asked(tmp_path, capsys):
-    from baselines import tune
-    from baselines.pid import SCHEDULES
+    from lvgym.baselines import tune
+    from lvgym.baselines.pid import SCHEDULES
 
     shipped = SCHEDULES / "smile.yaml"
     before = shipped.read_bytes()
@@ -108,7 +108,7 @@ def test_tune_never_overwrites_a_shipped_schedule_unless_asked(tmp_path, capsys)
 def test_tune_writes_where_it_is_told(tmp_path, capsys):
     import yaml
 
-    from baselines import tune
+    from lvgym.baselines import tune
 
     out = tmp_path / "tuned" / "smile.yaml"
     assert tune.main(["--vehicle", "smile", "--times", "28.8", "--out", str(out)]) == 0

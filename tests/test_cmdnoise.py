@@ -1,5 +1,5 @@
 """The gimbal rate the gyro's noise commands through a policy, measured in the nonlinear simulation
-(lvgym.benchmark.cmdnoise), against the linear loop's value (baselines.noise) and for the zero policy."""
+(experiments.command_noise.cmdnoise), against the linear loop's value (lvgym.baselines.design.noise) and for the zero policy."""
 
 import math
 import warnings
@@ -8,10 +8,10 @@ import control
 import numpy as np
 import pytest
 
-from baselines.filters import StructuralFilter
-from baselines.flexdesign import controller_tf, row_plants
-from baselines.noise import command_noise_rate
-from baselines.pid import GainSchedule
+from lvgym.baselines.filters import StructuralFilter
+from lvgym.baselines.design.flexdesign import controller_tf, row_plants
+from lvgym.baselines.design.noise import command_noise_rate
+from lvgym.baselines.pid import GainSchedule
 from lvgym.benchmark import cmdnoise
 from lvgym.benchmark.registry import POLICIES
 from lvgym.benchmark.suites import get_suite
@@ -33,7 +33,7 @@ def test_zero_policy_commands_no_rate_and_the_table_says_so():
 def test_gs_pid_flex_noise_in_flight_is_the_linear_loops():
     """Over 7-12 s the shipped gs-pid-flex flies its 10 s row (stretch 6.5-12.5 s): the RMS of the
     gimbal rate its command's response to the gyro noise asks for, flown (two validation seeds, both
-    axes), against baselines.noise.command_noise_rate of that row on the rigid pitch plant at 10 s, within
+    axes), against lvgym.baselines.design.noise.command_noise_rate of that row on the rigid pitch plant at 10 s, within
     15 % (250 samples per axis and seed)."""
     sched = GainSchedule.load("smile_flex")
     r = min(sched.meta["rows"], key=lambda r: abs(r["time_s"] - 10.0))

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 import lvgym  # noqa: F401
-from baselines.pid import smile_scheduled_pid
+from lvgym.baselines.pid import smile_scheduled_pid
 from lvgym.envs.coast import DAMPING, coast_moment
 from lvgym.errors import ConfigError
 from lvgym.simulator.layouts import CONTEXT

@@ -1,4 +1,4 @@
-"""``python -m agents.curves``: learning curves against wall time from run folders (hand-made folders here:
+"""``python -m experiments.training_speed.curves``: learning curves against wall time from run folders (hand-made folders here:
 the fields are the ones CheckpointCallback writes, test_agents.py checks that it writes them)."""
 
 from __future__ import annotations
@@ -8,7 +8,7 @@ import math
 
 import pytest
 
-from agents import curves
+from lvgym.agents import curves
 
 
 def _condition(score: float, failures: float = 0.0) -> dict:

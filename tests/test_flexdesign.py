@@ -1,5 +1,5 @@
 """gs-pid-flex: the structural filters, the filtered scheduled PID and its design on the v1 flight loop
-(baselines.filters, baselines.pid, baselines.flexdesign)."""
+(lvgym.baselines.filters, lvgym.baselines.pid, lvgym.baselines.design.flexdesign)."""
 
 import math
 import warnings
@@ -10,10 +10,10 @@ import numpy as np
 import pytest
 
 import lvgym  # noqa: F401
-from baselines import flexdesign as FD
-from baselines import linearize as L
-from baselines.filters import FilterChain, StructuralFilter
-from baselines.pid import SCHEDULES, GainSchedule, GainScheduledPIDPolicy
+from lvgym.baselines import flexdesign as FD
+from lvgym.baselines import linearize as L
+from lvgym.baselines.filters import FilterChain, StructuralFilter
+from lvgym.baselines.pid import SCHEDULES, GainSchedule, GainScheduledPIDPolicy
 
 DT = 0.02
 FILT = StructuralFilter(lead_zero_radps=5.0, lead_pole_radps=50.0, lowpass_radps=120.0, lowpass_damping=0.5,
@@ -81,7 +81,7 @@ def test_schedule_with_filters_interpolates_them():
 
 def test_policy_law_is_the_designed_controller():
     """The gimbal the filtered scheduled PID commands from a sequence of rate errors equals the output
-    of C(z) = PID(z) F(z) (:func:`baselines.flexdesign.controller_tf`) for the same sequence."""
+    of C(z) = PID(z) F(z) (:func:`lvgym.baselines.design.flexdesign.controller_tf`) for the same sequence."""
     env = gym.make("lvgym/SmileAscent-v1")
     row = {"mass_kg": 6000.0, "kp": 0.3, "ki": 0.4, "kd": 0.01, "filter": FILT.as_dict()}
     pol = GainScheduledPIDPolicy(GainSchedule.from_dict({"variable": "mass", "rows": [row]}), env=env)
@@ -145,7 +145,7 @@ def row288():
 
 
 def test_grid_margins_agree_with_the_exact_ones(row288):
-    """The optimiser's margins read on its grid agree with :func:`baselines.linearize.margins` (a
+    """The optimiser's margins read on its grid agree with :func:`lvgym.baselines.design.linearize.margins` (a
     dense interpolated response) at the shipped 28.8 s row."""
     plants, modes, _ = row288
     sched = GainSchedule.load("smile_flex")
@@ -234,7 +234,7 @@ def test_gs_pid_flex_flies_the_nonrigid_v1_vehicle():
 def test_design_command_never_overwrites_the_shipped_schedule(tmp_path):
     from lvgym.errors import ConfigError
 
-    from baselines.tune import output_path
+    from lvgym.baselines.design.tune import output_path
 
     assert output_path("smile", None, False, stem="smile_flex").name == "smile_flex.yaml"
     assert output_path("smile", None, False, stem="smile_flex").parent != SCHEDULES
@@ -247,11 +247,11 @@ def test_design_command_never_overwrites_the_shipped_schedule(tmp_path):
 
 
 def test_the_noise_requirement_is_reported_and_held_when_asked(row288):
-    """check_loops reports the gimbal rate the gyro's noise commands on every loop (baselines.noise); by
+    """check_loops reports the gimbal rate the gyro's noise commands on every loop (lvgym.baselines.design.noise); by
     default it is not a requirement (the shipped 28.8 s row commands about six times the servo's rate limit
     from the noise, docs/flex-design.md), with ``noise_rate_fraction`` set it is one, and the design
     problem then penalises it (its violations get one more entry, positive here)."""
-    from baselines.noise import command_noise_rate
+    from lvgym.baselines.design.noise import command_noise_rate
 
     plants, modes, info = row288
     r = min(GainSchedule.load("smile_flex").meta["rows"], key=lambda r: abs(r["time_s"] - 28.8))

@@ -1,4 +1,4 @@
-"""The linear headroom study (baselines.headroom): the Dryden filter against the specification's spectrum, the
+"""The linear headroom study (experiments.lqg_headroom.headroom): the Dryden filter against the specification's spectrum, the
 delay margin against hand numbers, the shipped lqg row designed again, and the trade at the 10 s row."""
 
 from __future__ import annotations
@@ -10,7 +10,7 @@ import sys
 import numpy as np
 import pytest
 
-from baselines import headroom as hr
+from lvgym.baselines import headroom as hr
 from lvgym.environment.turbulence import dryden_psd
 
 
@@ -113,7 +113,7 @@ def test_full_grid():
 
 
 def test_command_line_refuses_a_time_that_is_not_a_row():
-    out = subprocess.run([sys.executable, "-m", "baselines.headroom", "--rows", "11"], capture_output=True, text=True,
+    out = subprocess.run([sys.executable, "-m", "experiments.lqg_headroom.headroom", "--rows", "11"], capture_output=True, text=True,
                          timeout=120)
     assert out.returncode != 0
     lines = out.stderr.strip().splitlines()
@@ -123,7 +123,7 @@ def test_command_line_refuses_a_time_that_is_not_a_row():
 def test_front_schedule_replaces_only_the_studied_row(row10, tmp_path):
     """The written schedule holds row 10's best design within -2 dB / 60 % in both planes and every other row
     as shipped; the lqg law flies it, and its boost differs from the shipped law's once the row is in use (6.5 s)."""
-    from baselines.lqg import LQGSchedule
+    from lvgym.baselines.lqg import LQGSchedule
     from lvgym.benchmark.runner import PolicySpec, run_episode
     from lvgym.benchmark.suites import get_suite
 
@@ -137,7 +137,7 @@ def test_front_schedule_replaces_only_the_studied_row(row10, tmp_path):
             assert same == (i != 1), (plane, i)                                 # row 1 is the 10 s row
             assert a.interval_s == b.interval_s
     cond = next(c for c in get_suite("smile-v1").conditions if c.model == "nonrigid").with_options(mission_time_s=8.0)
-    front = PolicySpec("lqg-front", "baselines.lqg:smile_lqg", (("name", "lqg-front"), ("schedule", str(path))))
-    shipped = PolicySpec("lqg", "baselines.lqg:smile_lqg", (("name", "lqg"),))
+    front = PolicySpec("lqg-front", "lvgym.baselines.lqg:smile_lqg", (("name", "lqg-front"), ("schedule", str(path))))
+    shipped = PolicySpec("lqg", "lvgym.baselines.lqg:smile_lqg", (("name", "lqg"),))
     a, b = run_episode(front, cond, 0), run_episode(shipped, cond, 0)
     assert a["rate_error_boost_rad"] != b["rate_error_boost_rad"] and not a["failed"]

@@ -15,7 +15,7 @@ import pytest
 
 import lvgym
 
-ON_TOP = ("agents", "baselines", "baselines_pid")         # controllers and agents sit on top of lvgym
+ON_TOP = ("lvgym.agents", "lvgym.baselines", "baselines_pid", "experiments")   # controllers and agents on top
 ABOVE_ALL = ("gymnasium", "stable_baselines3", "torch", "lvgym.envs", "lvgym.simulator", "lvgym.benchmark") + ON_TOP
 
 FORBIDDEN = {

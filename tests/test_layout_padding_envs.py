@@ -24,7 +24,7 @@ def fly_all() -> dict[str, np.ndarray]:
     import gymnasium as gym
 
     import lvgym  # noqa: F401
-    from baselines.pid import smile_scheduled_pid
+    from lvgym.baselines.pid import smile_scheduled_pid
 
     out: dict[str, np.ndarray] = {}
 
@@ -51,7 +51,7 @@ def fly_all() -> dict[str, np.ndarray]:
     flight = gym.make("lvgym/SmileAscent-v0", model="nonrigid", wind="turbulence", randomize=True,
                       observation="flight", mission_time_s=2.0)
     run("flight", flight, smile_scheduled_pid(flight, "smile"), 120)
-    from baselines.bangbang import BangBangRollPolicy
+    from lvgym.baselines.bangbang import BangBangRollPolicy
     run("stratos", gym.make("lvgym/StratosIII-v0", model="nonrigid", wind="profile", mission_time_s=2.0),
         BangBangRollPolicy(0.2), 120)
     slender = gym.make("lvgym/SlenderAscent-v0", model="nonrigid", wind="turbulence", randomize=True,

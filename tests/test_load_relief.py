@@ -1,7 +1,7 @@
-"""The load relief of the gain-scheduled PID (baselines.pid, ``accel_gain``), the slender vehicle's
+"""The load relief of the gain-scheduled PID (lvgym.baselines.pid, ``accel_gain``), the slender vehicle's
 gs-pid-flex schedule and its drift requirement against the q-alpha limit, the tube's structural q-alpha
-limit (baselines.structural_limit) and the linear-programme bound on the q-alpha of any gimbal history
-(baselines.loadbound)."""
+limit (experiments.aeroelastic_divergence.structural_limit) and the linear-programme bound on the q-alpha of any gimbal history
+(experiments.load_relief.loadbound)."""
 
 from __future__ import annotations
 
@@ -12,13 +12,13 @@ import numpy as np
 import pytest
 
 import lvgym  # noqa: F401
-from baselines import flexdesign as FD
-from baselines.divergence import Lift, free_free_beam
-from baselines.filters import StructuralFilter
-from baselines.loadbound import min_peak_qalpha
-from baselines.pid import ACCEL_SIGNS, FLEX_SCHEDULES, GainSchedule, GainScheduledPIDPolicy, flex_pid
-from baselines.qalpha_floor import fly, summary
-from baselines.structural_limit import bending_moment_per_qsa, buckling_stress_pa, qalpha_limit_pa_deg
+from lvgym.baselines import flexdesign as FD
+from experiments.aeroelastic_divergence.divergence import Lift, free_free_beam
+from lvgym.baselines.filters import StructuralFilter
+from experiments.load_relief.loadbound import min_peak_qalpha
+from lvgym.baselines.pid import ACCEL_SIGNS, FLEX_SCHEDULES, GainSchedule, GainScheduledPIDPolicy, flex_pid
+from experiments.load_relief.qalpha_floor import fly, summary
+from experiments.aeroelastic_divergence.structural_limit import bending_moment_per_qsa, buckling_stress_pa, qalpha_limit_pa_deg
 from lvgym.benchmark.registry import POLICIES
 from lvgym.benchmark.runner import PolicySpec
 from lvgym.benchmark.suites import get_suite
@@ -171,7 +171,7 @@ def test_the_drift_requirement_contradicts_the_qalpha_limit():
     assert all(0.5 < r["plain"]["ki"] < 0.8 for r in meta["rows"])
     suite = get_suite("slender-v1")
     seeds = suite.seeds("validation", 10)
-    plain = PolicySpec("plain", "baselines.pid:GainScheduledPIDPolicy", (("schedule", FD.plain_schedule(sched)),))
+    plain = PolicySpec("plain", "lvgym.baselines.pid:GainScheduledPIDPolicy", (("schedule", FD.plain_schedule(sched)),))
     for cond in suite.conditions:
         seed = {"rigid": seeds[5], "nonrigid": seeds[3]}[cond.model]
         held = summary(fly(plain, cond, seed))

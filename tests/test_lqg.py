@@ -1,4 +1,4 @@
-"""The LQG baseline (baselines.lqg_design, baselines.lqg): its plant, its margins, its law and its flight."""
+"""The LQG baseline (lvgym.baselines.design.lqg_design, lvgym.baselines.lqg): its plant, its margins, its law and its flight."""
 
 import warnings
 from dataclasses import fields
@@ -9,11 +9,11 @@ import numpy as np
 import pytest
 
 import lvgym  # noqa: F401
-from baselines import flightloop as F
-from baselines import linearize as L
-from baselines import lqg_design as D
-from baselines import lqg_row as R
-from baselines.lqg import LQGLaw, LQGPolicy, LQGRow, LQGSchedule, smile_lqg
+from lvgym.baselines import flightloop as F
+from lvgym.baselines import linearize as L
+from lvgym.baselines import lqg_design as D
+from lvgym.baselines import lqg_row as R
+from lvgym.baselines.lqg import LQGLaw, LQGPolicy, LQGRow, LQGSchedule, smile_lqg
 from lvgym.errors import ConfigError
 
 T0 = 28.8
@@ -59,7 +59,7 @@ def test_grid_margins_agree_with_linearize_margins_on_a_pid_loop(ops):
     rigid PID's 10-state loop: the same phase margin and crossover, the gain margin within 0.1 dB
     (the polynomial method's root finding is the less accurate: |L| at its phase crossover is 0.920,
     0.73 dB), the same closed-loop verdict."""
-    from baselines import charts
+    from lvgym.baselines import charts
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")

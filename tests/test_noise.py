@@ -1,4 +1,4 @@
-"""The gimbal rate the flight gyro's noise commands on the linear loop (baselines.noise), against hand
+"""The gimbal rate the flight gyro's noise commands on the linear loop (lvgym.baselines.design.noise), against hand
 numbers."""
 
 import math
@@ -7,8 +7,8 @@ import control
 import numpy as np
 import pytest
 
-from baselines.linearize import operating_point
-from baselines.noise import command_noise_rate, gyro_noise, noise_rate_on_grid
+from lvgym.baselines.design.linearize import operating_point
+from lvgym.baselines.design.noise import command_noise_rate, gyro_noise, noise_rate_on_grid
 
 DT = 0.02
 SIGMA = 3e-4                   # rad/s per sample

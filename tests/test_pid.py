@@ -9,10 +9,10 @@ import numpy as np
 import pytest
 
 import lvgym  # noqa: F401
-from baselines import linearize as lin
-from baselines import tune
-from baselines.bangbang import NEGATIVE, NONE, POSITIVE, BangBangRollPolicy
-from baselines.pid import DiscretePID, GainSchedule, GainScheduledPIDPolicy, PIDPolicy, smile_scheduled_pid
+from lvgym.baselines import linearize as lin
+from lvgym.baselines import tune
+from lvgym.baselines.bangbang import NEGATIVE, NONE, POSITIVE, BangBangRollPolicy
+from lvgym.baselines.pid import DiscretePID, GainSchedule, GainScheduledPIDPolicy, PIDPolicy, smile_scheduled_pid
 from lvgym.benchmark.policy import Policy, ZeroPolicy
 
 
@@ -180,11 +180,11 @@ def test_closed_loop_pid_beats_zero_under_wind():
 
 def test_old_package_name_still_works():
     """``baselines_pid`` (the package's old name) gives the same classes as ``baselines``."""
-    import baselines
+    import lvgym.baselines
     import baselines_pid
-    import baselines_pid.pid
-    import baselines_pid.tune
+    import lvgym.baselines.pid
+    import lvgym.baselines.design.tune
 
     assert baselines_pid.GainScheduledPIDPolicy is baselines.GainScheduledPIDPolicy
-    assert baselines_pid.pid.GainSchedule is baselines.pid.GainSchedule
-    assert baselines_pid.tune.main is baselines.tune.main
+    assert lvgym.baselines.pid.GainSchedule is lvgym.baselines.pid.GainSchedule
+    assert lvgym.baselines.design.tune.main is lvgym.baselines.design.tune.main

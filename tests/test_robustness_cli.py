@@ -1,11 +1,11 @@
-"""``python -m agents.robustness``: the commands of the rigid-trained against non-rigid-trained experiment
+"""``python -m experiments.rigid_vs_nonrigid_training.robustness``: the commands of the rigid-trained against non-rigid-trained experiment
 (no training here: the commands are what the experiment runs, checked by ``--dry-run``'s list)."""
 
 from __future__ import annotations
 
 from argparse import Namespace
 
-from agents import robustness
+from lvgym.agents import robustness
 
 
 def _args(**kw) -> Namespace:

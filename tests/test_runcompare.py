@@ -1,4 +1,4 @@
-"""Agents compared over training runs across results folders (lvgym.benchmark.runcompare), against hand numbers."""
+"""Agents compared over training runs across results folders (experiments.training_configurations.runcompare), against hand numbers."""
 
 from __future__ import annotations
 
@@ -80,12 +80,12 @@ def test_bad_inputs_name_what_is_allowed(tmp_path):
 
 def test_command_line(tmp_path):
     a = write(tmp_path / "a", {"x-s0": [1.0, 2.0], "x-s1": [1.5, 2.5], "lqg": [3.0, 3.0]})
-    run = subprocess.run([sys.executable, "-m", "lvgym.benchmark.runcompare", str(a), "--condition", "nonrigid",
+    run = subprocess.run([sys.executable, "-m", "experiments.training_configurations.runcompare", str(a), "--condition", "nonrigid",
                           "--reps", "100"], capture_output=True, text=True, timeout=300)
     assert run.returncode == 0, run.stderr
     assert "| smile-v1 | smile-v1/nonrigid | x | 2 | 2 |" in run.stdout
     assert "| smile-v1 | smile-v1/nonrigid | x | lqg | 1.000 [1.000, 1.000] |" in run.stdout
-    bad = subprocess.run([sys.executable, "-m", "lvgym.benchmark.runcompare", str(tmp_path / "nope")],
+    bad = subprocess.run([sys.executable, "-m", "experiments.training_configurations.runcompare", str(tmp_path / "nope")],
                          capture_output=True, text=True, timeout=300)
     assert bad.returncode == 1
     assert bad.stderr.strip().count("\n") == 0 and "episodes.csv" in bad.stderr

@@ -1,4 +1,4 @@
-"""The slender vehicle's aeroelastic static instability: an independent model (baselines/divergence.py:
+"""The slender vehicle's aeroelastic static instability: an independent model (experiments/aeroelastic_divergence/divergence.py:
 own free-free beam, own nose lift and incidence, lvgym's Barrowman fin numbers only) against lvgym's
 linearised SlenderAscent-v1 plant (docs/aerodynamics.md, "Independent check of the divergence").
 
@@ -12,7 +12,7 @@ kPa without the compression and 475 kPa with aerodynamics alone. Growth rates [1
 import numpy as np
 import pytest
 
-from baselines import divergence as dv
+from lvgym.baselines import divergence as dv
 
 
 @pytest.fixture(scope="module")

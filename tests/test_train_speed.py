@@ -1,8 +1,8 @@
-"""agents.train_speed: throughput read from a run's progress table, by hand."""
+"""experiments.training_speed.train_speed: throughput read from a run's progress table, by hand."""
 
 import pytest
 
-from agents.train_speed import speed_table, throughput
+from experiments.training_speed.train_speed import speed_table, throughput
 
 HEADER = "time/time_elapsed,time/fps,time/total_timesteps,time/train_wall_s,time/iterations,time/env_share\n"
 

@@ -1,4 +1,4 @@
-"""Uncontrolled flights, rigid against nonrigid (lvgym.verify.uncontrolled; docs/uncontrolled.md).
+"""Uncontrolled flights, rigid against nonrigid (experiments.uncontrolled_departures.uncontrolled; docs/uncontrolled.md).
 
 The margins are measured (docs/uncontrolled.md has the tables). What they say:
 - Stratos III as shipped does NOT depart at the thrust drop, rigid or nonrigid: its N2O slosh mass is
@@ -110,7 +110,7 @@ def test_stratos3_thesis_thrust_law_no_body_departure_before_drag_wins():
 def test_smile_slosh_modes_stable_at_max_q_even_undamped():
     """Linearised at max q (28.8 s, thesis) with every slosh damping set to zero, SMILE's only unstable
     pole is the rigid flight-path drift; the slosh modes keep a small aerodynamic damping."""
-    from baselines import linearize as L
+    from lvgym.baselines import linearize as L
 
     op = L.operating_point("smile", 28.8, "nonrigid")
     lay = op.sim.layout

@@ -25,7 +25,7 @@ _ci_high                reference (0.5: neither is better), with its interval
 ======================  ===========================================================================
 
 :func:`run_groups` aggregates policies that are training runs of one agent (labels ``<agent>-s<seed>``,
-as ``agents.robustness`` names them): rliable's IQM over the ``(runs, episodes)`` matrix.
+as ``experiments.rigid_vs_nonrigid_training.robustness`` names them): rliable's IQM over the ``(runs, episodes)`` matrix.
 """
 
 from __future__ import annotations
@@ -95,9 +95,9 @@ def run_groups(records: Sequence[dict[str, Any]], metric: str = "score",
     for suite, cond, pol in values:
         m = RUN_LABEL.match(pol)
         if m:
-            agents.setdefault((suite, cond, m.group("agent")), []).append(pol)
+            lvgym.agents.setdefault((suite, cond, m.group("agent")), []).append(pol)
     out = []
-    for (suite, cond, agent), pols in agents.items():
+    for (suite, cond, agent), pols in lvgym.agents.items():
         if len(pols) < 2:
             continue
         common = sorted(set.intersection(*(set(values[(suite, cond, p)]) for p in pols)))

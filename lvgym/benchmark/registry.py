@@ -3,7 +3,7 @@ lvgym.benchmark.margins``, ``... budget``), how a name or a saved model's path b
 :class:`~.runner.PolicySpec`, and the options and checks those commands share (:func:`flight_parser`,
 :func:`resolve_flights`).
 
-A spec holds an import path as a string (``"baselines.pid:smile_tuned_pid"``); the factory is imported in
+A spec holds an import path as a string (``"lvgym.baselines.pid:smile_tuned_pid"``); the factory is imported in
 the worker that flies the policy, so this module imports neither ``baselines`` nor ``agents`` (the layers
 of DESIGN.md: the benchmark sits below the controllers and the agents).
 """
@@ -26,28 +26,28 @@ __all__ = ["POLICIES", "flight_parser", "resolve_flights", "resolve_policy"]
 #: policy names -> how a worker builds them (factories are imported lazily, in the workers)
 POLICIES: dict[str, PolicySpec] = {
     "zero": ZERO,
-    # our tuning on the rigid linearisation (baselines.tune): one gain set, and the schedule on mass
-    "pid": PolicySpec("pid", "baselines.pid:smile_tuned_pid"),
-    "gs-pid": PolicySpec("gs-pid", "baselines.pid:smile_scheduled_pid", (("name", "gs-pid"), ("schedule", "smile"))),
-    # designed on the non-rigid v1 flight loop (baselines.flexdesign, docs/flex-design.md): structural
-    # filters and gains scheduled on mass, the schedule of the env's vehicle (baselines.pid.FLEX_SCHEDULES)
-    "gs-pid-flex": PolicySpec("gs-pid-flex", "baselines.pid:flex_pid", (("name", "gs-pid-flex"),)),
-    # adaptive augmenting control on gs-pid-flex (baselines.aac, docs/adaptive-control.md)
-    "aac": PolicySpec("aac", "baselines.aac:flex_aac", (("name", "aac"),)),
+    # our tuning on the rigid linearisation (lvgym.baselines.design.tune): one gain set, and the schedule on mass
+    "pid": PolicySpec("pid", "lvgym.baselines.pid:smile_tuned_pid"),
+    "gs-pid": PolicySpec("gs-pid", "lvgym.baselines.pid:smile_scheduled_pid", (("name", "gs-pid"), ("schedule", "smile"))),
+    # designed on the non-rigid v1 flight loop (lvgym.baselines.design.flexdesign, docs/flex-design.md): structural
+    # filters and gains scheduled on mass, the schedule of the env's vehicle (lvgym.baselines.pid.FLEX_SCHEDULES)
+    "gs-pid-flex": PolicySpec("gs-pid-flex", "lvgym.baselines.pid:flex_pid", (("name", "gs-pid-flex"),)),
+    # adaptive augmenting control on gs-pid-flex (lvgym.baselines.aac, docs/adaptive-control.md)
+    "aac": PolicySpec("aac", "lvgym.baselines.aac:flex_aac", (("name", "aac"),)),
     # the thesis's gains (6.3.1) and its Table 6.10 schedule, as published
-    "pid-thesis": PolicySpec("pid-thesis", "baselines.pid:smile_single_pid"),
-    "gs-pid-thesis": PolicySpec("gs-pid-thesis", "baselines.pid:smile_scheduled_pid",
+    "pid-thesis": PolicySpec("pid-thesis", "lvgym.baselines.pid:smile_single_pid"),
+    "gs-pid-thesis": PolicySpec("gs-pid-thesis", "lvgym.baselines.pid:smile_scheduled_pid",
                                 (("name", "gs-pid-thesis"), ("schedule", "smile_thesis"))),
-    # LQG on the non-rigid flight plant, scheduled over the flight (baselines.lqg_design, docs/lqg.md)
-    "lqg": PolicySpec("lqg", "baselines.lqg:smile_lqg", (("name", "lqg"),)),
+    # LQG on the non-rigid flight plant, scheduled over the flight (lvgym.baselines.design.lqg_design, docs/lqg.md)
+    "lqg": PolicySpec("lqg", "lvgym.baselines.lqg:smile_lqg", (("name", "lqg"),)),
     # lqg with its boost and max-q rows moved along the turbulence-against-margin trade: the design of lowest
-    # turbulence rate error within 2 dB of gain margin and 60 % of the delay margin (baselines.headroom)
-    "lqg-front": PolicySpec("lqg-front", "baselines.lqg:smile_lqg",
+    # turbulence rate error within 2 dB of gain margin and 60 % of the delay margin (experiments.lqg_headroom.headroom)
+    "lqg-front": PolicySpec("lqg-front", "lvgym.baselines.lqg:smile_lqg",
                             (("name", "lqg-front"), ("schedule", "smile_lqg_front"))),
     # the shipped learned policies (agents/trained, docs/training.md): PPO of SmileAscent-v0 (the ideal state
     # observation), and protocol v1's: PPO residual on lqg, flight sensors, a 4-sample history
-    "ppo": PolicySpec("ppo", "agents.policy:shipped_policy"),
-    "ppo-res-lqg": PolicySpec("ppo-res-lqg", "agents.policy:shipped_policy",
+    "ppo": PolicySpec("ppo", "lvgym.agents.policy:shipped_policy"),
+    "ppo-res-lqg": PolicySpec("ppo-res-lqg", "lvgym.agents.policy:shipped_policy",
                               (("file", "ppo_res_lqg_smile_v1"), ("name", "ppo-res-lqg"))),
 }
 
@@ -70,8 +70,8 @@ def resolve_policy(name: str, prog: str = "evaluate.py") -> PolicySpec:
         if not path.exists():
             raise SystemExit(f"{prog}: policy {name!r}: no such file")
         if path.is_dir():                       # a training run folder: its best (or final) model
-            return PolicySpec(path.name, "agents.policy:load_policy", (("path", str(path.resolve())),))
-        return PolicySpec(path.stem, "agents.policy:load_policy", (("path", str(path.resolve())),))
+            return PolicySpec(path.name, "lvgym.agents.policy:load_policy", (("path", str(path.resolve())),))
+        return PolicySpec(path.stem, "lvgym.agents.policy:load_policy", (("path", str(path.resolve())),))
     raise SystemExit(f"{prog}: policy {name!r}: one of {sorted(POLICIES)}, a path to an SB3 .zip model or a "
                      "train.py run folder")
 

@@ -302,7 +302,7 @@ class SlenderAscentV1Env(SlenderAscentEnv):
     (13.7-18.5 1/s, beyond the 15 rad/s servo, with 30 ms of delay and hold) admits no TVC loop with
     useful margins; the 4.5 mm tube (+42 kg) diverges only above 1.6 times the flight's dynamic pressure
     and keeps its first mode at 13.6 Hz (docs/aerodynamics.md, "Aeroelastic divergence";
-    ``baselines/divergence.py`` checks it independently). ``wall_thickness_m=0.002`` flies the thesis's tube."""
+    ``experiments/aeroelastic_divergence/divergence.py`` checks it independently). ``wall_thickness_m=0.002`` flies the thesis's tube."""
 
     DEFAULTS = {**SlenderAscentEnv.DEFAULTS, **V1_OPTIONS}
     WALL_THICKNESS_M = 0.0045

@@ -43,7 +43,7 @@ def wind_spec(tier: str, mission_time: float) -> Any:
     Protocol v1's: ``turbulence_gust``: ``turbulence`` plus a random 1-cosine gust (``random_gust``: 5-15 m/s,
     30-300 m, from any direction, onset 1-15 km); ``maxq_gust``: a random jet-stream profile plus a random
     gust whose onset lies in the max-q region (``MAXQ_GUST_ONSET_M``); ``random_gust``: the random gust of
-    ``turbulence_gust`` alone (``lvgym.benchmark.budget`` flies it to share out the error)."""
+    ``turbulence_gust`` alone (``experiments.error_budget.budget`` flies it to share out the error)."""
     profile = {"model": "profile", "altitude_m": [0.0, 1000.0, 10000.0, 100000.0],
                "speed": [5.0, 12.0, 20.0, 20.0], "direction_deg": [270.0, 270.0, 270.0, 270.0]}
     if tier == "none":

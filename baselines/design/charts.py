@@ -1,0 +1,149 @@
+"""Bode and Nichols charts of a gain schedule's open loops, rigid and non-rigid, margins marked.
+
+``python -m lvgym.baselines.design.charts --vehicle smile --protocol v1 --schedule smile [--out results/charts]``
+
+At each row of the schedule (``baselines/schedules/<schedule>.yaml`` or a path) the vehicle is linearised
+at the row's flight time (:func:`.linearize.operating_point` of the protocol's env), the flight
+computer's plant is built (:func:`.flightloop.flight_plant`: servo, vehicle, slope at the IMU, gyro
+filters, hold, delay) and the row's discrete PID closes it. Per row one figure ``loop_<t>s.png``: the
+open loop's magnitude and phase against frequency up to the Nyquist frequency of the control rate, and its
+Nichols chart, for the rigid and the non-rigid model, with the gain and phase margins of
+:func:`.linearize.margins` written in the legend and the crossovers marked. A row in a coast (no thrust)
+is skipped with a message. ``margins.json`` beside the figures holds the numbers.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+import warnings
+from pathlib import Path
+from typing import Any
+
+import control
+import numpy as np
+
+from .flightloop import flight_plant, frequency_response, mode_frequencies
+from .linearize import margins, operating_point, pid_tf
+from ..pid import GainSchedule
+
+
+def open_loop(op, gains: tuple[float, float, float, float], plane: str = "pitch") -> control.StateSpace:
+    """The discrete open loop ``C(z) G(z)`` of the flight computer's plant at ``op`` with the PID
+    ``gains`` (kp, ki, kd, n) at the env's control period (negative feedback of the gyro rate)."""
+    g = flight_plant(op, plane)
+    return control.series(g, control.ss(pid_tf(*gains, dt=g.dt)))
+
+
+def row_loops(vehicle: str, protocol: str, t: float, gains) -> dict[str, Any] | None:
+    """Open loops, margins and plant modes at flight time ``t`` [s], or None in a coast."""
+    out: dict[str, Any] = {}
+    for model in ("rigid", "nonrigid"):
+        op = operating_point(vehicle, t, model, protocol=protocol)
+        if float(op.sim.conditions("thrust")[0]) <= 0.0:
+            return None
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            L = open_loop(op, gains)
+            out[model] = {"loop": L, "margins": margins(L)}
+        if model == "nonrigid":
+            out["modes_radps"] = mode_frequencies(op)
+    return out
+
+
+def _chart(t: float, loops: dict[str, Any], path: Path) -> None:
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    dt = loops["rigid"]["loop"].dt
+    w = np.logspace(-1, math.log10(math.pi / dt), 3000)
+    fig, (a_mag, a_nic) = plt.subplots(1, 2, figsize=(12, 4.5))
+    a_ph = a_mag.twinx()
+    for model, color in (("rigid", "C0"), ("nonrigid", "C3")):
+        r = frequency_response(loops[model]["loop"], w)
+        mag = 20 * np.log10(np.abs(r))
+        ph = np.degrees(np.unwrap(np.angle(r)))
+        ph -= 360.0 * np.round((ph[np.argmin(np.abs(mag))] + 180.0) / 360.0)     # -180 near the crossover
+        m = loops[model]["margins"]
+        label = (f"{model}: GM {m['gain_margin_db']:.1f} dB, PM {m['phase_margin_deg']:.1f} deg at "
+                 f"{m['gain_crossover_radps']:.1f} rad/s, {'stable' if m['closed_loop_stable'] else 'UNSTABLE'}")
+        a_mag.semilogx(w, mag, color=color, label=label)
+        a_ph.semilogx(w, ph, color=color, ls=":", lw=0.8)
+        a_nic.plot(ph, mag, color=color, label=model)
+        if np.isfinite(m["gain_crossover_radps"]):
+            a_mag.axvline(m["gain_crossover_radps"], color=color, lw=0.5, ls="--")
+    for kind, style in (("slosh", "g"), ("bending", "m")):
+        for f in loops["modes_radps"][kind]:
+            if f < math.pi / dt:
+                a_mag.axvline(f, color=style, lw=0.4, alpha=0.6)
+    a_mag.axhline(0.0, color="k", lw=0.5)
+    a_mag.set_xlabel("frequency [rad/s] (green: slosh, magenta: bending)")
+    a_mag.set_ylabel("|L| [dB] (solid)")
+    a_ph.set_ylabel("phase [deg] (dotted)")
+    a_mag.legend(fontsize=7, loc="lower left")
+    a_mag.set_title(f"open loop at {t:g} s")
+    for c in range(-3, 2):
+        a_nic.axvline(-180.0 + 360.0 * c, color="0.7", lw=0.5)
+    a_nic.plot([-180.0], [0.0], "k+", ms=12)
+    a_nic.axhline(0.0, color="k", lw=0.5)
+    a_nic.set_xlabel("phase [deg]")
+    a_nic.set_ylabel("|L| [dB]")
+    a_nic.set_ylim(-60, 40)
+    a_nic.set_title("Nichols chart (+: the critical point)")
+    a_nic.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+
+
+def charts(vehicle: str, protocol: str, schedule: str, out: Path, log=print) -> dict[str, Any]:
+    """Write the charts of every row of ``schedule`` into ``out``; returns the margins per row."""
+    sched = GainSchedule.load(schedule)
+    out.mkdir(parents=True, exist_ok=True)
+    doc: dict[str, Any] = {"vehicle": vehicle, "protocol": protocol, "schedule": str(schedule), "rows": []}
+    for row, value in zip(sched.meta["rows"], sched.points):
+        t = float(row["time_s"])
+        loops = row_loops(vehicle, protocol, t, sched.gains(value))
+        if loops is None:
+            log(f"t = {t:g} s: no thrust (coast), skipped")
+            continue
+        _chart(t, loops, out / f"loop_{t:g}s.png")
+        entry = {"time_s": t, **{m: {k: (round(v, 3) if isinstance(v, float) else v)
+                                     for k, v in loops[m]["margins"].items()} for m in ("rigid", "nonrigid")},
+                 "modes_radps": {k: [round(f, 2) for f in v] for k, v in loops["modes_radps"].items()}}
+        doc["rows"].append(entry)
+        r, n = entry["rigid"], entry["nonrigid"]
+        log(f"t = {t:5.1f} s  rigid GM {r['gain_margin_db']:6.2f} dB PM {r['phase_margin_deg']:6.1f} deg "
+            f"{'stable' if r['closed_loop_stable'] else 'UNSTABLE'}   nonrigid GM {n['gain_margin_db']:6.2f} dB "
+            f"PM {n['phase_margin_deg']:6.1f} deg {'stable' if n['closed_loop_stable'] else 'UNSTABLE'}")
+    (out / "margins.json").write_text(json.dumps(doc, indent=1))
+    return doc
+
+
+def main(argv: list[str] | None = None) -> int:
+    from lvgym.cli import fail, one_line_errors
+    from lvgym.errors import ConfigError
+
+    from .linearize import ENV_IDS
+
+    ap = one_line_errors(argparse.ArgumentParser(prog="python -m lvgym.baselines.design.charts", description=__doc__.split("\n\n")[0]))
+    ap.add_argument("--vehicle", default="smile", choices=sorted(ENV_IDS["v1"]))
+    ap.add_argument("--protocol", default="v1", choices=sorted(ENV_IDS))
+    ap.add_argument("--schedule", default="smile", help="a schedule name in baselines/schedules or a YAML path")
+    ap.add_argument("--out", default="results/charts", help="folder of the figures and margins.json")
+    a = ap.parse_args(argv)
+    try:
+        GainSchedule.load(a.schedule)
+    except (OSError, KeyError, ValueError) as exc:
+        fail(ap.prog, ConfigError("--schedule", a.schedule, f"a readable gain schedule ({exc})"))
+    out = Path(a.out) / f"{a.vehicle}_{a.protocol}_{Path(a.schedule).stem}"
+    charts(a.vehicle, a.protocol, a.schedule, out)
+    print(f"wrote {out}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

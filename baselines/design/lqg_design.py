@@ -1,0 +1,339 @@
+"""LQG rate loops designed on the flight computer's non-rigid plant, per plane, at frozen flight times.
+
+``python -m lvgym.baselines.design.lqg_design --vehicle smile [--out results/schedules] [--overwrite]``
+
+Each row's law is :mod:`.lqg_row`'s (plant with the delay as a state, LQR on the rate error and its leaky
+integral, steady-state Kalman filter of the v1 gyro, the compensator and its margins with the loop broken
+at the plant input). Here: the weights searched per row (:func:`search_row`) against the margin targets
+(:class:`MarginTargets`) on the rigid and non-rigid plants and on robustness plants (the ends of the row's
+interval, the slosh dispersed: :func:`dispersed`), the figure of merit (:func:`gust_response`), the rows'
+intervals (:func:`row_intervals`), and the schedule's files (:func:`save_schedule`, :func:`margin_table`).
+docs/lqg.md gives the reasoning and the numbers.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+import warnings
+from dataclasses import asdict, dataclass, fields, replace
+from pathlib import Path
+from typing import Any
+
+import control
+import numpy as np
+import scipy.linalg as sla
+
+from lvgym.errors import ConfigError, check_number
+
+from .flightloop import flight_plant, mode_frequencies
+from .linearize import OperatingPoint, operating_point
+from .lqg_row import (LQGWeights, RowDesign, closed_loop, closed_loop_growth, delayed_plant, design_row,
+                      frequency_grid, gain_at, margins_from_response, open_loop, plant_labels, response)
+
+SCHEDULES = Path(__file__).resolve().parents[1] / "schedules"
+#: the schedule rows [s] of SMILE v1: the boost (burnout 43 s) and the upper stage (ignition 54 s)
+SMILE_ROWS_S = (3.0, 10.0, 20.0, 28.8, 36.0, 41.0, 56.0, 62.0, 68.0)
+PLANE_NAMES = ("pitch", "yaw")
+
+
+# ---------------------------------------------------------------------------- the search
+@dataclass(frozen=True)
+class MarginTargets:
+    """What a row must meet (issue 17's margin checks): rigid and non-rigid loops closed-loop stable
+    with gain margin >= ``gm_db`` [dB] and phase margin >= ``pm_deg`` [deg] at every gain crossover
+    (the smallest in magnitude counts), the bending modes above the first attenuated to
+    ``|L| <= -attenuation_db`` [dB], and the non-rigid loop stable at the ends of the row's interval
+    with ``neighbour_gm_db`` and ``neighbour_pm_deg`` (the plant has moved away from the design's
+    model there: its slosh frequencies by about 1 rad/s)."""
+
+    gm_db: float = 6.0
+    pm_deg: float = 30.0
+    attenuation_db: float = 6.0
+    neighbour_gm_db: float = 3.0
+    neighbour_pm_deg: float = 15.0
+
+    def __post_init__(self) -> None:
+        for f in fields(self):
+            object.__setattr__(self, f.name, check_number(f"targets.{f.name}", getattr(self, f.name), 0.0, 180.0))
+
+
+#: the weights tried at every row (q_rate = 1; docs/lqg.md): integral, gimbal and mode-rate weights, gimbal
+#: and mode-rate process noise
+SEARCH_GRID = {"q_int": (10.0, 100.0), "r_gimbal": (1.0, 3.0, 10.0, 30.0, 300.0), "w_gimbal": (1e-8, 1e-7),
+               "q_modes": (1e-5, 1e-4, 1e-3), "w_modes": (1e-5, 1e-4, 1e-3, 1e-2)}
+_SEARCH_W = np.logspace(-5, math.log10(math.pi / 0.02 * 0.9999), 5000)
+
+
+def assess(d: RowDesign, plants: dict[str, control.StateSpace], modes: dict[str, list[float]],
+           w: np.ndarray | None = None, plant_responses: dict[str, np.ndarray] | None = None) -> dict[str, Any]:
+    """Margins of the row's compensator on each plant of ``plants`` (``rigid``, ``nonrigid``, and
+    neighbouring non-rigid plants ``t=<time>``) and the non-rigid loop's gain [dB] at the slosh and
+    bending frequencies [rad/s] of ``modes``. ``plant_responses``: the plants' responses on ``w``, if
+    already computed (the loop's is the product with the compensator's)."""
+    comp = d.compensator()
+    w = frequency_grid(d.dt) if w is None else np.asarray(w, float)
+    kr = -response(comp, w)
+    out: dict[str, Any] = {}
+    for name, g in plants.items():
+        gr = plant_responses[name] if plant_responses is not None else response(g, w)
+        L = open_loop(comp, g)
+        growth = closed_loop_growth(L)
+        out[name] = {**margins_from_response(kr * gr, w), "closed_loop_stable": growth < 1e-4,
+                     "max_pole_real_per_s": growth}
+        if name == "nonrigid":
+            out["slosh_db"] = gain_at(L, modes["slosh"])
+            out["bending_db"] = gain_at(L, modes["bending"])
+    return out
+
+
+def shortfall(a: dict[str, Any], tg: MarginTargets) -> float:
+    """How far an :func:`assess` result is from the targets (0: met), in units of the targets: the sum
+    of the relative shortfalls of each loop's gain and phase margin (the neighbours' against their own
+    targets) and of the attenuation of the higher bending modes, plus 10 per unstable loop."""
+    s = 0.0
+    for name, m in a.items():
+        if not isinstance(m, dict):
+            continue
+        if not m["closed_loop_stable"]:
+            s += 10.0
+            continue
+        gm, pm = (tg.gm_db, tg.pm_deg) if name in ("rigid", "nonrigid") else (tg.neighbour_gm_db, tg.neighbour_pm_deg)
+        s += max(0.0, 1.0 - m["gain_margin_db"] / gm) if gm > 0 else 0.0
+        s += max(0.0, 1.0 - abs(m["phase_margin_deg"]) / pm) if pm > 0 else 0.0
+    for db in a.get("bending_db", [])[1:]:
+        s += max(0.0, (db + tg.attenuation_db) / max(tg.attenuation_db, 1.0))
+    return s
+
+
+def gust_response(d: RowDesign, op: OperatingPoint, plane: str) -> float:
+    """The figure of merit among designs that meet the targets: the H2 norm [rad/s per (m/s)] of the
+    closed loop (the row's compensator on the plant of ``op``) from a white disturbance of the lateral
+    velocity of the plane (``v_z`` pitch, ``v_y`` yaw: what a gust does to the angle of attack) to the
+    gyro rate; a lightly damped weathercock mode makes it large. The square root of
+    ``C_cl P C_cl^T`` with ``P = A_cl P A_cl^T + B_cl B_cl^T``."""
+    A, B, C, _ = delayed_plant(op, plane)
+    labels = plant_labels(op, plane)
+    Bd = np.zeros((A.shape[0], 1))
+    Bd[labels.index(PLANE_VELOCITY[plane]), 0] = 1.0
+    Acl, _ = closed_loop(A, B, C, d.compensator())
+    nk = Acl.shape[0] - A.shape[0]
+    Bcl = np.vstack([Bd, np.zeros((nk, 1))])
+    Ccl = np.hstack([C, np.zeros((1, nk))])
+    if np.abs(np.linalg.eigvals(Acl)).max() >= 1.0:
+        return math.inf
+    P = sla.solve_discrete_lyapunov(Acl, Bcl @ Bcl.T)
+    return float(math.sqrt(max((Ccl @ P @ Ccl.T).item(), 0.0)))
+
+
+#: the lateral velocity state of each plane (the gust's entry for :func:`gust_response`)
+PLANE_VELOCITY = {"pitch": "v_z", "yaw": "v_y"}
+
+
+def dispersed(op: OperatingPoint, frequency_scale: float, damping_scale: float) -> OperatingPoint:
+    """``op`` with its pendulums' frequencies scaled by ``frequency_scale`` (lengths / f^2 and the damper
+    frequency x f, as the env's ``slosh_frequency`` dispersion) and their damping ratios by
+    ``damping_scale`` (the ``slosh_damping`` dispersion)."""
+    lay = op.sim.dynamics.layout
+    p = op.p.copy()
+    for j in range(op.sim.dynamics.n_slosh):
+        p[lay.slosh_param(j, "length")] /= frequency_scale ** 2
+        p[lay.slosh_param(j, "omega")] *= frequency_scale
+        p[lay.slosh_param(j, "zeta")] *= damping_scale
+    return replace(op, p=p)
+
+
+#: the dispersed plants every row must stay stable on (:func:`dispersed`: slosh frequency, damping): the
+#: env's slosh-frequency dispersion at 2 sigma (x N(1, 5 %)) with the low end of its damping dispersion
+#: (x [0.5, 2])
+DISPERSED_SLOSH = ((0.9, 0.5), (1.1, 0.5))
+
+
+def search_row(op_nonrigid: OperatingPoint, op_rigid: OperatingPoint, neighbours: dict[str, OperatingPoint],
+               plane: str, tg: MarginTargets = MarginTargets(), grid: dict = SEARCH_GRID,
+               log=print) -> tuple[RowDesign, dict[str, Any], list[dict]]:
+    """Every combination of the weights of ``grid`` at one row: among the designs whose loops are
+    stable on the rigid, the non-rigid and the ``neighbours``' non-rigid plants (name -> operating
+    point: the ends of the row's interval, the dispersed plants) and meet ``tg``, the one of the
+    smallest rigid gust response (:func:`gust_response`); if none meets them, the one of smallest
+    :func:`shortfall`. Returns the design, its assessment on the full frequency grid and the
+    table of every candidate."""
+    modes = mode_frequencies(op_nonrigid, plane)
+    plants = {"rigid": flight_plant(op_rigid, plane), "nonrigid": flight_plant(op_nonrigid, plane)}
+    plants.update({name: flight_plant(op, plane) for name, op in neighbours.items()})
+    responses = {k: response(g, _SEARCH_W) for k, g in plants.items()}
+    table, cands = [], []
+    keys = list(grid)
+    for vals in np.array(np.meshgrid(*[grid[k] for k in keys], indexing="ij")).reshape(len(keys), -1).T:
+        w = LQGWeights(**dict(zip(keys, (float(v) for v in vals))))
+        try:
+            d = design_row(op_nonrigid, plane, w)
+        except (ValueError, np.linalg.LinAlgError) as exc:
+            table.append({**asdict(w), "error": str(exc)})
+            continue
+        comp = d.compensator()
+        unstable = [k for k, g in plants.items() if closed_loop_growth(open_loop(comp, g)) >= 1e-4]
+        if unstable:                                   # cheap rejection: no margins of an unstable loop
+            table.append({**asdict(w), "shortfall": 10.0 * len(unstable), "unstable": unstable})
+            cands.append((10.0 * len(unstable), 0.0, len(cands), d, None))
+            continue
+        a = assess(d, plants, modes, _SEARCH_W, responses)
+        sf = shortfall(a, tg)
+        h2 = gust_response(d, op_rigid, plane)
+        table.append({**asdict(w), "shortfall": sf, "gust_h2": h2})
+        cands.append((sf, h2, len(cands), d, a))
+    if not cands:
+        raise RuntimeError(f"no design of the grid could be computed at t = {op_nonrigid.t:g} s ({plane})")
+    cands.sort(key=lambda c: (c[0] > 0, c[0] if c[0] > 0 else c[1], c[2]))
+    d = cands[0][3]
+    final = assess(d, plants, modes)
+    final["gust_h2"] = gust_response(d, op_rigid, plane)
+    log(f"  {plane} t = {d.t:5.1f} s: q_int {d.weights.q_int:g}, r {d.weights.r_gimbal:g}, w {d.weights.w_gimbal:g}, "
+        f"q_modes {d.weights.q_modes:g}, w_modes {d.weights.w_modes:g}: shortfall {shortfall(final, tg):.3f}, "
+        f"{sum(1 for c in cands if c[0] == 0)} of {len(table)} designs meet the targets")
+    return d, final, table
+
+
+# ---------------------------------------------------------------------------- the schedule
+#: SMILE v1's thrusting phases with the controller on [s]: from controller start to burnout, and from
+#: stage-2 ignition to the mission's end, each trimmed by 0.5 s at its burnout, ignition and end
+SMILE_PHASES_S = ((2.0, 42.5), (54.5, 69.5))
+
+
+def row_intervals(rows: tuple[float, ...], phases: tuple[tuple[float, float], ...]) -> list[tuple[float, float]]:
+    """Each row's interval of use [s]: from the midpoint with the previous row of its phase (or the
+    phase's start) to the midpoint with the next (or the phase's end)."""
+    out = []
+    for t in rows:
+        ph = [p for p in phases if p[0] <= t <= p[1]]
+        if not ph:
+            raise ConfigError("rows", t, f"a flight time inside a thrusting phase {list(phases)}")
+        lo, hi = ph[0]
+        same = sorted(r for r in rows if lo <= r <= hi)
+        i = same.index(t)
+        out.append((lo if i == 0 else 0.5 * (same[i - 1] + t), hi if i == len(same) - 1 else 0.5 * (t + same[i + 1])))
+    return out
+
+
+def _op(vehicle: str, t: float, model: str, upper_after_s: float) -> OperatingPoint:
+    """The v1 operating point; past ``upper_after_s`` flown with the rigid gain-scheduled PID (the zero
+    action tumbles the SMILE v1 upper stage), before it with the gimbal centred."""
+    if t > upper_after_s:
+        from ..pid import smile_scheduled_pid
+        return operating_point(vehicle, t, model, protocol="v1", policy=lambda env: smile_scheduled_pid(env, "smile"))
+    return operating_point(vehicle, t, model, protocol="v1")
+
+
+def row_neighbours(vehicle: str, t: float, interval: tuple[float, float], op_nonrigid: OperatingPoint,
+                   upper_after_s: float) -> dict[str, OperatingPoint]:
+    """The robustness plants a row must stay stable on: the non-rigid points at the ends of its
+    ``interval`` [s] (those more than 0.05 s from ``t``) and the row's own with its slosh dispersed
+    (:data:`DISPERSED_SLOSH`)."""
+    near = {f"t={x:.1f}": _op(vehicle, x, "nonrigid", upper_after_s) for x in interval if abs(x - t) > 0.05}
+    near.update({f"slosh f x{f:g} zeta x{z:g}": dispersed(op_nonrigid, f, z) for f, z in DISPERSED_SLOSH})
+    return near
+
+
+def design_schedule(vehicle: str = "smile", rows: tuple[float, ...] = SMILE_ROWS_S,
+                    phases: tuple[tuple[float, float], ...] = SMILE_PHASES_S, tg: MarginTargets = MarginTargets(),
+                    grid: dict = SEARCH_GRID, planes: tuple[str, ...] = PLANE_NAMES, log=print) -> dict[str, Any]:
+    """Design every row and plane (:func:`search_row`); the neighbours of a row are the non-rigid plants
+    at the ends of its interval (:func:`row_intervals`) and at the row with its slosh dispersed
+    (:data:`DISPERSED_SLOSH`)."""
+    if vehicle != "smile":
+        raise ConfigError("vehicle", vehicle, "'smile' (the LQG schedule is designed for SMILE v1 only)")
+    intervals = row_intervals(tuple(rows), phases)
+    upper_after = phases[0][1] + 0.5
+    out: dict[str, Any] = {"vehicle": vehicle, "rows": [], "targets": asdict(tg), "grid": {k: list(v) for k, v in grid.items()}}
+    for t, (lo, hi) in zip(rows, intervals):
+        log(f"t = {t:g} s (used {lo:g}-{hi:g} s)")
+        op_n, op_r = _op(vehicle, t, "nonrigid", upper_after), _op(vehicle, t, "rigid", upper_after)
+        near = row_neighbours(vehicle, t, (lo, hi), op_n, upper_after)
+        entry: dict[str, Any] = {"time_s": float(op_n.t), "interval_s": [lo, hi]}
+        chosen = None
+        for plane in planes:                 # the first plane's search; the others fly its weights (axisymmetric)
+            g = grid if chosen is None else {k: (v,) for k, v in asdict(chosen).items()}
+            d, a, table = search_row(op_n, op_r, near, plane, tg, g, log)
+            chosen = chosen or d.weights
+            entry[plane] = {"design": d, "assessment": a, "search": table,
+                            "modes_radps": mode_frequencies(op_n, plane)}
+        out["rows"].append(entry)
+    return out
+
+
+def save_schedule(doc: dict[str, Any], path: Path) -> None:
+    """The schedule's matrices as ``.npz`` (keys ``<plane>_<row>_<name>``, the rows' ``time_s`` and
+    ``switch_s``, the interval ends)."""
+    arrays: dict[str, np.ndarray] = {"time_s": np.array([r["time_s"] for r in doc["rows"]]),
+                                     "interval_s": np.array([r["interval_s"] for r in doc["rows"]]),
+                                     "planes": np.array([p for p in PLANE_NAMES if p in doc["rows"][0]])}
+    for i, r in enumerate(doc["rows"]):
+        for plane in arrays["planes"]:
+            d: RowDesign = r[str(plane)]["design"]
+            pre = f"{plane}_{i}_"
+            for name in ("A", "B", "C", "Kx", "M"):
+                arrays[pre + name] = getattr(d, name)
+            arrays[pre + "Ki"] = np.array(d.Ki)
+            arrays[pre + "a"] = np.array(d.a)
+            arrays[pre + "dt"] = np.array(d.dt)
+            arrays[pre + "labels"] = np.array(d.state_labels)
+            arrays[pre + "weights"] = np.array([getattr(d.weights, f.name) for f in fields(LQGWeights)])
+    path.parent.mkdir(parents=True, exist_ok=True)
+    np.savez(path, **arrays)
+
+
+def _m(m: dict[str, Any]) -> str:
+    st = "stable" if m["closed_loop_stable"] else "UNSTABLE"
+    return (f"{m['gain_margin_db']:.1f} / {m['gain_reduction_margin_db']:.1f} / {m['phase_margin_deg']:.1f} at "
+            f"{m['gain_crossover_radps']:.3g} / {st}")
+
+
+def margin_table(doc: dict[str, Any]) -> str:
+    """The margins per row and plane as a Markdown table."""
+    lines = ["| t [s] | plane | q_int, r_gimbal, w_gimbal, q_modes, w_modes | rigid GM / GRM [dB] / PM [deg] at [rad/s] / CL | "
+             "non-rigid GM / GRM / PM at / CL | slosh max dB | bending dB | gust H2 | robustness plants (non-rigid): interval ends, "
+             "slosh dispersed |",
+             "|---:|---|---|---|---|---:|---|---:|---|"]
+    for r in doc["rows"]:
+        for plane in PLANE_NAMES:
+            if plane not in r:
+                continue
+            d, a = r[plane]["design"], r[plane]["assessment"]
+            ends = "; ".join(f"{k}: {_m(v)}" for k, v in a.items()
+                             if isinstance(v, dict) and k not in ("rigid", "nonrigid"))
+            wt = d.weights
+            lines.append(f"| {r['time_s']:g} | {plane} | {wt.q_int:g}, {wt.r_gimbal:g}, {wt.w_gimbal:g}, {wt.q_modes:g}, {wt.w_modes:g} "
+                         f"| {_m(a['rigid'])} | {_m(a['nonrigid'])} | {max(a['slosh_db']):.1f} | "
+                         f"{', '.join(f'{x:.1f}' for x in a['bending_db'])} | {a['gust_h2']:.4f} | {ends} |")
+    return "\n".join(lines) + "\n"
+
+
+def main(argv: list[str] | None = None) -> int:
+    from lvgym.cli import one_line_errors
+
+    ap = one_line_errors(argparse.ArgumentParser(prog="python -m lvgym.baselines.design.lqg_design",
+                                                 description=__doc__.split("\n\n")[0]))
+    ap.add_argument("--vehicle", default="smile", choices=["smile"])
+    ap.add_argument("--out", default="results/schedules", help="folder of smile_lqg.npz and smile_lqg_margins.md")
+    ap.add_argument("--overwrite", action="store_true", help=f"write into the shipped {SCHEDULES} instead of --out")
+    ap.add_argument("--rows", type=float, nargs="+", default=list(SMILE_ROWS_S), help="flight times [s] of the rows")
+    a = ap.parse_args(argv)
+    out = SCHEDULES if a.overwrite else Path(a.out)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        doc = design_schedule(a.vehicle, tuple(a.rows))
+    save_schedule(doc, out / f"{a.vehicle}_lqg.npz")
+    head = (f"# LQG schedule of {a.vehicle} v1: margins per row\n\nWritten by `python -m lvgym.baselines.design.lqg_design "
+            f"--vehicle {a.vehicle}`. Loop broken at the plant input; GM / GRM: gain and gain-reduction margin, "
+            "PM: phase margin at the gain crossover of smallest |PM|, CL: closed-loop stability; slosh and "
+            "bending: the non-rigid loop's |L| at each mode (bending modes above Nyquist folded). Targets: "
+            f"{doc['targets']}.\n\n")
+    (out / f"{a.vehicle}_lqg_margins.md").write_text(head + margin_table(doc))
+    print(margin_table(doc))
+    print(f"wrote {out / (a.vehicle + '_lqg.npz')} and {out / (a.vehicle + '_lqg_margins.md')}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,208 @@
+"""Tune PID rate gains on the linearised rigid vehicle and write a gain schedule.
+
+``python -m lvgym.baselines.design.tune --vehicle smile`` writes ``results/schedules/smile.yaml`` (or ``--out``);
+the shipped schedules that ``gs-pid`` reads (``baselines/schedules/``) are replaced only with
+``--overwrite`` (``python -m lvgym.baselines.design.tune --vehicle smile --overwrite``).
+
+At each flight time of the schedule: linearise the rigid vehicle (:func:`.linearize.linearize`), put the
+servo, the zero-order hold of the control period and the discrete PID in the loop, and place the gain
+crossover at the target bandwidth with the target phase margin (thesis 6.3.1: 75 rad/s and 35 deg at
+28.8 s). The PID has three gains and the two targets fix two: the integral zero is put a third of
+the crossover (``Ki = Kp * w_c / ki_ratio``) and Kp, Kd solve ``C(jw_c) G(jw_c) = -exp(j PM)``. When
+the target cannot be met (a gain would be negative, or the closed loop is unstable), the crossover is
+lowered step by step to the highest that meets the phase margin; the achieved numbers are written
+beside the targets. Each row also carries the loop's margins with the rigid and the non-rigid
+(slosh and bending) linearisation.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+import warnings
+from pathlib import Path
+from typing import Any
+
+import control
+import numpy as np
+import yaml
+
+from .linearize import linearize, loop, margins, operating_point
+from ..pid import SCHEDULES
+
+#: flight times of the schedule per vehicle [s] (smile: those of Table 6.10) and their env options
+VEHICLE_TIMES = {"smile": (3.0, 15.0, 28.8, 40.0, 46.0), "stratos3": (2.0, 6.0, 10.0, 14.0, 18.0),
+                 "slender": (1.0, 3.0, 5.0, 7.0, 9.0)}
+
+
+def _freq(sys_: control.LTI, w: float) -> complex:
+    return complex(sys_(np.exp(1j * w * sys_.dt)) if sys_.dt else sys_(1j * w))
+
+
+def place(plant: control.StateSpace, wc: float, pm_deg: float, dt: float | None = 0.02, n: float = 500.0,
+          ki_ratio: float = 3.0, servo: tuple[float, float] = (15.0, 0.7)) -> tuple[float, float, float, float] | None:
+    """Gains (kp, ki, kd, n) putting the loop's gain crossover at ``wc`` [rad/s] with phase margin
+    ``pm_deg``, or None when that needs a negative gain."""
+    g = loop(plant, (1.0, 0.0, 0.0, None), dt, servo)          # servo * plant (discretised) with C = 1
+    G = _freq(g, wc)
+    target = -np.exp(1j * math.radians(pm_deg)) / G            # required C(jw_c)
+    if dt:
+        z = np.exp(1j * wc * dt)
+        I = dt * z / (z - 1)
+        D = n * (z - 1) / ((1 + n * dt) * z - 1)
+    else:
+        s = 1j * wc
+        I, D = 1 / s, n * s / (s + n)
+    a = 1 + (wc / ki_ratio) * I                                 # C = kp a + kd D
+    M = np.array([[a.real, D.real], [a.imag, D.imag]])
+    kp, kd = np.linalg.solve(M, [target.real, target.imag])
+    if kp < 0 or kd < 0:
+        return None
+    return float(kp), float(kp * wc / ki_ratio), float(kd), float(n)
+
+
+def tune(plant: control.StateSpace, bandwidth: float = 75.0, pm_deg: float = 35.0, dt: float | None = 0.02,
+         n: float = 500.0, ki_ratio: float = 3.0, servo: tuple[float, float] = (15.0, 0.7),
+         min_gm_db: float = 0.0, drift_tol: float = 0.02) -> dict[str, Any]:
+    """Gains for the target, or for the highest crossover below it (log steps of 2 %) that meets the phase
+    margin with a gain margin of at least ``min_gm_db`` and a closed loop whose poles are stable except
+    for a drift slower than ``drift_tol`` [1/s] (a doubling time of 35 s at 0.02: after staging the
+    small upper stage has an unstable drift pole pair near the origin, 0.0075 1/s for SMILE at 46 s,
+    that a rate loop without attitude feedback does not stabilise and need not over a minute)."""
+    w = bandwidth
+    while w > 0.05 * bandwidth:
+        gains = place(plant, w, pm_deg, dt, n, ki_ratio, servo)
+        if gains is not None:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                m = margins(loop(plant, gains, dt, servo))
+            if m["max_pole_real_per_s"] < drift_tol and m["gain_margin_db"] >= min_gm_db:
+                return {"gains": gains, "crossover_radps": w, "target_met": w == bandwidth, **m}
+        w /= 1.02
+    raise RuntimeError(f"no PID meets a {pm_deg} deg phase margin above {0.05 * bandwidth:.3g} rad/s")
+
+
+def loop_margins(plant: control.StateSpace, gains, dt: float | None = 0.02, servo=(15.0, 0.7)) -> dict[str, float]:
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return margins(loop(plant, gains, dt, servo))
+
+
+def _rounded(m: dict) -> dict:
+    return {k: (round(v, 5 if k.startswith("max_pole") else 2) if isinstance(v, float) else v) for k, v in m.items()}
+
+
+def schedule(vehicle: str = "smile", times=None, bandwidth: float = 75.0, pm_deg: float = 35.0, dt: float = 0.02,
+             n: float = 500.0, ki_ratio: float = 3.0, log=print) -> dict[str, Any]:
+    """Tune at each time and return the schedule document (variable: vehicle mass)."""
+    times = VEHICLE_TIMES.get(vehicle, VEHICLE_TIMES["smile"]) if times is None else times
+    rows: list[dict[str, Any]] = []
+    skipped: list[dict[str, Any]] = []
+    for t in times:
+        op = operating_point(vehicle, t, "rigid")
+        tl = op.sim.timeline
+        if float(op.sim.conditions("thrust")[0]) <= 0.0:
+            log(f"t = {t:g} s: no thrust (coast), skipped")
+            continue
+        mass = float(tl.interp("mass", [t])[0])
+        rigid = linearize(op=op)
+        try:
+            res = tune(rigid, bandwidth, pm_deg, dt, n, ki_ratio)
+        except RuntimeError as exc:               # e.g. an aerodynamically unstable vehicle beyond a Mach
+            unstable = np.linalg.eigvals(rigid.A).real.max()
+            log(f"t = {t:g} s: skipped, {exc} (fastest open-loop pole of the rigid plant {unstable:+.3g} 1/s)")
+            skipped.append({"time_s": float(t), "reason": str(exc),
+                            "max_open_loop_pole_real_per_s": round(float(unstable), 5)})
+            continue
+        gains = res["gains"]
+        nonrigid = linearize(op=operating_point(vehicle, t, "nonrigid"))
+        mr, mn = loop_margins(rigid, gains, dt), loop_margins(nonrigid, gains, dt)
+        row = {"time_s": float(t), "mass_kg": round(mass, 1), "kp": round(gains[0], 4), "ki": round(gains[1], 4),
+               "kd": round(gains[2], 4), "n": gains[3], "crossover_radps": round(res["crossover_radps"], 2),
+               "target_met": bool(res["target_met"]),
+               "rigid": _rounded(mr), "nonrigid": _rounded(mn)}
+        rows.append(row)
+        log(f"t = {t:5.1f} s  m = {mass:8.1f} kg  Kp {gains[0]:.4f}  Ki {gains[1]:.4f}  Kd {gains[2]:.4f}  "
+            f"w_c {res['crossover_radps']:.1f} rad/s  rigid GM {mr['gain_margin_db']:.1f} dB PM "
+            f"{mr['phase_margin_deg']:.1f} deg  nonrigid GM {mn['gain_margin_db']:.1f} dB PM "
+            f"{mn['phase_margin_deg']:.1f} deg stable {mn['closed_loop_stable']}")
+    return {"vehicle": vehicle, "source": "python -m lvgym.baselines.design.tune (rigid linearisation, discrete loop)",
+            "variable": "mass", "target": {"bandwidth_radps": bandwidth, "phase_margin_deg": pm_deg,
+                                           "control_dt_s": dt, "ki_ratio": ki_ratio},
+            "rows": rows, "skipped": skipped}
+
+
+#: where a tuned schedule goes unless --out says otherwise
+RESULTS = Path("results") / "schedules"
+
+
+def output_path(vehicle: str, out: str | None, overwrite: bool, stem: str | None = None) -> Path:
+    """The file a run writes: ``out``, else the shipped schedule with ``overwrite``, else
+    ``results/schedules/<stem>.yaml`` (``stem`` defaults to the vehicle). A shipped schedule (a file in
+    ``baselines/schedules/``) is never written without ``overwrite``: a ``ConfigError`` naming ``--out``
+    instead."""
+    from lvgym.errors import ConfigError
+
+    stem = stem or vehicle
+    if out is None:
+        return SCHEDULES / f"{stem}.yaml" if overwrite else RESULTS / f"{stem}.yaml"
+    path = Path(out)
+    shipped = path.resolve().parent == SCHEDULES.resolve()
+    if shipped and path.exists() and not overwrite:
+        raise ConfigError("--out", out, "not a shipped schedule (gs-pid reads it): add --overwrite to replace it, "
+                          f"or write elsewhere (default {RESULTS / (stem + '.yaml')})")
+    if path.is_dir():
+        raise ConfigError("--out", out, "a YAML file path, not a folder")
+    return path
+
+
+def main(argv: list[str] | None = None) -> int:
+    from lvgym.cli import fail, one_line_errors, option_number
+    from lvgym.errors import ConfigError
+
+    ap = one_line_errors(argparse.ArgumentParser(prog="python -m lvgym.baselines.design.tune",
+                                                 description=__doc__.split("\n\n")[0]))
+    ap.add_argument("--vehicle", default="smile", choices=sorted(VEHICLE_TIMES))
+    ap.add_argument("--out", default=None, help="YAML file (default results/schedules/<vehicle>.yaml; with "
+                    "--overwrite: the shipped baselines/schedules/<vehicle>.yaml)")
+    ap.add_argument("--overwrite", action="store_true", help="allow replacing a shipped schedule (gs-pid reads them)")
+    ap.add_argument("--times", type=float, nargs="*", default=None, help="flight times [s]")
+    ap.add_argument("--bandwidth", type=float, default=75.0, help="target gain crossover [rad/s]")
+    ap.add_argument("--phase-margin", type=float, default=35.0, help="target phase margin [deg]")
+    ap.add_argument("--dt", type=float, default=0.02, help="control period [s] (0: continuous)")
+    ap.add_argument("--n", type=float, default=500.0, help="derivative filter coefficient [rad/s]")
+    ap.add_argument("--ki-ratio", type=float, default=3.0, help="crossover over integral zero")
+    a = ap.parse_args(argv)
+    try:                                             # every value checked before the (slow) tuning
+        out = output_path(a.vehicle, a.out, a.overwrite)
+        option_number("--bandwidth", a.bandwidth, 0.0, 1e4, lo_open=True)
+        option_number("--phase-margin", a.phase_margin, 0.0, 90.0, lo_open=True)
+        option_number("--dt", a.dt, 0.0, 1.0)
+        option_number("--n", a.n, 0.0, 1e6, lo_open=True)
+        option_number("--ki-ratio", a.ki_ratio, 0.0, 1e6, lo_open=True)
+        for t in a.times or ():
+            option_number("--times", t, 0.0, 3600.0)
+    except ConfigError as exc:
+        fail(ap.prog, exc)
+    doc = schedule(a.vehicle, a.times, a.bandwidth, a.phase_margin, a.dt or None, a.n, a.ki_ratio)
+    if len(doc["rows"]) < 1:
+        print(f"no flight time of {a.vehicle} could be tuned; nothing written", file=sys.stderr)
+        return 1
+    from lvgym.benchmark.results import atomic_write_text
+
+    again = f"python -m lvgym.baselines.design.tune --vehicle {a.vehicle}" + (" --overwrite" if out.parent.resolve() ==
+                                                                     SCHEDULES.resolve() else f" --out {out}")
+    out.parent.mkdir(parents=True, exist_ok=True)
+    atomic_write_text(out, f"# Gain schedule of {a.vehicle}, regenerated by: {again}\n"
+                      "# Gains: rad of gimbal per rad/s of rate error (kp), per rad (ki), per rad/s^2 (kd); n [rad/s].\n"
+                      + yaml.safe_dump(doc, sort_keys=False, default_flow_style=None, width=120))
+    print(f"wrote {out}" + ("" if out.parent.resolve() == SCHEDULES.resolve() else
+                            f" (the shipped schedule that gs-pid reads is {SCHEDULES / (a.vehicle + '.yaml')}; "
+                            "replace it with --overwrite)"))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
+
