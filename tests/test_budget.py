@@ -10,7 +10,7 @@ import sys
 import numpy as np
 import pytest
 
-from lvgym.benchmark import budget
+from experiments.error_budget import budget
 from lvgym.benchmark.registry import resolve_policy
 from lvgym.benchmark.runner import run_episode
 from lvgym.benchmark.suites import V1_DISPERSIONS, get_suite

@@ -88,7 +88,7 @@ def test_study_values_are_checked_in_the_library_too():
 
 # ------------------------------------------------------------------------------------------ tuning
 def test_tune_never_overwrites_a_shipped_schedule_unless_asked(tmp_path, capsys):
-    from lvgym.baselines import tune
+    from lvgym.baselines.design import tune
     from lvgym.baselines.pid import SCHEDULES
 
     shipped = SCHEDULES / "smile.yaml"
@@ -108,7 +108,7 @@ def test_tune_never_overwrites_a_shipped_schedule_unless_asked(tmp_path, capsys)
 def test_tune_writes_where_it_is_told(tmp_path, capsys):
     import yaml
 
-    from lvgym.baselines import tune
+    from lvgym.baselines.design import tune
 
     out = tmp_path / "tuned" / "smile.yaml"
     assert tune.main(["--vehicle", "smile", "--times", "28.8", "--out", str(out)]) == 0

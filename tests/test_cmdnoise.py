@@ -12,7 +12,7 @@ from lvgym.baselines.filters import StructuralFilter
 from lvgym.baselines.design.flexdesign import controller_tf, row_plants
 from lvgym.baselines.design.noise import command_noise_rate
 from lvgym.baselines.pid import GainSchedule
-from lvgym.benchmark import cmdnoise
+from experiments.command_noise import cmdnoise
 from lvgym.benchmark.registry import POLICIES
 from lvgym.benchmark.suites import get_suite
 

@@ -8,7 +8,7 @@ import math
 
 import pytest
 
-from lvgym.agents import curves
+from experiments.training_speed import curves
 
 
 def _condition(score: float, failures: float = 0.0) -> dict:

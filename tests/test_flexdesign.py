@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 
 import lvgym  # noqa: F401
-from lvgym.baselines import flexdesign as FD
-from lvgym.baselines import linearize as L
+from lvgym.baselines.design import flexdesign as FD
+from lvgym.baselines.design import linearize as L
 from lvgym.baselines.filters import FilterChain, StructuralFilter
 from lvgym.baselines.pid import SCHEDULES, GainSchedule, GainScheduledPIDPolicy
 

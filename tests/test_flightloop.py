@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 import lvgym  # noqa: F401
-from lvgym.baselines import flightloop as F
-from lvgym.baselines import linearize as L
+from lvgym.baselines.design import flightloop as F
+from lvgym.baselines.design import linearize as L
 
 T0 = 28.8
 
@@ -80,7 +80,7 @@ def test_charts_write_figures_and_margins(tmp_path):
 
     import yaml
 
-    from lvgym.baselines import charts
+    from lvgym.baselines.design import charts
 
     sched = tmp_path / "two.yaml"
     sched.write_text(yaml.safe_dump({"variable": "time", "rows": [

@@ -10,7 +10,7 @@ import sys
 import numpy as np
 import pytest
 
-from lvgym.baselines import headroom as hr
+from experiments.lqg_headroom import headroom as hr
 from lvgym.environment.turbulence import dryden_psd
 
 

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 import lvgym  # noqa: F401
-from lvgym.baselines import flexdesign as FD
+from lvgym.baselines.design import flexdesign as FD
 from experiments.aeroelastic_divergence.divergence import Lift, free_free_beam
 from lvgym.baselines.filters import StructuralFilter
 from experiments.load_relief.loadbound import min_peak_qalpha

@@ -9,10 +9,10 @@ import numpy as np
 import pytest
 
 import lvgym  # noqa: F401
-from lvgym.baselines import flightloop as F
-from lvgym.baselines import linearize as L
-from lvgym.baselines import lqg_design as D
-from lvgym.baselines import lqg_row as R
+from lvgym.baselines.design import flightloop as F
+from lvgym.baselines.design import linearize as L
+from lvgym.baselines.design import lqg_design as D
+from lvgym.baselines.design import lqg_row as R
 from lvgym.baselines.lqg import LQGLaw, LQGPolicy, LQGRow, LQGSchedule, smile_lqg
 from lvgym.errors import ConfigError
 
@@ -59,7 +59,7 @@ def test_grid_margins_agree_with_linearize_margins_on_a_pid_loop(ops):
     rigid PID's 10-state loop: the same phase margin and crossover, the gain margin within 0.1 dB
     (the polynomial method's root finding is the less accurate: |L| at its phase crossover is 0.920,
     0.73 dB), the same closed-loop verdict."""
-    from lvgym.baselines import charts
+    from lvgym.baselines.design import charts
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")

@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 import lvgym  # noqa: F401
-from lvgym.baselines import linearize as lin
-from lvgym.baselines import tune
+from lvgym.baselines.design import linearize as lin
+from lvgym.baselines.design import tune
 from lvgym.baselines.bangbang import NEGATIVE, NONE, POSITIVE, BangBangRollPolicy
 from lvgym.baselines.pid import DiscretePID, GainSchedule, GainScheduledPIDPolicy, PIDPolicy, smile_scheduled_pid
 from lvgym.benchmark.policy import Policy, ZeroPolicy
@@ -179,12 +179,16 @@ def test_closed_loop_pid_beats_zero_under_wind():
 
 
 def test_old_package_name_still_works():
-    """``baselines_pid`` (the package's old name) gives the same classes as ``baselines``."""
-    import lvgym.baselines
+    """``baselines_pid`` (the controllers' old name, kept in a checkout, not installed) gives the same objects
+    as ``lvgym.baselines``."""
     import baselines_pid
-    import lvgym.baselines.pid
-    import lvgym.baselines.design.tune
+    import baselines_pid.pid
+    import baselines_pid.tune
 
-    assert baselines_pid.GainScheduledPIDPolicy is baselines.GainScheduledPIDPolicy
-    assert lvgym.baselines.pid.GainSchedule is lvgym.baselines.pid.GainSchedule
-    assert lvgym.baselines.design.tune.main is lvgym.baselines.design.tune.main
+    import lvgym.baselines
+    import lvgym.baselines.design.tune
+    import lvgym.baselines.pid
+
+    assert baselines_pid.GainScheduledPIDPolicy is lvgym.baselines.GainScheduledPIDPolicy
+    assert baselines_pid.pid.GainSchedule is lvgym.baselines.pid.GainSchedule
+    assert baselines_pid.tune.main is lvgym.baselines.design.tune.main

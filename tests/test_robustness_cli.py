@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from argparse import Namespace
 
-from lvgym.agents import robustness
+from experiments.rigid_vs_nonrigid_training import robustness
 
 
 def _args(**kw) -> Namespace:

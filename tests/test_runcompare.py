@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from lvgym.benchmark import runcompare
+from experiments.training_configurations import runcompare
 from lvgym.errors import ConfigError
 
 SUITE, COND = "smile-v1", "smile-v1/nonrigid"

@@ -12,7 +12,7 @@ kPa without the compression and 475 kPa with aerodynamics alone. Growth rates [1
 import numpy as np
 import pytest
 
-from lvgym.baselines import divergence as dv
+from experiments.aeroelastic_divergence import divergence as dv
 
 
 @pytest.fixture(scope="module")

@@ -14,7 +14,7 @@ import math
 import numpy as np
 import pytest
 
-from lvgym.verify import uncontrolled as U
+from experiments.uncontrolled_departures import uncontrolled as U
 
 DEG = math.degrees(1.0)
 
@@ -110,7 +110,7 @@ def test_stratos3_thesis_thrust_law_no_body_departure_before_drag_wins():
 def test_smile_slosh_modes_stable_at_max_q_even_undamped():
     """Linearised at max q (28.8 s, thesis) with every slosh damping set to zero, SMILE's only unstable
     pole is the rigid flight-path drift; the slosh modes keep a small aerodynamic damping."""
-    from lvgym.baselines import linearize as L
+    from lvgym.baselines.design import linearize as L
 
     op = L.operating_point("smile", 28.8, "nonrigid")
     lay = op.sim.layout

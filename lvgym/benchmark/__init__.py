@@ -7,8 +7,6 @@
 - :mod:`.scoring`: v1's per-episode metrics (failure-charged score, phases, flexibility, q-alpha cost);
 - :mod:`.stats`: bootstrap intervals, paired tests, rliable's IQM and probability of improvement;
 - :mod:`.compare`: the paired comparison of policies and agents over training runs;
-- :mod:`.runcompare`: agents over their training runs across results folders
-  (``python -m experiments.training_configurations.runcompare``: rliable's IQM and probability of improvement);
 - :mod:`.runner`: :func:`run_episode` and :func:`evaluate` (serial, local process pool or Ray);
 - :mod:`.tables`, :mod:`.results`: the Markdown tables; atomic CSV / JSON / Markdown / PNG result files;
 - :mod:`.registry`: the policies the command lines know by name (import paths, never the packages);

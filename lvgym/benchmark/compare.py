@@ -95,9 +95,9 @@ def run_groups(records: Sequence[dict[str, Any]], metric: str = "score",
     for suite, cond, pol in values:
         m = RUN_LABEL.match(pol)
         if m:
-            lvgym.agents.setdefault((suite, cond, m.group("agent")), []).append(pol)
+            agents.setdefault((suite, cond, m.group("agent")), []).append(pol)
     out = []
-    for (suite, cond, agent), pols in lvgym.agents.items():
+    for (suite, cond, agent), pols in agents.items():
         if len(pols) < 2:
             continue
         common = sorted(set.intersection(*(set(values[(suite, cond, p)]) for p in pols)))

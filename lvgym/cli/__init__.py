@@ -12,7 +12,7 @@ from __future__ import annotations
 import argparse
 from typing import Any, NoReturn
 
-from .errors import ConfigError, check_number
+from lvgym.errors import ConfigError, check_number
 
 __all__ = ["fail", "one_line_errors", "option_number", "parse_number"]
 
