@@ -16,7 +16,7 @@ def test_case(case):
 
 def test_case_e_drift_regression():
     """Case E at 1 ms: 2.86e-5 of the internal energy was measured with the masses of CASE_E (the
-    thesis-cases target of 1e-6 is not met there, see docs/verification.md); guard against growth."""
+    reference target of 1e-6 is not met there, see docs/verification.md); guard against growth."""
     assert CASE_E["m_slosh"] == (1.0, 2.0)
     assert energy_drift(1e-3) < 3.5e-5
     assert energy_drift(4e-4) < 1e-6

@@ -1,4 +1,4 @@
-"""Verification cases of the dynamics core (thesis chapter 4, ``shared/reference/thesis-cases.md``).
+"""Verification cases of the dynamics core (thesis chapter 4; docs/verification.md).
 
 Each ``case_*`` function runs one case and returns its ``Check`` rows; the tests assert them and
 ``python -m lvgym.verify`` prints them. Step sizes are arguments so that tests and the report use the
@@ -202,7 +202,7 @@ def case_e(dts=(4e-3, 2e-3, 1e-3, 5e-4)) -> list[Check]:
     for dt, d in zip(dts, drifts):
         note = ""
         if dt == 1e-3:
-            note = ("thesis-cases target 1e-6 at 1 ms is not met: the 0.16 m hinge motion at 15 Hz "
+            note = ("the reference target 1e-6 at 1 ms is not met: the 0.16 m hinge motion at 15 Hz "
                     "(145 g) makes the pendulums tumble chaotically; see docs/verification.md")
         out.append(Check("E", f"max energy drift / E_int, dt = {dt:g} s", 0.0, d, "", None, note=note))
     for a, b, dta in zip(drifts[:-1], drifts[1:], dts[:-1]):

@@ -1,6 +1,6 @@
 """Reference case M: the thesis's mass-model verification (Tables 4.1-4.4), every row within 0.1 %.
 
-The expected numbers are those of ``shared/reference/thesis-cases.md`` (recomputed from the thesis's own
+The expected numbers are those of the thesis's Tables 4.1-4.4 (recomputed from the thesis's own
 formulas with kappa on the radius); where the thesis's printed value differs, the note gives it.
 """
 
@@ -31,7 +31,7 @@ _ROWS = [
     ("oxidiser pendulum length", "m", 0.0, "static", 1.086, lambda p, s, mm: p.pendulum_length[0], ""),
     ("oxidiser pendulum length (Roberts, uncapped)", "m", T_END, "static", 1.651,
      lambda p, s, mm: p.tanks[0].pendulum_length_roberts,
-     "the dynamics uses it capped at the liquid height (0.857 m), DESIGN.md note 4"),
+     "the dynamics uses it capped at the liquid height (0.857 m), physics note 4"),
     ("Ixx fixed oxidiser", "kg m2", 0.0, "static", 15993.71, lambda p, s, mm: p.tanks[0].fixed_inertia[0, 0], ""),
     ("Ixx fixed oxidiser", "kg m2", T_END, "static", 456.015, lambda p, s, mm: p.tanks[0].fixed_inertia[0, 0], ""),
     ("Ixx fixed fuel", "kg m2", 0.0, "static", 7128.64, lambda p, s, mm: p.tanks[1].fixed_inertia[0, 0], ""),
