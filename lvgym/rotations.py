@@ -1,7 +1,7 @@
 """Attitude arithmetic shared by every layer (imports nothing of lvgym): scalar-first quaternions.
 
 ``q_bi`` is the attitude of frame b relative to frame i; ``C_ib = R(q_bi)`` takes b components to i
-components (``v_i = C_ib @ v_b``), as in the dynamics core and DESIGN.md.
+components (``v_i = C_ib @ v_b``), as in the dynamics core and docs/conventions.md.
 """
 
 from __future__ import annotations

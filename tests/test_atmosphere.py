@@ -80,14 +80,14 @@ def test_us76_speed_of_sound_table_iii(us76, z, a):
 
 
 def test_us76_layer_base_pressures_from_public_data():
-    # public-data.md: base pressures [Pa] of the seven layers, computed here from the lapse rates;
+    # the standard's printed base pressures [Pa] of the seven layers, computed here from the lapse rates;
     # they agree to 1e-5 (the listed values come from slightly different arithmetic), while the typo
     # 3.956720 some code has at 71 km is 7.6e-5 off
     listed = [101325.0, 22632.0, 5474.87, 868.014, 110.906, 66.9384, 3.95642]
     np.testing.assert_allclose(atm.US76_PB, listed, rtol=1e-5)
     assert abs(atm.US76_PB[6] / 3.956720 - 1.0) > 5e-5
     np.testing.assert_allclose(atm.US76_TB, [288.15, 216.65, 216.65, 228.65, 270.65, 270.65, 214.65])
-    # top of the seventh layer (public-data.md): 186.946 K and 0.3733836 Pa at 84.852 km'
+    # top of the seventh layer (U.S. Standard Atmosphere, 1976): 186.946 K and 0.3733836 Pa at 84.852 km'
     out = np.empty(4)
     atm.us76_lower(6356766.0 * 84852.0 / (6356766.0 - 84852.0), out)
     assert out[2] == pytest.approx(186.946, abs=5e-4)

@@ -10,7 +10,7 @@ from scipy.special import lpmv
 from lvgym.environment import earth, gravity, registry
 from lvgym.errors import ConfigError
 
-GM_EGM, R_EGM = 3.986004415e14, 6378136.3          # EGM2008's own constants (public-data.md)
+GM_EGM, R_EGM = 3.986004415e14, 6378136.3          # EGM2008's own constants (Pavlis et al., 2012)
 OMEGA = earth.WGS84_OMEGA
 
 

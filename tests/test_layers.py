@@ -1,4 +1,4 @@
-"""DESIGN.md layers: nothing imports upward.
+"""The layers of docs/architecture.md: nothing imports upward.
 
 The dynamics core imports neither gymnasium nor the environment models nor the vehicle layer; the
 environment models and the vehicle layer are independent of each other and of everything above them; the

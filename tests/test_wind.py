@@ -31,7 +31,7 @@ def test_none_is_zero():
     np.testing.assert_array_equal(model.velocity_ned([0.0, 1e4], [0.0, 5.0]), np.zeros((2, 3)))
 
 
-# ---------------------------------------------------------------- 1-cosine gust (public-data.md)
+# ---------------------------------------------------------------- 1-cosine gust (MIL-HDBK-1797)
 def test_one_minus_cosine_shape_at_hand_points():
     # V = (Vm / 2)(1 - cos(pi x / dm)) for 0 <= x <= dm, 0 before, Vm after (MIL-F-8785C)
     gust = make("wind", {"model": "gust", "amplitude": 10.0, "length": 100.0,
@@ -109,7 +109,7 @@ def test_profile_config_errors():
 
 # ---------------------------------------------------------------- Dryden scales and intensities
 def test_dryden_low_altitude_scales_match_the_formula():
-    # public-data.md / MIL-F-8785C: L_u = L_v = h / (0.177 + 0.000823 h)^1.2, L_w = h (h in ft),
+    # MIL-F-8785C: L_u = L_v = h / (0.177 + 0.000823 h)^1.2, L_w = h (h in ft),
     # sigma_w = 0.1 W20, sigma_u / sigma_w = 1 / (0.177 + 0.000823 h)^0.4. At h = 500 ft by hand:
     # 0.177 + 0.4115 = 0.5885; 0.5885^1.2 = 0.52930 -> L_u = 944.66 ft; 0.5885^-0.4 = 1.23624.
     # (The wrong 0.00823 / exponent 0.2 variant gives 373.5 ft.)

@@ -5,7 +5,7 @@ lvgym.benchmark.margins``, ``... budget``), how a name or a saved model's path b
 
 A spec holds an import path as a string (``"lvgym.baselines.pid:smile_tuned_pid"``); the factory is imported in
 the worker that flies the policy, so this module imports neither ``baselines`` nor ``agents`` (the layers
-of DESIGN.md: the benchmark sits below the controllers and the agents).
+of docs/architecture.md: the benchmark sits below the controllers and the agents).
 """
 
 from __future__ import annotations

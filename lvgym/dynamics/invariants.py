@@ -2,8 +2,8 @@
 
 Energy follows thesis eq. 4.15-4.21: kinetic energy of B, the modes and the slosh bodies,
 gravitational potential ``-m g . r`` in a uniform field, and the elastic energy
-``0.5 eta^T Omega^2 eta``. The *internal* energy used to normalise an energy drift (DESIGN.md
-note 7) is the energy of the internal motions: rotation of B, bending (kinetic and elastic) and the
+``0.5 eta^T Omega^2 eta``. The *internal* energy used to normalise an energy drift (physics
+note 7, docs/physics-notes.md) is the energy of the internal motions: rotation of B, bending (kinetic and elastic) and the
 slosh motion relative to the CG of B.
 """
 
@@ -24,7 +24,7 @@ ENERGY = Packed("energy terms", [
     Field("gravitational", 1, "J", "potential -m g . r in the uniform field"),
     Field("elastic", 1, "J", "0.5 eta^T Omega^2 eta"),
     Field("total", 1, "J", "kinetic + gravitational + elastic"),
-    Field("internal", 1, "J", "rotation + bending + slosh motion relative to the CG of B (DESIGN.md note 7)"),
+    Field("internal", 1, "J", "rotation + bending + slosh motion relative to the CG of B (physics note 7)"),
     Field("rotation", 1, "J", "rotation of B"),
     Field("bending", 1, "J", "kinetic and elastic energy of the modes"),
     Field("slosh", 1, "J", "slosh motion relative to the CG of B"),

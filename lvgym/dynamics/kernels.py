@@ -9,7 +9,7 @@ The coupled equations are those of the null-space method (thesis eq. 2.41-2.52):
 with the independent speeds ``u = [v_zw_i, omega_bi_b, eta_dot, w_1 .. w_N]``. The pendulum speeds
 ``w_j`` are the two components of the pendulum angular velocity normal to its rod: a point mass has
 no rotation about the rod, so the rod-axis speed of the thesis's 3-DOF slosh body (which makes A
-singular for a point mass, DESIGN.md note 3) is not a coordinate. The pendulum attitude is a
+singular for a point mass, physics note 3) is not a coordinate. The pendulum attitude is a
 quaternion, regular through 90 degrees and in free tumbling.
 
 A is assembled blockwise: each pendulum's 2x2 block ``(m L^2 + J) I`` is eliminated by its Schur

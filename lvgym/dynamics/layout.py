@@ -6,7 +6,7 @@ the caller may change before every step) and the loads ``u`` (forces held over a
 says where each named quantity lives, so that Python code never indexes by hand. A layout is fixed
 by the number of slosh pendulums ``n_slosh`` (N) and of bending modes per plane ``n_modes`` (K).
 
-Conventions (see DESIGN.md): SI units, radians; quaternions are Hamilton, scalar first;
+Conventions (docs/conventions.md): SI units, radians; quaternions are Hamilton, scalar first;
 ``q_bi`` is the attitude of the body frame b relative to the inertial frame i, with
 ``C_ib = R(q_bi)`` (``v_i = C_ib @ v_b``). Stations are body-frame coordinates measured from the
 nose tip, ``+x_b`` forward, so stations along the vehicle are zero or negative.

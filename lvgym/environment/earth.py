@@ -1,6 +1,6 @@
 """The Earth: WGS84 ellipsoid, its rotation, local frames and the launch site (thesis section 3.2).
 
-Frames (DESIGN.md conventions, ``v_b = C_bi @ v_i``):
+Frames (docs/conventions.md, ``v_b = C_bi @ v_i``):
 
 - ``e`` Earth-fixed (ECEF): origin at the Earth's centre, ``z_e`` along the rotation axis, ``x_e``
   through latitude 0, longitude 0.

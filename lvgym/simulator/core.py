@@ -62,7 +62,7 @@ from .vehicleaero import aeroelastic_strips, stage_aerodynamics, vehicle_strips
 _ADVANCE, _SLOSH = Kernel(advance_range), Kernel(slosh_angles_range)
 
 
-#: launch sites of the shipped vehicles (public-data.md); azimuth clockwise from north
+#: launch sites of the shipped vehicles (published coordinates of the ranges); azimuth clockwise from north
 SITES = {
     "andoya": LaunchSite(latitude_deg=69.2943, longitude_deg=16.0205, altitude_m=10.0, azimuth_deg=0.0),
     "el_arenosillo": LaunchSite(latitude_deg=37.0970, longitude_deg=-6.7350, altitude_m=20.0, azimuth_deg=225.0),

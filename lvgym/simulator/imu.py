@@ -3,7 +3,7 @@
 A strapdown IMU at station ``x_imu`` on the body axis. Its sensors see the structure where it is:
 
 - the **rate gyros** see the body rate of B plus the rate of the bending slope at the station
-  (DESIGN.md, physics note 6): ``u_x = omega_x``, ``u_y = omega_y - sum_k phi'_k(x_imu) eta_dot_z,k``,
+  (docs/physics-notes.md, note 6): ``u_x = omega_x``, ``u_y = omega_y - sum_k phi'_k(x_imu) eta_dot_z,k``,
   ``u_z = omega_z + sum_k phi'_k(x_imu) eta_dot_y,k``;
 - the **accelerometers** see the specific force at the station: that of the CG of B
   (``C_bi (a_zw_i - g_i)``), the lever-arm terms ``omega_dot x r + omega x (omega x r)`` with ``r`` the

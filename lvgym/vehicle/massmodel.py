@@ -189,7 +189,7 @@ class MassModel:
     """Mass properties and propellant depletion of ``vehicle``.
 
     ``cg_convention``: ``"static"`` (default; the fixed liquid mass keeps the liquid's static CG,
-    DESIGN.md note 2) or ``"thesis"`` (fixed mass at the liquid centroid, as the thesis's tables)."""
+    physics note 2) or ``"thesis"`` (fixed mass at the liquid centroid, as the thesis's tables)."""
 
     def __init__(self, vehicle: Vehicle, cg_convention: str = "static"):
         if cg_convention not in CG_CONVENTIONS:

@@ -1,21 +1,21 @@
 """Liquid tanks and hybrid grains: mass, CG, inertia and the slosh pendulum (thesis 2.3, 4.1).
 
 The equivalent mechanical model of the first lateral slosh mode of a cylindrical tank of radius R and
-liquid height h (Abramson, NASA SP-106; thesis eq. 2.23-2.29 with the radius, DESIGN.md note 1):
+liquid height h (Abramson, NASA SP-106; thesis eq. 2.23-2.29 with the radius, physics note 1):
 
 - ``kappa = xi h / R`` with ``xi = 1.84119``, the first root of ``J1'``;
 - slosh mass ``m_s = m_liq 2 tanh(kappa) / ((xi^2 - 1) kappa)``;
 - pendulum length ``L = R / (xi tanh kappa)`` (so ``omega^2 = a / L``), capped at the liquid height
-  (thesis 4.1.2, DESIGN.md note 4);
+  (thesis 4.1.2, physics note 4);
 - the slosh mass sits ``h/2 - (2R/xi) tanh(kappa/2)`` above the liquid's CG, the hinge one pendulum
   length above the slosh mass;
 - the fixed mass ``m_f = m_liq - m_s`` is a solid cylinder of the liquid's radius and height with the
   slip factor on its roll inertia (eq. 4.3-4.4). By default it sits where fixed and slosh mass at rest
-  together keep the liquid's static CG (DESIGN.md note 2, Abramson); ``cg_convention="thesis"`` puts it
+  together keep the liquid's static CG (physics note 2, Abramson); ``cg_convention="thesis"`` puts it
   at the liquid centroid as the thesis did (which moves the vehicle's CG).
 
 Below :data:`MIN_SLOSH_HEIGHT` of liquid the tank has no slosh degree of freedom: its pendulum is
-inactive (mass 0) and the liquid is all fixed mass (DESIGN.md note 4).
+inactive (mass 0) and the liquid is all fixed mass (physics note 4; docs/physics-notes.md).
 """
 
 from __future__ import annotations
