@@ -1,0 +1,145 @@
+"""The tables of docs/rl.md, generated from the layouts of ``lvgym/envs/layouts.py``.
+
+    python docs/gen_tables.py            # rewrite the generated blocks of docs/rl.md
+    python docs/gen_tables.py --check    # exit 1 (and say which block) if docs/rl.md is not what the layouts give
+
+A generated block sits between ``<!-- generated: NAME -->`` and ``<!-- end: NAME -->``. The page in the
+repository holds the tables (readable without building the site), ``tests/test_docs_site.py`` checks that
+they are what the layouts give, and this module is also an mkdocs hook (``mkdocs.yml``, ``hooks:``): the
+site renders the blocks from the layouts at build time. The ``info`` keys are not a layout: their table is
+:data:`INFO` below, and the test compares its keys with a flown env's ``info``.
+"""
+
+from __future__ import annotations
+
+import re
+import sys
+from pathlib import Path
+from typing import Any, Callable
+
+PAGE = Path(__file__).resolve().parent / "rl.md"
+
+#: the keys of a step's ``info`` (``AscentFuncEnv.transition_info``): unit and meaning. After a reset the
+#: ``info`` holds ``time``, ``cumulative_rate_error``, ``mass`` and ``controller_on`` only.
+INFO = {
+    "reward_terms": ("-", "the named reward terms of the step (table above); they add up to the reward"),
+    "cumulative_rate_error": ("rad", "integral of abs(rate - reference) since the reset (roll, pitch, yaw)"),
+    "rate_error": ("rad/s", "abs(rate - reference) after the step (roll, pitch, yaw)"),
+    "qbar": ("Pa", "dynamic pressure"),
+    "mach": ("-", "Mach number"),
+    "alpha_total": ("rad", "total angle of attack"),
+    "qalpha_pa_deg": ("Pa deg", "dynamic pressure times total angle of attack (the structural load measure)"),
+    "time": ("s", "flight time"),
+    "stage": ("-", "index of the lowest attached stage"),
+    "controller_on": ("-", "whether the controller acted in the step (off before `controller_on_after_s` "
+                           "and while no engine burns)"),
+    "slosh_angles": ("rad", "each pendulum's deflection from the body axis in the x-y and x-z body planes (0 at rest, "
+                             "hanging aft); NaN for a pendulum without mass"),
+    "eta": ("sqrt(kg) m", "modal coordinates: the K modes of the y plane, then z"),
+    "gimbal": ("rad", "gimbal angles (pitch, yaw)"),
+    "gimbal_rate": ("rad/s", "gimbal rates (pitch, yaw)"),
+    "effort_rad_s": ("rad s", "integral of abs(gimbal pitch) + abs(gimbal yaw) over the control period"),
+    "attitude_error": ("rad", "attitude error (pitch, yaw) against the reference axis"),
+    "mass": ("kg", "vehicle mass"),
+    "termination": ("-", "why the episode ended (the termination table), empty while it flies"),
+    "events": ("-", "the events of the step (burnout, separation, ignition, lift-off, rail exit)"),
+}
+
+
+def _cell(text: str) -> str:
+    """A Markdown table cell: pipes and emphasis characters escaped."""
+    return text.replace("|", "\\|").replace("*", "\\*")
+
+
+def _table(header: list[str], rows: list[list[str]]) -> str:
+    lines = ["| " + " | ".join(header) + " |", "|" + "|".join("---" for _ in header) + "|"]
+    lines += ["| " + " | ".join(_cell(c) for c in row) + " |" for row in rows]
+    return "\n".join(lines)
+
+
+def observation() -> str:
+    """The observation of the three modes (``state``, ``sensors``, ``flight``), entry by entry."""
+    from lvgym.envs.layouts import FLIGHT_SOURCE, OBS_FLIGHT, OBS_SENSORS, OBS_STATE
+
+    rows = []
+    for (o, f), (_, g), (_, h) in zip(OBS_STATE.leaves(), OBS_SENSORS.leaves(), OBS_FLIGHT.leaves()):
+        same = f.name == g.name == h.name and f.doc == g.doc == h.doc
+        name = f"`{f.name}`" if f.name == g.name else f"`{f.name}` / `{g.name}`"
+        unit = f.unit if f.unit == g.unit else f"{f.unit} / {g.unit}"
+        meaning = f.doc if same else f"state: {f.doc}; sensors: {g.doc}; flight: {h.doc}"
+        source = FLIGHT_SOURCE[g.name] if same else f"state: none (ideal); sensors, flight: {FLIGHT_SOURCE[g.name]}"
+        rows.append([str(o), name, unit, meaning, source])
+    return _table(["index", "name (state / sensors, flight)", "unit", "meaning", "flight computer source"], rows)
+
+
+def action() -> str:
+    """The action of each ``control`` (as the observation history records it)."""
+    from lvgym.envs.layouts import ACTIONS
+
+    space = {"tvc": "`Box(-1, 1, (2,))`", "rcs": "`MultiDiscrete([3])`"}
+    rows = [[f"`{control}`", space[control], str(o), f"`{f.name}`", f.unit, f.doc]
+            for control, layout in ACTIONS.items() for o, f in layout.leaves()]
+    return _table(["control", "space", "index", "name", "unit", "meaning"], rows)
+
+
+def reward() -> str:
+    """The reward terms (``info["reward_terms"]``), in the compiled kernel's order."""
+    from lvgym.envs.layouts import REWARD
+
+    return _table(["term", "unit", "meaning"], [[f"`{f.name}`", f.unit, f.doc] for _, f in REWARD.leaves()])
+
+
+def termination() -> str:
+    """The termination codes and the truncation."""
+    from lvgym.envs.layouts import REASONS
+
+    rows = [[str(code), f"`{reason}`", "terminated"] if reason else
+            [str(code), '`""`', "not terminated; truncated when the mission time (`mission_time_s`) is flown"]
+            for code, reason in enumerate(REASONS)]
+    return _table(["code", "`info[\"termination\"]`", "ends the episode as"], rows)
+
+
+def info() -> str:
+    """The keys of a step's ``info``."""
+    return _table(["key", "unit", "meaning"], [[f"`{key}`", unit, doc] for key, (unit, doc) in INFO.items()])
+
+
+BLOCKS: dict[str, Callable[[], str]] = {"observation": observation, "action": action, "reward": reward,
+                                        "termination": termination, "info": info}
+_BLOCK = re.compile(r"(<!-- generated: (\w+) -->\n)(.*?)(<!-- end: \2 -->)", re.S)
+
+
+def render(markdown: str) -> str:
+    """``markdown`` with every generated block filled from the layouts."""
+    def fill(m: re.Match) -> str:
+        if m.group(2) not in BLOCKS:
+            raise KeyError(f"docs/rl.md: generated block {m.group(2)!r}: unknown; known: {sorted(BLOCKS)}")
+        return f"{m.group(1)}{BLOCKS[m.group(2)]()}\n{m.group(4)}"
+    return _BLOCK.sub(fill, markdown)
+
+
+def stale(markdown: str) -> list[str]:
+    """The names of the blocks of ``markdown`` that differ from what the layouts give."""
+    fresh = {m.group(2): m.group(3) for m in _BLOCK.finditer(render(markdown))}
+    return [m.group(2) for m in _BLOCK.finditer(markdown) if m.group(3) != fresh[m.group(2)]]
+
+
+def on_page_markdown(markdown: str, page: Any, **kwargs: Any) -> str:
+    """mkdocs hook: the generated blocks of the page, from the layouts."""
+    return render(markdown) if _BLOCK.search(markdown) else markdown
+
+
+def main(argv: list[str]) -> int:
+    text = PAGE.read_text(encoding="utf-8")
+    if "--check" in argv:
+        old = stale(text)
+        if old:
+            print(f"docs/rl.md: generated blocks out of date: {', '.join(old)} (run python docs/gen_tables.py)")
+            return 1
+        return 0
+    PAGE.write_text(render(text), encoding="utf-8")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
