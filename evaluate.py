@@ -43,6 +43,8 @@ from typing import Any
 from lvgym.benchmark import (EXECUTORS, PROTOCOL_VERSION, SEED_SETS, SUITES, PolicySpec, compare, degradation, evaluate,
                              get_suite, markdown_table, run_groups, summarize, write_results)
 from lvgym.benchmark.registry import POLICIES, resolve_policy  # noqa: F401  (the registry, shared with margins)
+import lvgym.agents  # noqa: F401,E402  (registers the shipped learned policies and the loader of saved models)
+import lvgym.baselines  # noqa: F401,E402  (registers the controllers: pid, gs-pid, lqg, ...)
 from lvgym.cli import fail, one_line_errors
 from lvgym.errors import ConfigError
 from lvgym.parallel import TaskFailed, exit_on_sigterm
