@@ -87,7 +87,7 @@ def load_factory(reference: str, path: str = "") -> Any:
     obj: Any = module
     for part in attr.split("."):
         if not hasattr(obj, part):
-            raise FactoryError(f"{target!r} has no {attr!r} (factory {reference!r})")
+            raise FactoryError(f"{target!r} has no {attr!r}")
         obj = getattr(obj, part)
     return obj
 
