@@ -66,5 +66,5 @@ def test_a_bad_suite_or_model_is_one_line_naming_what_is_allowed():
     with pytest.raises(ConfigError, match=r"^model = 'nonrigd': one of \['rigid', 'nonrigid'\] \(the flight models of "
                                           r"suite 'slender-v1'\) \(did you mean 'nonrigid'\?\)$"):
         lvgym.make_vec_env("slender-v1", "nonrigd", num_envs=2)
-    with pytest.raises(ConfigError, match=r"^wnd = 'none': unknown env option \(did you mean 'wind'\?\)"):
+    with pytest.raises(ConfigError, match=r"^wnd = 'none': unknown option \(did you mean 'wind'\?\)"):
         lvgym.make_env("smile-v1", wnd="none")

@@ -251,8 +251,8 @@ class TaskSpec:
         known = set(cls.__dataclass_fields__)
         for key in overrides:
             if key not in known:
-                raise ConfigError(key, overrides[key], f"unknown env option{did_you_mean(key, sorted(known | set(also)))}; "
-                                  f"the options: {OPTIONS_DOC}")
+                raise ConfigError(key, overrides[key], f"unknown option{did_you_mean(key, sorted(known | set(also)))}; "
+                                  f"the env options: {OPTIONS_DOC}")
         return cls(**{**defaults, **overrides})
 
 
