@@ -455,5 +455,5 @@ def main(argv: list[str] | None = None) -> list[dict[str, Any]]:
 
 
 if __name__ == "__main__":            # the command is in the command layer, which registers the policies
-    raise SystemExit(f"{PROG}: run python -m lvgym.cli.margins (the command layer registers the built-in policies; "
-                     "the benchmark layer knows no controller)")
+    raise SystemExit("python -m lvgym.benchmark.margins: the command is now python -m lvgym.cli.margins (the command "
+                     "layer registers the built-in policies; the benchmark layer knows no controller)")

@@ -1,5 +1,5 @@
 """The policies the benchmark's command lines know by name (``evaluate.py``, ``python -m
-lvgym.benchmark.margins``, ``... budget``), how a name, a factory or a saved model's path becomes a
+lvgym.cli.margins``, ``... budget``), how a name, a factory or a saved model's path becomes a
 :class:`~.runner.PolicySpec`, and the options and checks those commands share (:func:`flight_parser`,
 :func:`resolve_flights`).
 
@@ -176,8 +176,8 @@ def flight_parser(prog: str, doc: str, default_policies: Sequence[str], default_
                                                 epilog=doc.split("\n\n", 2)[2],
                                                 formatter_class=argparse.RawDescriptionHelpFormatter))
     p.add_argument("--policies", nargs="+", default=list(default_policies), metavar="POLICY",
-                   help=f"names {sorted(POLICIES)}, SB3 .zip paths or train.py run folders "
-                        f"(default: {' '.join(default_policies)})")
+                   help=f"names {sorted(POLICIES)}, module:factory, path/to/file.py:factory, SB3 .zip paths or "
+                        f"train.py run folders, each optionally label=... (default: {' '.join(default_policies)})")
     p.add_argument("--suite", default=default_suite, help=f"of {sorted(SUITES)} (default {default_suite})")
     p.add_argument("--mission-time-s", default=None, help="shorten every episode (smoke tests only)")
     p.add_argument("--executor", choices=EXECUTORS, default="local", help="default: local process pool")

@@ -108,12 +108,16 @@ class Condition:
         """A batched env of ``num_envs`` rows of this condition (the id's ``vector_entry_point``: one
         simulator over all rows); ``reset(seed=s)`` seeds row ``i`` with ``s + i``, the single env's
         episode of seed ``s + i``."""
+        import warnings
+
         import gymnasium
 
         import lvgym  # noqa: F401  (registers the env ids)
 
-        return gymnasium.make_vec(self.env_id, num_envs=int(num_envs), vectorization_mode="vector_entry_point",
-                                  **self.env_kwargs())
+        with warnings.catch_warnings():            # a frozen v0 suite flies its v0 env on purpose
+            warnings.filterwarnings("ignore", message=".*is out of date", category=DeprecationWarning)
+            return gymnasium.make_vec(self.env_id, num_envs=int(num_envs), vectorization_mode="vector_entry_point",
+                                      **self.env_kwargs())
 
     def with_options(self, **options: Any) -> Condition:
         """This condition with env keywords added or replaced (e.g. a short ``mission_time_s`` for tests)."""
