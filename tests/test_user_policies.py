@@ -50,6 +50,14 @@ def make(env):
 
 def broken(env):
     raise ValueError("no gain table for " + type(env.unwrapped).__name__)
+
+
+def plain():                     # a factory without the env: its policy's own name labels the results
+    return Constant(None, 0.3)
+
+
+def plain_broken():
+    raise KeyError("pitch")
 '''
 
 
@@ -129,6 +137,16 @@ def test_a_bad_policy_is_refused_in_one_line_before_any_episode(user_folder, arg
         EVALUATE.main(["--policies", arg, *ARGS, "--out", str(user_folder / "out")])
     assert re.search(message, str(err.value.code)), err.value.code
     assert not (user_folder / "out").exists()
+
+
+def test_a_policys_own_name_labels_it_when_known_without_an_env(user_folder):
+    assert registry.resolve_policy("my_policy.py:make").name == "my_policy"          # a factory of the env
+    assert registry.resolve_policy("my_policy.py:plain").name == "constant"          # what it returns is named
+    assert registry.resolve_policy("my_policy.py:Constant").name == "constant"       # a class's name
+    assert registry.resolve_policy("fixed=my_policy.py:plain").name == "fixed"       # label= wins
+    with pytest.raises(SystemExit, match=r"^evaluate\.py: policy 'my_policy\.py:plain_broken': its factory raised "
+                                         r"KeyError: 'pitch'$"):
+        registry.resolve_policy("my_policy.py:plain_broken")
 
 
 def _factory(env, gain=1.0):

@@ -13,12 +13,15 @@ agents). A spec holds its factory as a string; the factory is imported in the wo
 ``--policies`` takes, in :func:`resolve_policy`'s order: a registered name; ``module:factory`` (an
 importable module, or one beside the working folder); ``path/to/file.py:factory`` (a Python file, loaded
 by path under a private name in every worker: no ``__main__`` guard needed); a saved model a loader
-takes. Any of them may be prefixed with ``label=`` to name it in the results.
+takes. Any of them may be prefixed with ``label=`` to name it in the results; a factory's policy is
+otherwise labelled by its own ``name`` where that is known without an env (a class's ``name``, or what a
+factory without parameters returns), else by the file's stem or the module's last name.
 """
 
 from __future__ import annotations
 
 import argparse
+import inspect
 import os
 import re
 from collections.abc import Callable, Sequence
@@ -131,7 +134,31 @@ def _factory_spec(text: str, label: str, prog: str) -> PolicySpec:
         raise SystemExit(f"{prog}: policy {text!r}: {exc}")
     if not callable(factory):
         raise SystemExit(f"{prog}: policy {text!r}: {attr!r} is a {type(factory).__name__}, not a callable factory")
-    return spec
+    own = "" if label else _own_name(factory, text, prog)
+    return PolicySpec(own, spec.factory, spec.kwargs, spec.path) if own else spec
+
+
+def _own_name(factory: Callable[..., Any], text: str, prog: str) -> str:
+    """The policy's own ``name`` where it is known without an env (it then labels the results): a class's
+    ``name`` attribute, or the ``name`` of what a factory without parameters returns (called here, so that
+    one that raises fails before any episode). ``""`` for a factory of the env."""
+    if isinstance(factory, type):
+        name = getattr(factory, "name", "")
+        return name if isinstance(name, str) else ""
+    try:
+        params = inspect.signature(factory).parameters.values()
+    except (TypeError, ValueError):
+        return ""
+    if any(p.name == "env" or (p.default is p.empty and p.kind not in (p.VAR_POSITIONAL, p.VAR_KEYWORD))
+           for p in params):
+        return ""
+    try:
+        policy = factory()
+    except Exception as exc:  # noqa: BLE001  (the user's factory: its error, in one line)
+        first = str(exc).strip().splitlines()[0] if str(exc).strip() else ""
+        raise SystemExit(f"{prog}: policy {text!r}: its factory raised {type(exc).__name__}{': ' + first if first else ''}")
+    name = getattr(policy, "name", "")
+    return name if isinstance(name, str) else ""
 
 
 def resolve_policy(name: str, prog: str = "evaluate.py") -> PolicySpec:
