@@ -10,7 +10,10 @@ Policies are names of :data:`POLICIES` (``zero``, ``pid``, ``gs-pid``: our rigid
 flexible vehicle; ``lqg-front``: ``lqg`` traded to the learned policy's margins (``experiments.lqg_headroom.headroom``);
 ``ppo``: the learned policy shipped for v0, ``ppo-res-lqg``: the one shipped for v1) or
 paths of saved stable-baselines3 models (``.zip``; an optional ``<stem>_vecnormalize.pkl`` next to it
-normalises the observations) or of ``train.py`` run folders. Suites are names of ``lvgym.benchmark.SUITES``. Episodes run on a local process pool
+normalises the observations) or of ``train.py`` run folders, or your own policy: ``module:factory`` or
+``path/to/my_policy.py:factory`` (a function of the env, or of nothing, that returns an object with
+``name``, ``reset()`` and ``act(observation, info)``; the file is loaded by path in every worker and needs
+no ``__main__`` guard); ``label=...`` in front names any of them in the tables. Suites are names of ``lvgym.benchmark.SUITES``. Episodes run on a local process pool
 by default; the Markdown table is printed, and CSV, JSON, the table and PNG plots go to ``--out``
 (each file written atomically: an interrupted run leaves no half-written file). ``--seed-set
 validation`` evaluates on the training seeds; reported numbers use the ``test`` seeds (the default).
@@ -43,6 +46,8 @@ from typing import Any
 from lvgym.benchmark import (EXECUTORS, PROTOCOL_VERSION, SEED_SETS, SUITES, PolicySpec, compare, degradation, evaluate,
                              get_suite, markdown_table, run_groups, summarize, write_results)
 from lvgym.benchmark.registry import POLICIES, resolve_policy  # noqa: F401  (the registry, shared with margins)
+import lvgym.agents  # noqa: F401,E402  (registers the shipped learned policies and the loader of saved models)
+import lvgym.baselines  # noqa: F401,E402  (registers the controllers: pid, gs-pid, lqg, ...)
 from lvgym.cli import fail, one_line_errors
 from lvgym.errors import ConfigError
 from lvgym.parallel import TaskFailed, exit_on_sigterm
@@ -92,8 +97,9 @@ def parse_args(argv: list[str] | None = None) -> Args:
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0], epilog=__doc__.split("\n\n", 2)[2],
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--policies", nargs="+", default=d.policies, metavar="POLICY",
-                   help=f"names {sorted(POLICIES)}, SB3 .zip paths or train.py run folders (runs/<name>: its best "
-                        f"model) (default: {' '.join(d.policies)})")
+                   help=f"names {sorted(POLICIES)}, your own module:factory or path/to/file.py:factory, SB3 .zip "
+                        f"paths or train.py run folders (runs/<name>: its best model), each optionally label=... "
+                        f"(default: {' '.join(d.policies)})")
     p.add_argument("--suites", nargs="+", default=d.suites, metavar="SUITE",
                    help=f"of {sorted(SUITES)} (default: {' '.join(d.suites)})")
     p.add_argument("--episodes", type=int, default=d.episodes, help=f"per condition and policy (default {d.episodes})")

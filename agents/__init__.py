@@ -8,5 +8,19 @@ lvgym envs.
 - :mod:`experiments.rigid_vs_nonrigid_training.robustness`: the rigid-trained vs nonrigid-trained experiment.
 
 Training itself is ``train.py`` at the repository root (``docs/training.md``). Nothing in ``lvgym`` imports this
-package; importing it does not import stable-baselines3 (the submodules do).
+package; importing it does not import stable-baselines3 (the submodules do). Importing it registers the
+shipped learned policies with the benchmark (``ppo``, ``ppo-res-lqg``) and the loader of saved models
+(``evaluate.py --policies runs/my_run`` or ``model.zip``); their factories are named as strings, imported
+only where a policy flies.
 """
+
+from lvgym.benchmark.registry import register_policy, register_policy_loader
+
+# the shipped learned policies (agents/trained, docs/training.md): PPO of SmileAscent-v0 (the ideal state
+# observation), and protocol v1's: PPO residual on lqg, flight sensors, a 4-sample history
+register_policy("ppo", "lvgym.agents.policy:shipped_policy")
+register_policy("ppo-res-lqg", "lvgym.agents.policy:shipped_policy", file="ppo_res_lqg_smile_v1", name="ppo-res-lqg")
+# a saved stable-baselines3 model (an optional <stem>_vecnormalize.pkl next to it normalises the
+# observations) or a train.py run folder (its best model)
+register_policy_loader("lvgym.agents.policy:load_policy", suffixes=(".zip",), folders=True,
+                       description="a stable-baselines3 .zip model or a train.py run folder")

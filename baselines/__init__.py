@@ -6,12 +6,36 @@ Every controller implements the benchmark's policy interface (:class:`lvgym.benc
 tunes a gain schedule on the rigid linearisation (into ``results/schedules/``; ``--overwrite`` replaces
 the shipped one in ``schedules/``); ``python -m experiments.control_study.study`` runs the
 thesis's control study (docs/control-study.md).
+
+Importing this package registers its controllers with the benchmark by name
+(:func:`lvgym.benchmark.register_policy`): ``pid``, ``gs-pid``, ``gs-pid-flex``, ``aac``, ``pid-thesis``,
+``gs-pid-thesis``, ``lqg``, ``lqg-front`` (``evaluate.py --policies lqg``).
 """
 
-from .aac import AACParams, AdaptiveAugmentingPolicy, smile_aac
+from lvgym.benchmark.registry import register_policy
+
+from .aac import AACParams, AdaptiveAugmentingPolicy, flex_aac, smile_aac
 from .bangbang import BangBangRollPolicy
-from .pid import (DiscretePID, GainSchedule, GainScheduledPIDPolicy, PIDPolicy, smile_scheduled_pid,
-                  smile_single_pid)
+from .lqg import smile_lqg
+from .pid import (DiscretePID, GainSchedule, GainScheduledPIDPolicy, PIDPolicy, flex_pid, smile_scheduled_pid,
+                  smile_single_pid, smile_tuned_pid)
+
+# our tuning on the rigid linearisation (lvgym.baselines.design.tune): one gain set, and the schedule on mass
+register_policy("pid", smile_tuned_pid)
+register_policy("gs-pid", smile_scheduled_pid, name="gs-pid", schedule="smile")
+# designed on the non-rigid v1 flight loop (lvgym.baselines.design.flexdesign, docs/flex-design.md): structural
+# filters and gains scheduled on mass, the schedule of the env's vehicle (lvgym.baselines.pid.FLEX_SCHEDULES)
+register_policy("gs-pid-flex", flex_pid, name="gs-pid-flex")
+# adaptive augmenting control on gs-pid-flex (lvgym.baselines.aac, docs/adaptive-control.md)
+register_policy("aac", flex_aac, name="aac")
+# the thesis's gains (6.3.1) and its Table 6.10 schedule, as published
+register_policy("pid-thesis", smile_single_pid)
+register_policy("gs-pid-thesis", smile_scheduled_pid, name="gs-pid-thesis", schedule="smile_thesis")
+# LQG on the non-rigid flight plant, scheduled over the flight (lvgym.baselines.design.lqg_design, docs/lqg.md)
+register_policy("lqg", smile_lqg, name="lqg")
+# lqg with its boost and max-q rows moved along the turbulence-against-margin trade: the design of lowest
+# turbulence rate error within 2 dB of gain margin and 60 % of the delay margin (experiments.lqg_headroom.headroom)
+register_policy("lqg-front", smile_lqg, name="lqg-front", schedule="smile_lqg_front")
 
 __all__ = ["AACParams", "AdaptiveAugmentingPolicy", "BangBangRollPolicy", "DiscretePID", "GainSchedule",
            "GainScheduledPIDPolicy", "PIDPolicy", "smile_aac", "smile_scheduled_pid", "smile_single_pid"]

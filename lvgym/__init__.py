@@ -2,19 +2,71 @@
 
 ``import lvgym`` registers the environments with Gymnasium by name (their modules load on
 ``gymnasium.make``), so the physics layers can be imported without Gymnasium's machinery.
+
+The benchmark's own envs, as a suite's condition flies them (wind, gust, dispersions and all)::
+
+    env = lvgym.make_env("smile-v1", model="nonrigid")                # gymnasium.Env
+    venv = lvgym.make_vec_env("smile-v1", "rigid", num_envs=8)        # gymnasium VectorEnv, row i = seed + i
 """
+
+from __future__ import annotations
+
+from typing import Any
 
 __version__ = "0.1.0"
 
-#: env id -> (entry point, vector entry point)
+#: the one table of env ids: id -> the env class, as its import path (``gymnasium.make`` imports it on
+#: first use, so ``import lvgym`` stays light). Each id's ``vector_entry_point`` is :func:`make_vector`
+#: with the id; ``lvgym.envs.ENVS`` holds the classes themselves.
 ENV_IDS = {
-    "lvgym/SmileAscent-v0": ("lvgym.envs.ascent:SmileAscentEnv", "lvgym.envs:smile_ascent_vector"),
-    "lvgym/SmileAscent-v1": ("lvgym.envs.ascent:SmileAscentV1Env", "lvgym.envs:smile_ascent_v1_vector"),
-    "lvgym/StratosIII-v0": ("lvgym.envs.ascent:StratosIIIEnv", "lvgym.envs:stratos3_vector"),
-    "lvgym/SlenderAscent-v0": ("lvgym.envs.ascent:SlenderAscentEnv", "lvgym.envs:slender_ascent_vector"),
-    "lvgym/StratosIII-v1": ("lvgym.envs.ascent:StratosIIIV1Env", "lvgym.envs:stratos3_v1_vector"),
-    "lvgym/SlenderAscent-v1": ("lvgym.envs.ascent:SlenderAscentV1Env", "lvgym.envs:slender_ascent_v1_vector"),
+    "lvgym/SmileAscent-v0": "lvgym.envs.ascent:SmileAscentEnv",
+    "lvgym/SmileAscent-v1": "lvgym.envs.ascent:SmileAscentV1Env",
+    "lvgym/StratosIII-v0": "lvgym.envs.ascent:StratosIIIEnv",
+    "lvgym/SlenderAscent-v0": "lvgym.envs.ascent:SlenderAscentEnv",
+    "lvgym/StratosIII-v1": "lvgym.envs.ascent:StratosIIIV1Env",
+    "lvgym/SlenderAscent-v1": "lvgym.envs.ascent:SlenderAscentV1Env",
 }
+
+
+def env_class(env_id: str) -> type:
+    """The env class of a registered id (of :data:`ENV_IDS`; a ``ValueError`` names the ids otherwise)."""
+    import importlib
+
+    if env_id not in ENV_IDS:
+        from lvgym.errors import ConfigError, did_you_mean
+
+        raise ConfigError("env_id", env_id, f"one of {sorted(ENV_IDS)}{did_you_mean(env_id, ENV_IDS)}")
+    module, _, name = ENV_IDS[env_id].partition(":")
+    return getattr(importlib.import_module(module), name)
+
+
+def make_vector(env_id: str, num_envs: int = 1, **options: Any) -> Any:
+    """The batched Gymnasium ``VectorEnv`` of ``num_envs`` rows of ``env_id`` with ``options``
+    (:class:`lvgym.envs.AscentVectorEnv`): every id's ``vector_entry_point``, i.e. what
+    ``gymnasium.make_vec(env_id, num_envs, vectorization_mode="vector_entry_point", **options)`` builds."""
+    from lvgym.envs.vector import AscentVectorEnv
+
+    return AscentVectorEnv(env_class(env_id), num_envs, **options)
+
+
+def make_env(suite: str, model: str = "nonrigid", **overrides: Any) -> Any:
+    """The env of the condition of benchmark suite ``suite`` flown with flight model ``model``: the very
+    env the benchmark flies (:meth:`lvgym.benchmark.Condition.make_env`: wind, gust, dispersions, sensors
+    and mission time of the suite), with env keywords ``overrides`` added or replaced. Reset it with a
+    seed of the suite's seed sets to fly the benchmark's episode of that seed. A bad suite or model raises
+    a one-line ``ConfigError`` naming what is allowed."""
+    from lvgym.benchmark.suites import condition
+
+    return condition(suite, model, **overrides).make_env()
+
+
+def make_vec_env(suite: str, model: str = "nonrigid", num_envs: int = 1, **overrides: Any) -> Any:
+    """:func:`make_env`'s env batched: a Gymnasium ``VectorEnv`` of ``num_envs`` rows
+    (:meth:`lvgym.benchmark.Condition.make_vec_env`); ``reset(seed=s)`` seeds row ``i`` with ``s + i``,
+    so row ``i`` flies the benchmark's episode of seed ``s + i``."""
+    from lvgym.benchmark.suites import condition
+
+    return condition(suite, model, **overrides).make_vec_env(num_envs)
 
 
 def register_envs() -> None:
@@ -23,9 +75,13 @@ def register_envs() -> None:
         import gymnasium as gym
     except ImportError:  # pragma: no cover - gymnasium is a dependency; the physics does not need it
         return
-    for env_id, (entry, vector_entry) in ENV_IDS.items():
+    import functools
+
+    for env_id, entry in ENV_IDS.items():
         if env_id not in gym.registry:
-            gym.register(id=env_id, entry_point=entry, vector_entry_point=vector_entry)
+            gym.register(id=env_id, entry_point=entry, vector_entry_point=functools.partial(make_vector, env_id))
 
 
 register_envs()
+
+__all__ = ["ENV_IDS", "env_class", "make_env", "make_vec_env", "make_vector", "register_envs"]

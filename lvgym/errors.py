@@ -95,6 +95,17 @@ def check_choice(key: str, value: Any, allowed: tuple[str, ...], source: str | N
     return str(value)
 
 
+def did_you_mean(value: Any, choices: Any) -> str:
+    """`` (did you mean 'x'?)`` naming the closest of ``choices`` to ``value`` (:func:`difflib.get_close_matches`),
+    or ``""`` when none is close: the hint a one-line error appends after what is allowed."""
+    import difflib
+
+    if not isinstance(value, str):
+        return ""
+    close = difflib.get_close_matches(value, [str(c) for c in choices], n=1)
+    return f" (did you mean {close[0]!r}?)" if close else ""
+
+
 def check_bool(key: str, value: Any, source: str | None = None) -> bool:
     """``value`` when it is a bool; else a :class:`ConfigError` naming ``key``."""
     if not isinstance(value, bool):

@@ -183,3 +183,60 @@ def test_slender_aerodynamics_frozen_at_mach_2_by_default():
     assert info["termination"] == "q-alpha beyond the structural limit" and info["time"] < 7.5
     with pytest.raises(ConfigError, match="aero_mach"):
         gym.make("lvgym/SlenderAscent-v0", aero_mach=40.0)
+
+
+def test_an_unknown_keyword_is_one_short_line_with_the_closest_option():
+    with pytest.raises(ConfigError) as err:
+        gym.make("lvgym/SmileAscent-v1", wnd="turbulence")
+    assert str(err.value) == ("wnd = 'turbulence': unknown option (did you mean 'wind'?); the env options: "
+                              "help(lvgym.envs.TaskSpec)")
+    with pytest.raises(ConfigError, match=r"^lenght = 9: unknown option \(did you mean 'length'\?\)"):  # the class's own
+        gym.make("lvgym/SlenderAscent-v1", lenght=9)
+    with pytest.raises(ConfigError, match=r"^lenght = 9: unknown option \(did you mean 'length'\?\)"):
+        gym.make_vec("lvgym/SlenderAscent-v0", num_envs=2, vectorization_mode="vector_entry_point", lenght=9)
+    with pytest.raises(ConfigError, match=r"^zzz = 1: unknown option; the env options"):          # nothing close
+        gym.make("lvgym/StratosIII-v1", zzz=1)
+
+
+def test_an_unknown_reset_option_names_the_key_and_the_keys_allowed():
+    from lvgym.envs import make_sb3_vec_env
+
+    allowed = r"unknown reset option \(allowed keys: none\)"
+    env = gym.make("lvgym/SmileAscent-v1", mission_time_s=0.1)
+    env.reset(seed=0, options={})                                       # empty or None: fine
+    with pytest.raises(ConfigError, match=rf"^reset\(options\)\['wind'\] = 'gust': {allowed}; 'wind' is an env "
+                                          r"keyword \(gymnasium\.make\(env_id, wind=\.\.\.\)\)"):
+        env.reset(seed=0, options={"wind": "gust"})
+    venv = gym.make_vec("lvgym/SmileAscent-v1", num_envs=2, vectorization_mode="vector_entry_point", mission_time_s=0.1)
+    with pytest.raises(ConfigError, match=rf"^reset\(options\)\['sede'\] = 3: {allowed}; the env options"):
+        venv.reset(seed=0, options={"sede": 3})
+    sb3 = make_sb3_vec_env("lvgym/SmileAscent-v1", num_envs=2, seed=0, mission_time_s=0.1)
+    sb3.set_options({"reward": 1})
+    with pytest.raises(ConfigError, match=rf"^reset\(options\)\['reward'\] = 1: {allowed}"):
+        sb3.reset()
+    sb3.set_options(None)
+    assert sb3.reset().shape == (2, 14)
+
+
+def test_one_table_of_ids_and_one_vector_entry_point():
+    import functools
+
+    from lvgym.envs import ENVS, SlenderAscentEnv, SlenderAscentV1Env
+    from lvgym.envs.vector import batch_task
+
+    assert list(ENVS) == list(lvgym.ENV_IDS) and set(ENVS) == set(ENV_IDS)
+    for env_id, cls in ENVS.items():
+        spec = gym.spec(env_id)
+        assert spec.entry_point == lvgym.ENV_IDS[env_id] and lvgym.env_class(env_id) is cls
+        assert isinstance(spec.vector_entry_point, functools.partial)
+        assert spec.vector_entry_point.func is lvgym.make_vector and spec.vector_entry_point.args == (env_id,)
+    # the slender geometry's defaults are class attributes, read by the single and the batched env alike
+    assert SlenderAscentEnv.GEOMETRY["diameter"] == 0.3 and SlenderAscentV1Env.GEOMETRY["diameter"] == 0.2833
+    for cls, key in ((SlenderAscentEnv, ("slender", 8.5, 0.3, 2.0)),
+                     (SlenderAscentV1Env, ("slender", 8.5, 0.2833, 2.0, 0.0045))):
+        assert batch_task(cls, {}).vehicle == key == cls().task.vehicle
+    assert batch_task(SlenderAscentV1Env, {"wall_thickness_m": 0.002, "aero_mach": None}).vehicle == \
+        ("slender", 8.5, 0.2833, None, 0.002)
+    with pytest.raises(ConfigError, match=r"^env_id = 'lvgym/SmileAscent-v2': one of .* \(did you mean "
+                                          r"'lvgym/SmileAscent-v1'\?\)$"):
+        lvgym.env_class("lvgym/SmileAscent-v2")

@@ -2,13 +2,20 @@
 
 The dynamics core imports neither gymnasium nor the environment models nor the vehicle layer; the
 environment models and the vehicle layer are independent of each other and of everything above them; the
-simulator imports no gymnasium. Checked on the import statements of every module of a layer, followed
-through the lvgym modules they import (the package root only registers env names with Gymnasium).
+simulator imports no gymnasium; the benchmark names no controller or agent. Checked on the import
+statements of every module of a layer, and on the import paths it writes as strings (a policy's factory
+``"package.module:function"``, a module name handed to importlib), followed through the lvgym modules they
+import (the package root only registers env names with Gymnasium).
+
+The policy registry's dependencies point the other way: ``lvgym.baselines`` and ``lvgym.agents`` register
+their policies with the benchmark, and the command layer (``evaluate.py``, ``lvgym.cli.policies``) imports
+every module that registers one.
 """
 
 import ast
 import importlib.util
 import pkgutil
+import re
 from pathlib import Path
 
 import pytest
@@ -29,11 +36,34 @@ FORBIDDEN = {
 ROOT = Path(lvgym.__file__).parent
 
 
-def _imports(module: str) -> set[str]:
-    """Absolute names imported by the source of ``module``."""
-    spec = importlib.util.find_spec(module)
-    tree = ast.parse(Path(spec.origin).read_text(encoding="utf-8"))
-    package = module if spec.origin.endswith("__init__.py") else module.rpartition(".")[0]
+#: a string that names a module (``"lvgym.baselines.pid"``) or a factory in one (``"lvgym.agents.policy:load"``)
+#: (a dotted name or a factory: a bare word such as "experiments" may be a dict key)
+IMPORT_PATH = re.compile(r"^(?P<module>(?:lvgym|baselines_pid|experiments|gymnasium|stable_baselines3|sb3_contrib|torch)"
+                         r"(?:\.\w+)*)(?::[\w.]+)?$")
+
+
+def _names_a_module(text: str) -> str:
+    """The module an import-path string names (``""`` for other strings)."""
+    m = IMPORT_PATH.match(text)
+    return m["module"] if m and ("." in m["module"] or ":" in text) else ""
+
+
+def _docstrings(tree: ast.AST) -> set[int]:
+    """ids of the docstring nodes of a module, its classes and functions (prose, not import paths)."""
+    out = set()
+    for node in ast.walk(tree):
+        if isinstance(node, (ast.Module, ast.ClassDef, ast.FunctionDef, ast.AsyncFunctionDef)) and node.body:
+            first = node.body[0]
+            if isinstance(first, ast.Expr) and isinstance(first.value, ast.Constant) and isinstance(first.value.value, str):
+                out.add(id(first.value))
+    return out
+
+
+def _source_imports(path: Path, package: str) -> set[str]:
+    """Absolute names imported by the source file ``path`` of a module of ``package``, and the modules
+    named by import-path strings in its code."""
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    prose = _docstrings(tree)
     out: set[str] = set()
     for node in ast.walk(tree):
         if isinstance(node, ast.Import):
@@ -46,7 +76,17 @@ def _imports(module: str) -> set[str]:
             out.add(base)
             out |= {f"{base}.{a.name}" for a in node.names if importlib.util.find_spec(base) is not None
                     and _is_module(f"{base}.{a.name}")}
+        elif isinstance(node, ast.Constant) and isinstance(node.value, str) and id(node) not in prose:
+            if _names_a_module(node.value):
+                out.add(_names_a_module(node.value))
     return out
+
+
+def _imports(module: str) -> set[str]:
+    """Absolute names imported by the source of ``module`` (statements and import-path strings)."""
+    spec = importlib.util.find_spec(module)
+    package = module if spec.origin.endswith("__init__.py") else module.rpartition(".")[0]
+    return _source_imports(Path(spec.origin), package)
 
 
 def _is_module(name: str) -> bool:
@@ -56,11 +96,9 @@ def _is_module(name: str) -> bool:
         return False
 
 
-def _closure(package: str) -> set[str]:
-    pkg = importlib.import_module(package)
-    todo = [package] + [m.name for m in pkgutil.walk_packages(pkg.__path__, package + ".")]
+def _follow(todo: list[str], names: set[str]) -> set[str]:
+    """``names`` with everything the lvgym modules of ``todo`` import, followed through lvgym modules."""
     seen: set[str] = set()
-    names: set[str] = set()
     while todo:
         m = todo.pop()
         if m in seen or m == "lvgym":
@@ -73,6 +111,29 @@ def _closure(package: str) -> set[str]:
     return names
 
 
+def _closure(package: str) -> set[str]:
+    pkg = importlib.import_module(package)
+    return _follow([package] + [m.name for m in pkgutil.walk_packages(pkg.__path__, package + ".")], set())
+
+
+def _registering_modules() -> set[str]:
+    """The modules of lvgym that call ``register_policy`` or ``register_policy_loader`` (outside the
+    registry itself)."""
+    out = set()
+    names = ["lvgym.baselines", "lvgym.agents"]
+    for package in ("lvgym", "lvgym.baselines", "lvgym.agents"):     # the last two live in their own folders
+        names += [m.name for m in pkgutil.walk_packages(importlib.import_module(package).__path__, package + ".")]
+    for name in sorted(set(names)):
+        if name.startswith("lvgym.benchmark"):
+            continue
+        spec = importlib.util.find_spec(name)
+        tree = ast.parse(Path(spec.origin).read_text(encoding="utf-8"))
+        if any(isinstance(n, ast.Call) and getattr(n.func, "id", getattr(n.func, "attr", None))
+               in ("register_policy", "register_policy_loader") for n in ast.walk(tree)):
+            out.add(name)
+    return out
+
+
 @pytest.mark.parametrize("package", sorted(FORBIDDEN))
 def test_layer_imports_nothing_above_it(package):
     bad = sorted(n for n in _closure(package) if n.startswith(FORBIDDEN[package]))
@@ -82,3 +143,30 @@ def test_layer_imports_nothing_above_it(package):
 def test_the_check_sees_an_upward_import():
     assert any(n.startswith("lvgym.simulator") for n in _closure("lvgym.envs"))
     assert "gymnasium" in _closure("lvgym.envs")
+
+
+def test_the_check_sees_an_import_path_written_as_a_string():
+    assert "lvgym.agents.policy" in _imports("lvgym.agents")            # ppo's factory, registered as a string
+    assert "lvgym.benchmark.runner" in _imports("lvgym.benchmark.registry")   # zero's
+
+
+def test_the_benchmark_names_no_controller_and_the_command_layer_imports_every_registering_module():
+    registering = _registering_modules()
+    assert {"lvgym.baselines", "lvgym.agents"} <= registering
+    assert not any(m.startswith(("lvgym.benchmark", "lvgym.envs", "lvgym.simulator")) for m in registering)
+    evaluate = _follow([], _source_imports(ROOT.parent / "evaluate.py", ""))
+    evaluate = _follow([n for n in evaluate if n.startswith("lvgym.") and _is_module(n)], evaluate)
+    assert registering <= evaluate, f"evaluate.py does not import {sorted(registering - evaluate)}"
+    assert registering <= _follow(["lvgym.cli.policies"], set())
+
+
+def test_every_registered_factory_lives_at_or_below_the_package_that_registers_it():
+    import lvgym.cli.policies  # noqa: F401  (registers the built-ins)
+    from lvgym.benchmark.registry import LOADERS, POLICIES
+
+    factories = [spec.factory for spec in POLICIES.values()] + [loader.factory for loader in LOADERS]
+    modules = {f.partition(":")[0] for f in factories}
+    assert modules == {"lvgym.benchmark.runner", "lvgym.baselines.pid", "lvgym.baselines.aac", "lvgym.baselines.lqg",
+                       "lvgym.agents.policy"}
+    for module in modules:                          # a worker imports it: the factory reaches no study
+        assert not any(n.startswith("experiments") for n in _follow([module], set())), module

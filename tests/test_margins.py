@@ -7,6 +7,7 @@ import math
 import numpy as np
 import pytest
 
+import lvgym.cli.policies  # noqa: F401  (registers the built-in policies: pid)
 from lvgym.benchmark import get_suite
 from lvgym.benchmark.margins import (RATE_ERROR_FLOOR_RADPS, RATE_LIMIT_FLOOR_S, MarginOptions, _summary, bounds, main,
                                      margins_table, time_domain_margins, verdict)

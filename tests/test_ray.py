@@ -120,10 +120,13 @@ def test_evaluate_on_ray_gives_the_serial_results_and_worker_errors_reach_the_ca
 
     bad = tmp_path / "broken.zip"
     bad.write_bytes(b"not a zip file")
-    with pytest.raises(TaskFailed, match=r"task failed: policy 'broken' on 'smile-windy/\w+' seed \d+: .*zip") as err:
+    # a policy that cannot be built: one line naming it and the cause (a PolicyError from the worker)
+    with pytest.raises(SystemExit, match=r"^evaluate\.py: task failed: policy 'broken' on 'smile-windy/\w+' seed \d+: "
+                                         r"policy = 'broken': its factory \S+ raised ValueError: .*zip") as err:
         evaluate.main(["--policies", str(bad), "--suites", "smile-windy", "--episodes", "1", "--mission-time-s", "0.5",
                        "--executor", "ray", "--workers", "2", "--no-plots", "--no-progress", "--out", str(tmp_path / "b")])
     assert "RayTaskError" not in str(err.value)                    # the task's own error, not Ray's wrapper
+    assert len(str(err.value).splitlines()) == 1
 
 
 def test_a_study_on_ray_gives_the_serial_table(ray_cluster, tmp_path):
@@ -137,3 +140,30 @@ def test_a_study_on_ray_gives_the_serial_table(ray_cluster, tmp_path):
     for col in ("diameter", "ld", "f1_hz", "flex_total", "cg_total"):            # equal to rounding (see above)
         assert list(on_ray.table[col]) == list(serial.table[col]), col    # bit for bit (modes on one BLAS thread)
     assert (tmp_path / "ray" / "runs.csv").is_file()
+
+
+def test_a_users_policy_file_and_module_reach_the_ray_workers(ray_cluster, tmp_path, monkeypatch):
+    """The cluster's workers share neither this process's sys.path nor its working folder: the file is
+    loaded by its path, the module from the folder its spec carries."""
+    from test_user_policies import POLICY_FILE
+
+    (tmp_path / "my_policy.py").write_text(POLICY_FILE, encoding="utf-8")
+    (tmp_path / "ray_user_controllers.py").write_text("from my_policy import make  # noqa: F401\n", encoding="utf-8")
+    monkeypatch.chdir(tmp_path)
+    evaluate = _evaluate_module()
+    argv = ["--policies", "my_policy.py:make", "ray_user_controllers:make", "--suites", "smile-v1", "--episodes", "1",
+            "--mission-time-s", "3", "--no-plots", "--no-progress"]
+    try:
+        on_ray = evaluate.main([*argv, "--executor", "ray", "--workers", "2", "--out", str(tmp_path / "ray")])
+        serial = evaluate.main([*argv, "--executor", "serial", "--out", str(tmp_path / "serial")])
+    finally:
+        for name in [n for n in sys.modules if n in ("my_policy", "ray_user_controllers")
+                     or n.startswith("_lvgym_policy_")]:
+            del sys.modules[name]
+        while str(tmp_path) in sys.path:
+            sys.path.remove(str(tmp_path))
+    key = ("policy", "condition", "seed", "failed", "rate_error_rad")
+    assert [tuple(r[k] for k in key) for r in on_ray["records"]] == [tuple(r[k] for k in key) for r in serial["records"]]
+    assert {r["policy"] for r in on_ray["records"]} == {"my_policy", "ray_user_controllers"}
+    pids = {int(line.split()[0]) for line in (tmp_path / "loads.log").read_text().splitlines()}
+    assert pids - {os.getpid()}, "Ray's workers loaded the user's file"

@@ -132,8 +132,8 @@ def test_rail_exit_is_found_at_the_physics_step():
 
 def test_batched_row_infos_equal_single_row_infos():
     from lvgym.envs.ascent import _row, _rows
-    from lvgym.envs import smile_ascent_vector
-    env = smile_ascent_vector(num_envs=3, model="nonrigid", wind="gust")
+    from lvgym import make_vector
+    env = make_vector("lvgym/SmileAscent-v0", num_envs=3, model="nonrigid", wind="gust")
     env.reset(seed=1)
     for _ in range(120):
         _, _, _, _, info = env.step(np.full((3, 2), 0.1, dtype=np.float32))

@@ -30,6 +30,7 @@ from typing import Any
 import numpy as np
 
 from lvgym.cli import fail, one_line_errors, option_number
+import lvgym.cli.policies  # noqa: F401  (registers the built-in policies the command line names)
 from lvgym.errors import ConfigError
 from lvgym.parallel import EXECUTORS, check_workers, exit_on_sigterm, run_map
 

@@ -39,6 +39,7 @@ from typing import Any
 import numpy as np
 
 from lvgym.cli import fail, option_number, parse_number
+import lvgym.cli.policies  # noqa: F401  (registers the built-in policies the command line names)
 from lvgym.errors import ConfigError
 from lvgym.parallel import check_workers, exit_on_sigterm
 

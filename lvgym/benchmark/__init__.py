@@ -9,7 +9,8 @@
 - :mod:`.compare`: the paired comparison of policies and agents over training runs;
 - :mod:`.runner`: :func:`run_episode` and :func:`evaluate` (serial, local process pool or Ray);
 - :mod:`.tables`, :mod:`.results`: the Markdown tables; atomic CSV / JSON / Markdown / PNG result files;
-- :mod:`.registry`: the policies the command lines know by name (import paths, never the packages);
+- :mod:`.registry`: the policies the command lines know by name (:func:`register_policy`: the controllers
+  and agents register themselves; the command layer imports them) and how ``--policies`` resolves;
 - :mod:`.margins`, :mod:`.perturb`: time-domain gain and delay margins of any policy
   (``python -m lvgym.benchmark.margins``; import ``lvgym.benchmark.margins`` for
   :func:`~.margins.time_domain_margins`: it is not imported here, so that ``-m`` runs it cleanly).
@@ -20,12 +21,15 @@ from .metrics import (CVAR_LEVEL, SUMMARY_METRICS, V1_METRICS, Trajectory, Traje
                       episode_metrics, rank, summarize)
 from .policy import Policy, ZeroPolicy
 from .results import atomic_write, atomic_write_text, markdown_table, write_results
-from .runner import EXECUTORS, ZERO, PolicySpec, build_policy, evaluate, make_tasks, play_episode, run_episode
+from .registry import register_policy, register_policy_loader
+from .runner import (EXECUTORS, ZERO, PolicyError, PolicySpec, build_policy, evaluate, make_tasks, play_episode,
+                     run_episode)
 from .suites import (DEFAULT_SUITE, PROTOCOL_VERSION, SEED_SETS, SUITES, TEST_SEED0, VALIDATION_SEED0, Condition,
-                     Suite, get_suite)
+                     Suite, condition, get_suite)
 
 __all__ = ["CVAR_LEVEL", "Condition", "DEFAULT_SUITE", "EXECUTORS", "PROTOCOL_VERSION", "Policy", "PolicySpec",
            "SEED_SETS", "SUITES", "SUMMARY_METRICS", "Suite", "TEST_SEED0", "Trajectory", "TrajectoryBuilder",
            "V1_METRICS", "VALIDATION_SEED0", "ZERO", "ZeroPolicy", "atomic_write", "atomic_write_text", "build_policy",
-           "compare", "cvar", "degradation", "episode_metrics", "evaluate", "get_suite", "make_tasks",
-           "markdown_table", "play_episode", "rank", "run_episode", "run_groups", "summarize", "write_results"]
+           "compare", "condition", "cvar", "degradation", "episode_metrics", "evaluate", "get_suite", "make_tasks",
+           "markdown_table", "play_episode", "rank", "register_policy", "register_policy_loader", "run_episode",
+           "run_groups", "summarize", "write_results", "PolicyError"]

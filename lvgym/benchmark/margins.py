@@ -1,9 +1,9 @@
 """Time-domain margins of any policy in the nonlinear simulation: gain margins up and down [dB] and the
 delay margin [ms] (docs/benchmark.md, "Time-domain margins").
 
-    python -m lvgym.benchmark.margins                                  # pid and gs-pid on smile-v1, 5 test seeds
-    python -m lvgym.benchmark.margins --policies zero pid gs-pid ppo --seeds 10 --models rigid
-    python -m lvgym.benchmark.margins --policies runs/ppo_smile --physics-dt-s 0.005   # 5 ms delay resolution
+    python -m lvgym.cli.margins                                  # the default policies on smile-v1, 5 test seeds
+    python -m lvgym.cli.margins --policies zero pid gs-pid ppo --seeds 10 --models rigid
+    python -m lvgym.cli.margins --policies runs/ppo_smile --physics-dt-s 0.005   # 5 ms delay resolution
 
 Between the policy and the actuator a multiplicative gain ``k`` (:class:`~.perturb.GainPolicy`), and
 separately a pure delay (:class:`~.perturb.ActuatorDelay`, in whole physics steps), are raised, per seed,
@@ -58,7 +58,7 @@ DEFAULT_SUITE = "smile-v1"
 #: every default policy of evaluate.py that has a loop to perturb (zero has none)
 DEFAULT_POLICIES = ["gs-pid", "gs-pid-flex", "lqg", "lqg-front", "aac", "ppo-res-lqg"]
 DEFAULT_SEEDS = 5
-PROG = "python -m lvgym.benchmark.margins"
+PROG = "python -m lvgym.cli.margins"
 #: the nominal time at the gimbal rate limit counts as at least this in the rate-limit bound [s]
 RATE_LIMIT_FLOOR_S = 1.0
 #: the nominal rate error counts as at least this mean rate over the nominal flight in the rate-error bound
@@ -454,7 +454,6 @@ def main(argv: list[str] | None = None) -> list[dict[str, Any]]:
     return results
 
 
-if __name__ == "__main__":            # run as the imported module, so that the workers find its tasks by name
-    from lvgym.benchmark.margins import main as _main
-
-    _main()
+if __name__ == "__main__":            # the command is in the command layer, which registers the policies
+    raise SystemExit("python -m lvgym.benchmark.margins: the command is now python -m lvgym.cli.margins (the command "
+                     "layer registers the built-in policies; the benchmark layer knows no controller)")

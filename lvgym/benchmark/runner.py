@@ -10,14 +10,15 @@ depend on the executor, the number of workers or the order in which episodes fin
 
 from __future__ import annotations
 
-import importlib
 import inspect
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
+from lvgym.errors import ConfigError
 from lvgym.parallel import EXECUTORS, default_workers, run_map
 
+from .factory import load_factory
 from .metrics import TrajectoryBuilder, episode_metrics
 from .policy import Policy, ZeroPolicy
 from .scoring import FlightLog, flight_metrics
@@ -26,27 +27,30 @@ from .suites import PROTOCOL_VERSION, Condition, Suite
 
 @dataclass(frozen=True)
 class PolicySpec:
-    """A policy by reference: ``factory`` is ``"package.module:attribute"``, imported in the worker and
-    called with ``kwargs`` (sorted ``(key, value)`` pairs), plus ``env=<the condition's env>`` when it
-    takes an ``env`` argument. ``name`` labels the policy in the results."""
+    """A policy by reference: ``factory`` is ``"package.module:attribute"`` or
+    ``"/abs/path/file.py:attribute"`` (:mod:`.factory`), imported in the worker and called with ``kwargs``
+    (sorted ``(key, value)`` pairs), plus ``env=<the condition's env>`` when it takes an ``env`` argument.
+    ``name`` labels the policy in the results; ``path`` (optional) is a folder the worker appends to
+    ``sys.path`` before importing the factory's module (a user's module outside the installed packages)."""
 
     name: str
     factory: str
     kwargs: tuple[tuple[str, Any], ...] = ()
+    path: str = ""
 
     def resolve(self) -> Callable[..., Any]:
-        """The factory object (raises ``ImportError`` naming the missing module or attribute)."""
-        module, _, attr = self.factory.partition(":")
+        """The factory object (raises ``ImportError`` naming the policy and the missing module, file or
+        attribute, or what the module's code raised)."""
         try:
-            mod = importlib.import_module(module)
+            return load_factory(self.factory, self.path)
         except ImportError as exc:
-            raise ImportError(f"policy {self.name!r}: cannot import {module!r} ({exc})") from exc
-        obj: Any = mod
-        for part in attr.split(".") if attr else []:
-            if not hasattr(obj, part):
-                raise ImportError(f"policy {self.name!r}: {module!r} has no {attr!r} (factory {self.factory!r})")
-            obj = getattr(obj, part)
-        return obj
+            raise type(exc)(f"policy {self.name!r}: {exc}") from exc
+
+
+class PolicyError(ConfigError):
+    """A policy that could not be built: its factory did not import, raised, or gave no Policy. One line
+    (``policy = 'name': ...``) naming the policy and the cause, which survives a worker process (the
+    cause is also ``__cause__`` where the policy is built)."""
 
 
 def zero_policy(env: Any) -> ZeroPolicy:
@@ -60,8 +64,13 @@ ZERO = PolicySpec("zero", "lvgym.benchmark.runner:zero_policy")
 
 
 def build_policy(spec: PolicySpec, env: Any) -> Policy:
-    """Call ``spec``'s factory (with ``env=env`` if it takes one); checks the result is a Policy."""
-    factory = spec.resolve()
+    """Call ``spec``'s factory (with ``env=env`` if it takes one); checks the result is a Policy. A
+    factory that does not import or raises, or a result that is no Policy, raises a :class:`PolicyError`
+    naming the policy and the cause in one line (from the cause)."""
+    try:
+        factory = spec.resolve()
+    except ImportError as exc:
+        raise PolicyError("policy", spec.name, str(exc).removeprefix(f"policy {spec.name!r}: ")) from exc
     kwargs = dict(spec.kwargs)
     try:
         params = inspect.signature(factory).parameters
@@ -69,10 +78,15 @@ def build_policy(spec: PolicySpec, env: Any) -> Policy:
         params = {}
     if "env" in params:
         kwargs["env"] = env
-    policy = factory(**kwargs)
+    try:
+        policy = factory(**kwargs)
+    except Exception as exc:
+        text = str(exc).strip().splitlines()[0] if str(exc).strip() else ""
+        raise PolicyError("policy", spec.name, f"its factory {spec.factory} raised {type(exc).__name__}"
+                                               f"{': ' + text if text else ''}") from exc
     if not isinstance(policy, Policy):
-        raise TypeError(f"policy {spec.name!r}: {spec.factory} gave {type(policy).__name__}, which lacks "
-                        "name, reset() or act(observation, info)")
+        raise PolicyError("policy", spec.name, f"its factory {spec.factory} gave {type(policy).__name__}, which "
+                                               "lacks name, reset() or act(observation, info)")
     return policy
 
 
@@ -189,5 +203,5 @@ def evaluate(policies: Sequence[PolicySpec], suites: Sequence[Suite], episodes: 
     return run_map(run_task, tasks, executor, workers, progress, desc="episodes", unit="ep", describe=_describe)
 
 
-__all__ = ["EXECUTORS", "PROTOCOL_VERSION", "PolicySpec", "Task", "ZERO", "build_policy", "default_workers",
+__all__ = ["EXECUTORS", "PROTOCOL_VERSION", "PolicyError", "PolicySpec", "Task", "ZERO", "build_policy", "default_workers",
            "episode_objects", "evaluate", "make_tasks", "play_episode", "run_episode", "run_task", "zero_policy"]

@@ -50,6 +50,8 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from typing import Any
 
+from lvgym.errors import ConfigError, did_you_mean
+
 PROTOCOL_VERSION = "v0"
 #: first validation seed; validation seeds are ``VALIDATION_SEED0 + i`` for ``i < N_VALIDATION_SEEDS``
 VALIDATION_SEED0 = 0
@@ -101,6 +103,21 @@ class Condition:
         with warnings.catch_warnings():            # a frozen v0 suite flies its v0 env on purpose
             warnings.filterwarnings("ignore", message=".*is out of date", category=DeprecationWarning)
             return gymnasium.make(self.env_id, **self.env_kwargs())
+
+    def make_vec_env(self, num_envs: int = 1) -> Any:
+        """A batched env of ``num_envs`` rows of this condition (the id's ``vector_entry_point``: one
+        simulator over all rows); ``reset(seed=s)`` seeds row ``i`` with ``s + i``, the single env's
+        episode of seed ``s + i``."""
+        import warnings
+
+        import gymnasium
+
+        import lvgym  # noqa: F401  (registers the env ids)
+
+        with warnings.catch_warnings():            # a frozen v0 suite flies its v0 env on purpose
+            warnings.filterwarnings("ignore", message=".*is out of date", category=DeprecationWarning)
+            return gymnasium.make_vec(self.env_id, num_envs=int(num_envs), vectorization_mode="vector_entry_point",
+                                      **self.env_kwargs())
 
     def with_options(self, **options: Any) -> Condition:
         """This condition with env keywords added or replaced (e.g. a short ``mission_time_s`` for tests)."""
@@ -199,8 +216,22 @@ SUITES.update(SUITES_V1)
 
 
 def get_suite(name: str) -> Suite:
-    """The suite called ``name``; a ``ValueError`` lists the known names otherwise."""
+    """The suite called ``name``; a :class:`~lvgym.errors.ConfigError` (a ``ValueError``) lists the known
+    names otherwise, with the closest one."""
     try:
         return SUITES[name]
-    except KeyError:
-        raise ValueError(f"suite = {name!r}: one of {sorted(SUITES)}") from None
+    except (KeyError, TypeError):
+        raise ConfigError("suite", name, f"one of {sorted(SUITES)}{did_you_mean(name, SUITES)}") from None
+
+
+def condition(suite: str, model: str = "nonrigid", **overrides: Any) -> Condition:
+    """The condition of suite ``suite`` flown with flight model ``model`` (what ``lvgym.make_env`` builds),
+    with env keywords ``overrides`` added or replaced (:meth:`Condition.with_options`); a bad suite or
+    model raises a one-line :class:`~lvgym.errors.ConfigError` naming what is allowed."""
+    s = get_suite(suite)
+    models = [c.model for c in s.conditions]
+    if model not in models:
+        raise ConfigError("model", model, f"one of {models} (the flight models of suite {s.name!r})"
+                                          f"{did_you_mean(model, models)}")
+    cond = s.conditions[models.index(model)]
+    return cond.with_options(**overrides) if overrides else cond

@@ -9,7 +9,8 @@
 
 Each is a thin adapter over the functional env :class:`~.functional.AscentFuncEnv` (explicit state and
 parameters, batched over rows); each has a native batched ``VectorEnv`` as its ``vector_entry_point``
-(``gymnasium.make_vec(id, num_envs=N, vectorization_mode="vector_entry_point", **options)``) and an SB3
+(``gymnasium.make_vec(id, num_envs=N, vectorization_mode="vector_entry_point", **options)``, which calls
+:func:`lvgym.make_vector` with the id; the ids and their classes are one table, :data:`lvgym.ENV_IDS`) and an SB3
 ``VecEnv`` adapter, :func:`make_sb3_vec_env`, over the same batched code. ``env.unwrapped.get_state()``
 and ``set_state(state)`` capture and restore an episode (:mod:`.snapshot`).
 """
@@ -17,6 +18,8 @@ and ``set_state(state)`` capture and restore an episode (:mod:`.snapshot`).
 from __future__ import annotations
 
 from typing import Any
+
+from lvgym import ENV_IDS, env_class, make_vector
 
 from .ascent import (AscentEnv, SlenderAscentEnv, SlenderAscentV1Env, SmileAscentEnv, SmileAscentV1Env,
                      StratosIIIEnv, StratosIIIV1Env)
@@ -26,49 +29,16 @@ from .snapshot import EpisodeState
 from .spec import FLIGHT_DEFAULTS, RANDOMIZE, WIND_TIERS, TaskSpec
 from .vector import AscentVectorEnv
 
-ENVS = {"lvgym/SmileAscent-v0": SmileAscentEnv, "lvgym/SmileAscent-v1": SmileAscentV1Env,
-        "lvgym/StratosIII-v0": StratosIIIEnv,
-        "lvgym/SlenderAscent-v0": SlenderAscentEnv, "lvgym/StratosIII-v1": StratosIIIV1Env,
-        "lvgym/SlenderAscent-v1": SlenderAscentV1Env}
-
-
-def smile_ascent_vector(num_envs: int = 1, **options: Any) -> AscentVectorEnv:
-    """``vector_entry_point`` of ``lvgym/SmileAscent-v0``."""
-    return AscentVectorEnv(SmileAscentEnv, num_envs, **options)
-
-
-def smile_ascent_v1_vector(num_envs: int = 1, **options: Any) -> AscentVectorEnv:
-    """``vector_entry_point`` of ``lvgym/SmileAscent-v1``."""
-    return AscentVectorEnv(SmileAscentV1Env, num_envs, **options)
-
-
-def stratos3_vector(num_envs: int = 1, **options: Any) -> AscentVectorEnv:
-    """``vector_entry_point`` of ``lvgym/StratosIII-v0``."""
-    return AscentVectorEnv(StratosIIIEnv, num_envs, **options)
-
-
-def slender_ascent_vector(num_envs: int = 1, **options: Any) -> AscentVectorEnv:
-    """``vector_entry_point`` of ``lvgym/SlenderAscent-v0``."""
-    return AscentVectorEnv(SlenderAscentEnv, num_envs, **options)
-
-
-def stratos3_v1_vector(num_envs: int = 1, **options: Any) -> AscentVectorEnv:
-    """``vector_entry_point`` of ``lvgym/StratosIII-v1``."""
-    return AscentVectorEnv(StratosIIIV1Env, num_envs, **options)
-
-
-def slender_ascent_v1_vector(num_envs: int = 1, **options: Any) -> AscentVectorEnv:
-    """``vector_entry_point`` of ``lvgym/SlenderAscent-v1``."""
-    return AscentVectorEnv(SlenderAscentV1Env, num_envs, **options)
+#: env id -> env class, for every id of the one table :data:`lvgym.ENV_IDS`
+ENVS = {env_id: env_class(env_id) for env_id in ENV_IDS}
 
 
 def make_sb3_vec_env(env_id: str, num_envs: int = 1, seed: int | None = None, **options: Any):
     """A stable-baselines3 ``VecEnv`` of ``num_envs`` rows of ``env_id`` (batched, one simulator;
     :class:`~.sb3.AscentSB3VecEnv`, imported here so that ``import lvgym`` does not import SB3)."""
-    if env_id not in ENVS:
-        raise ValueError(f"env_id = {env_id!r}: one of {sorted(ENVS)}")
+    cls = env_class(env_id)                          # a ConfigError names the ids for an unknown one
     from .sb3 import AscentSB3VecEnv
-    return AscentSB3VecEnv(ENVS[env_id], num_envs, seed, **options)
+    return AscentSB3VecEnv(cls, num_envs, seed, **options)
 
 
 def __getattr__(name: str) -> Any:
@@ -82,6 +52,4 @@ __all__ = ["ENVS", "FLIGHT_DEFAULTS", "OBSERVATIONS", "OBS_FLIGHT", "OBS_SENSORS
            "REWARD_TERMS", "TASK", "WIND_TIERS",
            "AscentEnv", "AscentFuncEnv", "AscentParams", "AscentSB3VecEnv", "AscentState", "AscentVectorEnv",
            "EpisodeState", "SlenderAscentEnv", "SlenderAscentV1Env", "SmileAscentEnv", "SmileAscentV1Env",
-           "StratosIIIEnv", "StratosIIIV1Env", "TaskSpec", "make_sb3_vec_env", "slender_ascent_v1_vector",
-           "slender_ascent_vector", "smile_ascent_v1_vector", "smile_ascent_vector", "stratos3_v1_vector",
-           "stratos3_vector"]
+           "StratosIIIEnv", "StratosIIIV1Env", "TaskSpec", "env_class", "make_sb3_vec_env", "make_vector"]

@@ -49,7 +49,7 @@ import numpy as np
 from .functional import AscentFuncEnv, AscentState
 from .layouts import observation_table
 from .snapshot import EpisodeState, rng_state, set_rng_state
-from .spec import FLIGHT_DEFAULTS, TaskSpec
+from .spec import FLIGHT_DEFAULTS, TaskSpec, check_reset_options
 from .views import FuncViews
 
 __doc__ = __doc__ % {"observation": "\n".join("    " + line for line in observation_table().splitlines())}
@@ -97,6 +97,8 @@ class AscentEnv(FuncViews, gym.Env):
 
     metadata = {"render_modes": ["human", "rgb_array"], "render_fps": 25}
     DEFAULTS: dict[str, Any] = {}
+    #: the keywords the class takes beside the :class:`~.spec.TaskSpec` fields (an unknown keyword's hint)
+    KEYWORDS: tuple[str, ...] = ("render_mode", "vehicles")
 
     def __init__(self, render_mode: str | None = None, *, vehicles: Sequence[Any] | None = None,
                  **options: Any) -> None:
@@ -104,9 +106,9 @@ class AscentEnv(FuncViews, gym.Env):
             raise ValueError(f"render_mode = {render_mode!r}: one of {self.metadata['render_modes']} or None")
         self.render_mode = render_mode
         if vehicles is None:
-            self.specs = (TaskSpec.build(self.DEFAULTS, options),)
+            self.specs = (TaskSpec.build(self.DEFAULTS, options, self.KEYWORDS),)
         else:
-            self.specs = tuple(TaskSpec.build(self.DEFAULTS, {**options, "vehicle": v}) for v in vehicles)
+            self.specs = tuple(TaskSpec.build(self.DEFAULTS, {**options, "vehicle": v}, self.KEYWORDS) for v in vehicles)
         self._funcs: dict[int, AscentFuncEnv] = {}
         self._select(0)
         self.action_space, self.observation_space = self.func.action_space, self.func.observation_space
@@ -129,6 +131,9 @@ class AscentEnv(FuncViews, gym.Env):
 
     # ------------------------------------------------------------------------------ Gymnasium
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
+        """Start an episode (``seed`` seeds the env's generator); ``options`` takes no key (an unknown one
+        raises: the task's options are keywords of the constructor)."""
+        check_reset_options(options)
         super().reset(seed=seed)
         if len(self.specs) > 1:
             self._select(int(self.np_random.integers(len(self.specs))))
@@ -262,19 +267,34 @@ class SlenderAscentEnv(AscentEnv):
     DEFAULTS = {"site": "andoya", "mission_time_s": 10.0, "rate_weights": (0.0, 1.0, 1.0)}
     #: the tube's wall [m] when ``wall_thickness_m`` is not given (None: the thesis's 2 mm)
     WALL_THICKNESS_M: float | None = None
+    #: the geometry keywords and their defaults: ``length`` [m], ``diameter`` [m] (or a ``(low, high)``
+    #: range), ``aero_mach`` [-] (None: the full tables), ``wall_thickness_m`` [m] (None: ``WALL_THICKNESS_M``)
+    GEOMETRY: dict[str, Any] = {"length": 8.5, "diameter": 0.3, "aero_mach": DEFAULT_AERO_MACH,
+                                "wall_thickness_m": None}
+    KEYWORDS = AscentEnv.KEYWORDS + tuple(GEOMETRY)
 
-    def __init__(self, render_mode: str | None = None, length: float = 8.5, diameter: Any = 0.3,
-                 aero_mach: float | None = DEFAULT_AERO_MACH, wall_thickness_m: float | None = None,
-                 **options: Any) -> None:
+    def __init__(self, render_mode: str | None = None, **options: Any) -> None:
+        geometry = self.geometry(options)
+        diameter = geometry["diameter"]
         d = np.atleast_1d(np.asarray(diameter, dtype=float))
         if d.size not in (1, 2) or np.any(d <= 0):
             raise ValueError(f"diameter = {diameter!r}: a diameter [m] > 0 or a (low, high) pair")
         self.diameters = tuple(np.linspace(d[0], d[-1], 4 if d.size == 2 else 1).tolist())
-        self.length = float(length)
-        self.aero_mach = None if aero_mach is None else float(aero_mach)
-        self.wall_thickness_m = self.WALL_THICKNESS_M if wall_thickness_m is None else float(wall_thickness_m)
+        self.length = float(geometry["length"])
+        self.aero_mach = geometry["aero_mach"]
+        self.wall_thickness_m = geometry["wall_thickness_m"]
         super().__init__(render_mode, vehicles=[slender_key(self.length, dia, self.aero_mach, self.wall_thickness_m)
                                                 for dia in self.diameters], **options)
+
+    @classmethod
+    def geometry(cls, options: dict[str, Any]) -> dict[str, Any]:
+        """Pop the geometry keywords from ``options`` (the class's :data:`GEOMETRY` where absent):
+        ``aero_mach`` and ``wall_thickness_m`` as floats (or None; a missing wall is ``WALL_THICKNESS_M``)."""
+        g = {key: options.pop(key, default) for key, default in cls.GEOMETRY.items()}
+        g["aero_mach"] = None if g["aero_mach"] is None else float(g["aero_mach"])
+        wall = g["wall_thickness_m"]
+        g["wall_thickness_m"] = cls.WALL_THICKNESS_M if wall is None else float(wall)
+        return g
 
 
 def slender_key(length: float, diameter: float, aero_mach: float | None, wall_thickness_m: float | None = None) -> tuple:
@@ -306,11 +326,5 @@ class SlenderAscentV1Env(SlenderAscentEnv):
 
     DEFAULTS = {**SlenderAscentEnv.DEFAULTS, **V1_OPTIONS}
     WALL_THICKNESS_M = 0.0045
-
-    def __init__(self, render_mode: str | None = None, length: float = 8.5, diameter: Any = 0.2833,
-                 aero_mach: float | None = DEFAULT_AERO_MACH, wall_thickness_m: float | None = None,
-                 **options: Any) -> None:
-        """As :class:`SlenderAscentEnv`, with the ``slender-v1`` suite's geometry by default (L/D 30:
-        8.5 m, 0.2833 m)."""
-        super().__init__(render_mode, length=length, diameter=diameter, aero_mach=aero_mach,
-                         wall_thickness_m=wall_thickness_m, **options)
+    #: as :class:`SlenderAscentEnv`, with the ``slender-v1`` suite's geometry by default (L/D 30: 8.5 m, 0.2833 m)
+    GEOMETRY = {**SlenderAscentEnv.GEOMETRY, "diameter": 0.2833}

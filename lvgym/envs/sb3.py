@@ -17,6 +17,7 @@ from stable_baselines3.common.vec_env.base_vec_env import VecEnv
 
 from .ascent import _rows
 from .functional import AscentFuncEnv, AscentState
+from .spec import check_reset_options
 from .vector import batch_task
 from .views import FuncViews
 
@@ -38,6 +39,9 @@ class AscentSB3VecEnv(FuncViews, VecEnv):
         self.state: AscentState | None = None
 
     def reset(self) -> np.ndarray:
+        for options in self._options:                # set_options(...): no key is taken (as the single env)
+            check_reset_options(options)
+        self._reset_options()
         if self._seed is not None:
             self._rngs = [gym.utils.seeding.np_random(self._seed + i)[0] for i in range(self.num_envs)]
             self._seed = None

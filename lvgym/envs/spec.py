@@ -10,7 +10,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
-from lvgym.errors import ConfigError, check_bool, check_choice, check_number
+from lvgym.errors import ConfigError, check_bool, check_choice, check_number, did_you_mean
 from lvgym.simulator import MODE_BASES, MODELS, SLOSH_FREQUENCIES
 
 #: protocol v0's wind tiers, then v1's, then ``random_gust`` (v1's gust alone, for the error budget)
@@ -244,10 +244,32 @@ class TaskSpec:
         return int(round(self.control_dt_s / self.physics_dt_s))
 
     @classmethod
-    def build(cls, defaults: Mapping[str, Any], overrides: Mapping[str, Any]) -> TaskSpec:
-        """Defaults of an env updated by the user's keywords (unknown keywords raise)."""
+    def build(cls, defaults: Mapping[str, Any], overrides: Mapping[str, Any], also: tuple[str, ...] = ()) -> TaskSpec:
+        """Defaults of an env updated by the user's keywords. An unknown keyword raises a one-line
+        :class:`~lvgym.errors.ConfigError` with the closest option (of the fields and of ``also``, the
+        env's own keywords) and where the options are documented."""
         known = set(cls.__dataclass_fields__)
         for key in overrides:
             if key not in known:
-                raise ConfigError(key, overrides[key], f"unknown option; allowed: {sorted(known)}")
+                raise ConfigError(key, overrides[key], f"unknown option{did_you_mean(key, sorted(known | set(also)))}; "
+                                  f"the env options: {OPTIONS_DOC}")
         return cls(**{**defaults, **overrides})
+
+
+#: where the env options are documented (what an unknown option's error points to)
+OPTIONS_DOC = "help(lvgym.envs.TaskSpec)"
+#: the keys ``reset(options=...)`` takes (none: every option is a keyword of the env's constructor)
+RESET_OPTIONS: tuple[str, ...] = ()
+
+
+def check_reset_options(options: Mapping[str, Any] | None) -> None:
+    """Refuse a key of ``reset(options=...)`` that is not in :data:`RESET_OPTIONS`: a one-line
+    :class:`~lvgym.errors.ConfigError` naming the key and the keys allowed (an option given there would
+    otherwise be ignored without a word)."""
+    for key, value in (options or {}).items():
+        if key not in RESET_OPTIONS:
+            allowed = f"one of {RESET_OPTIONS}" if RESET_OPTIONS else "none"
+            hint = f"; {key!r} is an env keyword (gymnasium.make(env_id, {key}=...))" \
+                if key in TaskSpec.__dataclass_fields__ else did_you_mean(key, RESET_OPTIONS)
+            raise ConfigError(f"reset(options)[{key!r}]", value, f"unknown reset option (allowed keys: {allowed}){hint}; "
+                              f"the env options: {OPTIONS_DOC}")

@@ -9,8 +9,6 @@ after an episode's end resets that row, ignores its action and returns reward 0)
 
 from __future__ import annotations
 
-import inspect
-
 from typing import Any
 
 import gymnasium as gym
@@ -18,10 +16,10 @@ import numpy as np
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
-from .ascent import DEFAULT_AERO_MACH, SlenderAscentEnv, slender_key
+from .ascent import SlenderAscentEnv, slender_key
 from .functional import AscentFuncEnv, AscentState
 from .snapshot import EpisodeState, rng_state, set_rng_state
-from .spec import TaskSpec
+from .spec import TaskSpec, check_reset_options
 from .views import FuncViews
 
 
@@ -29,18 +27,13 @@ def batch_task(env_cls: type, options: dict[str, Any]) -> TaskSpec:
     """The task of ``num_envs`` rows of ``env_cls`` with ``options`` (one vehicle for all rows)."""
     options = dict(options)
     if issubclass(env_cls, SlenderAscentEnv):
-        defaults = inspect.signature(env_cls.__init__).parameters     # the env class's own geometry defaults
-        length = options.pop("length", defaults["length"].default)
-        diameter = options.pop("diameter", defaults["diameter"].default)
-        if np.size(diameter) != 1:
+        geometry = env_cls.geometry(options)                  # the class's GEOMETRY where not given
+        if np.size(geometry["diameter"]) != 1:
             raise ValueError("diameter ranges are drawn per episode by the single SlenderAscent env only; "
                              "a vector env flies one geometry (make one vector env per diameter)")
-        aero_mach = options.pop("aero_mach", DEFAULT_AERO_MACH)
-        wall = options.pop("wall_thickness_m", None)
-        options["vehicle"] = slender_key(length, float(np.ravel(diameter)[0]),
-                                         None if aero_mach is None else float(aero_mach),
-                                         env_cls.WALL_THICKNESS_M if wall is None else float(wall))
-    return TaskSpec.build(env_cls.DEFAULTS, options)
+        options["vehicle"] = slender_key(geometry["length"], float(np.ravel(geometry["diameter"])[0]),
+                                         geometry["aero_mach"], geometry["wall_thickness_m"])
+    return TaskSpec.build(env_cls.DEFAULTS, options, env_cls.KEYWORDS)
 
 
 def _select(rows: Any, n: int) -> np.ndarray:
@@ -68,6 +61,9 @@ class AscentVectorEnv(FuncViews, VectorEnv):
         self._needs_reset = np.zeros(self.num_envs, dtype=bool)
 
     def reset(self, *, seed: int | list[int | None] | None = None, options: dict[str, Any] | None = None):
+        """Reset every row (an int ``seed`` seeds row ``i`` with ``seed + i``); ``options`` takes no key
+        (an unknown one raises, as for the single env)."""
+        check_reset_options(options)
         if seed is None or isinstance(seed, int):
             seeds = [None if seed is None else seed + i for i in range(self.num_envs)]
         else:
