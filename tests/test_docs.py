@@ -46,7 +46,6 @@ def test_rl_examples_run():
     _run("rl.md", snapshot)                 # it asserts the bit-for-bit replay itself
 
 
-@pytest.mark.skipif(not hasattr(lvgym, "make_env"), reason="needs lvgym.make_env")
 def test_rl_benchmark_env_example_runs():
     _, make_env, _ = _python_blocks("rl.md")
     ns = _run("rl.md", make_env)

@@ -1,10 +1,6 @@
 """The README's quick starts run: every python and sh block, in a temporary folder, shortened where a full
 run would take minutes (:data:`SHORTEN`: options each command documents, such as ``--episodes 2
 --mission-time-s 5``).
-
-A block that uses an interface another part of the code base provides is skipped, with the reason, until
-that part is there: ``lvgym.make_env`` and ``evaluate.py --policies path/to/file.py:factory`` (:data:`DOORS`),
-the ``lvgym`` command (:data:`CLI`).
 """
 
 from __future__ import annotations
@@ -25,11 +21,8 @@ ROOT = Path(__file__).resolve().parents[1]
 README = (ROOT / "README.md").read_text(encoding="utf-8")
 BLOCKS = re.findall(r"```(python|sh)\n(.*?)```", README, re.S)
 
-#: ``lvgym.make_env`` and the policy registry's ``file.py:factory`` (the doors of the benchmark)
-DOORS = hasattr(lvgym, "make_env")
 #: the ``lvgym`` command and its subcommands
 CLI = importlib.util.find_spec("lvgym.cli.main") is not None
-NEEDS_DOORS = "needs lvgym.make_env and evaluate.py --policies file.py:factory"
 NEEDS_CLI = "needs the lvgym command (lvgym.cli.main)"
 
 #: the set-up commands of the README (they install into .venv or run the whole benchmark: not run here)
@@ -92,7 +85,6 @@ def test_readme_is_short():
     assert len(README.splitlines()) <= 200
 
 
-@pytest.mark.skipif(not DOORS, reason=NEEDS_DOORS)
 def test_fly_an_env():
     namespace: dict = {}
     exec(compile(_python(0), "README.md (fly an env)", "exec"), namespace)
@@ -129,7 +121,6 @@ def test_own_controller_file_acts(tmp_path):
     assert action.dtype == np.float32
 
 
-@pytest.mark.skipif(not DOORS, reason=NEEDS_DOORS)
 def test_own_controller_evaluated(tmp_path):
     (tmp_path / "my_policy.py").write_text(_python(1), encoding="utf-8")
     (command,) = _sh(3)
@@ -137,7 +128,6 @@ def test_own_controller_evaluated(tmp_path):
     assert "my-pd" in proc.stdout and "gs-pid-flex" in proc.stdout
 
 
-@pytest.mark.skipif(not DOORS, reason=NEEDS_DOORS)
 def test_own_vehicle(tmp_path, monkeypatch):
     (command,) = _sh(4)
     _run(command, tmp_path)
