@@ -114,6 +114,13 @@ def _guess_algo(path: Path) -> str | None:
     return None
 
 
+#: what a saved model's training schedules are replaced with when it is loaded to fly: a policy acts without
+#: them, and a schedule is pickled by reference to the module that defined it (``agents.config`` in the
+#: models saved before the package was installed as ``lvgym.agents``), which a flight should not need
+FLY_ONLY = {"learning_rate": 0.0, "lr_schedule": lambda _: 0.0, "clip_range": lambda _: 0.0,
+            "clip_range_vf": None, "exploration_schedule": lambda _: 0.0}
+
+
 def guess_and_load(path: str | Path) -> Any:
     """The SB3 model at ``path`` when no sidecar names its algorithm: the algorithm suggested by the
     policy class stored in the zip first, then every algorithm train.py trains
@@ -132,7 +139,7 @@ def guess_and_load(path: str | Path) -> Any:
             errors.append(f"{algo}: {exc}")
             continue
         try:
-            return cls.load(str(path), device="cpu")
+            return cls.load(str(path), device="cpu", custom_objects=FLY_ONLY)
         except Exception as exc:  # noqa: BLE001 (a wrong algorithm fails in many ways)
             errors.append(f"{algo}: {type(exc).__name__}: {exc}")
     raise ValueError(f"policy {str(path)!r}: no SB3 algorithm loads it ({'; '.join(errors)}); "
@@ -146,8 +153,9 @@ def read_meta(zip_path: str | Path) -> dict[str, Any]:
 
 
 def load_model(zip_path: str | Path, algo: str | None = None) -> Any:
-    """The SB3 model at ``zip_path`` on the CPU: class from ``algo``, else from the sidecar JSON, else
-    guessed by :func:`guess_and_load` (policies saved by other tools)."""
+    """The SB3 model at ``zip_path`` on the CPU, to fly (its training schedules replaced, :data:`FLY_ONLY`):
+    class from ``algo``, else from the sidecar JSON, else guessed by :func:`guess_and_load` (policies saved
+    by other tools)."""
     algo = algo or read_meta(zip_path).get("algo")
     if algo is None:
         return guess_and_load(zip_path)
@@ -155,7 +163,7 @@ def load_model(zip_path: str | Path, algo: str | None = None) -> Any:
         cls = algo_class(str(algo))
     except ValueError:
         raise ValueError(f"{str(zip_path)!r}: algo = {algo!r}: one of {sorted(ALGOS.values())}") from None
-    return cls.load(str(zip_path), device="cpu")
+    return cls.load(str(zip_path), device="cpu", custom_objects=FLY_ONLY)
 
 
 def load_vecnormalize(zip_path: str | Path) -> Any:
