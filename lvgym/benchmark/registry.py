@@ -1,7 +1,6 @@
-"""The policies the benchmark's command lines know by name (``evaluate.py``, ``python -m
-lvgym.benchmark.margins``, ``... budget``), how a name or a saved model's path becomes a
-:class:`~.runner.PolicySpec`, and the options and checks those commands share (:func:`flight_parser`,
-:func:`resolve_flights`).
+"""The policies the benchmark's command lines know by name (``evaluate.py``, ``lvgym margins``,
+``... budget``) and how a name or a saved model's path becomes a :class:`~.runner.PolicySpec`. The
+options those commands share are declared in the command layer (:mod:`lvgym.cli.flights`).
 
 A spec holds an import path as a string (``"lvgym.baselines.pid:smile_tuned_pid"``); the factory is imported in
 the worker that flies the policy, so this module imports neither ``baselines`` nor ``agents`` (the layers
@@ -10,18 +9,11 @@ of DESIGN.md: the benchmark sits below the controllers and the agents).
 
 from __future__ import annotations
 
-import argparse
-from collections.abc import Sequence
 from pathlib import Path
-from typing import Any
-
-from lvgym.cli import fail, one_line_errors
-from lvgym.parallel import EXECUTORS
 
 from .runner import ZERO, PolicySpec
-from .suites import SUITES, Condition, Suite, get_suite
 
-__all__ = ["POLICIES", "flight_parser", "resolve_flights", "resolve_policy"]
+__all__ = ["POLICIES", "resolve_policy"]
 
 #: policy names -> how a worker builds them (factories are imported lazily, in the workers)
 POLICIES: dict[str, PolicySpec] = {
@@ -75,43 +67,3 @@ def resolve_policy(name: str, prog: str = "evaluate.py") -> PolicySpec:
     raise SystemExit(f"{prog}: policy {name!r}: one of {sorted(POLICIES)}, a path to an SB3 .zip model or a "
                      "train.py run folder")
 
-
-def flight_parser(prog: str, doc: str, default_policies: Sequence[str], default_suite: str,
-                  default_out: str) -> argparse.ArgumentParser:
-    """A benchmark command's parser (one-line errors; ``doc``'s first paragraph as its description, from its
-    third on as its epilog) with ``--policies`` and ``--suite`` (which :func:`resolve_flights` resolves),
-    ``--mission-time-s``, ``--executor``, ``--workers`` (checked by the command), ``--out`` (default
-    ``default_out``) and ``--no-progress``."""
-    p = one_line_errors(argparse.ArgumentParser(prog=prog, description=doc.split("\n\n")[0],
-                                                epilog=doc.split("\n\n", 2)[2],
-                                                formatter_class=argparse.RawDescriptionHelpFormatter))
-    p.add_argument("--policies", nargs="+", default=list(default_policies), metavar="POLICY",
-                   help=f"names {sorted(POLICIES)}, SB3 .zip paths or train.py run folders "
-                        f"(default: {' '.join(default_policies)})")
-    p.add_argument("--suite", default=default_suite, help=f"of {sorted(SUITES)} (default {default_suite})")
-    p.add_argument("--mission-time-s", default=None, help="shorten every episode (smoke tests only)")
-    p.add_argument("--executor", choices=EXECUTORS, default="local", help="default: local process pool")
-    p.add_argument("--workers", default=None, help="default: the CPUs available")
-    p.add_argument("--out", default=default_out, help=f"results folder (default {default_out}/)")
-    p.add_argument("--no-progress", dest="progress", action="store_false", help="hide the progress bar")
-    return p
-
-
-def resolve_flights(prog: str, policy_names: Sequence[str], suite_name: str, models: Sequence[str] | None = None,
-                    **overrides: Any) -> tuple[list[PolicySpec], Suite, list[Condition]]:
-    """A command line's policies (:func:`resolve_policy`, distinct labels), its suite with the env
-    ``overrides`` that are not None (:meth:`~.suites.Suite.with_options`) and the suite's conditions of the
-    flight ``models`` (None: all); a bad value exits with a one-line message starting ``prog:``."""
-    policies = [resolve_policy(n, prog) for n in policy_names]
-    if len({p.name for p in policies}) != len(policies):
-        fail(prog, f"--policies {' '.join(policy_names)}: each label must be distinct")
-    try:
-        suite = get_suite(suite_name)
-    except ValueError as exc:
-        fail(prog, exc)
-    suite = suite.with_options(**{k: v for k, v in overrides.items() if v is not None})
-    conds = [c for c in suite.conditions if models is None or c.model in models]
-    if not conds:
-        fail(prog, f"--models {' '.join(models or ())}: suite {suite.name!r} has "
-                   f"{sorted({c.model for c in suite.conditions})}")
-    return policies, suite, conds
