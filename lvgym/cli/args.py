@@ -44,6 +44,7 @@ import importlib
 import importlib.util
 import inspect
 import math
+import re
 import sys
 import textwrap
 import types
@@ -56,8 +57,8 @@ from lvgym.errors import ConfigError, check_number
 
 from . import fail, one_line_errors
 
-__all__ = ["Command", "Spec", "arg", "build_parser", "command_name", "dispatch", "parse", "parse_given",
-           "running_as"]
+__all__ = ["Command", "Spec", "arg", "build_parser", "check_fields", "command_name", "dispatch", "parse",
+           "parse_given", "running_as"]
 
 _CLI = "lvgym.cli"                                    # the key of a field's Spec in its metadata
 _COMMAND: contextvars.ContextVar[str | None] = contextvars.ContextVar("lvgym_command", default=None)
@@ -197,7 +198,7 @@ def _help(f: dataclasses.Field, doc: str, kind: _Kind, flag: str) -> str:
     text = _spec(f).help or doc
     default = f.default if f.default is not dataclasses.MISSING else (
         f.default_factory() if f.default_factory is not dataclasses.MISSING else dataclasses.MISSING)
-    if default is not dataclasses.MISSING and "default" not in text:
+    if default is not dataclasses.MISSING and not re.search(r"\(default\b|\bdefault:", text):
         if kind.scalar is bool and not kind.many:
             text += f" (default: {flag if default else '--no-' + flag[2:]})"
         elif default is not None and default != []:
@@ -340,6 +341,30 @@ def parse_given(cls: type, argv: Sequence[str] | None = None, prog: str = "", do
         parser.error(str(exc))
     given = {f.name for f in dataclasses.fields(cls) if f.name in vars(ns) and not _spec(f).positional}
     return out, given
+
+
+def check_fields(obj: Any) -> Any:
+    """``obj`` (a dataclass instance built in Python, not from a command line) when every field declared
+    with a range, choices or a check (:func:`arg`) holds an allowed value; else the ConfigError naming
+    the option that the command line would have given."""
+    hints = _hints(type(obj))
+    for f in dataclasses.fields(obj):
+        s, value = _spec(f), getattr(obj, f.name)
+        if not f.init or value is None or s.switches is not None:
+            continue
+        kind = _kind(hints[f.name])
+        option = f.name if s.positional else (s.flag or "--" + f.name.replace("_", "-"))
+        choices = s.choices() if callable(s.choices) else s.choices
+        choices = tuple(choices) if choices is not None else (kind.literal or None)
+        if kind.width:
+            items = [x for group in (value if kind.many else [value]) for x in group]
+        else:
+            items = list(value) if kind.many else [value]
+        for item in items:
+            if choices is not None and item not in choices:
+                raise ConfigError(option, item, f"one of {list(choices)}")
+        _value(option, value, kind, s)
+    return obj
 
 
 def parse(cls: type, argv: Sequence[str] | None = None, prog: str = "", doc: str | None = None,
