@@ -3,7 +3,7 @@
 a log (:class:`ProgressLineCallback`, ``--progress-interval-s``)::
 
     train.py: step 1,228,800 / 5,000,000 (24.6 %), 2,310 steps/s, elapsed 0:08:52, about 0:27:12 left;
-    validation score 0.7134 at step 1,000,000
+    validation at step 1,000,000: score 0.7134, failure rate 0 %
 """
 
 from __future__ import annotations
@@ -109,8 +109,10 @@ class ProgressLineCallback(BaseCallback):
             text += f", about {clock((self.target - n) / rate)} left"
         evaluations = getattr(self.checkpoint, "evaluations", None)
         if evaluations:
-            last = evaluations[-1]
-            text += f"; validation score {last['score']:.4g} at step {int(last['num_timesteps']):,}"
+            last = evaluations[-1]                   # its "score" is [failure rate, score] (lexicographic)
+            score = last.get("episode_score", last["score"][-1] if isinstance(last["score"], list) else last["score"])
+            text += (f"; validation at step {int(last['num_timesteps']):,}: score {float(score):.4g}, "
+                     f"failure rate {100.0 * float(last.get('failure_rate', 0.0)):.0f} %")
         return text
 
     def write(self) -> None:
