@@ -210,7 +210,7 @@ def build_parser(cls: type, prog: str, doc: str | None = None, epilog: bool | st
     """The argparse parser of dataclass ``cls``: one-line errors, ``doc``'s first paragraph as its
     description and, with ``epilog`` (True: the rest of ``doc``; or a text), an epilog. Options not given
     are left out of the namespace (their defaults are the dataclass's)."""
-    paragraphs = (doc or "").strip().split("\n\n", 1)
+    paragraphs = inspect.cleandoc(doc or "").split("\n\n", 1)
     tail = epilog if isinstance(epilog, str) else (paragraphs[1] if epilog and len(paragraphs) > 1 else None)
     p = _Parser(prog=command_name(prog), description=paragraphs[0] or None, epilog=tail,
                 formatter_class=argparse.RawDescriptionHelpFormatter, argument_default=argparse.SUPPRESS)
