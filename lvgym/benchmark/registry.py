@@ -66,4 +66,3 @@ def resolve_policy(name: str, prog: str = "evaluate.py") -> PolicySpec:
         return PolicySpec(path.stem, "lvgym.agents.policy:load_policy", (("path", str(path.resolve())),))
     raise SystemExit(f"{prog}: policy {name!r}: one of {sorted(POLICIES)}, a path to an SB3 .zip model or a "
                      "train.py run folder")
-

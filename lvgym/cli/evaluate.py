@@ -27,8 +27,9 @@ The tables (per suite; every mean with its 95 % bootstrap interval over the seed
      degradation counts the failures);
   4. paired comparison: each policy against the reference (``--reference``, else the best-ranked
      policy of the condition) on the same seeds: mean difference of the score with its interval,
-     wins/ties/losses, Wilcoxon and t p-values, rliable's IQM and probability of improvement;
-  5. agents over training runs (policies labelled ``<agent>-s<seed>``): rliable's IQM over the runs.
+     wins/ties/losses, Wilcoxon and t p-values, the IQM and the probability of improvement
+     (:mod:`lvgym.benchmark.stats`);
+  5. agents over training runs (policies labelled ``<agent>-s<seed>``): the IQM over the runs.
 docs/benchmark.md defines every metric.
 """
 
