@@ -23,7 +23,6 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from lvgym.cli import fail
 from lvgym.cli.args import arg, command_name, parse
 from lvgym.errors import ConfigError
 
@@ -170,8 +169,9 @@ def main(argv: list[str] | None = None) -> None:
     references = dict(_reference(x) for x in args.reference)
     try:
         rows = [r for run in args.runs for r in load_curves(run)]
-    except FileNotFoundError as exc:
-        fail(command_name(prog), exc)
+    except FileNotFoundError as exc:                 # one line on stderr, as a refused option
+        sys.stderr.write(f"{command_name(prog)}: {exc}\n")
+        raise SystemExit(2) from None
     table = summary_rows(rows, references)
     minutes = lambda s: "-" if s is None else f"{s / 60.0:.1f}"             # noqa: E731
     head = ["run", "condition", "first", "best", "best failures", "best at [M steps]", "best at [min]",
