@@ -5,7 +5,7 @@ under it) is its help; its default is shown; its type says how the text becomes 
 
     @dataclass
     class Args:
-        episodes: int = arg(50, lo=1, hi=10**6)
+        episodes: int = arg(50, lo=1, hi=10**6, allowed="an integer >= 1")
         \"\"\"episodes (seeds) per condition and policy\"\"\"
         executor: str = arg("local", choices=EXECUTORS)
         \"\"\"local (process pool), serial or ray\"\"\"
