@@ -2,14 +2,17 @@
 lvgym envs.
 
 - :mod:`lvgym.agents.config`: per-env hyperparameters (``agents/hyperparams/<algo>.yaml``) as validated dataclasses;
-- :mod:`lvgym.agents.callbacks`: crash-safe checkpoints, validation on the protocol's validation seeds, progress;
+- :mod:`lvgym.agents.train`: the training command (``lvgym train``; ``train.py`` at the repository root runs
+  it), with :mod:`lvgym.agents.trainsetup` (recipes, env keywords, seeds, the vectorised env);
+- :mod:`lvgym.agents.callbacks`: crash-safe checkpoints, validation on the protocol's validation seeds;
+- :mod:`lvgym.agents.progress`: the progress bar and the progress line;
 - :mod:`lvgym.agents.policy`: :class:`~lvgym.agents.policy.SB3Policy`, a trained model behind the benchmark Policy interface;
 - :mod:`lvgym.agents.residual`: residual policies on a classical baseline (training wrapper and adapter);
 - :mod:`experiments.rigid_vs_nonrigid_training.robustness`: the rigid-trained vs nonrigid-trained experiment.
 
-Training itself is ``train.py`` at the repository root (``docs/training.md``). Nothing in ``lvgym`` imports this
-package; importing it does not import stable-baselines3 (the submodules do). Importing it registers the
-shipped learned policies with the benchmark (``ppo``, ``ppo-res-lqg``) and the loader of saved models
+Training is ``lvgym train`` (``docs/training.md``). Nothing in ``lvgym`` imports this package (the command
+layer names it); importing it does not import stable-baselines3 (the submodules do). Importing it registers
+the shipped learned policies with the benchmark (``ppo``, ``ppo-res-lqg``) and the loader of saved models
 (``evaluate.py --policies runs/my_run`` or ``model.zip``); their factories are named as strings, imported
 only where a policy flies.
 """

@@ -1,4 +1,5 @@
-"""Training callbacks: crash-safe checkpoints with validation on the benchmark protocol, and a progress bar.
+"""Training callbacks: crash-safe checkpoints with validation on the benchmark protocol (the progress bar
+and line: :mod:`lvgym.agents.progress`).
 
 A checkpoint ``checkpoints/step_<N>`` (N = env steps, 12 digits) is::
 
@@ -44,6 +45,7 @@ from lvgym.benchmark.results import atomic_path, atomic_write_text, json_text, r
 from lvgym.benchmark.suites import Suite, get_suite
 
 from .policy import SB3Policy, adapt, copy_policy, policy_files
+from .progress import ProgressBarCallback  # noqa: F401  (its old place)
 
 _STEM = re.compile(r"^step_(\d{12})$")
 #: what a validation's ``score`` is: compared lexicographically, lower is better (older runs' checkpoints
@@ -238,7 +240,9 @@ class CheckpointCallback(BaseCallback):
     (and at the end; ``eval_freq <= 0`` or no evaluator: never). Also checkpoints (without validation) at
     the first rollout boundary ``interval_s`` seconds of wall time after the last checkpoint (0: never),
     and when ``stop`` (a :class:`SignalStop`) has a signal: training then ends at the next env step with a
-    checkpoint and without ``final_model``. Keeps the newest ``keep`` checkpoints and the best one.
+    checkpoint and without ``final_model``; so too at the first env step past ``deadline`` (a
+    ``time.monotonic()`` value: the run's wall-time budget, :attr:`out_of_time`). Keeps the newest ``keep``
+    checkpoints and the best one.
     ``meta``: written into every JSON (algo, env id and kwargs, ...). ``state``: the JSON of the
     checkpoint a resumed run starts from (restores the evaluation history, the best and the wall time
     spent, ``train_wall_s``)."""
@@ -246,7 +250,7 @@ class CheckpointCallback(BaseCallback):
     def __init__(self, run_dir: str | Path, save_freq: int, meta: dict[str, Any], vecnormalize: Any = None,
                  evaluator: ValidationEvaluator | None = None, eval_freq: int = 0, keep: int = 3,
                  state: dict[str, Any] | None = None, verbose: int = 0, interval_s: float = 0.0,
-                 stop: SignalStop | None = None) -> None:
+                 stop: SignalStop | None = None, deadline: float | None = None) -> None:
         super().__init__(verbose)
         self.run_dir = Path(run_dir)
         self.folder = self.run_dir / "checkpoints"
@@ -264,6 +268,8 @@ class CheckpointCallback(BaseCallback):
         self.last_eval = int(self.evaluations[-1]["num_timesteps"]) if self.evaluations else 0
         self.interval_s = float(interval_s)
         self.stop = stop
+        self.deadline = deadline
+        self.out_of_time = False                     # the deadline passed: training stops as on a signal
         self.wall0 = float(state.get("train_wall_s", 0.0))
         self.t_start = self.last_save_time = time.monotonic()
         self.clock = None                            # the venv's EnvClock (lvgym.agents.timing), found at the start
@@ -284,9 +290,11 @@ class CheckpointCallback(BaseCallback):
 
     @property
     def stopping(self) -> bool:
-        return self.stop is not None and self.stop.signum is not None
+        return self.out_of_time or (self.stop is not None and self.stop.signum is not None)
 
     def _on_step(self) -> bool:
+        if self.deadline is not None and not self.out_of_time and time.monotonic() >= self.deadline:
+            self.out_of_time = True
         return not self.stopping                    # False ends model.learn (then _on_training_end)
 
     def train_wall_s(self) -> float:
@@ -320,7 +328,10 @@ class CheckpointCallback(BaseCallback):
                 self.last_step_save = self.num_timesteps
 
     def _on_training_end(self) -> None:
-        if self.stopping:                           # a signal: checkpoint now, no validation, no final model
+        if self.out_of_time and self.num_timesteps >= int(getattr(self.model, "_total_timesteps", 0) or 0) > 0:
+            self.out_of_time = False                 # the deadline came with the last step: the run is done
+        if self.stopping:                           # a signal or the deadline: checkpoint now, no validation,
+                                                    # no final model
             if self.num_timesteps != self.last_save or not list_checkpoints(self.folder):
                 self.save(evaluate=False)
             return
@@ -415,47 +426,6 @@ def load_replay_buffer(model: Any, stem: Path) -> bool:
     with open(path, "rb") as f:
         model.replay_buffer = pickle.load(f)
     return True
-
-
-# ------------------------------------------------------------------------------------------ progress
-class ProgressBarCallback(BaseCallback):
-    """A tqdm bar of env steps towards the run's target (continuing from the resumed step), with the
-    steps per second and the mean return of the last episodes (SB3's own bar needs ``rich``)."""
-
-    def __init__(self, enabled: bool = True, refresh_s: float = 0.5) -> None:
-        super().__init__()
-        self.enabled = enabled
-        self.refresh_s = refresh_s
-        self.bar: Any = None
-        self._last = 0.0
-
-    def _on_training_start(self) -> None:
-        from tqdm.auto import tqdm
-
-        self.bar = tqdm(total=int(self.model._total_timesteps), initial=int(self.model.num_timesteps),
-                        unit="step", unit_scale=True, dynamic_ncols=True, disable=not self.enabled,
-                        file=sys.stderr, desc="training")
-
-    def _advance(self) -> None:
-        n = int(self.model.num_timesteps)
-        if self.bar.total is not None and n > self.bar.total:     # the last rollout overshoots the target
-            self.bar.total = n
-        self.bar.update(n - self.bar.n)
-
-    def _on_step(self) -> bool:
-        now = time.monotonic()
-        if self.bar is not None and now - self._last >= self.refresh_s:
-            self._last = now
-            self._advance()
-            buf = self.model.ep_info_buffer
-            if buf:
-                self.bar.set_postfix(ep_return=f"{np.mean([e['r'] for e in buf]):.3g}", refresh=False)
-        return True
-
-    def _on_training_end(self) -> None:
-        if self.bar is not None:
-            self._advance()
-            self.bar.close()
 
 
 def evaluate_saved(path: str | Path, suite: str = "smile-windy", episodes: int = 10,

@@ -10,12 +10,13 @@ A saved policy is three files with one stem::
 ``evaluate.py`` loads saved models through :func:`load_policy`. :class:`SB3Policy` accepts such a ``.zip``, its stem, or a run folder of ``train.py`` (``runs/<name>``: its best model by
 validation, else its final model, else its last checkpoint).
 
-    python -m lvgym.agents.policy export runs/ppo-smile agents/trained/ppo_smile_ascent   # copy a run's policy
+    lvgym export-policy runs/ppo-smile agents/trained/ppo_smile_ascent   # copy a run's policy
+    python -m lvgym.agents.policy export runs/ppo-smile agents/trained/ppo_smile_ascent   # the same
 """
 
 from __future__ import annotations
 
-import argparse
+import dataclasses
 import functools
 import json
 import pickle
@@ -27,6 +28,7 @@ from typing import Any
 import numpy as np
 
 from lvgym.benchmark.results import atomic_path, atomic_write_text
+from lvgym.cli.args import arg
 
 from .config import ALGOS, algo_class, algo_name
 
@@ -369,21 +371,38 @@ def _plain_layout(n: int) -> Any:
     return Packed("observation", [Field("entry", n, "-", "observation entries")], interface=True)
 
 
-def _export(args: argparse.Namespace) -> None:
-    src = resolve_model_path(args.run)
+@dataclasses.dataclass
+class ExportArgs:
+    """Command-line arguments (``lvgym export-policy --help``)."""
+
+    run: str = arg(positional=True, metavar="RUN")
+    """run folder (runs/<name>: its best, else final, else latest model) or a .zip"""
+    stem: str = arg(positional=True, metavar="STEM")
+    """destination without suffix, e.g. agents/trained/ppo_smile_ascent"""
+
+
+def export_main(argv: list[str] | None = None) -> None:
+    """``lvgym export-policy RUN STEM``: copy a run's policy (best, else final, else latest) to STEM.zip,
+    STEM_vecnormalize.pkl and STEM.json."""
+    from lvgym.cli import fail
+    from lvgym.cli.args import command_name, parse
+
+    prog = "python -m lvgym.agents.policy export"
+    args = parse(ExportArgs, argv, prog, export_main.__doc__)
+    try:
+        src = resolve_model_path(args.run)
+    except (FileNotFoundError, ValueError) as exc:
+        fail(command_name(prog), exc)
     dst = copy_policy(src, args.stem, {"exported_from": str(src)})
     print(f"{src} -> {dst}")
 
 
 def main(argv: list[str] | None = None) -> None:
-    """``python -m lvgym.agents.policy export RUN STEM``: copy a run's policy (best, else final, else latest)."""
-    p = argparse.ArgumentParser(prog="python -m lvgym.agents.policy", description=main.__doc__)
-    sub = p.add_subparsers(dest="cmd", required=True)
-    e = sub.add_parser("export", help="copy a run's policy to STEM.zip, STEM_vecnormalize.pkl, STEM.json")
-    e.add_argument("run", help="run folder (runs/<name>) or a .zip")
-    e.add_argument("stem", help="destination without suffix, e.g. agents/trained/ppo_smile_ascent")
-    args = p.parse_args(argv)
-    _export(args)
+    """``python -m lvgym.agents.policy export RUN STEM`` (``lvgym export-policy RUN STEM``)."""
+    from lvgym.cli.args import Command, dispatch
+
+    dispatch([Command("export", "lvgym.agents.policy:export_main", "copy a run's policy to STEM.zip, "
+                      "STEM_vecnormalize.pkl, STEM.json")], argv, "python -m lvgym.agents.policy")
 
 
 if __name__ == "__main__":

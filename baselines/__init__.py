@@ -2,7 +2,7 @@
 docs/adaptive-control.md) and a bang-bang roll controller (thesis 5.3).
 
 Every controller implements the benchmark's policy interface (:class:`lvgym.benchmark.Policy`):
-``reset()`` and ``act(observation, info) -> action``. ``python -m lvgym.baselines.design.tune --vehicle smile``
+``reset()`` and ``act(observation, info) -> action``. ``lvgym design pid --vehicle smile``
 tunes a gain schedule on the rigid linearisation (into ``results/schedules/``; ``--overwrite`` replaces
 the shipped one in ``schedules/``); ``python -m experiments.control_study.study`` runs the
 thesis's control study (docs/control-study.md).

@@ -1,4 +1,4 @@
-"""Speed of the dynamics core: RK4 steps per second (``python -m lvgym.bench``).
+"""Speed of the dynamics core: RK4 steps per second (``lvgym bench``, ``python -m lvgym.bench``).
 
 For three vehicle sizes (rigid; 1 slosh + 1 mode per plane; 6 slosh + 2 modes per plane) and for one
 vehicle and a batch of 256, on one core. ``steps/s`` counts vehicle-steps (one RK4 step of one vehicle,
@@ -9,13 +9,14 @@ caller pays when it returns to Python after every step).
 
 from __future__ import annotations
 
-import argparse
 import os
 import platform
 import time
+from dataclasses import dataclass
 
 import numpy as np
 
+from .cli.args import arg, parse
 from .dynamics import NonRigidModel, step_batch, zoh_loads
 
 CONFIGS = (("rigid", 0, 0), ("1 slosh + 1 mode/plane", 1, 1), ("6 slosh + 2 modes/plane", 6, 2))
@@ -75,10 +76,17 @@ def run(min_time: float = 1.0, dt: float = 1e-3) -> list[dict]:
     return rows
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--min-time", type=float, default=1.0, help="seconds per measurement")
-    args = parser.parse_args()
+@dataclass
+class Args:
+    """Command-line arguments (``lvgym bench --help``)."""
+
+    min_time: float = arg(1.0, lo=0.0, lo_open=True, hi=3600.0)
+    """seconds per measurement"""
+
+
+def main(argv: list[str] | None = None) -> None:
+    """``lvgym bench`` (``python -m lvgym.bench``): print the table."""
+    args = parse(Args, argv, "python -m lvgym.bench", __doc__)
     rows = run(args.min_time)
     print(f"# RK4 steps per second, one core ({platform.processor() or platform.machine()}, "
           f"{os.cpu_count()} cores, numba)\n")

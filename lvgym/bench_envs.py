@@ -1,4 +1,4 @@
-"""Speed of the ascent envs: env steps per second (``python -m lvgym.bench_envs``).
+"""Speed of the ascent envs: env steps per second (``lvgym bench-envs``, ``python -m lvgym.bench_envs``).
 
 ``lvgym/SmileAscent-v0`` rigid and non-rigid at the defaults (50 Hz control over 100 Hz RK4: two RK4
 steps, nine evaluations of the flight loads, the servo, the task signals per env step), with zero
@@ -35,15 +35,17 @@ processes of their medians and the ratios (``DIR`` / this: how many times faster
 
 from __future__ import annotations
 
-import argparse
 import os
 import platform
 import time
+from dataclasses import dataclass
+from typing import Literal
 
 import gymnasium as gym
 import numpy as np
 
 import lvgym  # noqa: F401  (registers the envs)
+from lvgym.cli.args import arg, parse
 from lvgym.envs import make_sb3_vec_env
 
 ENV_ID = "lvgym/SmileAscent-v0"
@@ -270,18 +272,30 @@ def load_average() -> str:
         return "?"
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--min-time", type=float, default=2.0, help="seconds per measurement")
-    parser.add_argument("--batch", type=int, default=1024, help="rows of the batched envs")
-    parser.add_argument("--repeats", type=int, default=5, help="runs per construction case")
-    parser.add_argument("--only", choices=("steps", "construction"), help="one of the two tables")
-    parser.add_argument("--against", metavar="DIR", help="construction: compare with the checkout whose lvgym "
-                        "package is in DIR, process by process in turn (see the module docstring)")
-    parser.add_argument("--rounds", type=int, default=3, help="--against: processes of each checkout per case")
-    parser.add_argument("--case", action="append", choices=sorted(CONSTRUCTION.values()),
-                        help="--against: only these construction cases (repeatable)")
-    args = parser.parse_args()
+@dataclass
+class Args:
+    """Command-line arguments (``lvgym bench-envs --help``)."""
+
+    min_time: float = arg(2.0, lo=0.0, lo_open=True, hi=3600.0)
+    """seconds per measurement"""
+    batch: int = arg(1024, lo=1, hi=1 << 20)
+    """rows of the batched envs"""
+    repeats: int = arg(5, lo=1, hi=10_000)
+    """runs per construction case"""
+    only: Literal["steps", "construction"] | None = None
+    """one of the two tables (default: both)"""
+    against: str | None = arg(None, metavar="DIR")
+    """construction: compare with the checkout whose lvgym package is in DIR, process by process in turn
+    (see the module docstring)"""
+    rounds: int = arg(3, lo=1, hi=10_000)
+    """--against: processes of each checkout per case"""
+    case: list[str] | None = arg(None, choices=tuple(sorted(CONSTRUCTION.values())), extend=True, metavar="CASE")
+    """--against: only these construction cases (a repeated flag adds)"""
+
+
+def main(argv: list[str] | None = None) -> None:
+    """``lvgym bench-envs`` (``python -m lvgym.bench_envs``): print the tables."""
+    args = parse(Args, argv, "python -m lvgym.bench_envs", __doc__)
     if args.against:
         cases = {k: v for k, v in CONSTRUCTION.items() if not args.case or v in args.case}
         rows = compare(args.against, args.rounds, args.repeats, cases)

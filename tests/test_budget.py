@@ -123,7 +123,7 @@ def test_short_budget_matches_the_runner(tmp_path):
 
 @pytest.mark.parametrize("args, message", [
     (["--episodes", "1"], "--episodes = 1: an integer in [2, 10000]"),
-    (["--episodes", "many"], "--episodes = 'many': a number"),
+    (["--episodes", "many"], "--episodes = 'many': an integer in [2, 10000]"),
     (["--models", "wobbly"], "--models wobbly: suite 'smile-v1' has ['nonrigid', 'rigid']"),
 ])
 def test_command_line_errors_are_one_line(args, message):

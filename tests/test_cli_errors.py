@@ -49,12 +49,15 @@ def test_evaluate_refuses_bad_values_before_any_episode(tmp_path, capsys, argv, 
     assert not (tmp_path / "out").exists()
 
 
+SEE = r" \(see python -m lvgym\.studies --help\)$"
+
+
 @pytest.mark.parametrize("argv, message", [
-    (["doe", "--aero-mach", "-1"], r"^python -m lvgym\.studies: --aero-mach = -1\.0: a number in \[0\.0, 25\.0\]$"),
-    (["ld-sweep", "--step", "0"], r"^python -m lvgym\.studies: --step = 0\.0: a number in \(0\.0, 0\.3\]$"),
-    (["ld-sweep", "--step", "-0.1"], r"--step = -0\.1: a number in \(0\.0, 0\.3\]$"),
-    (["tw-sweep", "--step", "50"], r"--step = 50\.0: a number in \(0\.0, 20\.0\]$"),
-    (["tw-sweep", "--workers", "0"], r"--workers = 0: an integer in \[1, 100000\]$"),
+    (["doe", "--aero-mach", "-1"], r"^python -m lvgym\.studies: error: --aero-mach = -1\.0: a number in \[0\.0, 25\.0\]" + SEE),
+    (["ld-sweep", "--step", "0"], r"^python -m lvgym\.studies: error: --step = 0\.0: a number in \(0\.0, 0\.3\]" + SEE),
+    (["ld-sweep", "--step", "-0.1"], r"--step = -0\.1: a number in \(0\.0, 0\.3\]" + SEE),
+    (["tw-sweep", "--step", "50"], r"--step = 50\.0: a number in \(0\.0, 20\.0\]" + SEE),
+    (["tw-sweep", "--workers", "0"], r"--workers = 0: an integer in \[1, 100000\]" + SEE),
     (["doe", "--step", "0.01"], r"--step = 0\.01: only for ld-sweep and tw-sweep"),
     (["doe", "--aero", "fancy"], r"argument --aero: invalid choice: 'fancy'"),
 ])

@@ -4,7 +4,6 @@ import doctest
 import pathlib
 import re
 
-import pytest
 
 import lvgym
 import lvgym.dynamics.model

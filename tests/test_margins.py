@@ -1,5 +1,5 @@
-"""Time-domain margins (lvgym.benchmark.perturb, lvgym.benchmark.margins): the gain and the delay between
-policy and actuator, the bisection, the bound, and a short end-to-end run."""
+"""Time-domain margins (lvgym.benchmark.perturb, lvgym.benchmark.margins; the command lvgym.cli.margins): the
+gain and the delay between policy and actuator, the bisection, the bound, and a short end-to-end run."""
 
 import json
 import math
@@ -9,11 +9,12 @@ import pytest
 
 import lvgym.cli.policies  # noqa: F401  (registers the built-in policies: pid)
 from lvgym.benchmark import get_suite
-from lvgym.benchmark.margins import (RATE_ERROR_FLOOR_RADPS, RATE_LIMIT_FLOOR_S, MarginOptions, _summary, bounds, main,
+from lvgym.benchmark.margins import (RATE_ERROR_FLOOR_RADPS, RATE_LIMIT_FLOOR_S, MarginOptions, _summary, bounds,
                                      margins_table, time_domain_margins, verdict)
 from lvgym.benchmark.perturb import ActuatorDelay, GainPolicy, db_to_gain, find_threshold, gain_to_db
 from lvgym.benchmark.registry import POLICIES
 from lvgym.benchmark.suites import Condition
+from lvgym.cli.margins import main
 from lvgym.simulator.layouts import ACTUATOR
 
 SHORT = 8.0          # s of mission of the end-to-end runs (the controller is on from 2 s)

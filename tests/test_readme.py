@@ -15,7 +15,6 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import lvgym
 
 ROOT = Path(__file__).resolve().parents[1]
 README = (ROOT / "README.md").read_text(encoding="utf-8")

@@ -176,3 +176,36 @@ def test_the_default_run_is_the_v1_recipe_and_given_options_win(tmp_path):
     args, config, _, _ = TRAIN.prepare(*TRAIN.parse_args(base + ["--env-id", "lvgym/SmileAscent-v0"]))
     assert args.residual is None and "history" not in config["env_kwargs"]
     assert not (tmp_path / "r").exists()
+
+
+def test_a_spent_wall_time_budget_stops_with_a_checkpoint_and_says_so(tmp_path, capsys):
+    """``--max-wall-time``: the run stops at the next env step once the budget (counted from the start of
+    the command) is spent, writes a checkpoint, says so and returns (no exit status); --resume finishes it."""
+    argv = _argv(tmp_path, "budget", steps=10**7, extra=("--eval-freq", "0", "--checkpoint-freq", "1000000000",
+                                                         "--checkpoint-interval-s", "0", "--max-wall-time", "2"))
+    run = TRAIN.train(argv)
+    err = capsys.readouterr().err
+    assert "train.py: the wall-time budget of 2 s is spent: stopped at step" in err, err
+    assert f"continue with python train.py --resume {run}" in err
+    (step, _), = list_checkpoints(run / "checkpoints")
+    assert 0 < step < 10**7 and not (run / "final_model.json").exists()
+    TRAIN.train(["--resume", str(run), "--total-timesteps", str(step + 128), "--no-progress"])
+    assert (run / "final_model.json").is_file()
+
+
+def test_the_progress_line_gives_steps_speed_time_and_the_validation_score(tmp_path, capsys):
+    """``--progress-interval-s``: a line on stdout at the end of a rollout once the interval has passed (here
+    at every rollout: 3 rollouts of 4 x 32 steps) and one at the end, with the latest validation score."""
+    run = TRAIN.train(_argv(tmp_path, "lines", steps=384, extra=("--progress-interval-s", "1e-9")))
+    lines = [x for x in capsys.readouterr().out.splitlines() if x.startswith("train.py: step ")]
+    assert 2 <= len(lines) <= 4, lines
+    import re
+
+    for line in lines:
+        assert re.fullmatch(r"train\.py: step [\d,]+ / 384 \([\d.]+ %\), [\d,]+ steps/s, elapsed \d+:\d\d:\d\d.*", line)
+    assert lines[-1].startswith("train.py: step 384 / 384 (100.0 %)") and "left" not in lines[-1]
+    assert re.search(r"; validation at step 384: score [-\d.e+]+, failure rate \d+ %$", lines[-1]), lines[-1]
+    assert "validation" not in lines[0]                       # none before the first validation (step 256)
+    assert (run / "final_model.json").is_file()
+    quiet = TRAIN.train(_argv(tmp_path, "quiet", steps=128, extra=("--eval-freq", "0", "--progress-interval-s", "0")))
+    assert "train.py: step" not in capsys.readouterr().out and (quiet / "final_model.json").is_file()

@@ -1,6 +1,7 @@
 """Bode and Nichols charts of a gain schedule's open loops, rigid and non-rigid, margins marked.
 
-``python -m lvgym.baselines.design.charts --vehicle smile --protocol v1 --schedule smile [--out results/charts]``
+``lvgym design charts --vehicle smile --protocol v1 --schedule smile [--out results/charts]``
+(``python -m lvgym.baselines.design.charts``)
 
 At each row of the schedule (``baselines/schedules/<schedule>.yaml`` or a path) the vehicle is linearised
 at the row's flight time (:func:`.linearize.operating_point` of the protocol's env), the flight
@@ -14,16 +15,18 @@ is skipped with a message. ``margins.json`` beside the figures holds the numbers
 
 from __future__ import annotations
 
-import argparse
 import json
 import math
 import sys
 import warnings
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import control
 import numpy as np
+
+from lvgym.cli.args import arg
 
 from .flightloop import flight_plant, frequency_response, mode_frequencies
 from .linearize import margins, operating_point, pid_tf
@@ -123,22 +126,44 @@ def charts(vehicle: str, protocol: str, schedule: str, out: Path, log=print) -> 
     return doc
 
 
-def main(argv: list[str] | None = None) -> int:
-    from lvgym.cli import fail, one_line_errors
+def _linearize_choices(which: str):
+    def choices() -> tuple[str, ...]:
+        from .linearize import ENV_IDS
+
+        return tuple(sorted(ENV_IDS["v1"] if which == "vehicle" else ENV_IDS))
+    return choices
+
+
+def _readable(option: str, schedule: str) -> str:
+    """``--schedule``: a gain schedule that loads."""
     from lvgym.errors import ConfigError
 
-    from .linearize import ENV_IDS
-
-    ap = one_line_errors(argparse.ArgumentParser(prog="python -m lvgym.baselines.design.charts", description=__doc__.split("\n\n")[0]))
-    ap.add_argument("--vehicle", default="smile", choices=sorted(ENV_IDS["v1"]))
-    ap.add_argument("--protocol", default="v1", choices=sorted(ENV_IDS))
-    ap.add_argument("--schedule", default="smile", help="a schedule name in baselines/schedules or a YAML path")
-    ap.add_argument("--out", default="results/charts", help="folder of the figures and margins.json")
-    a = ap.parse_args(argv)
     try:
-        GainSchedule.load(a.schedule)
+        GainSchedule.load(schedule)
     except (OSError, KeyError, ValueError) as exc:
-        fail(ap.prog, ConfigError("--schedule", a.schedule, f"a readable gain schedule ({exc})"))
+        raise ConfigError(option, schedule, f"a readable gain schedule ({exc})") from None
+    return schedule
+
+
+@dataclass
+class Args:
+    """Command-line arguments (``lvgym design charts --help``)."""
+
+    vehicle: str = arg("smile", choices=_linearize_choices("vehicle"))
+    """the vehicle linearised"""
+    protocol: str = arg("v1", choices=_linearize_choices("protocol"))
+    """the protocol whose env is linearised"""
+    schedule: str = arg("smile", check=_readable)
+    """a schedule name in baselines/schedules or a YAML path"""
+    out: str = "results/charts"
+    """folder of the figures and margins.json (a subfolder per vehicle, protocol and schedule)"""
+
+
+def main(argv: list[str] | None = None) -> int:
+    """``lvgym design charts`` (``python -m lvgym.baselines.design.charts``): write the charts."""
+    from lvgym.cli.args import parse
+
+    a = parse(Args, argv, "python -m lvgym.baselines.design.charts", __doc__)
     out = Path(a.out) / f"{a.vehicle}_{a.protocol}_{Path(a.schedule).stem}"
     charts(a.vehicle, a.protocol, a.schedule, out)
     print(f"wrote {out}")

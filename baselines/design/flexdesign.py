@@ -1,8 +1,8 @@
 """Design of ``gs-pid-flex``: a gain-scheduled PID with structural filters, designed on the non-rigid
 linear model of protocol v1's flight loop, at frozen flight times (docs/flex-design.md).
 
-``python -m lvgym.baselines.design.flexdesign --vehicle smile`` writes ``results/schedules/smile_flex.yaml`` (the
-schedule, its margins and its frozen-time checks) and ``smile_flex_margins.md`` (the margin table); the
+``lvgym design pid-flex --vehicle smile`` (``python -m lvgym.baselines.design.flexdesign``) writes
+``results/schedules/smile_flex.yaml`` (the schedule, its margins and its frozen-time checks) and ``smile_flex_margins.md`` (the margin table); the
 shipped schedule (``baselines/schedules/smile_flex.yaml``, the one ``gs-pid-flex`` flies) is replaced
 only with ``--overwrite``.
 
@@ -24,11 +24,13 @@ python-control loops, in pitch and yaw, on all those plants.
 from __future__ import annotations
 
 import warnings
-from dataclasses import asdict
+from dataclasses import asdict, dataclass
 from typing import Any, Callable
 
 import control
 import numpy as np
+
+from lvgym.cli.args import arg
 
 from ..filters import StructuralFilter
 from .flexproblem import (PARAMETERS, START, Requirements, RowProblem, _controller_poly, _from_unit,  # noqa: F401
@@ -254,58 +256,62 @@ def design_schedule(vehicle: str = "smile", times=None, req: Requirements | None
             "rows": rows, "skipped": skipped}
 
 
+@dataclass
+class Args:
+    """Command-line arguments (``lvgym design pid-flex --help``)."""
+
+    vehicle: str = arg("smile", choices=tuple(sorted(FLEX_TIMES)))
+    """the vehicle whose schedule is designed"""
+    out: str | None = None
+    """YAML file (default results/schedules/<vehicle>_flex.yaml; with --overwrite: the shipped
+    baselines/schedules/<vehicle>_flex.yaml)"""
+    overwrite: bool = False
+    """allow replacing a shipped schedule (gs-pid-flex reads it)"""
+    times: list[float] | None = arg(None, nargs="*", lo=0.0, lo_open=True, hi=3600.0)
+    """flight times of the rows [s] (default: the vehicle's, FLEX_TIMES)"""
+    starts: int = arg(2, lo=0, hi=100)
+    """random starts of the optimiser per row (besides the warm one)"""
+    seed: int = 0
+    """seed of the random starts"""
+    load_relief: tuple[float, float] | None = arg(None, lo=0.0, hi=1.0, metavar=("KI_SCALE", "ACCEL_GAIN"))
+    """load relief: scale every row's integral gain by KI_SCALE and add ACCEL_GAIN [rad/s per m/s^2]"""
+    planes: list[str] = arg(default_factory=lambda: ["pitch"], choices=("pitch", "yaw"))
+    """planes the optimiser holds to the requirements: pitch, or pitch yaw"""
+    noise_rate: float | None = arg(None, lo=0.0, lo_open=True, hi=100.0, metavar="FRACTION")
+    """hold the gimbal rate the gyro's noise commands to this fraction of the servo's rate limit (RMS;
+    default: reported, not required; docs/flex-design.md)"""
+
+
 def main(argv: list[str] | None = None) -> int:
-    import argparse
+    """``lvgym design pid-flex`` (``python -m lvgym.baselines.design.flexdesign``): design and write the schedule."""
     import sys
 
     import yaml
 
     from lvgym.benchmark.results import atomic_write_text
-    from lvgym.cli import fail, one_line_errors, option_number
+    from lvgym.cli import fail
+    from lvgym.cli.args import command_name, parse
     from lvgym.errors import ConfigError
 
     from .tune import SCHEDULES, output_path
 
-    ap = one_line_errors(argparse.ArgumentParser(prog="python -m lvgym.baselines.design.flexdesign",
-                                                 description=__doc__.split("\n\n")[0]))
-    ap.add_argument("--vehicle", default="smile", choices=sorted(FLEX_TIMES))
-    ap.add_argument("--out", default=None, help="YAML file (default results/schedules/<vehicle>_flex.yaml; with "
-                    "--overwrite: the shipped baselines/schedules/<vehicle>_flex.yaml)")
-    ap.add_argument("--overwrite", action="store_true", help="allow replacing a shipped schedule (gs-pid-flex reads it)")
-    ap.add_argument("--times", type=float, nargs="*", default=None, help="flight times of the rows [s]")
-    ap.add_argument("--starts", type=int, default=2, help="random starts of the optimiser per row (besides the warm one)")
-    ap.add_argument("--seed", type=int, default=0, help="seed of the random starts")
-    ap.add_argument("--load-relief", type=float, nargs=2, default=None, metavar=("KI_SCALE", "ACCEL_GAIN"),
-                    help="load relief: scale every row's integral gain by KI_SCALE and add ACCEL_GAIN [rad/s per m/s^2]")
-    ap.add_argument("--planes", nargs="+", choices=("pitch", "yaw"), default=["pitch"],
-                    help="planes the optimiser holds to the requirements: pitch (default) or pitch yaw")
-    ap.add_argument("--noise-rate", type=float, default=None, metavar="FRACTION",
-                    help="hold the gimbal rate the gyro's noise commands to this fraction of the servo's rate limit "
-                    "(RMS; default: reported, not required; docs/flex-design.md)")
-    a = ap.parse_args(argv)
-    try:
+    prog = "python -m lvgym.baselines.design.flexdesign"
+    a = parse(Args, argv, prog, __doc__)
+    try:                                             # refused before the (slow) design
         out = output_path(a.vehicle, a.out, a.overwrite, stem=f"{a.vehicle}_flex")
-        option_number("--starts", a.starts, 0, 100)
-        for t in a.times or ():
-            option_number("--times", t, 0.0, 3600.0, lo_open=True)
-        if a.load_relief is not None:
-            option_number("--load-relief KI_SCALE", a.load_relief[0], 0.0, 1.0)
-            option_number("--load-relief ACCEL_GAIN", a.load_relief[1], 0.0, 1.0)
-        if a.noise_rate is not None:
-            option_number("--noise-rate", a.noise_rate, 0.0, 100.0, lo_open=True)
     except ConfigError as exc:
-        fail(ap.prog, exc)
-    doc = design_schedule(a.vehicle, a.times, Requirements(noise_rate_fraction=a.noise_rate), starts=a.starts, seed=a.seed,
-                          relief=None if a.load_relief is None else tuple(a.load_relief), planes=tuple(dict.fromkeys(
-                              ["pitch", *a.planes])))
+        fail(command_name(prog), exc)
+    planes = tuple(dict.fromkeys(["pitch", *a.planes]))
+    doc = design_schedule(a.vehicle, a.times, Requirements(noise_rate_fraction=a.noise_rate), starts=a.starts,
+                          seed=a.seed, relief=a.load_relief, planes=planes)
     if not doc["rows"]:
         print(f"no flight time of {a.vehicle} could be designed; nothing written", file=sys.stderr)
         return 1
     shipped = out.parent.resolve() == SCHEDULES.resolve()
-    again = (f"python -m lvgym.baselines.design.flexdesign --vehicle {a.vehicle} --starts {a.starts}"
+    again = (f"lvgym design pid-flex --vehicle {a.vehicle} --starts {a.starts}"
              + ("" if a.load_relief is None else " --load-relief {:g} {:g}".format(*a.load_relief))
              + ("" if not a.times else " --times " + " ".join(f"{t:g}" for t in a.times))
-             + ("" if a.planes == ["pitch"] else " --planes " + " ".join(dict.fromkeys(["pitch", *a.planes])))
+             + ("" if planes == ("pitch",) else " --planes " + " ".join(planes))
              + ("" if a.noise_rate is None else f" --noise-rate {a.noise_rate:g}")
              + (" --overwrite" if shipped else f" --out {out}"))
     out.parent.mkdir(parents=True, exist_ok=True)

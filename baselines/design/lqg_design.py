@@ -1,6 +1,7 @@
 """LQG rate loops designed on the flight computer's non-rigid plant, per plane, at frozen flight times.
 
-``python -m lvgym.baselines.design.lqg_design --vehicle smile [--out results/schedules] [--overwrite]``
+``lvgym design lqg --vehicle smile [--out results/schedules] [--overwrite]``
+(``python -m lvgym.baselines.design.lqg_design``)
 
 Each row's law is :mod:`.lqg_row`'s (plant with the delay as a state, LQR on the rate error and its leaky
 integral, steady-state Kalman filter of the v1 gyro, the compensator and its margins with the loop broken
@@ -13,18 +14,18 @@ docs/lqg.md gives the reasoning and the numbers.
 
 from __future__ import annotations
 
-import argparse
 import math
 import sys
 import warnings
 from dataclasses import asdict, dataclass, fields, replace
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
 
 import control
 import numpy as np
 import scipy.linalg as sla
 
+from lvgym.cli.args import arg
 from lvgym.errors import ConfigError, check_number
 
 from .flightloop import flight_plant, mode_frequencies
@@ -309,22 +310,37 @@ def margin_table(doc: dict[str, Any]) -> str:
     return "\n".join(lines) + "\n"
 
 
-def main(argv: list[str] | None = None) -> int:
-    from lvgym.cli import one_line_errors
+@dataclass
+class Args:
+    """Command-line arguments (``lvgym design lqg --help``)."""
 
-    ap = one_line_errors(argparse.ArgumentParser(prog="python -m lvgym.baselines.design.lqg_design",
-                                                 description=__doc__.split("\n\n")[0]))
-    ap.add_argument("--vehicle", default="smile", choices=["smile"])
-    ap.add_argument("--out", default="results/schedules", help="folder of smile_lqg.npz and smile_lqg_margins.md")
-    ap.add_argument("--overwrite", action="store_true", help=f"write into the shipped {SCHEDULES} instead of --out")
-    ap.add_argument("--rows", type=float, nargs="+", default=list(SMILE_ROWS_S), help="flight times [s] of the rows")
-    a = ap.parse_args(argv)
+    vehicle: Literal["smile"] = "smile"
+    """the vehicle (the LQG schedule is designed for SMILE v1 only)"""
+    out: str = "results/schedules"
+    """folder of <vehicle>_lqg.npz and <vehicle>_lqg_margins.md"""
+    overwrite: bool = False
+    """write into the shipped baselines/schedules instead of --out"""
+    rows: list[float] = arg(default_factory=lambda: list(SMILE_ROWS_S), lo=0.0, hi=3600.0)
+    """flight times [s] of the rows"""
+
+
+def main(argv: list[str] | None = None) -> int:
+    """``lvgym design lqg`` (``python -m lvgym.baselines.design.lqg_design``): design and write the schedule."""
+    from lvgym.cli import fail
+    from lvgym.cli.args import command_name, parse
+
+    prog = "python -m lvgym.baselines.design.lqg_design"
+    a = parse(Args, argv, prog, __doc__)
+    try:
+        row_intervals(tuple(a.rows), SMILE_PHASES_S)        # every row in a thrusting phase, before the design
+    except ConfigError as exc:
+        fail(command_name(prog), ConfigError("--rows", exc.value, exc.allowed))
     out = SCHEDULES if a.overwrite else Path(a.out)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         doc = design_schedule(a.vehicle, tuple(a.rows))
     save_schedule(doc, out / f"{a.vehicle}_lqg.npz")
-    head = (f"# LQG schedule of {a.vehicle} v1: margins per row\n\nWritten by `python -m lvgym.baselines.design.lqg_design "
+    head = (f"# LQG schedule of {a.vehicle} v1: margins per row\n\nWritten by `lvgym design lqg "
             f"--vehicle {a.vehicle}`. Loop broken at the plant input; GM / GRM: gain and gain-reduction margin, "
             "PM: phase margin at the gain crossover of smallest |PM|, CL: closed-loop stability; slosh and "
             "bending: the non-rigid loop's |L| at each mode (bending modes above Nyquist folded). Targets: "

@@ -1,8 +1,9 @@
 """Tune PID rate gains on the linearised rigid vehicle and write a gain schedule.
 
-``python -m lvgym.baselines.design.tune --vehicle smile`` writes ``results/schedules/smile.yaml`` (or ``--out``);
-the shipped schedules that ``gs-pid`` reads (``baselines/schedules/``) are replaced only with
-``--overwrite`` (``python -m lvgym.baselines.design.tune --vehicle smile --overwrite``).
+``lvgym design pid --vehicle smile`` (``python -m lvgym.baselines.design.tune``) writes
+``results/schedules/smile.yaml`` (or ``--out``); the shipped schedules that ``gs-pid`` reads
+(``baselines/schedules/``) are replaced only with ``--overwrite`` (``lvgym design pid --vehicle smile
+--overwrite``).
 
 At each flight time of the schedule: linearise the rigid vehicle (:func:`.linearize.linearize`), put the
 servo, the zero-order hold of the control period and the discrete PID in the loop, and place the gain
@@ -17,16 +18,18 @@ beside the targets. Each row also carries the loop's margins with the rigid and 
 
 from __future__ import annotations
 
-import argparse
 import math
 import sys
 import warnings
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import control
 import numpy as np
 import yaml
+
+from lvgym.cli.args import arg
 
 from .linearize import linearize, loop, margins, operating_point
 from ..pid import SCHEDULES
@@ -157,42 +160,50 @@ def output_path(vehicle: str, out: str | None, overwrite: bool, stem: str | None
     return path
 
 
+@dataclass
+class Args:
+    """Command-line arguments (``lvgym design pid --help``)."""
+
+    vehicle: str = arg("smile", choices=tuple(sorted(VEHICLE_TIMES)))
+    """the vehicle whose schedule is tuned"""
+    out: str | None = None
+    """YAML file (default results/schedules/<vehicle>.yaml; with --overwrite: the shipped
+    baselines/schedules/<vehicle>.yaml)"""
+    overwrite: bool = False
+    """allow replacing a shipped schedule (gs-pid reads them)"""
+    times: list[float] | None = arg(None, nargs="*", lo=0.0, hi=3600.0)
+    """flight times of the rows [s] (default: the vehicle's, VEHICLE_TIMES)"""
+    bandwidth: float = arg(75.0, lo=0.0, lo_open=True, hi=1e4)
+    """target gain crossover [rad/s]"""
+    phase_margin: float = arg(35.0, lo=0.0, lo_open=True, hi=90.0)
+    """target phase margin [deg]"""
+    dt: float = arg(0.02, lo=0.0, hi=1.0)
+    """control period [s] (0: continuous)"""
+    n: float = arg(500.0, lo=0.0, lo_open=True, hi=1e6)
+    """derivative filter coefficient [rad/s]"""
+    ki_ratio: float = arg(3.0, lo=0.0, lo_open=True, hi=1e6)
+    """crossover over the integral zero"""
+
+
 def main(argv: list[str] | None = None) -> int:
-    from lvgym.cli import fail, one_line_errors, option_number
+    """``lvgym design pid`` (``python -m lvgym.baselines.design.tune``): tune and write the schedule."""
+    from lvgym.cli import fail
+    from lvgym.cli.args import command_name, parse
     from lvgym.errors import ConfigError
 
-    ap = one_line_errors(argparse.ArgumentParser(prog="python -m lvgym.baselines.design.tune",
-                                                 description=__doc__.split("\n\n")[0]))
-    ap.add_argument("--vehicle", default="smile", choices=sorted(VEHICLE_TIMES))
-    ap.add_argument("--out", default=None, help="YAML file (default results/schedules/<vehicle>.yaml; with "
-                    "--overwrite: the shipped baselines/schedules/<vehicle>.yaml)")
-    ap.add_argument("--overwrite", action="store_true", help="allow replacing a shipped schedule (gs-pid reads them)")
-    ap.add_argument("--times", type=float, nargs="*", default=None, help="flight times [s]")
-    ap.add_argument("--bandwidth", type=float, default=75.0, help="target gain crossover [rad/s]")
-    ap.add_argument("--phase-margin", type=float, default=35.0, help="target phase margin [deg]")
-    ap.add_argument("--dt", type=float, default=0.02, help="control period [s] (0: continuous)")
-    ap.add_argument("--n", type=float, default=500.0, help="derivative filter coefficient [rad/s]")
-    ap.add_argument("--ki-ratio", type=float, default=3.0, help="crossover over integral zero")
-    a = ap.parse_args(argv)
-    try:                                             # every value checked before the (slow) tuning
+    a = parse(Args, argv, "python -m lvgym.baselines.design.tune", __doc__)
+    try:                                             # refused before the (slow) tuning
         out = output_path(a.vehicle, a.out, a.overwrite)
-        option_number("--bandwidth", a.bandwidth, 0.0, 1e4, lo_open=True)
-        option_number("--phase-margin", a.phase_margin, 0.0, 90.0, lo_open=True)
-        option_number("--dt", a.dt, 0.0, 1.0)
-        option_number("--n", a.n, 0.0, 1e6, lo_open=True)
-        option_number("--ki-ratio", a.ki_ratio, 0.0, 1e6, lo_open=True)
-        for t in a.times or ():
-            option_number("--times", t, 0.0, 3600.0)
     except ConfigError as exc:
-        fail(ap.prog, exc)
+        fail(command_name("python -m lvgym.baselines.design.tune"), exc)
     doc = schedule(a.vehicle, a.times, a.bandwidth, a.phase_margin, a.dt or None, a.n, a.ki_ratio)
     if len(doc["rows"]) < 1:
         print(f"no flight time of {a.vehicle} could be tuned; nothing written", file=sys.stderr)
         return 1
     from lvgym.benchmark.results import atomic_write_text
 
-    again = f"python -m lvgym.baselines.design.tune --vehicle {a.vehicle}" + (" --overwrite" if out.parent.resolve() ==
-                                                                     SCHEDULES.resolve() else f" --out {out}")
+    again = f"lvgym design pid --vehicle {a.vehicle}" + (" --overwrite" if out.parent.resolve() ==
+                                                         SCHEDULES.resolve() else f" --out {out}")
     out.parent.mkdir(parents=True, exist_ok=True)
     atomic_write_text(out, f"# Gain schedule of {a.vehicle}, regenerated by: {again}\n"
                       "# Gains: rad of gimbal per rad/s of rate error (kp), per rad (ki), per rad/s^2 (kd); n [rad/s].\n"

@@ -12,16 +12,17 @@ non-rigid``), over the validation seeds ``0 .. seeds-1`` (never the test seeds).
 
 from __future__ import annotations
 
-import argparse
 import ast
 import sys
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from lvgym.benchmark.runner import play_episode
-from lvgym.benchmark.suites import get_suite
-from lvgym.cli import fail, one_line_errors, option_number
+from lvgym.benchmark.suites import SUITES, get_suite
+from lvgym.cli import fail
+from lvgym.cli.args import arg, command_name, parse
 from lvgym.errors import ConfigError
 
 from lvgym.baselines.aac import FLEX_AAC, AACParams, AdaptiveAugmentingPolicy, _check_keywords
@@ -98,22 +99,28 @@ def line(row: dict[str, Any]) -> str:
     return f"{row['variant']!s:50s} x{row['scale']:<4g} {cells}"
 
 
+@dataclass
+class Args:
+    """Command-line arguments (``python -m experiments.aac_tuning.aac_sweep --help``)."""
+
+    variants: list[str] = arg(positional=True, metavar="VARIANT")
+    """"key=value, ..." of AACParams over aac's defaults, or none (gs-pid-flex alone)"""
+    scales: list[float] = arg(default_factory=lambda: [1.0, 2.0, 0.4], lo=0.0, lo_open=True, hi=100.0)
+    """multipliers of the base loop's command"""
+    suite: str = arg("smile-v1", metavar="SUITE", choices=lambda: sorted(SUITES))
+    """the suite flown"""
+    seeds: int = arg(10, lo=1, hi=10_000)
+    """validation seeds 0 .. SEEDS-1"""
+
+
 def main(argv: list[str] | None = None) -> int:
+    """Fly the variants, print the table."""
     prog = "python -m experiments.aac_tuning.aac_sweep"
-    ap = one_line_errors(argparse.ArgumentParser(prog=prog, description=__doc__.split("\n\n")[0]))
-    ap.add_argument("variants", nargs="+", help='"key=value, ..." of AACParams over aac\'s defaults, or none')
-    ap.add_argument("--scales", type=float, nargs="+", default=[1.0, 2.0, 0.4])
-    ap.add_argument("--suite", default="smile-v1")
-    ap.add_argument("--seeds", type=int, default=10, help="validation seeds 0 .. SEEDS-1")
-    a = ap.parse_args(argv)
+    a = parse(Args, argv, prog, __doc__)
     try:
-        option_number("--seeds", a.seeds, 1, 10000, integer=True)
-        for x in a.scales:
-            option_number("--scales", x, 0.0, 100.0, lo_open=True)
         variants = [parse_variant(v) for v in a.variants]
-        get_suite(a.suite)
     except (ConfigError, KeyError, ValueError) as exc:
-        fail(prog, exc)
+        fail(command_name(prog), exc)
     print(f"{a.suite}, validation seeds 0-{a.seeds - 1}: mean score rigid / non-rigid [rad] (failures)")
     sweep(variants, a.scales, a.suite, a.seeds)
     sys.stdout.flush()

@@ -28,10 +28,12 @@ SP-8007's knockdown: with the 4.5 mm wall it is well above yield, so yield gover
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
+from lvgym.cli.args import arg
 from lvgym.vehicle.sections import MATERIALS, tube_area, tube_second_moment
 
 from experiments.aeroelastic_divergence.divergence import Beam, Lift, vehicle_beam, vehicle_lift
@@ -132,12 +134,21 @@ def slender_v1_qalpha_limit(t: float = 8.0, thrust_n: float | None = None, drag_
     return out
 
 
+@dataclass
+class Args:
+    """Command-line arguments (``python -m experiments.aeroelastic_divergence.structural_limit --help``)."""
+
+    times: list[float] = arg(default_factory=lambda: [4.0, 6.0, 8.0], positional=True, lo=0.0, hi=100.0, metavar="T")
+    """flight times [s] of SlenderAscent-v1"""
+
+
 def main(argv: list[str] | None = None) -> int:
     """``python -m experiments.aeroelastic_divergence.structural_limit [times...]``: the limit at flight times [s] of
     ``SlenderAscent-v1`` (default 4, 6, 8 s), with the thrust and axial drag of its calm flight there."""
     from lvgym.baselines.design.linearize import aero_slopes, operating_point
+    from lvgym.cli.args import parse
 
-    times = [float(v) for v in (argv if argv is not None else __import__("sys").argv[1:])] or [4.0, 6.0, 8.0]
+    times = parse(Args, argv, "python -m experiments.aeroelastic_divergence.structural_limit", main.__doc__).times
     print("| t [s] | mass [kg] | thrust / drag [kN] | bending moment per q S alpha, free / trimmed [m] | station [m] "
           "| compression [kN] | q-alpha limit [MPa deg] |\n|---:|---:|---|---|---:|---:|---:|")
     for t in times:

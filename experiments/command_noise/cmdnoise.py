@@ -20,7 +20,6 @@ included, as :mod:`.margins` measures the gain and delay margins.
 
 from __future__ import annotations
 
-import argparse
 import math
 import sys
 from collections.abc import Sequence
@@ -29,10 +28,9 @@ from typing import Any
 
 import numpy as np
 
-from lvgym.cli import fail, one_line_errors, option_number
 import lvgym.cli.policies  # noqa: F401  (registers the built-in policies the command line names)
-from lvgym.errors import ConfigError
-from lvgym.parallel import EXECUTORS, check_workers, exit_on_sigterm, run_map
+from lvgym.cli.args import arg, command_name, parse
+from lvgym.parallel import EXECUTORS, exit_on_sigterm, run_map
 
 from lvgym.benchmark.runner import PolicySpec, build_policy
 from lvgym.benchmark.suites import SEED_SETS, SUITES, Condition, get_suite
@@ -141,29 +139,36 @@ def noise_table(records: Sequence[dict[str, Any]]) -> str:
     return "\n".join(lines) + "\n"
 
 
+@dataclass
+class Args:
+    """Command-line arguments (``python -m experiments.command_noise.cmdnoise --help``)."""
+
+    policies: list[str] = arg(default_factory=lambda: list(DEFAULT_POLICIES), metavar="POLICY")
+    """registered names, SB3 .zip files or train.py run folders"""
+    suite: str = arg("smile-v1", metavar="SUITE", choices=lambda: sorted(SUITES))
+    """the suite flown"""
+    seeds: int = arg(3, lo=1, hi=10_000)
+    """seeds per policy and condition"""
+    seed_set: str = arg("test", choices=SEED_SETS)
+    """test or validation"""
+    models: list[str] | None = arg(None, metavar="MODEL")
+    """the conditions' flight models (default: all of the suite)"""
+    executor: str = arg("local", choices=EXECUTORS)
+    """local (process pool), serial or ray"""
+    workers: int | None = arg(None, lo=1, hi=100_000)
+    """parallel workers (default: the CPUs available)"""
+    progress: bool = True
+    """show a progress bar"""
+
+
 def main(argv: Sequence[str] | None = None) -> int:
+    """Fly, print the table."""
     from lvgym.benchmark.registry import resolve_policy
 
     exit_on_sigterm()
-    ap = one_line_errors(argparse.ArgumentParser(prog=PROG, description=__doc__.split("\n\n")[0]))
-    ap.add_argument("--policies", nargs="+", default=DEFAULT_POLICIES,
-                    help="registered names, SB3 .zip files or train.py run folders")
-    ap.add_argument("--suite", default="smile-v1", choices=sorted(SUITES))
-    ap.add_argument("--seeds", type=int, default=3, help="seeds per policy and condition")
-    ap.add_argument("--seed-set", default="test", choices=SEED_SETS)
-    ap.add_argument("--models", nargs="+", default=None, help="conditions' models (default: all of the suite)")
-    ap.add_argument("--executor", default="local", choices=EXECUTORS)
-    ap.add_argument("--workers", type=int, default=None)
-    ap.add_argument("--no-progress", action="store_true")
-    a = ap.parse_args(argv)
-    try:
-        option_number("--seeds", a.seeds, 1, 10000, integer=True)
-        workers = check_workers(a.workers, "--workers")
-    except ConfigError as exc:
-        fail(PROG, exc)
-    specs = [resolve_policy(p, PROG) for p in a.policies]
-    records = run_command_noise(specs, a.suite, a.seeds, a.seed_set, a.models, a.executor, workers,
-                                not a.no_progress)
+    a = parse(Args, argv, PROG, __doc__)
+    specs = [resolve_policy(p, command_name(PROG)) for p in a.policies]
+    records = run_command_noise(specs, a.suite, a.seeds, a.seed_set, a.models, a.executor, a.workers, a.progress)
     sys.stdout.write(noise_table(records))
     return 0
 

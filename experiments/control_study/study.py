@@ -11,9 +11,9 @@ and ``control_study.json`` with the cumulative pitch and yaw rate errors [rad] a
 
 from __future__ import annotations
 
-import argparse
 import json
 import sys
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -22,6 +22,7 @@ import numpy as np
 
 import lvgym  # noqa: F401
 from lvgym.benchmark.policy import ZeroPolicy
+from lvgym.cli.args import arg, parse
 
 from lvgym.baselines.pid import GainSchedule, PIDPolicy, smile_scheduled_pid, smile_single_pid
 
@@ -119,11 +120,25 @@ def study(wind: str = "profile", out: Path | None = None, names=None, log=print)
     return results
 
 
+def _wind_tiers() -> tuple[str, ...]:
+    from lvgym.envs.spec import WIND_TIERS
+
+    return tuple(WIND_TIERS)
+
+
+@dataclass
+class Args:
+    """Command-line arguments (``python -m experiments.control_study.study --help``)."""
+
+    wind: list[str] = arg(default_factory=lambda: ["none", "profile"], nargs="*", choices=_wind_tiers)
+    """the wind tiers flown, one study each"""
+    out: str = "docs/figures"
+    """folder of the figures and control_study.json"""
+
+
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m experiments.control_study.study", description=__doc__.split("\n\n")[0])
-    ap.add_argument("--wind", nargs="*", default=["none", "profile"])
-    ap.add_argument("--out", default="docs/figures")
-    a = ap.parse_args(argv)
+    """Run the study for every wind, write its figures and JSON."""
+    a = parse(Args, argv, "python -m experiments.control_study.study", __doc__)
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
     doc = {"thesis": THESIS}

@@ -27,27 +27,26 @@ after the fact). From Python: :func:`variants`, :func:`budget_rows` and :func:`r
 
 from __future__ import annotations
 
-import argparse
 import datetime as dt
 import sys
 import time
 from collections.abc import Sequence
-from dataclasses import replace
+from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from lvgym.cli import fail, option_number, parse_number
 import lvgym.cli.policies  # noqa: F401  (registers the built-in policies the command line names)
-from lvgym.errors import ConfigError
-from lvgym.parallel import check_workers, exit_on_sigterm
+from lvgym.cli.args import arg, command_name, parse
+from lvgym.cli.flights import FlightArgs, resolve_flights
+from lvgym.parallel import exit_on_sigterm
 
 from lvgym.benchmark.results import atomic_write_text, csv_text, json_text
 from lvgym.benchmark.runner import PolicySpec, evaluate
 from lvgym.benchmark.scoring import PHASES
 from lvgym.benchmark.stats import bootstrap_ci, paired
-from lvgym.benchmark.suites import SEED_SETS, Condition, Suite
+from lvgym.benchmark.suites import SEED_SETS, SUITES, Condition, Suite
 
 __all__ = ["DISTURBANCES", "PHASES", "WIND_PARTS", "budget_rows", "budget_table", "run_budget", "sources",
            "variants"]
@@ -183,33 +182,31 @@ def run_budget(policies: Sequence[PolicySpec], conditions: Sequence[Condition], 
     return records
 
 
-def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
-    """The command line, every value checked before any worker starts."""
-    from lvgym.benchmark.registry import flight_parser
+@dataclass
+class Args(FlightArgs):
+    """Command-line arguments (``python -m experiments.error_budget.budget --help``)."""
 
-    p = flight_parser(PROG, __doc__, DEFAULT_POLICIES, DEFAULT_SUITE, "results/budget")
-    p.add_argument("--models", nargs="+", default=["nonrigid"], metavar="MODEL",
-                   help="the suite's conditions of these flight models (default: nonrigid)")
-    p.add_argument("--episodes", default=DEFAULT_EPISODES, help=f"seeds per variant (default {DEFAULT_EPISODES})")
-    p.add_argument("--seed-set", choices=SEED_SETS, default="validation", help="default: validation (a diagnosis)")
-    ns = p.parse_args(argv)
-    try:
-        ns.episodes = option_number("--episodes", parse_number(ns.episodes, "--episodes"), 2, 10_000, integer=True)
-        ns.workers = check_workers(parse_number(ns.workers, "--workers"), "--workers")
-        ns.mission_time_s = option_number("--mission-time-s", parse_number(ns.mission_time_s, "--mission-time-s"),
-                                          0.0, 3600.0, lo_open=True)
-    except ConfigError as exc:
-        fail(PROG, exc)
-    return ns
+    policies: list[str] = arg(default_factory=lambda: list(DEFAULT_POLICIES), metavar="POLICY")
+    suite: str = arg(DEFAULT_SUITE, metavar="SUITE", choices=lambda: sorted(SUITES))
+    out: str = "results/budget"
+    models: list[str] = arg(default_factory=lambda: ["nonrigid"], metavar="MODEL")
+    """the suite's conditions of these flight models"""
+    episodes: int = arg(DEFAULT_EPISODES, lo=2, hi=10_000)
+    """seeds per variant"""
+    seed_set: str = arg("validation", choices=SEED_SETS)
+    """validation (a diagnosis) or test"""
+
+
+def parse_args(argv: list[str] | None = None) -> Args:
+    """The command line, every value checked before any worker starts."""
+    return parse(Args, argv, PROG, __doc__, epilog=True)
 
 
 def main(argv: list[str] | None = None) -> list[dict[str, Any]]:
     """Fly, print the table, write ``episodes.csv``, ``budget.csv`` and ``budget.json``; returns the rows."""
-    from lvgym.benchmark.registry import resolve_flights
-
     args = parse_args(argv)
     exit_on_sigterm()
-    policies, suite, conds = resolve_flights(PROG, args.policies, args.suite, args.models,
+    policies, suite, conds = resolve_flights(command_name(PROG), args.policies, args.suite, args.models,
                                              mission_time_s=args.mission_time_s)
     t0 = time.perf_counter()
     records = run_budget(policies, conds, suite, args.episodes, args.seed_set, args.executor, args.workers,
@@ -217,7 +214,7 @@ def main(argv: list[str] | None = None) -> list[dict[str, Any]]:
     wall = time.perf_counter() - t0
     rows = budget_rows(records)
     meta = {"suite": suite.name, "version": suite.version, "seed_set": args.seed_set, "episodes": len(records),
-            "args": vars(args), "wall_time_s": round(wall, 3),
+            "args": asdict(args), "wall_time_s": round(wall, 3),
             "created_utc": dt.datetime.now(dt.timezone.utc).isoformat(timespec="seconds")}
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)

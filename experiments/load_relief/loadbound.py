@@ -23,10 +23,13 @@ and east; at another roll a plane could have up to sqrt(2) times more, see ``del
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 from scipy import linalg, optimize
+
+from lvgym.cli.args import arg, parse
 
 from lvgym.baselines.design.linearize import aero_slopes, analytic_rigid, operating_point
 
@@ -113,10 +116,19 @@ def min_peak_qalpha(models: dict[str, np.ndarray], time_s: np.ndarray, qbar_pa: 
 SLENDER_TIMES = (1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 8.9)
 
 
+@dataclass
+class Args:
+    """Command-line arguments (``python -m experiments.load_relief.loadbound --help``)."""
+
+    seeds: int = arg(10, lo=1, hi=10_000)
+    """validation seeds 0 .. n-1"""
+    gimbal_deg: float = arg(5.0, lo=0.0, lo_open=True, hi=90.0)
+    """gimbal limit per plane [deg]"""
+
+
 def main(argv: list[str] | None = None) -> int:
     """``python -m experiments.load_relief.loadbound --seeds 10``: the bound per plane on ``slender-v1``'s rigid
     validation seeds, in the wind of each seed's flight with the gimbal at zero (q-alpha limit lifted)."""
-    import argparse
     import math
 
     from lvgym.benchmark.runner import ZERO
@@ -124,10 +136,7 @@ def main(argv: list[str] | None = None) -> int:
 
     from experiments.load_relief.qalpha_floor import fly
 
-    ap = argparse.ArgumentParser(prog="python -m experiments.load_relief.loadbound", description=__doc__.split("\n\n")[0])
-    ap.add_argument("--seeds", type=int, default=10, help="validation seeds 0 .. n-1")
-    ap.add_argument("--gimbal-deg", type=float, default=5.0, help="gimbal limit per plane [deg]")
-    a = ap.parse_args(argv)
+    a = parse(Args, argv, "python -m experiments.load_relief.loadbound", __doc__)
     models = rigid_models(SLENDER_TIMES)
     cond = get_suite("slender-v1").conditions[0].with_options(qalpha_limit_pa_deg=1e9)
     for seed in range(a.seeds):

@@ -19,12 +19,14 @@ also flies the plain designs (integral kept) the load-relief schedule's rows rec
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from lvgym.benchmark.runner import PolicySpec, build_policy
-from lvgym.benchmark.suites import get_suite
+from lvgym.benchmark.suites import SUITES, get_suite
+from lvgym.cli.args import arg, command_name, parse
 
 __all__ = ["fly", "summary", "hold_qalpha"]
 
@@ -71,28 +73,36 @@ def summary(rec: dict[str, Any]) -> dict[str, float | str | bool]:
             "wind_h_max_mps": float(rec["wind_h"].max())}
 
 
-def main(argv: list[str] | None = None) -> int:
-    import argparse
+@dataclass
+class Args:
+    """Command-line arguments (``python -m experiments.load_relief.qalpha_floor --help``)."""
 
+    policies: list[str] = arg(default_factory=lambda: ["zero"], metavar="POLICY")
+    """registered names, SB3 .zip files or train.py run folders"""
+    suite: str = arg("slender-v1", metavar="SUITE", choices=lambda: sorted(SUITES))
+    """the suite flown"""
+    seeds: int = arg(10, lo=1, hi=10_000)
+    """validation seeds 0 .. n-1"""
+    schedule: list[str] = arg(default_factory=list, extend=True, metavar="YAML")
+    """also fly the gain-scheduled PID of these schedule files (a repeated flag adds)"""
+    plain: list[str] = arg(default_factory=list, extend=True, metavar="YAML")
+    """also fly the plain designs (integral kept) that these load-relief schedules' rows record"""
+    unlimited: bool = False
+    """lift the q-alpha limit (1e9 Pa deg): every flight goes to the mission's end, so the peaks are those of
+    the whole flight"""
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Fly, print a line per episode and a summary per policy and condition."""
     from lvgym.benchmark.registry import resolve_policy
 
     from lvgym.baselines.design.flexdesign import plain_schedule
     from lvgym.baselines.pid import GainSchedule
 
-    ap = argparse.ArgumentParser(prog="python -m experiments.load_relief.qalpha_floor", description=__doc__.split("\n\n")[0])
-    ap.add_argument("--policies", nargs="+", default=["zero"])
-    ap.add_argument("--suite", default="slender-v1")
-    ap.add_argument("--seeds", type=int, default=10, help="validation seeds 0 .. n-1")
-    ap.add_argument("--schedule", action="append", default=[], metavar="YAML",
-                    help="also fly the gain-scheduled PID of this schedule file (repeatable)")
-    ap.add_argument("--plain", action="append", default=[], metavar="YAML",
-                    help="also fly the plain designs (integral kept) that this load-relief schedule's rows record "
-                    "(repeatable)")
-    ap.add_argument("--unlimited", action="store_true", help="lift the q-alpha limit (1e9 Pa deg): every flight "
-                    "goes to the mission's end, so the peaks are those of the whole flight")
-    a = ap.parse_args(argv)
+    prog = "python -m experiments.load_relief.qalpha_floor"
+    a = parse(Args, argv, prog, __doc__)
     suite = get_suite(a.suite)
-    specs = [(n, resolve_policy(n, "python -m experiments.load_relief.qalpha_floor")) for n in a.policies]
+    specs = [(n, resolve_policy(n, command_name(prog))) for n in a.policies]
     specs += [(f"file:{i}", PolicySpec(f"file:{i}", "lvgym.baselines.pid:GainScheduledPIDPolicy", (("schedule", p),)))
               for i, p in enumerate(a.schedule)]
     specs += [(f"plain:{i}", PolicySpec(f"plain:{i}", "lvgym.baselines.pid:GainScheduledPIDPolicy",

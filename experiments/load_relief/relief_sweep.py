@@ -14,13 +14,15 @@ failures, the mean score [rad], the largest and the median peak q-alpha [kPa deg
 from __future__ import annotations
 
 import copy
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 import yaml
 
 from lvgym.benchmark.runner import play_episode
-from lvgym.benchmark.suites import get_suite
+from lvgym.benchmark.suites import SUITES, get_suite
+from lvgym.cli.args import arg, parse
 
 from lvgym.baselines.pid import GainSchedule, GainScheduledPIDPolicy
 
@@ -72,15 +74,23 @@ def _keywords(spec: str) -> dict[str, Any]:
     return {k.arg: ast.literal_eval(k.value) for k in call.keywords}
 
 
-def main(argv: list[str] | None = None) -> int:
-    import argparse
+@dataclass
+class Args:
+    """Command-line arguments (``python -m experiments.load_relief.relief_sweep --help``)."""
 
-    ap = argparse.ArgumentParser(prog="python -m experiments.load_relief.relief_sweep", description=__doc__.split("\n\n")[0])
-    ap.add_argument("--schedule", required=True, help="a schedule YAML (a plain flexdesign output)")
-    ap.add_argument("--suite", default="slender-v1")
-    ap.add_argument("--seeds", type=int, default=10, help="validation seeds 0 .. n-1")
-    ap.add_argument("variants", nargs="+", help='keyword lists, e.g. "ki_scale=0.05, accel_gain=0.001"')
-    a = ap.parse_args(argv)
+    schedule: str
+    """a schedule YAML (a plain flexdesign output)"""
+    variants: list[str] = arg(positional=True, metavar="VARIANT")
+    """keyword lists, e.g. 'ki_scale=0.05, accel_gain=0.001'"""
+    suite: str = arg("slender-v1", metavar="SUITE", choices=lambda: sorted(SUITES))
+    """the suite flown"""
+    seeds: int = arg(10, lo=1, hi=10_000)
+    """validation seeds 0 .. n-1"""
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Fly every variant, print a line each."""
+    a = parse(Args, argv, "python -m experiments.load_relief.relief_sweep", __doc__)
     with open(a.schedule) as f:
         doc = yaml.safe_load(f)
     envs = {c.model: c.make_env() for c in get_suite(a.suite).conditions}

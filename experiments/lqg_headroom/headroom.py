@@ -39,7 +39,6 @@ numbers.
 
 from __future__ import annotations
 
-import argparse
 import itertools
 import math
 import sys
@@ -52,7 +51,8 @@ import control
 import numpy as np
 import scipy.linalg as sla
 
-from lvgym.cli import fail, one_line_errors, option_number, parse_number
+from lvgym.cli import option_number
+from lvgym.cli.args import arg, parse
 from lvgym.environment.turbulence import INTENSITIES, dryden_scales
 from lvgym.errors import ConfigError
 
@@ -356,27 +356,40 @@ def front_schedule(results: list[dict[str, Any]], slack_db: float, dm_fraction: 
     return chosen
 
 
+def _schedule_rows(option: str, rows: list[float]) -> list[float]:
+    """``--rows``: rows of the lqg schedule."""
+    for t in rows:
+        if t not in SMILE_ROWS_S:
+            raise ConfigError(option, t, f"rows of the lqg schedule {list(SMILE_ROWS_S)}")
+    return rows
+
+
+def _slack(option: str, slack: tuple[float, float]) -> tuple[float, float]:
+    """``--slack DB FRACTION``: a gain-margin loss in [0, 40] dB and a delay-margin fraction in [0, 1]."""
+    return (float(option_number(option, slack[0], 0.0, 40.0)), float(option_number(option, slack[1], 0.0, 1.0)))
+
+
+@dataclass
+class Args:
+    """Command-line arguments (``python -m experiments.lqg_headroom.headroom --help``)."""
+
+    rows: list[float] = arg(default_factory=lambda: list(DEFAULT_ROWS), lo=0.0, hi=100.0, check=_schedule_rows,
+                            metavar="T")
+    """rows of the lqg schedule [s]"""
+    grid: str = arg("full", choices=tuple(sorted(GRIDS)))
+    """the weights searched"""
+    out: str | None = None
+    """write the designs of every row as JSON here"""
+    write_schedule: str | None = arg(None, metavar="PATH")
+    """write the schedule with each row's best design within --slack here (.npz)"""
+    slack: tuple[float, float] = arg(DEFAULT_SLACK, check=_slack, metavar=("DB", "FRACTION"))
+    """the margin loss of --write-schedule: gain margins [dB], delay margins kept"""
+
+
 def main(argv: list[str] | None = None) -> list[dict[str, Any]]:
-    p = one_line_errors(argparse.ArgumentParser(prog=PROG, description=__doc__.split("\n\n")[0]))
-    p.add_argument("--rows", nargs="+", default=list(DEFAULT_ROWS), metavar="T",
-                   help=f"rows of the lqg schedule [s] (default {' '.join(f'{x:g}' for x in DEFAULT_ROWS)})")
-    p.add_argument("--grid", choices=sorted(GRIDS), default="full")
-    p.add_argument("--out", default=None, help="write the designs of every row as JSON here")
-    p.add_argument("--write-schedule", default=None, metavar="PATH",
-                   help="write the schedule with each row's best design within --slack here (.npz)")
-    p.add_argument("--slack", nargs=2, default=list(DEFAULT_SLACK), metavar=("DB", "FRACTION"),
-                   help="the margin loss of --write-schedule: gain margins [dB], delay margins kept "
-                        f"(default {DEFAULT_SLACK[0]:g} {DEFAULT_SLACK[1]:g})")
-    args = p.parse_args(argv)
-    try:
-        rows = [float(option_number("--rows", parse_number(x, "--rows"), 0.0, 100.0)) for x in args.rows]
-        slack_db = float(option_number("--slack", parse_number(args.slack[0], "--slack"), 0.0, 40.0))
-        dm_fraction = float(option_number("--slack", parse_number(args.slack[1], "--slack"), 0.0, 1.0))
-        for t in rows:
-            if t not in SMILE_ROWS_S:
-                raise ConfigError("--rows", t, f"rows of the lqg schedule {list(SMILE_ROWS_S)}")
-    except ConfigError as exc:
-        fail(PROG, exc)
+    """Search every row, print the table; write the designs and the schedule if asked."""
+    args = parse(Args, argv, PROG, __doc__)
+    rows, (slack_db, dm_fraction) = args.rows, args.slack
     t0 = time.perf_counter()
     results = [headroom(t, GRIDS[args.grid], log=lambda s: print(s, file=sys.stderr)) for t in rows]
     print(headroom_table(results))

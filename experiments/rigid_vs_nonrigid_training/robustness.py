@@ -28,11 +28,13 @@ that ``evaluate.py`` labels it by run), then ``evaluate.py`` runs on the test se
 
 from __future__ import annotations
 
-import argparse
 import shlex
 import subprocess
 import sys
+from dataclasses import dataclass
 from pathlib import Path
+
+from lvgym.cli.args import arg, parse
 
 ROOT = Path(__file__).resolve().parents[2]
 MODELS = ("nonrigid", "rigid")   # non-rigid first: the policy to ship, if time runs short
@@ -42,7 +44,7 @@ def run_name(tag: str, model: str, seed: int) -> str:
     return f"robust-{tag}-{model}-s{seed}"
 
 
-def train_command(args: argparse.Namespace, model: str, seed: int) -> list[str]:
+def train_command(args: Args, model: str, seed: int) -> list[str]:
     """The train.py command of one run (``--resume`` if its folder exists)."""
     folder = Path(args.runs_dir) / run_name(args.tag or args.algo, model, seed)
     if (folder / "config.yaml").is_file():
@@ -55,7 +57,7 @@ def train_command(args: argparse.Namespace, model: str, seed: int) -> list[str]:
     return cmd
 
 
-def commands(args: argparse.Namespace) -> list[list[str]]:
+def commands(args: Args) -> list[list[str]]:
     """Every command of the experiment, in order (training runs already finished are left out)."""
     out: list[list[str]] = []
     exported: list[str] = []
@@ -73,25 +75,43 @@ def commands(args: argparse.Namespace) -> list[list[str]]:
     return out
 
 
+@dataclass
+class Args:
+    """Command-line arguments (``python -m experiments.rigid_vs_nonrigid_training.robustness --help``)."""
+
+    env_id: str = "lvgym/SmileAscent-v1"
+    """training env"""
+    algo: str = arg("ppo", choices=("ppo", "sac", "td3", "recurrent-ppo"))
+    """the algorithm"""
+    tag: str | None = None
+    """configuration name in the run names (default: the algorithm)"""
+    train_args: str = ""
+    """further train.py options for every run, one string, e.g. '--residual lqg'"""
+    seeds: list[int] = arg(default_factory=lambda: [0, 1, 2], lo=0, hi=10**6)
+    """training seeds, one run of each model each"""
+    total_timesteps: int | None = arg(None, lo=1, hi=10**12)
+    """per run (default: the hyperparameter file's)"""
+    wind: str = "protocol"
+    """training wind tier (protocol: the env's own, the suite's for v1)"""
+    randomize: list[str] = arg(default_factory=lambda: ["protocol"])
+    """training randomisation (protocol: the env's own, every dispersion for v1)"""
+    suites: list[str] = arg(default_factory=lambda: ["smile-v1"], metavar="SUITE")
+    """suites of the evaluation"""
+    baselines: list[str] = arg(default_factory=lambda: ["gs-pid-flex", "lqg"], nargs="*", metavar="POLICY")
+    """evaluate.py policy names beside the agents"""
+    episodes: int = arg(50, lo=1, hi=10**6)
+    """test seeds per condition and policy"""
+    runs_dir: str = "runs"
+    """folder of the run folders"""
+    out: str = "results/robustness"
+    """results folder of the evaluation"""
+    dry_run: bool = False
+    """print the commands only"""
+
+
 def main(argv: list[str] | None = None) -> None:
-    p = argparse.ArgumentParser(prog="python -m experiments.rigid_vs_nonrigid_training.robustness", description=__doc__.split("\n\n")[0])
-    p.add_argument("--env-id", default="lvgym/SmileAscent-v1", help="training env (default lvgym/SmileAscent-v1)")
-    p.add_argument("--algo", default="ppo", choices=("ppo", "sac", "td3", "recurrent-ppo"))
-    p.add_argument("--tag", default=None, help="configuration name in the run names (default: the algorithm)")
-    p.add_argument("--train-args", default="", help='further train.py options for every run, e.g. "--residual lqg"')
-    p.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2])
-    p.add_argument("--total-timesteps", default=None, help="per run (default: the hyperparameter file's)")
-    p.add_argument("--wind", default="protocol", help="training wind tier (default protocol: the env's own, the suite's for v1)")
-    p.add_argument("--randomize", nargs="+", default=["protocol"],
-                   help="training randomisation (default protocol: the env's own, every dispersion for v1)")
-    p.add_argument("--suites", nargs="+", default=["smile-v1"])
-    p.add_argument("--baselines", nargs="*", default=["gs-pid-flex", "lqg"],
-                   help="evaluate.py policy names beside the agents")
-    p.add_argument("--episodes", type=int, default=50, help="test seeds per condition and policy")
-    p.add_argument("--runs-dir", default="runs")
-    p.add_argument("--out", default="results/robustness")
-    p.add_argument("--dry-run", action="store_true", help="print the commands only")
-    args = p.parse_args(argv)
+    """Print and run (unless --dry-run) the experiment's commands."""
+    args = parse(Args, argv, "python -m experiments.rigid_vs_nonrigid_training.robustness", __doc__)
     for cmd in commands(args):
         print("+ " + shlex.join(cmd), flush=True)
         if not args.dry_run:

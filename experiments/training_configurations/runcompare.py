@@ -21,18 +21,19 @@ each configuration is the same policy on the same seeds); otherwise it is refuse
 
 from __future__ import annotations
 
-import argparse
 import csv
 import itertools
 import math
 import sys
 from collections.abc import Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from lvgym.cli import fail, one_line_errors
+from lvgym.cli import fail
+from lvgym.cli.args import arg, command_name, parse
 from lvgym.errors import ConfigError
 from lvgym.benchmark.compare import RUN_LABEL
 from lvgym.benchmark.metrics import per_seed
@@ -151,20 +152,27 @@ def table(rows: Sequence[dict[str, Any]], metric: str = "score") -> str:
     return "\n".join(out)
 
 
+@dataclass
+class Args:
+    """Command-line arguments (``python -m experiments.training_configurations.runcompare --help``)."""
+
+    folders: list[str] = arg(positional=True, metavar="FOLDER")
+    """results folders of evaluate.py (each with episodes.csv)"""
+    metric: str = "score"
+    """a column of episodes.csv (lower is better)"""
+    condition: list[str] | None = None
+    """conditions to compare (e.g. nonrigid or smile-v1/nonrigid; default: all)"""
+    reps: int = arg(REPS, lo=100, hi=10**8, allowed="an integer of at least 100")
+    """bootstrap resamples"""
+
+
 def main(argv: Sequence[str] | None = None) -> None:
-    parser = one_line_errors(argparse.ArgumentParser(prog=PROG, description=__doc__.split("\n\n")[0]))
-    parser.add_argument("folders", nargs="+", help="results folders of evaluate.py (each with episodes.csv)")
-    parser.add_argument("--metric", default="score", help="a column of episodes.csv (default: score; lower is better)")
-    parser.add_argument("--condition", nargs="+", default=None,
-                        help="conditions to compare (e.g. nonrigid or smile-v1/nonrigid; default: all)")
-    parser.add_argument("--reps", type=int, default=REPS, help=f"bootstrap resamples (default {REPS})")
-    args = parser.parse_args(argv)
+    """Compare, print the table."""
+    args = parse(Args, argv, PROG, __doc__)
     try:
-        if args.reps < 100:
-            raise ConfigError("--reps", args.reps, "an integer of at least 100")
         rows = compare_agents(merge(args.folders, args.metric), args.condition, args.reps)
     except ConfigError as exc:
-        fail(PROG, exc)
+        fail(command_name(PROG), exc)
     sys.stdout.write(table(rows, args.metric) + "\n")
 
 

@@ -16,12 +16,15 @@ reference ``NAME/CONDITION`` is for that condition only).
 
 from __future__ import annotations
 
-import argparse
 import csv
 import json
 import sys
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
+
+from lvgym.cli.args import arg, command_name, parse
+from lvgym.errors import ConfigError
 
 __all__ = ["load_curves", "main", "reached", "summary_rows"]
 
@@ -128,28 +131,47 @@ def _plot(rows: list[dict[str, Any]], references: dict[str, float], path: Path) 
     plt.close(fig)
 
 
-def _reference(text: str) -> tuple[str, float]:
+def _reference(text: str, option: str = "--reference") -> tuple[str, float]:
+    """``NAME[/CONDITION]=SCORE`` as (name, score)."""
     name, sep, value = text.partition("=")
     try:
         if not sep or not name:
             raise ValueError
         return name, float(value)
     except ValueError:
-        raise argparse.ArgumentTypeError(f"--reference {text!r}: NAME[/CONDITION]=SCORE, e.g. lqg/nonrigid=0.67") from None
+        raise ConfigError(option, text, "NAME[/CONDITION]=SCORE, e.g. lqg/nonrigid=0.67") from None
+
+
+def _checked(items: list[str], option: str) -> list[str]:
+    """``items``, each a reference (:func:`_reference`)."""
+    for x in items:
+        _reference(x, option)
+    return items
+
+
+@dataclass
+class Args:
+    """Command-line arguments (``python -m experiments.training_speed.curves --help``)."""
+
+    runs: list[str] = arg(positional=True, metavar="RUN")
+    """run folders (with evaluations.json)"""
+    reference: list[str] = arg(default_factory=list, nargs="*", metavar="NAME[/CONDITION]=SCORE",
+                               check=lambda option, items: _checked(items, option))
+    """scores to reach, e.g. a baseline's validation score"""
+    out: str | None = None
+    """folder for curves.csv and curves.png (default: print only)"""
 
 
 def main(argv: list[str] | None = None) -> None:
-    p = argparse.ArgumentParser(prog="python -m experiments.training_speed.curves", description=__doc__.split("\n\n")[0])
-    p.add_argument("runs", nargs="+", help="run folders (with evaluations.json)")
-    p.add_argument("--reference", nargs="*", type=_reference, default=[],
-                   help="NAME[/CONDITION]=SCORE lines to reach, e.g. a baseline's validation score")
-    p.add_argument("--out", default=None, help="folder for curves.csv and curves.png (default: print only)")
-    args = p.parse_args(argv)
-    references = dict(args.reference)
+    """Print the table; write curves.csv and curves.png with --out."""
+    prog = "python -m experiments.training_speed.curves"
+    args = parse(Args, argv, prog, __doc__)
+    references = dict(_reference(x) for x in args.reference)
     try:
         rows = [r for run in args.runs for r in load_curves(run)]
-    except FileNotFoundError as exc:
-        p.exit(2, f"{p.prog}: {exc}\n")
+    except FileNotFoundError as exc:                 # one line on stderr, as a refused option
+        sys.stderr.write(f"{command_name(prog)}: {exc}\n")
+        raise SystemExit(2) from None
     table = summary_rows(rows, references)
     minutes = lambda s: "-" if s is None else f"{s / 60.0:.1f}"             # noqa: E731
     head = ["run", "condition", "first", "best", "best failures", "best at [M steps]", "best at [min]",

@@ -17,17 +17,18 @@ env step is a training experiment (several seeds, learning curves against wall t
 
 from __future__ import annotations
 
-import argparse
 import csv
 import shlex
 import statistics
 import subprocess
 import sys
 import tempfile
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from lvgym.cli import fail, one_line_errors, option_number
+from lvgym.cli import fail
+from lvgym.cli.args import arg, command_name, parse
 from lvgym.errors import ConfigError
 
 __all__ = ["throughput", "run_variant", "speed_table"]
@@ -77,26 +78,44 @@ def speed_table(results: dict[str, list[dict[str, float]]]) -> str:
     return "\n".join(lines) + "\n"
 
 
-def main(argv: list[str] | None = None) -> int:
-    ap = one_line_errors(argparse.ArgumentParser(prog=PROG, description=__doc__.split("\n\n")[0]))
-    ap.add_argument("--common", default="--env-id lvgym/SmileAscent-v1",
-                    help="train.py arguments every variant shares (one string)")
-    ap.add_argument("--variant", nargs=2, action="append", metavar=("NAME", "ARGS"), required=True,
-                    help="a variant's name and its extra train.py arguments (one string, may be empty)")
-    ap.add_argument("--steps", type=int, default=300_000, help="env steps per run")
-    ap.add_argument("--repeats", type=int, default=2)
-    ap.add_argument("--keep", default=None, help="keep the runs in this folder (default: a temporary one)")
-    a = ap.parse_args(argv)
+def _split(option: str, text: str) -> list[str]:
+    """``text`` split as a shell would (a ConfigError naming ``option`` if it cannot be)."""
     try:
-        option_number("--steps", a.steps, 1, 10**9, integer=True)
-        option_number("--repeats", a.repeats, 1, 100, integer=True)
-        names = [v[0] for v in a.variant]
+        return shlex.split(text)
+    except ValueError as exc:
+        raise ConfigError(option, text, f"train.py arguments as one string ({exc})") from None
+
+
+@dataclass
+class Args:
+    """Command-line arguments (``python -m experiments.training_speed.train_speed --help``)."""
+
+    variant: list[tuple[str, str]] = arg(metavar=("NAME", "ARGS"))
+    """a variant's name and its extra train.py arguments (one string, may be empty); repeat the flag"""
+    common: str = "--env-id lvgym/SmileAscent-v1"
+    """train.py arguments every variant shares (one string)"""
+    steps: int = arg(300_000, lo=1, hi=10**9)
+    """env steps per run"""
+    repeats: int = arg(2, lo=1, hi=100)
+    """runs of each variant, in turn"""
+    keep: str | None = None
+    """keep the runs in this folder (default: a temporary one)"""
+
+    def __post_init__(self) -> None:
+        names = [v[0] for v in self.variant]
         if len(set(names)) != len(names):
             raise ConfigError("--variant", names, "distinct names")
-        common = shlex.split(a.common)
-        extras = {n: shlex.split(args) for n, args in a.variant}
-    except (ConfigError, ValueError) as exc:
-        fail(PROG, exc)
+        _split("--common", self.common)
+        for _, args in self.variant:
+            _split("--variant", args)
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run the variants in turn, print the table."""
+    a = parse(Args, argv, PROG, __doc__)
+    names = [v[0] for v in a.variant]
+    common = shlex.split(a.common)
+    extras = {n: shlex.split(args) for n, args in a.variant}
     results: dict[str, list[dict[str, Any]]] = {n: [] for n in names}
     with tempfile.TemporaryDirectory(prefix="lvgym-speed-") as tmp:
         runs = Path(a.keep) if a.keep else Path(tmp)
@@ -105,7 +124,7 @@ def main(argv: list[str] | None = None) -> int:
                 try:
                     r = run_variant(common, extras[n], a.steps, runs, f"{n}-r{k}")
                 except (RuntimeError, ValueError) as exc:
-                    fail(PROG, exc)
+                    fail(command_name(PROG), exc)
                 results[n].append(r)
                 print(f"{n} repeat {k}: {r['steps_per_s']:,.0f} env steps/s, env share {r['env_share']:.2f}",
                       file=sys.stderr, flush=True)

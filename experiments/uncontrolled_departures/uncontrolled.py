@@ -23,12 +23,14 @@ from __future__ import annotations
 
 import math
 import tempfile
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import yaml
 
+from lvgym.cli.args import parse
 from lvgym.envs.spec import wind_spec
 from lvgym.simulator import Simulator
 from lvgym.vehicle.config import VEHICLE_DIR
@@ -405,7 +407,14 @@ def _table(rows: list[dict[str, Any]]) -> str:
     return "\n".join(lines)
 
 
-def main() -> None:
+@dataclass
+class Args:
+    """No options."""
+
+
+def main(argv: list[str] | None = None) -> None:
+    """Print the tables and write the figures."""
+    parse(Args, argv, "python -m experiments.uncontrolled_departures.uncontrolled", __doc__)
     print("Stratos III, uncontrolled (thesis 5.2): peak pitch-yaw rate and pendulum angle")
     print(_table(stratos3_summary()))
     print("\nSMILE, uncontrolled (thesis 6.3.1)")

@@ -8,8 +8,10 @@ gimbal at zero: the plant, the winds, the dispersions and the sensors alone) and
 the rate error, the failure and its reason, the flight time, the largest q-alpha and the first
 observation. ``tests/test_protocol_fingerprint.py`` compares a fresh run with the stored file.
 
-    python -m lvgym.benchmark.fingerprint --version v1 --check     # compare with the stored file
-    python -m lvgym.benchmark.fingerprint --version v1 --write     # (re)write it: only when freezing
+    lvgym fingerprint --version v1 --check     # compare with the stored file
+    lvgym fingerprint --version v1 --write     # (re)write it: only when freezing
+
+(``python -m lvgym.benchmark.fingerprint`` is the same command, declared in :mod:`lvgym.cli.fingerprint`.)
 
 Reproducibility: on one machine and one set of library versions the episodes are the same to the bit;
 across CPUs and BLAS builds the floating-point sums can round differently, so the numbers are compared to
@@ -18,9 +20,7 @@ a relative ``RTOL`` (1e-3) and the failure and its reason exactly.
 
 from __future__ import annotations
 
-import argparse
 import json
-import sys
 from pathlib import Path
 from typing import Any
 
@@ -121,31 +121,7 @@ def compare(fresh: list[dict[str, Any]], reference: list[dict[str, Any]], rtol: 
     return out
 
 
-def main(argv: list[str] | None = None) -> None:
-    p = argparse.ArgumentParser(prog="python -m lvgym.benchmark.fingerprint", description=__doc__.split("\n\n")[0])
-    p.add_argument("--version", default="v1", help="protocol version (default v1)")
-    p.add_argument("--seeds", type=int, default=1, help="test seeds per condition (default 1)")
-    mode = p.add_mutually_exclusive_group(required=True)
-    mode.add_argument("--check", action="store_true", help="compare a fresh run with the stored fingerprint")
-    mode.add_argument("--write", action="store_true", help="write the stored fingerprint (when freezing)")
-    args = p.parse_args(argv)
-    try:
-        fresh = fingerprint(args.version, args.seeds)
-    except ValueError as exc:
-        p.exit(2, f"{p.prog}: {exc}\n")
-    path = FINGERPRINTS / f"{args.version}.json"
-    if args.write:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        path.write_text(json.dumps({"version": args.version, "policies": list(POLICIES), "seeds": args.seeds,
-                                    "episodes": fresh}, indent=1) + "\n", encoding="utf-8")
-        print(f"{len(fresh)} episodes written to {path}")
-        return
-    diffs = compare(fresh, stored(args.version))
-    for line in diffs:
-        print(line)
-    print(f"{len(fresh)} episodes: " + ("the same" if not diffs else f"{len(diffs)} differences"))
-    sys.exit(1 if diffs else 0)
+if __name__ == "__main__":            # the command line is lvgym fingerprint (lvgym.cli.fingerprint)
+    from lvgym.cli.fingerprint import main
 
-
-if __name__ == "__main__":
     main()

@@ -1,9 +1,11 @@
 """Time-domain margins of any policy in the nonlinear simulation: gain margins up and down [dB] and the
 delay margin [ms] (docs/benchmark.md, "Time-domain margins").
 
-    python -m lvgym.cli.margins                                  # the default policies on smile-v1, 5 test seeds
-    python -m lvgym.cli.margins --policies zero pid gs-pid ppo --seeds 10 --models rigid
-    python -m lvgym.cli.margins --policies runs/ppo_smile --physics-dt-s 0.005   # 5 ms delay resolution
+    lvgym margins                                          # the default policies on smile-v1, 5 test seeds
+    lvgym margins --policies zero pid gs-pid ppo --seeds 10 --models rigid
+    lvgym margins --policies runs/ppo_smile --physics-dt-s 0.005   # 5 ms delay resolution
+
+(``python -m lvgym.benchmark.margins`` is the same command; it is declared in :mod:`lvgym.cli.margins`.)
 
 Between the policy and the actuator a multiplicative gain ``k`` (:class:`~.perturb.GainPolicy`), and
 separately a pure delay (:class:`~.perturb.ActuatorDelay`, in whole physics steps), are raised, per seed,
@@ -27,20 +29,16 @@ folders, as ``evaluate.py`` takes them. From Python: :func:`time_domain_margins`
 
 from __future__ import annotations
 
-import argparse
-import datetime as dt
 import math
 import statistics
-import sys
 import time
 from collections.abc import Sequence
 from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any
 
-from lvgym.cli import fail, option_number, parse_number
 from lvgym.errors import ConfigError, check_number
-from lvgym.parallel import TaskFailed, check_workers, exit_on_sigterm, run_map
+from lvgym.parallel import run_map
 
 from .perturb import db_to_gain, find_threshold, fly
 from .results import atomic_write_text, csv_text, json_text
@@ -58,7 +56,6 @@ DEFAULT_SUITE = "smile-v1"
 #: every default policy of evaluate.py that has a loop to perturb (zero has none)
 DEFAULT_POLICIES = ["gs-pid", "gs-pid-flex", "lqg", "lqg-front", "aac", "ppo-res-lqg"]
 DEFAULT_SEEDS = 5
-PROG = "python -m lvgym.cli.margins"
 #: the nominal time at the gimbal rate limit counts as at least this in the rate-limit bound [s]
 RATE_LIMIT_FLOOR_S = 1.0
 #: the nominal rate error counts as at least this mean rate over the nominal flight in the rate-error bound
@@ -358,102 +355,7 @@ def write_margins(out: str | Path, results: Sequence[dict[str, Any]], meta: dict
             atomic_write_text(out / "margins.json", json_text({"meta": meta, "results": list(results)}))]
 
 
-# ------------------------------------------------------------------------------------------------ CLI
-def _control_dt_s(condition: Condition) -> float:
-    """The control period of ``condition``'s env [s], from its registered class's defaults."""
-    import importlib
+if __name__ == "__main__":            # the command line is lvgym margins (lvgym.cli.margins)
+    from lvgym.cli.margins import main
 
-    import gymnasium
-
-    import lvgym  # noqa: F401  (registers the env ids)
-    from lvgym.envs.spec import TaskSpec
-
-    entry = gymnasium.spec(condition.env_id).entry_point
-    module, _, attr = entry.partition(":") if isinstance(entry, str) else (None, "", "")
-    defaults = getattr(importlib.import_module(module), attr).DEFAULTS if module else {}
-    return float(dict(condition.options).get("control_dt_s", defaults.get("control_dt_s", TaskSpec.control_dt_s)))
-
-
-def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
-    """The command line, every value checked before any worker starts."""
-    from .registry import flight_parser
-
-    d = MarginOptions()
-    p = flight_parser(PROG, __doc__, DEFAULT_POLICIES, DEFAULT_SUITE, "results/margins")
-    p.add_argument("--models", nargs="+", default=None, metavar="MODEL",
-                   help="only the suite's conditions of these flight models (default: all, e.g. rigid and nonrigid)")
-    p.add_argument("--seeds", default=DEFAULT_SEEDS, help=f"seeds per condition (default {DEFAULT_SEEDS})")
-    p.add_argument("--seed-set", choices=SEED_SETS, default="test", help="default: test (a measurement)")
-    p.add_argument("--experiments", nargs="+", choices=EXPERIMENTS, default=list(EXPERIMENTS))
-    p.add_argument("--error-ratio", default=d.error_ratio,
-                   help=f"bound: rate_error_rad above this times the seed's nominal fails (default {d.error_ratio:g})")
-    p.add_argument("--rate-limit-ratio", default=d.rate_limit_ratio,
-                   help="bound: time at the gimbal rate limit above this times the seed's nominal (at least "
-                        f"{RATE_LIMIT_FLOOR_S:g} s) fails; inf: no such bound (default {d.rate_limit_ratio:g})")
-    p.add_argument("--gain-max-db", default=d.gain_max_db, help=f"searched up to [dB] (default {d.gain_max_db:g})")
-    p.add_argument("--gain-min-db", default=d.gain_min_db, help=f"searched down to [dB] (default {d.gain_min_db:g})")
-    p.add_argument("--gain-tol-db", default=d.gain_tol_db, help=f"gain bracket [dB] (default {d.gain_tol_db:g})")
-    p.add_argument("--gain-step-db", default=d.gain_step_db,
-                   help=f"first step of the outward gain search [dB], doubling (default {d.gain_step_db:g})")
-    p.add_argument("--delay-max-s", default=d.delay_max_s, help=f"delay searched up to [s] (default {d.delay_max_s:g})")
-    p.add_argument("--physics-dt-s", default=None,
-                   help="physics step [s], the delay's resolution (default: the env's, 0.01; it also changes the "
-                        "integration step and the servo_delay dispersion's quantum)")
-    ns = p.parse_args(argv)
-    try:
-        ns.seeds = option_number("--seeds", parse_number(ns.seeds), 1, 10_000, integer=True)
-        ns.workers = check_workers(parse_number(ns.workers), "--workers")
-        ns.physics_dt_s = option_number("--physics-dt-s", parse_number(ns.physics_dt_s), 0.0, 0.05, lo_open=True)
-        ns.mission_time_s = option_number("--mission-time-s", parse_number(ns.mission_time_s), 0.0, 3600.0,
-                                          lo_open=True)
-        names = ("error_ratio", "rate_limit_ratio", "gain_max_db", "gain_min_db", "gain_tol_db", "gain_step_db",
-                 "delay_max_s")
-        for key in names:
-            setattr(ns, key, parse_number(getattr(ns, key), f"--{key.replace('_', '-')}"))
-        try:
-            ns.options = MarginOptions(**{k: getattr(ns, k) for k in names})
-        except ConfigError as exc:
-            raise ConfigError(f"--{exc.key.replace('_', '-')}", exc.value, exc.allowed) from None
-    except ConfigError as exc:
-        p.error(str(exc))
-    return ns
-
-
-def main(argv: list[str] | None = None) -> list[dict[str, Any]]:
-    """Measure, print the table, write the result files; returns the results."""
-    from .registry import resolve_flights
-
-    args = parse_args(argv)
-    exit_on_sigterm()
-    policies, suite, conds = resolve_flights(PROG, args.policies, args.suite, args.models,
-                                             mission_time_s=args.mission_time_s, physics_dt_s=args.physics_dt_s)
-    if args.physics_dt_s is not None:
-        for c in conds:
-            n = _control_dt_s(c) / args.physics_dt_s
-            if abs(n - round(n)) > 1e-6:
-                fail(PROG, f"--physics-dt-s = {args.physics_dt_s}: the control period {_control_dt_s(c)} s of "
-                           f"{c.env_id} must be a whole multiple of it")
-    t0 = time.perf_counter()
-    try:
-        results = run_margins(policies, conds, suite.seeds(args.seed_set, args.seeds), seed_set=args.seed_set,
-                              options=args.options, experiments=args.experiments, executor=args.executor,
-                              workers=args.workers, progress=args.progress)
-    except TaskFailed as exc:
-        if isinstance(exc.__cause__, ConfigError):
-            fail(PROG, exc)
-        raise
-    wall = time.perf_counter() - t0
-    meta = {"suite": suite.name, "version": suite.version, "overrides": dict(suite.overrides),
-            "args": {k: v for k, v in vars(args).items() if k != "options"}, "options": asdict(args.options),
-            "wall_time_s": round(wall, 3), "episodes": sum(r["episodes"] for r in results),
-            "created_utc": dt.datetime.now(dt.timezone.utc).isoformat(timespec="seconds")}
-    paths = write_margins(args.out, results, meta)
-    print(margins_table(results))
-    print(f"{meta['episodes']} episodes in {wall:.1f} s ({args.executor}); results in {Path(args.out)}/: "
-          f"{', '.join(p.name for p in paths)}", file=sys.stderr)
-    return results
-
-
-if __name__ == "__main__":            # the command is in the command layer, which registers the policies
-    raise SystemExit("python -m lvgym.benchmark.margins: the command is now python -m lvgym.cli.margins (the command "
-                     "layer registers the built-in policies; the benchmark layer knows no controller)")
+    main()

@@ -1,7 +1,6 @@
-"""The policies the benchmark's command lines know by name (``evaluate.py``, ``python -m
-lvgym.cli.margins``, ``... budget``), how a name, a factory or a saved model's path becomes a
-:class:`~.runner.PolicySpec`, and the options and checks those commands share (:func:`flight_parser`,
-:func:`resolve_flights`).
+"""The policies the benchmark's command lines know by name (``evaluate.py``, ``lvgym margins``,
+``... budget``) and how a name, a factory or a saved model's path becomes a :class:`~.runner.PolicySpec`.
+The options those commands share are declared in the command layer (:mod:`lvgym.cli.flights`).
 
 Policies register themselves: :func:`register_policy` (``lvgym.baselines`` and ``lvgym.agents`` call it
 for their built-ins, a user for their own) and :func:`register_policy_loader` (how a saved model's file
@@ -20,7 +19,6 @@ factory without parameters returns), else by the file's stem or the module's las
 
 from __future__ import annotations
 
-import argparse
 import inspect
 import os
 import re
@@ -30,16 +28,12 @@ from importlib.machinery import PathFinder
 from pathlib import Path
 from typing import Any
 
-from lvgym.cli import fail, one_line_errors
 from lvgym.errors import ConfigError, did_you_mean
-from lvgym.parallel import EXECUTORS
 
 from .factory import callable_reference, is_file_reference, load_factory, module_root
 from .runner import ZERO, PolicySpec
-from .suites import SUITES, Condition, Suite, get_suite
 
-__all__ = ["LOADERS", "POLICIES", "PolicyLoader", "flight_parser", "register_policy", "register_policy_loader",
-           "resolve_flights", "resolve_policy"]
+__all__ = ["LOADERS", "POLICIES", "PolicyLoader", "register_policy", "register_policy_loader", "resolve_policy"]
 
 #: policy names -> how a worker builds them (filled by :func:`register_policy`; the benchmark's own: zero)
 POLICIES: dict[str, PolicySpec] = {"zero": ZERO}
@@ -191,44 +185,3 @@ def resolve_policy(name: str, prog: str = "evaluate.py") -> PolicySpec:
         raise SystemExit(f"{prog}: policy {text!r}: not a saved policy a loader takes; a policy is {_forms()}")
     raise SystemExit(f"{prog}: policy {text!r}{did_you_mean(text, POLICIES)}: not {_forms()}; the registered "
                      f"names: {sorted(POLICIES)}")
-
-
-def flight_parser(prog: str, doc: str, default_policies: Sequence[str], default_suite: str,
-                  default_out: str) -> argparse.ArgumentParser:
-    """A benchmark command's parser (one-line errors; ``doc``'s first paragraph as its description, from its
-    third on as its epilog) with ``--policies`` and ``--suite`` (which :func:`resolve_flights` resolves),
-    ``--mission-time-s``, ``--executor``, ``--workers`` (checked by the command), ``--out`` (default
-    ``default_out``) and ``--no-progress``."""
-    p = one_line_errors(argparse.ArgumentParser(prog=prog, description=doc.split("\n\n")[0],
-                                                epilog=doc.split("\n\n", 2)[2],
-                                                formatter_class=argparse.RawDescriptionHelpFormatter))
-    p.add_argument("--policies", nargs="+", default=list(default_policies), metavar="POLICY",
-                   help=f"names {sorted(POLICIES)}, module:factory, path/to/file.py:factory, SB3 .zip paths or "
-                        f"train.py run folders, each optionally label=... (default: {' '.join(default_policies)})")
-    p.add_argument("--suite", default=default_suite, help=f"of {sorted(SUITES)} (default {default_suite})")
-    p.add_argument("--mission-time-s", default=None, help="shorten every episode (smoke tests only)")
-    p.add_argument("--executor", choices=EXECUTORS, default="local", help="default: local process pool")
-    p.add_argument("--workers", default=None, help="default: the CPUs available")
-    p.add_argument("--out", default=default_out, help=f"results folder (default {default_out}/)")
-    p.add_argument("--no-progress", dest="progress", action="store_false", help="hide the progress bar")
-    return p
-
-
-def resolve_flights(prog: str, policy_names: Sequence[str], suite_name: str, models: Sequence[str] | None = None,
-                    **overrides: Any) -> tuple[list[PolicySpec], Suite, list[Condition]]:
-    """A command line's policies (:func:`resolve_policy`, distinct labels), its suite with the env
-    ``overrides`` that are not None (:meth:`~.suites.Suite.with_options`) and the suite's conditions of the
-    flight ``models`` (None: all); a bad value exits with a one-line message starting ``prog:``."""
-    policies = [resolve_policy(n, prog) for n in policy_names]
-    if len({p.name for p in policies}) != len(policies):
-        fail(prog, f"--policies {' '.join(policy_names)}: each label must be distinct")
-    try:
-        suite = get_suite(suite_name)
-    except ValueError as exc:
-        fail(prog, exc)
-    suite = suite.with_options(**{k: v for k, v in overrides.items() if v is not None})
-    conds = [c for c in suite.conditions if models is None or c.model in models]
-    if not conds:
-        fail(prog, f"--models {' '.join(models or ())}: suite {suite.name!r} has "
-                   f"{sorted({c.model for c in suite.conditions})}")
-    return policies, suite, conds

@@ -1,10 +1,17 @@
-"""Small helpers shared by the command lines (``train.py``, ``evaluate.py``, ``python -m lvgym.studies``,
-``python -m lvgym.baselines.design.tune``): one-line errors, and options checked before any work starts.
+"""The command layer: the console script ``lvgym`` and the command lines of every tool.
+
+- this package's root keeps the small helpers any layer's command line uses (:func:`fail`,
+  :func:`one_line_errors`, :func:`option_number`, :func:`parse_number`) and imports no upper layer;
+- :mod:`.args`: a command line declared as a dataclass (help from the fields' docstrings, ranges and
+  choices on the fields), and the subcommands of a console script; it too imports no upper layer;
+- :mod:`.main`: the console script ``lvgym`` (``lvgym --help`` lists the commands);
+- :mod:`.evaluate`, :mod:`.margins`, :mod:`.fingerprint`: the benchmark's commands, with the options the
+  flight commands share (:mod:`.flights`); the benchmark layer itself builds no parser.
 
 A command line refuses a bad value in one line that names the option, the value and what is allowed,
 before it creates a folder or starts a worker::
 
-    train.py: --total-timesteps = -5: an integer in [1, 1000000000000]
+    train.py: error: --total-timesteps = -5: an integer in [1, 1000000000000] (see train.py --help)
 """
 
 from __future__ import annotations

@@ -36,7 +36,6 @@ The example picture ``docs/figures/render_example.png`` is made by
 from __future__ import annotations
 
 import math
-import sys
 import threading
 from dataclasses import dataclass
 
@@ -47,6 +46,7 @@ from matplotlib.collections import LineCollection, PatchCollection
 from matplotlib.figure import Figure
 from matplotlib.patches import Circle, Polygon
 
+from lvgym.cli.args import arg
 from lvgym.errors import ConfigError
 
 _DPI = 100.0
@@ -445,8 +445,27 @@ def example_frame() -> RenderFrame:
                        rates_degps=rates, stage="stage 1", info="Mach 1.42  q 38.5 kPa")
 
 
-if __name__ == "__main__":  # python -m lvgym.envs.render OUT.png
+@dataclass
+class Args:
+    """Command-line arguments (``lvgym render --help``)."""
+
+    out: str = arg("render_example.png", positional=True)
+    """the PNG file written"""
+    exaggeration: float = arg(50.0, lo=0.0, hi=1e6)
+    """bending deflection drawn this many times its size"""
+
+
+def main(argv: list[str] | None = None) -> None:
+    """``lvgym render [OUT.png]`` (``python -m lvgym.envs.render``): draw :func:`example_frame` to a PNG."""
     import matplotlib.image
-    out = sys.argv[1] if len(sys.argv) > 1 else "render_example.png"
-    matplotlib.image.imsave(out, Renderer().render_rgb(example_frame()))
-    print(f"wrote {out} (matplotlib {matplotlib.__version__})")
+
+    from lvgym.cli.args import parse
+
+    args = parse(Args, argv, "python -m lvgym.envs.render", "Draw the renderer's example frame (a made-up "
+                 "8.5 m vehicle at t = 21 s, bending and two slosh pendulums) to a PNG.")
+    matplotlib.image.imsave(args.out, Renderer(args.exaggeration).render_rgb(example_frame()))
+    print(f"wrote {args.out} (matplotlib {matplotlib.__version__})")
+
+
+if __name__ == "__main__":
+    main()

@@ -382,5 +382,18 @@ def thesis_comparison_markdown(material: Material = MATERIALS["al_ansys"], t_wal
     return "\n".join(out)
 
 
-if __name__ == "__main__":
+def main(argv: list[str] | None = None) -> None:
+    """``python -m lvgym.vehicle.beam``: print :func:`thesis_comparison_markdown` (no options)."""
+    from lvgym.cli.args import parse
+
+    @dataclass
+    class Args:
+        """No options."""
+
+    parse(Args, argv, "python -m lvgym.vehicle.beam", "Print the beam's bending modes against the thesis's "
+          "(Tables 6.8 and 6.9, Eq. 6.2 and 6.3) as a Markdown table.")
     print(thesis_comparison_markdown())
+
+
+if __name__ == "__main__":
+    main()

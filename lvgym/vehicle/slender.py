@@ -36,6 +36,7 @@ lvgym.errors.ConfigError: slender_vehicle: fill = 1.2: must be in (0, 1]
 from __future__ import annotations
 
 import math
+from dataclasses import asdict, dataclass
 from typing import Any
 
 import numpy as np
@@ -198,5 +199,36 @@ def slender_yaml(**parameters: Any) -> str:
     return HEADER + body
 
 
+@dataclass
+class Args:
+    """Command-line arguments (``python -m lvgym.vehicle.slender --help``): the thesis's five factors."""
+
+    length: float = 8.5
+    """overall length L [m], in [3, 30]"""
+    diameter: float = 0.3
+    """outer diameter D [m], in (2 wall + 0.02, L / 5]"""
+    fill: float = 1.0
+    """tank fill ratio at lift-off [-], in (0, 1]"""
+    mass_flow: float = 30.0
+    """propellant mass flow [kg/s], in (0, 1000]"""
+    slosh_damping: float = 0.5
+    """damping ratio of the slosh pendulum [-], in [0, 2]"""
+
+
+def main(argv: list[str] | None = None) -> None:
+    """``python -m lvgym.vehicle.slender``: print the vehicle file of the factors (the defaults:
+    ``lvgym/vehicles/slender.yaml``)."""
+    from lvgym.cli import fail
+    from lvgym.cli.args import command_name, parse
+
+    prog = "python -m lvgym.vehicle.slender"
+    args = parse(Args, argv, prog, "Print the YAML vehicle file of the parametric slender vehicle (thesis 6.1-6.2).")
+    try:
+        text = slender_yaml(**asdict(args))
+    except ConfigError as exc:                        # named as the option
+        fail(command_name(prog), ConfigError("--" + exc.key.replace("_", "-"), exc.value, exc.allowed))
+    print(text, end="")
+
+
 if __name__ == "__main__":
-    print(slender_yaml(), end="")
+    main()

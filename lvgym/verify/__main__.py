@@ -1,12 +1,26 @@
-"""Print the verification table: ``python -m lvgym.verify``. Exits 1 when a checked row fails."""
+"""Print the verification table: ``lvgym verify`` (``python -m lvgym.verify``). Exits 1 when a checked row fails.
+
+``lvgym verify rocketpy`` and ``lvgym verify rocketpy-timing`` are the side-by-side validation against
+RocketPy (:mod:`.rocketpy_case`, :mod:`.rocketpy_timing`).
+"""
 
 import sys
 import time
+from dataclasses import dataclass
+
+from lvgym.cli.args import parse
 
 from . import ALL_CASES, table
 
 
-def main() -> int:
+@dataclass
+class Args:
+    """No options."""
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Print the table of every case of the thesis's chapter 4; 1 when a checked row fails."""
+    parse(Args, argv, "python -m lvgym.verify", __doc__, epilog=True)
     rows = []
     start = time.perf_counter()
     for case in ALL_CASES:

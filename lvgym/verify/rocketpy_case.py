@@ -1,6 +1,6 @@
 """Validation of the rigid simulator against RocketPy: the shipped ``stratos3`` flown by both, no wind.
 
-``python -m lvgym.verify.rocketpy_case`` flies the vehicle with lvgym's :class:`~lvgym.simulator.Simulator`
+``lvgym verify rocketpy`` (``python -m lvgym.verify.rocketpy_case``) flies the vehicle with lvgym's :class:`~lvgym.simulator.Simulator`
 (``model="rigid"``, flat non-rotating site, constant gravity, US76, zero gimbal) and with RocketPy 1.13
 (a dev dependency, imported only inside the functions of this module), prints Markdown tables of apogee,
 maximum Mach number, their times and the burnout time of both with the relative differences, and writes
@@ -37,7 +37,6 @@ burnout (CG = CDM) both give the height of the same point above the same ground.
 
 from __future__ import annotations
 
-import argparse
 import math
 import sys
 import time
@@ -47,6 +46,7 @@ from typing import Any
 
 import numpy as np
 
+from lvgym.cli.args import arg, parse
 from lvgym.environment import make
 from lvgym.simulator import Simulator
 
@@ -452,14 +452,23 @@ def plot(comparisons: list[Comparison], path: Path = FIGURE) -> Path:
     return path
 
 
+@dataclass
+class Args:
+    """Command-line arguments (``lvgym verify rocketpy --help``)."""
+
+    figure: Path = FIGURE
+    """PNG path of the figure"""
+    tol: float = arg(0.02, lo=0.0, hi=1.0)
+    """relative tolerance on apogee and maximum Mach"""
+    sensitivity: bool = True
+    """fly the RocketPy variants"""
+    timing: bool = True
+    """time both codes, cold and warm (rocketpy_timing)"""
+
+
 def main(argv: list[str] | None = None) -> int:
     """Print the tables, write the figure; exit 1 when a case differs by more than ``--tol``."""
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--figure", type=Path, default=FIGURE, help="PNG path (default: %(default)s)")
-    parser.add_argument("--tol", type=float, default=0.02, help="relative tolerance (default: %(default)s)")
-    parser.add_argument("--no-sensitivity", action="store_true", help="skip the RocketPy variants")
-    parser.add_argument("--no-timing", action="store_true", help="skip the wall times, cold and warm")
-    args = parser.parse_args(argv)
+    args = parse(Args, argv, "python -m lvgym.verify.rocketpy_case", __doc__)
     start = time.perf_counter()
     comparisons = [compare(e, r) for e, r in CASES]
     ok = True
@@ -467,10 +476,10 @@ def main(argv: list[str] | None = None) -> int:
         print(f"\n### {VEHICLE}, elevation {c.elevation_deg:g} deg, rail {c.rail_length:g} m\n")
         print(c.table())
         ok &= all(abs(c.relative(k)) <= args.tol for k in ("apogee", "max_mach"))
-    if not args.no_sensitivity:
+    if args.sensitivity:
         print(f"\n### RocketPy variants, elevation {comparisons[0].elevation_deg:g} deg\n")
         print(sensitivity_table(comparisons[0]))
-    if not args.no_timing:
+    if args.timing:
         from .rocketpy_timing import timing_table
 
         print(f"\n### Wall times, {VEHICLE}, elevation {comparisons[0].elevation_deg:g} deg\n")

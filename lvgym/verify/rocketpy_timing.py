@@ -1,7 +1,7 @@
 """Wall times of lvgym and RocketPy flying the same Stratos III flight to apogee, with and without set-up.
 
-``python -m lvgym.verify.rocketpy_case`` prints this table after its comparisons (``--no-timing`` skips it);
-``python -m lvgym.verify.rocketpy_timing`` prints it alone. Both simulators fly the main case of
+``lvgym verify rocketpy`` prints this table after its comparisons (``--no-timing`` skips it);
+``lvgym verify rocketpy-timing`` (``python -m lvgym.verify.rocketpy_timing``) prints it alone. Both simulators fly the main case of
 :mod:`.rocketpy_case` (85 deg, 10 m rail) twice in one process, after the imports and after Numba has
 loaded its compiled kernels (a warm-up flight of each, or the comparisons, ran first):
 
@@ -21,12 +21,12 @@ of that row are those of its second flight).
 
 from __future__ import annotations
 
-import argparse
 import os
 import tempfile
 import time
-from dataclasses import replace
+from dataclasses import dataclass, replace
 
+from lvgym.cli.args import arg, parse
 from lvgym.simulator.cache import using
 
 from .rocketpy_case import ELEVATION_DEG, RAIL_LENGTH, VEHICLE, Trajectory, fly_lvgym, fly_rocketpy, lvgym_simulator
@@ -69,11 +69,19 @@ def timing_table(elevation_deg: float = ELEVATION_DEG, rail_length: float = RAIL
     return "\n".join(out)
 
 
+@dataclass
+class Args:
+    """Command-line arguments (``lvgym verify rocketpy-timing --help``)."""
+
+    elevation: float = arg(ELEVATION_DEG, lo=0.0, lo_open=True, hi=90.0)
+    """rail elevation [deg]"""
+    rail: float = arg(RAIL_LENGTH, lo=0.0, lo_open=True, hi=1000.0)
+    """rail length [m] (RocketPy needs a rail > 0)"""
+
+
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--elevation", type=float, default=ELEVATION_DEG, help="rail elevation [deg]")
-    parser.add_argument("--rail", type=float, default=RAIL_LENGTH, help="rail length [m]")
-    args = parser.parse_args(argv)
+    """Print the table of wall times."""
+    args = parse(Args, argv, "python -m lvgym.verify.rocketpy_timing", __doc__)
     print(f"### Wall times [s], {VEHICLE}, elevation {args.elevation:g} deg, rail {args.rail:g} m\n")
     print(timing_table(args.elevation, args.rail, warm_up=True))
     return 0

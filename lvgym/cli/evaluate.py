@@ -1,0 +1,169 @@
+"""Compare TVC policies on the frozen benchmark protocol (``lvgym.benchmark``).
+
+    lvgym evaluate                                       # the default comparison (see DEFAULT_*)
+    lvgym evaluate --policies zero pid gs-pid runs/ppo_smile.zip --suites smile-windy --episodes 50   # v0
+    lvgym evaluate --executor ray --workers 4            # Ray (pip install 'lvgym[ray]'): a local Ray
+    RAY_ADDRESS=auto lvgym evaluate --executor ray        # ... or the running cluster (``ray start``)
+
+(``python evaluate.py`` in a checkout is the same command.) Policies are names of :data:`POLICIES`
+(``zero``, ``pid``, ``gs-pid``: our rigid tuning; ``pid-thesis``, ``gs-pid-thesis``: the thesis's gains
+and Table 6.10; ``gs-pid-flex``, ``lqg``, ``aac``: designed for the flexible vehicle; ``lqg-front``:
+``lqg`` traded to the learned policy's margins (``experiments.lqg_headroom.headroom``); ``ppo``: the
+learned policy shipped for v0, ``ppo-res-lqg``: the one shipped for v1) or paths of saved
+stable-baselines3 models (``.zip``; an optional ``<stem>_vecnormalize.pkl`` next to it normalises the
+observations) or of ``train.py`` run folders, or your own policy: ``module:factory`` or
+``path/to/my_policy.py:factory`` (a function of the env, or of nothing, that returns an object with
+``name``, ``reset()`` and ``act(observation, info)``; the file is loaded by path in every worker and needs
+no ``__main__`` guard); ``label=...`` in front names any of them in the tables. Suites are names of
+``lvgym.benchmark.SUITES``. Episodes
+run on a local process pool by default; the Markdown table is printed, and CSV, JSON, the table and PNG
+plots go to ``--out`` (each file written atomically: an interrupted run leaves no half-written file).
+``--seed-set validation`` evaluates on the training seeds; reported numbers use the ``test`` seeds (the
+default).
+
+The tables (per suite; every mean with its 95 % bootstrap interval over the seeds, lower is better):
+  1. summary: condition x policy, ranked by failure rate, then by score (the rate error plus, for a failed
+     episode, the env's failure penalty for the mission left), with the rate error, CVaR10, max rate,
+     effort, max alpha and q-alpha;
+  2. rate error per flight phase: policy x model x (boost, max q, coast, upper stage, total);
+  3. rigid-to-non-rigid degradation: failure rates rigid and non-rigid, score and rate error of both
+     with their ratio and paired difference (a failed episode is charged by its score, so the score's
+     degradation counts the failures);
+  4. paired comparison: each policy against the reference (``--reference``, else the best-ranked
+     policy of the condition) on the same seeds: mean difference of the score with its interval,
+     wins/ties/losses, Wilcoxon and t p-values, the IQM and the probability of improvement
+     (:mod:`lvgym.benchmark.stats`);
+  5. agents over training runs (policies labelled ``<agent>-s<seed>``): the IQM over the runs.
+docs/benchmark.md defines every metric.
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+import sys
+import time
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from typing import Any
+
+from lvgym.benchmark import (EXECUTORS, PROTOCOL_VERSION, SEED_SETS, SUITES, PolicySpec, compare, degradation, evaluate,
+                             get_suite, markdown_table, run_groups, summarize, write_results)
+from lvgym.cli.policies import POLICIES, resolve_policy  # (registers the built-in policies)
+from lvgym.errors import ConfigError
+from lvgym.parallel import TaskFailed, exit_on_sigterm
+
+from . import fail
+from .args import arg, command_name, parse
+
+__all__ = ["Args", "DEFAULT_EPISODES", "DEFAULT_POLICIES", "DEFAULT_SUITES", "POLICIES", "main", "parse_args",
+           "resolve_policy"]
+
+PROG = "evaluate.py"
+#: the default comparison (issue 17): no control, the rigid-designed gs-pid (the thesis's question), the
+#: designs for the flexible vehicle (gs-pid-flex, lqg, lqg-front, aac) and the shipped learned policy
+DEFAULT_POLICIES = ["zero", "gs-pid", "gs-pid-flex", "lqg", "lqg-front", "aac", "ppo-res-lqg"]
+#: the main suite of protocol v1 (``smile-windy`` is v0's)
+DEFAULT_SUITES = ["smile-v1"]
+#: episodes per condition and policy of the default run (2 conditions x 6 policies x 50 = 600 episodes of 70 s)
+DEFAULT_EPISODES = 50
+#: the longest episode an env takes (``lvgym.envs.TaskSpec.mission_time_s``) [s]
+MAX_MISSION_TIME_S = 3600.0
+
+
+@dataclass
+class Args:
+    """Command-line arguments (``lvgym evaluate --help``)."""
+
+    policies: list[str] = arg(default_factory=lambda: list(DEFAULT_POLICIES), metavar="POLICY")
+    """registered policy names (zero, pid, gs-pid, gs-pid-flex, lqg, aac, ppo-res-lqg, ...), module:factory,
+    path/to/file.py:factory, paths of stable-baselines3 .zip models or train.py run folders (runs/<name>: its
+    best model); label=... in front names any of them"""
+    suites: list[str] = arg(default_factory=lambda: list(DEFAULT_SUITES), metavar="SUITE",
+                            choices=lambda: sorted(SUITES))
+    """suite names of the protocol"""
+    episodes: int = arg(DEFAULT_EPISODES, lo=1, hi=10**6, allowed="an integer >= 1")
+    """episodes (seeds) per condition and policy"""
+    executor: str = arg("local", choices=EXECUTORS)
+    """local (process pool), serial or ray"""
+    workers: int | None = arg(None, lo=1, hi=100_000, allowed="an integer >= 1")
+    """parallel workers (default: the CPUs available)"""
+    out: str = "results"
+    """folder of the result files"""
+    seed_set: str = arg("test", choices=SEED_SETS)
+    """test (reported numbers) or validation (training and tuning)"""
+    reference: str | None = arg(None, metavar="POLICY")
+    """policy label every policy is compared with (default: the best-ranked policy of each condition)"""
+    mission_time_s: float | None = arg(None, lo=0.0, lo_open=True, hi=MAX_MISSION_TIME_S,
+                                       allowed=f"a number of seconds in (0, {MAX_MISSION_TIME_S:g}]")
+    """shorten every episode to this many seconds (smoke tests only; results are marked '+override')"""
+    plots: bool = True
+    """write PNG plots"""
+    progress: bool = True
+    """show a progress bar"""
+
+
+def parse_args(argv: list[str] | None = None) -> Args:
+    """The command line as :class:`Args`, every value checked before any worker starts (an env would
+    refuse a bad one only in the worker)."""
+    return parse(Args, argv, PROG, __doc__, epilog=True)
+
+
+def _unique(specs: list[PolicySpec]) -> list[PolicySpec]:
+    """Distinct labels: a repeated one gets ``-2``, ``-3``, ..."""
+    seen: dict[str, int] = {}
+    out = []
+    for s in specs:
+        seen[s.name] = seen.get(s.name, 0) + 1
+        out.append(s if seen[s.name] == 1 else PolicySpec(f"{s.name}-{seen[s.name]}", s.factory, s.kwargs))
+    return out
+
+
+def main(argv: list[str] | None = None) -> dict[str, Any]:
+    """Run the comparison, print the Markdown table, write the result files; returns the results."""
+    args = parse_args(argv)
+    prog = command_name(PROG)
+    exit_on_sigterm()                                # clean up temporary files on kill (SIGTERM)
+    policies = _unique([resolve_policy(n, prog) for n in args.policies])
+    if args.reference is not None and args.reference not in [p.name for p in policies]:
+        raise SystemExit(f"{prog}: --reference = {args.reference!r}: one of the policy labels "
+                         f"{[p.name for p in policies]}")
+    try:
+        suites = [get_suite(n) for n in args.suites]
+    except ValueError as exc:
+        fail(prog, exc)
+    if args.mission_time_s is not None:
+        suites = [s.with_options(mission_time_s=float(args.mission_time_s)) for s in suites]
+    t0 = time.perf_counter()
+    try:
+        records = evaluate(policies, suites, args.episodes, args.seed_set, args.executor, args.workers,
+                           args.progress)
+    except TaskFailed as exc:                        # a bad value met in a worker: its message, in one line
+        if isinstance(exc.__cause__, ConfigError):
+            fail(prog, exc)
+        raise
+    wall = time.perf_counter() - t0
+    summary = summarize(records)
+    deg = degradation(summary, "score", records=records) + degradation(summary, "rate_error_rad", records=records)
+    comparison = compare(records, summary, "score", args.reference)
+    groups = run_groups(records, "score")
+    meta = {
+        "protocol": PROTOCOL_VERSION, "seed_set": args.seed_set, "episodes": args.episodes, "args": asdict(args),
+        "suites": {s.name: {"version": s.version, "description": s.description, "overrides": dict(s.overrides),
+                            "first_seed": s.seeds(args.seed_set, args.episodes)[0],
+                            "last_seed": s.seeds(args.seed_set, args.episodes)[-1],
+                            "conditions": [c.to_dict() for c in s.conditions]} for s in suites},
+        "policies": [{"name": p.name, "factory": p.factory, "kwargs": dict(p.kwargs)} for p in policies],
+        "wall_time_s": round(wall, 3), "created_utc": dt.datetime.now(dt.timezone.utc).isoformat(timespec="seconds"),
+    }
+    table = markdown_table(summary, deg, meta, comparison, groups)
+    paths = write_results(args.out, records, summary, deg, meta, plots=args.plots, comparison=comparison,
+                          groups=groups)
+    print(table)
+    print(f"{len(records)} episodes in {wall:.1f} s ({args.executor}); results in {Path(args.out)}/: "
+          f"{', '.join(sorted(paths))}", file=sys.stderr)
+    return {"records": records, "summary": summary, "degradation": deg, "comparison": comparison,
+            "run_groups": groups, "meta": meta, "table": table}
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,61 @@
+"""``lvgym fingerprint`` (``python -m lvgym.benchmark.fingerprint``): a frozen protocol's fingerprint,
+compared with the stored file or (when freezing) written (:mod:`lvgym.benchmark.fingerprint`).
+
+    lvgym fingerprint --version v1 --check      # compare a fresh run with the stored file (exit 1: differs)
+    lvgym fingerprint --version v1 --write      # (re)write it: only when freezing
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+from dataclasses import dataclass
+from typing import Literal
+
+from lvgym.benchmark.fingerprint import FINGERPRINTS, POLICIES, compare, fingerprint, stored
+from lvgym.benchmark.suites import SUITES
+
+from . import fail
+from .args import arg, command_name, parse
+
+__all__ = ["Args", "main"]
+
+PROG = "python -m lvgym.benchmark.fingerprint"
+
+
+@dataclass
+class Args:
+    """Command-line arguments (``lvgym fingerprint --help``)."""
+
+    mode: Literal["check", "write"] = arg(switches={
+        "check": "compare a fresh run with the stored fingerprint", "write": "write the stored fingerprint (when freezing)"})
+    version: str = arg("v1", choices=lambda: sorted({s.version for s in SUITES.values()}))
+    """protocol version"""
+    seeds: int = arg(1, lo=1, hi=1000)
+    """test seeds per condition"""
+
+
+def main(argv: list[str] | None = None) -> None:
+    """Check (exit 1 when the fresh run differs) or write the fingerprint."""
+    args = parse(Args, argv, PROG, __doc__, epilog=True)
+    prog = command_name(PROG)
+    try:
+        fresh = fingerprint(args.version, args.seeds)
+    except ValueError as exc:
+        fail(prog, exc)
+    path = FINGERPRINTS / f"{args.version}.json"
+    if args.mode == "write":
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(json.dumps({"version": args.version, "policies": list(POLICIES), "seeds": args.seeds,
+                                    "episodes": fresh}, indent=1) + "\n", encoding="utf-8")
+        print(f"{len(fresh)} episodes written to {path}")
+        return
+    diffs = compare(fresh, stored(args.version))
+    for line in diffs:
+        print(line)
+    print(f"{len(fresh)} episodes: " + ("the same" if not diffs else f"{len(diffs)} differences"))
+    sys.exit(1 if diffs else 0)
+
+
+if __name__ == "__main__":
+    main()

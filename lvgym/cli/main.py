@@ -1,0 +1,84 @@
+"""The console script ``lvgym``: every command of the benchmark, one subcommand each.
+
+    lvgym --help                       # the commands, one line each
+    lvgym evaluate --help              # a command's options
+    lvgym evaluate --policies zero lqg --suites smile-v1 --episodes 10
+    lvgym train --total-timesteps 2e6 --max-wall-time 3600
+    lvgym design pid --vehicle smile
+
+``python -m lvgym`` is the same. Each subcommand is the command line of a module (``lvgym evaluate`` is
+``evaluate.py``, ``lvgym margins`` is ``python -m lvgym.benchmark.margins``, ...), declared once as a
+dataclass (:mod:`lvgym.cli.args`); the module is imported only when its command runs, after checking that
+the extra it needs is installed (``lvgym train`` without stable-baselines3: ``pip install 'lvgym[train]'``).
+"""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Sequence
+
+from .args import Command, dispatch
+
+__all__ = ["COMMANDS", "main"]
+
+_BENCHMARK = ("tqdm", "matplotlib")
+_TRAIN = ("stable_baselines3", "torch", "tqdm")
+_CONTROL = ("control", "matplotlib")
+
+#: the subcommands: name, module:function, one line of help, the extra and the modules it installs
+COMMANDS: tuple[Command, ...] = (
+    Command("evaluate", "lvgym.cli.evaluate:main", "compare policies on the frozen benchmark protocol (evaluate.py)",
+            "benchmark", _BENCHMARK),
+    Command("train", "lvgym.agents.train:main", "train a policy with stable-baselines3 (train.py)", "train", _TRAIN),
+    Command("margins", "lvgym.cli.margins:main", "time-domain gain and delay margins of policies in the nonlinear "
+            "simulation", "benchmark", _BENCHMARK),
+    Command("fingerprint", "lvgym.cli.fingerprint:main", "check (or write) a frozen protocol's fingerprint"),
+    Command("verify", "lvgym.verify.__main__:main", "the verification table against the thesis (chapter 4)", sub=(
+        Command("rocketpy", "lvgym.verify.rocketpy_case:main", "the rigid simulator against RocketPy (Stratos III)",
+                "dev", ("rocketpy", "matplotlib")),
+        Command("rocketpy-timing", "lvgym.verify.rocketpy_timing:main", "wall times of lvgym and RocketPy, the "
+                "same flight", "dev", ("rocketpy",)),
+    )),
+    Command("bench", "lvgym.bench:main", "speed of the dynamics core (RK4 steps per second)"),
+    Command("bench-envs", "lvgym.bench_envs:main", "speed of the ascent envs (env steps per second, construction)"),
+    Command("studies", "lvgym.studies.__main__:main", "the thesis's studies: doe, ld-sweep, tw-sweep", "studies",
+            ("pandas", "statsmodels", "matplotlib")),
+    Command("render", "lvgym.envs.render:main", "draw the renderer's example frame to a PNG", "benchmark",
+            ("matplotlib",)),
+    Command("export-policy", "lvgym.agents.policy:export_main", "copy a training run's policy to a stem "
+            "(STEM.zip, STEM_vecnormalize.pkl, STEM.json)", "train", ("stable_baselines3", "torch")),
+    Command("design", None, "the classical controllers' offline design tools", sub=(
+        Command("pid", "lvgym.baselines.design.tune:main", "tune the rigid PID gain schedule (gs-pid)", "control",
+                _CONTROL),
+        Command("pid-flex", "lvgym.baselines.design.flexdesign:main", "design the PID with structural filters "
+                "for the flexible vehicle (gs-pid-flex)", "control", _CONTROL),
+        Command("lqg", "lvgym.baselines.design.lqg_design:main", "design the LQG schedule on the non-rigid plant "
+                "(lqg)", "control", _CONTROL),
+        Command("charts", "lvgym.baselines.design.charts:main", "Bode and Nichols charts of a gain schedule's "
+                "open loops", "control", _CONTROL),
+    )),
+)
+
+_DESCRIPTION = ("lvgym: a Gymnasium benchmark for thrust-vector control of flexible, sloshing launch vehicles. "
+                "Its commands:")
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run ``lvgym <command> ...``; returns the exit status (a command's own int, else 0)."""
+    argv = list(sys.argv[1:] if argv is None else argv)
+    if argv[:1] == ["--version"]:
+        from importlib.metadata import PackageNotFoundError, version
+
+        try:
+            print(f"lvgym {version('lvgym')}")
+        except PackageNotFoundError:
+            import lvgym
+
+            print(f"lvgym {lvgym.__version__}")
+        return 0
+    result = dispatch(COMMANDS, argv, "lvgym", _DESCRIPTION)
+    return result if isinstance(result, int) and not isinstance(result, bool) else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
