@@ -12,8 +12,7 @@
 - :mod:`.registry`: the policies the command lines know by name (:func:`register_policy`: the controllers
   and agents register themselves; the command layer imports them) and how ``--policies`` resolves;
 - :mod:`.margins`, :mod:`.perturb`: time-domain gain and delay margins of any policy
-  (``python -m lvgym.benchmark.margins``; import ``lvgym.benchmark.margins`` for
-  :func:`~.margins.time_domain_margins`: it is not imported here, so that ``-m`` runs it cleanly).
+  (``lvgym margins``; import ``lvgym.benchmark.margins`` for :func:`~.margins.time_domain_margins`).
 """
 
 from .compare import compare, run_groups

@@ -11,7 +11,6 @@ observation. ``tests/test_protocol_fingerprint.py`` compares a fresh run with th
     lvgym fingerprint --version v1 --check     # compare with the stored file
     lvgym fingerprint --version v1 --write     # (re)write it: only when freezing
 
-(``python -m lvgym.benchmark.fingerprint`` is the same command, declared in :mod:`lvgym.cli.fingerprint`.)
 
 Reproducibility: on one machine and one set of library versions the episodes are the same to the bit;
 across CPUs and BLAS builds the floating-point sums can round differently, so the numbers are compared to
@@ -119,9 +118,3 @@ def compare(fresh: list[dict[str, Any]], reference: list[dict[str, Any]], rtol: 
         out += [f"{key(r)} {f}: {r[f]!r} against {old[f]!r}" for f in NUMBERS
                 if not np.isclose(r[f], old[f], rtol=rtol, atol=0.0)]
     return out
-
-
-if __name__ == "__main__":            # the command line is lvgym fingerprint (lvgym.cli.fingerprint)
-    from lvgym.cli.fingerprint import main
-
-    main()

@@ -5,7 +5,6 @@ delay margin [ms] (docs/benchmark.md, "Time-domain margins").
     lvgym margins --policies zero pid gs-pid ppo --seeds 10 --models rigid
     lvgym margins --policies runs/ppo_smile --physics-dt-s 0.005   # 5 ms delay resolution
 
-(``python -m lvgym.benchmark.margins`` is the same command; it is declared in :mod:`lvgym.cli.margins`.)
 
 Between the policy and the actuator a multiplicative gain ``k`` (:class:`~.perturb.GainPolicy`), and
 separately a pure delay (:class:`~.perturb.ActuatorDelay`, in whole physics steps), are raised, per seed,
@@ -353,9 +352,3 @@ def write_margins(out: str | Path, results: Sequence[dict[str, Any]], meta: dict
             atomic_write_text(out / "margin_trials.csv", csv_text(trials)),
             atomic_write_text(out / "margins.md", margins_table(results)),
             atomic_write_text(out / "margins.json", json_text({"meta": meta, "results": list(results)}))]
-
-
-if __name__ == "__main__":            # the command line is lvgym margins (lvgym.cli.margins)
-    from lvgym.cli.margins import main
-
-    main()

@@ -1,4 +1,4 @@
-"""``lvgym fingerprint`` (``python -m lvgym.benchmark.fingerprint``): a frozen protocol's fingerprint,
+"""``lvgym fingerprint``: a frozen protocol's fingerprint,
 compared with the stored file or (when freezing) written (:mod:`lvgym.benchmark.fingerprint`).
 
     lvgym fingerprint --version v1 --check      # compare a fresh run with the stored file (exit 1: differs)
@@ -20,7 +20,7 @@ from .args import arg, command_name, parse
 
 __all__ = ["Args", "main"]
 
-PROG = "python -m lvgym.benchmark.fingerprint"
+PROG = "lvgym fingerprint"
 
 
 @dataclass

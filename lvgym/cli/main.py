@@ -7,7 +7,7 @@
     lvgym design pid --vehicle smile
 
 ``python -m lvgym`` is the same. Each subcommand is the command line of a module (``lvgym evaluate`` is
-``evaluate.py``, ``lvgym margins`` is ``python -m lvgym.benchmark.margins``, ...), declared once as a
+``evaluate.py``, ``lvgym design pid`` is ``python -m lvgym.baselines.design.tune``, ...), declared once as a
 dataclass (:mod:`lvgym.cli.args`); the module is imported only when its command runs, after checking that
 the extra it needs is installed (``lvgym train`` without stable-baselines3: ``pip install 'lvgym[train]'``).
 """

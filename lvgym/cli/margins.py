@@ -1,4 +1,4 @@
-"""``lvgym margins`` (``python -m lvgym.benchmark.margins``): time-domain margins of policies in the
+"""``lvgym margins``: time-domain margins of policies in the
 nonlinear simulation, gain up and down [dB] and delay [ms] (:mod:`lvgym.benchmark.margins`).
 
     lvgym margins                                          # the default policies on smile-v1, 5 test seeds
@@ -31,7 +31,7 @@ from .flights import FlightArgs, resolve_flights
 
 __all__ = ["Args", "main", "parse_args"]
 
-PROG = "python -m lvgym.benchmark.margins"
+PROG = "lvgym margins"
 _D = MarginOptions()
 _OPTIONS = ("error_ratio", "rate_limit_ratio", "gain_max_db", "gain_min_db", "gain_tol_db", "gain_step_db",
             "delay_max_s")
