@@ -25,6 +25,8 @@ from typing import Any
 
 import numpy as np
 
+from lvgym.errors import require
+
 __all__ = ["StructuralFilter", "FilterChain", "FILTER_KEYS"]
 
 
@@ -89,6 +91,7 @@ class StructuralFilter:
     def tf(self, dt: float) -> Any:
         """The discrete filter chain as a python-control transfer function at ``dt`` [s] (a design tool's
         view: needs python-control, ``pip install 'lvgym[control]'``; flying the filter does not)."""
+        require("control", "control", "StructuralFilter.tf")
         import control
 
         g = control.tf([1.0], [1.0], dt)

@@ -9,6 +9,7 @@ allowed range in one line, e.g.::
 
 from __future__ import annotations
 
+import importlib.util
 from typing import Any
 
 
@@ -74,6 +75,15 @@ class _Missing:
 
 #: marker for a required key that is absent
 MISSING = _Missing()
+
+
+def require(package: str, extra: str, feature: str) -> None:
+    """Check that ``package`` (an import name, e.g. ``"matplotlib"``), which ``feature`` needs and lvgym's
+    core install leaves out, is installed; if not, raise ``ModuleNotFoundError`` in one line naming the
+    extra that installs it, e.g. ``Recorder.plot needs matplotlib: pip install 'lvgym[studies]'``."""
+    if importlib.util.find_spec(package) is None:
+        raise ModuleNotFoundError(f"{feature} needs {package}, which lvgym's core install leaves out: "
+                                  f"pip install 'lvgym[{extra}]'", name=package)
 
 
 # ---------------------------------------------------------------------------- validators

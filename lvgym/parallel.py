@@ -15,6 +15,7 @@ lose the message); Ray's ``RayTaskError`` wrapper is removed. With ``describe``,
 
 from __future__ import annotations
 
+import importlib.util
 import os
 import sys
 from collections.abc import Callable, Sequence
@@ -181,6 +182,29 @@ def _ray(fn: Callable[[T], R], tasks: Sequence[T], done: Callable[[int, R], None
             ray.shutdown()
 
 
+class _NoBar:
+    """Stands in for tqdm's bar when there is none to draw."""
+
+    def __enter__(self) -> _NoBar:
+        return self
+
+    def __exit__(self, *exc: Any) -> None:
+        return None
+
+    def update(self, n: int = 1) -> None:
+        return None
+
+
+def _progress_bar(total: int, desc: str, unit: str, progress: bool) -> Any:
+    """tqdm's bar on stderr when ``progress`` and tqdm is installed (the ``benchmark`` extra; the core install
+    has no bar and runs the same)."""
+    if not progress or importlib.util.find_spec("tqdm") is None:
+        return _NoBar()
+    from tqdm.auto import tqdm
+
+    return tqdm(total=total, desc=desc, unit=unit, file=sys.stderr, dynamic_ncols=True)
+
+
 def run_map(fn: Callable[[T], R], tasks: Sequence[T], executor: str = "local", workers: int | None = None,
             progress: bool = True, on_result: Callable[[int, R], None] | None = None,
             desc: str = "runs", unit: str = "run", describe: Callable[[T], str] | None = None) -> list[R]:
@@ -189,7 +213,8 @@ def run_map(fn: Callable[[T], R], tasks: Sequence[T], executor: str = "local", w
     executor: ``local`` (a spawn process pool of ``workers`` processes, default the CPUs available; one
     worker runs serially), ``serial`` (this process) or ``ray`` (Ray tasks; starts a local Ray with
     ``workers`` CPUs unless ``ray.init`` was called already or ``$RAY_ADDRESS`` names a cluster to join).
-    ``fn`` must be a module-level function and the tasks picklable. ``on_result(i, result)`` is called in
+    ``fn`` must be a module-level function and the tasks picklable. ``progress``: a tqdm bar on stderr (none
+    without tqdm, which the ``benchmark`` extra installs). ``on_result(i, result)`` is called in
     this process as each task finishes. An exception in a task stops the map and is raised here as
     itself, or as a :class:`TaskFailed` (a ``RuntimeError``) naming the task by ``describe(task)`` when
     ``describe`` is given. ``workers`` must be an integer >= 1 (a ConfigError otherwise)."""
@@ -200,10 +225,7 @@ def run_map(fn: Callable[[T], R], tasks: Sequence[T], executor: str = "local", w
     if not tasks:
         return []
     n = max(1, min(workers or default_workers(), len(tasks)))
-    from tqdm.auto import tqdm
-
-    with tqdm(total=len(tasks), desc=desc, unit=unit, disable=not progress, file=sys.stderr,
-              dynamic_ncols=True) as bar:
+    with _progress_bar(len(tasks), desc, unit, progress) as bar:
         def done(i: int, r: R) -> None:
             results[i] = r
             if on_result is not None:

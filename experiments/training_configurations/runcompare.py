@@ -1,4 +1,4 @@
-"""Agents compared over their training runs, across results folders (rliable's IQM and probability of improvement).
+"""Agents compared over their training runs, across results folders (IQM and probability of improvement).
 
 ``evaluate.py`` compares policies within one evaluation. A training configuration (an agent) is judged
 on several training runs, often evaluated apart (one ``evaluate.py`` per configuration, each with the
@@ -7,9 +7,10 @@ classical baseline beside it). This reads their ``episodes.csv`` and, per (suite
 - every agent's ``(runs, episodes)`` matrix of ``metric`` on the seeds all of them flew: an agent is the
   label ``<agent>-s<seed>`` with its runs (:data:`.compare.RUN_LABEL`); any other policy (``lqg``) is an
   agent of one run;
-- rliable's IQM of each matrix with its stratified-bootstrap interval (:func:`.stats.iqm`), which
-  resamples runs within each episode and episodes, so it holds both the training seeds and the test seeds;
-- rliable's probability of improvement of every agent over every other (:func:`.stats.probability_of_improvement`:
+- the IQM of each matrix with its stratified-bootstrap interval (:func:`.stats.iqm`), which resamples the
+  runs within each episode (the episodes stay fixed), so it holds the spread of the training seeds on these
+  test seeds (an agent of one run has an interval of zero width);
+- the probability of improvement of every agent over every other (:func:`.stats.probability_of_improvement`:
   the chance that a run of the first scores lower on an episode than a run of the second, averaged over
   the episodes; 0.5: neither is better), with its interval.
 
@@ -111,9 +112,7 @@ def compare_agents(values: dict[tuple[str, str, str], dict[int, float]], conditi
     """Per (suite, condition) (``conditions``: their names, default all): one ``iqm`` row per agent
     (``runs``, ``episodes``, ``mean``, ``iqm``, ``iqm_ci_low``, ``iqm_ci_high``) in the order of the IQM,
     then one ``p_improvement`` row per pair, the agent of the lower IQM over the other (``agent`` over
-    ``other``: ``p``, ``ci_low``, ``ci_high``; the other way round is ``1 - p``). rliable's bootstrap of
-    the probability of improvement is slow: about a minute per pair of 3 x 50 matrices with ``reps`` 2000
-    on 2 shared cores (lower ``reps`` for a first look)."""
+    ``other``: ``p``, ``ci_low``, ``ci_high``; the other way round is ``1 - p``)."""
     keys = sorted({(s, c) for s, c, _ in values if conditions is None or c.split("/")[-1] in conditions or c in conditions})
     if not keys:
         raise ConfigError("--condition", list(conditions or []), "conditions of the results: " + ", ".join(
@@ -143,7 +142,7 @@ def table(rows: Sequence[dict[str, Any]], metric: str = "score") -> str:
         if r["kind"] == "iqm":
             out.append(f"| {r['suite']} | {r['condition']} | {r['agent']} | {r['runs']} | {r['episodes']} | "
                        f"{r['mean']:.4f} | {r['iqm']:.4f} [{r['iqm_ci_low']:.4f}, {r['iqm_ci_high']:.4f}] |")
-    out += ["", "P(a better than b): rliable's probability that a run of a scores lower than a run of b on an episode",
+    out += ["", "P(a better than b): the probability that a run of a scores lower than a run of b on an episode",
             "", "| suite | condition | a | b | P(a better than b) [95 % CI] |", "|---|---|---|---|---:|"]
     for r in rows:
         if r["kind"] == "p_improvement":

@@ -1,11 +1,11 @@
-"""Policies compared on the same seeds: paired tests, rliable's IQM and probability of improvement.
+"""Policies compared on the same seeds: paired tests, the IQM and the probability of improvement.
 
 Within every (suite, condition) each policy is compared with a reference policy: a named one
 (``reference``), else the best-ranked one of that condition (:func:`.metrics.rank`: failure rate, then
 mean score). The seeds of a suite are common random numbers (the same wind, dispersions and noise for
-every policy), so the comparison is paired (:func:`.stats.paired`); rliable's estimates
-(:func:`.stats.iqm`, :func:`.stats.probability_of_improvement`) take each policy's episodes as the runs
-of one task, so the interval comes from resampling the episodes.
+every policy), so the comparison is paired (:func:`.stats.paired`); the aggregate estimates of Agarwal
+et al. (2021) (:func:`.stats.iqm`, :func:`.stats.probability_of_improvement`) take each policy's episodes
+as the runs of one task, so the interval comes from resampling the episodes.
 
 Rows of :func:`compare` (lower is better for every metric compared; ``metric`` is ``score`` by default):
 
@@ -18,14 +18,14 @@ diff, diff_ci_low,      mean of the per-seed difference policy - reference with 
 diff_ci_high
 wins, ties, losses      seeds where the policy is better than (lower), equal to, worse than the reference
 p_wilcoxon, p_ttest     two-sided Wilcoxon signed-rank and paired t-test p-values
-iqm, iqm_ci_low,        interquartile mean of the policy's ``metric`` over its episodes with rliable's
+iqm, iqm_ci_low,        interquartile mean of the policy's ``metric`` over its episodes with its
 iqm_ci_high             stratified-bootstrap interval
-p_improvement, _ci_low, rliable's probability that an episode of the policy scores lower than one of the
+p_improvement, _ci_low, probability of improvement: that an episode of the policy scores lower than one of the
 _ci_high                reference (0.5: neither is better), with its interval
 ======================  ===========================================================================
 
 :func:`run_groups` aggregates policies that are training runs of one agent (labels ``<agent>-s<seed>``,
-as ``experiments.rigid_vs_nonrigid_training.robustness`` names them): rliable's IQM over the ``(runs, episodes)`` matrix.
+as ``experiments.rigid_vs_nonrigid_training.robustness`` names them): the IQM over the ``(runs, episodes)`` matrix.
 """
 
 from __future__ import annotations
@@ -89,7 +89,7 @@ def run_groups(records: Sequence[dict[str, Any]], metric: str = "score",
                reps: int = REPS) -> list[dict[str, Any]]:
     """Per (suite, condition, agent) whose policies are at least two training runs (labels
     :data:`RUN_LABEL`) flown on the same seeds: ``runs``, ``episodes``, the mean of ``metric`` and
-    rliable's IQM over the ``(runs, episodes)`` matrix with its stratified-bootstrap interval."""
+    the IQM over the ``(runs, episodes)`` matrix with its stratified-bootstrap interval."""
     values = per_seed(records, metric)
     agents: dict[tuple[Any, Any, str], list[str]] = {}
     for suite, cond, pol in values:

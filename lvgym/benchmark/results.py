@@ -29,6 +29,7 @@ from typing import IO, Any
 
 import numpy as np
 
+from ..errors import require
 from .tables import markdown_table
 
 __all__ = ["atomic_path", "atomic_write", "atomic_write_text", "csv_text", "json_text", "markdown_table",
@@ -131,6 +132,7 @@ def json_text(obj: Any) -> str:
 # ---------------------------------------------------------------------------------------------- plots
 def _figure(width: float, height: float) -> Any:
     """A matplotlib Figure on the Agg canvas (no pyplot, no global backend change)."""
+    require("matplotlib", "benchmark", "the benchmark's plots")
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 

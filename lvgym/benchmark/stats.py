@@ -1,18 +1,22 @@
-"""Intervals and paired comparisons of benchmark results (scipy and rliable).
+"""Intervals and paired comparisons of benchmark results (numpy and scipy).
 
 A benchmark number without its uncertainty says little: these functions give the interval of a summary
 over seeds, the paired comparison of two policies flown on the same seeds (the suites pair them: the same
-seed is the same wind, dispersions and sensor noise for every policy), and rliable's aggregate estimates
-(interquartile mean, probability of improvement) for results over several training seeds.
+seed is the same wind, dispersions and sensor noise for every policy), and the aggregate estimates of
+Agarwal et al., "Deep RL at the edge of the statistical precipice", NeurIPS 2021 (interquartile mean,
+probability of improvement) for results over several training seeds.
 
 - :func:`bootstrap_ci`: a percentile-BCa bootstrap interval of a statistic over episodes
   (``scipy.stats.bootstrap``).
 - :func:`paired`: two policies on the same seeds: the mean difference with its bootstrap interval, the
   wins, the Wilcoxon signed-rank test and the paired t-test (``scipy.stats``).
-- :func:`iqm` and :func:`probability_of_improvement`: rliable's stratified-bootstrap estimates over
-  ``(runs, episodes)`` score matrices (Agarwal et al., "Deep RL at the edge of the statistical precipice",
-  NeurIPS 2021), lower scores being better here (rate errors), so the probability of improvement of ``a``
-  over ``b`` is ``P(a < b)``.
+- :func:`iqm` and :func:`probability_of_improvement`: the interquartile mean (``scipy.stats.trim_mean``)
+  and the probability of improvement (the Mann-Whitney U statistic over ``m n``, ``scipy.stats.mannwhitneyu``)
+  over ``(runs, episodes)`` score matrices, with stratified-bootstrap percentile intervals that resample
+  the runs within each episode, as the rliable library of that paper defines them (lvgym used rliable
+  1.2.0 until its repository was archived; tests/test_stats.py checks these against its recorded numbers).
+  Lower scores are better here (rate errors), so the probability of improvement of ``a`` over ``b`` is
+  ``P(a < b)``.
 
 Every random draw has a seed (``seed``), so an interval is reproducible.
 """
@@ -102,31 +106,70 @@ def _matrix(scores: Any) -> np.ndarray:
     return m
 
 
-def iqm(scores: dict[str, Any], level: float = LEVEL, reps: int = REPS, seed: int = 0) -> dict[str, tuple[float, float, float]]:
-    """Interquartile mean of each policy's ``(runs, episodes)`` scores with rliable's stratified bootstrap
-    interval: ``{name: (iqm, low, high)}``."""
-    from rliable import library as rly
-    from rliable import metrics
+def _percentile_interval(replicates: np.ndarray, level: float) -> tuple[float, float]:
+    """The percentile interval at confidence ``level`` of bootstrap ``replicates`` (numpy's linear
+    interpolation between order statistics, as rliable's ``method="percentile"`` took it from ``arch``)."""
+    alpha = (1.0 - level) / 2
+    low, high = np.percentile(replicates, [100 * alpha, 100 * (1.0 - alpha)])
+    return float(low), float(high)
 
-    np.random.seed(seed)                              # rliable draws from numpy's global generator
-    data = {k: _matrix(v) for k, v in scores.items()}
-    point, ci = rly.get_interval_estimates(data, lambda s: np.array([metrics.aggregate_iqm(s)]), reps=reps,
-                                           confidence_interval_size=level)
-    return {k: (float(point[k][0]), float(ci[k][0, 0]), float(ci[k][1, 0])) for k in data}
+
+def _stratified(scores: np.ndarray, reps: int, rng: np.random.RandomState) -> np.ndarray:
+    """``reps`` stratified resamples ``(reps, runs, tasks)`` of a ``(runs, tasks)`` matrix: within each task
+    (column) the runs are drawn with replacement, independently of the other tasks (rliable's
+    ``StratifiedBootstrap``: the tasks are fixed, the runs are the sample)."""
+    runs, tasks = scores.shape
+    rows = rng.randint(0, runs, size=(reps, runs, tasks))
+    return scores[rows, np.arange(tasks)]
+
+
+def _iqm(scores: np.ndarray) -> np.ndarray:
+    """Interquartile mean of each ``(..., runs, tasks)`` matrix: the mean of the middle half of its pooled
+    scores (``scipy.stats.trim_mean``, 25 % cut from either end)."""
+    return stats.trim_mean(scores.reshape(scores.shape[:-2] + (-1,)), 0.25, axis=-1)
+
+
+def _improvement(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """Probability that a run of ``x`` scores lower than a run of ``y`` (ties count one half) on a task,
+    averaged over the tasks, of each pair of ``(..., runs, tasks)`` matrices: the Mann-Whitney U statistic
+    of ``y`` against ``x`` over ``m n`` per task."""
+    m, n = x.shape[-2], y.shape[-2]
+    u = stats.mannwhitneyu(y, x, axis=-2, method="asymptotic").statistic   # pairs y > x, ties one half
+    return np.mean(u / (m * n), axis=-1)
+
+
+def iqm(scores: dict[str, Any], level: float = LEVEL, reps: int = REPS, seed: int = 0) -> dict[str, tuple[float, float, float]]:
+    """Interquartile mean of each policy's ``(runs, episodes)`` scores with its stratified-bootstrap
+    percentile interval: ``{name: (iqm, low, high)}``.
+
+    The resampling indices come from one Mersenne-Twister stream seeded with ``seed``
+    (``numpy.random.RandomState``), drawn for the policies in the order of ``scores``: the draws rliable
+    made from numpy's global generator after ``np.random.seed(seed)``, so the intervals are the ones it gave
+    (tests/test_stats.py checks them against recorded rliable numbers)."""
+    rng = np.random.RandomState(seed)
+    out = {}
+    for name, value in scores.items():
+        m = _matrix(value)
+        out[name] = (float(_iqm(m)), *_percentile_interval(_iqm(_stratified(m, reps, rng)), level))
+    return out
 
 
 def probability_of_improvement(a: Any, b: Any, level: float = LEVEL, reps: int = REPS,
                                seed: int = 0) -> tuple[float, float, float]:
-    """rliable's probability that a run of ``a`` scores lower (better) than one of ``b``, with its
-    interval: ``(p, low, high)``; ``a`` and ``b`` are ``(runs, episodes)`` matrices of the same episodes."""
-    from rliable import library as rly
-    from rliable import metrics
-
-    np.random.seed(seed)
+    """Probability that a run of ``a`` scores lower (better) than a run of ``b`` on an episode (task),
+    averaged over the episodes, with its bootstrap percentile interval: ``(p, low, high)``; ``a`` and ``b``
+    are ``(runs, episodes)`` matrices of the same episodes, their runs resampled independently within each
+    episode (rliable's ``StratifiedIndependentBootstrap``; the stream as in :func:`iqm`, ``a``'s draws then
+    ``b``'s in every replicate)."""
     x, y = _matrix(a), _matrix(b)
     if x.shape[1] != y.shape[1]:
         raise ValueError(f"{x.shape[1]} and {y.shape[1]} episodes: the same episodes (tasks) for both")
-    # rliable's probability of improvement counts x > y as an improvement: negate (lower is better here)
-    point, ci = rly.get_interval_estimates({"p": (-x, -y)}, metrics.probability_of_improvement, reps=reps,
-                                           confidence_interval_size=level)
-    return float(point["p"]), float(np.ravel(ci["p"])[0]), float(np.ravel(ci["p"])[1])
+    rng = np.random.RandomState(seed)
+    rows_x = np.empty((reps,) + x.shape, dtype=np.int64)
+    rows_y = np.empty((reps,) + y.shape, dtype=np.int64)
+    for r in range(reps):                              # interleaved, as rliable drew them
+        rows_x[r] = rng.randint(0, x.shape[0], size=x.shape)
+        rows_y[r] = rng.randint(0, y.shape[0], size=y.shape)
+    tasks = np.arange(x.shape[1])
+    replicates = _improvement(x[rows_x, tasks], y[rows_y, tasks])
+    return (float(_improvement(x, y)), *_percentile_interval(replicates, level))

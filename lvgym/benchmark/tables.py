@@ -184,8 +184,8 @@ def markdown_table(summary: Sequence[Row], degradation: Sequence[Row], meta: Map
         if comp:
             out += _section(f"Paired comparison of the score ({suite}) with the reference policy of each "
                             "condition on the same seeds: diff = policy - reference (negative: better); P(better): "
-                            "rliable's probability that an episode of the policy scores lower", comparison_table(comp))
-        out += _section(f"Agents over their training runs ({suite}): rliable's IQM of the score over "
+                            "the probability that an episode of the policy scores lower", comparison_table(comp))
+        out += _section(f"Agents over their training runs ({suite}): IQM of the score over "
                         "(runs, episodes)", run_groups_table(_of_suite(groups, suite)))
         out.append("")
     return "\n".join(out)

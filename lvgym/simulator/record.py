@@ -39,6 +39,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ..errors import require
+
 if TYPE_CHECKING:                                    # pragma: no cover
     import pandas as pd
     from matplotlib.figure import Figure
@@ -176,7 +178,9 @@ class Recorder:
 
     # ------------------------------------------------------------------------------ output
     def frame(self, row: int | None = None) -> pd.DataFrame:
-        """One line per snapshot of the simulator's batch row ``row`` (default: the first recorded)."""
+        """One line per snapshot of the simulator's batch row ``row`` (default: the first recorded; needs
+        pandas, ``pip install 'lvgym[studies]'``)."""
+        require("pandas", "studies", "Recorder.frame")
         import pandas as pd
 
         i = self._index(row)
@@ -197,6 +201,8 @@ class Recorder:
         suffix = path.suffix.lower()
         if suffix not in FORMATS:
             raise ValueError(f"cannot save to {path.name!r}: suffix {path.suffix!r} is not one of {FORMATS}")
+        if suffix == ".parquet":
+            require("pyarrow", "studies", "Recorder.save to Parquet")
         df = self.frame(row)
         path.parent.mkdir(parents=True, exist_ok=True)
         fd, tmp_name = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
@@ -218,6 +224,7 @@ class Recorder:
     def plot(self, row: int | None = None, path: str | os.PathLike[str] | None = None) -> Figure:
         """Draw :data:`PANELS` of ``row`` against time on a 3 x 3 grid, events as vertical lines; with
         ``path``, also save it as a PNG (Agg canvas; nothing is shown)."""
+        require("matplotlib", "studies", "Recorder.plot")
         from matplotlib.backends.backend_agg import FigureCanvasAgg
         from matplotlib.figure import Figure
 
@@ -286,6 +293,7 @@ class Recorder:
 
 def load(path: str | os.PathLike[str]) -> pd.DataFrame:
     """Read a file written by :meth:`Recorder.save` back into the frame it was written from."""
+    require("pandas", "studies", "lvgym.simulator.load")
     import pandas as pd
 
     path = Path(path)

@@ -5,9 +5,14 @@ sweeps over L/D and thrust-to-weight of the parametric slender vehicle, run in p
 :func:`doe_study`, :func:`ld_sweep_study`, :func:`tw_sweep_study`. Findings: docs/studies.md.
 """
 
-from .doe import anova, design
-from .responses import RESPONSES, RunSetup, responses, run_case
-from .study import StudyResult, doe_study, ld_sweep_study, tw_sweep_study
+from ..errors import require
+
+require("pandas", "studies", "lvgym.studies")
+require("statsmodels", "studies", "lvgym.studies")
+
+from .doe import anova, design  # noqa: E402  (after the check: the studies' modules import pandas)
+from .responses import RESPONSES, RunSetup, responses, run_case  # noqa: E402
+from .study import StudyResult, doe_study, ld_sweep_study, tw_sweep_study  # noqa: E402
 
 __all__ = ["RESPONSES", "RunSetup", "StudyResult", "anova", "design", "doe_study", "ld_sweep_study",
            "responses", "run_case", "tw_sweep_study"]

@@ -48,6 +48,7 @@ import numpy as np
 
 from lvgym.cli.args import arg, parse
 from lvgym.environment import make
+from lvgym.errors import require
 from lvgym.simulator import Simulator
 
 G0 = 9.80665                          #: standard gravity, both simulators [m/s^2]
@@ -304,6 +305,7 @@ def rocketpy_flight(elevation_deg: float = ELEVATION_DEG, rail_length: float = R
     issue #1186, fix proposed in PR #1196); ``jet_damping=False``: a diagnostic, put the nozzle at the CDM
     and zero its gyration tensor, which removes RocketPy's jet-damping terms (lvgym has none). ``sim``: the
     lvgym simulator of the same launch whose vehicle and tables RocketPy is given (default: built here)."""
+    require("rocketpy", "dev", "the RocketPy comparison")
     from rocketpy import Environment, Flight, Function, GenericMotor, Rocket
 
     if motor not in ("tabulated", "generic"):
@@ -419,6 +421,7 @@ def sensitivity_table(base: Comparison) -> str:
 def plot(comparisons: list[Comparison], path: Path = FIGURE) -> Path:
     """Altitude and Mach against time of both simulators (first comparison), and lvgym minus RocketPy
     (RocketPy interpolated to lvgym's times) for all of them; PNG at ``path`` (Agg canvas)."""
+    require("matplotlib", "dev", "the RocketPy comparison's plot")
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
