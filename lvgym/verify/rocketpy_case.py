@@ -48,7 +48,7 @@ from typing import Any
 import numpy as np
 
 from lvgym.environment import make
-from lvgym.simulator import Simulator
+from lvgym.simulator import EnvironmentSpec, LaunchSpec, Simulator, TimelineSpec
 
 G0 = 9.80665                          #: standard gravity, both simulators [m/s^2]
 VEHICLE = "stratos3"
@@ -147,8 +147,9 @@ def _peak(t: np.ndarray, y: np.ndarray) -> tuple[float, float]:
 def lvgym_simulator(elevation_deg: float = ELEVATION_DEG, rail_length: float = RAIL_LENGTH,
                     t_end: float = T_END) -> Simulator:
     """The rigid ``stratos3`` on the flat non-rotating site, constant gravity, US76, no wind."""
-    return Simulator(VEHICLE, model="rigid", site="flat", gravity="constant", atmosphere="us76", wind="none",
-                     t_end=t_end, elevation_deg=elevation_deg, rail_length=rail_length)
+    return Simulator(VEHICLE, "rigid", launch=LaunchSpec("flat", elevation_deg, rail_length),
+                     environment=EnvironmentSpec(gravity="constant", atmosphere="us76", wind="none"),
+                     timeline=TimelineSpec(t_end=t_end))
 
 
 def fly_lvgym(elevation_deg: float = ELEVATION_DEG, rail_length: float = RAIL_LENGTH,
