@@ -8,7 +8,7 @@ from lvgym.environment.aerodynamics import AxisymmetricAero
 from lvgym.environment.aeroelastic import resample_modes
 from lvgym.envs.spec import wind_spec
 from lvgym.errors import ConfigError
-from lvgym.simulator import Simulator, flight_loads
+from lvgym.simulator import EnvironmentSpec, Simulator, TimelineSpec, flight_loads
 from lvgym.simulator.layouts import CTX, DS
 from lvgym.simulator.strips import N_STRIPS
 
@@ -20,8 +20,9 @@ def _call_loads(fn, t, x, p, ctx, u):
     fn(t, x, p, ctx, u)
 
 
-def slender(model="nonrigid", **kw):
-    return Simulator("slender", model, t_end=T_END, wind="none", **kw)
+def slender(model="nonrigid", aeroelastic=None):
+    return Simulator("slender", model, environment=EnvironmentSpec(wind="none", aeroelastic=aeroelastic),
+                     timeline=TimelineSpec(t_end=T_END))
 
 
 def fly(sim, seconds, batch=1, rngs=None, winds=None):
@@ -52,7 +53,7 @@ def test_option_follows_the_vehicle_file():
     assert sim.timeline.strip_stations.shape == (1, N_STRIPS)
     assert slender(aeroelastic=False).strips is None
     assert slender("rigid", aeroelastic=True).strips is None            # no modes: nothing to load
-    smile = Simulator("smile", "nonrigid", t_end=1.0)
+    smile = Simulator("smile", "nonrigid", timeline=TimelineSpec(t_end=1.0))
     assert not smile.aeroelastic and smile.strips is None
     with pytest.raises(ValueError, match="aeroelastic"):
         slender(aeroelastic="yes")
@@ -163,7 +164,7 @@ def test_zero_mode_shapes_at_the_strips_fly_as_without():
     off = slender(aeroelastic=False)
     tl = slender(aeroelastic=True).timeline
     tl = replace(tl, phi_strip=np.zeros_like(tl.phi_strip), dphi_strip=np.zeros_like(tl.dphi_strip))
-    zeroed = Simulator("slender", "nonrigid", wind="none", timeline=tl, aeroelastic=True)
+    zeroed = Simulator("slender", "nonrigid", environment=EnvironmentSpec(wind="none", aeroelastic=True), timeline=tl)
     assert zeroed.strips is not None
     fly(zeroed, 0.6)
     fly(off, 0.6)
@@ -191,12 +192,13 @@ def test_batch_rows_fly_as_single_vehicles():
 def test_a_prebuilt_timeline_without_strips_is_refused():
     tl = slender(aeroelastic=False).timeline
     with pytest.raises(ValueError, match="strips"):
-        Simulator("slender", "nonrigid", timeline=tl, aeroelastic=True)
+        Simulator("slender", "nonrigid", environment=EnvironmentSpec(aeroelastic=True), timeline=tl)
     # a table without geometry has no strip distribution
     table = AxisymmetricAero({"mach": [0.0, 2.0], "alpha_deg": [0.0, 10.0], "CA": [[0.3, 0.3], [0.4, 0.4]],
                               "CN": [[0.0, 1.5], [0.0, 1.2]], "Cm": [[0.0, -3.0], [0.0, -2.5]]}, 0.07, 0.3, -4.0)
     with pytest.raises(ConfigError, match="aeroelastic"):
-        Simulator("slender", "nonrigid", t_end=1.0, aeroelastic=True, aerodynamics=table)
+        Simulator("slender", "nonrigid", environment=EnvironmentSpec(aerodynamics=table, aeroelastic=True),
+                  timeline=TimelineSpec(t_end=1.0))
 
 
 def test_env_option():

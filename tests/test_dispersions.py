@@ -7,12 +7,12 @@ import pytest
 
 import lvgym  # noqa: F401
 from lvgym.envs.spec import RANDOMIZE, RANDOMIZE_V0, TaskSpec
-from lvgym.simulator import Simulator
+from lvgym.simulator import Simulator, TimelineSpec
 from lvgym.simulator.layouts import CONDITIONS, CONTEXT, DISPERSION
 
 
 def _conditions():
-    sim = Simulator("smile", "rigid", t_end=5.0)
+    sim = Simulator("smile", "rigid", timeline=TimelineSpec(t_end=5.0))
     sim.reset(1, rng=np.random.default_rng(0))
     for _ in range(150):                          # 3 s: off the pad, with an angle of attack from the kick
         sim.step(np.array([[0.01, -0.005]]), 0.02)
@@ -96,7 +96,7 @@ def test_v1_randomisations_change_the_flight():
 
 def _servo_after_one_period(servo_dispersion):
     from lvgym.simulator.servo import Servo
-    sim = Simulator("smile", "rigid", t_end=2.0, servo=Servo(15.0, 0.7))
+    sim = Simulator("smile", "rigid", timeline=TimelineSpec(t_end=2.0), servo=Servo(15.0, 0.7))
     sim.reset(1, rng=np.random.default_rng(0), servo_dispersion=servo_dispersion)
     sim.step(np.array([[0.01, 0.0]]), 0.02)              # two physics steps of 10 ms
     first = sim.gimbal[0, 0]
@@ -239,7 +239,7 @@ def test_imu_station_interpolation_against_timelines_built_at_the_station():
 
 def _imu_flight(imu, timeline, shift, n=100, model="nonrigid"):
     from lvgym.simulator.servo import Servo
-    sim = Simulator("smile_v1", model, t_end=timeline.t_end, timeline=timeline, imu=imu, servo=Servo(15.0, 0.7))
+    sim = Simulator("smile_v1", model, timeline=timeline, imu=imu, servo=Servo(15.0, 0.7))
     sim.reset(1, rng=np.random.default_rng(0), imu_station=None if shift is None else [shift])
     out = []
     for k in range(n):

@@ -21,7 +21,7 @@ from lvgym.envs.ascent import SmileAscentEnv
 from lvgym.envs.functional import AscentFuncEnv
 from lvgym.envs.layouts import FLIGHT_DRAWS, NAV, OBS_FLIGHT, OBS_SENSORS, OBSERVATIONS
 from lvgym.rotations import quat_mul
-from lvgym.simulator import Simulator
+from lvgym.simulator import PhysicsSpec, Simulator, TimelineSpec
 from lvgym.simulator.imu import Imu, imu_output_k, lti_step_k, specific_force_k
 
 H = 0.01
@@ -107,7 +107,8 @@ def _flex_flight(n_steps=250, station=-2.5):
     """A flexible SMILE excited by gimbal doublets, stepped one physics step at a time; per step the
     body rate, modal rates, slopes at the IMU and the IMU's outputs."""
     imu = Imu(station)
-    sim = Simulator("smile", model="flex", t_end=5.0, sensor_stations=[station], imu=imu, physics_dt=H)
+    sim = Simulator("smile", "flex", timeline=TimelineSpec(t_end=5.0, sensor_stations=[station]),
+                    physics=PhysicsSpec(H), imu=imu)
     sim.reset(1)
     K = sim.dynamics.n_modes
     rec = {"omega": [], "eta_dot": [], "dphi": [], "gyro": []}
@@ -158,7 +159,7 @@ def test_the_gyro_sees_the_slope_rate_through_its_filters():
 
 
 def test_on_the_pad_the_accelerometers_read_no_lateral_force_and_the_gyros_the_earth_rate():
-    sim = Simulator("smile", model="rigid", t_end=2.0, sensor_stations=[-2.0], imu=Imu(-2.0))
+    sim = Simulator("smile", "rigid", timeline=TimelineSpec(t_end=2.0, sensor_stations=[-2.0]), imu=Imu(-2.0))
     sim.reset(1)
     rate, force = np.zeros(3), np.zeros(2)
     imu_output_k(sim.setup.imu, sim.data.imu[0], rate, force)

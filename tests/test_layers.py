@@ -170,3 +170,46 @@ def test_every_registered_factory_lives_at_or_below_the_package_that_registers_i
                        "lvgym.agents.policy"}
     for module in modules:                          # a worker imports it: the factory reaches no study
         assert not any(n.startswith("experiments") for n in _follow([module], set())), module
+
+
+#: the installed packages (pyproject.toml's package-dir: agents/ is lvgym.agents, baselines/ lvgym.baselines)
+INSTALLED = ("lvgym", "lvgym.agents", "lvgym.baselines")
+_LOADERS = {"import_module", "__import__", "run_module", "find_spec"}
+
+
+def _installed_modules() -> list[str]:
+    names: set[str] = set()
+    for package in INSTALLED:
+        pkg = importlib.import_module(package)
+        names |= {package} | {m.name for m in pkgutil.walk_packages(pkg.__path__, package + ".")}
+    return sorted(names)
+
+
+def _loads_by_name(module: str) -> set[str]:
+    """Module names ``module`` imports by a string (``importlib.import_module("x")``, ``__import__``,
+    ``runpy.run_module``, ``find_spec``)."""
+    tree = ast.parse(Path(importlib.util.find_spec(module).origin).read_text(encoding="utf-8"))
+    out = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Call) and node.args and isinstance(node.args[0], ast.Constant):
+            name = node.func.attr if isinstance(node.func, ast.Attribute) else getattr(node.func, "id", "")
+            if name in _LOADERS and isinstance(node.args[0].value, str):
+                out.add(node.args[0].value)
+    return out
+
+
+def _experiments(names: set[str]) -> list[str]:
+    return sorted(n for n in names if n == "experiments" or n.startswith("experiments."))
+
+
+def test_nothing_installed_imports_the_experiments():
+    """experiments/ (the one-off studies) is not installed: no module of lvgym, lvgym.agents or
+    lvgym.baselines imports it, by an import statement or by name."""
+    modules = _installed_modules()
+    assert {"lvgym.cli", "lvgym.agents.policy", "lvgym.baselines.pid", "lvgym.baselines.design.tune"} <= set(modules)
+    found = {m: _experiments(_imports(m) | _loads_by_name(m)) for m in modules}
+    bad = {m: names for m, names in found.items() if names}
+    assert not bad, f"installed modules import experiments/: {bad}"
+    # the checks see such imports: a study's __main__ imports its module, another study loads sys by name
+    assert "experiments.error_budget.budget" in _imports("experiments.error_budget.budget")
+    assert _loads_by_name("experiments.aeroelastic_divergence.structural_limit") == {"sys"}

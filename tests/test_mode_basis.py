@@ -5,7 +5,7 @@ the compiled step that applies them row by row."""
 import numpy as np
 import pytest
 
-from lvgym.simulator import Simulator, build_timeline, cache
+from lvgym.simulator import Simulator, TimelineSpec, build_timeline, cache
 from lvgym.vehicle import MassModel, load_vehicle
 from lvgym.vehicle.structure import mode_transfer, stiffness_factor, vehicle_modes
 
@@ -145,8 +145,8 @@ def _kick(sim, rows=None):
 
 def test_the_step_projects_once_at_the_change():
     stations = np.linspace(0.0, -11.0, 23)
-    sim = Simulator("smile", model="nonrigid", t_end=6.0, mode_interval=2.0, mode_basis="projected",
-                    sensor_stations=stations)
+    sim = Simulator("smile", "nonrigid", timeline=TimelineSpec(t_end=6.0, sensor_stations=stations, mode_interval=2.0,
+                                                              mode_basis="projected"))
     sim.reset(1)
     for _ in range(99):
         sim.step([[0.0, 0.0]], 0.02)
@@ -172,10 +172,9 @@ def test_the_step_projects_once_at_the_change():
 def test_a_period_ending_on_the_change_projects_at_the_next_one():
     """A control period that ends at the change time projects at the start of the next period: the
     same flight as one period across the change (and not the held one)."""
-    kw = dict(model="nonrigid", t_end=4.0, mode_interval=2.0)
-    on = Simulator("smile", mode_basis="projected", **kw)
-    across = Simulator("smile", timeline=on.timeline, mode_basis="projected", **kw)
-    held = Simulator("smile", **kw)
+    on = Simulator("smile", "nonrigid", timeline=TimelineSpec(t_end=4.0, mode_interval=2.0, mode_basis="projected"))
+    across = Simulator("smile", "nonrigid", timeline=on.timeline)
+    held = Simulator("smile", "nonrigid", timeline=TimelineSpec(t_end=4.0, mode_interval=2.0))
     for sim, periods in ((on, (1.0, 1.0, 0.02)), (across, (1.0, 1.02)), (held, (1.0, 1.0, 0.02))):
         sim.reset(1)
         _kick(sim)
@@ -187,9 +186,8 @@ def test_a_period_ending_on_the_change_projects_at_the_next_one():
 
 
 def test_projected_equals_held_where_no_change_falls():
-    kw = dict(model="nonrigid", t_end=3.0)
-    held = Simulator("smile", **kw)
-    proj = Simulator("smile", mode_basis="projected", **kw)
+    held = Simulator("smile", "nonrigid", timeline=TimelineSpec(t_end=3.0))
+    proj = Simulator("smile", "nonrigid", timeline=TimelineSpec(t_end=3.0, mode_basis="projected"))
     assert proj.timeline.mode_change_t.size == 0
     for sim in (held, proj):
         sim.reset(1)
@@ -200,13 +198,12 @@ def test_projected_equals_held_where_no_change_falls():
 
 
 def test_batch_rows_at_different_times_equal_single_rows_across_changes():
-    kw = dict(model="nonrigid", t_end=8.0, mode_interval=2.0, mode_basis="projected")
-    sim = Simulator("smile", **kw)
+    sim = Simulator("smile", "nonrigid", timeline=TimelineSpec(t_end=8.0, mode_interval=2.0, mode_basis="projected"))
     sim.reset(2)
     _kick(sim)
-    single = Simulator("smile", timeline=sim.timeline, **kw)
+    single = Simulator("smile", "nonrigid", timeline=sim.timeline)
     single.reset(1)
-    first = Simulator("smile", timeline=sim.timeline, **kw)
+    first = Simulator("smile", "nonrigid", timeline=sim.timeline)
     first.reset(1)
     _kick(first)
     for _ in range(50):
@@ -221,7 +218,7 @@ def test_batch_rows_at_different_times_equal_single_rows_across_changes():
         first.step([[0.01, -0.01]], 0.02)
     np.testing.assert_array_equal(sim.x[0], first.x[0])
     np.testing.assert_array_equal(sim.x[1], single.x[0])
-    held = Simulator("smile", model="nonrigid", t_end=8.0, mode_interval=2.0)
+    held = Simulator("smile", "nonrigid", timeline=TimelineSpec(t_end=8.0, mode_interval=2.0))
     held.reset(1)
     _kick(held)
     for _ in range(170):
@@ -229,11 +226,16 @@ def test_batch_rows_at_different_times_equal_single_rows_across_changes():
     assert not np.array_equal(held.x[0], first.x[0])
 
 
-def test_a_prebuilt_timeline_must_match_the_mode_options(projected_timeline):
+def test_a_prebuilt_timeline_brings_its_mode_options_and_must_fly_the_model(projected_timeline):
+    sim = Simulator("smile", "nonrigid", timeline=projected_timeline)
+    assert sim.timeline is projected_timeline
+    assert (sim.timeline.mode_basis, sim.timeline.mode_interval) == ("projected", 2.0)
+    with pytest.raises(ValueError, match="timeline"):
+        Simulator("smile", "rigid", timeline=projected_timeline)
     with pytest.raises(ValueError, match="mode_basis"):
-        Simulator("smile", model="nonrigid", timeline=projected_timeline)
+        TimelineSpec(mode_basis="kept")
     with pytest.raises(ValueError, match="mode_interval"):
-        Simulator("smile", model="nonrigid", timeline=projected_timeline, mode_basis="projected", mode_interval=1.0)
+        TimelineSpec(mode_interval=-1.0)
 
 
 def test_task_options_reach_the_simulator():

@@ -9,7 +9,7 @@ import pandas as pd
 import pytest
 from matplotlib.figure import Figure
 
-from lvgym.simulator import Simulator
+from lvgym.simulator import Simulator, TimelineSpec
 from lvgym.simulator.record import FORMATS, PANELS, Recorder, fly, load
 
 DEG = math.degrees(1.0)
@@ -27,7 +27,7 @@ def wobble(sim: Simulator) -> np.ndarray:
 
 @pytest.fixture(scope="module")
 def flown():
-    sim = Simulator("stratos3", model="nonrigid", t_end=3.0)
+    sim = Simulator("stratos3", "nonrigid", timeline=TimelineSpec(t_end=3.0))
     sim.reset(batch=2)
     return sim, fly(sim, 1.0, record_dt=0.1, step_dt=0.02, gimbal=wobble)
 
@@ -50,7 +50,7 @@ def test_columns_present_and_finite(flown):
 
 
 def test_values_agree_with_the_simulator_at_the_snapshot():
-    sim = Simulator("stratos3", model="nonrigid", t_end=3.0)
+    sim = Simulator("stratos3", "nonrigid", timeline=TimelineSpec(t_end=3.0))
     sim.reset(batch=3)
     rec = Recorder(sim, rows=[2, 0])
     rec.snapshot()
@@ -96,7 +96,7 @@ def test_values_agree_with_the_simulator_at_the_snapshot():
 
 
 def test_rigid_model_has_no_slosh_or_eta_columns():
-    sim = Simulator("stratos3", model="rigid", t_end=3.0)
+    sim = Simulator("stratos3", "rigid", timeline=TimelineSpec(t_end=3.0))
     sim.reset()
     df = fly(sim, 0.5, record_dt=0.1).frame()
     assert not [c for c in df.columns if c.startswith(("slosh_", "eta_"))]
@@ -128,7 +128,7 @@ def recorded(rec: Recorder, row: int) -> int:
 
 
 def test_fly_continues_from_the_current_time_with_uneven_intervals():
-    sim = Simulator("stratos3", model="rigid", t_end=3.0)
+    sim = Simulator("stratos3", "rigid", timeline=TimelineSpec(t_end=3.0))
     sim.reset()
     first = fly(sim, 0.3, record_dt=0.1)
     second = fly(sim, 0.25, record_dt=0.07, step_dt=0.02, gimbal=np.array([[0.001, 0.0]]))
@@ -143,7 +143,7 @@ def test_fly_continues_from_the_current_time_with_uneven_intervals():
 
 
 def test_snapshot_accumulates_the_events_of_several_steps():
-    sim = Simulator("stratos3", model="rigid", t_end=3.0)
+    sim = Simulator("stratos3", "rigid", timeline=TimelineSpec(t_end=3.0))
     sim.reset(batch=2)
     rec = Recorder(sim, rows=[1])
     rec.snapshot()
@@ -211,7 +211,7 @@ def test_plot_has_the_panels_and_writes_a_png(flown, tmp_path):
     assert any(np.allclose(line.get_xdata(), t_liftoff) for line in altitude.get_lines())
     slosh = fig.axes[PANELS.index("slosh angles")]
     assert len(slosh.get_lines()) >= 2
-    rigid = Simulator("stratos3", model="rigid", t_end=3.0)
+    rigid = Simulator("stratos3", "rigid", timeline=TimelineSpec(t_end=3.0))
     rigid.reset()
     fig = fly(rigid, 0.2).plot()
     eta = fig.axes[PANELS.index("eta")]

@@ -13,7 +13,7 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 import lvgym  # noqa: F401  (registers the envs)
-from lvgym.simulator import Simulator
+from lvgym.simulator import LaunchSpec, PhysicsSpec, Simulator, TimelineSpec
 from lvgym.simulator.core import dcm_batch
 from lvgym.simulator.layouts import ACTUATOR
 from lvgym.simulator.servo import DIRECT, Servo, servo_step_k
@@ -117,8 +117,8 @@ def test_servo_rejects_bad_values():
 
 def test_rail_exit_is_found_at_the_physics_step():
     """Travel along the rail is checked after every RK4 step, not only at the end of a step() call."""
-    sim = Simulator("stratos3", model="rigid", site="el_arenosillo", elevation_deg=85.0, rail_length=10.0,
-                    t_end=3.0, physics_dt=0.01)
+    sim = Simulator("stratos3", "rigid", launch=LaunchSpec("el_arenosillo", 85.0, 10.0),
+                    timeline=TimelineSpec(t_end=3.0), physics=PhysicsSpec(0.01))
     sim.reset()
     exit_t = None
     while exit_t is None:

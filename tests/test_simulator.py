@@ -5,18 +5,19 @@ import numpy as np
 import pytest
 
 from lvgym.environment import Environment
-from lvgym.simulator import CONDITIONS, SITES, Simulator
+from lvgym.simulator import CONDITIONS, SITES, EnvironmentSpec, LaunchSpec, Simulator, TimelineSpec
 from lvgym.vehicle import MassModel
 
 
 @pytest.fixture(scope="module")
 def smile():
-    return Simulator("smile", model="nonrigid", t_end=60.0)
+    return Simulator("smile", "nonrigid", timeline=TimelineSpec(t_end=60.0))
 
 
 def test_flight_conditions_equal_the_environment_models(smile):
-    sim = Simulator("stratos3", model="rigid", site="el_arenosillo", wind={"model": "profile",
-                    "altitude_m": [0.0, 10e3], "speed": [5.0, 30.0], "direction_deg": [270.0, 200.0]}, t_end=5.0)
+    wind = {"model": "profile", "altitude_m": [0.0, 10e3], "speed": [5.0, 30.0], "direction_deg": [270.0, 200.0]}
+    sim = Simulator("stratos3", "rigid", launch=LaunchSpec("el_arenosillo"), environment=EnvironmentSpec(wind=wind),
+                    timeline=TimelineSpec(t_end=5.0))
     sim.reset()
     rng = np.random.default_rng(3)
     x = sim.x[0].copy()
@@ -73,8 +74,8 @@ def test_events_are_reported_once_at_their_times(smile):
 
 
 def test_rail_holds_the_attitude_until_exit():
-    sim = Simulator("stratos3", model="nonrigid", site="el_arenosillo", elevation_deg=80.0, rail_length=10.0,
-                    t_end=3.0)
+    sim = Simulator("stratos3", "nonrigid", launch=LaunchSpec("el_arenosillo", 80.0, 10.0),
+                    timeline=TimelineSpec(t_end=3.0))
     sim.reset()
     q0 = sim.state("q_bi")[0].copy()
     events = []
@@ -92,11 +93,10 @@ def test_rail_holds_the_attitude_until_exit():
 
 
 def test_batch_rows_at_different_times_equal_single_rows():
-    kw = dict(model="nonrigid", t_end=50.0, wind={"model": "gust", "amplitude": 10.0, "length": 100.0,
-                                                  "onset": 500.0})
-    sim = Simulator("smile", **kw)
+    gust = EnvironmentSpec(wind={"model": "gust", "amplitude": 10.0, "length": 100.0, "onset": 500.0})
+    sim = Simulator("smile", "nonrigid", environment=gust, timeline=TimelineSpec(t_end=50.0))
     sim.reset(2)
-    single = Simulator("smile", timeline=sim.timeline, **kw)
+    single = Simulator("smile", "nonrigid", environment=gust, timeline=sim.timeline)
     single.reset(1)
     for _ in range(50):
         sim.step([[0.01, -0.01], [0.0, 0.0]], 0.02)
@@ -109,7 +109,7 @@ def test_batch_rows_at_different_times_equal_single_rows():
 
 
 def test_rigid_and_nonrigid_share_the_rigid_equivalent_mass(smile):
-    rigid = Simulator("smile", model="rigid", t_end=60.0)
+    rigid = Simulator("smile", "rigid", timeline=TimelineSpec(t_end=60.0))
     t = np.array([0.0, 20.0, 50.0])
     np.testing.assert_allclose(rigid.timeline.interp("mass", t), smile.timeline.interp("mass", t))
     m_nr = smile.timeline.params_at(t)[:, 0] + smile.timeline.interp("slosh_mass", t).sum(axis=1)
@@ -128,9 +128,33 @@ def test_bad_options_raise_with_the_key():
     with pytest.raises(ValueError, match="model"):
         Simulator("smile", model="elastic")
     with pytest.raises(ValueError, match="site"):
-        Simulator("smile", site="kourou")
+        Simulator("smile", launch=LaunchSpec(site="kourou"))
     with pytest.raises(ValueError, match="elevation_deg"):
-        Simulator("smile", elevation_deg=120.0)
+        Simulator("smile", launch=LaunchSpec(elevation_deg=120.0))
+
+
+def test_the_specs_are_frozen_and_a_bad_value_names_its_key_in_one_line():
+    import dataclasses
+    import pickle
+
+    from lvgym.errors import ConfigError
+    from lvgym.simulator import PhysicsSpec
+
+    bad = {"site": lambda: LaunchSpec(site="kourou"), "rail_length": lambda: LaunchSpec(rail_length=-1.0),
+           "aeroelastic": lambda: EnvironmentSpec(aeroelastic="yes"), "t_end": lambda: TimelineSpec(t_end=0.0),
+           "n_modes": lambda: TimelineSpec(n_modes=1.5), "sensor_stations": lambda: TimelineSpec(sensor_stations=1.0),
+           "cg_convention": lambda: TimelineSpec(cg_convention="wet"), "physics_dt": lambda: PhysicsSpec(0.5),
+           "slosh_frequency": lambda: PhysicsSpec(slosh_frequency="vacuum"), "threads": lambda: PhysicsSpec(threads=0),
+           "launch": lambda: Simulator("smile", launch="andoya")}
+    for key, make in bad.items():
+        with pytest.raises(ConfigError, match=f"^{key} = ") as err:
+            make()
+        assert "\n" not in str(err.value) and str(pickle.loads(pickle.dumps(err.value))) == str(err.value)
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        TimelineSpec().t_end = 1.0
+    spec = TimelineSpec(t_end=5, n_modes=np.int64(2), sensor_stations=np.array([-1.0, -2.5]))
+    assert (spec.t_end, spec.n_modes, spec.sensor_stations) == (5.0, 2, (-1.0, -2.5))
+    assert LaunchSpec("flat").launch_site() is SITES["flat"]
 
 
 def test_conditions_names_are_checked(smile):
@@ -159,9 +183,9 @@ def test_aerodynamics_of_the_stack_in_flight_after_separation():
     data = _smile_mapping()
     data["stages"][1]["aerodynamics"] = {"model": "barrowman", "nose": {"shape": "ogive", "length": 1.8},
                                          "body": {"diameter": 1.1, "length": 5.3}}
-    sim = Simulator(parse_vehicle(data), model="rigid", t_end=46.0,
-                    wind={"model": "profile", "altitude_m": [0.0, 1e5], "speed": [5.0, 5.0],
-                          "direction_deg": [90.0, 90.0]})
+    wind = {"model": "profile", "altitude_m": [0.0, 1e5], "speed": [5.0, 5.0], "direction_deg": [90.0, 90.0]}
+    sim = Simulator(parse_vehicle(data), "rigid", environment=EnvironmentSpec(wind=wind),
+                    timeline=TimelineSpec(t_end=46.0))
     sim.reset()
     lift_off, upper = sim.stage_aerodynamics[0], sim.stage_aerodynamics[1]
     assert upper is not lift_off and sim.stage_aerodynamics[2] is upper       # stage 3 inherits
@@ -175,7 +199,7 @@ def test_aerodynamics_of_the_stack_in_flight_after_separation():
     # the finless upper stack is statically unstable (positive Cm at positive alpha), the lift-off stack stable
     assert lift_off.coefficients(5.8, np.radians(2.0))["Cm"] < 0.0 < upper.coefficients(5.8, np.radians(2.0))["Cm"]
     # the shipped smile keeps the lift-off stack's aerodynamics all flight (as the thesis)
-    shipped = Simulator("smile", model="rigid", t_end=2.0)
+    shipped = Simulator("smile", "rigid", timeline=TimelineSpec(t_end=2.0))
     assert all(m is shipped.aerodynamics for m in shipped.stage_aerodynamics)
 
 

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from lvgym.dynamics import NonRigidModel
-from lvgym.simulator import CONDITIONS, Simulator
+from lvgym.simulator import CONDITIONS, PhysicsSpec, Simulator, TimelineSpec
 from lvgym.simulator.piece import axial_specific_force_k, slosh_frequency_k
 
 
@@ -78,7 +78,8 @@ def flights():
     """SMILE, slosh model, zero gimbal, to 44.5 s (through burnout into the drag coast), both options."""
     out = {}
     for option in ("vacuum_thrust", "specific_force"):
-        sim = Simulator("smile", model="slosh", t_end=46.0, slosh_frequency=option)
+        sim = Simulator("smile", "slosh", timeline=TimelineSpec(t_end=46.0),
+                        physics=PhysicsSpec(slosh_frequency=option))
         sim.reset(1)
         lay = sim.layout
         i_w = [lay.slosh_param(j, "omega").start for j in range(sim.dynamics.n_slosh)]

@@ -15,7 +15,7 @@ import pytest
 
 from lvgym.dynamics import kernels
 from lvgym.environment import make
-from lvgym.environment.aerokernels import aero_loads_at, aero_loads_k, interp_k
+from lvgym.environment.aerokernels import AeroAt, AirData, LoadsAt, TableAt, aero_loads_at, aero_loads_k, interp_k
 from lvgym.environment.atmosphere import atmosphere_state, atmosphere_state_at
 from lvgym.environment.gravity import (F_A, F_B, F_F0, F_FA, F_FB, F_FZ, P_COEF, P_DEGREE, P_GM, P_ORDER, P_RADIUS,
                                        gravity_at, gravity_k, harmonics_k, harmonics_work)
@@ -178,10 +178,10 @@ def test_aero_in_place_equals_public_kernel(kind):
         va = rng.normal(0.0, 300.0, 3)
         om = rng.normal(0.0, 0.3, 3)
         f, m, st = np.empty(3), np.empty(3), np.empty(7)
-        aero_loads_k(va, om, 0.9, 330.0, -3.1, 1000.0, p, grid, dims, table, f, m, st)
+        aero_loads_k(va, om, 0.9, 330.0, -3.1, 1000.0, model.kernel_args(), f, m, st)
         out = np.full(13, np.nan)
-        aero_loads_at(*va, *om, 0.9, 330.0, -3.1, 1000.0, packed, op, packed, og, packed, od, dims.size, packed, ot,
-                      table.shape[1], out, 0, 3, 6, False)
+        in_place = AeroAt(packed, op, TableAt(packed, og, packed, od, dims.size, packed, ot, table.shape[1]))
+        aero_loads_at(AirData(tuple(va), tuple(om), 0.9, 330.0, -3.1, 1000.0), in_place, out, LoadsAt(0, 3, 6), False)
         np.testing.assert_array_equal(out[:6], np.concatenate([f, m]))
         np.testing.assert_array_equal(out[[8, 10, 11, 12]], st[[2, 4, 5, 6]])
         assert np.all(np.isnan(out[[6, 7, 9]]))                  # flow angles skipped at RK4 stages

@@ -32,16 +32,16 @@ import yaml
 
 from lvgym.cli.args import parse
 from lvgym.envs.spec import wind_spec
-from lvgym.simulator import Simulator
+from lvgym.simulator import LaunchSpec, Simulator, TimelineSpec
 from lvgym.vehicle.config import VEHICLE_DIR
 
 DEG = math.degrees(1.0)
 FIGURES = Path(__file__).resolve().parents[2] / "docs" / "figures"
 
-STRATOS3 = {"site": "el_arenosillo", "elevation_deg": 85.0, "rail_length": 10.0}
+STRATOS3 = LaunchSpec("el_arenosillo", elevation_deg=85.0, rail_length=10.0)
 STRATOS3_T_END = 30.0            # [s] the StratosIII-v0 mission
 THRUST_DROP = (22.0, 23.0)       # [s] 12.5 kN -> 6 kN in stratos3.yaml's thrust table
-SMILE = {"site": "andoya", "elevation_deg": 90.0, "rail_length": 0.0}
+SMILE = LaunchSpec("andoya", elevation_deg=90.0, rail_length=0.0)
 SMILE_T_END = 60.0
 SMILE_EVENTS = {"burnout": 43.0, "separation": 44.0, "ignition": 45.0}   # [s] smile.yaml
 LATE_GUST = {"model": "gust", "amplitude": 15.0, "length": 200.0, "direction_deg": 270.0, "onset": 12300.0}
@@ -166,7 +166,7 @@ def run_stratos3(model: str, drop_thrust_n: float | None = None, thesis_slosh: b
     winds = list(stratos3_winds().values())
     vehicle = _stratos3_vehicle(drop_thrust_n, thesis_thrust)
     try:
-        sim = Simulator(vehicle, model=model, t_end=STRATOS3_T_END, **STRATOS3)
+        sim = Simulator(vehicle, model, launch=STRATOS3, timeline=TimelineSpec(t_end=STRATOS3_T_END))
     finally:
         if vehicle != "stratos3":
             Path(vehicle).unlink(missing_ok=True)
@@ -179,7 +179,7 @@ def run_smile(model: str, winds: dict[str, Any] | None = None, gimbal_sine: tupl
               t_end: float = SMILE_T_END, dt: float = 0.05) -> dict[str, np.ndarray]:
     """SMILE uncontrolled (or with a gimbal sine), one batch row per wind (default :func:`smile_winds`)."""
     w = list((winds or smile_winds()).values())
-    sim = Simulator("smile", model=model, t_end=SMILE_T_END, **SMILE)
+    sim = Simulator("smile", model, launch=SMILE, timeline=TimelineSpec(t_end=SMILE_T_END))
     sim.reset(batch=len(w), rng=np.random.default_rng(0), winds=w)
     return fly(sim, t_end, dt, gimbal_sine)
 
@@ -289,7 +289,7 @@ def coast_growth(h: dict[str, np.ndarray] | None = None, t0: float = 44.2, t1: f
     ``exp(lambda t)`` with ``lambda = sqrt(|ax| / L)``. Returns per attached tank the fitted growth
     rate [1/s] of the pendulum angle over ``[t0, t1]`` [s], the predicted one and the mean ``ax``."""
     h = h if h is not None else run_smile("nonrigid", {"none": "none"}, t_end=45.0, dt=0.02)
-    sim = Simulator("smile", model="nonrigid", t_end=SMILE_T_END, **SMILE)
+    sim = Simulator("smile", "nonrigid", launch=SMILE, timeline=TimelineSpec(t_end=SMILE_T_END))
     p = sim.timeline.params_at([0.5 * (t0 + t1)])[0]
     sel = (h["t"] >= t0) & (h["t"] <= t1)
     ax = float(h["ax"][sel, 0].mean())
@@ -390,7 +390,7 @@ def figures(out_dir: Path = FIGURES) -> list[Path]:
                   "what-if nonrigid: thrust < drag, 15 kg slosh": (hn2, 0, "C3--")})
     sr, sn = run_smile("rigid"), run_smile("nonrigid")
     tq = float(sn["t"][np.argmax(sn["qbar"][:, 1])])
-    names = Simulator("smile", model="nonrigid", t_end=1.0).timeline.slosh_names
+    names = Simulator("smile", "nonrigid", timeline=TimelineSpec(t_end=1.0)).timeline.slosh_names
     p2 = _figure("SMILE uncontrolled, jet stream 50 m/s at 10.5 km (thesis 6.3.1)", sr, sn, 1,
                  {"max q": tq, **SMILE_EVENTS}, names, out_dir / "uncontrolled_smile.png")
     hist: dict = {}

@@ -27,7 +27,9 @@ modes (:func:`_modes`), the slosh elimination (:func:`_eliminate_pendulum`, per 
 
 Every offset comes from a layout: the state, parameters, loads and speeds from :mod:`.layout`, the
 kernel's own work arrays from ``SLOSH_WORK``, ``WORK_ROWS``, ``RANK_ONE`` and ``ATTITUDES`` there too
-(so the padding switch of :mod:`lvgym.packing` moves them); the scratch is one :data:`DerivWork`. Everything is plain
+(so the padding switch of :mod:`lvgym.packing` moves them); the scratch is one :data:`DerivWork`. The steps
+take a few named blocks: the rigid body's motion (:data:`BodyMotion`), the tilted thrust
+(:data:`GimbalThrust`) and a pendulum's scratch (:data:`PendulumWork`). Everything is plain
 loops over small arrays compiled with numba; a batch is a loop over the same per-vehicle kernel, so
 one code path serves one vehicle and many.
 """
@@ -64,6 +66,18 @@ DerivWork = namedtuple("DerivWork", [
     "slosh",                            # (max(N, 1), SLOSH_WORK.size): rows kept for the back-substitution
     "work",                             # WORK_ROWS rows of max(n_r, 3) columns
 ])
+
+#: the rigid body's motion that the steps of :func:`vehicle_deriv` read: ``C_ib`` (3, 3) the attitude
+#: matrix; ``omega_b`` (3) [rad/s] the body rate, body axes, and ``omega_i`` the same in inertial
+#: components; ``r_cg`` (3) [m] the CG of B (numbers)
+BodyMotion = namedtuple("BodyMotion", ["C_ib", "omega_b", "omega_i", "r_cg"])
+#: the thrust tilted by the mode slope at the gimbal ``f_b`` (3) [N] and the deflected gimbal from the CG
+#: of B ``r_b`` (3) [m], body frame (numbers; :func:`_gimbal_thrust`)
+GimbalThrust = namedtuple("GimbalThrust", ["f_b", "r_b"])
+#: the arrays a pendulum's elimination writes: ``C_is`` (3, 3) its attitude matrix; ``rhs`` (n_r) the
+#: reduced right-hand side; ``h`` (n_r) a row; ``slosh`` the rows kept for the back-substitution and
+#: ``work`` the rank-one terms (:data:`DerivWork`)
+PendulumWork = namedtuple("PendulumWork", ["C_is", "rhs", "h", "slosh", "work"])
 
 
 @nb.njit(cache=True, error_model="numpy")
@@ -213,7 +227,7 @@ def hinge_offset(x, p, j, cg0, cg1, cg2, K, N):
 @nb.njit(cache=True, error_model="numpy", inline="always")
 def _gimbal_thrust(x, p, u, cg0, cg1, cg2, K, N):
     """Thrust tilted by the mode slope at the gimbal and the deflected gimbal from the CG of B
-    (thesis eq. 2.20-2.22), body frame: ``(f0, f1, f2, re0, re1, re2)``."""
+    (thesis eq. 2.20-2.22), body frame: a :data:`GimbalThrust`."""
     o_eta = at(X.eta, K, N)
     o_pg = at(P.phi_gimbal, K, N)
     o_dg = at(P.dphi_gimbal, K, N)
@@ -248,14 +262,18 @@ def _gimbal_thrust(x, p, u, cg0, cg1, cg2, K, N):
     re0 = p[o_gim] - cg0
     re1 = p[o_gim + 1] - cg1 + dy
     re2 = p[o_gim + 2] - cg2 + dz
-    return f0, f1, f2, re0, re1, re2
+    return GimbalThrust((f0, f1, f2), (re0, re1, re2))
 
 
 @nb.njit(cache=True, error_model="numpy", inline="always")
-def _rigid_body(p, u, Cb, w0, w1, w2, f0, f1, f2, re0, re1, re2, K, N, A, rhs):
+def _rigid_body(p, u, body, thrust, K, N, A, rhs):
     """Mass matrix of B (zero elsewhere in ``A``) and the right-hand side of its Newton and Euler
     equations: external force, gravity and thrust (inertial); external moment, gyroscopic term and
-    thrust moment (body)."""
+    thrust moment (body). ``body``: a :data:`BodyMotion`; ``thrust``: a :data:`GimbalThrust`."""
+    Cb = body.C_ib
+    w0, w1, w2 = body.omega_b
+    f0, f1, f2 = thrust.f_b
+    re0, re1, re2 = thrust.r_b
     nr = at(SIZES.speeds, K, N)
     o_v = at(V.v_zw_i, K, N)
     o_w = at(V.omega_bi_b, K, N)
@@ -303,12 +321,18 @@ def _modes(x, p, u, f1, f2, K, N, A, rhs):
 
 
 @nb.njit(cache=True, error_model="numpy", inline="always")
-def _eliminate_pendulum(j, x, p, u, K, N, Cb, Cs, w0, w1, w2, wi0, wi1, wi2, cg0, cg1, cg2, rhs, h, sw, work, nq):
+def _eliminate_pendulum(j, x, p, u, K, N, body, scratch, nq):
     """Eliminate pendulum j by its Schur complement, per unit slosh mass: add its damper's reaction
     torque and ``m B^T C^T z`` to ``rhs``, collect its rank-one terms ``m s n n^T`` (and ``m (1 - s) I``
-    for a slosh body with inertia) in ``work`` from term ``nq`` on, keep in its row ``j`` of ``sw`` what the
-    back-substitution needs (an inactive pendulum, ``m <= 0``, only its mass). Returns the number of
-    terms collected so far."""
+    for a slosh body with inertia) in ``work`` from term ``nq`` on, keep in its row ``j`` of ``slosh`` what
+    the back-substitution needs (an inactive pendulum, ``m <= 0``, only its mass). ``body``: a
+    :data:`BodyMotion`; ``scratch``: a :data:`PendulumWork` (``rhs``, ``h``, ``slosh``, ``work``). Returns the
+    number of terms collected so far."""
+    Cb, Cs = body.C_ib, scratch.C_is
+    w0, w1, w2 = body.omega_b
+    wi0, wi1, wi2 = body.omega_i
+    cg0, cg1, cg2 = body.r_cg
+    rhs, h, sw, work = scratch.rhs, scratch.h, scratch.slosh, scratch.work
     nr = at(SIZES.speeds, K, N)
     o = at(P.slosh, K, N) + j * at(SLOSH_BLOCK, K, N)
     m = p[o + at(S.m, K, N)]
@@ -483,18 +507,21 @@ def vehicle_deriv(x, p, u, xdot, ws):
     w0, w1, w2 = x[o_w], x[o_w + 1], x[o_w + 2]
     o_cg = at(P.r_cg, K, N)
     cg0, cg1, cg2 = p[o_cg], p[o_cg + 1], p[o_cg + 2]
-    # loads, rigid body and modes
-    f0, f1, f2, re0, re1, re2 = _gimbal_thrust(x, p, u, cg0, cg1, cg2, K, N)
-    _rigid_body(p, u, Cb, w0, w1, w2, f0, f1, f2, re0, re1, re2, K, N, A, rhs)
-    _modes(x, p, u, f1, f2, K, N, A, rhs)
-    # slosh pendulums, eliminated one by one; the body rate in inertial components for their dampers
+    # the body rate in inertial components, for the pendulums' dampers
     wi0 = Cb[0, 0] * w0 + Cb[0, 1] * w1 + Cb[0, 2] * w2
     wi1 = Cb[1, 0] * w0 + Cb[1, 1] * w1 + Cb[1, 2] * w2
     wi2 = Cb[2, 0] * w0 + Cb[2, 1] * w1 + Cb[2, 2] * w2
+    body = BodyMotion(Cb, (w0, w1, w2), (wi0, wi1, wi2), (cg0, cg1, cg2))
+    # loads, rigid body and modes
+    thrust = _gimbal_thrust(x, p, u, cg0, cg1, cg2, K, N)
+    _rigid_body(p, u, body, thrust, K, N, A, rhs)
+    _, f1, f2 = thrust.f_b
+    _modes(x, p, u, f1, f2, K, N, A, rhs)
+    # slosh pendulums, eliminated one by one
+    scratch = PendulumWork(Cs, rhs, h, sw, work)
     nq = 0                                  # rank-one terms of A_r collected in work
     for j in range(N):
-        nq = _eliminate_pendulum(j, x, p, u, K, N, Cb, Cs, w0, w1, w2, wi0, wi1, wi2, cg0, cg1, cg2, rhs, h, sw,
-                                 work, nq)
+        nq = _eliminate_pendulum(j, x, p, u, K, N, body, scratch, nq)
     # the reduced system, then the back-substitution
     _solve(A, rhs, work, nq, K, N)
     _kinematics(x, rhs, w0, w1, w2, K, N, xdot)

@@ -21,8 +21,8 @@ f_b``; damping ``rho V S L^2 / 4 (Clp p, Cmq q, Cnr r)``. ``axisymmetric`` table
 damping derivatives are used as tabulated, so give them about the flight's mean CG. Axes are
 clamped at the grid ends. Everything is zero, without NaN, at zero airspeed.
 
-Compiled callers use :func:`aero_loads_k` with ``model.kernel_args() = (p, grid, dims, table)``:
-``p = [kind, S, L, x_ref]``; ``grid`` the axis vectors (Mach, angles in rad, altitude in m) end to
+Compiled callers use :func:`aero_loads_k` with ``model.kernel_args()``, an ``AeroArrays(params, grid,
+dims, table)``: ``params = [kind, S, L, x_ref]``; ``grid`` the axis vectors (Mach, angles in rad, altitude in m) end to
 end; ``dims`` their lengths; ``table`` one row per grid point (C order), columns ``COLUMNS[kind]``.
 """
 
@@ -40,7 +40,8 @@ import numpy as np
 from lvgym.errors import MISSING, ConfigError
 
 from .aerokernels import (FLOW, KIND_AXISYMMETRIC, KIND_TABLES6, P_KIND, P_LREF, P_SREF, P_XREF,  # noqa: F401
-                          aero_loads_at, aero_loads_batch, aero_loads_k, interp_at, interp_k)
+                          AeroArrays, AeroAt, AirData, LoadsAt, TableAt, aero_loads_at, aero_loads_batch,
+                          aero_loads_k, interp_at, interp_k)
 from .registry import register
 
 #: coefficient columns of the table of each kind, in kernel order
@@ -183,9 +184,10 @@ class AeroTables:
             raise ConfigError("table", "non-finite coefficient", "finite numbers", source=source)
         self.table = table
 
-    def kernel_args(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """``(p, grid, dims, table)`` for :func:`aero_loads_k` / :func:`aero_loads_batch`."""
-        return self.params, self.grid, self.dims, self.table
+    def kernel_args(self) -> AeroArrays:
+        """The :data:`~.aerokernels.AeroArrays` ``(params, grid, dims, table)`` for :func:`aero_loads_k` /
+        :func:`aero_loads_batch`."""
+        return AeroArrays(self.params, self.grid, self.dims, self.table)
 
     def coefficients(self, *point: float) -> dict[str, float]:
         """Interpolated coefficients at one grid point ``(mach, angles [rad], ...)``."""
@@ -214,7 +216,7 @@ class AeroTables:
 
         f, m, s = np.zeros((b, 3)), np.zeros((b, 3)), np.zeros((b, len(STATE_FIELDS)))
         aero_loads_batch(rows(v, 3), rows(omega_bi_b, 3), rows(rho, None), rows(speed_of_sound, None),
-                         rows(x_cg, None), rows(altitude, None), *self.kernel_args(), f, m, s)
+                         rows(x_cg, None), rows(altitude, None), self.kernel_args(), f, m, s)
         if v.ndim == 1:
             return f[0], m[0], AeroState(*[s[0, k] for k in range(s.shape[1])])
         return f, m, AeroState(*[s[:, k] for k in range(s.shape[1])])

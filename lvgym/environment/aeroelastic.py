@@ -27,12 +27,14 @@ With ``include_rigid=False`` the body force and moment hold only the elastic par
 deflection-rate terms), to be added to a table model's rigid loads; ``f_eta`` always holds the
 whole distribution, since the rigid angle of attack bends the vehicle too.
 
-Compiled callers use :func:`strip_loads_k` with ``model.kernel_args()``.
+Compiled callers use :func:`strip_loads_k` with ``model.kernel_args()`` (a :data:`StripTable`), the modes
+at the strips and the modal state (a :data:`StripModes`) and the output arrays (a :data:`StripLoads`).
 """
 
 from __future__ import annotations
 
 import math
+from collections import namedtuple
 from typing import Any
 
 import numba as nb
@@ -40,19 +42,30 @@ import numpy as np
 
 from lvgym.errors import ConfigError
 
+#: a strip model's arrays (``kernel_args()``): ``x_strip`` (n) stations [m]; ``mach_grid`` (n_m) and
+#: ``cna_table`` (n_m, n) the strips' CN-alpha shares [1/rad] against Mach (linear, clamped); ``s_ref``
+#: [m^2]; ``include_rigid``: whether ``f_b``, ``m_b`` include the rigid-body crossflow terms
+StripTable = namedtuple("StripTable", ["x_strip", "mach_grid", "cna_table", "s_ref", "include_rigid"])
+#: the bending of one vehicle at the strips: ``phi``, ``dphi`` (K, n) mode shapes [1/sqrt(kg)] and slopes
+#: [1/(m sqrt(kg))] at the strips; ``eta``, ``eta_dot`` (2K) the modal coordinates and rates (y plane, then z)
+StripModes = namedtuple("StripModes", ["phi", "dphi", "eta", "eta_dot"])
+#: what :func:`strip_loads_k` writes: ``f_b`` (3) [N], ``m_b`` (3) [N m], ``f_eta`` (2K), ``df_strip`` (n, 2) [N]
+StripLoads = namedtuple("StripLoads", ["f_b", "m_b", "f_eta", "df_strip"])
+
 
 @nb.njit(cache=True)
-def strip_loads_k(v_air_b, omega_bi_b, rho, sound, x_cg, x_strip, mach_grid, cna_table, s_ref,
-                  phi, dphi, eta, eta_dot, include_rigid, f_b, m_b, f_eta, df_strip):
-    """Strip-theory normal force ``f_b`` [N], moment about the CG ``m_b`` [N m] (body frame, written
-    into 3-vectors) and generalised modal forces ``f_eta`` (2K) of one vehicle; ``df_strip`` (n, 2)
-    receives each strip's force (y, z) [N].
+def strip_loads_k(v_air_b, omega_bi_b, rho, sound, x_cg, strips, modes, loads):
+    """Strip-theory normal force ``loads.f_b`` [N], moment about the CG ``loads.m_b`` [N m] (body frame,
+    written into 3-vectors) and generalised modal forces ``loads.f_eta`` (2K) of one vehicle;
+    ``loads.df_strip`` (n, 2) receives each strip's force (y, z) [N] (a :data:`StripLoads`).
 
-    ``x_strip`` (n) stations [m]; ``mach_grid`` (n_m) and ``cna_table`` (n_m, n) the strips' CN-alpha
-    shares [1/rad] against Mach (linear, clamped); ``s_ref`` [m^2]; ``phi``, ``dphi`` (K, n) mode
-    shapes [1/sqrt(kg)] and slopes [1/(m sqrt(kg))] at the strips; ``eta``, ``eta_dot`` (2K);
-    ``include_rigid``: whether ``f_b``, ``m_b`` include the rigid-body crossflow terms.
+    ``v_air_b`` (3) [m/s], ``omega_bi_b`` (3) [rad/s], ``rho`` [kg/m^3], ``sound`` [m/s], ``x_cg`` CG
+    station [m]; ``strips`` the model's :data:`StripTable`; ``modes`` the :data:`StripModes` (shapes and
+    slopes at the strips, modal coordinates and rates).
     """
+    x_strip, mach_grid, cna_table, s_ref, include_rigid = strips
+    phi, dphi, eta, eta_dot = modes
+    f_b, m_b, f_eta, df_strip = loads
     n_k = phi.shape[0]
     u, v, w = v_air_b[0], v_air_b[1], v_air_b[2]
     speed = math.sqrt(u * u + v * v + w * w)
@@ -99,13 +112,13 @@ def strip_loads_k(v_air_b, omega_bi_b, rho, sound, x_cg, x_strip, mach_grid, cna
 
 
 @nb.njit(cache=True)
-def strip_loads_batch(v_air_b, omega_bi_b, rho, sound, x_cg, x_strip, mach_grid, cna_table, s_ref,
-                      phi, dphi, eta, eta_dot, include_rigid, f_b, m_b, f_eta, df_strip):
-    """:func:`strip_loads_k` over a leading batch axis (``phi``, ``dphi`` per vehicle: (B, K, n))."""
+def strip_loads_batch(v_air_b, omega_bi_b, rho, sound, x_cg, strips, modes, loads):
+    """:func:`strip_loads_k` over a leading batch axis (``strips`` shared; every array of ``modes`` and
+    ``loads`` per vehicle: ``phi``, ``dphi`` (B, K, n))."""
     for b in range(v_air_b.shape[0]):
-        strip_loads_k(v_air_b[b], omega_bi_b[b], rho[b], sound[b], x_cg[b], x_strip, mach_grid,
-                      cna_table, s_ref, phi[b], dphi[b], eta[b], eta_dot[b], include_rigid,
-                      f_b[b], m_b[b], f_eta[b], df_strip[b])
+        strip_loads_k(v_air_b[b], omega_bi_b[b], rho[b], sound[b], x_cg[b], strips,
+                      StripModes(modes.phi[b], modes.dphi[b], modes.eta[b], modes.eta_dot[b]),
+                      StripLoads(loads.f_b[b], loads.m_b[b], loads.f_eta[b], loads.df_strip[b]))
 
 
 def resample_modes(x_strip: Any, x_nodes: Any, phi_nodes: Any, dphi_nodes: Any
@@ -141,8 +154,8 @@ class StripAeroelastic:
         Whether the body force and moment include the rigid-body terms (True) or only the elastic
         increment (False); ``f_eta`` always uses the whole distribution.
 
-    Compiled callers: :func:`strip_loads_k` with :meth:`kernel_args` (``x_strip, mach_grid,
-    cna_table, s_ref, phi, dphi, include_rigid``).
+    Compiled callers: :func:`strip_loads_k` with :meth:`kernel_args` (a :data:`StripTable`) and the
+    modes at the strips (:attr:`phi`, :attr:`dphi`, or the vehicle's of the moment).
     """
 
     def __init__(self, x_strip: Any, width: Any, cna_per_m: Any, ref_area: float, phi: Any = None,
@@ -183,10 +196,9 @@ class StripAeroelastic:
             raise ConfigError("dphi", arrays[1].shape, f"the shape of phi, {arrays[0].shape}")
         return arrays[0], arrays[1]
 
-    def kernel_args(self) -> tuple[Any, ...]:
-        """``(x_strip, mach_grid, cna_table, s_ref, phi, dphi, include_rigid)`` for the kernel."""
-        return (self.x_strip, self.mach_grid, self.cna_table, self.ref_area, self.phi, self.dphi,
-                self.include_rigid)
+    def kernel_args(self) -> StripTable:
+        """The :data:`StripTable` ``(x_strip, mach_grid, cna_table, s_ref, include_rigid)`` for the kernel."""
+        return StripTable(self.x_strip, self.mach_grid, self.cna_table, self.ref_area, self.include_rigid)
 
     def cn_alpha(self, mach: float = 0.0) -> float:
         """Sum of the strips' normal-force slopes [1/rad] at Mach ``mach``."""
@@ -216,10 +228,9 @@ class StripAeroelastic:
                 raise ConfigError("loads argument", a.shape, f"broadcastable to {shape}") from None
 
         f, m, fe, df = np.zeros((b, 3)), np.zeros((b, 3)), np.zeros((b, 2 * k)), np.zeros((b, n, 2))
+        modes = StripModes(rows(ph, (b, k, n)), rows(dph, (b, k, n)), rows(eta, (b, 2 * k)), rows(eta_dot, (b, 2 * k)))
         strip_loads_batch(rows(v, (b, 3)), rows(omega_bi_b, (b, 3)), rows(rho, (b,)),
-                          rows(speed_of_sound, (b,)), rows(x_cg, (b,)), self.x_strip, self.mach_grid,
-                          self.cna_table, self.ref_area, rows(ph, (b, k, n)), rows(dph, (b, k, n)),
-                          rows(eta, (b, 2 * k)), rows(eta_dot, (b, 2 * k)), self.include_rigid,
-                          f, m, fe, df)
+                          rows(speed_of_sound, (b,)), rows(x_cg, (b,)), self.kernel_args(), modes,
+                          StripLoads(f, m, fe, df))
         out = (f, m, fe, df) if strips else (f, m, fe)
         return tuple(a[0] for a in out) if v.ndim == 1 else out

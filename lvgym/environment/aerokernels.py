@@ -1,14 +1,17 @@
 """Compiled kernels of the aerodynamic tables (:mod:`.aerodynamics` documents the models and re-exports
 these): multilinear table interpolation and the aerodynamic force and moment of either table kind.
 
-:func:`aero_loads_k` takes the model's ``kernel_args() = (p, grid, dims, table)``; :func:`aero_loads_at`
-is the same kernel reading those arrays in place from packed arrays at given offsets (the simulator's
-context), without array views or allocation, which is what the flight loads call at every RK4 stage.
+:func:`aero_loads_k` takes the model's ``kernel_args()``, an :data:`AeroArrays`; :func:`aero_loads_at`
+is the same kernel reading those arrays in place from packed arrays at given offsets (an :data:`AeroAt`:
+the simulator's context), without array views or allocation, which is what the flight loads call at
+every RK4 stage. The kernels take a few named blocks: the air data (:data:`AirData`), the model's arrays
+and where the loads go (:data:`LoadsAt`).
 """
 
 from __future__ import annotations
 
 import math
+from collections import namedtuple
 
 import numba as nb
 import numpy as np
@@ -32,11 +35,30 @@ _FL = FLOW.at
 KIND_AXISYMMETRIC, KIND_TABLES6 = 0.0, 1.0
 P_KIND, P_SREF, P_LREF, P_XREF = 0, 1, 2, 3
 
+#: a table model's arrays (``kernel_args()``): ``params`` ``[kind, S [m^2], L [m], x_ref [m]]``, ``grid`` the
+#: axes end to end, ``dims`` their lengths, ``table`` (rows of the grid points, row major; a column per
+#: coefficient)
+AeroArrays = namedtuple("AeroArrays", ["params", "grid", "dims", "table"])
+#: a table read in place from packed arrays: the axes at ``grid[o_grid:]``, their ``n_dims`` lengths at
+#: ``dims[o_dims:]`` (integers or whole floats), the table row major with ``n_col`` columns at ``table[o_table:]``
+TableAt = namedtuple("TableAt", ["grid", "o_grid", "dims", "o_dims", "n_dims", "table", "o_table", "n_col"])
+#: a table model read in place: its ``params`` (as :data:`AeroArrays`) at ``params[o_params:]`` and its
+#: :data:`TableAt` ``table``
+AeroAt = namedtuple("AeroAt", ["params", "o_params", "table"])
+#: the air data of one evaluation (numbers): ``v_air_b`` (u, v, w) [m/s] the velocity relative to the air,
+#: body axes; ``omega_bi_b`` (3) [rad/s]; ``rho`` [kg/m^3]; ``sound`` speed of sound [m/s]; ``x_cg`` CG
+#: station [m]; ``alt`` altitude [m] (only for ``tables6`` with an altitude axis; anything otherwise)
+AirData = namedtuple("AirData", ["v_air_b", "omega_bi_b", "rho", "sound", "x_cg", "alt"])
+#: where :func:`aero_loads_at` writes into its output array: the offsets of the force ``f_b`` (3), the
+#: moment ``m_b`` (3) and the flow state ``flow`` (layout :data:`FLOW`)
+LoadsAt = namedtuple("LoadsAt", ["f_b", "m_b", "flow"])
+
 
 @nb.njit(cache=True)
-def interp_at(grid, og, dims, od, nd, table, ot, ncol, q, out):
-    """:func:`interp_k` on arrays read in place: the axes at ``grid[og:]``, their ``nd`` lengths at
-    ``dims[od:]``, the table row major with ``ncol`` columns at ``table[ot:]`` (packed arrays)."""
+def interp_at(tab, q, out):
+    """:func:`interp_k` on the table ``tab`` (a :data:`TableAt`) read in place from packed arrays."""
+    grid, og, dims, od, nd = tab.grid, tab.o_grid, tab.dims, tab.o_dims, tab.n_dims
+    table, ot, ncol = tab.table, tab.o_table, tab.n_col
     idx = np.zeros(nd, np.int64)
     wgt = np.zeros(nd)
     stride = np.ones(nd, np.int64)
@@ -79,7 +101,7 @@ def interp_k(grid, dims, table, q, out):
     """Multilinear interpolation of every column of ``table`` at the point ``q`` (one value per
     axis), clamped to the grid; axes of length 1 are constant. Writes ``out[:table.shape[1]]``."""
     # dims may be integers or whole floats (a packed context)
-    interp_at(grid, 0, dims, 0, dims.shape[0], table.ravel(), 0, table.shape[1], q, out)
+    interp_at(TableAt(grid, 0, dims, 0, dims.shape[0], table.ravel(), 0, table.shape[1]), q, out)
 
 
 @nb.njit(cache=True, inline="always")
@@ -94,10 +116,11 @@ def _axis_k(grid, off, n, x):
 
 
 @nb.njit(cache=True, inline="always")
-def _axisymmetric_k(grid, og, dims, od, table, ot, nc, mach, alpha_t, x_ref, x_cg, l_ref):
-    """``CA, CN, Cm, Cmq, Clp`` of an axisymmetric table (read in place as in :func:`interp_at`) at
-    (Mach, total angle of attack), with Cmq moved from ``x_ref`` to the CG (see the module
-    docstring); bilinear, without allocation (the same values as :func:`interp_k`)."""
+def _axisymmetric_k(tab, mach, alpha_t, x_ref, x_cg, l_ref):
+    """``CA, CN, Cm, Cmq, Clp`` of an axisymmetric table (a :data:`TableAt`, read in place) at (Mach,
+    total angle of attack), with Cmq moved from ``x_ref`` to the CG (see the module docstring);
+    bilinear, without allocation (the same values as :func:`interp_k`)."""
+    grid, og, dims, od, table, ot, nc = tab.grid, tab.o_grid, tab.dims, tab.o_dims, tab.table, tab.o_table, tab.n_col
     nm, na = int(dims[od]), int(dims[od + 1])
     i0, i1, wm = _axis_k(grid, og, nm, mach)
     j0, j1, wa = _axis_k(grid, og + nm, na, alpha_t)
@@ -121,13 +144,17 @@ def _axisymmetric_k(grid, og, dims, od, table, ot, nc, mach, alpha_t, x_ref, x_c
 
 
 @nb.njit(cache=True, inline="always")
-def aero_loads_at(u, v, w, p0, p1, p2, rho, sound, x_cg, alt, p, op, grid, og, dims, od, nd, table, ot, nc, out,
-                  of, om, os, full):
-    """:func:`aero_loads_k` on arrays read in place: ``v_air_b = (u, v, w)``, ``omega_bi_b = (p0, p1,
-    p2)``; the parameters at ``p[op:]``, the table arrays as :func:`interp_at`; writes ``f_b``,
-    ``m_b``, ``state`` into ``out[of:of + 3]``, ``out[om:om + 3]``, ``out[os:os + 7]`` (with ``full``
+def aero_loads_at(air, model, out, dest, full):
+    """:func:`aero_loads_k` on arrays read in place: the air data ``air`` (an :data:`AirData`), the model
+    ``model`` (an :data:`AeroAt`); writes ``f_b``, ``m_b``, ``state`` into ``out`` at the offsets ``dest``
+    (a :data:`LoadsAt`: ``out[f_b:f_b + 3]``, ``out[m_b:m_b + 3]``, ``out[flow:flow + 7]``; with ``full``
     false, alpha, beta and phi_a are not written: no load depends on them). The axisymmetric kind
     allocates nothing."""
+    u, v, w = air.v_air_b
+    p0, p1, p2 = air.omega_bi_b
+    rho, sound, x_cg = air.rho, air.sound, air.x_cg
+    p, op, tab = model.params, model.o_params, model.table
+    of, om, os = dest.f_b, dest.m_b, dest.flow
     vperp = math.sqrt(v * v + w * w)
     speed = math.sqrt(u * u + vperp * vperp)
     alpha_t = math.atan2(vperp, u)
@@ -137,8 +164,7 @@ def aero_loads_at(u, v, w, p0, p1, p2, rho, sound, x_cg, alt, p, op, grid, og, d
     qs = qbar * s_ref
     kd = 0.25 * rho * speed * s_ref * l_ref * l_ref          # damping: qbar S L * L / (2 V)
     if p[op + P_KIND] == KIND_AXISYMMETRIC:
-        ca, cn, cm, cmq, clp = _axisymmetric_k(grid, og, dims, od, table, ot, nc, mach, alpha_t, p[op + P_XREF],
-                                               x_cg, l_ref)
+        ca, cn, cm, cmq, clp = _axisymmetric_k(tab, mach, alpha_t, p[op + P_XREF], x_cg, l_ref)
         sp, cp = (v / vperp, w / vperp) if vperp > 0.0 else (0.0, 1.0)
         out[of] = -qs * ca
         out[of + 1] = -qs * cn * sp
@@ -147,9 +173,9 @@ def aero_loads_at(u, v, w, p0, p1, p2, rho, sound, x_cg, alt, p, op, grid, og, d
         out[om + 1] = qs * l_ref * cm * cp + kd * cmq * p1
         out[om + 2] = -qs * l_ref * cm * sp + kd * cmq * p2
     else:
-        c = np.zeros(nc)
-        q = np.array([mach, math.atan2(w, u), math.atan2(v, math.sqrt(u * u + w * w)), alt])
-        interp_at(grid, og, dims, od, nd, table, ot, nc, q, c)
+        c = np.zeros(tab.n_col)
+        q = np.array([mach, math.atan2(w, u), math.atan2(v, math.sqrt(u * u + w * w)), air.alt])
+        interp_at(tab, q, c)
         out[of] = -qs * c[0]
         out[of + 1] = qs * c[1]
         out[of + 2] = -qs * c[2]
@@ -170,19 +196,22 @@ def aero_loads_at(u, v, w, p0, p1, p2, rho, sound, x_cg, alt, p, op, grid, og, d
 
 
 @nb.njit(cache=True)
-def aero_loads_k(v_air_b, omega_bi_b, rho, sound, x_cg, alt, p, grid, dims, table, f_b, m_b, state):
+def aero_loads_k(v_air_b, omega_bi_b, rho, sound, x_cg, alt, model, f_b, m_b, state):
     """Aerodynamic force ``f_b`` [N] and moment about the CG ``m_b`` [N m] (body frame) of either
     table kind, written into the 3-vectors ``f_b``, ``m_b``; ``state`` (7) receives alpha, beta,
     alpha_t, phi_a [rad], Mach [-], qbar [Pa], airspeed [m/s].
 
     ``v_air_b`` (3) [m/s] vehicle velocity relative to the air, body axes; ``omega_bi_b`` (3)
     [rad/s]; ``rho`` [kg/m^3]; ``sound`` speed of sound [m/s]; ``x_cg`` CG station [m]; ``alt``
-    altitude [m] (only for ``tables6`` with an altitude axis; anything otherwise).
+    altitude [m] (only for ``tables6`` with an altitude axis; anything otherwise); ``model`` the
+    model's :data:`AeroArrays` (``kernel_args()``).
     """
     out = np.empty(13)
-    aero_loads_at(v_air_b[0], v_air_b[1], v_air_b[2], omega_bi_b[0], omega_bi_b[1], omega_bi_b[2], rho, sound,
-                  x_cg, alt, p, 0, grid, 0, dims, 0, dims.shape[0], table.ravel(), 0, table.shape[1], out, 0, 3, 6,
-                  True)
+    p, grid, dims, table = model
+    air = AirData((v_air_b[0], v_air_b[1], v_air_b[2]), (omega_bi_b[0], omega_bi_b[1], omega_bi_b[2]), rho, sound,
+                  x_cg, alt)
+    tab = TableAt(grid, 0, dims, 0, dims.shape[0], table.ravel(), 0, table.shape[1])
+    aero_loads_at(air, AeroAt(p, 0, tab), out, LoadsAt(0, 3, 6), True)
     for i in range(3):
         f_b[i] = out[i]
         m_b[i] = out[3 + i]
@@ -191,8 +220,7 @@ def aero_loads_k(v_air_b, omega_bi_b, rho, sound, x_cg, alt, p, grid, dims, tabl
 
 
 @nb.njit(cache=True)
-def aero_loads_batch(v_air_b, omega_bi_b, rho, sound, x_cg, alt, p, grid, dims, table, f_b, m_b, state):
-    """:func:`aero_loads_k` over a leading batch axis of every per-vehicle argument."""
+def aero_loads_batch(v_air_b, omega_bi_b, rho, sound, x_cg, alt, model, f_b, m_b, state):
+    """:func:`aero_loads_k` over a leading batch axis of every per-vehicle argument (``model`` shared)."""
     for j in range(v_air_b.shape[0]):
-        aero_loads_k(v_air_b[j], omega_bi_b[j], rho[j], sound[j], x_cg[j], alt[j], p, grid, dims,
-                     table, f_b[j], m_b[j], state[j])
+        aero_loads_k(v_air_b[j], omega_bi_b[j], rho[j], sound[j], x_cg[j], alt[j], model, f_b[j], m_b[j], state[j])

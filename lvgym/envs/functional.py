@@ -37,7 +37,8 @@ import numpy as np
 from gymnasium import spaces
 from gymnasium.experimental.functional import FuncEnv
 
-from lvgym.simulator import SimData, Simulator, Timeline, aeroelastic_strips, build_timeline
+from lvgym.simulator import (EnvironmentSpec, LaunchSpec, PhysicsSpec, SimData, Simulator, Timeline, aeroelastic_strips,
+                             build_timeline)
 from lvgym.simulator import data as simdata
 from lvgym.simulator.core import Kernel
 from lvgym.simulator.imu import Imu
@@ -146,10 +147,9 @@ class AscentFuncEnv(FuncEnv):
         n_s = tl.sensor_stations.size
         imu = (Imu(self.imu, 0, s.gyro_bandwidth_hz, s.gyro_damping, s.antialias_hz,
                    probes=tuple(range(n_s - len(probes), n_s))) if s.observation == "flight" else None)
-        self.sim = Simulator(vehicle, s.model, site=s.site, elevation_deg=s.elevation_deg,
-                             rail_length=s.rail_length_m, physics_dt=s.physics_dt_s, timeline=tl, servo=servo,
-                             aeroelastic=s.aeroelastic, mode_basis=s.mode_basis, slosh_frequency=s.slosh_frequency,
-                             imu=imu)
+        self.sim = Simulator(vehicle, s.model, launch=LaunchSpec(s.site, s.elevation_deg, s.rail_length_m),
+                             environment=EnvironmentSpec(aeroelastic=s.aeroelastic), timeline=tl,
+                             physics=PhysicsSpec(s.physics_dt_s, s.slosh_frequency), servo=servo, imu=imu)
         self.n_steps = int(round(s.mission_time_s / s.control_dt_s))
         #: the layout of one sample of the observation mode (the observation itself without ``history``)
         self.sample_layout = OBSERVATIONS[s.observation]

@@ -88,11 +88,16 @@ def attitude_error_k(C, a, out):
 
 
 @nb.njit(cache=True, nogil=True)
-def observe_k(task, t, x, cond, act, C, a, on, ref_pitch, bias, dphi, mass, n_slosh, n_modes, obs, att):
-    """Noise-free observation of one row into ``obs`` (layout OBS_STATE or OBS_SENSORS) and its
-    attitude error into ``att``. ``dphi`` (K,): mode slopes at the IMU (sensors only); ``mass`` [kg] of
-    the whole stack."""
-    attitude_error_k(C, a, att)
+def observe_k(task, setup, sim, ts, b, C, ref_pitch, dphi, mass):
+    """Noise-free observation of row ``b`` into ``ts.obs[b]`` (layout OBS_STATE or OBS_SENSORS) and its
+    attitude error into ``ts.att[b]``, from the simulator's row ``b`` of ``sim``, the reference axis
+    ``ts.axis_ref_i[b]``, the controller flag ``ts.on[b]`` and the gyro bias ``ts.gyro_bias[b]``. ``C``:
+    ``C_ib`` of the row; ``ref_pitch`` [rad/s] the reference pitch rate; ``dphi`` (K,): mode slopes at the
+    IMU (sensors only); ``mass`` [kg] of the whole stack."""
+    t, x, cond, act = sim.t[b], sim.x[b], sim.conditions[b], sim.actuator[b]
+    on, bias, obs, att = ts.on[b], ts.gyro_bias[b], ts.obs[b], ts.att[b]
+    n_slosh, n_modes = setup.n_slosh, setup.n_modes
+    attitude_error_k(C, ts.axis_ref_i[b], att)
     ow = XF.omega_bi_b
     w0, w1, w2 = x[ow], x[ow + 1], x[ow + 2]
     if task[T.sensors] != 0.0:
@@ -162,9 +167,7 @@ def reset_signals(rows, task, setup, sim, ts, tables):
         ts.mass[b] = mass
         ts.stage[b] = int(tables.stage[j])
         ref_pitch = reference_pitch_rate_k(task, setup.rail[RL.omega_e], t, xb, sim.conditions[b])
-        observe_k(task, t, xb, sim.conditions[b], sim.actuator[b], C, ts.axis_ref_i[b], ts.on[b],
-                  ref_pitch, ts.gyro_bias[b], tables.dphi_sensor[j, 0],
-                  mass, setup.n_slosh, setup.n_modes, ts.obs[b], ts.att[b])
+        observe_k(task, setup, sim, ts, b, C, ref_pitch, tables.dphi_sensor[j, 0], mass)
         if task[T.flight] != 0.0:
             for i in range(4):
                 ts.nav[b, NV.q_nav + i] = xb[oq + i]
@@ -216,8 +219,7 @@ def step_signals_range(lo, hi, task, setup, sim, ts, tables):
         j, mass = _imu_and_mass_k(tables, t)
         ts.mass[b] = mass
         ts.stage[b] = int(tables.stage[j])
-        observe_k(task, t, xb, cond, act, C, a, ts.on[b], ref_pitch, ts.gyro_bias[b], tables.dphi_sensor[j, 0], mass,
-                  setup.n_slosh, setup.n_modes, ts.obs[b], ts.att[b])
+        observe_k(task, setup, sim, ts, b, C, ref_pitch, tables.dphi_sensor[j, 0], mass)
         if task[T.flight] != 0.0 and not failed:
             flight_observe_k(task, setup, sim, ts, b, a, ref_pitch, False, C)
         qalpha = cond[D.qbar] * math.degrees(cond[D.alpha_total])

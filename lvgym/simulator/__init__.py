@@ -1,7 +1,8 @@
 """Simulator layer: the vehicle, its environment and the dynamics core flown together (no rewards, no
-spaces). :class:`Simulator` steps a batch whose state is one :class:`SimData` value; :class:`Timeline`
-tabulates the mass model and modes; :mod:`.flight` holds the compiled loads (:mod:`.strips` their aeroelastic part); :mod:`.layouts` describes
-every packed vector; :mod:`.record` records, saves and plots trajectories."""
+spaces). :class:`Simulator` (built from the frozen specs of :mod:`.spec`) steps a batch whose state is one
+:class:`SimData` value; :class:`Timeline` tabulates the mass model and modes; :mod:`.flight` holds the
+compiled loads (:mod:`.strips` their aeroelastic part); :mod:`.layouts` describes every packed vector;
+:mod:`.record` records, saves and plots trajectories."""
 
 from .core import SITES, Kernel, Simulator, aeroelastic_strips
 from .data import SimData
@@ -9,7 +10,9 @@ from .flight import flight_conditions_batch, flight_loads, pack_context
 from .layouts import CONDITIONS, CONTEXT
 from .piece import SLOSH_FREQUENCIES
 from .record import Recorder, fly, load
+from .spec import EnvironmentSpec, LaunchSpec, PhysicsSpec, TimelineSpec
 from .timeline import MODE_BASES, MODELS, Tables, Timeline, build_timeline
 
-__all__ = ["CONDITIONS", "aeroelastic_strips", "CONTEXT", "Kernel", "MODE_BASES", "MODELS", "Recorder", "SLOSH_FREQUENCIES", "SITES", "SimData", "Simulator", "Tables",
-           "Timeline", "build_timeline", "fly", "flight_conditions_batch", "flight_loads", "load", "pack_context"]
+__all__ = ["CONDITIONS", "aeroelastic_strips", "CONTEXT", "EnvironmentSpec", "Kernel", "LaunchSpec", "MODE_BASES",
+           "MODELS", "PhysicsSpec", "Recorder", "SLOSH_FREQUENCIES", "SITES", "SimData", "Simulator", "Tables",
+           "TimelineSpec", "Timeline", "build_timeline", "fly", "flight_conditions_batch", "flight_loads", "load", "pack_context"]

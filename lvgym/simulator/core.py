@@ -3,10 +3,12 @@
 :class:`Simulator` composes a vehicle file (mass model, staging, bending modes, through a
 :class:`~.timeline.Timeline`), the environment models (launch site, gravity, atmosphere, wind,
 aerodynamics, through the compiled :mod:`.flight` loads) and the dynamics core, for one vehicle or a
-batch of them that may be at different times. It knows nothing of rewards or observation spaces.
+batch of them that may be at different times. It knows nothing of rewards or observation spaces. Besides
+the vehicle and the model it takes four frozen specs (:mod:`.spec`): the launch (site, rail), the
+environment's models, what the timeline tabulates (or a prebuilt timeline) and how the physics is stepped.
 
->>> from lvgym.simulator import Simulator
->>> sim = Simulator("stratos3", model="rigid", t_end=5.0)
+>>> from lvgym.simulator import Simulator, TimelineSpec
+>>> sim = Simulator("stratos3", "rigid", timeline=TimelineSpec(t_end=5.0))
 >>> sim.reset()
 >>> events = sim.step([[0.0, 0.0]], 1.0)        # gimbal (pitch, yaw) [rad] held for 1 s
 >>> bool(sim.conditions("altitude")[0] > 10.0)
@@ -42,7 +44,7 @@ import numpy as np
 
 from lvgym.environment import LaunchSite, make
 from lvgym.environment.earth import WGS84_OMEGA, dcm_to_quat
-from lvgym.errors import check_choice
+from lvgym.errors import ConfigError, check_choice
 from lvgym.rotations import quat_to_dcm_batch
 from lvgym.vehicle import MassModel, Vehicle, load_vehicle
 
@@ -54,20 +56,13 @@ from .imu import IMU_OFF, Imu
 from .layouts import ACTUATOR, CONDITIONS, CONTEXT, DISPERSION, IMU_STATE, RAIL, RAIL_STATE, RS
 from .piece import SLOSH_FREQUENCIES
 from .servo import DIRECT, Servo
+from .spec import SITES, EnvironmentSpec, LaunchSpec, PhysicsSpec, TimelineSpec
 from .strips import StripSetup, strip_stations
 from .threads import ROWS_PER_THREAD, Kernel, default_threads, pool
 from .timeline import MODELS, Timeline, build_timeline
 from .vehicleaero import aeroelastic_strips, stage_aerodynamics, vehicle_strips
 
 _ADVANCE, _SLOSH = Kernel(advance_range), Kernel(slosh_angles_range)
-
-
-#: launch sites of the shipped vehicles (published coordinates of the ranges); azimuth clockwise from north
-SITES = {
-    "andoya": LaunchSite(latitude_deg=69.2943, longitude_deg=16.0205, altitude_m=10.0, azimuth_deg=0.0),
-    "el_arenosillo": LaunchSite(latitude_deg=37.0970, longitude_deg=-6.7350, altitude_m=20.0, azimuth_deg=225.0),
-    "flat": LaunchSite(latitude_deg=0.0, longitude_deg=0.0, altitude_m=0.0, azimuth_deg=90.0, flat_earth=True),
-}
 
 
 def dcm_batch(q: np.ndarray) -> np.ndarray:
@@ -84,86 +79,64 @@ class Simulator:
     ----------
     vehicle: a shipped vehicle name, a YAML path or a :class:`~lvgym.vehicle.Vehicle`.
     model: ``rigid``, ``slosh``, ``flex`` or ``nonrigid`` (see :mod:`.timeline`).
-    site: a :class:`LaunchSite` or a key of :data:`SITES` (default ``andoya``).
-    gravity, atmosphere, wind: names or mappings for :func:`lvgym.environment.make`, or models; the wind
-        may also be given per row at :meth:`reset`.
-    aerodynamics: ``"vehicle"`` (the vehicle file's ``aerodynamics`` section), a name/mapping/model, or
-        None (no aerodynamic loads).
-    t_end: mission time [s] tabulated by the timeline; physics_dt: largest RK4 step [s].
-    elevation_deg: rail elevation above the horizon [deg] (90: vertical); rail_length [m].
-    n_modes: bending modes per plane (default: the vehicle file's; modes above the Nyquist frequency of
-        the RK4 step, ``1 / (2 physics_dt)``, are decoupled, see :func:`.timeline.build_timeline`);
-        sensor_stations [m]: where the mode slopes are tabulated (an IMU); cg_convention: ``static`` or
-        ``thesis``; timeline_dt [s]; timeline: a prebuilt :class:`Timeline` to share between simulators
+    launch: a :class:`~.spec.LaunchSpec` (site, rail elevation and length; default Andoya, vertical, no rail).
+    environment: an :class:`~.spec.EnvironmentSpec` (gravity, atmosphere, wind, aerodynamic models, the
+        aeroelastic strip loads).
+    timeline: a :class:`~.spec.TimelineSpec` (what to tabulate: mission time, modes, sensor stations, ...),
+        or a prebuilt :class:`Timeline` to share between simulators, whose options are then the simulator's
         (with the aeroelastic loads on, built with :func:`aeroelastic_strips`' stations).
-    aeroelastic: the strip-theory aeroelastic loads (:mod:`.strips`): True, False or None (the vehicle
-        file's ``structure.aeroelastic``). They act only on a model with bending modes and aerodynamics;
-        the v0 envs pass False.
-    mode_interval [s]: recompute the modes also every so many seconds (None: the vehicle file's setting);
-        mode_basis: ``held`` (v0: the modal coordinates kept as numbers across a change of the modes) or
-        ``projected`` (the deflection field kept, see :mod:`.timeline`); with a prebuilt ``timeline`` they
-        must be its own (``mode_interval`` None or equal).
-    slosh_frequency: the pendulums' damper frequency, ``vacuum_thrust`` (v0: ``sqrt(T_0 / m / L)`` from the
-        timeline's vacuum thrust) or ``specific_force`` (``sqrt(|a_x| / L)`` from the axial specific force,
-        thrust at ambient pressure plus the aerodynamic axial force over the mass, of the row's latest
-        flight conditions; see :mod:`.piece`).
-    imu: an :class:`~.imu.Imu` (its ``sensor`` indexes ``sensor_stations``) whose gyro and accelerometer
-        filters are advanced at every physics step into ``data.imu`` (default None: no IMU; a step must
-        then last a whole number of ``physics_dt``).
+    physics: a :class:`~.spec.PhysicsSpec` (largest RK4 step, slosh damper frequency, threads).
+    servo: a :class:`~.servo.Servo` moving the gimbal at every physics step (default None: the gimbal takes
+        the command at once).
+    imu: an :class:`~.imu.Imu` (its ``sensor`` indexes the timeline's sensor stations) whose gyro and
+        accelerometer filters are advanced at every physics step into ``data.imu`` (default None: no IMU; a
+        step must then last a whole number of ``physics_dt``).
     """
 
-    def __init__(self, vehicle: str | Vehicle = "smile", model: str = "nonrigid", *, site: Any = "andoya",
-                 gravity: Any = "egm2008", atmosphere: Any = "us76", wind: Any = "none", aerodynamics: Any = "vehicle",
-                 t_end: float = 60.0, physics_dt: float = 0.01, elevation_deg: float = 90.0, rail_length: float = 0.0,
-                 n_modes: int | None = None, sensor_stations: Sequence[float] = (), cg_convention: str = "static",
-                 timeline_dt: float = 0.05, timeline: Timeline | None = None, servo: Servo | None = None,
-                 threads: int | None = None, aeroelastic: bool | None = None, mode_interval: float | None = None,
-                 mode_basis: str = "held", slosh_frequency: str = "vacuum_thrust", imu: Imu | None = None) -> None:
-        if model not in MODELS:
-            raise ValueError(f"model = {model!r}: one of {MODELS}")
-        if not 0.0 < physics_dt <= 0.1:
-            raise ValueError(f"physics_dt = {physics_dt!r}: a step in (0, 0.1] s")
-        if not 0.0 < elevation_deg <= 90.0:
-            raise ValueError(f"elevation_deg = {elevation_deg!r}: in (0, 90] deg")
-        if not rail_length >= 0.0:
-            raise ValueError(f"rail_length = {rail_length!r}: a length >= 0 m")
+    def __init__(self, vehicle: str | Vehicle = "smile", model: str = "nonrigid", *,
+                 launch: LaunchSpec = LaunchSpec(), environment: EnvironmentSpec = EnvironmentSpec(),
+                 timeline: TimelineSpec | Timeline = TimelineSpec(), physics: PhysicsSpec = PhysicsSpec(),
+                 servo: Servo | None = None, imu: Imu | None = None) -> None:
+        check_choice("model", model, MODELS)
+        for key, value, kinds in (("launch", launch, (LaunchSpec,)), ("environment", environment, (EnvironmentSpec,)),
+                                  ("timeline", timeline, (TimelineSpec, Timeline)),
+                                  ("physics", physics, (PhysicsSpec,))):
+            if not isinstance(value, kinds):
+                raise ConfigError(key, value, "a " + " or a ".join(k.__name__ for k in kinds))
+        self.launch, self.environment, self.physics = launch, environment, physics
         self.vehicle = vehicle if isinstance(vehicle, Vehicle) else load_vehicle(vehicle)
         self.model = model
-        if isinstance(site, str):
-            if site not in SITES:
-                raise ValueError(f"site = {site!r}: one of {sorted(SITES)} or a LaunchSite")
-            site = SITES[site]
-        self.site: LaunchSite = site
-        self.gravity = make("gravity", gravity) if isinstance(gravity, (str, dict)) else gravity
-        self.atmosphere = make("atmosphere", atmosphere) if isinstance(atmosphere, (str, dict)) else atmosphere
-        self.wind = wind
-        self.stage_aerodynamics = stage_aerodynamics(self.vehicle, aerodynamics)
+        self.site: LaunchSite = launch.launch_site()
+        env = environment
+        self.gravity = make("gravity", env.gravity) if isinstance(env.gravity, (str, dict)) else env.gravity
+        self.atmosphere = (make("atmosphere", env.atmosphere) if isinstance(env.atmosphere, (str, dict))
+                           else env.atmosphere)
+        self.wind = env.wind
+        self.stage_aerodynamics = stage_aerodynamics(self.vehicle, env.aerodynamics)
         self.aerodynamics = self.stage_aerodynamics[0]
-        if aeroelastic not in (None, True, False):
-            raise ValueError(f"aeroelastic = {aeroelastic!r}: True, False or None (the vehicle file's)")
-        self.aeroelastic = bool(self.vehicle.structure.aeroelastic if aeroelastic is None else aeroelastic)
+        self.aeroelastic = bool(self.vehicle.structure.aeroelastic if env.aeroelastic is None else env.aeroelastic)
         strips = (vehicle_strips(self.vehicle, self.stage_aerodynamics)
                   if self.aeroelastic and self.aerodynamics is not None else None)
         stations = None if strips is None else strip_stations(strips)
-        self.physics_dt = float(physics_dt)
-        self.elevation = math.radians(elevation_deg)
-        self.rail_length = float(rail_length)
-        self.mass_model = MassModel(self.vehicle, cg_convention)
-        self.slosh_frequency = check_choice("slosh_frequency", slosh_frequency, SLOSH_FREQUENCIES)
-        self.timeline = timeline if timeline is not None else build_timeline(
-            self.mass_model, model, t_end, timeline_dt, n_modes, sensor_stations, 0.5 / physics_dt,
-            strip_stations=stations, mode_interval=mode_interval, mode_basis=mode_basis)
-        if timeline is not None and timeline.model != model:
-            raise ValueError(f"the timeline flies model {timeline.model!r}, not {model!r}")
-        if timeline is not None and (mode_basis != timeline.mode_basis or
-                                     mode_interval not in (None, timeline.mode_interval)):
-            raise ValueError(f"mode_basis = {mode_basis!r}, mode_interval = {mode_interval!r}: the timeline's are "
-                             f"{timeline.mode_basis!r}, {timeline.mode_interval!r}")
+        self.physics_dt = physics.physics_dt
+        self.elevation = math.radians(launch.elevation_deg)
+        self.rail_length = launch.rail_length
+        self.slosh_frequency = physics.slosh_frequency
+        if isinstance(timeline, Timeline):
+            if timeline.model != model:
+                raise ConfigError("timeline", f"a timeline of model {timeline.model!r}", f"one of model {model!r}")
+            self.timeline = timeline
+        else:
+            self.timeline = build_timeline(MassModel(self.vehicle, timeline.cg_convention), model, timeline.t_end,
+                                           timeline.timeline_dt, timeline.n_modes, timeline.sensor_stations,
+                                           0.5 / self.physics_dt, strip_stations=stations,
+                                           mode_interval=timeline.mode_interval, mode_basis=timeline.mode_basis)
         self.dynamics = self.timeline.dynamics
         K = self.dynamics.n_modes
         if stations is not None and K > 0 and not np.array_equal(self.timeline.strip_stations, stations):
-            raise ValueError("the timeline has no mode shapes at the aeroelastic strips: build it with "
-                             "strip_stations=aeroelastic_strips(...) or pass aeroelastic=False")
+            raise ConfigError("timeline", "a timeline without mode shapes at the aeroelastic strips",
+                              "one built with strip_stations=aeroelastic_strips(...), or "
+                              "EnvironmentSpec(aeroelastic=False)")
         #: the strip models in force (one per stage), or None: no aeroelastic loads
         self.strips = None if strips is None or K == 0 else StripSetup(strips, K, self.dynamics.n_slosh)
         self.layout = self.dynamics.layout
@@ -179,11 +152,9 @@ class Simulator:
         self.servo = servo
         self.imu = imu
         if imu is not None and not all(0 <= i < self.timeline.sensor_stations.size for i in (imu.sensor, *imu.probes)):
-            raise ValueError(f"imu.sensor = {imu.sensor}, imu.probes = {imu.probes}: the timeline has "
-                             f"{self.timeline.sensor_stations.size} sensor stations")
-        self.threads = int(threads) if threads is not None else default_threads()
-        if self.threads < 1:
-            raise ValueError(f"threads = {threads!r}: at least 1")
+            raise ConfigError("imu", f"sensor {imu.sensor}, probes {imu.probes}",
+                              f"sensor stations of the timeline (it has {self.timeline.sensor_stations.size})")
+        self.threads = physics.threads if physics.threads is not None else default_threads()
         self.tables = self.timeline.tables
         self.setup = StepSetup(rail=self.rail, servo=DIRECT if servo is None else servo.params(),
                                physics_dt=self.physics_dt, n_slosh=self.dynamics.n_slosh,

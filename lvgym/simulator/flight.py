@@ -45,7 +45,7 @@ import numpy as np
 
 from lvgym.dynamics.layout import LOADS, PARAMS, STATE
 from lvgym.dynamics.stepper import compile_loads
-from lvgym.environment.aerokernels import aero_loads_at
+from lvgym.environment.aerokernels import AeroAt, AirData, LoadsAt, TableAt, aero_loads_at
 from lvgym.environment.atmosphere import atmosphere_state_at
 from lvgym.environment.earth import SITE_SIZE, site_dcm_ni_latlon_at, site_geodetic_at, site_velocity_wrt_earth_at
 from lvgym.environment.gravity import gravity_at, harmonics_work
@@ -96,8 +96,9 @@ def flight_conditions_at(t, x, p, ctx, cond, oc, full):
     fa, ma, st = oc + D.f_aero_b, oc + D.m_aero_b, oc + D.flow
     ow = XF.omega_bi_b
     if ctx[CTX.aero_on] != 0.0:
-        aero_loads_at(u, v, w, x[ow], x[ow + 1], x[ow + 2], rho, sound, p[PF.r_cg], alt, ctx, o_ap, ctx, o_ag, ctx,
-                      o_ad, o_at - o_ad, ctx, o_at, n_col, cond, fa, ma, st, full)
+        air = AirData((u, v, w), (x[ow], x[ow + 1], x[ow + 2]), rho, sound, p[PF.r_cg], alt)
+        model = AeroAt(ctx, o_ap, TableAt(ctx, o_ag, ctx, o_ad, o_at - o_ad, ctx, o_at, n_col))
+        aero_loads_at(air, model, cond, LoadsAt(fa, ma, st), full)
     else:                                                         # flow angles only
         vperp = math.sqrt(v * v + w * w)
         speed = math.sqrt(u * u + vperp * vperp)

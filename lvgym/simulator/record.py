@@ -5,9 +5,9 @@ steps); :meth:`Recorder.frame` turns one row's snapshots into a :class:`pandas.D
 :meth:`Recorder.save` writes it to CSV or Parquet atomically and :meth:`Recorder.plot` draws it in
 one call. :func:`fly` steps a simulator and records it at a fixed interval.
 
->>> from lvgym.simulator import Simulator
+>>> from lvgym.simulator import Simulator, TimelineSpec
 >>> from lvgym.simulator.record import fly
->>> sim = Simulator("stratos3", model="rigid", t_end=2.0)
+>>> sim = Simulator("stratos3", "rigid", timeline=TimelineSpec(t_end=2.0))
 >>> sim.reset()
 >>> rec = fly(sim, 1.0, record_dt=0.5)
 >>> rec.frame()["t_s"].round(6).tolist()

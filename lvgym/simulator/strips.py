@@ -41,7 +41,7 @@ import numba as nb
 import numpy as np
 
 from lvgym.dynamics.layout import U, X
-from lvgym.environment.aeroelastic import StripAeroelastic, strip_loads_k
+from lvgym.environment.aeroelastic import StripAeroelastic, StripLoads, StripModes, StripTable, strip_loads_k
 from lvgym.errors import ConfigError
 from lvgym.packing import at
 
@@ -152,11 +152,13 @@ def strip_loads_at(x, p_cg, ctx, cond, oc):
     n_eta = odf - oe                                      # 2K modal coordinates (y plane, then z)
     o_eta, o_etad = at(X.eta, K, N), at(X.eta_dot, K, N)
     ow, va = at(X.omega_bi_b, K, N), oc + D.v_air_b
-    strip_loads_k(cond[va:va + 3], x[ow:ow + 3], cond[oc + D.density], cond[oc + D.speed_of_sound], p_cg,
-                  ctx[ox:ox + n], ctx[om:om + n_m], ctx[oa:oa + n_m * n].reshape((n_m, n)),
-                  ctx[a + AEL.s_ref], ctx[op:op + K * n].reshape((K, n)), ctx[od:od + K * n].reshape((K, n)),
-                  x[o_eta:o_eta + n_eta], x[o_etad:o_etad + n_eta], False, ctx[of:of + 3], ctx[omb:omb + 3],
-                  ctx[oe:odf], ctx[odf:end].reshape((n, 2)))
+    strips = StripTable(ctx[ox:ox + n], ctx[om:om + n_m], ctx[oa:oa + n_m * n].reshape((n_m, n)), ctx[a + AEL.s_ref],
+                        False)
+    modes = StripModes(ctx[op:op + K * n].reshape((K, n)), ctx[od:od + K * n].reshape((K, n)),
+                       x[o_eta:o_eta + n_eta], x[o_etad:o_etad + n_eta])
+    loads = StripLoads(ctx[of:of + 3], ctx[omb:omb + 3], ctx[oe:odf], ctx[odf:end].reshape((n, 2)))
+    strip_loads_k(cond[va:va + 3], x[ow:ow + 3], cond[oc + D.density], cond[oc + D.speed_of_sound], p_cg, strips,
+                  modes, loads)
     kn = ctx[CTX.dispersion + DS.normal_scale]          # the normal-force dispersion scales every strip's CN-alpha
     if kn != 1.0:
         for i in range(3):

@@ -160,7 +160,7 @@ def run_case(params: dict[str, Any]) -> dict[str, Any]:
     ``wall_s`` [s] the run's wall time."""
     import time
 
-    from lvgym.simulator import Simulator
+    from lvgym.simulator import EnvironmentSpec, LaunchSpec, PhysicsSpec, Simulator, TimelineSpec
     from lvgym.vehicle.slender import slender_vehicle
 
     start = time.perf_counter()
@@ -176,10 +176,11 @@ def run_case(params: dict[str, Any]) -> dict[str, Any]:
     elif setup.aero == "reference":
         aero = dict(slender_vehicle().aerodynamics) | {"mach": [float(setup.aero_mach)]}
     stations = np.linspace(0.0, -L, int(setup.n_stations))
-    sim = Simulator(vehicle=vehicle, model=setup.model, site=setup.site, wind=setup.wind, aerodynamics=aero,
-                    t_end=setup.t_end, physics_dt=setup.physics_dt, elevation_deg=setup.elevation_deg,
-                    rail_length=setup.rail_length, sensor_stations=stations, threads=1,
-                    aeroelastic=False)          # the thesis's study flew no aeroelastic loads
+    sim = Simulator(vehicle, setup.model, launch=LaunchSpec(setup.site, setup.elevation_deg, setup.rail_length),
+                    environment=EnvironmentSpec(wind=setup.wind, aerodynamics=aero,
+                                                aeroelastic=False),  # the thesis's study flew no aeroelastic loads
+                    timeline=TimelineSpec(t_end=setup.t_end, sensor_stations=stations),
+                    physics=PhysicsSpec(setup.physics_dt, threads=1))
     sim.reset(batch=1, rng=np.random.default_rng(0))
     n = int(round(setup.t_end / setup.sample_dt))
     ts, etas, cgs, alphas = [0.0], [sim.state("eta")[0].copy()], [sim.lateral_cg_offset()[0]], [0.0]

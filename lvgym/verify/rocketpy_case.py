@@ -49,7 +49,7 @@ import numpy as np
 from lvgym.cli.args import arg, parse
 from lvgym.environment import make
 from lvgym.errors import require
-from lvgym.simulator import Simulator
+from lvgym.simulator import EnvironmentSpec, LaunchSpec, Simulator, TimelineSpec
 
 G0 = 9.80665                          #: standard gravity, both simulators [m/s^2]
 VEHICLE = "stratos3"
@@ -148,8 +148,9 @@ def _peak(t: np.ndarray, y: np.ndarray) -> tuple[float, float]:
 def lvgym_simulator(elevation_deg: float = ELEVATION_DEG, rail_length: float = RAIL_LENGTH,
                     t_end: float = T_END) -> Simulator:
     """The rigid ``stratos3`` on the flat non-rotating site, constant gravity, US76, no wind."""
-    return Simulator(VEHICLE, model="rigid", site="flat", gravity="constant", atmosphere="us76", wind="none",
-                     t_end=t_end, elevation_deg=elevation_deg, rail_length=rail_length)
+    return Simulator(VEHICLE, "rigid", launch=LaunchSpec("flat", elevation_deg, rail_length),
+                     environment=EnvironmentSpec(gravity="constant", atmosphere="us76", wind="none"),
+                     timeline=TimelineSpec(t_end=t_end))
 
 
 def fly_lvgym(elevation_deg: float = ELEVATION_DEG, rail_length: float = RAIL_LENGTH,
