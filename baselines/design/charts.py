@@ -45,7 +45,7 @@ def row_loops(vehicle: str, protocol: str, t: float, gains) -> dict[str, Any] | 
     out: dict[str, Any] = {}
     for model in ("rigid", "nonrigid"):
         op = operating_point(vehicle, t, model, protocol=protocol)
-        if float(op.sim.conditions("thrust")[0]) <= 0.0:
+        if op.condition("thrust") <= 0.0:
             return None
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")

@@ -55,7 +55,7 @@ def row_plants(vehicle: str, t: float, policy: Callable | None) -> tuple[dict, d
     thrust = None
     for model in ("rigid", "nonrigid"):
         op = operating_point(vehicle, t, model, protocol="v1", policy=policy)
-        thrust = float(op.sim.conditions("thrust")[0])
+        thrust = op.condition("thrust")
         for plane in plants:
             plants[plane][model] = flight_plant(op, plane)
         if model == "nonrigid":

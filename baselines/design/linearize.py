@@ -40,6 +40,7 @@ from lvgym.simulator import flight_loads
 from lvgym.packing import Field, Packed
 from lvgym.rotations import quat_mul
 from lvgym.simulator import CONDITIONS, CONTEXT
+from lvgym.simulator import data as simdata
 from lvgym.simulator.flight import flight_conditions_batch
 
 #: the env of each vehicle per protocol version (the vehicle's own file in v1: ``smile_v1`` for SMILE)
@@ -57,7 +58,8 @@ INPUTS = ("gimbal_pitch", "gimbal_yaw", "moment_x")
 class OperatingPoint:
     """A flight state to linearise about: time ``t`` [s], the dynamics state ``x``, parameters ``p`` and
     simulator context ``c`` of one row, the simulator ``sim`` (its timeline, IMU and servo), the env's
-    task spec ``task`` and the env options it was flown with."""
+    task spec ``task``, the env options it was flown with and ``data``, a copy of the row's simulator
+    state (a one-row :class:`~lvgym.simulator.SimData`; :meth:`condition` reads its flight conditions)."""
 
     t: float
     x: np.ndarray
@@ -66,6 +68,15 @@ class OperatingPoint:
     sim: Any
     env_options: dict
     task: Any = None
+    data: Any = None
+
+    def condition(self, name: str) -> Any:
+        """Flight condition ``name`` (:data:`lvgym.simulator.CONDITIONS`) at the operating point (a float
+        for a scalar entry, else an array)."""
+        if self.data is None:
+            raise ValueError("this operating point holds no simulator rows (data=None)")
+        value = self.sim.conditions(self.data, name)[0]
+        return float(value) if np.ndim(value) == 0 else np.array(value)
 
 
 def operating_point(vehicle: str = "smile", t: float = 28.8, model: str = "rigid", protocol: str = "v0",
@@ -98,20 +109,22 @@ def operating_point(vehicle: str = "smile", t: float = 28.8, model: str = "rigid
         policy = policy(env)
     if policy is not None:
         policy.reset()
-    sim = task.sim                                   # its rows are the env's state
+    sim = task.sim
     if protocol == "v0":
         if t > 0:
-            sim.step(np.zeros((1, 2)), float(t))
+            sim.step(task.state.sim, np.zeros((1, 2)), float(t))
     else:
         zero = np.zeros(env.action_space.shape, env.action_space.dtype)
         dt = float(task.task.control_dt_s)
-        while float(sim.t[0]) < float(t) - 0.5 * dt:
+        while float(task.state.sim.t[0]) < float(t) - 0.5 * dt:
             action = zero if policy is None else policy.act(obs, info)
             obs, _, term, trunc, info = env.step(action)
             if term or trunc:
                 raise RuntimeError(f"{env_id} ({model}) ended at {info['time']:.2f} s before t = {t} s: "
                                    f"{info.get('termination', '')}")
-    return OperatingPoint(float(sim.t[0]), sim.x[0].copy(), sim.p[0].copy(), sim.c[0].copy(), sim, opts, task.task)
+    d = task.state.sim
+    return OperatingPoint(float(d.t[0]), d.x[0].copy(), d.p[0].copy(), d.ctx[0].copy(), sim, opts, task.task,
+                          simdata.take(d, [0]))
 
 
 def _rot(q: np.ndarray, theta: np.ndarray) -> np.ndarray:
@@ -302,7 +315,7 @@ def analytic_rigid(op: OperatingPoint) -> control.StateSpace:
     cg = float(tl.interp("cg", [op.t])[0][0]) if np.ndim(tl.cg) == 2 else float(tl.interp("cg", [op.t])[0])
     lay = op.sim.layout
     gimbal = float(op.p[lay.params["r_gimbal"]][0])
-    T = float(op.sim.conditions("thrust")[0])
+    T = op.condition("thrust")
     n_a, m_a, V, D = aero_slopes(op)
     l = cg - gimbal
     A = np.array([[-n_a / (m * V), (-T + D - n_a) / m, 0.0], [0.0, 0.0, 1.0], [m_a / (J * V), m_a / J, 0.0]])

@@ -105,7 +105,7 @@ def schedule(vehicle: str = "smile", times=None, bandwidth: float = 75.0, pm_deg
     for t in times:
         op = operating_point(vehicle, t, "rigid")
         tl = op.sim.timeline
-        if float(op.sim.conditions("thrust")[0]) <= 0.0:
+        if op.condition("thrust") <= 0.0:
             log(f"t = {t:g} s: no thrust (coast), skipped")
             continue
         mass = float(tl.interp("mass", [t])[0])

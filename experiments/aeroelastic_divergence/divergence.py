@@ -345,6 +345,7 @@ def pinned_operating_point(t: float, diameter: float = 0.2833, length: float = 8
 
     import lvgym  # noqa: F401
     from lvgym.baselines.design.linearize import OperatingPoint
+    from lvgym.simulator import data as simdata
 
     opts = {"model": "nonrigid", "wind": "none", "diameter": diameter, "length": length,
             "wall_thickness_m": wall_thickness}
@@ -352,15 +353,15 @@ def pinned_operating_point(t: float, diameter: float = 0.2833, length: float = 8
     off = gym.make("lvgym/SlenderAscent-v1", aeroelastic=False, **opts)
     on.reset(seed=0)
     off.reset(seed=0)
-    son, soff = on.unwrapped.sim, off.unwrapped.sim
     zero = np.zeros(on.action_space.shape, on.action_space.dtype)
     dt = float(on.unwrapped.task.control_dt_s)
-    while float(son.t[0]) < t - 0.5 * dt:
+    while float(on.unwrapped.state.sim.t[0]) < t - 0.5 * dt:
         on.step(zero)
         off.step(zero)
-        son.x[0][:] = soff.x[0]
-    return OperatingPoint(float(son.t[0]), son.x[0].copy(), son.p[0].copy(), son.c[0].copy(), son, opts,
-                          on.unwrapped.task)
+        on.unwrapped.state.sim.x[0][:] = off.unwrapped.state.sim.x[0]
+    son = on.unwrapped.state.sim
+    return OperatingPoint(float(son.t[0]), son.x[0].copy(), son.p[0].copy(), son.ctx[0].copy(), on.unwrapped.sim, opts,
+                          on.unwrapped.task, simdata.take(son, [0]))
 
 
 def lvgym_poles(op: Any, plane: str = "pitch") -> dict[str, Any]:
@@ -374,8 +375,8 @@ def lvgym_poles(op: Any, plane: str = "pitch") -> dict[str, Any]:
     tl = op.sim.timeline
     n_a, m_a, V, D = aero_slopes(op)
     return {"t": op.t, "poles": ev, "max_real": float(real.max()) if real.size else -math.inf,
-            "fc": FlightCondition(float(op.sim.conditions("qbar")[0]), float(V),
-                                  float(op.sim.conditions("thrust")[0]), float(D)),
+            "fc": FlightCondition(op.condition("qbar"), float(V),
+                                  op.condition("thrust"), float(D)),
             "mass": float(tl.interp("mass", [op.t])[0]), "inertia": float(tl.interp("inertia", [op.t])[0][1, 1]),
             "cg": -float(np.ravel(tl.interp("cg", [op.t])[0])[0]), "m_alpha": float(m_a), "n_alpha": float(n_a)}
 
@@ -437,7 +438,7 @@ def stabilisability(op: Any, plane: str = "pitch") -> dict[str, float]:
     arm = cg - float(op.p[op.sim.layout.params["r_gimbal"]][0])
     return {"p": p, "z": z, "theta": theta, "servo_lag": lag, "p_tau": p * (theta + lag),
             "mt_delay": math.exp(p * theta) * ratio, "mt_servo": math.exp(p * (theta + lag)) * ratio,
-            "tvc_moment_per_rad": float(op.sim.conditions("thrust")[0]) * arm,
+            "tvc_moment_per_rad": op.condition("thrust") * arm,
             "servo_radps": float(s.frequency)}
 
 

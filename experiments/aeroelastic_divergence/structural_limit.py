@@ -153,7 +153,7 @@ def main(argv: list[str] | None = None) -> int:
           "| compression [kN] | q-alpha limit [MPa deg] |\n|---:|---:|---|---|---:|---:|---:|")
     for t in times:
         op = operating_point("slender", t, "rigid", protocol="v1")
-        thrust, drag = float(op.sim.conditions("thrust")[0]), float(aero_slopes(op)[3])
+        thrust, drag = op.condition("thrust"), float(aero_slopes(op)[3])
         r = slender_v1_qalpha_limit(t, thrust_n=thrust, drag_n=drag)
         worst = min(("free", "trimmed"), key=lambda c: r[c]["limit_pa_deg"])
         print(f"| {t:g} | {r['mass_kg']:.0f} | {thrust / 1e3:.1f} / {drag / 1e3:.1f} | {r['free']['moment_per_qsa_m']:.2f} / "

@@ -46,7 +46,7 @@ def fly(policy_spec: PolicySpec, condition: Any, seed: int) -> dict[str, np.ndar
     rows = []
     while True:
         obs, _, terminated, truncated, info = env.step(policy.act(obs, info))
-        sim = env.unwrapped.sim
+        sim = env.unwrapped.flight
         wind = np.asarray(sim.conditions("wind_n")[0], float)
         v_air = float(np.linalg.norm(sim.conditions("v_air_b")[0]))
         rows.append([info["time"], info["qbar"], info["alpha_total"], info["qalpha_pa_deg"],

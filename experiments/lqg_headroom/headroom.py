@@ -95,9 +95,9 @@ class Turbulence:
 def row_turbulence(op: Any, intensity: str = "moderate") -> Turbulence:
     """The v1 turbulence at the operating point ``op``: MIL-F-8785C's transverse scale length and intensity
     at its altitude (``lvgym.environment.turbulence.dryden_scales``) and its airspeed."""
-    alt = float(op.sim.conditions("altitude")[0])
+    alt = op.condition("altitude")
     lengths, sigmas = dryden_scales(alt, *INTENSITIES[intensity])
-    return Turbulence(float(sigmas[1]), float(lengths[1]), float(op.sim.conditions("airspeed")[0]), alt)
+    return Turbulence(float(sigmas[1]), float(lengths[1]), op.condition("airspeed"), alt)
 
 
 def dryden_filter(turb: Turbulence, dt: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -256,7 +256,7 @@ def smile_suite_departures(suite: str = "smile-windy", n: int = 50, histories: d
                 t = float(info["time"])
                 if len(trace) < round(10.0 * t):
                     trace.append((t, DEG * math.hypot(*info["attitude_error"])))
-                omega = env.unwrapped.sim.state("omega_bi_b")[0]
+                omega = env.unwrapped.flight.state("omega_bi_b")[0]
                 for key, v in (("qa", info["qalpha_pa_deg"]), ("rate", math.hypot(omega[1], omega[2])),
                                ("q", info["qbar"])):
                     if v > best[key][0] and (key == "q" or t <= SMILE_EVENTS["burnout"]):

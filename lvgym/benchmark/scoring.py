@@ -107,7 +107,7 @@ class FlightLog:
         diff = None
         if self.gyro_index is not None:
             u = env.unwrapped
-            w = u.sim.state("omega_bi_b", u.state.sim)[0]
+            w = u.flight.state("omega_bi_b")[0]
             ip, iy, iref = self.gyro_index
             diff = (float(observation[ip]) + float(observation[iref]) - w[1], float(observation[iy]) - w[2])
         self.add(reward, info, diff)

@@ -1,9 +1,12 @@
 """Gymnasium environments of thrust-vector (and roll) control in ascent.
 
 Physics lives in the simulator; :class:`~.functional.AscentFuncEnv` is the task as pure functions of an
-explicit state; these classes only adapt one row of it to ``gymnasium.Env`` (the state is
-``env.unwrapped.state``; :meth:`AscentEnv.get_state` and :meth:`AscentEnv.set_state` capture and restore
-it whole, see :mod:`.snapshot`). Options are keywords (see :class:`~.spec.TaskSpec`), e.g.
+explicit state; :class:`~.core.BatchCore` resets and steps its rows; these classes are the
+``gymnasium.Env`` face of one row of it. The episode's state is ``env.unwrapped.state`` (an
+:data:`~.functional.AscentState` value); ``env.unwrapped.flight`` reads its simulator rows by name
+(``flight.t[0]``, ``flight.conditions("qbar")[0]``, ``flight.state("omega_bi_b")[0]``,
+``flight.gimbal[0]``: :class:`lvgym.simulator.SimView`); :meth:`AscentEnv.get_state` and
+:meth:`AscentEnv.set_state` capture and restore it whole (see :mod:`.snapshot`). Options are keywords (see :class:`~.spec.TaskSpec`), e.g.
 ``gymnasium.make("lvgym/SmileAscent-v0", model="rigid", wind="turbulence", randomize=True)``.
 
 Observation (``Box(-inf, inf, (14,), float32)``), for ``observation="state"`` (the ideal state of the
@@ -46,9 +49,10 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 
+from .core import BatchCore, row_info
 from .functional import AscentFuncEnv, AscentState
 from .layouts import observation_table
-from .snapshot import EpisodeState, rng_state, set_rng_state
+from .snapshot import EpisodeState
 from .spec import FLIGHT_DEFAULTS, TaskSpec, check_reset_options
 from .views import FuncViews
 
@@ -56,38 +60,6 @@ __doc__ = __doc__ % {"observation": "\n".join("    " + line for line in observat
 
 #: Mach number at which SlenderAscent-v0 freezes the vehicle's aerodynamic tables by default [-]
 DEFAULT_AERO_MACH = 2.0
-
-
-def _row(info: dict[str, Any], b: int) -> dict[str, Any]:
-    """The info of row ``b`` of a batch info dict (scalars as Python floats)."""
-    out: dict[str, Any] = {}
-    for key, value in info.items():
-        if key == "reward_terms":
-            out[key] = {k: float(v[b]) for k, v in value.items()}
-        elif key == "events":
-            out[key] = list(value[b])
-        else:
-            v = value[b]
-            out[key] = v.item() if isinstance(v, np.generic) else v
-    return out
-
-
-def _rows(info: dict[str, Any], batch: int) -> list[dict[str, Any]]:
-    """The infos of every row of a batch info dict, as :func:`_row` gives them, built column by column
-    (one ``tolist`` per key instead of one look-up per key and row)."""
-    columns: dict[str, list] = {}
-    for key, value in info.items():
-        if key == "reward_terms":
-            names = list(value)
-            columns[key] = [dict(zip(names, vals)) for vals in zip(*(value[k].tolist() for k in names))]
-        elif key == "events":
-            columns[key] = [list(e) for e in value]
-        elif value.ndim == 1:
-            columns[key] = value.tolist()
-        else:
-            columns[key] = list(value)
-    keys = list(columns)
-    return [dict(zip(keys, vals)) for vals in zip(*columns.values())] if keys else [{} for _ in range(batch)]
 
 
 class AscentEnv(FuncViews, gym.Env):
@@ -109,25 +81,27 @@ class AscentEnv(FuncViews, gym.Env):
             self.specs = (TaskSpec.build(self.DEFAULTS, options, self.KEYWORDS),)
         else:
             self.specs = tuple(TaskSpec.build(self.DEFAULTS, {**options, "vehicle": v}, self.KEYWORDS) for v in vehicles)
-        self._funcs: dict[int, AscentFuncEnv] = {}
+        self._cores: dict[int, BatchCore] = {}
         self._select(0)
         self.action_space, self.observation_space = self.func.action_space, self.func.observation_space
-        self.state: AscentState | None = None
         self._renderer: Any = None
         self._rates: list[tuple[float, float, float, float]] = []     # (t, roll, pitch, yaw rate) for rendering
 
     def _select(self, variant: int) -> None:
-        """Fly variant ``variant`` (its functional env is built on first use and kept)."""
-        if variant not in self._funcs:
-            self._funcs[variant] = AscentFuncEnv(self.specs[variant])
-        self.variant, self.func = variant, self._funcs[variant]
-        self.task = self.func.spec
+        """Fly variant ``variant`` (its functional env and one-row core are built on first use and kept)."""
+        if variant not in self._cores:
+            self._cores[variant] = BatchCore(AscentFuncEnv(self.specs[variant]), 1)
+        self.variant, self.core = variant, self._cores[variant]
+        self.func, self.task = self.core.func, self.core.func.spec
 
-    def _bind(self) -> None:
-        """Point the simulator's read-outs (``env.unwrapped.sim.x``, ``.conditions(...)``) at the state."""
-        self.func.sim.data = self.state.sim
+    @property
+    def state(self) -> AscentState | None:
+        """The episode's state (one row; None before the first reset): the value the functional env
+        steps. Read it through :attr:`flight` (the simulator's read-outs) or ``state.task``."""
+        return self.core.state
 
-    # facts of the task (sim, timeline, vehicle, observation_layout, gimbal_limit): .views.FuncViews
+    # facts of the task (sim, timeline, vehicle, observation_layout, gimbal_limit) and the current
+    # flight (flight): .views.FuncViews
 
     # ------------------------------------------------------------------------------ Gymnasium
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
@@ -137,33 +111,26 @@ class AscentEnv(FuncViews, gym.Env):
         super().reset(seed=seed)
         if len(self.specs) > 1:
             self._select(int(self.np_random.integers(len(self.specs))))
-        self.state = self.func.initial([self.np_random])
-        self._bind()
+        self.core.reset(rngs=[self.np_random])
         self._rates = []
-        info = _row(self.func.state_info(self.state), 0)
-        return self.func.observation(self.state)[0], info
+        return self.core.observation()[0], row_info(self.core.reset_info(), 0)
 
     def step(self, action):
         if self.state is None:
             raise RuntimeError("call reset() before step()")
-        func = self.func
-        a = func.check_action(action)
-        self.state = func.transition(self.state, a[None], [self.np_random], inplace=True, checked=True)
-        ts = self.state.task
-        row = _row(func.transition_info(None, action, self.state), 0)
+        a = self.func.check_action(action)
+        out = self.core.step(a[None], checked=True)
+        row = row_info(out.info, 0)
         w = self.state.sim.x[0, self.sim.layout.state["omega_bi_b"]]
         self._rates.append((row["time"], float(w[0]), float(w[1]), float(w[2])))
         if self.render_mode == "human":
             self.render()
-        return func.observation(self.state)[0], float(ts.reward[0]), bool(ts.reason[0] != 0), bool(ts.truncated[0]), row
+        return out.obs[0], float(out.reward[0]), bool(out.terminated[0]), bool(out.truncated[0]), row
 
     # ------------------------------------------------------------------------------ state as data
     def get_state(self) -> EpisodeState:
         """The episode's whole state (a copy; see :mod:`.snapshot`)."""
-        if self.state is None:
-            raise RuntimeError("call reset() before get_state()")
-        return EpisodeState(self.task, self.func.take(self.state), [rng_state(self.np_random)],
-                            {"variant": [self.variant], "rates": [list(self._rates)]})
+        return self.core.get_state(extra={"variant": [self.variant], "rates": [list(self._rates)]})
 
     def set_state(self, state: EpisodeState) -> None:
         """Continue from ``state`` (from :meth:`get_state` of an env with the same options, or one row of
@@ -173,10 +140,9 @@ class AscentEnv(FuncViews, gym.Env):
             raise ValueError(f"the state flies vehicle variant {variant}; this env has {len(self.specs)}")
         state.check(self.specs[variant], 1)
         self._select(variant)
-        self.state = self.func.take(state.state)
-        set_rng_state(self.np_random, state.rng[0])
+        self.core.rngs[0] = self.np_random
+        self.core.set_state(state)
         self._rates = list(state.extra.get("rates", [[]])[0])
-        self._bind()
 
     def render(self):
         if self.render_mode is None:

@@ -1,4 +1,4 @@
-"""From an ascent env to a :class:`~.render.RenderFrame`: what the picture shows, read off the simulator."""
+"""From an ascent env to a :class:`~.render.RenderFrame`: what the picture shows, read off its flight."""
 
 from __future__ import annotations
 
@@ -14,23 +14,23 @@ from .render import HumanViewer, Renderer, RenderFrame
 
 def make_frame(env: Any) -> RenderFrame:
     """A render frame of the single ascent env ``env`` (its row 0)."""
-    sim, tl = env.sim, env.timeline
+    sim, tl = env.flight, env.timeline                     # the rows (a SimView), the tables
+    dyn, lay = env.sim.dynamics, env.sim.layout
     t = float(sim.t[0])
     length = float(env.vehicle.length)
     render = slice(1, 1 + RENDER_STATIONS)                  # station 0 is the IMU, its probes follow these
     stations = tl.sensor_stations[render]
     deflection = np.zeros_like(stations)
-    if sim.dynamics.n_modes:
+    if dyn.n_modes:
         phi = tl.left("phi_sensor", sim.t)[0, render]       # (S, K) shapes of the modes in force
         deflection = phi @ sim.state("eta")[0, 1]           # pitch-plane (z) deflection [m]
     C_ib = dcm_batch(sim.state("q_bi")[:1])[0]
     up = -sim.conditions("g_i")[0] / np.linalg.norm(sim.conditions("g_i")[0])
     # the body axis' angle from the local vertical, signed as a rotation about the body pitch axis y_b
     pitch = np.degrees(np.arctan2(np.cross(up, C_ib[:, 0]) @ C_ib[:, 1], up @ C_ib[:, 0]))
-    N = sim.dynamics.n_slosh
+    N = dyn.n_slosh
     if N:
         p = sim.p[0]
-        lay = sim.layout
         hinges = np.array([p[lay.slosh_param(j, "r_hinge")][0] for j in range(N)])
         lengths = np.array([p[lay.slosh_param(j, "length")][0] for j in range(N)])
         masses = np.array([p[lay.slosh_param(j, "m")][0] for j in range(N)])
@@ -49,14 +49,14 @@ def make_frame(env: Any) -> RenderFrame:
     return RenderFrame(t=t, length=length, diameter=float(env.vehicle.stages[0].outer_diameter),
                        pitch_deg=float(pitch), stations=stations, deflection=deflection, slosh_stations=hinges,
                        slosh_lengths=lengths, slosh_angles_deg=angles, slosh_masses=masses,
-                       gimbal_station=float(sim.p[0, sim.layout.params["r_gimbal"].start]),
+                       gimbal_station=float(sim.p[0, lay.params["r_gimbal"].start]),
                        gimbal_deg=float(np.degrees(sim.gimbal[0, 0])),
                        wind_mps=(float(np.hypot(wind[0], wind[1])), float(-wind[2])),
                        rates_t=rates[:, 0] if rates.size else np.zeros(0),
                        rates_degps=np.degrees(rates[:, 1:]) if rates.size else np.zeros((0, 3)),
                        stage=tl.stage_names[int(tl.left("stage", sim.t)[0])],
                        info=f"Mach {sim.conditions('mach')[0]:.2f}  q {sim.conditions('qbar')[0] / 1e3:.1f} kPa",
-                       model=env.task.model, termination=ended, bending=sim.dynamics.n_modes > 0, rate_axes=axes)
+                       model=env.task.model, termination=ended, bending=dyn.n_modes > 0, rate_axes=axes)
 
 
 def render_frame(env: Any, mode: str) -> np.ndarray | None:

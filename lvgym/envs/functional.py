@@ -11,7 +11,7 @@ episode's whole state is one :data:`AscentState` value, batched over rows::
     obs, reward, done = func.observation(state), func.reward(None, None, state), func.terminal(state)
 
 ``transition(..., inplace=True)`` reuses the input state's arrays for the output (as JAX's buffer
-donation); the Gymnasium adapters (:mod:`.ascent`, :mod:`.vector`) step that way, so they copy nothing.
+donation); the batch core under the Gymnasium faces (:mod:`.core`) steps that way, so it copies nothing.
 A transition records its outputs (reward terms, termination, the observation with its sensor noise, the
 events) in the new state, so :meth:`reward`, :meth:`terminal` and :meth:`transition_info` read the new
 state only. ``rng``: one ``numpy.random.Generator`` per row (the Gymnasium envs' ``np_random``), or None
@@ -121,8 +121,8 @@ def _rows(rows: Any) -> np.ndarray:
 class AscentFuncEnv(FuncEnv):
     """The ascent task of one :class:`~.spec.TaskSpec` as pure functions of an explicit state (see the
     module docstring). Attributes: ``spec``, ``vehicle``, ``timeline``, ``sim`` (the
-    :class:`~lvgym.simulator.Simulator` whose constants it flies; its own ``data`` is unused unless an
-    adapter binds it), ``gimbal_limit`` [rad], ``imu`` station [m], ``n_steps``, ``sample_layout``
+    :class:`~lvgym.simulator.Simulator` whose constants it flies; the rows are the state's ``sim``),
+    ``gimbal_limit`` [rad], ``imu`` station [m], ``n_steps``, ``sample_layout``
     (:data:`.layouts.OBSERVATIONS` of the observation mode), ``observation_layout`` (the same, or with
     ``history`` the stacked one of :mod:`.history`), ``history`` (its :class:`~.history.HistoryStack` or
     None), ``action_space``, ``observation_space``
@@ -265,8 +265,8 @@ class AscentFuncEnv(FuncEnv):
             mis.append(m)
             loads.append(ld)
             ts.gyro_bias[b] = g.normal(0.0, s.gyro_bias_radps, 3) if "sensor_noise" in s.randomize else np.zeros(3)
-        sim = self.sim.reset_rows(rows, [w[1] for w in winds], [w[0] for w in winds], np.array(mis), np.array(scales),
-                                  np.array(offsets), data=state.sim, dispersion=np.array(loads),
+        sim = self.sim.reset_rows(state.sim, rows, [w[1] for w in winds], [w[0] for w in winds], np.array(mis),
+                                  np.array(scales), np.array(offsets), dispersion=np.array(loads),
                                   servo_dispersion=np.array(servos),
                                   imu_station=np.array(stations) if self._imu_sigma else None)
         ts.cum_error[rows] = 0.0
@@ -318,7 +318,7 @@ class AscentFuncEnv(FuncEnv):
             cmd = np.zeros((B, 2))
             moment = np.zeros((B, 3))
             moment[:, 0] = np.where(on, (a - 1.0) * s.rcs_torque_nm, 0.0)
-        events = self.sim.step(cmd, s.control_dt_s, moment, data=sim, force=force)
+        events = self.sim.step(sim, cmd, s.control_dt_s, moment, force=force)
         ts.steps[:] += 1
         self._draw_flight(sim, ts, range(B), rng, self._draw_sigma)
         self.sim.run_rows(_SIGNALS, B, params.task, params.setup, sim, ts, params.tables)
@@ -399,10 +399,10 @@ class AscentFuncEnv(FuncEnv):
         cond = self.sim.conditions
         return {"reward_terms": dict(zip(REWARD_TERMS, ts.terms.T.copy())),
                 "cumulative_rate_error": ts.cum_error.copy(), "rate_error": ts.rate_error.copy(),
-                "qbar": cond("qbar", sim).copy(), "mach": cond("mach", sim).copy(),
-                "alpha_total": cond("alpha_total", sim).copy(), "qalpha_pa_deg": ts.qalpha.copy(), "time": sim.t.copy(),
+                "qbar": cond(sim, "qbar").copy(), "mach": cond(sim, "mach").copy(),
+                "alpha_total": cond(sim, "alpha_total").copy(), "qalpha_pa_deg": ts.qalpha.copy(), "time": sim.t.copy(),
                 "stage": ts.stage.copy(), "controller_on": ts.on_step.copy(),
-                "slosh_angles": self.sim.slosh_angles(sim), "eta": self.sim.state("eta", sim).copy(),
+                "slosh_angles": self.sim.slosh_angles(sim), "eta": self.sim.state(sim, "eta").copy(),
                 "gimbal": self.gimbal(next_state), "gimbal_rate": ACTUATOR.view(sim.actuator, "gimbal_rate").copy(),
                 "effort_rad_s": self.effort(next_state),
                 "attitude_error": ts.att.copy(), "mass": ts.mass.copy(),

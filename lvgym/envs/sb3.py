@@ -1,4 +1,4 @@
-"""A stable-baselines3 ``VecEnv`` over one :class:`~.functional.AscentFuncEnv` (imports stable-baselines3).
+"""A stable-baselines3 ``VecEnv`` face of the batch core (:class:`~.core.BatchCore`; imports stable-baselines3).
 
 It follows stable-baselines3's conventions: a finished row resets at once, its last observation is in
 ``infos[i]["terminal_observation"]`` and ``infos[i]["TimeLimit.truncated"]`` says whether the mission
@@ -15,7 +15,7 @@ import gymnasium as gym
 import numpy as np
 from stable_baselines3.common.vec_env.base_vec_env import VecEnv
 
-from .ascent import _rows
+from .core import BatchCore, row_infos
 from .functional import AscentFuncEnv, AscentState
 from .spec import check_reset_options
 from .vector import batch_task
@@ -30,25 +30,29 @@ class AscentSB3VecEnv(FuncViews, VecEnv):
     def __init__(self, env_cls: type, num_envs: int = 1, seed: int | None = None, **options: Any) -> None:
         options.pop("render_mode", None)
         self.task = batch_task(env_cls, options)
-        self.func = AscentFuncEnv(self.task)
+        self.core = BatchCore(AscentFuncEnv(self.task), int(num_envs), autoreset="same_step")
+        self.func = self.core.func
         self.render_mode = None                      # the batched rows do not render
         super().__init__(int(num_envs), self.func.observation_space, self.func.action_space)
         self._seed = seed
         self._actions: np.ndarray | None = None
-        self._rngs = [np.random.default_rng(None if seed is None else seed + i) for i in range(self.num_envs)]
-        self.state: AscentState | None = None
+        self.core.rngs = [np.random.default_rng(None if seed is None else seed + i) for i in range(self.num_envs)]
+
+    @property
+    def state(self) -> AscentState | None:
+        """The rows' state (None before the first reset)."""
+        return self.core.state
 
     def reset(self) -> np.ndarray:
         for options in self._options:                # set_options(...): no key is taken (as the single env)
             check_reset_options(options)
         self._reset_options()
         if self._seed is not None:
-            self._rngs = [gym.utils.seeding.np_random(self._seed + i)[0] for i in range(self.num_envs)]
+            self.core.rngs = [gym.utils.seeding.np_random(self._seed + i)[0] for i in range(self.num_envs)]
             self._seed = None
-        self.state = self.func.initial(self._rngs)
-        self.func.sim.data = self.state.sim
-        self.reset_infos = _rows(self.func.state_info(self.state), self.num_envs)
-        return self.func.observation(self.state)
+        self.core.reset()
+        self.reset_infos = row_infos(self.core.reset_info(), self.num_envs)
+        return self.core.observation()
 
     def step_async(self, actions: np.ndarray) -> None:
         self._actions = np.asarray(actions)
@@ -56,27 +60,18 @@ class AscentSB3VecEnv(FuncViews, VecEnv):
     def step_wait(self):
         if self.state is None or self._actions is None:
             raise RuntimeError("call reset() and step_async() before step_wait()")
-        func = self.func
         actions = self._actions
         if actions.ndim == 1 and self.task.control == "rcs":     # SB3 hands MultiDiscrete([3]) actions as (B,)
             actions = actions[:, None]
-        self.state = func.transition(self.state, actions, self._rngs, inplace=True)
-        obs, reward = func.observation(self.state), func.reward(None, self._actions, self.state)
-        terminated, truncated = func.terminal(self.state), func.truncation(self.state)
-        done = terminated | truncated
-        infos = _rows(func.transition_info(None, self._actions, self.state), self.num_envs)
-        for b in np.flatnonzero(done):
-            infos[b]["terminal_observation"] = obs[b].copy()
-            infos[b]["TimeLimit.truncated"] = bool(truncated[b] and not terminated[b])
-        if done.any():
-            rows = np.flatnonzero(done)
-            self.state = func.reset(self.state, rows, [self._rngs[b] for b in rows])
-            self.func.sim.data = self.state.sim
-            obs[rows] = func.observation(self.state)[rows]
-            fresh = _rows(func.state_info(self.state), self.num_envs)
-            for b in rows:
+        out = self.core.step(actions)
+        infos = row_infos(out.info, self.num_envs)
+        if out.reset.size:
+            fresh = row_infos(self.core.reset_info(), self.num_envs)
+            for i, b in enumerate(out.reset):
+                infos[b]["terminal_observation"] = out.final_obs[i]
+                infos[b]["TimeLimit.truncated"] = bool(out.truncated[b] and not out.terminated[b])
                 self.reset_infos[b] = fresh[b]
-        return obs, reward.astype(np.float32), done, infos
+        return out.obs, out.reward.astype(np.float32), out.terminated | out.truncated, infos
 
     def seed(self, seed: int | None = None):
         self._seed = seed

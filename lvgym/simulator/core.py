@@ -9,9 +9,11 @@ environment's models, what the timeline tabulates (or a prebuilt timeline) and h
 
 >>> from lvgym.simulator import Simulator, TimelineSpec
 >>> sim = Simulator("stratos3", "rigid", timeline=TimelineSpec(t_end=5.0))
->>> sim.reset()
->>> events = sim.step([[0.0, 0.0]], 1.0)        # gimbal (pitch, yaw) [rad] held for 1 s
->>> bool(sim.conditions("altitude")[0] > 10.0)
+>>> data = sim.reset()                          # one vehicle on the pad: its state, a SimData
+>>> events = sim.step(data, [[0.0, 0.0]], 1.0)  # gimbal (pitch, yaw) [rad] held for 1 s
+>>> bool(sim.conditions(data, "altitude")[0] > 10.0)
+True
+>>> bool(sim.view(data).t[0] == 1.0)            # the same rows, read by name
 True
 
 Stepping. :meth:`Simulator.step` advances every row by ``duration`` seconds in one compiled call
@@ -22,11 +24,14 @@ body moves within the structure between pieces, the state is shifted so that the
 it was (:meth:`NonRigidModel.shift_cg`). An optional gimbal :class:`~.servo.Servo` moves at every
 physics step. Large batches are split over threads.
 
-State as data. Everything that changes during a flight is in :attr:`Simulator.data`, a
-:class:`~.data.SimData` (one row per vehicle); the simulator itself holds only constants. Every method
-that changes or reads rows also takes an explicit ``data=`` (the functional env passes its own), and
-:meth:`Simulator.get_rows` / :meth:`Simulator.set_rows` copy rows out and back: a restored row flies on
-bit for bit as the original would have.
+State as a value. Everything that changes during a flight is in a :class:`~.data.SimData` (one row per
+vehicle) that :meth:`Simulator.reset` returns; the simulator itself holds only what does not change
+during a flight (the vehicle, its timeline, the environment models, the rail, the servo). Every method
+that changes or reads rows takes that value explicitly: :meth:`Simulator.step` and
+:meth:`Simulator.reset_rows` change it in place, the read-outs (:meth:`Simulator.conditions`,
+:meth:`Simulator.state`, :meth:`Simulator.slosh_angles`, ...) read it, and :meth:`Simulator.view` binds
+them to one value (:class:`~.view.SimView`). :func:`.data.take` / :func:`.data.put` copy rows out and
+back: a restored row flies on bit for bit as the original would have.
 
 Lift-off. The vehicle starts on the pad, axis along the launch rail (``elevation_deg`` above the
 horizon towards ``site.azimuth_deg``), and is held there while the thrust cannot lift it. It then slides
@@ -59,6 +64,7 @@ from .servo import DIRECT, Servo
 from .spec import SITES, EnvironmentSpec, LaunchSpec, PhysicsSpec, TimelineSpec
 from .strips import StripSetup, strip_stations
 from .threads import ROWS_PER_THREAD, Kernel, default_threads, pool
+from .view import SimView
 from .timeline import MODELS, Timeline, build_timeline
 from .vehicleaero import aeroelastic_strips, stage_aerodynamics, vehicle_strips
 
@@ -162,30 +168,16 @@ class Simulator:
                                slosh_frequency=SLOSH_FREQUENCIES.index(self.slosh_frequency),
                                imu=IMU_OFF if imu is None else imu.params(self.physics_dt))
         self._event_times_all = np.array([t for t, _ in self.timeline.events], dtype=float)
-        self.data: SimData = self.new_data(0)
 
     # ------------------------------------------------------------------------------ the rows
     def new_data(self, batch: int) -> SimData:
         """Zeroed rows for ``batch`` vehicles (call :meth:`reset_rows` on them before flying)."""
         return simdata.allocate(batch, self.layout.n_x, self.layout.n_p)
 
-    @property
-    def batch(self) -> int:
-        """Rows of :attr:`data`."""
-        return int(self.data.t.size)
-
-    def get_rows(self, rows: Any = None, data: SimData | None = None) -> SimData:
-        """A copy of the rows ``rows`` (default all) of ``data`` (default :attr:`data`)."""
-        return simdata.take(self.data if data is None else data, rows)
-
-    def set_rows(self, rows: Any, src: SimData, data: SimData | None = None) -> SimData:
-        """Write the rows of ``src`` (from :meth:`get_rows`) into the rows ``rows`` of ``data`` (default
-        :attr:`data`); returns the updated value (a new one when the context had to widen)."""
-        own = data is None
-        out = simdata.put(self.data if own else data, rows, src)
-        if own:
-            self.data = out
-        return out
+    def view(self, data: SimData) -> SimView:
+        """The read-outs of the rows ``data`` by name (:class:`~.view.SimView`: ``.t``, ``.x``,
+        ``.conditions("qbar")``, ``.state("omega_bi_b")``, ``.gimbal``, ...; views of ``data``'s arrays)."""
+        return SimView(self, data)
 
     # ------------------------------------------------------------------------------ set-up
     def _wind_params(self, wind: Any, rng: np.random.Generator) -> np.ndarray:
@@ -196,20 +188,21 @@ class Simulator:
     def reset(self, batch: int = 1, rng: np.random.Generator | None = None, winds: Sequence[Any] | None = None,
               misalignment: np.ndarray | None = None, param_scale: np.ndarray | None = None,
               param_offset: np.ndarray | None = None, dispersion: np.ndarray | None = None,
-              servo_dispersion: np.ndarray | None = None, imu_station: np.ndarray | None = None) -> None:
-        """Put ``batch`` vehicles on the pad at t = 0 (see :meth:`reset_rows` for the options)."""
+              servo_dispersion: np.ndarray | None = None, imu_station: np.ndarray | None = None) -> SimData:
+        """``batch`` new vehicles on the pad at t = 0: a new :class:`~.data.SimData` (see
+        :meth:`reset_rows` for the options)."""
         B = int(batch)
         if B < 1:
             raise ValueError(f"batch = {batch!r}: at least one vehicle")
-        self.data = self.reset_rows(np.arange(B), rng, winds, misalignment, param_scale, param_offset,
-                                    data=self.new_data(B), dispersion=dispersion, servo_dispersion=servo_dispersion,
-                                    imu_station=imu_station)
+        return self.reset_rows(self.new_data(B), np.arange(B), rng, winds, misalignment, param_scale, param_offset,
+                               dispersion=dispersion, servo_dispersion=servo_dispersion, imu_station=imu_station)
 
-    def reset_rows(self, rows: Any, rng: np.random.Generator | Sequence[np.random.Generator] | None = None,
+    def reset_rows(self, data: SimData, rows: Any,
+                   rng: np.random.Generator | Sequence[np.random.Generator] | None = None,
                    winds: Sequence[Any] | None = None, misalignment: np.ndarray | None = None,
                    param_scale: np.ndarray | None = None, param_offset: np.ndarray | None = None,
-                   data: SimData | None = None, dispersion: np.ndarray | None = None,
-                   servo_dispersion: np.ndarray | None = None, imu_station: np.ndarray | None = None) -> SimData:
+                   dispersion: np.ndarray | None = None, servo_dispersion: np.ndarray | None = None,
+                   imu_station: np.ndarray | None = None) -> SimData:
         """Put the vehicles ``rows`` back on the pad at t = 0; the others are untouched.
 
         ``rng``: one generator, or one per row, for whatever is random (the wind models' ``reset``);
@@ -220,12 +213,9 @@ class Simulator:
         (layout :data:`.layouts.DISPERSION`; default neutral); ``servo_dispersion`` (R, 2) the rows' servo
         natural-frequency factor [-] and delay [physics steps] (default 1 and 0); ``imu_station`` (R,) [m] the
         rows' IMU station shifts along +x_b (default 0: the nominal station; with an IMU only, within the
-        stations its ``probes`` tabulate, :meth:`.imu.Imu.placement`). ``data``: the rows to reset (default
-        :attr:`data`, which is then updated); returns them (a new value when the context widened)."""
-        own = data is None
-        if own and self.batch == 0:
-            raise RuntimeError("call reset() before reset_rows()")
-        d = self.data if own else data
+        stations its ``probes`` tabulate, :meth:`.imu.Imu.placement`). ``data``: the rows (changed in
+        place); returns them (a new value when the context had to widen: use the returned one)."""
+        d = data
         rows = np.atleast_1d(np.asarray(rows, dtype=int))
         R = rows.size
         rngs = list(rng) if isinstance(rng, (list, tuple)) else [rng] * R
@@ -267,15 +257,13 @@ class Simulator:
         self._place_on_pad(rows, d)
         q_si = self.layout.view(d.x, "state", "q_si")
         q_si[rows] = d.x[rows][:, None, self.layout.state["q_bi"]]
-        self.update_conditions(rows, d)
+        self.update_conditions(d, rows)
         if self.imu is not None:
             d.imu[rows] = self._imu_at_rest(rows, d)
             shift = np.zeros(R) if imu_station is None else np.broadcast_to(np.asarray(imu_station, float), (R,))
             IMU_STATE.view(d.imu, "station")[rows] = self.imu.placement(shift, self.timeline.sensor_stations)
         elif imu_station is not None and np.any(np.asarray(imu_station) != 0.0):
             raise ValueError("imu_station: a shifted IMU station needs a simulator with an IMU (imu=)")
-        if own:
-            self.data = d
         return d
 
     def _imu_at_rest(self, rows: np.ndarray, d: SimData) -> np.ndarray:
@@ -326,18 +314,18 @@ class Simulator:
             return
         list(pool(self.threads).map(lambda ch: fn(ch[0], ch[1], *args), chunks))
 
-    def step(self, gimbal: Any, duration: float, moment: Any = None,
-             data: SimData | None = None, *, force: Any = None) -> list[list[tuple[float, str]]]:
+    def step(self, data: SimData, gimbal: Any, duration: float, moment: Any = None, *,
+             force: Any = None) -> list[list[tuple[float, str]]]:
         """Advance every row by ``duration`` [s] with the gimbal command ``gimbal`` (B, 2) [rad]
         (pitch, yaw; see :mod:`.flight` for the signs), a commanded body moment ``moment`` (B, 3)
         [N m] (reaction control; default none) and a body force at the CG ``force`` (B, 3) [N], body
-        axes (settling thrust; default none) held; returns each row's events. ``data``: the rows
-        (default :attr:`data`), changed in place.
+        axes (settling thrust; default none) held; returns each row's events. ``data``: the rows,
+        changed in place.
 
         Without a servo the gimbal takes the command at once; with one (``servo=``) it moves towards
         it at every physics step. The actuator rows then hold the integrals of |gimbal| [rad s] and
-        |gimbal rate| [rad] (both axes summed) over the period (:attr:`effort`)."""
-        d = self.data if data is None else data
+        |gimbal rate| [rad] (both axes summed) over the period (:meth:`effort`)."""
+        d = data
         B = int(d.t.size)
         if B == 0:
             raise RuntimeError("call reset() before step()")
@@ -370,79 +358,83 @@ class Simulator:
             events[b] = sorted(evs, key=lambda e: e[0])
         return events
 
-    def update_conditions(self, rows: Any = None, data: SimData | None = None) -> None:
+    def update_conditions(self, data: SimData, rows: Any = None) -> None:
         """Recompute the flight conditions (and the thrust and aerodynamic block in force) of the rows
-        ``rows`` (default all) at their current times, e.g. after their state was written by hand."""
-        d = self.data if data is None else data
-        idx = np.arange(d.t.size) if rows is None else np.atleast_1d(np.asarray(rows, dtype=np.int64))
-        conditions_rows(idx.astype(np.int64), d, self.tables)
+        ``rows`` (default all) of ``data`` at their current times, e.g. after their state was written by hand."""
+        idx = np.arange(data.t.size) if rows is None else np.atleast_1d(np.asarray(rows, dtype=np.int64))
+        conditions_rows(idx.astype(np.int64), data, self.tables)
 
     # ------------------------------------------------------------------------------ read-outs
-    # the arrays of :attr:`data` (views: writing them writes the rows)
-    t = property(lambda self: self.data.t, doc="time of each row [s] (B,)")
-    x = property(lambda self: self.data.x, doc="dynamics state (B, n_x)")
-    p = property(lambda self: self.data.p, doc="dynamics parameters in force (B, n_p)")
-    c = property(lambda self: self.data.ctx, doc="context (B, n_ctx), layout CONTEXT then the models' blocks")
-    failed = property(lambda self: self.data.failed, doc="rows whose state turned non-finite (B,)")
-    gimbal = property(lambda self: ACTUATOR.view(self.data.actuator, "gimbal"), doc="gimbal angles (B, 2) [rad]")
-    gimbal_rate = property(lambda self: ACTUATOR.view(self.data.actuator, "gimbal_rate"),
-                           doc="gimbal rates (B, 2) [rad/s]")
-    cmd = property(lambda self: ACTUATOR.view(self.data.actuator, "command"), doc="gimbal command (B, 2) [rad]")
+    # of explicit rows ``data`` (views: writing them writes the rows); SimView holds them by name
+    @staticmethod
+    def gimbal(data: SimData) -> np.ndarray:
+        """Gimbal angles (B, 2) [rad] (a view)."""
+        return ACTUATOR.view(data.actuator, "gimbal")
 
-    @property
-    def effort(self) -> np.ndarray:
+    @staticmethod
+    def gimbal_rate(data: SimData) -> np.ndarray:
+        """Gimbal rates (B, 2) [rad/s] (a view)."""
+        return ACTUATOR.view(data.actuator, "gimbal_rate")
+
+    @staticmethod
+    def command(data: SimData) -> np.ndarray:
+        """Gimbal command held over the last step (B, 2) [rad] (a view)."""
+        return ACTUATOR.view(data.actuator, "command")
+
+    @staticmethod
+    def effort(data: SimData) -> np.ndarray:
         """Integrals of |gimbal| [rad s] and |gimbal rate| [rad] over the last period (B, 2)."""
-        a = self.data.actuator
+        a = data.actuator
         return np.stack([a[:, ACTUATOR.index("effort")], a[:, ACTUATOR.index("effort_rate")]], axis=1)
 
-    @property
-    def on_rail(self) -> np.ndarray:
-        """Whether each row is still held on the pad or rail."""
-        return self.data.rail_state[:, RS.on] != 0.0
+    @staticmethod
+    def on_rail(data: SimData) -> np.ndarray:
+        """Whether each row is still held on the pad or rail (B,)."""
+        return data.rail_state[:, RS.on] != 0.0
 
-    @property
-    def lifted(self) -> np.ndarray:
-        """Whether each row has lifted off."""
-        return self.data.rail_state[:, RS.lifted] != 0.0
+    @staticmethod
+    def lifted(data: SimData) -> np.ndarray:
+        """Whether each row has lifted off (B,)."""
+        return data.rail_state[:, RS.lifted] != 0.0
 
-    @property
-    def rail_s(self) -> np.ndarray:
-        """Travel of the structure along the rail [m] (frozen at rail exit)."""
-        return self.data.rail_state[:, RS.s]
+    @staticmethod
+    def rail_s(data: SimData) -> np.ndarray:
+        """Travel of the structure along the rail [m] (B,) (frozen at rail exit; a view)."""
+        return data.rail_state[:, RS.s]
 
-    def conditions(self, name: str, data: SimData | None = None) -> np.ndarray:
-        """Flight condition ``name`` (an entry of :data:`.layouts.CONDITIONS`) of every row at its
-        current time (a view)."""
-        d = self.data if data is None else data
+    @staticmethod
+    def conditions(data: SimData, name: str) -> np.ndarray:
+        """Flight condition ``name`` (an entry of :data:`.layouts.CONDITIONS`) of every row of ``data`` at
+        its current time (a view; (B,) for a scalar entry)."""
         if name not in CONDITIONS:
             raise KeyError(f"condition {name!r}: one of {sorted(CONDITIONS.names)}")
-        out = CONDITIONS.view(d.conditions, name)
+        out = CONDITIONS.view(data.conditions, name)
         return out[:, 0] if out.shape[1] == 1 else out
 
-    def state(self, name: str, data: SimData | None = None) -> np.ndarray:
-        """State entry ``name`` of every row (a view, see :class:`lvgym.dynamics.Layout`)."""
-        return self.layout.view(self.data.x if data is None else data.x, "state", name)
+    def state(self, data: SimData, name: str) -> np.ndarray:
+        """State entry ``name`` of every row of ``data`` (a view, see :class:`lvgym.dynamics.Layout`)."""
+        return self.layout.view(data.x, "state", name)
 
-    def slosh_angles(self, data: SimData | None = None) -> np.ndarray:
+    def slosh_angles(self, data: SimData) -> np.ndarray:
         """Pendulum deflections from the body axis (B, N, 2) [rad]: the rod's angle in the x-y and x-z
         body planes (0 at rest, hanging aft); NaN for a pendulum without mass (an empty or dropped
         tank, whose frozen state means nothing)."""
-        d = self.data if data is None else data
-        N, B = self.dynamics.n_slosh, int(d.t.size)
+        N, B = self.dynamics.n_slosh, int(data.t.size)
         out = np.zeros((B, N, 2))
         if N:
-            self.run_rows(_SLOSH, B, d.x, N, self.dynamics.n_modes, out)
-            out[d.p[:, self._i_slosh_m] <= 0.0] = np.nan
+            self.run_rows(_SLOSH, B, data.x, N, self.dynamics.n_modes, out)
+            out[data.p[:, self._i_slosh_m] <= 0.0] = np.nan
         return out
 
-    def lateral_cg_offset(self) -> np.ndarray:
+    def lateral_cg_offset(self, data: SimData) -> np.ndarray:
         """Lateral offset of the whole vehicle's CG from the body axis (B, 2) [m] (y_b, z_b): the slosh
         masses out of their rest position (free-free modes leave the CG of B on the axis)."""
+        x, p = data.x, data.p
         if self.dynamics.n_slosh == 0:
-            return np.zeros((self.batch, 2))
-        r_j, _ = self.dynamics.slosh_kinematics(self.x, self.p)
-        C_ib = dcm_batch(self.state("q_bi"))
-        rho_b = np.einsum("bji,bnj->bni", C_ib, r_j - self.state("r_zw_i")[:, None, :])
-        m_j = self.p[:, [self.layout.slosh_param(j, "m").start for j in range(self.dynamics.n_slosh)]]
-        m_total = self.p[:, self.layout.params["m_b"].start] + m_j.sum(axis=1)
+            return np.zeros((x.shape[0], 2))
+        r_j, _ = self.dynamics.slosh_kinematics(x, p)
+        C_ib = dcm_batch(self.state(data, "q_bi"))
+        rho_b = np.einsum("bji,bnj->bni", C_ib, r_j - self.state(data, "r_zw_i")[:, None, :])
+        m_j = p[:, [self.layout.slosh_param(j, "m").start for j in range(self.dynamics.n_slosh)]]
+        m_total = p[:, self.layout.params["m_b"].start] + m_j.sum(axis=1)
         return np.einsum("bn,bni->bi", m_j, rho_b[..., 1:]) / m_total[:, None]

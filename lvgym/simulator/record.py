@@ -1,15 +1,15 @@
 """Trajectory recording: what a :class:`~.core.Simulator` flew, as a table, a file and a figure.
 
 :class:`Recorder` takes a snapshot of chosen batch rows whenever asked (after ``reset`` and after
-steps); :meth:`Recorder.frame` turns one row's snapshots into a :class:`pandas.DataFrame`,
+steps, given the rows' :class:`~.data.SimData`); :meth:`Recorder.frame` turns one row's snapshots into a :class:`pandas.DataFrame`,
 :meth:`Recorder.save` writes it to CSV or Parquet atomically and :meth:`Recorder.plot` draws it in
 one call. :func:`fly` steps a simulator and records it at a fixed interval.
 
 >>> from lvgym.simulator import Simulator, TimelineSpec
 >>> from lvgym.simulator.record import fly
 >>> sim = Simulator("stratos3", "rigid", timeline=TimelineSpec(t_end=2.0))
->>> sim.reset()
->>> rec = fly(sim, 1.0, record_dt=0.5)
+>>> data = sim.reset()
+>>> rec = fly(sim, data, 1.0, record_dt=0.5)
 >>> rec.frame()["t_s"].round(6).tolist()
 [0.0, 0.5, 1.0]
 
@@ -46,6 +46,8 @@ if TYPE_CHECKING:                                    # pragma: no cover
     from matplotlib.figure import Figure
 
     from .core import Simulator
+    from .data import SimData
+    from .view import SimView
 
 __all__ = ["FORMATS", "PANELS", "Recorder", "fly", "load"]
 
@@ -64,22 +66,24 @@ def _tag(name: str) -> str:
 
 
 class Recorder:
-    """Snapshots of the batch rows ``rows`` (default all) of a reset simulator ``sim``.
+    """Snapshots of the batch rows ``rows`` (default all) of the rows ``data`` (a reset
+    :class:`~.data.SimData` of the simulator ``sim``; it gives the batch size).
 
-    Call :meth:`snapshot` after ``reset`` and after steps; pass it the events that ``sim.step``
+    Call :meth:`snapshot` with the rows after ``reset`` and after steps; pass it the events that ``sim.step``
     returned (or hand them to :meth:`add_events` after every step when snapshots are rarer than steps).
     The columns are fixed at construction by the simulator's model (slosh columns only for models
     with pendulums, ``eta`` columns only for models with bending modes).
     """
 
-    def __init__(self, sim: Simulator, rows: Sequence[int] | np.ndarray | None = None) -> None:
-        if sim.batch == 0:
+    def __init__(self, sim: Simulator, data: SimData, rows: Sequence[int] | np.ndarray | None = None) -> None:
+        self.batch = batch = int(data.t.size)
+        if batch == 0:
             raise RuntimeError("reset() the simulator before recording it")
         self.sim = sim
-        self.rows = (np.arange(sim.batch) if rows is None
+        self.rows = (np.arange(batch) if rows is None
                      else np.atleast_1d(np.asarray(rows, dtype=int)).reshape(-1))
-        if self.rows.size == 0 or np.any((self.rows < 0) | (self.rows >= sim.batch)):
-            raise ValueError(f"rows = {rows!r}: batch rows in 0..{sim.batch - 1}")
+        if self.rows.size == 0 or np.any((self.rows < 0) | (self.rows >= batch)):
+            raise ValueError(f"rows = {rows!r}: batch rows in 0..{batch - 1}")
         if np.unique(self.rows).size != self.rows.size:
             raise ValueError(f"rows = {rows!r}: each row once")
         self.n_slosh, self.n_modes = sim.dynamics.n_slosh, sim.dynamics.n_modes
@@ -106,21 +110,23 @@ class Recorder:
 
     def add_events(self, events: Sequence[Sequence[tuple[float, str]]]) -> None:
         """Accumulate the events ``sim.step`` returned (one list per batch row) for the next snapshot."""
-        if len(events) != self.sim.batch:
-            raise ValueError(f"{len(events)} event lists for a batch of {self.sim.batch}: pass what "
+        if len(events) != self.batch:
+            raise ValueError(f"{len(events)} event lists for a batch of {self.batch}: pass what "
                              "sim.step returned, one list per batch row")
         for i, b in enumerate(self.rows):
             for t, text in events[b]:
                 self._pending[i].append((float(t), str(text)))
 
-    def snapshot(self, events: Sequence[Sequence[tuple[float, str]]] | None = None) -> None:
-        """Append the current state of the recorded rows; ``events``: what the last ``sim.step``
-        returned (added to those given to :meth:`add_events` since the previous snapshot)."""
+    def snapshot(self, data: SimData, events: Sequence[Sequence[tuple[float, str]]] | None = None) -> None:
+        """Append the state of the recorded rows of ``data`` (the simulator's rows now); ``events``: what
+        the last ``sim.step`` returned (added to those given to :meth:`add_events` since the previous
+        snapshot)."""
         if events is not None:
             self.add_events(events)
-        sim, rows = self.sim, self.rows
+        rows = self.rows
+        sim = self.sim.view(data)
         if sim.batch <= int(rows.max()):
-            raise RuntimeError(f"the simulator has {sim.batch} rows now; recorded rows are {rows.tolist()}")
+            raise RuntimeError(f"the data has {sim.batch} rows; recorded rows are {rows.tolist()}")
         deg = math.degrees(1.0)
         t = sim.t[rows]
 
@@ -134,17 +140,18 @@ class Recorder:
         parts += [cond("wind_n"), deg * sim.gimbal[rows]]
         if self.n_slosh:
             ang = deg * sim.slosh_angles()[rows]                                    # (R, N, 2)
-            m_s = sim.timeline.interp("slosh_mass", t)[:, :self.n_slosh]           # (R, N)
+            m_s = self.sim.timeline.interp("slosh_mass", t)[:, :self.n_slosh]           # (R, N)
             parts.append(np.concatenate([ang, m_s[..., None]], axis=2).reshape(rows.size, -1))
         if self.n_modes:
             parts.append(sim.state("eta")[rows].reshape(rows.size, -1))            # y modes, then z
-        J = sim.timeline.interp("inertia", t)
-        parts += [sim.lateral_cg_offset()[rows], sim.timeline.interp("mass", t)[:, None],
-                  sim.timeline.interp("cg", t)[:, :1], np.diagonal(J, axis1=1, axis2=2), self._thrust(t)[:, None]]
+        tl = self.sim.timeline
+        J = tl.interp("inertia", t)
+        parts += [sim.lateral_cg_offset()[rows], tl.interp("mass", t)[:, None], tl.interp("cg", t)[:, :1],
+                  np.diagonal(J, axis1=1, axis2=2), self._thrust(t, cond("pressure"))[:, None]]
         values = np.concatenate([np.asarray(p, dtype=float).reshape(rows.size, -1) for p in parts], axis=1)
         assert values.shape[1] == len(self.columns) - 2, (values.shape, len(self.columns))
-        names = sim.timeline.stage_names
-        stages = [names[int(s)] for s in sim.timeline.left("stage", t)]
+        names = tl.stage_names
+        stages = [names[int(s)] for s in tl.left("stage", t)]
         texts = []
         for i in range(rows.size):
             texts.append(_EVENT_SEP.join(f"{tt:.3f} s {e}" for tt, e in self._pending[i]))
@@ -154,14 +161,13 @@ class Recorder:
         self._stages.append(stages)
         self._texts.append(texts)
 
-    def _thrust(self, t: np.ndarray) -> np.ndarray:
-        """Thrust [N] of the recorded rows at their times ``t``: ``max(T_0 - A_e p_amb, 0)`` with the
-        timeline's ``T_0`` and ``A_e`` at ``t`` (the formula of :mod:`.flight`). Not
-        ``sim.conditions("thrust")``, which holds ``T_0`` of the middle of the last step (and 0 after
-        ``reset``)."""
+    def _thrust(self, t: np.ndarray, p_amb: np.ndarray) -> np.ndarray:
+        """Thrust [N] of the recorded rows at their times ``t`` and ambient pressures ``p_amb`` [Pa]:
+        ``max(T_0 - A_e p_amb, 0)`` with the timeline's ``T_0`` and ``A_e`` at ``t`` (the formula of
+        :mod:`.flight`). Not the condition ``thrust``, which holds ``T_0`` of the middle of the last
+        step (and 0 after ``reset``)."""
         tl = self.sim.timeline
         t0, ae = tl.interp("thrust0", t), tl.interp("exit_area", t)
-        p_amb = np.asarray(self.sim.conditions("pressure"))[self.rows]
         return np.where(t0 > 0.0, np.maximum(t0 - ae * p_amb, 0.0), 0.0)
 
     def __len__(self) -> int:
@@ -307,30 +313,33 @@ def load(path: str | os.PathLike[str]) -> pd.DataFrame:
     raise ValueError(f"cannot load {path.name!r}: suffix {path.suffix!r} is not one of {FORMATS}")
 
 
-def fly(sim: Simulator, duration: float, record_dt: float = 0.1, step_dt: float = 0.02,
-        gimbal: np.ndarray | Callable[[Simulator], Any] | None = None, *,
+def fly(sim: Simulator, data: SimData, duration: float, record_dt: float = 0.1, step_dt: float = 0.02,
+        gimbal: np.ndarray | Callable[[SimView], Any] | None = None, *,
         rows: Sequence[int] | None = None) -> Recorder:
-    """Step ``sim`` (already reset; not reset here) for ``duration`` [s] from its current time with
-    steps of at most ``step_dt`` [s], snapshotting every ``record_dt`` [s] (and at the start and the end).
+    """Step the rows ``data`` of ``sim`` (already reset; not reset here; changed in place) for
+    ``duration`` [s] from their current time with steps of at most ``step_dt`` [s], snapshotting every
+    ``record_dt`` [s] (and at the start and the end).
 
-    ``gimbal``: None (zeros), a (B, 2) array [rad] held throughout, or a callable ``gimbal(sim)``
-    returning one, evaluated before every step. ``rows``: the batch rows recorded (default all)."""
+    ``gimbal``: None (zeros), a (B, 2) array [rad] held throughout, or a callable ``gimbal(view)`` of the
+    rows' :class:`~.view.SimView` returning one, evaluated before every step. ``rows``: the batch rows
+    recorded (default all)."""
     if not duration > 0.0 or not record_dt > 0.0 or not step_dt > 0.0:
         raise ValueError(f"duration = {duration!r}, record_dt = {record_dt!r} and step_dt = {step_dt!r} "
                          "must be > 0 s")
-    rec = Recorder(sim, rows)
-    rec.snapshot()
+    rec = Recorder(sim, data, rows)
+    rec.snapshot(data)
     marks = [k * record_dt for k in range(1, int(math.floor(duration / record_dt + 1e-9)) + 1)]
     if not marks or duration - marks[-1] > 1e-9 * max(1.0, duration):
         marks.append(duration)                        # a last, shorter interval
-    zeros = np.zeros((sim.batch, 2))
+    zeros = np.zeros((rec.batch, 2))
+    view = sim.view(data)
     done = 0.0
     for mark in marks:
         span = mark - done
         n = max(1, int(math.ceil(span / step_dt - 1e-9)))
         for _ in range(n):
-            g = zeros if gimbal is None else (gimbal(sim) if callable(gimbal) else gimbal)
-            rec.add_events(sim.step(g, span / n))
-        rec.snapshot()
+            g = zeros if gimbal is None else (gimbal(view) if callable(gimbal) else gimbal)
+            rec.add_events(sim.step(data, g, span / n))
+        rec.snapshot(data)
         done = mark
     return rec

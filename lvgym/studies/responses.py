@@ -181,17 +181,18 @@ def run_case(params: dict[str, Any]) -> dict[str, Any]:
                                                 aeroelastic=False),  # the thesis's study flew no aeroelastic loads
                     timeline=TimelineSpec(t_end=setup.t_end, sensor_stations=stations),
                     physics=PhysicsSpec(setup.physics_dt, threads=1))
-    sim.reset(batch=1, rng=np.random.default_rng(0))
+    data = sim.reset(batch=1, rng=np.random.default_rng(0))
+    v = sim.view(data)
     n = int(round(setup.t_end / setup.sample_dt))
-    ts, etas, cgs, alphas = [0.0], [sim.state("eta")[0].copy()], [sim.lateral_cg_offset()[0]], [0.0]
+    ts, etas, cgs, alphas = [0.0], [v.state("eta")[0].copy()], [v.lateral_cg_offset()[0]], [0.0]
     events: list[tuple[float, str]] = []
     for _ in range(n):
-        events += sim.step(np.zeros((1, 2)), setup.sample_dt)[0]
-        ts.append(float(sim.t[0]))
-        etas.append(sim.state("eta")[0].copy())
-        cgs.append(sim.lateral_cg_offset()[0])
-        fast = not sim.on_rail[0] and sim.conditions("qbar")[0] > QBAR_MIN
-        alphas.append(float(sim.conditions("alpha_total")[0]) if fast else 0.0)
+        events += sim.step(data, np.zeros((1, 2)), setup.sample_dt)[0]
+        ts.append(float(v.t[0]))
+        etas.append(v.state("eta")[0].copy())
+        cgs.append(v.lateral_cg_offset()[0])
+        fast = not v.on_rail[0] and v.conditions("qbar")[0] > QBAR_MIN
+        alphas.append(float(v.conditions("alpha_total")[0]) if fast else 0.0)
     t = np.array(ts)
     eta = np.array(etas)
     tl = sim.timeline

@@ -158,18 +158,19 @@ def fly_lvgym(elevation_deg: float = ELEVATION_DEG, rail_length: float = RAIL_LE
     """Fly lvgym's rigid simulator with the gimbal at zero until just past apogee."""
     start = time.perf_counter()
     sim = lvgym_simulator(elevation_deg, rail_length, t_end)
-    sim.reset()
+    data = sim.reset()
     setup = time.perf_counter() - start
+    v = sim.view(data)
     up = np.array([1.0, 0.0, 0.0])                       # flat site: the launch frame's +x is up
-    t, alt, mach = [0.0], [float(sim.conditions("altitude")[0])], [float(sim.conditions("mach")[0])]
+    t, alt, mach = [0.0], [float(v.conditions("altitude")[0])], [float(v.conditions("mach")[0])]
     while True:
-        sim.step([[0.0, 0.0]], STEP)
-        if sim.failed[0]:
-            raise RuntimeError(f"lvgym's flight failed (non-finite state) at t = {sim.t[0]:.2f} s")
-        t.append(float(sim.t[0]))
-        alt.append(float(sim.conditions("altitude")[0]))
-        mach.append(float(sim.conditions("mach")[0]))
-        if t[-1] > 1.0 and float(sim.state("v_zw_i")[0] @ up) < 0.0:
+        sim.step(data, [[0.0, 0.0]], STEP)
+        if v.failed[0]:
+            raise RuntimeError(f"lvgym's flight failed (non-finite state) at t = {v.t[0]:.2f} s")
+        t.append(float(v.t[0]))
+        alt.append(float(v.conditions("altitude")[0]))
+        mach.append(float(v.conditions("mach")[0]))
+        if t[-1] > 1.0 and float(v.state("v_zw_i")[0] @ up) < 0.0:
             break
         if t[-1] >= t_end - STEP:
             raise RuntimeError(f"no apogee before t_end = {t_end} s: raise t_end")

@@ -45,9 +45,9 @@ def timings(elevation_deg: float = ELEVATION_DEG, rail_length: float = RAIL_LENG
             lv_warm = fly_lvgym(elevation_deg, rail_length)
             start = time.perf_counter()
             sim = lvgym_simulator(elevation_deg, rail_length)
-            sim.reset()
+            data = sim.reset()
             set_up = time.perf_counter()
-            sim.step([[0.0, 0.0]], float(lv_warm.t[-1]))          # to where the flight above stopped
+            sim.step(data, [[0.0, 0.0]], float(lv_warm.t[-1]))          # to where the flight above stopped
             lv_one = replace(lv_warm, setup_time=set_up - start, wall_time=time.perf_counter() - start)
         if warm_up:
             fly_rocketpy(elevation_deg, rail_length, sim=sim)
