@@ -8,6 +8,7 @@ from lvgym.environment.aerodynamics import AxisymmetricAero
 from lvgym.environment.aeroelastic import resample_modes
 from lvgym.envs.spec import wind_spec
 from lvgym.errors import ConfigError
+from lvgym.simulator import data as simdata
 from lvgym.simulator import EnvironmentSpec, Simulator, TimelineSpec, flight_loads
 from lvgym.simulator.layouts import CTX, DS
 from lvgym.simulator.strips import N_STRIPS
@@ -26,10 +27,11 @@ def slender(model="nonrigid", aeroelastic=None):
 
 
 def fly(sim, seconds, batch=1, rngs=None, winds=None):
-    sim.reset(batch, rng=rngs, winds=winds)
+    """``batch`` new rows of ``sim`` flown ``seconds`` with the gimbal centred: their SimView."""
+    d = sim.reset(batch, rng=rngs, winds=winds)
     for _ in range(int(round(seconds / 0.02))):
-        sim.step(np.zeros((batch, 2)), 0.02)
-    return sim
+        sim.step(d, np.zeros((batch, 2)), 0.02)
+    return sim.view(d)
 
 
 @pytest.fixture(scope="module")
@@ -41,10 +43,10 @@ def flown():
 @pytest.fixture
 def pair(flown):
     """:func:`flown`, its rows restored after the test."""
-    saved = [sim.get_rows() for sim in flown]
+    saved = [simdata.take(v.data) for v in flown]
     yield flown
-    for sim, rows in zip(flown, saved):
-        sim.set_rows(np.arange(sim.batch), rows)
+    for v, rows in zip(flown, saved):
+        simdata.put(v.data, np.arange(v.batch), rows)
 
 
 def test_option_follows_the_vehicle_file():
@@ -76,13 +78,14 @@ def test_strip_modes_are_the_beam_modes_at_the_strips():
     assert np.abs(phi).max() > 0.05 and np.abs(dphi).max() > 0.01
 
 
-def _bent_state(sim, seed):
-    """The simulator's state with large random modal deflections and rates and a body rate."""
+def _bent_state(v, seed):
+    """The state of the rows ``v`` (a SimView) with large random modal deflections and rates and a body rate."""
     rng = np.random.default_rng(seed)
-    x = sim.x.copy()
-    sim.layout.view(x, "state", "eta")[:] = rng.normal(0, 0.02, (1, 2, sim.dynamics.n_modes))
-    sim.layout.view(x, "state", "eta_dot")[:] = rng.normal(0, 1.0, (1, 2, sim.dynamics.n_modes))
-    sim.layout.view(x, "state", "omega_bi_b")[:] = [0.01, 0.05, -0.03]
+    x = v.x.copy()
+    lay = v.sim.layout
+    lay.view(x, "state", "eta")[:] = rng.normal(0, 0.02, (1, 2, v.sim.dynamics.n_modes))
+    lay.view(x, "state", "eta_dot")[:] = rng.normal(0, 1.0, (1, 2, v.sim.dynamics.n_modes))
+    lay.view(x, "state", "omega_bi_b")[:] = [0.01, 0.05, -0.03]
     return x
 
 
@@ -90,14 +93,15 @@ def test_compiled_loads_agree_with_the_python_path(pair):
     # a state with large modal deflections, rates and body rates: the conditions' force and moment gain
     # exactly the strips' elastic increment, and the loads' f_eta are the strips' modal forces
     on, off = pair
-    lay = on.layout
+    lay = on.sim.layout
     x = _bent_state(on, 5)
-    for sim in (on, off):
-        sim.x[:] = x
-        sim.update_conditions()
+    for v in (on, off):
+        v.x[:] = x
+        v.sim.update_conditions(v.data)
     assert on.t[0] == off.t[0] and np.array_equal(on.p, off.p)
-    model = on.strips.stages[0]
-    phi, dphi = on.timeline.left("phi_strip", on.t)[0], on.timeline.left("dphi_strip", on.t)[0]
+    model = on.sim.strips.stages[0]
+    tl = on.sim.timeline
+    phi, dphi = tl.left("phi_strip", on.t)[0], tl.left("dphi_strip", on.t)[0]
     eta, eta_dot = on.state("eta")[0].ravel(), on.state("eta_dot")[0].ravel()
     f_b, m_b, f_eta = model.loads(off.conditions("v_air_b")[0], x[0, lay.state["omega_bi_b"]],
                                   off.conditions("density")[0], off.conditions("speed_of_sound")[0],
@@ -125,14 +129,14 @@ def test_the_normal_force_dispersion_scales_the_strip_loads(pair):
     # v1's ``aerodynamics`` draw multiplies the normal force: the strips' elastic force, moment and modal
     # forces scale with it as the table's normal force does (both come from one CN-alpha distribution)
     on, off = pair
-    lay = on.layout
+    lay = on.sim.layout
     x = _bent_state(on, 7)
     out = {}
     for kn in (1.0, 1.2):
         for name, sim in (("on", on), ("off", off)):
             sim.x[:] = x
             sim.c[0, CTX.dispersion + DS.normal_scale] = kn
-            sim.update_conditions()
+            sim.sim.update_conditions(sim.data)
             u = lay.zeros_loads()
             ctx = sim.c[0].copy()
             _call_loads(flight_loads, float(sim.t[0] - ctx[CTX.time0]), x[0].copy(), sim.p[0].copy(), ctx, u)
@@ -166,8 +170,7 @@ def test_zero_mode_shapes_at_the_strips_fly_as_without():
     tl = replace(tl, phi_strip=np.zeros_like(tl.phi_strip), dphi_strip=np.zeros_like(tl.dphi_strip))
     zeroed = Simulator("slender", "nonrigid", environment=EnvironmentSpec(wind="none", aeroelastic=True), timeline=tl)
     assert zeroed.strips is not None
-    fly(zeroed, 0.6)
-    fly(off, 0.6)
+    zeroed, off = fly(zeroed, 0.6), fly(off, 0.6)
     np.testing.assert_array_equal(zeroed.x, off.x)
     np.testing.assert_array_equal(zeroed.data.conditions, off.data.conditions)
 

@@ -37,7 +37,7 @@ def _coast(**options) -> tuple[float, float, float]:
     while not done:
         obs, _, term, trunc, info = env.step(pid.act(obs, info))
         done = term or trunc
-        m = float(np.abs(CONTEXT.view(u.sim.data.ctx[:, :CONTEXT.size], "moment_b")[0]).max())
+        m = float(np.abs(CONTEXT.view(u.state.sim.ctx[:, :CONTEXT.size], "moment_b")[0]).max())
         if info["time"] < 43.0 - 1e-9:
             before = max(before, m)
         else:
@@ -78,8 +78,8 @@ def test_settling_thrust_is_a_body_force_at_the_cg():
         if info["time"] >= 43.5 - 1e-9:
             break
     # equal until the burnout at 43 s (the force acts only in a coast), then the speed gain is F / m t
-    v = u.sim.data.x[0, lay["v_zw_i"]]
-    v_ref = r.sim.data.x[0, lay["v_zw_i"]]
+    v = u.flight.x[0, lay["v_zw_i"]]
+    v_ref = r.flight.x[0, lay["v_zw_i"]]
     gain = float(np.linalg.norm(v) - np.linalg.norm(v_ref))
     assert gain == pytest.approx(1e4 / info["mass"] * 0.5, rel=0.05)
 

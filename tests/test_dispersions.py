@@ -8,15 +8,15 @@ import pytest
 import lvgym  # noqa: F401
 from lvgym.envs.spec import RANDOMIZE, RANDOMIZE_V0, TaskSpec
 from lvgym.simulator import Simulator, TimelineSpec
+from lvgym.simulator import data as simdata
 from lvgym.simulator.layouts import CONDITIONS, CONTEXT, DISPERSION
 
 
 def _conditions():
     sim = Simulator("smile", "rigid", timeline=TimelineSpec(t_end=5.0))
-    sim.reset(1, rng=np.random.default_rng(0))
+    d = sim.reset(1, rng=np.random.default_rng(0))
     for _ in range(150):                          # 3 s: off the pad, with an angle of attack from the kick
-        sim.step(np.array([[0.01, -0.005]]), 0.02)
-    d = sim.get_rows()
+        sim.step(d, np.array([[0.01, -0.005]]), 0.02)
     return sim, d
 
 
@@ -24,17 +24,17 @@ def test_load_dispersions_scale_the_forces_and_move_the_centre_of_pressure():
     sim, d = _conditions()
     kn, ka, ks, dx = 1.07, 0.95, 1.02, 0.3
     disp = DISPERSION.pack({"thrust_scale": ks, "normal_scale": kn, "axial_scale": ka, "cp_shift": dx})
-    # the same state and time, conditions recomputed with the dispersions
-    sim.set_rows([0], d)
-    CONTEXT.view(sim.data.ctx[:, :CONTEXT.size], "dispersion")[0] = disp
-    sim.update_conditions()
+    # the same state and time (a copy of the rows), conditions recomputed with the dispersions
+    e = simdata.take(d)
+    CONTEXT.view(e.ctx[:, :CONTEXT.size], "dispersion")[0] = disp
+    sim.update_conditions(e)
     view = lambda c, k: CONDITIONS.view(c, k)            # noqa: E731
     f0, m0 = view(d.conditions[0], "f_aero_b"), view(d.conditions[0], "m_aero_b")
-    f1, m1 = view(sim.data.conditions[0], "f_aero_b"), view(sim.data.conditions[0], "m_aero_b")
+    f1, m1 = view(e.conditions[0], "f_aero_b"), view(e.conditions[0], "m_aero_b")
     assert abs(f0[2]) > 10.0 and abs(f0[1]) > 1.0       # a normal force to act on
     np.testing.assert_allclose(f1, [ka * f0[0], kn * f0[1], kn * f0[2]], rtol=1e-12)
     np.testing.assert_allclose(m1, [m0[0], kn * m0[1] - dx * kn * f0[2], kn * m0[2] + dx * kn * f0[1]], rtol=1e-12)
-    t0, t1 = view(d.conditions[0], "thrust")[0], view(sim.data.conditions[0], "thrust")[0]
+    t0, t1 = view(d.conditions[0], "thrust")[0], view(e.conditions[0], "thrust")[0]
     assert t1 == pytest.approx(ks * t0, rel=1e-12)
 
 
@@ -97,11 +97,11 @@ def test_v1_randomisations_change_the_flight():
 def _servo_after_one_period(servo_dispersion):
     from lvgym.simulator.servo import Servo
     sim = Simulator("smile", "rigid", timeline=TimelineSpec(t_end=2.0), servo=Servo(15.0, 0.7))
-    sim.reset(1, rng=np.random.default_rng(0), servo_dispersion=servo_dispersion)
-    sim.step(np.array([[0.01, 0.0]]), 0.02)              # two physics steps of 10 ms
-    first = sim.gimbal[0, 0]
-    sim.step(np.array([[0.01, 0.0]]), 0.02)
-    return first, sim.gimbal[0, 0]
+    d = sim.reset(1, rng=np.random.default_rng(0), servo_dispersion=servo_dispersion)
+    sim.step(d, np.array([[0.01, 0.0]]), 0.02)           # two physics steps of 10 ms
+    first = sim.gimbal(d)[0, 0]
+    sim.step(d, np.array([[0.01, 0.0]]), 0.02)
+    return first, sim.gimbal(d)[0, 0]
 
 
 def test_servo_dispersions_against_hand_numbers():
@@ -240,11 +240,11 @@ def test_imu_station_interpolation_against_timelines_built_at_the_station():
 def _imu_flight(imu, timeline, shift, n=100, model="nonrigid"):
     from lvgym.simulator.servo import Servo
     sim = Simulator("smile_v1", model, timeline=timeline, imu=imu, servo=Servo(15.0, 0.7))
-    sim.reset(1, rng=np.random.default_rng(0), imu_station=None if shift is None else [shift])
+    d = sim.reset(1, rng=np.random.default_rng(0), imu_station=None if shift is None else [shift])
     out = []
     for k in range(n):
-        sim.step(np.array([[0.01 * np.sin(0.3 * k), 0.005]]), 0.02)
-        out.append(sim.data.imu[0].copy())
+        sim.step(d, np.array([[0.01 * np.sin(0.3 * k), 0.005]]), 0.02)
+        out.append(d.imu[0].copy())
     return np.array(out)
 
 

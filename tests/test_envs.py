@@ -78,7 +78,7 @@ def test_controller_is_off_during_the_staging_coast():
     env = gym.make("lvgym/SmileAscent-v0", model="rigid").unwrapped
     env.reset(seed=0)
     ons = {}
-    while env.sim.t[0] < 45.5:
+    while env.flight.t[0] < 45.5:
         _, _, term, trunc, info = env.step(np.zeros(2, dtype=np.float32))
         ons[round(info["time"], 2)] = info["controller_on"]
         assert not term

@@ -109,21 +109,21 @@ def _flex_flight(n_steps=250, station=-2.5):
     imu = Imu(station)
     sim = Simulator("smile", "flex", timeline=TimelineSpec(t_end=5.0, sensor_stations=[station]),
                     physics=PhysicsSpec(H), imu=imu)
-    sim.reset(1)
+    d = sim.reset(1)
     K = sim.dynamics.n_modes
     rec = {"omega": [], "eta_dot": [], "dphi": [], "gyro": []}
     rate, force = np.zeros(3), np.zeros(2)
 
     def keep():
-        rec["omega"].append(sim.state("omega_bi_b")[0].copy())
-        rec["eta_dot"].append(sim.state("eta_dot")[0].copy())
-        rec["dphi"].append(sim.timeline.left("dphi_sensor", sim.t)[0, 0].copy())
-        imu_output_k(sim.setup.imu, sim.data.imu[0], rate, force)
+        rec["omega"].append(sim.state(d, "omega_bi_b")[0].copy())
+        rec["eta_dot"].append(sim.state(d, "eta_dot")[0].copy())
+        rec["dphi"].append(sim.timeline.left("dphi_sensor", d.t)[0, 0].copy())
+        imu_output_k(sim.setup.imu, d.imu[0], rate, force)
         rec["gyro"].append(rate.copy())
 
     keep()
     for k in range(n_steps):
-        sim.step([[0.03 * np.sign(np.sin(k * 0.7)), 0.02 * np.sign(np.cos(k * 0.45))]], H)
+        sim.step(d, [[0.03 * np.sign(np.sin(k * 0.7)), 0.02 * np.sign(np.cos(k * 0.45))]], H)
         keep()
     return imu, sim, K, {k: np.array(v) for k, v in rec.items()}
 
@@ -160,13 +160,13 @@ def test_the_gyro_sees_the_slope_rate_through_its_filters():
 
 def test_on_the_pad_the_accelerometers_read_no_lateral_force_and_the_gyros_the_earth_rate():
     sim = Simulator("smile", "rigid", timeline=TimelineSpec(t_end=2.0, sensor_stations=[-2.0]), imu=Imu(-2.0))
-    sim.reset(1)
+    d = sim.reset(1)
     rate, force = np.zeros(3), np.zeros(2)
-    imu_output_k(sim.setup.imu, sim.data.imu[0], rate, force)
-    np.testing.assert_allclose(rate, sim.state("omega_bi_b")[0], atol=1e-15)
+    imu_output_k(sim.setup.imu, d.imu[0], rate, force)
+    np.testing.assert_allclose(rate, sim.state(d, "omega_bi_b")[0], atol=1e-15)
     assert np.abs(force).max() < 1e-3
     with pytest.raises(ValueError, match="physics_dt"):
-        sim.step([[0.0, 0.0]], 0.015)
+        sim.step(d, [[0.0, 0.0]], 0.015)
 
 
 def _func(**kw):

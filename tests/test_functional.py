@@ -191,7 +191,7 @@ def test_gravity_turn_follows_the_chosen_velocity(velocity):
     r, v = state.sim.x[0, lay.state["r_zw_i"]], state.sim.x[0, lay.state["v_zw_i"]]
     if velocity == "earth":
         v = v - np.cross([0.0, 0.0, WGS84_OMEGA], r)
-    g = func.sim.conditions("g_i", state.sim)[0]
+    g = func.sim.conditions(state.sim, "g_i")[0]
     sin_th = np.linalg.norm(np.cross(v / np.linalg.norm(v), -g / np.linalg.norm(g)))
     expected = -np.linalg.norm(g) * sin_th / np.linalg.norm(v)
     ref = func.observation(state)[0, func.observation_layout.index("pitch_rate_reference")]

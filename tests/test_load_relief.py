@@ -85,8 +85,8 @@ def test_accelerometer_signs_in_a_crosswind():
     rows = []
     while True:
         obs, _, term, trunc, info = env.step(np.zeros(2, np.float32))
-        va = env.unwrapped.sim.conditions("v_air_b")[0]
-        w = env.unwrapped.sim.x[0, env.unwrapped.sim.layout.state["omega_bi_b"]]
+        va = env.unwrapped.flight.conditions("v_air_b")[0]
+        w = env.unwrapped.flight.state("omega_bi_b")[0]
         rows.append([info["time"], va[2] / va[0], va[1] / va[0], obs[lay.index("accel_z")], obs[lay.index("accel_y")],
                      w[1], w[2]])
         if term or trunc:

@@ -134,34 +134,40 @@ def test_held_timelines_have_no_changes_and_the_cache_keeps_the_options(tmp_path
         build_timeline(mm, **kw, mode_basis="rotated")
 
 
-def _kick(sim, rows=None):
-    """A bending deflection to carry: modal coordinates and rates set by hand."""
-    eta = sim.state("eta")
-    eta_dot = sim.state("eta_dot")
+def _kick(v, rows=None):
+    """A bending deflection to carry: modal coordinates and rates set by hand (``v``: the rows' SimView)."""
+    eta = v.state("eta")
+    eta_dot = v.state("eta_dot")
     sel = slice(None) if rows is None else rows
     eta[sel] = np.array([[2e-3, -1e-3], [1e-3, 5e-4]])
     eta_dot[sel] = np.array([[1e-2, 0.0], [0.0, -1e-2]])
+
+
+def _reset(sim, batch=1):
+    """New rows of ``sim`` and their read-outs."""
+    d = sim.reset(batch)
+    return d, sim.view(d)
 
 
 def test_the_step_projects_once_at_the_change():
     stations = np.linspace(0.0, -11.0, 23)
     sim = Simulator("smile", "nonrigid", timeline=TimelineSpec(t_end=6.0, sensor_stations=stations, mode_interval=2.0,
                                                               mode_basis="projected"))
-    sim.reset(1)
+    d, v = _reset(sim)
     for _ in range(99):
-        sim.step([[0.0, 0.0]], 0.02)
-    sim.step([[0.0, 0.0]], 2.0 - 1e-7 - float(sim.t[0]))
-    _kick(sim)
-    eta0 = sim.state("eta")[0].copy()
-    t0 = float(sim.t[0])
-    sim.step([[0.0, 0.0]], 2e-7)                                  # across t = 2 s
-    eta1 = sim.state("eta")[0].copy()
+        sim.step(d, [[0.0, 0.0]], 0.02)
+    sim.step(d, [[0.0, 0.0]], 2.0 - 1e-7 - float(d.t[0]))
+    _kick(v)
+    eta0 = v.state("eta")[0].copy()
+    t0 = float(d.t[0])
+    sim.step(d, [[0.0, 0.0]], 2e-7)                               # across t = 2 s
+    eta1 = v.state("eta")[0].copy()
     tl = sim.timeline
     T = tl.mode_transfer[int(np.argmin(np.abs(tl.mode_change_t - 2.0)))]
     np.testing.assert_allclose(eta1, eta0 @ T.T, rtol=1e-5, atol=1e-10)
     # the deflection field at the stations is continuous up to a rigid-body line
     phi0 = tl.left("phi_sensor", [t0])[0]
-    phi1 = tl.left("phi_sensor", [float(sim.t[0])])[0]
+    phi1 = tl.left("phi_sensor", [float(d.t[0])])[0]
     assert not np.array_equal(phi0, phi1)
     before, after = phi0 @ eta0[0], phi1 @ eta1[0]
     projected = _line_residual(stations, before - after)
@@ -175,11 +181,14 @@ def test_a_period_ending_on_the_change_projects_at_the_next_one():
     on = Simulator("smile", "nonrigid", timeline=TimelineSpec(t_end=4.0, mode_interval=2.0, mode_basis="projected"))
     across = Simulator("smile", "nonrigid", timeline=on.timeline)
     held = Simulator("smile", "nonrigid", timeline=TimelineSpec(t_end=4.0, mode_interval=2.0))
+    views = []
     for sim, periods in ((on, (1.0, 1.0, 0.02)), (across, (1.0, 1.02)), (held, (1.0, 1.0, 0.02))):
-        sim.reset(1)
-        _kick(sim)
-        for d in periods:
-            sim.step([[0.01, -0.01]], d)
+        d, v = _reset(sim)
+        _kick(v)
+        for dt in periods:
+            sim.step(d, [[0.01, -0.01]], dt)
+        views.append(v)
+    on, across, held = views
     assert on.t[0] == across.t[0] == 2.02
     np.testing.assert_allclose(on.state("eta"), across.state("eta"), rtol=1e-9, atol=1e-15)
     assert np.abs(held.state("eta") - on.state("eta")).max() > 1e-3 * np.abs(on.state("eta")).max()
@@ -189,41 +198,43 @@ def test_projected_equals_held_where_no_change_falls():
     held = Simulator("smile", "nonrigid", timeline=TimelineSpec(t_end=3.0))
     proj = Simulator("smile", "nonrigid", timeline=TimelineSpec(t_end=3.0, mode_basis="projected"))
     assert proj.timeline.mode_change_t.size == 0
+    rows = []
     for sim in (held, proj):
-        sim.reset(1)
-        _kick(sim)
+        d, v = _reset(sim)
+        _kick(v)
         for _ in range(50):
-            sim.step([[0.01, -0.01]], 0.02)
-    np.testing.assert_array_equal(held.x, proj.x)
+            sim.step(d, [[0.01, -0.01]], 0.02)
+        rows.append(d)
+    np.testing.assert_array_equal(rows[0].x, rows[1].x)
 
 
 def test_batch_rows_at_different_times_equal_single_rows_across_changes():
     sim = Simulator("smile", "nonrigid", timeline=TimelineSpec(t_end=8.0, mode_interval=2.0, mode_basis="projected"))
-    sim.reset(2)
-    _kick(sim)
+    d, v = _reset(sim, 2)
+    _kick(v)
     single = Simulator("smile", "nonrigid", timeline=sim.timeline)
-    single.reset(1)
+    ds, vs = _reset(single)
     first = Simulator("smile", "nonrigid", timeline=sim.timeline)
-    first.reset(1)
-    _kick(first)
+    df, vf = _reset(first)
+    _kick(vf)
     for _ in range(50):
-        sim.step([[0.01, -0.01], [0.0, 0.0]], 0.02)
-        first.step([[0.01, -0.01]], 0.02)
-    sim.reset_rows([1])
-    _kick(sim, [1])
-    _kick(single)
+        sim.step(d, [[0.01, -0.01], [0.0, 0.0]], 0.02)
+        first.step(df, [[0.01, -0.01]], 0.02)
+    d = sim.reset_rows(d, [1])
+    _kick(sim.view(d), [1])
+    _kick(vs)
     for _ in range(120):                                          # row 0 crosses 2 s at step 50, row 1 at 100
-        sim.step([[0.01, -0.01], [0.01, -0.01]], 0.02)
-        single.step([[0.01, -0.01]], 0.02)
-        first.step([[0.01, -0.01]], 0.02)
-    np.testing.assert_array_equal(sim.x[0], first.x[0])
-    np.testing.assert_array_equal(sim.x[1], single.x[0])
+        sim.step(d, [[0.01, -0.01], [0.01, -0.01]], 0.02)
+        single.step(ds, [[0.01, -0.01]], 0.02)
+        first.step(df, [[0.01, -0.01]], 0.02)
+    np.testing.assert_array_equal(d.x[0], df.x[0])
+    np.testing.assert_array_equal(d.x[1], ds.x[0])
     held = Simulator("smile", "nonrigid", timeline=TimelineSpec(t_end=8.0, mode_interval=2.0))
-    held.reset(1)
-    _kick(held)
+    dh, vh = _reset(held)
+    _kick(vh)
     for _ in range(170):
-        held.step([[0.01, -0.01]], 0.02)
-    assert not np.array_equal(held.x[0], first.x[0])
+        held.step(dh, [[0.01, -0.01]], 0.02)
+    assert not np.array_equal(dh.x[0], df.x[0])
 
 
 def test_a_prebuilt_timeline_brings_its_mode_options_and_must_fly_the_model(projected_timeline):

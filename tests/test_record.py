@@ -9,7 +9,7 @@ import pandas as pd
 import pytest
 from matplotlib.figure import Figure
 
-from lvgym.simulator import Simulator, TimelineSpec
+from lvgym.simulator import Simulator, SimView, TimelineSpec
 from lvgym.simulator.record import FORMATS, PANELS, Recorder, fly, load
 
 DEG = math.degrees(1.0)
@@ -19,21 +19,21 @@ BASE = ["t_s", "r_x_m", "r_y_m", "r_z_m", "v_x_mps", "v_y_mps", "v_z_mps", "q0",
         "cg_offset_z_m", "mass_kg", "cg_x_m", "Ixx_kgm2", "Iyy_kgm2", "Izz_kgm2", "thrust_n", "stage", "events"]
 
 
-def wobble(sim: Simulator) -> np.ndarray:
-    """A small gimbal command that differs per row and over time [rad]."""
-    rows = np.arange(sim.batch)[:, None]
-    return 0.002 * np.sin(3.0 * sim.t[:, None] + rows) * np.array([[1.0, -0.5]])
+def wobble(view: SimView) -> np.ndarray:
+    """A small gimbal command that differs per row and over time [rad] (``view``: the rows' read-outs)."""
+    rows = np.arange(view.batch)[:, None]
+    return 0.002 * np.sin(3.0 * view.t[:, None] + rows) * np.array([[1.0, -0.5]])
 
 
 @pytest.fixture(scope="module")
 def flown():
     sim = Simulator("stratos3", "nonrigid", timeline=TimelineSpec(t_end=3.0))
-    sim.reset(batch=2)
-    return sim, fly(sim, 1.0, record_dt=0.1, step_dt=0.02, gimbal=wobble)
+    data = sim.reset(batch=2)
+    return sim, fly(sim, data, 1.0, record_dt=0.1, step_dt=0.02, gimbal=wobble), data
 
 
 def test_columns_present_and_finite(flown):
-    sim, rec = flown
+    sim, rec, _ = flown
     df = rec.frame()
     tank = sim.timeline.slosh_names[0]
     expected = BASE + [f"slosh_{tank}_y_deg", f"slosh_{tank}_z_deg", f"slosh_{tank}_mass_kg"]
@@ -51,13 +51,15 @@ def test_columns_present_and_finite(flown):
 
 def test_values_agree_with_the_simulator_at_the_snapshot():
     sim = Simulator("stratos3", "nonrigid", timeline=TimelineSpec(t_end=3.0))
-    sim.reset(batch=3)
-    rec = Recorder(sim, rows=[2, 0])
-    rec.snapshot()
+    data = sim.reset(batch=3)
+    rec = Recorder(sim, data, rows=[2, 0])
+    rec.snapshot(data)
+    v = sim.view(data)
     for _ in range(40):
-        rec.add_events(sim.step(wobble(sim), 0.02))
-    rec.snapshot()
+        rec.add_events(sim.step(data, wobble(v), 0.02))
+    rec.snapshot(data)
     tl = sim.timeline
+    sim = v                                                      # the rows' read-outs, by name
     for b in (2, 0):
         last = rec.frame(b).iloc[-1]
         assert last["t_s"] == sim.t[b]
@@ -71,7 +73,7 @@ def test_values_agree_with_the_simulator_at_the_snapshot():
         for cols, name in ((["r_x_m", "r_y_m", "r_z_m"], "r_zw_i"), (["v_x_mps", "v_y_mps", "v_z_mps"], "v_zw_i"),
                            (["q0", "q1", "q2", "q3"], "q_bi"), (["p_radps", "q_radps", "r_radps"], "omega_bi_b")):
             np.testing.assert_array_equal(last[cols].to_numpy(float), sim.state(name)[b])
-        K = sim.dynamics.n_modes
+        K = tl.dynamics.n_modes
         eta = sim.state("eta")[b]
         np.testing.assert_array_equal(last[[f"eta_y{k}" for k in range(K)]].to_numpy(float), eta[0])
         np.testing.assert_array_equal(last[[f"eta_z{k}" for k in range(K)]].to_numpy(float), eta[1])
@@ -97,8 +99,7 @@ def test_values_agree_with_the_simulator_at_the_snapshot():
 
 def test_rigid_model_has_no_slosh_or_eta_columns():
     sim = Simulator("stratos3", "rigid", timeline=TimelineSpec(t_end=3.0))
-    sim.reset()
-    df = fly(sim, 0.5, record_dt=0.1).frame()
+    df = fly(sim, sim.reset(), 0.5, record_dt=0.1).frame()
     assert not [c for c in df.columns if c.startswith(("slosh_", "eta_"))]
     assert set(BASE) <= set(df.columns)
     assert (df[["cg_offset_y_m", "cg_offset_z_m"]].to_numpy() == 0.0).all()
@@ -106,7 +107,7 @@ def test_rigid_model_has_no_slosh_or_eta_columns():
 
 
 def test_fly_records_at_the_interval_and_carries_the_events(flown):
-    sim, rec = flown
+    sim, rec, data = flown
     for b in (0, 1):
         df = rec.frame(b)
         np.testing.assert_allclose(np.diff(df["t_s"].to_numpy()), 0.1, atol=1e-9)
@@ -119,7 +120,7 @@ def test_fly_records_at_the_interval_and_carries_the_events(flown):
         assert df["events"][hits[0]] == f"{t_event[0]:.3f} s lift-off"
     # the gimbal callable was evaluated at every step: the column holds the last command of each interval
     df = rec.frame(1)
-    np.testing.assert_allclose(df[["gimbal_pitch_deg", "gimbal_yaw_deg"]].to_numpy()[-1], DEG * sim.gimbal[1])
+    np.testing.assert_allclose(df[["gimbal_pitch_deg", "gimbal_yaw_deg"]].to_numpy()[-1], DEG * sim.gimbal(data)[1])
     assert df["gimbal_pitch_deg"].iloc[1:].nunique() == 10
 
 
@@ -129,40 +130,40 @@ def recorded(rec: Recorder, row: int) -> int:
 
 def test_fly_continues_from_the_current_time_with_uneven_intervals():
     sim = Simulator("stratos3", "rigid", timeline=TimelineSpec(t_end=3.0))
-    sim.reset()
-    first = fly(sim, 0.3, record_dt=0.1)
-    second = fly(sim, 0.25, record_dt=0.07, step_dt=0.02, gimbal=np.array([[0.001, 0.0]]))
+    data = sim.reset()
+    first = fly(sim, data, 0.3, record_dt=0.1)
+    second = fly(sim, data, 0.25, record_dt=0.07, step_dt=0.02, gimbal=np.array([[0.001, 0.0]]))
     t = second.frame()["t_s"].to_numpy()
     np.testing.assert_allclose(t, [0.3, 0.37, 0.44, 0.51, 0.55], atol=1e-9)
     assert first.frame()["t_s"].iloc[-1] == t[0]
     np.testing.assert_allclose(second.frame()["gimbal_pitch_deg"].iloc[1:], DEG * 0.001, rtol=1e-14)
-    short = fly(sim, 0.03, record_dt=0.1)
+    short = fly(sim, data, 0.03, record_dt=0.1)
     np.testing.assert_allclose(short.frame()["t_s"], [0.55, 0.58], atol=1e-9)
     with pytest.raises(ValueError):
-        fly(sim, 0.0)
+        fly(sim, data, 0.0)
 
 
 def test_snapshot_accumulates_the_events_of_several_steps():
     sim = Simulator("stratos3", "rigid", timeline=TimelineSpec(t_end=3.0))
-    sim.reset(batch=2)
-    rec = Recorder(sim, rows=[1])
-    rec.snapshot()
-    events = [sim.step([[0.0, 0.0]], 0.02) for _ in range(10)]
+    data = sim.reset(batch=2)
+    rec = Recorder(sim, data, rows=[1])
+    rec.snapshot(data)
+    events = [sim.step(data, [[0.0, 0.0]], 0.02) for _ in range(10)]
     for ev in events[:-1]:
         rec.add_events(ev)
-    rec.snapshot(events=events[-1])
-    rec.snapshot([[], []])
+    rec.snapshot(data, events=events[-1])
+    rec.snapshot(data, [[], []])
     df = rec.frame(1)
     assert df["events"].tolist()[0] == "" and "lift-off" in df["events"][1] and df["events"][2] == ""
     with pytest.raises(ValueError, match="batch of 2"):
-        rec.snapshot(events=[[]])
+        rec.snapshot(data, events=[[]])
     with pytest.raises(ValueError, match="rows"):
-        Recorder(sim, rows=[2])
+        Recorder(sim, data, rows=[2])
 
 
 @pytest.mark.parametrize("suffix", FORMATS)
 def test_saved_files_read_back_equal_to_the_frame(flown, tmp_path, suffix):
-    _, rec = flown
+    _, rec, _ = flown
     path = rec.save(tmp_path / "sub" / f"run{suffix}", row=1)
     assert path.exists() and path.parent.name == "sub"
     df = rec.frame(1)
@@ -176,7 +177,7 @@ def test_saved_files_read_back_equal_to_the_frame(flown, tmp_path, suffix):
 
 
 def test_save_is_atomic(flown, tmp_path, monkeypatch):
-    _, rec = flown
+    _, rec, _ = flown
     target = tmp_path / "run.parquet"
     rec.save(target)
     rec.save(tmp_path / "run.csv")
@@ -199,7 +200,7 @@ def test_save_is_atomic(flown, tmp_path, monkeypatch):
 
 
 def test_plot_has_the_panels_and_writes_a_png(flown, tmp_path):
-    _, rec = flown
+    _, rec, _ = flown
     path = tmp_path / "run.png"
     fig = rec.plot(row=0, path=path)
     assert isinstance(fig, Figure)
@@ -212,7 +213,6 @@ def test_plot_has_the_panels_and_writes_a_png(flown, tmp_path):
     slosh = fig.axes[PANELS.index("slosh angles")]
     assert len(slosh.get_lines()) >= 2
     rigid = Simulator("stratos3", "rigid", timeline=TimelineSpec(t_end=3.0))
-    rigid.reset()
-    fig = fly(rigid, 0.2).plot()
+    fig = fly(rigid, rigid.reset(), 0.2).plot()
     eta = fig.axes[PANELS.index("eta")]
     assert [t.get_text() for t in eta.texts] == ["none in this model"]

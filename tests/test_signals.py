@@ -38,7 +38,7 @@ def test_observation_and_reference_equal_numpy_formulas(observation):
                    observation=observation, randomize=["wind", "mass", "thrust_misalignment"])
     env.reset(seed=3)
     core = env.unwrapped
-    sim, spec, lay = core.sim, core.task, core.observation_layout
+    spec, lay = core.task, core.observation_layout
     rng = np.random.default_rng(0)
     checked = 0
     for k in range(700):
@@ -47,6 +47,7 @@ def test_observation_and_reference_equal_numpy_formulas(observation):
         assert not term and not trunc
         if k % 70 != 69:
             continue
+        sim = core.flight                                         # the episode's rows, read by name
         t = float(sim.t[0])
         x_b = sim.state("v_zw_i")[0]
         ref = _reference_pitch_rate(core, t, x_b, sim.conditions("g_i")[0], spec)
@@ -119,27 +120,28 @@ def test_rail_exit_is_found_at_the_physics_step():
     """Travel along the rail is checked after every RK4 step, not only at the end of a step() call."""
     sim = Simulator("stratos3", "rigid", launch=LaunchSpec("el_arenosillo", 85.0, 10.0),
                     timeline=TimelineSpec(t_end=3.0), physics=PhysicsSpec(0.01))
-    sim.reset()
+    d = sim.reset()
     exit_t = None
     while exit_t is None:
-        for t, e in sim.step([[0.0, 0.0]], 0.1)[0]:            # 10 physics steps per call
+        for t, e in sim.step(d, [[0.0, 0.0]], 0.1)[0]:         # 10 physics steps per call
             if e == "rail exit":
                 exit_t = t
-    speed = np.linalg.norm(sim.state("v_zw_i")[0] - np.cross([0, 0, sim.omega_e], sim.state("r_zw_i")[0]))
-    assert 10.0 <= sim.rail_s[0] < 10.0 + 0.01 * speed         # within one physics step of travel
+    v = sim.view(d)
+    speed = np.linalg.norm(v.state("v_zw_i")[0] - np.cross([0, 0, sim.omega_e], v.state("r_zw_i")[0]))
+    assert 10.0 <= v.rail_s[0] < 10.0 + 0.01 * speed           # within one physics step of travel
     assert abs(exit_t / 0.01 - round(exit_t / 0.01)) < 1e-6      # on a physics step, inside the call
 
 
 def test_batched_row_infos_equal_single_row_infos():
-    from lvgym.envs.ascent import _row, _rows
     from lvgym import make_vector
+    from lvgym.envs.core import row_info, row_infos
     env = make_vector("lvgym/SmileAscent-v0", num_envs=3, model="nonrigid", wind="gust")
     env.reset(seed=1)
     for _ in range(120):
         _, _, _, _, info = env.step(np.full((3, 2), 0.1, dtype=np.float32))
-    rows = _rows(info, 3)
+    rows = row_infos(info, 3)
     for b in range(3):
-        one = _row(info, b)
+        one = row_info(info, b)
         assert rows[b].keys() == one.keys()
         for key, value in one.items():
             if isinstance(value, np.ndarray):

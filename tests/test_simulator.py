@@ -18,25 +18,25 @@ def test_flight_conditions_equal_the_environment_models(smile):
     wind = {"model": "profile", "altitude_m": [0.0, 10e3], "speed": [5.0, 30.0], "direction_deg": [270.0, 200.0]}
     sim = Simulator("stratos3", "rigid", launch=LaunchSpec("el_arenosillo"), environment=EnvironmentSpec(wind=wind),
                     timeline=TimelineSpec(t_end=5.0))
-    sim.reset()
+    d = sim.reset()
     rng = np.random.default_rng(3)
-    x = sim.x[0].copy()
+    x = d.x[0].copy()
     lay = sim.layout.state
     x[lay["r_zw_i"]] += sim.C_ib0[:, 0] * 4000.0
     x[lay["v_zw_i"]] += sim.C_ib0 @ np.array([600.0, 20.0, -35.0])
     x[lay["omega_bi_b"]] = rng.normal(0.0, 0.1, 3)
-    sim.x[0] = x
-    sim.t[0] = 12.0
-    sim.update_conditions()
+    d.x[0] = x
+    d.t[0] = 12.0
+    sim.update_conditions(d)
     env = Environment(sim.site, gravity=sim.gravity, atmosphere=sim.atmosphere, wind=sim.wind,
                       aerodynamics=sim.aerodynamics)
     env.reset(np.random.default_rng(0))
     fc = env.conditions(12.0, x[lay["r_zw_i"]], x[lay["v_zw_i"]], x[lay["q_bi"]], x[lay["omega_bi_b"]],
-                        sim.p[0, sim.layout.params["r_cg"].start])
+                        d.p[0, sim.layout.params["r_cg"].start])
     for name in ("altitude", "density", "pressure", "mach", "qbar", "alpha", "beta", "alpha_total"):
-        assert sim.conditions(name)[0] == pytest.approx(getattr(fc, name)[0], rel=1e-10, abs=1e-12), name
+        assert sim.conditions(d, name)[0] == pytest.approx(getattr(fc, name)[0], rel=1e-10, abs=1e-12), name
     for name in ("wind_n", "v_air_b", "f_aero_b", "m_aero_b", "g_i"):
-        np.testing.assert_allclose(sim.conditions(name)[0], getattr(fc, name)[0], rtol=1e-10, atol=1e-9)
+        np.testing.assert_allclose(sim.conditions(d, name)[0], getattr(fc, name)[0], rtol=1e-10, atol=1e-9)
 
 
 def test_thrust_includes_the_ambient_pressure(smile):
@@ -60,10 +60,10 @@ def test_timeline_matches_the_mass_model_between_rows(smile):
 
 
 def test_events_are_reported_once_at_their_times(smile):
-    smile.reset()
+    d = smile.reset()
     seen = []
-    while smile.t[0] < 46.0:
-        for t, e in smile.step([[0.0, 0.0]], 0.03)[0]:
+    while d.t[0] < 46.0:
+        for t, e in smile.step(d, [[0.0, 0.0]], 0.03)[0]:
             seen.append((round(t, 9), e))
     names = [e for _, e in seen]
     assert names[0] == "lift-off"
@@ -76,36 +76,50 @@ def test_events_are_reported_once_at_their_times(smile):
 def test_rail_holds_the_attitude_until_exit():
     sim = Simulator("stratos3", "nonrigid", launch=LaunchSpec("el_arenosillo", 80.0, 10.0),
                     timeline=TimelineSpec(t_end=3.0))
-    sim.reset()
-    q0 = sim.state("q_bi")[0].copy()
+    d = sim.reset()
+    v = sim.view(d)
+    q0 = v.state("q_bi")[0].copy()
     events = []
-    while sim.on_rail[0]:
-        events += sim.step([[0.02, -0.02]], 0.01)[0]     # gimbal deflected: would turn it off the rail
-        w = sim.state("omega_bi_b")[0]
+    while v.on_rail[0]:
+        events += sim.step(d, [[0.02, -0.02]], 0.01)[0]     # gimbal deflected: would turn it off the rail
+        w = v.state("omega_bi_b")[0]
         assert np.linalg.norm(w) < 1e-4                     # only the Earth's rate
     names = [e for _, e in events]
     assert names == ["lift-off", "rail exit"]
-    assert sim.rail_s[0] >= 10.0
-    assert abs(sim.state("q_bi")[0] @ q0) > 1 - 1e-9        # Earth turned less than 1e-4 rad
-    before = sim.state("omega_bi_b")[0].copy()
-    sim.step([[0.02, -0.02]], 0.2)
-    assert np.linalg.norm(sim.state("omega_bi_b")[0] - before) > 1e-3
+    assert v.rail_s[0] >= 10.0
+    assert abs(v.state("q_bi")[0] @ q0) > 1 - 1e-9        # Earth turned less than 1e-4 rad
+    before = v.state("omega_bi_b")[0].copy()
+    sim.step(d, [[0.02, -0.02]], 0.2)
+    assert np.linalg.norm(v.state("omega_bi_b")[0] - before) > 1e-3
 
 
 def test_batch_rows_at_different_times_equal_single_rows():
     gust = EnvironmentSpec(wind={"model": "gust", "amplitude": 10.0, "length": 100.0, "onset": 500.0})
     sim = Simulator("smile", "nonrigid", environment=gust, timeline=TimelineSpec(t_end=50.0))
-    sim.reset(2)
+    d = sim.reset(2)
     single = Simulator("smile", "nonrigid", environment=gust, timeline=sim.timeline)
-    single.reset(1)
+    one = single.reset(1)
     for _ in range(50):
-        sim.step([[0.01, -0.01], [0.0, 0.0]], 0.02)
-    sim.reset_rows([1])
+        sim.step(d, [[0.01, -0.01], [0.0, 0.0]], 0.02)
+    d = sim.reset_rows(d, [1])
     for _ in range(60):
-        sim.step([[0.01, -0.01], [0.01, -0.01]], 0.02)
-        single.step([[0.01, -0.01]], 0.02)
-    assert sim.t[1] == pytest.approx(single.t[0])
-    np.testing.assert_array_equal(sim.x[1], single.x[0])
+        sim.step(d, [[0.01, -0.01], [0.01, -0.01]], 0.02)
+        single.step(one, [[0.01, -0.01]], 0.02)
+    assert d.t[1] == pytest.approx(one.t[0])
+    np.testing.assert_array_equal(d.x[1], one.x[0])
+
+
+def test_the_simulator_holds_no_rows_and_its_view_reads_the_given_ones():
+    sim = Simulator("stratos3", "rigid", timeline=TimelineSpec(t_end=2.0))
+    a, b = sim.reset(), sim.reset(3)
+    assert not hasattr(sim, "data") and a.t.shape == (1,) and b.t.shape == (3,)
+    sim.step(b, np.zeros((3, 2)), 0.5)
+    assert a.t[0] == 0.0 and np.all(b.t == 0.5)                   # only the given rows moved
+    v = sim.view(b)
+    assert v.batch == 3 and v.t is b.t and v.x is b.x
+    assert np.shares_memory(v.conditions("qbar"), b.conditions) and v.conditions("qbar").shape == (3,)
+    np.testing.assert_array_equal(v.state("omega_bi_b"), b.x[:, sim.layout.state["omega_bi_b"]])
+    np.testing.assert_array_equal(v.gimbal, sim.gimbal(b))
 
 
 def test_rigid_and_nonrigid_share_the_rigid_equivalent_mass(smile):
@@ -158,9 +172,9 @@ def test_the_specs_are_frozen_and_a_bad_value_names_its_key_in_one_line():
 
 
 def test_conditions_names_are_checked(smile):
-    smile.reset()
+    d = smile.reset()
     with pytest.raises(KeyError, match="one of"):
-        smile.conditions("altitud")
+        smile.conditions(d, "altitud")
     assert set(CONDITIONS.names) >= {"altitude", "mach", "qbar", "alpha", "thrust"}
     assert "flat" in SITES
 
@@ -186,16 +200,17 @@ def test_aerodynamics_of_the_stack_in_flight_after_separation():
     wind = {"model": "profile", "altitude_m": [0.0, 1e5], "speed": [5.0, 5.0], "direction_deg": [90.0, 90.0]}
     sim = Simulator(parse_vehicle(data), "rigid", environment=EnvironmentSpec(wind=wind),
                     timeline=TimelineSpec(t_end=46.0))
-    sim.reset()
+    d = sim.reset()
+    v = sim.view(d)
     lift_off, upper = sim.stage_aerodynamics[0], sim.stage_aerodynamics[1]
     assert upper is not lift_off and sim.stage_aerodynamics[2] is upper       # stage 3 inherits
     for t_stop, model in ((43.5, lift_off), (45.5, upper)):
-        while sim.t[0] < t_stop - 1e-9:
-            sim.step([[0.0, 0.0]], 0.05)
-        f, m, _ = model.loads(sim.conditions("v_air_b")[0], sim.state("omega_bi_b")[0], sim.conditions("density")[0],
-                              sim.conditions("speed_of_sound")[0], sim.p[0, sim._i_cg])
-        np.testing.assert_allclose(sim.conditions("f_aero_b")[0], f, rtol=1e-12, atol=1e-9)
-        np.testing.assert_allclose(sim.conditions("m_aero_b")[0], m, rtol=1e-12, atol=1e-9)
+        while d.t[0] < t_stop - 1e-9:
+            sim.step(d, [[0.0, 0.0]], 0.05)
+        f, m, _ = model.loads(v.conditions("v_air_b")[0], v.state("omega_bi_b")[0], v.conditions("density")[0],
+                              v.conditions("speed_of_sound")[0], d.p[0, sim._i_cg])
+        np.testing.assert_allclose(v.conditions("f_aero_b")[0], f, rtol=1e-12, atol=1e-9)
+        np.testing.assert_allclose(v.conditions("m_aero_b")[0], m, rtol=1e-12, atol=1e-9)
     # the finless upper stack is statically unstable (positive Cm at positive alpha), the lift-off stack stable
     assert lift_off.coefficients(5.8, np.radians(2.0))["Cm"] < 0.0 < upper.coefficients(5.8, np.radians(2.0))["Cm"]
     # the shipped smile keeps the lift-off stack's aerodynamics all flight (as the thesis)

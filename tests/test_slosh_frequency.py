@@ -80,19 +80,20 @@ def flights():
     for option in ("vacuum_thrust", "specific_force"):
         sim = Simulator("smile", "slosh", timeline=TimelineSpec(t_end=46.0),
                         physics=PhysicsSpec(slosh_frequency=option))
-        sim.reset(1)
+        d = sim.reset(1)
+        v = sim.view(d)
         lay = sim.layout
         i_w = [lay.slosh_param(j, "omega").start for j in range(sim.dynamics.n_slosh)]
         i_L = [lay.slosh_param(j, "length").start for j in range(sim.dynamics.n_slosh)]
         rec = {}
         for k in range(int(round(44.5 / 0.02))):
-            sim.step([[0.0, 0.0]], 0.02)
-            t = round(float(sim.t[0]), 6)
+            sim.step(d, [[0.0, 0.0]], 0.02)
+            t = round(float(v.t[0]), 6)
             if t in (10.0, 43.5, 44.5):
-                m = sim.p[0, lay.params["m_b"]][0] + sim.p[0, [lay.slosh_param(j, "m").start
-                                                               for j in range(sim.dynamics.n_slosh)]].sum()
-                a_x = (sim.conditions("thrust_b")[0, 0] + sim.conditions("f_aero_b")[0, 0]) / m
-                rec[t] = (sim.p[0, i_w].copy(), sim.p[0, i_L].copy(), a_x, sim.timeline.params_at([t])[0, i_w])
+                m = v.p[0, lay.params["m_b"]][0] + v.p[0, [lay.slosh_param(j, "m").start
+                                                           for j in range(sim.dynamics.n_slosh)]].sum()
+                a_x = (v.conditions("thrust_b")[0, 0] + v.conditions("f_aero_b")[0, 0]) / m
+                rec[t] = (v.p[0, i_w].copy(), v.p[0, i_L].copy(), a_x, sim.timeline.params_at([t])[0, i_w])
         out[option] = rec
     return out
 

@@ -111,15 +111,16 @@ def _thesis_slosh(sim: Simulator) -> tuple[np.ndarray, np.ndarray]:
     return scale, offset
 
 
-def fly(sim: Simulator, t_end: float, dt: float = 0.05, gimbal_sine: tuple[float, float] | None = None
+def fly(sim: Simulator, data: Any, t_end: float, dt: float = 0.05, gimbal_sine: tuple[float, float] | None = None
         ) -> dict[str, np.ndarray]:
-    """Fly every row of the reset ``sim`` to ``t_end`` [s], sampling every ``dt`` [s].
+    """Fly every row of the reset rows ``data`` of ``sim`` to ``t_end`` [s], sampling every ``dt`` [s].
 
     ``gimbal_sine``: (amplitude [rad], frequency [Hz]) of a pitch gimbal sine, else the gimbal is 0.
     Returns ``t`` (n,) [s], ``omega`` (n, B, 3) [rad/s], ``slosh`` (n, B, N, 2) [rad] (NaN for an
     empty or separated tank), ``qbar`` (n, B) [Pa], ``ax`` (n, B) [m/s^2] specific force along
     ``x_b`` (thrust plus axial aerodynamic force over the stack's mass)."""
-    B, N = sim.batch, sim.dynamics.n_slosh
+    v = sim.view(data)
+    B, N = v.batch, sim.dynamics.n_slosh
     lay = sim.layout
     m_cols = [lay.slosh_param(j, "m").start for j in range(N)]
     out: dict[str, list] = {k: [] for k in ("t", "omega", "slosh", "qbar", "ax")}
@@ -127,17 +128,17 @@ def fly(sim: Simulator, t_end: float, dt: float = 0.05, gimbal_sine: tuple[float
     n = int(round(t_end / dt))
     for _ in range(n):
         if gimbal_sine is not None:
-            g[:, 0] = gimbal_sine[0] * np.sin(2.0 * math.pi * gimbal_sine[1] * sim.t)
-        sim.step(g, dt)
-        out["t"].append(sim.t[0])
-        out["omega"].append(sim.state("omega_bi_b").copy())
-        ang = sim.slosh_angles()
+            g[:, 0] = gimbal_sine[0] * np.sin(2.0 * math.pi * gimbal_sine[1] * v.t)
+        sim.step(data, g, dt)
+        out["t"].append(v.t[0])
+        out["omega"].append(v.state("omega_bi_b").copy())
+        ang = v.slosh_angles()
         if N:
-            ang[sim.p[:, m_cols] <= 0.0] = np.nan
+            ang[v.p[:, m_cols] <= 0.0] = np.nan
         out["slosh"].append(ang)
-        out["qbar"].append(sim.conditions("qbar").copy())
-        mass = sim.timeline.interp("mass", sim.t)
-        out["ax"].append((sim.conditions("thrust") + sim.conditions("f_aero_b")[:, 0]) / mass)
+        out["qbar"].append(v.conditions("qbar").copy())
+        mass = sim.timeline.interp("mass", v.t)
+        out["ax"].append((v.conditions("thrust") + v.conditions("f_aero_b")[:, 0]) / mass)
     return {k: np.asarray(v) for k, v in out.items()}
 
 
@@ -171,8 +172,9 @@ def run_stratos3(model: str, drop_thrust_n: float | None = None, thesis_slosh: b
         if vehicle != "stratos3":
             Path(vehicle).unlink(missing_ok=True)
     scale, offset = _thesis_slosh(sim) if thesis_slosh and sim.dynamics.n_slosh else (None, None)
-    sim.reset(batch=len(winds), rng=np.random.default_rng(0), winds=winds, param_scale=scale, param_offset=offset)
-    return fly(sim, STRATOS3_T_END, dt)
+    data = sim.reset(batch=len(winds), rng=np.random.default_rng(0), winds=winds, param_scale=scale,
+                     param_offset=offset)
+    return fly(sim, data, STRATOS3_T_END, dt)
 
 
 def run_smile(model: str, winds: dict[str, Any] | None = None, gimbal_sine: tuple[float, float] | None = None,
@@ -180,8 +182,8 @@ def run_smile(model: str, winds: dict[str, Any] | None = None, gimbal_sine: tupl
     """SMILE uncontrolled (or with a gimbal sine), one batch row per wind (default :func:`smile_winds`)."""
     w = list((winds or smile_winds()).values())
     sim = Simulator("smile", model, launch=SMILE, timeline=TimelineSpec(t_end=SMILE_T_END))
-    sim.reset(batch=len(w), rng=np.random.default_rng(0), winds=w)
-    return fly(sim, t_end, dt, gimbal_sine)
+    data = sim.reset(batch=len(w), rng=np.random.default_rng(0), winds=w)
+    return fly(sim, data, t_end, dt, gimbal_sine)
 
 
 def stratos3_summary(dt: float = 0.05) -> list[dict[str, Any]]:
