@@ -134,13 +134,15 @@ def options() -> str:
     from lvgym.envs.spec import GROUPS, TaskSpec
 
     top = field_docs(TaskSpec)
-    rows = [["", "`vehicle`", "(the env's)", "a shipped name, a YAML path or a `SlenderGeometry`", _markdown(top["vehicle"])],
+    rows = [["", "`vehicle`", "(the env's)", "a shipped name, a YAML path or a `SlenderGeometry`",
+             _markdown(top["vehicle"])],
             ["", "`model`", "`'nonrigid'`", "`rigid`, `slosh`, `flex`, `nonrigid`", _markdown(top["model"])]]
     for group, cls in GROUPS.items():
         docs = field_docs(cls)
         for f in dataclasses.fields(cls):
             rule = rule_of(f)
-            rows.append([f"`{group}`", f"`{f.name}`", f"`{_shown(f.default)}`", rule.allowed() if rule else "see the meaning",
+            allowed = rule.allowed() if rule else "see the meaning"
+            rows.append([f"`{group}`", f"`{f.name}`", f"`{_shown(f.default)}`", allowed,
                          _markdown(docs[f.name])])
     return _table(["group", "keyword", "default", "allowed", "meaning"], rows)
 

@@ -96,7 +96,8 @@ class Dispersion:
 
     def __post_init__(self) -> None:
         if self.law not in LAWS or self.effect not in EFFECTS:
-            raise ValueError(f"dispersion {self.name!r}: law {self.law!r} of {LAWS}, effect {self.effect!r} of {EFFECTS}")
+            raise ValueError(f"dispersion {self.name!r}: law {self.law!r} of {LAWS}, effect {self.effect!r} of "
+                             f"{EFFECTS}")
         if self.law == "normal" and not 0.0 < self.sigma <= self.clip:
             raise ValueError(f"dispersion {self.name!r}: sigma {self.sigma} > 0 and clip {self.clip} >= sigma")
 
@@ -128,7 +129,8 @@ class Dispersion:
     def law_text(self) -> str:
         """The law and its spread in words (the docs table's column)."""
         if self.law == "normal":
-            return f"x N(1, {self._amount(self.sigma)})" if self.effect == "factor" else f"+ N(0, {self._amount(self.sigma)})"
+            sigma = self._amount(self.sigma)
+            return f"x N(1, {sigma})" if self.effect == "factor" else f"+ N(0, {sigma})"
         if self.law == "log_uniform":
             return f"x log-uniform [{self.low:g}, {self.high:g}]"
         return f"+ {' or '.join(str(k) for k in range(int(self.low), int(self.high) + 1))} {self.unit}"
@@ -139,7 +141,9 @@ class Dispersion:
 
 
 def _normal(name: str, what: str, moves: tuple, sigma: float, clip: float, source: str, **kw: Any) -> Dispersion:
-    return Dispersion(name, what, moves, "normal", kw.pop("effect", "factor"), sigma=sigma, clip=clip, source=source, **kw)
+    """A row of the normal law (a factor unless ``effect="offset"``)."""
+    return Dispersion(name, what, moves, "normal", kw.pop("effect", "factor"), sigma=sigma, clip=clip, source=source,
+                      **kw)
 
 
 _TWO = "the damping of a baffled tank is known to a factor of two at best"
@@ -175,7 +179,8 @@ DISPERSIONS: tuple[Dispersion, ...] = (
             "the same for frequencies; with `slosh_frequency=\"specific_force\"` the damper's frequency follows "
             "from the dispersed length"),
     Dispersion("bending_damping", "modal damping ratios", (Move("params.zeta_modes"),), "log_uniform", "factor",
-               low=0.5, high=2.0, source="structural damping is seldom known better than a factor of two before flight"),
+               low=0.5, high=2.0,
+               source="structural damping is seldom known better than a factor of two before flight"),
     _normal("servo_bandwidth", "the servo's natural frequency", (Move("servo.frequency_scale"),), 0.1, 0.3,
             "a hydraulic or electromechanical actuator's bandwidth moves with load, supply pressure and "
             "temperature by some ten per cent"),
@@ -221,7 +226,8 @@ class DispersionPlan:
                 "loads": DISPERSION.pack({"thrust_scale": 1.0, "normal_scale": 1.0, "axial_scale": 1.0}),
                 "servo": SERVO_DISPERSION.pack({"frequency_scale": 1.0}), "station": np.zeros(1)}
 
-    def draw(self, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, float]:
+    def draw(self, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray,
+                                                      float]:
         """One row's parameter scale and offset (n_p,), thrust misalignment (2,) [rad], load dispersions
         (layout DISPERSION), servo dispersion (layout :data:`SERVO_DISPERSION`) and IMU station shift [m],
         drawn from ``rng`` row by row in the table's order."""

@@ -22,7 +22,8 @@ from .dispersions import RANDOMIZE, RANDOMIZE_V0
 
 __all__ = ["ActuatorOptions", "AtmosphereOptions", "CoastOptions", "DispersionOptions", "GuidanceOptions",
            "LaunchOptions", "LimitOptions", "Options", "PhysicsOptions", "RewardOptions", "Rule", "SensorOptions",
-           "TimingOptions", "option", "rule_of", "CONTROLS", "OBSERVATIONS", "REFERENCES", "REFERENCE_VELOCITIES", "WIND_TIERS"]
+           "TimingOptions", "option", "rule_of", "CONTROLS", "OBSERVATIONS", "REFERENCES", "REFERENCE_VELOCITIES",
+           "WIND_TIERS"]
 
 #: protocol v0's wind tiers, then v1's, then ``random_gust`` (v1's gust alone, for the error budget)
 WIND_TIERS = ("none", "profile", "gust", "turbulence", "random", "turbulence_gust", "maxq_gust", "random_gust")
@@ -69,7 +70,8 @@ class Rule:
         elif self.boolean:
             return "true, false or None" if self.optional else "true or false"
         elif self.lo is not None:
-            text = f"{'integer' if self.integer else 'number'} in {'(' if self.lo_open else '['}{self.lo:g}, {self.hi:g}]"
+            left = "(" if self.lo_open else "["
+            text = f"{'integer' if self.integer else 'number'} in {left}{self.lo:g}, {self.hi:g}]"
         else:
             return "None" if self.optional else ""
         return f"None or {text}" if self.optional else text
@@ -140,7 +142,8 @@ class TimingOptions(Options):
         check_number("control_dt_s", self.control_dt_s, self.physics_dt_s, 1.0)
         n = self.control_dt_s / self.physics_dt_s
         if abs(n - round(n)) > 1e-6:
-            raise ConfigError("control_dt_s", self.control_dt_s, f"a whole multiple of physics_dt_s = {self.physics_dt_s}")
+            raise ConfigError("control_dt_s", self.control_dt_s,
+                              f"a whole multiple of physics_dt_s = {self.physics_dt_s}")
 
     @property
     def substeps(self) -> int:
@@ -186,7 +189,8 @@ class DispersionOptions(Options):
 
     def check(self) -> None:
         r = self.randomize
-        names = set(RANDOMIZE_V0) if r is True else set() if r in (False, None) else set(r) if not isinstance(r, str) else {r}
+        names = (set(RANDOMIZE_V0) if r is True else set() if r in (False, None) else {r} if isinstance(r, str)
+                 else set(r))
         bad = sorted(names - set(RANDOMIZE))
         if bad:
             raise ConfigError("randomize", bad[0], f"True (the v0 set {RANDOMIZE_V0}), False or a set of {RANDOMIZE}")

@@ -104,7 +104,8 @@ def _group(name: str, value: Any, current: Any) -> Any:
         known = [f.name for f in fields(cls)]
         for key in value:
             if key not in known:
-                raise ConfigError(f"{name}.{key}", value[key], f"unknown option of {cls.__name__}{did_you_mean(key, known)}; "
+                raise ConfigError(f"{name}.{key}", value[key],
+                                  f"unknown option of {cls.__name__}{did_you_mean(key, known)}; "
                                   f"its options: {known}")
         return replace(current, **value)
     raise ConfigError(name, value, f"a {cls.__name__} or a mapping of its options")
@@ -216,7 +217,8 @@ def check_keywords(options: Mapping[str, Any], also: tuple[str, ...] = ()) -> No
     known ones (and of ``also``, an env's own keywords) and where the options are documented."""
     for key in options:
         if key not in KEYWORDS:
-            raise ConfigError(key, options[key], f"unknown option{did_you_mean(key, sorted(set(KEYWORDS) | set(also)))}; "
+            close = did_you_mean(key, sorted(set(KEYWORDS) | set(also)))
+            raise ConfigError(key, options[key], f"unknown option{close}; "
                               f"the env options: {OPTIONS_DOC}")
 
 
