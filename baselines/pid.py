@@ -58,6 +58,7 @@ docs/flex-design.md, "The slender vehicle").
 from __future__ import annotations
 
 import math
+from collections.abc import Hashable
 from dataclasses import dataclass, field
 from functools import cached_property
 from pathlib import Path
@@ -65,8 +66,8 @@ from typing import Any
 
 import numpy as np
 
-from lvgym.envs.ascent import DEFAULT_AERO_MACH, SlenderAscentV1Env, slender_key
 from lvgym.envs.layouts import G0
+from lvgym.envs.presets import SLENDER_V1
 from lvgym.errors import ConfigError
 from lvgym.vehicle.yamlfile import read_yaml
 
@@ -376,17 +377,17 @@ def smile_scheduled_pid(env: Any, schedule: str = "smile_thesis", name: str | No
 
 
 #: the gs-pid-flex schedule (``baselines/schedules/<name>.yaml``, written by ``python -m lvgym.baselines.design.flexdesign``)
-#: of each vehicle a v1 env flies, keyed by the env's ``task.vehicle`` (a name, or the slender vehicle's key
-#: tuple: ``SlenderAscent-v1``'s default 8.5 m x 0.2833 m, 4.5 mm tube, with load relief; docs/flex-design.md)
-FLEX_SCHEDULES: dict = {"smile_v1": "smile_flex", "stratos3": "stratos3_flex",
-                        slender_key(8.5, 0.2833, DEFAULT_AERO_MACH, SlenderAscentV1Env.WALL_THICKNESS_M): "slender_flex"}
+#: of each vehicle a v1 env flies, keyed by the env's ``task.vehicle`` (a name, or the slender vehicle's
+#: SlenderGeometry: ``SlenderAscent-v1``'s default 8.5 m x 0.2833 m, 4.5 mm tube, with load relief;
+#: docs/flex-design.md)
+FLEX_SCHEDULES: dict = {"smile_v1": "smile_flex", "stratos3": "stratos3_flex", SLENDER_V1.vehicle: "slender_flex"}
 
 
 def flex_pid(env: Any, name: str = "gs-pid-flex") -> GainScheduledPIDPolicy:
     """``gs-pid-flex``: the filtered gain-scheduled PID designed on the non-rigid v1 flight loop of the
     vehicle ``env`` flies (:data:`FLEX_SCHEDULES`); a vehicle without a flex design is refused."""
     vehicle = getattr(env.unwrapped.task, "vehicle", None)
-    if not isinstance(vehicle, (str, tuple)) or vehicle not in FLEX_SCHEDULES:
+    if not isinstance(vehicle, Hashable) or vehicle not in FLEX_SCHEDULES:
         raise ConfigError("env vehicle", vehicle, f"one of {list(FLEX_SCHEDULES)}: the vehicles of a v1 env "
                           "with a gs-pid-flex schedule (python -m lvgym.baselines.design.flexdesign --vehicle ...)")
     return GainScheduledPIDPolicy(FLEX_SCHEDULES[vehicle], env=env, name=name)
