@@ -232,27 +232,33 @@ class LQGPolicy:
 
 
 class LQGBatch:
-    """``n`` independent copies of an :class:`LQGPolicy` (one per env row), stepped together: ``act(rows,
-    observations, infos)`` gives the actions of the rows ``rows`` (an :class:`LQGPolicy` per row would give
-    the same, each in its own Python call; ``lvgym.agents.residual`` uses this for a residual's baselines)."""
+    """``n`` independent copies of an :class:`LQGPolicy` (one per env row), stepped together: the batched
+    interface of :mod:`.batch` (``act(rows, observations, info)`` with the batched env's info, of which it
+    reads ``info["time"][rows]``); an :class:`LQGPolicy` per row would give the same actions, each in its
+    own Python call (``lvgym.agents.residual`` uses this for a residual's baselines). ``gimbal`` (n, 2)
+    [rad]: each row's last command (the policy's ``last_gimbal``)."""
 
     def __init__(self, policy: LQGPolicy, n: int) -> None:
         self.name, self.limit = policy.name, policy.limit
         self._i_err, self._i_on = policy._i_err, policy._i_on
         self.axes = [LQGLaw(policy.schedule.rows[p], policy.schedule, policy.limit, n) for p in PLANES]
+        self.gimbal = np.zeros((int(n), 2))
 
     def reset(self, rows: Any) -> None:
         """Rows ``rows`` start an episode."""
         for law in self.axes:
             law.reset(rows)
+        self.gimbal[np.asarray(rows, dtype=np.int64).reshape(-1)] = 0.0
 
-    def act(self, rows: Any, observations: np.ndarray, infos: list[dict[str, Any]]) -> np.ndarray:
+    def act(self, rows: Any, observations: np.ndarray, info: dict[str, Any]) -> np.ndarray:
         """Actions (len(rows), 2) float32 of the rows ``rows`` for their observations (len(rows), n_obs) and
-        infos (each with ``time``)."""
-        obs = np.asarray(observations, dtype=float).reshape(len(infos), -1)
+        the batched env's ``info`` (every row's ``time``)."""
+        rows = np.asarray(rows, dtype=np.int64).reshape(-1)
+        obs = np.asarray(observations, dtype=float).reshape(rows.size, -1)
         on = obs[:, self._i_on] >= 0.5
-        t = np.array([float(i["time"]) for i in infos])
+        t = np.asarray(info["time"], dtype=float)[rows]
         u = np.stack([law.update(obs[:, i], t, on, rows) for law, i in zip(self.axes, self._i_err)], axis=1)
+        self.gimbal[rows] = u
         return np.clip(u / self.limit, -1.0, 1.0).astype(np.float32)
 
 
