@@ -16,10 +16,10 @@ from typing import Any
 import numpy as np
 
 from .filters import StructuralFilter
-from .pidkernel import (FILTERS_NONE, FILTERS_ROWS, FILTERS_TABLE, VAR_FIXED, VAR_MACH, VAR_VALUE, ObsColumns,
-                        PIDSetup, PIDState, PIDTable, pid_act_k)
+from .pidkernel import (COEFFS, FILTER_ROW, FILTERS_NONE, FILTERS_ROWS, FILTERS_TABLE, GAINS, PID_ROW, SECTIONS,
+                        VAR_FIXED, VAR_MACH, VAR_VALUE, ObsColumns, PIDSetup, PIDState, PIDTable, pid_act_k)
 
-__all__ = ["PIDBatch", "new_state", "obs_columns", "tables"]
+__all__ = ["PIDBatch", "coefficients", "new_state", "obs_columns", "tables"]
 
 #: the info key of each scheduling variable read from the info (Mach comes from the observation)
 _INFO_KEY = {"mass": "mass", "time": "time"}
@@ -31,21 +31,19 @@ def obs_columns(policy: Any) -> ObsColumns:
     return ObsColumns(np.asarray(policy._i_err, dtype=np.int64), acc, int(policy._i_on), int(policy._i_mach), -1)
 
 
-def _filter_blocks(filters: list[StructuralFilter], dt: float) -> tuple[np.ndarray, ...]:
-    """``fb``, ``fa`` (m, S, 3), ``fbsum``, ``fasum`` (m, S) of ``filters`` discretised at ``dt`` [s]."""
-    coeffs = [f.discrete(dt) for f in filters]
-    S = len(coeffs[0])
-    fb, fa, fbsum, fasum = np.zeros((len(filters), S, 3)), np.zeros((len(filters), S, 3)), \
-        np.zeros((len(filters), S)), np.zeros((len(filters), S))
-    for i, sections in enumerate(coeffs):
-        _write(sections, fb[i], fa[i], fbsum[i], fasum[i])
-    return fb, fa, fbsum, fasum
-
-
-def _write(sections: list, fb: np.ndarray, fa: np.ndarray, fbsum: np.ndarray, fasum: np.ndarray) -> None:
-    """One filter's discrete sections into its coefficient rows (the sums as ``FilterChain.reset`` takes them)."""
+def coefficients(filt: StructuralFilter, dt: float, out: np.ndarray | None = None) -> np.ndarray:
+    """The discrete sections of ``filt`` at ``dt`` [s] (:meth:`.filters.StructuralFilter.discrete`, the
+    per-row policy's call) packed by :data:`.pidkernel.COEFFS` into ``out`` (a new vector by default); the
+    sums as :meth:`.filters.FilterChain.reset` takes them (``b.sum()``, ``a.sum()``)."""
+    out = COEFFS.zeros() if out is None else out
+    sections = filt.discrete(dt)
+    if len(sections) != SECTIONS:
+        raise ValueError(f"a structural filter of {len(sections)} sections: the kernel runs {SECTIONS}")
+    b, a = COEFFS.view(out, "b"), COEFFS.view(out, "a")
+    bsum, asum = COEFFS.view(out, "bsum"), COEFFS.view(out, "asum")
     for s, (bz, az) in enumerate(sections):
-        fb[s], fa[s], fbsum[s], fasum[s] = bz, az, bz.sum(), az.sum()
+        b[s], a[s], bsum[s], asum[s] = bz, az, bz.sum(), az.sum()
+    return out
 
 
 def tables(policy: Any) -> tuple[PIDTable, PIDSetup]:
@@ -53,42 +51,41 @@ def tables(policy: Any) -> tuple[PIDTable, PIDSetup]:
     pid = policy.axes[0]
     schedule = getattr(policy, "schedule", None)
     signs = np.asarray(policy.accel_signs, dtype=float)
+    no_filters = np.zeros((1, COEFFS.size))
     if schedule is None:                                   # fixed gains: a table of one row, read as nearest
-        one = lambda v: np.array([float(v)])               # noqa: E731
-        tb = PIDTable(one(0.0), one(0.0), np.zeros(1, np.int64), one(pid.kp), one(pid.ki), one(pid.kd), one(pid.n),
-                      one(policy.accel_gain), *_no_filters())
+        gains = GAINS.pack({"kp": pid.kp, "ki": pid.ki, "kd": pid.kd, "n": pid.n, "accel": policy.accel_gain})
+        tb = PIDTable(np.zeros(1), np.zeros(1), np.zeros(1, np.int64), gains.reshape(-1, 1), no_filters)
         return tb, PIDSetup(pid.dt, policy.limit, VAR_FIXED, True, policy.accel_gain != 0.0, FILTERS_NONE, signs)
     x, xs, cols = schedule._table
     rank = np.empty(x.size, np.int64)
     rank[np.argsort(x)] = np.arange(x.size)
-    accel = cols.get("accel_gain", np.zeros(x.size))
+    gains = np.zeros((GAINS.size, x.size))
+    for name, col in (("kp", "kp"), ("ki", "ki"), ("kd", "kd"), ("n", "n"), ("accel", "accel_gain")):
+        gains[GAINS.index(name)] = cols.get(col, 0.0)
     nearest = schedule.interpolation == "nearest"
     if schedule.filters is None:
-        blocks, filters = _no_filters(), FILTERS_NONE
+        coeffs, filters = no_filters, FILTERS_NONE
     elif nearest:
-        blocks, filters = _filter_blocks(list(schedule.filters), pid.dt), FILTERS_TABLE
+        coeffs, filters = np.array([coefficients(f, pid.dt) for f in schedule.filters]), FILTERS_TABLE
     else:
-        blocks, filters = _no_filters(len(schedule.filter_at(schedule.points[0]).discrete(pid.dt))), FILTERS_ROWS
-    tb = PIDTable(x, xs, rank, cols["kp"], cols["ki"], cols["kd"], cols["n"], accel, *blocks)
+        coeffs, filters = no_filters, FILTERS_ROWS
     variable = VAR_MACH if schedule.variable == "mach" else VAR_VALUE
+    tb = PIDTable(x, xs, rank, np.ascontiguousarray(gains), coeffs)
     return tb, PIDSetup(pid.dt, policy.limit, variable, nearest, schedule.accel_gain is not None, filters, signs)
 
 
-def _no_filters(S: int = 0) -> tuple[np.ndarray, ...]:
-    return np.zeros((1, S, 3)), np.zeros((1, S, 3)), np.ones((1, S)), np.ones((1, S))
-
-
-def new_state(n: int, S: int) -> PIDState:
-    """The state of ``n`` rows with filters of ``S`` sections, as after :meth:`PIDBatch.reset`."""
-    z2 = lambda: np.zeros((n, 2))                      # noqa: E731
-    return PIDState(z2(), z2(), z2(), np.zeros((n, 2), bool), np.zeros((n, 2), bool), np.zeros(n, bool),
-                    np.zeros((n, 2, S)), np.zeros((n, 2, S)), np.zeros((n, S, 3)), np.zeros((n, S, 3)),
-                    np.ones((n, S)), np.ones((n, S)), np.full(n, -1, np.int64), z2())
+def new_state(n: int) -> PIDState:
+    """The state of ``n`` rows, as after :meth:`PIDBatch.reset` (no filter in use yet; the coefficient
+    sums 1, so that a row without filters divides by nothing else)."""
+    pid = PID_ROW.pack({"filt": -1.0}, n)
+    filters = FILTER_ROW.pack({"bsum": 1.0, "asum": 1.0}, n)
+    return PIDState(pid, filters)
 
 
 class PIDBatch:
-    """``n`` rows of a PID-family ``policy`` (:meth:`.pid.PIDPolicy.batch` says which), stepped together; the batched interface
-    of :mod:`.batch`. ``gimbal`` (n, 2) [rad]: each row's last command (the policy's ``last_gimbal``)."""
+    """``n`` rows of a PID-family ``policy`` (:meth:`.pid.PIDPolicy.batch` says which), stepped together;
+    the batched interface of :mod:`.batch`. :attr:`gimbal` (n, 2) [rad]: each row's last command (the
+    policy's ``last_gimbal``)."""
 
     def __init__(self, policy: Any, n: int) -> None:
         self.name, self.n = policy.name, int(n)
@@ -96,21 +93,22 @@ class PIDBatch:
         self.dt = float(policy.dt)
         self.tb, self.su = tables(policy)
         self.oc = obs_columns(policy)
-        self.st = new_state(self.n, self.tb.fb.shape[1])
+        self.st = new_state(self.n)
         self._filters: list[StructuralFilter | None] = [None] * self.n     # FILTERS_ROWS: each row's filter
         self._none = np.zeros(self.n)
         self._key = _INFO_KEY.get(self.schedule.variable) if self.schedule is not None else None
 
     @property
     def gimbal(self) -> np.ndarray:
-        return self.st.gimbal
+        return PID_ROW.view(self.st.pid, "gimbal")
 
     def reset(self, rows: Any) -> None:
-        """Rows ``rows`` start an episode (:meth:`.pid.PIDPolicy.reset`: the PIDs and the filters' start)."""
+        """Rows ``rows`` start an episode (:meth:`.pid.PIDPolicy.reset`: the PIDs and the filters' start;
+        the filter in use stays, as the policy's chains keep theirs)."""
         w = np.asarray(rows, dtype=np.int64).reshape(-1)
-        st = self.st
-        st.integral[w], st.deriv[w], st.e_prev[w], st.has_prev[w], st.saturated[w] = 0.0, 0.0, 0.0, False, False
-        st.filtering[w], st.gimbal[w] = False, 0.0
+        filt = self.st.pid[w, PID_ROW.index("filt")]
+        self.st.pid[w] = PID_ROW.zeros()
+        self.st.pid[w, PID_ROW.index("filt")] = filt
 
     def values(self, info: dict[str, Any]) -> np.ndarray:
         """Each row's scheduling value (n,) from the batched ``info`` (mass [kg] or time [s]), or zeros."""
@@ -123,12 +121,12 @@ class PIDBatch:
         value of the scheduling variable (discretised when it changed)."""
         if self.su.filters != FILTERS_ROWS:
             return
-        st = self.st
+        coeffs = self.st.filters[:, FILTER_ROW.slice("coeffs")]
         for j, b in enumerate(rows):
             v = float(obs[j, self.oc.mach]) * 10.0 if self.su.variable == VAR_MACH else float(value[b])
             filt = self.schedule.filter_at(v)
             if filt != self._filters[b]:
-                _write(filt.discrete(self.dt), st.fb[b], st.fa[b], st.fbsum[b], st.fasum[b])
+                coeffs[b] = coefficients(filt, self.dt)
                 self._filters[b] = filt
 
     def act(self, rows: Any, observations: np.ndarray, info: dict[str, Any]) -> np.ndarray:
