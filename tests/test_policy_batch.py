@@ -125,3 +125,13 @@ def test_the_schedule_lookups_are_numpys():
                 assert got == want or (np.isnan(got) and np.isnan(want)), (m, x)
             for x in np.r_[xp, rng.uniform(90.0, 210.0, 50), 0.5 * (xp[:-1] + xp[1:])]:
                 assert nearest_k(xp[::-1].copy(), float(x)) == int(np.argmin(np.abs(xp[::-1] - x)))
+
+
+def test_the_speed_study_replays_the_same_actions():
+    """experiments/policy_batch_speed: the recorded flight replayed through per-row policies and the batch
+    (it raises where their actions differ) gives a time per call of each."""
+    from experiments.policy_batch_speed.act_speed import time_policy
+
+    r = time_policy("aac", "smile-v1", rows=2, steps=120, repeats=1)
+    assert r["policy"] == "aac" and r["batch"] == "AACBatch"
+    assert r["row_us"] > 0.0 and r["batch_row_us"] > 0.0 and r["batch_call_us"] == pytest.approx(2 * r["batch_row_us"])
