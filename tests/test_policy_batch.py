@@ -13,11 +13,11 @@ import pytest
 
 import lvgym
 import lvgym.baselines  # noqa: F401  (registers the baselines)
-from lvgym.baselines.aac import flex_aac
+from lvgym.baselines.aac import AdaptiveAugmentingPolicy, flex_aac
 from lvgym.baselines.aacbatch import AACBatch
 from lvgym.baselines.batch import RowCopies
 from lvgym.baselines.lqg import LQGBatch
-from lvgym.baselines.pid import GainSchedule, GainScheduledPIDPolicy, PIDPolicy
+from lvgym.baselines.pid import GainSchedule, GainScheduledPIDPolicy, PIDPolicy, flex_pid
 from lvgym.baselines.pidbatch import PIDBatch
 from lvgym.baselines.pidkernel import interp_k, nearest_k
 from lvgym.benchmark.registry import POLICIES
@@ -109,7 +109,12 @@ def test_schedules_read_other_ways_and_aac_options():
 
 
 def test_a_law_the_kernels_do_not_know_flies_as_copies():
+    """A subclass of PIDPolicy, and aac on a base that is no PID of the kernels (the AAC tuning study's
+    scaled base, which delegates its attributes and must survive the copy)."""
+    from experiments.aac_tuning.aac_sweep import ScaledBase
+
     fly("smile-v1", lambda env: Halved(env=env, name="halved"), RowCopies, seed=6)
+    fly("smile-v1", lambda env: AdaptiveAugmentingPolicy(ScaledBase(flex_pid(env), 2.0), env=env), RowCopies, seed=7)
 
 
 def test_the_schedule_lookups_are_numpys():
