@@ -30,8 +30,8 @@ from lvgym.benchmark.registry import POLICIES
 from lvgym.benchmark.runner import build_policy
 from lvgym.errors import ConfigError, check_number
 
-__all__ = ["DEFAULT_BASELINE", "ResidualConfig", "ResidualEnv", "ResidualPolicy", "ResidualRows", "ResidualVecEnv",
-           "combine", "residual_options", "residual_venv"]
+__all__ = ["DEFAULT_BASELINE", "INFO_KEYS", "ResidualConfig", "ResidualEnv", "ResidualPolicy", "ResidualRows",
+           "ResidualVecEnv", "combine", "residual_options", "residual_venv", "stack_infos"]
 
 DEFAULT_BASELINE = "gs-pid-flex"
 #: registered policies that cannot be a residual's baseline (learned ones: the residual is on a classical law)
@@ -86,11 +86,22 @@ def combine(base: np.ndarray, learned: np.ndarray, scale: float) -> np.ndarray:
     return np.clip(mixed, -1.0, 1.0).astype(np.float32)
 
 
+#: the info keys a baseline's batch reads from the stacked infos (:func:`stack_infos`): a reset's info has
+#: these and no more (lvgym.baselines.batch)
+INFO_KEYS = ("time", "cumulative_rate_error", "mass", "controller_on")
+
+
+def stack_infos(infos: list[dict[str, Any]]) -> dict[str, np.ndarray]:
+    """The per-row ``infos`` (one dict per row, as an SB3 ``VecEnv`` gives them) as a batched info dict:
+    each of :data:`INFO_KEYS` that every row has, as an array with a leading axis of the rows."""
+    return {k: np.array([i[k] for i in infos]) for k in INFO_KEYS if all(k in i for i in infos)}
+
+
 class ResidualRows:
     """One baseline per env row (built by its registry factory on ``env``, a single or batched lvgym env)
     and the baseline action of each row for its coming step (:attr:`base`, (rows, n_a) float32). A baseline
-    whose policy has ``batch(n)`` (``lqg``: :class:`lvgym.baselines.lqg.LQGBatch`) flies every row in one object,
-    stepped together; the others, one policy per row."""
+    whose policy has ``batch(n)`` (the classical ones: :mod:`lvgym.baselines.batch`) flies every row in one
+    object, stepped together; the others, one policy per row."""
 
     def __init__(self, config: ResidualConfig, env: Any, rows: int) -> None:
         if not hasattr(env.action_space, "low"):
@@ -115,11 +126,12 @@ class ResidualRows:
         self.advance(rows, obs, infos)
 
     def advance(self, rows: Any, obs: np.ndarray, infos: list[dict[str, Any]]) -> None:
-        """Rows ``rows`` went one step on: their baselines act on the new observation."""
+        """Rows ``rows`` went one step on: their baselines act on the new observation (``infos``: every
+        row's info)."""
         if self.batch is not None:
             rows = np.asarray(list(rows), dtype=int)
             if rows.size:
-                self.base[rows] = self.batch.act(rows, obs[rows], [infos[b] for b in rows])
+                self.base[rows] = self.batch.act(rows, obs[rows], stack_infos(infos))
             return
         for b in rows:
             self.base[b] = self.policies[b].act(obs[b], infos[b])

@@ -71,8 +71,10 @@ from lvgym.envs.presets import SLENDER_V1
 from lvgym.errors import ConfigError
 from lvgym.vehicle.yamlfile import read_yaml
 
+from .batch import RowCopies
 from .filecache import read_once
 from .filters import FILTER_KEYS, FilterChain, StructuralFilter
+from .pidbatch import PIDBatch
 
 SCHEDULES = Path(__file__).resolve().parent / "schedules"
 VARIABLES = ("mass", "time", "mach")
@@ -324,6 +326,23 @@ class PIDPolicy:
         errors = self.filtered(self.errors(obs), on)
         self.last_gimbal = np.array([pid.update(e, on) for pid, e in zip(self.axes, errors)])
         return np.clip(self.last_gimbal / self.limit, -1.0, 1.0).astype(np.float32)
+
+    def batch(self, n: int) -> PIDBatch | RowCopies:
+        """The same controller for ``n`` rows of a batched env, stepped together (:mod:`.batch`): the compiled
+        :class:`.pidbatch.PIDBatch` for a PIDPolicy or GainScheduledPIDPolicy as built (both axes with the
+        same gains, limits and period; filters only from a schedule), else one copy of the policy per row."""
+        return PIDBatch(self, n) if self._batchable() else RowCopies(self, n)
+
+    def _batchable(self) -> bool:
+        kind = type(self)
+        if kind not in (PIDPolicy, GainScheduledPIDPolicy):        # a subclass may change the law
+            return False
+        a, b = self.axes
+        if not (a.dt == b.dt and a.u_min == b.u_min == -self.limit and a.u_max == b.u_max == self.limit):
+            return False
+        if kind is GainScheduledPIDPolicy:
+            return (self.chains is None) == (self.schedule.filters is None)
+        return self.chains is None and (a.kp, a.ki, a.kd, a.n) == (b.kp, b.ki, b.kd, b.n)
 
 
 class GainScheduledPIDPolicy(PIDPolicy):
