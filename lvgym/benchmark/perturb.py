@@ -31,7 +31,7 @@ from .policy import Policy
 from .runner import PolicySpec, episode_objects, play_episode
 from .suites import Condition
 
-__all__ = ["ActuatorDelay", "GainPolicy", "find_threshold", "db_to_gain", "fly", "gain_to_db"]
+__all__ = ["ActuatorDelay", "GainPolicy", "RowDelay", "find_threshold", "db_to_gain", "fly", "gain_to_db"]
 
 
 def db_to_gain(db: float) -> float:
@@ -112,6 +112,51 @@ class ActuatorDelay(gym.Wrapper):
             self._queue.append(np.array(action, copy=True))
             action = self._queue.popleft()
         return self.env.step(action)
+
+
+class RowDelay:
+    """:class:`ActuatorDelay` for the rows of a batched lvgym TVC env, each its own delay: row ``b`` gets
+    ``steps[b]`` physics steps (0: none), split as the wrapper splits them (whole periods into a
+    first-in first-out buffer of actions that starts neutral; the rest added to the row's servo delay,
+    written here, right after the env's reset). :meth:`apply` takes the actions the policies gave every
+    row and returns those the env gets (float64, which holds every action's value exactly)."""
+
+    def __init__(self, env: Any, steps: Any) -> None:
+        u = env.unwrapped
+        task = u.task
+        if task.control != "tvc":
+            raise ValueError(f"control = {task.control!r}: an actuator delay needs a TVC env")
+        n = int(env.num_envs)
+        raw = np.asarray(steps).reshape(-1)
+        if raw.size != n or np.any(raw < 0) or np.any(raw != np.round(raw)):
+            raise ValueError(f"steps = {raw.tolist()!r}: {n} whole numbers of physics steps >= 0, one per row")
+        steps = raw.astype(np.int64)
+        per = int(task.substeps)
+        self.physics_dt_s = float(task.control_dt_s) / per
+        delay = ACTUATOR.view(u.state.sim.actuator, "delay")
+        self.length = np.zeros(n, dtype=np.int64)
+        for b in np.flatnonzero(steps).tolist():
+            periods, servo_steps = divmod(int(steps[b]), per)
+            more, delay[b, 0] = divmod(int(round(delay[b, 0])) + servo_steps, per)
+            self.length[b] = periods + more
+        self.rows = np.flatnonzero(self.length)
+        n_a = int(np.prod(u.single_action_space.shape))
+        self._buffer = np.zeros((n, max(1, int(self.length.max(initial=0))), n_a))
+        self._next = np.zeros(n, dtype=np.int64)
+
+    def apply(self, actions: np.ndarray) -> np.ndarray:
+        """The actions (n, n_a) the env gets this step: a buffered row's oldest action (its buffer takes
+        this one), the others' own."""
+        q = self.rows
+        if not q.size:
+            return actions
+        a = np.asarray(actions)
+        out = a.astype(np.float64)
+        k = self._next[q]
+        out[q] = self._buffer[q, k]
+        self._buffer[q, k] = a[q]
+        self._next[q] = (k + 1) % self.length[q]
+        return out
 
 
 def find_threshold(passes: Callable[[float], bool], safe: float, limit: float, tol: float, first_step: float,

@@ -19,7 +19,7 @@ from lvgym.errors import ConfigError
 from lvgym.parallel import EXECUTORS, default_workers, run_map
 
 from .factory import load_factory
-from .metrics import TrajectoryBuilder, episode_metrics
+from .metrics import TrajectoryBuilder, combined_record, episode_metrics
 from .policy import Policy, ZeroPolicy
 from .scoring import FlightLog, flight_metrics
 from .suites import PROTOCOL_VERSION, Condition, Suite
@@ -118,13 +118,7 @@ def play_episode(policy: Policy, env: Any, seed: int) -> dict[str, Any]:
         log.step(env, obs, reward, info)
         if terminated or truncated:
             break
-    record = episode_metrics(traj.build())
-    v1 = flight_metrics(log)
-    for key in ("rate_error_rad", "failed", "failure_reason"):     # one definition, written once (v0's)
-        value = v1.pop(key)
-        if value != record[key]:
-            raise AssertionError(f"{key}: v1 {value!r} against v0 {record[key]!r}")
-    return {**record, **v1}
+    return combined_record(episode_metrics(traj.build()), flight_metrics(log))
 
 
 def episode_objects(policy_spec: PolicySpec, condition: Condition) -> tuple[Any, Policy]:
