@@ -26,11 +26,13 @@ from stable_baselines3.common.vec_env import VecEnvWrapper
 
 from lvgym.benchmark.policy import Policy
 import lvgym.baselines  # noqa: F401  (registers the baselines a residual policy flies on)
+from lvgym.benchmark.batch import RowPolicies, as_batch
 from lvgym.benchmark.registry import POLICIES
 from lvgym.benchmark.runner import build_policy
 from lvgym.errors import ConfigError, check_number
 
-__all__ = ["DEFAULT_BASELINE", "INFO_KEYS", "ResidualConfig", "ResidualEnv", "ResidualPolicy", "ResidualRows",
+__all__ = ["DEFAULT_BASELINE", "INFO_KEYS", "ResidualBatch", "ResidualConfig", "ResidualEnv", "ResidualPolicy",
+           "ResidualRows",
            "ResidualVecEnv", "combine", "residual_options", "residual_venv", "stack_infos"]
 
 DEFAULT_BASELINE = "gs-pid-flex"
@@ -189,7 +191,7 @@ class ResidualPolicy:
     the env gets (its observation history records that one, as the env's does)."""
 
     def __init__(self, learned: Any, config: ResidualConfig, env: Any, name: str | None = None) -> None:
-        self.learned, self.config = learned, config
+        self.learned, self.config, self.env = learned, config, env
         self.rows = ResidualRows(config, env, 1)
         self.name = name or getattr(learned, "name", "residual")
         self._fresh = True
@@ -208,4 +210,43 @@ class ResidualPolicy:
         action = self.rows.apply(self.learned.act(observation, info))[0]
         if hasattr(self.learned, "note_applied"):
             self.learned.note_applied(action)
+        return action
+
+    def batch(self, n: int) -> Any:
+        """The same policy for ``n`` rows of a batched env (:class:`ResidualBatch`; the interface of
+        :mod:`lvgym.benchmark.batch`); a learned policy without ``batch`` flies as one residual policy per row."""
+        if callable(getattr(self.learned, "batch", None)):
+            return ResidualBatch(self, n)
+        import copy
+
+        return RowPolicies(self, n, lambda: ResidualPolicy(copy.deepcopy(self.learned), self.config, self.env, self.name))
+
+
+class ResidualBatch:
+    """:class:`ResidualPolicy` for ``n`` rows: the baseline's batch (its ``batch(n)``, else one baseline per
+    row) and the learned policy's, mixed by :func:`combine`; each row's actions are the bits the residual
+    policy gives that row alone."""
+
+    def __init__(self, policy: ResidualPolicy, n: int) -> None:
+        self.name, self.config = policy.name, policy.config
+        spec = POLICIES[policy.config.baseline]
+        self.baseline = as_batch(build_policy(spec, policy.env), n, lambda: build_policy(spec, policy.env))
+        self.learned = policy.learned.batch(n)
+        self._fresh = np.ones(int(n), dtype=bool)
+
+    def reset(self, rows: Any) -> None:
+        rows = np.asarray(rows, dtype=np.int64).reshape(-1)
+        self.learned.reset(rows)
+        self._fresh[rows] = True
+
+    def act(self, rows: Any, observations: np.ndarray, info: dict[str, Any]) -> np.ndarray:
+        rows = np.asarray(rows, dtype=np.int64).reshape(-1)
+        fresh = rows[self._fresh[rows]]
+        if fresh.size:                               # the baseline starts its episode at the row's first step
+            self.baseline.reset(fresh)
+            self._fresh[fresh] = False
+        base = np.asarray(self.baseline.act(rows, observations, info), dtype=np.float32)
+        action = combine(base, np.reshape(self.learned.act(rows, observations, info), base.shape), self.config.scale)
+        if hasattr(self.learned, "note_applied"):
+            self.learned.note_applied(rows, action)
         return action
