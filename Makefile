@@ -21,7 +21,7 @@ verify: $(STAMP)
 	$(PY) -m lvgym.verify
 
 test: $(STAMP)
-	$(PY) -m pytest
+	$(PY) -m pytest -n auto
 
 bench: $(STAMP)
 	$(PY) -m lvgym.bench

@@ -273,6 +273,13 @@ class SB3Policy:
         self._last = np.asarray(action, dtype=np.float32)
         return action
 
+    def batch(self, n: int) -> Any:
+        """The same policy for ``n`` rows of a batched env (:class:`lvgym.agents.policybatch.SB3Batch`, the
+        interface of :mod:`lvgym.benchmark.batch`): each row's actions are the bits :meth:`act` gives it."""
+        from .policybatch import SB3Batch
+
+        return SB3Batch(self, n)
+
     def act_batch(self, observations: np.ndarray, episode_start: np.ndarray) -> np.ndarray:
         """Actions (B, n_a) for the observations (B, n_obs) of B env rows (a batched env's, with the
         model's own observation: a ``history`` env stacks natively); ``episode_start`` (B,) bool marks the

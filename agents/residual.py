@@ -26,12 +26,14 @@ from stable_baselines3.common.vec_env import VecEnvWrapper
 
 from lvgym.benchmark.policy import Policy
 import lvgym.baselines  # noqa: F401  (registers the baselines a residual policy flies on)
+from lvgym.benchmark.batch import RowPolicies, as_batch
 from lvgym.benchmark.registry import POLICIES
 from lvgym.benchmark.runner import build_policy
 from lvgym.errors import ConfigError, check_number
 
-__all__ = ["DEFAULT_BASELINE", "ResidualConfig", "ResidualEnv", "ResidualPolicy", "ResidualRows", "ResidualVecEnv",
-           "combine", "residual_options", "residual_venv"]
+__all__ = ["DEFAULT_BASELINE", "INFO_KEYS", "ResidualBatch", "ResidualConfig", "ResidualEnv", "ResidualPolicy",
+           "ResidualRows",
+           "ResidualVecEnv", "combine", "residual_options", "residual_venv", "stack_infos"]
 
 DEFAULT_BASELINE = "gs-pid-flex"
 #: registered policies that cannot be a residual's baseline (learned ones: the residual is on a classical law)
@@ -86,11 +88,22 @@ def combine(base: np.ndarray, learned: np.ndarray, scale: float) -> np.ndarray:
     return np.clip(mixed, -1.0, 1.0).astype(np.float32)
 
 
+#: the info keys a baseline's batch reads from the stacked infos (:func:`stack_infos`): a reset's info has
+#: these and no more (lvgym.baselines.batch)
+INFO_KEYS = ("time", "cumulative_rate_error", "mass", "controller_on")
+
+
+def stack_infos(infos: list[dict[str, Any]]) -> dict[str, np.ndarray]:
+    """The per-row ``infos`` (one dict per row, as an SB3 ``VecEnv`` gives them) as a batched info dict:
+    each of :data:`INFO_KEYS` that every row has, as an array with a leading axis of the rows."""
+    return {k: np.array([i[k] for i in infos]) for k in INFO_KEYS if all(k in i for i in infos)}
+
+
 class ResidualRows:
     """One baseline per env row (built by its registry factory on ``env``, a single or batched lvgym env)
     and the baseline action of each row for its coming step (:attr:`base`, (rows, n_a) float32). A baseline
-    whose policy has ``batch(n)`` (``lqg``: :class:`lvgym.baselines.lqg.LQGBatch`) flies every row in one object,
-    stepped together; the others, one policy per row."""
+    whose policy has ``batch(n)`` (the classical ones: :mod:`lvgym.baselines.batch`) flies every row in one
+    object, stepped together; the others, one policy per row."""
 
     def __init__(self, config: ResidualConfig, env: Any, rows: int) -> None:
         if not hasattr(env.action_space, "low"):
@@ -115,11 +128,12 @@ class ResidualRows:
         self.advance(rows, obs, infos)
 
     def advance(self, rows: Any, obs: np.ndarray, infos: list[dict[str, Any]]) -> None:
-        """Rows ``rows`` went one step on: their baselines act on the new observation."""
+        """Rows ``rows`` went one step on: their baselines act on the new observation (``infos``: every
+        row's info)."""
         if self.batch is not None:
             rows = np.asarray(list(rows), dtype=int)
             if rows.size:
-                self.base[rows] = self.batch.act(rows, obs[rows], [infos[b] for b in rows])
+                self.base[rows] = self.batch.act(rows, obs[rows], stack_infos(infos))
             return
         for b in rows:
             self.base[b] = self.policies[b].act(obs[b], infos[b])
@@ -177,7 +191,7 @@ class ResidualPolicy:
     the env gets (its observation history records that one, as the env's does)."""
 
     def __init__(self, learned: Any, config: ResidualConfig, env: Any, name: str | None = None) -> None:
-        self.learned, self.config = learned, config
+        self.learned, self.config, self.env = learned, config, env
         self.rows = ResidualRows(config, env, 1)
         self.name = name or getattr(learned, "name", "residual")
         self._fresh = True
@@ -196,4 +210,43 @@ class ResidualPolicy:
         action = self.rows.apply(self.learned.act(observation, info))[0]
         if hasattr(self.learned, "note_applied"):
             self.learned.note_applied(action)
+        return action
+
+    def batch(self, n: int) -> Any:
+        """The same policy for ``n`` rows of a batched env (:class:`ResidualBatch`; the interface of
+        :mod:`lvgym.benchmark.batch`); a learned policy without ``batch`` flies as one residual policy per row."""
+        if callable(getattr(self.learned, "batch", None)):
+            return ResidualBatch(self, n)
+        import copy
+
+        return RowPolicies(self, n, lambda: ResidualPolicy(copy.deepcopy(self.learned), self.config, self.env, self.name))
+
+
+class ResidualBatch:
+    """:class:`ResidualPolicy` for ``n`` rows: the baseline's batch (its ``batch(n)``, else one baseline per
+    row) and the learned policy's, mixed by :func:`combine`; each row's actions are the bits the residual
+    policy gives that row alone."""
+
+    def __init__(self, policy: ResidualPolicy, n: int) -> None:
+        self.name, self.config = policy.name, policy.config
+        spec = POLICIES[policy.config.baseline]
+        self.baseline = as_batch(build_policy(spec, policy.env), n, lambda: build_policy(spec, policy.env))
+        self.learned = policy.learned.batch(n)
+        self._fresh = np.ones(int(n), dtype=bool)
+
+    def reset(self, rows: Any) -> None:
+        rows = np.asarray(rows, dtype=np.int64).reshape(-1)
+        self.learned.reset(rows)
+        self._fresh[rows] = True
+
+    def act(self, rows: Any, observations: np.ndarray, info: dict[str, Any]) -> np.ndarray:
+        rows = np.asarray(rows, dtype=np.int64).reshape(-1)
+        fresh = rows[self._fresh[rows]]
+        if fresh.size:                               # the baseline starts its episode at the row's first step
+            self.baseline.reset(fresh)
+            self._fresh[fresh] = False
+        base = np.asarray(self.baseline.act(rows, observations, info), dtype=np.float32)
+        action = combine(base, np.reshape(self.learned.act(rows, observations, info), base.shape), self.config.scale)
+        if hasattr(self.learned, "note_applied"):
+            self.learned.note_applied(rows, action)
         return action

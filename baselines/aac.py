@@ -45,7 +45,9 @@ import numpy as np
 
 from lvgym.errors import ConfigError, check_bool, check_number
 
-from .pid import flex_pid, smile_scheduled_pid
+from .aacbatch import AACBatch
+from .batch import RowCopies
+from .pid import PIDPolicy, flex_pid, smile_scheduled_pid
 
 __all__ = ["AACParams", "AdaptiveAugmentingPolicy", "AdaptiveGainLaw", "FLEX_AAC", "FirstOrderFilter", "flex_aac", "smile_aac"]
 
@@ -186,13 +188,17 @@ class AdaptiveGainLaw:
             self.k[:] = 1.0
 
     def gain_step(self, k: np.ndarray, e2: np.ndarray, y: np.ndarray) -> np.ndarray:
-        """One exact (zero-order-hold) step of ``dk/dt = a e2 - b y (k - k_min) - c (k - 1)``, clipped."""
+        """One exact (zero-order-hold) step of ``dk/dt = a e2 - b y (k - k_min) - c (k - 1)``, clipped. The
+        decay ``exp(-r dt)`` is ``math.exp`` (the C library's), as the compiled batch
+        (:mod:`.aacbatch`) computes it: numpy's own ``exp`` of float arrays differs from it in the last bit
+        for a few per cent of arguments on CPUs with AVX-512."""
         p = self.p
         r = p.damper_gain * y + p.leak_rate
         drive = p.error_gain * e2 + p.damper_gain * y * p.k_min + p.leak_rate
+        decay = np.array([math.exp(-v * self.dt) if v > 0.0 else 1.0 for v in np.ravel(r)]).reshape(np.shape(r))
         with np.errstate(divide="ignore", invalid="ignore"):
             k_inf = np.where(r > 0.0, drive / np.where(r > 0.0, r, 1.0), 0.0)
-            k_new = np.where(r > 0.0, k_inf + (k - k_inf) * np.exp(-r * self.dt), k + drive * self.dt)
+            k_new = np.where(r > 0.0, k_inf + (k - k_inf) * decay, k + drive * self.dt)
         return np.clip(k_new, p.k_min, p.k_max)
 
     def step(self, u: np.ndarray, rate_error: np.ndarray, rate_ref: np.ndarray, on: bool) -> np.ndarray:
@@ -275,6 +281,13 @@ class AdaptiveAugmentingPolicy:
             k = self.law.gains()
             self.history.append((float(info.get("time", math.nan)), float(on), *k, *self.law.e, *self.law.y))
         return np.clip(self.last_gimbal / self.limit, -1.0, 1.0).astype(np.float32)
+
+    def batch(self, n: int) -> AACBatch | RowCopies:
+        """The same controller for ``n`` rows of a batched env, stepped together (:mod:`.batch`): the compiled
+        :class:`.aacbatch.AACBatch` on a PID-family base it knows (:meth:`.pid.PIDPolicy.batch`), else one
+        copy of the policy per row. The batch keeps no ``history``."""
+        known = type(self) is AdaptiveAugmentingPolicy and isinstance(self.base, PIDPolicy) and self.base._batchable()
+        return AACBatch(self, n) if known else RowCopies(self, n)
 
     def trajectory(self) -> dict[str, np.ndarray]:
         """The recorded history as arrays: ``time``, ``on``, ``k`` (n, 2), ``e`` (n, 2), ``y`` (n, 2)."""

@@ -43,7 +43,8 @@ import numpy as np
 from lvgym.errors import ConfigError
 
 from .filecache import read_once
-from .lqgkernel import LQGState, LQGTables, lqg_step_k, lqg_tables, row_index
+from .lqgkernel import LQGState, LQGTables, lqg_act_k, lqg_step_k, lqg_tables, row_index
+from .pidkernel import ObsColumns
 
 SCHEDULES = Path(__file__).resolve().parent / "schedules"
 PLANES = ("pitch", "yaw")
@@ -232,28 +233,36 @@ class LQGPolicy:
 
 
 class LQGBatch:
-    """``n`` independent copies of an :class:`LQGPolicy` (one per env row), stepped together: ``act(rows,
-    observations, infos)`` gives the actions of the rows ``rows`` (an :class:`LQGPolicy` per row would give
-    the same, each in its own Python call; ``lvgym.agents.residual`` uses this for a residual's baselines)."""
+    """``n`` independent copies of an :class:`LQGPolicy` (one per env row), stepped together: the batched
+    interface of :mod:`.batch` (``act(rows, observations, info)`` with the batched env's info, of which it
+    reads ``info["time"]``); an :class:`LQGPolicy` per row would give the same actions, each in its own
+    Python call. Used for the rows of a batched evaluation and a residual's baselines
+    (``lvgym.agents.residual``). ``gimbal`` (n, 2) [rad]: each row's last command (the policy's
+    ``last_gimbal``)."""
 
     def __init__(self, policy: LQGPolicy, n: int) -> None:
         self.name, self.limit = policy.name, policy.limit
-        self._i_err, self._i_on = policy._i_err, policy._i_on
         self.axes = [LQGLaw(policy.schedule.rows[p], policy.schedule, policy.limit, n) for p in PLANES]
+        self.oc = ObsColumns(np.asarray(policy._i_err, dtype=np.int64), np.full(2, -1, np.int64), int(policy._i_on),
+                             -1, -1)
+        self.gimbal = np.zeros((int(n), 2))
 
     def reset(self, rows: Any) -> None:
         """Rows ``rows`` start an episode."""
         for law in self.axes:
             law.reset(rows)
+        self.gimbal[np.asarray(rows, dtype=np.int64).reshape(-1)] = 0.0
 
-    def act(self, rows: Any, observations: np.ndarray, infos: list[dict[str, Any]]) -> np.ndarray:
+    def act(self, rows: Any, observations: np.ndarray, info: dict[str, Any]) -> np.ndarray:
         """Actions (len(rows), 2) float32 of the rows ``rows`` for their observations (len(rows), n_obs) and
-        infos (each with ``time``)."""
-        obs = np.asarray(observations, dtype=float).reshape(len(infos), -1)
-        on = obs[:, self._i_on] >= 0.5
-        t = np.array([float(i["time"]) for i in infos])
-        u = np.stack([law.update(obs[:, i], t, on, rows) for law, i in zip(self.axes, self._i_err)], axis=1)
-        return np.clip(u / self.limit, -1.0, 1.0).astype(np.float32)
+        the batched env's ``info`` (every row's ``time``): one call of :func:`.lqgkernel.lqg_act_k`."""
+        rows = np.asarray(rows, dtype=np.int64).reshape(-1)
+        obs = np.ascontiguousarray(observations).reshape(rows.size, -1)
+        out = np.empty((rows.size, 2), np.float32)
+        pitch, yaw = self.axes
+        lqg_act_k(pitch.tables, yaw.tables, pitch.state, yaw.state, self.oc, rows, obs,
+                  np.asarray(info["time"], dtype=np.float64), self.limit, self.gimbal, out)
+        return out
 
 
 def smile_lqg(env: Any, name: str = "lqg", schedule: str = "smile_lqg") -> LQGPolicy:

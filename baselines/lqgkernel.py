@@ -21,7 +21,9 @@ from typing import Any, NamedTuple
 import numba as nb
 import numpy as np
 
-__all__ = ["LQGState", "LQGTables", "lqg_step_k", "lqg_tables", "row_index"]
+from .pidkernel import clip_k
+
+__all__ = ["LQGState", "LQGTables", "lqg_act_k", "lqg_step_k", "lqg_tables", "row_index"]
 
 
 class LQGTables(NamedTuple):
@@ -143,3 +145,26 @@ def lqg_step_k(tb, st, which, y, t, on, u_limit, u):
             st.x[b, r] = 0.0
         st.saturated[b] = sat
         u[j] = uu
+
+
+@nb.njit(cache=True)
+def lqg_act_k(pitch, yaw, sp, sy, oc, rows, obs, t, u_limit, gimbal, out):
+    """Both planes' laws (``pitch``, ``yaw``: :class:`LQGTables`; ``sp``, ``sy``: :class:`LQGState`) for
+    the rows ``rows`` (k,) on their observations ``obs`` (k, n_obs) (``oc``: the columns of the rate errors
+    and the controller-on flag, :class:`.pidkernel.ObsColumns`) at the flight times ``t`` (n,) [s] of every
+    row: :func:`lqg_step_k` of each plane; the commands [rad] into ``gimbal`` (n, 2), the actions ``out``
+    (k, 2) float32 (gimbal / limit, clipped to [-1, 1])."""
+    k = rows.size
+    y, tk, u = np.empty(k), np.empty(k), np.empty(k)
+    on = np.empty(k, np.bool_)
+    for j in range(k):
+        tk[j] = t[rows[j]]
+        on[j] = float(obs[j, oc.on]) >= 0.5
+    for ax in range(2):
+        col = oc.err[ax]
+        for j in range(k):
+            y[j] = float(obs[j, col])
+        lqg_step_k(pitch if ax == 0 else yaw, sp if ax == 0 else sy, rows, y, tk, on, u_limit, u)
+        for j in range(k):
+            gimbal[rows[j], ax] = u[j]
+            out[j, ax] = np.float32(clip_k(u[j] / u_limit, -1.0, 1.0))

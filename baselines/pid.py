@@ -58,6 +58,7 @@ docs/flex-design.md, "The slender vehicle").
 from __future__ import annotations
 
 import math
+from collections.abc import Hashable
 from dataclasses import dataclass, field
 from functools import cached_property
 from pathlib import Path
@@ -65,13 +66,15 @@ from typing import Any
 
 import numpy as np
 
-from lvgym.envs.ascent import DEFAULT_AERO_MACH, SlenderAscentV1Env, slender_key
 from lvgym.envs.layouts import G0
+from lvgym.envs.presets import SLENDER_V1
 from lvgym.errors import ConfigError
 from lvgym.vehicle.yamlfile import read_yaml
 
+from .batch import RowCopies
 from .filecache import read_once
 from .filters import FILTER_KEYS, FilterChain, StructuralFilter
+from .pidbatch import PIDBatch
 
 SCHEDULES = Path(__file__).resolve().parent / "schedules"
 VARIABLES = ("mass", "time", "mach")
@@ -324,6 +327,23 @@ class PIDPolicy:
         self.last_gimbal = np.array([pid.update(e, on) for pid, e in zip(self.axes, errors)])
         return np.clip(self.last_gimbal / self.limit, -1.0, 1.0).astype(np.float32)
 
+    def batch(self, n: int) -> PIDBatch | RowCopies:
+        """The same controller for ``n`` rows of a batched env, stepped together (:mod:`.batch`): the compiled
+        :class:`.pidbatch.PIDBatch` for a PIDPolicy or GainScheduledPIDPolicy as built (both axes with the
+        same gains, limits and period; filters only from a schedule), else one copy of the policy per row."""
+        return PIDBatch(self, n) if self._batchable() else RowCopies(self, n)
+
+    def _batchable(self) -> bool:
+        kind = type(self)
+        if kind not in (PIDPolicy, GainScheduledPIDPolicy):        # a subclass may change the law
+            return False
+        a, b = self.axes
+        if not (a.dt == b.dt and a.u_min == b.u_min == -self.limit and a.u_max == b.u_max == self.limit):
+            return False
+        if kind is GainScheduledPIDPolicy:
+            return (self.chains is None) == (self.schedule.filters is None)
+        return self.chains is None and (a.kp, a.ki, a.kd, a.n) == (b.kp, b.ki, b.kd, b.n)
+
 
 class GainScheduledPIDPolicy(PIDPolicy):
     """:class:`PIDPolicy` with gains from a :class:`GainSchedule` updated at every step: on ``mass``
@@ -376,17 +396,17 @@ def smile_scheduled_pid(env: Any, schedule: str = "smile_thesis", name: str | No
 
 
 #: the gs-pid-flex schedule (``baselines/schedules/<name>.yaml``, written by ``python -m lvgym.baselines.design.flexdesign``)
-#: of each vehicle a v1 env flies, keyed by the env's ``task.vehicle`` (a name, or the slender vehicle's key
-#: tuple: ``SlenderAscent-v1``'s default 8.5 m x 0.2833 m, 4.5 mm tube, with load relief; docs/flex-design.md)
-FLEX_SCHEDULES: dict = {"smile_v1": "smile_flex", "stratos3": "stratos3_flex",
-                        slender_key(8.5, 0.2833, DEFAULT_AERO_MACH, SlenderAscentV1Env.WALL_THICKNESS_M): "slender_flex"}
+#: of each vehicle a v1 env flies, keyed by the env's ``task.vehicle`` (a name, or the slender vehicle's
+#: SlenderGeometry: ``SlenderAscent-v1``'s default 8.5 m x 0.2833 m, 4.5 mm tube, with load relief;
+#: docs/flex-design.md)
+FLEX_SCHEDULES: dict = {"smile_v1": "smile_flex", "stratos3": "stratos3_flex", SLENDER_V1.vehicle: "slender_flex"}
 
 
 def flex_pid(env: Any, name: str = "gs-pid-flex") -> GainScheduledPIDPolicy:
     """``gs-pid-flex``: the filtered gain-scheduled PID designed on the non-rigid v1 flight loop of the
     vehicle ``env`` flies (:data:`FLEX_SCHEDULES`); a vehicle without a flex design is refused."""
     vehicle = getattr(env.unwrapped.task, "vehicle", None)
-    if not isinstance(vehicle, (str, tuple)) or vehicle not in FLEX_SCHEDULES:
+    if not isinstance(vehicle, Hashable) or vehicle not in FLEX_SCHEDULES:
         raise ConfigError("env vehicle", vehicle, f"one of {list(FLEX_SCHEDULES)}: the vehicles of a v1 env "
                           "with a gs-pid-flex schedule (python -m lvgym.baselines.design.flexdesign --vehicle ...)")
     return GainScheduledPIDPolicy(FLEX_SCHEDULES[vehicle], env=env, name=name)

@@ -1,7 +1,10 @@
-"""The tables of docs/rl.md, generated from the layouts of ``lvgym/envs/layouts.py``.
+"""The tables of docs/rl.md and docs/benchmark.md, generated from the code: the layouts of
+``lvgym/envs/layouts.py``, the option groups of ``lvgym/envs/options.py`` (their field docstrings and
+ranges), the protocol presets of ``lvgym/envs/presets.py`` and the dispersion table of
+``lvgym/envs/dispersions.py``.
 
-    python docs/gen_tables.py            # rewrite the generated blocks of docs/rl.md
-    python docs/gen_tables.py --check    # exit 1 (and say which block) if docs/rl.md is not what the layouts give
+    python docs/gen_tables.py            # rewrite the generated blocks of the pages
+    python docs/gen_tables.py --check    # exit 1 (and say which blocks) if a page is not what the code gives
 
 A generated block sits between ``<!-- generated: NAME -->`` and ``<!-- end: NAME -->``. The page in the
 repository holds the tables (readable without building the site), ``tests/test_docs_site.py`` checks that
@@ -12,12 +15,16 @@ site renders the blocks from the layouts at build time. The ``info`` keys are no
 
 from __future__ import annotations
 
+import dataclasses
 import re
 import sys
 from pathlib import Path
 from typing import Any, Callable
 
 PAGE = Path(__file__).resolve().parent / "rl.md"
+#: the pages with generated blocks, and their blocks
+PAGES = {PAGE: ("options", "presets", "observation", "action", "reward", "termination", "info"),
+         PAGE.parent / "benchmark.md": ("dispersions",)}
 
 #: the keys of a step's ``info`` (``AscentFuncEnv.transition_info``): unit and meaning. After a reset the
 #: ``info`` holds ``time``, ``cumulative_rate_error``, ``mass`` and ``controller_on`` only.
@@ -44,6 +51,13 @@ INFO = {
     "termination": ("-", "why the episode ended (the termination table), empty while it flies"),
     "events": ("-", "the events of the step (burnout, separation, ignition, lift-off, rail exit)"),
 }
+
+
+def _markdown(doc: str) -> str:
+    """A docstring's reStructuredText as Markdown: ``code`` and :role:`~a.b.name` become code spans."""
+    doc = re.sub(r":\w+:`~[\w.]*?(\w+)`", r"`\1`", doc)
+    doc = re.sub(r":\w+:`\.*([\w.]+)`", r"`\1`", doc)
+    return doc.replace("``", "`")
 
 
 def _cell(text: str) -> str:
@@ -104,16 +118,71 @@ def info() -> str:
     return _table(["key", "unit", "meaning"], [[f"`{key}`", unit, doc] for key, (unit, doc) in INFO.items()])
 
 
-BLOCKS: dict[str, Callable[[], str]] = {"observation": observation, "action": action, "reward": reward,
-                                        "termination": termination, "info": info}
+def _shown(value: Any) -> str:
+    """A default or preset value as the tables show it."""
+    if isinstance(value, frozenset):
+        return "{" + ", ".join(sorted(value)) + "}" if value else "{}"
+    if hasattr(value, "__dataclass_fields__"):                          # a SlenderGeometry
+        return ", ".join(f"{k} {getattr(value, k)}" for k in value.__dataclass_fields__)
+    return repr(value) if isinstance(value, str) else str(value)
+
+
+def options() -> str:
+    """Every option of a task, group by group: its keyword, default, what is allowed and its docstring."""
+    from lvgym.cli.args import field_docs
+    from lvgym.envs.options import rule_of
+    from lvgym.envs.spec import GROUPS, TaskSpec
+
+    top = field_docs(TaskSpec)
+    rows = [["", "`vehicle`", "(the env's)", "a shipped name, a YAML path or a `SlenderGeometry`",
+             _markdown(top["vehicle"])],
+            ["", "`model`", "`'nonrigid'`", "`rigid`, `slosh`, `flex`, `nonrigid`", _markdown(top["model"])]]
+    for group, cls in GROUPS.items():
+        docs = field_docs(cls)
+        for f in dataclasses.fields(cls):
+            rule = rule_of(f)
+            allowed = rule.allowed() if rule else "see the meaning"
+            rows.append([f"`{group}`", f"`{f.name}`", f"`{_shown(f.default)}`", allowed,
+                         _markdown(docs[f.name])])
+    return _table(["group", "keyword", "default", "allowed", "meaning"], rows)
+
+
+def presets() -> str:
+    """The protocol presets of the env ids: every option a preset sets away from the defaults."""
+    from lvgym import ENV_IDS, env_class
+    from lvgym.envs.spec import TaskSpec
+
+    specs = {env_id: env_class(env_id).PRESET for env_id in ENV_IDS}
+    base = {env_id: TaskSpec(spec.vehicle).options() for env_id, spec in specs.items()}
+    keys = [k for k in next(iter(specs.values())).options()
+            if k == "vehicle" or any(spec.options()[k] != base[i][k] for i, spec in specs.items())]
+    rows = [[f"`{k}`"] + [_shown(spec.options()[k]) if k == "vehicle" or spec.options()[k] != base[i][k] else ""
+                          for i, spec in specs.items()] for k in keys]
+    return _table(["keyword"] + [f"`{i.removeprefix('lvgym/')}`" for i in specs], rows)
+
+
+def dispersions() -> str:
+    """The dispersions, row by row in the order a reset draws them (lvgym.envs.dispersions.DISPERSIONS)."""
+    from lvgym.envs.dispersions import DISPERSIONS, OTHER_RANDOMIZATIONS, RANDOMIZE_V0
+
+    rows = [[f"`{d.name}`" + (" (v0)" if d.name in RANDOMIZE_V0 else ""), d.what, d.law_text(), d.clip_text(), d.source]
+            for d in DISPERSIONS]
+    rows += [[f"`{name}`" + (" (v0)" if name in RANDOMIZE_V0 else ""), text.split(": ")[0], "", "", text.split(": ")[1]]
+             for name, text in OTHER_RANDOMIZATIONS.items()]
+    return _table(["name", "what is drawn", "law", "clip", "why this range"], rows)
+
+
+BLOCKS: dict[str, Callable[[], str]] = {"options": options, "presets": presets, "observation": observation,
+                                        "action": action, "reward": reward, "termination": termination, "info": info,
+                                        "dispersions": dispersions}
 _BLOCK = re.compile(r"(<!-- generated: (\w+) -->\n)(.*?)(<!-- end: \2 -->)", re.S)
 
 
 def render(markdown: str) -> str:
-    """``markdown`` with every generated block filled from the layouts."""
+    """``markdown`` with every generated block filled from the code."""
     def fill(m: re.Match) -> str:
         if m.group(2) not in BLOCKS:
-            raise KeyError(f"docs/rl.md: generated block {m.group(2)!r}: unknown; known: {sorted(BLOCKS)}")
+            raise KeyError(f"generated block {m.group(2)!r}: unknown; known: {sorted(BLOCKS)}")
         return f"{m.group(1)}{BLOCKS[m.group(2)]()}\n{m.group(4)}"
     return _BLOCK.sub(fill, markdown)
 
@@ -125,20 +194,22 @@ def stale(markdown: str) -> list[str]:
 
 
 def on_page_markdown(markdown: str, page: Any, **kwargs: Any) -> str:
-    """mkdocs hook: the generated blocks of the page, from the layouts."""
+    """mkdocs hook: the generated blocks of the page, from the code."""
     return render(markdown) if _BLOCK.search(markdown) else markdown
 
 
 def main(argv: list[str]) -> int:
-    text = PAGE.read_text(encoding="utf-8")
-    if "--check" in argv:
-        old = stale(text)
-        if old:
-            print(f"docs/rl.md: generated blocks out of date: {', '.join(old)} (run python docs/gen_tables.py)")
-            return 1
-        return 0
-    PAGE.write_text(render(text), encoding="utf-8")
-    return 0
+    status = 0
+    for page in PAGES:
+        text = page.read_text(encoding="utf-8")
+        if "--check" in argv:
+            old = stale(text)
+            if old:
+                print(f"docs/{page.name}: generated blocks out of date: {', '.join(old)} (run python docs/gen_tables.py)")
+                status = 1
+        else:
+            page.write_text(render(text), encoding="utf-8")
+    return status
 
 
 if __name__ == "__main__":

@@ -39,7 +39,7 @@ def test_load_dispersions_scale_the_forces_and_move_the_centre_of_pressure():
 
 
 def test_randomize_true_keeps_the_v0_set():
-    spec = TaskSpec(vehicle="smile", randomize=True)
+    spec = TaskSpec.build(None, {"vehicle": "smile", "randomize": True})
     assert spec.randomize == frozenset(RANDOMIZE_V0)
     assert set(RANDOMIZE) - set(RANDOMIZE_V0) == {"aerodynamics", "thrust_level", "slosh_mass", "slosh_frequency",
                                                   "bending_damping", "servo_bandwidth", "servo_delay",

@@ -230,13 +230,13 @@ def test_one_table_of_ids_and_one_vector_entry_point():
         assert spec.entry_point == lvgym.ENV_IDS[env_id] and lvgym.env_class(env_id) is cls
         assert isinstance(spec.vector_entry_point, functools.partial)
         assert spec.vector_entry_point.func is lvgym.make_vector and spec.vector_entry_point.args == (env_id,)
-    # the slender geometry's defaults are class attributes, read by the single and the batched env alike
-    assert SlenderAscentEnv.GEOMETRY["diameter"] == 0.3 and SlenderAscentV1Env.GEOMETRY["diameter"] == 0.2833
-    for cls, key in ((SlenderAscentEnv, ("slender", 8.5, 0.3, 2.0)),
-                     (SlenderAscentV1Env, ("slender", 8.5, 0.2833, 2.0, 0.0045))):
-        assert batch_task(cls, {}).vehicle == key == cls().task.vehicle
+    # the slender geometry's defaults are the presets' values, read by the single and the batched env alike
+    from lvgym.vehicle.slender import SlenderGeometry
+    for cls, key in ((SlenderAscentEnv, SlenderGeometry(8.5, 0.3, 2.0, 0.002)),
+                     (SlenderAscentV1Env, SlenderGeometry(8.5, 0.2833, 2.0, 0.0045))):
+        assert batch_task(cls, {}).vehicle == key == cls().task.vehicle == cls.PRESET.vehicle
     assert batch_task(SlenderAscentV1Env, {"wall_thickness_m": 0.002, "aero_mach": None}).vehicle == \
-        ("slender", 8.5, 0.2833, None, 0.002)
+        SlenderGeometry(8.5, 0.2833, None, 0.002)
     with pytest.raises(ConfigError, match=r"^env_id = 'lvgym/SmileAscent-v2': one of .* \(did you mean "
                                           r"'lvgym/SmileAscent-v1'\?\)$"):
         lvgym.env_class("lvgym/SmileAscent-v2")

@@ -171,7 +171,7 @@ def test_on_the_pad_the_accelerometers_read_no_lateral_force_and_the_gyros_the_e
 
 def _func(**kw):
     opts = {"model": "rigid", "observation": "flight", "mission_time_s": 1.0, **kw}
-    return AscentFuncEnv(TaskSpec.build(SmileAscentEnv.DEFAULTS, opts))
+    return AscentFuncEnv(TaskSpec.build(SmileAscentEnv.PRESET, opts))
 
 
 def test_the_gyro_bias_drifts_as_a_random_walk():

@@ -18,7 +18,7 @@ OPTS = {"model": "nonrigid", "wind": "turbulence", "randomize": True, "observati
 
 
 def _func(cls=SmileAscentEnv, **kw) -> AscentFuncEnv:
-    return AscentFuncEnv(TaskSpec.build(cls.DEFAULTS, {**OPTS, **kw}))
+    return AscentFuncEnv(TaskSpec.build(cls.PRESET, {**OPTS, **kw}))
 
 
 def _same_state(a, b) -> None:

@@ -194,9 +194,8 @@ def test_a_batch_of_rows_is_the_policy_of_each_row():
         obs[:, lay.index("pitch_rate_error")] = 2e-3 * rng.standard_normal(n)
         obs[:, lay.index("yaw_rate_error")] = 2e-3 * rng.standard_normal(n)
         obs[:, lay.index("controller_on")] = ((t < 43.0) | (t > 54.5)).astype(float)
-        infos = [{"time": float(x)} for x in t]
-        got = batch.act(rows, obs[rows], [infos[b] for b in rows])
-        want = np.array([single[b].act(obs[b], infos[b]) for b in rows]).reshape(-1, 2)
+        got = batch.act(rows, obs[rows], {"time": t.copy()})
+        want = np.array([single[b].act(obs[b], {"time": float(t[b])}) for b in rows]).reshape(-1, 2)
         np.testing.assert_array_equal(got, want)
         t[rows] += 0.02
         if step == 200:                                         # a row starts a new episode

@@ -21,8 +21,6 @@ README = (ROOT / "README.md").read_text(encoding="utf-8")
 BLOCKS = re.findall(r"```(python|sh)\n(.*?)```", README, re.S)
 
 #: the ``lvgym`` command and its subcommands
-CLI = importlib.util.find_spec("lvgym.cli.main") is not None
-NEEDS_CLI = "needs the lvgym command (lvgym.cli.main)"
 
 #: the set-up commands of the README (they install into .venv or run the whole benchmark: not run here)
 SETUP = ("make ", "pip ")
@@ -146,7 +144,6 @@ def test_linearise():
     assert plant.ninputs == plant.noutputs == 1 and plant.nstates > 6      # rigid body, slosh and bending states
 
 
-@pytest.mark.skipif(not CLI, reason=NEEDS_CLI)
 def test_design_and_margins(tmp_path):
     for command in _sh(5):
         _run(command, tmp_path)

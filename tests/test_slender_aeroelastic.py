@@ -100,18 +100,18 @@ def test_no_tvc_loop_with_margins_from_6s(lvgym_points):
 
 
 def test_slender_v1_flies_the_thicker_tube():
-    # v1's slender vehicle has the 4.5 mm wall this check recommends; v0 keeps the thesis's 2 mm tube and its key
+    # v1's slender vehicle has the 4.5 mm wall this check recommends; v0 keeps the thesis's 2 mm tube
     import gymnasium as gym
 
-    from lvgym.envs.ascent import slender_key
+    from lvgym.vehicle.slender import SlenderGeometry
 
     v0 = gym.make("lvgym/SlenderAscent-v0").unwrapped
     v1 = gym.make("lvgym/SlenderAscent-v1", length=8.5, diameter=0.2833, wind="none", randomize=[]).unwrapped
-    assert v0.task.vehicle == slender_key(8.5, 0.3, 2.0) and len(v0.task.vehicle) == 4
-    assert v1.task.vehicle[4] == 0.0045
+    assert v0.task.vehicle == SlenderGeometry(8.5, 0.3, 2.0) and v0.task.vehicle.wall_thickness == 0.002
+    assert v1.task.vehicle.wall_thickness == 0.0045
     assert v1.vehicle.stages[0].structure.mass > v0.vehicle.stages[0].structure.mass + 30.0
     thin = gym.make("lvgym/SlenderAscent-v1", wall_thickness_m=0.002).unwrapped
-    assert thin.task.vehicle[4] == 0.002
+    assert thin.task.vehicle.wall_thickness == 0.002
     # calm air, gimbal at zero: the 2 mm tube diverges near 4.2-4.8 s; the 4.5 mm one flies the 10 s
     env = gym.make("lvgym/SlenderAscent-v1", length=8.5, diameter=0.2833, wind="none", randomize=[])
     env.reset(seed=0)

@@ -229,7 +229,7 @@ def test_collected_rank_one_updates_equal_successive_ones():
 def test_signals_and_slosh_angles_on_row_ranges_equal_one_range():
     from lvgym.envs import AscentFuncEnv, TaskSpec
     from lvgym.envs.ascent import SmileAscentEnv
-    task = TaskSpec.build(SmileAscentEnv.DEFAULTS, {"model": "nonrigid", "wind": "random", "randomize": True})
+    task = TaskSpec.build(SmileAscentEnv.PRESET, {"model": "nonrigid", "wind": "random", "randomize": True})
     outs = []
     for threads in (1, 3):
         func = AscentFuncEnv(task)

@@ -134,8 +134,8 @@ def test_the_default_observation_and_randomisation_are_the_env_protocols():
     assert TRAIN.env_kwargs_of(TRAIN.Args(env_id="lvgym/SlenderAscent-v1"))["wind"] == "turbulence"
     import lvgym.envs as envs
 
-    assert envs.ENVS["lvgym/SmileAscent-v0"].DEFAULTS.get("observation", "state") == "state"
-    assert envs.ENVS["lvgym/SmileAscent-v1"].DEFAULTS["observation"] == "flight"
+    assert envs.ENVS["lvgym/SmileAscent-v0"].PRESET.observation == "state"
+    assert envs.ENVS["lvgym/SmileAscent-v1"].PRESET.observation == "flight"
     assert TRAIN.env_kwargs_of(TRAIN.Args(observation="state", randomize=["mass"], wind="turbulence")) == {
         "model": "nonrigid", "wind": "turbulence", "randomize": ["mass"], "observation": "state"}
 

@@ -26,11 +26,11 @@ SKIP = shutil.ignore_patterns(".git", ".venv", "venv", "build", "dist", "*.egg-i
                               ".pytest_cache", "results", "runs", "docs")
 #: the checkout's folders installed under ``lvgym`` (pyproject.toml's package-dir)
 INSTALLED = {"lvgym": "lvgym", "agents": "lvgym/agents", "baselines": "lvgym/baselines"}
-#: core modules that need an extra, with the package they miss; lvgym.envs' rendering and SB3 adapter
-#: still fail with Python's own "No module named ..." (the env reaches them only when asked to render or
-#: for an SB3 VecEnv); the studies name their extra in one line
+#: core modules that need an extra, with the package they miss and the extra their one-line error names
+#: (the env reaches them only when asked to render or for an SB3 VecEnv); the studies name theirs too
 NEEDS_EXTRA = {"lvgym.envs.render": "matplotlib", "lvgym.envs.frames": "matplotlib",
                "lvgym.envs.sb3": "stable_baselines3"}
+EXTRA_OF = {"matplotlib": "benchmark", "stable_baselines3": "train"}
 STUDIES_MESSAGE = "lvgym.studies needs pandas, which lvgym's core install leaves out: pip install 'lvgym[studies]'"
 
 
@@ -98,6 +98,8 @@ def test_wheel_with_the_core_only_flies_and_imports_no_extra(built, tmp_path):
     np.testing.assert_allclose(report["obs"], np.asarray(obs, dtype=float), rtol=1e-9, atol=1e-12)
     failed = {m: e for m, e in report["imports"].items() if e is not None}
     assert {m: e["name"] for m, e in failed.items() if not m.startswith("lvgym.studies")} == NEEDS_EXTRA
+    for module, package in NEEDS_EXTRA.items():
+        assert failed[module]["message"].endswith(f"pip install 'lvgym[{EXTRA_OF[package]}]'"), failed[module]
     studies = {m: e["message"] for m, e in failed.items() if m.startswith("lvgym.studies")}
     assert "lvgym.studies.doe" in studies and set(studies.values()) == {STUDIES_MESSAGE}
     assert len(report["imports"]) > 100 and report["imports"]["lvgym.benchmark.runner"] is None

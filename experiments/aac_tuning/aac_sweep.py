@@ -40,6 +40,8 @@ class ScaledBase:
         self.name = f"{base.name}*{scale:g}"
 
     def __getattr__(self, key: str) -> Any:          # the adaptive law reads the base's dt and limit
+        if key == "base":                             # not set yet (a copy being built): nothing to delegate to
+            raise AttributeError(key)
         return getattr(self.base, key)
 
     @property

@@ -25,7 +25,9 @@ from typing import Any
 
 import numpy as np
 
-from .runner import play_episode, zero_policy
+from .batch import as_batch
+from .rows import fly_rows
+from .runner import zero_policy
 from .suites import SUITES, Suite
 
 __all__ = ["FINGERPRINTS", "POLICIES", "RTOL", "ProbePolicy", "compare", "fingerprint", "stored"]
@@ -77,22 +79,33 @@ class ProbePolicy:
 POLICIES = {"zero": zero_policy, "probe": ProbePolicy}
 
 
-def _episode(suite: Suite, condition: Any, seed: int, policy: str) -> dict[str, Any]:
-    env = condition.make_env()
-    obs0, _ = env.reset(seed=int(seed))
-    first = _first(obs0)
-    m = play_episode(POLICIES[policy](env), env, seed)
+def _record(suite: Suite, condition: Any, seed: int, policy: str, first: np.ndarray, m: dict[str, Any]) -> dict[str, Any]:
     reason = m.get("failure_reason") or ""
-    return {"suite": suite.name, "condition": condition.name, "seed": int(seed), "policy": policy, "first_obs": first,
+    return {"suite": suite.name, "condition": condition.name, "seed": int(seed), "policy": policy, "first_obs": _first(first),
             "score": float(m["score"]), "rate_error_rad": float(m["rate_error_rad"]),
             "max_qalpha_pa_deg": float(m["max_qalpha_pa_deg"]), "failed": bool(m["failed"]),
             "failure_reason": str(reason), "duration_s": float(m["duration_s"])}
 
 
+def _condition_records(suite: Suite, condition: Any, seeds: list[int]) -> list[dict[str, Any]]:
+    """The fingerprint records of one condition: every seed with every policy, flown together as the rows of
+    its batched env (:func:`~.rows.fly_rows`: each row the single env's episode, to the bit)."""
+    rows = [(seed, name) for seed in seeds for name in POLICIES]
+    env = condition.make_env()
+    groups = []
+    for name, make in POLICIES.items():
+        mine = [i for i, (_, n) in enumerate(rows) if n == name]
+        groups.append((as_batch(make(env), len(rows), lambda make=make: make(env)), mine))
+    first: list[np.ndarray] = []
+    records = fly_rows(condition.make_vec_env(len(rows)), [seed for seed, _ in rows], groups, first_observations=first)
+    return [_record(suite, condition, seed, name, obs0, m) for (seed, name), obs0, m in zip(rows, first, records)]
+
+
 def fingerprint(version: str, seeds: int = 1) -> list[dict[str, Any]]:
-    """The fingerprint records of protocol ``version``: every suite, condition and first ``seeds`` test seeds."""
-    return [_episode(suite, cond, seed, policy) for suite in _suites(version) for cond in suite.conditions
-            for seed in suite.seeds("test", seeds) for policy in POLICIES]
+    """The fingerprint records of protocol ``version``: every suite, condition and first ``seeds`` test seeds
+    (each condition's episodes flown together)."""
+    return [r for suite in _suites(version) for cond in suite.conditions
+            for r in _condition_records(suite, cond, suite.seeds("test", seeds))]
 
 
 def stored(version: str) -> list[dict[str, Any]]:

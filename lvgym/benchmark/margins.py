@@ -24,6 +24,11 @@ Seeds: the ``test`` seeds by default: a margin is a measurement, not tuning (``-
 design loops). Policies are names of :data:`~.registry.POLICIES`, SB3 ``.zip`` paths or ``train.py`` run
 folders, as ``evaluate.py`` takes them. From Python: :func:`time_domain_margins` (one policy) and
 :func:`run_margins` (several, one process pool).
+
+The searches go on side by side: each round flies the next value of every search of a condition (every
+policy, seed and experiment of a task) as the rows of one batched flight (:func:`run_margin_task`), and each
+row is the episode the single env flies with that gain or delay, to the bit, so the margins do not depend on
+how the searches are grouped, the executor or the worker count.
 """
 
 from __future__ import annotations
@@ -37,11 +42,11 @@ from pathlib import Path
 from typing import Any
 
 from lvgym.errors import ConfigError, check_number
-from lvgym.parallel import run_map
+from lvgym.parallel import check_workers, default_workers, run_map
 
-from .perturb import db_to_gain, find_threshold, fly
+from .perturb import db_to_gain, summary, threshold_search
 from .results import atomic_write_text, csv_text, json_text
-from .runner import PolicySpec, episode_objects
+from .runner import PolicySpec, episode_objects, fly_block
 from .suites import SEED_SETS, SUITES, Condition, Suite
 
 __all__ = ["EXPERIMENTS", "MarginOptions", "MarginTask", "RATE_ERROR_FLOOR_RADPS", "RATE_LIMIT_FLOOR_S", "bounds",
@@ -94,24 +99,14 @@ class MarginOptions:
 
 @dataclass(frozen=True)
 class MarginTask:
-    """One search: ``experiment`` of ``policy`` on ``condition`` with ``seed``."""
+    """The searches of ``experiments`` for every policy of ``policies`` and seed of ``seeds`` on ``condition``,
+    flown together (:func:`run_margin_task`)."""
 
-    policy: PolicySpec
+    policies: tuple[PolicySpec, ...]
     condition: Condition
-    seed: int
-    experiment: str
+    seeds: tuple[int, ...]
+    experiments: tuple[str, ...]
     options: MarginOptions
-
-
-_NOMINAL: dict[tuple[PolicySpec, Condition, int], dict[str, Any]] = {}
-
-
-def _nominal(spec: PolicySpec, condition: Condition, seed: int) -> dict[str, Any]:
-    """The unperturbed episode of a seed (memoised per process; it is a function of its arguments)."""
-    key = (spec, condition, int(seed))
-    if key not in _NOMINAL:
-        _NOMINAL[key] = fly(spec, condition, seed)
-    return _NOMINAL[key]
 
 
 def physics_dt_s(spec: PolicySpec, condition: Condition) -> float:
@@ -141,48 +136,82 @@ def verdict(record: dict[str, Any], bound: dict[str, float]) -> str:
     return ""
 
 
-def run_margin_task(task: MarginTask) -> dict[str, Any]:
-    """Fly the nominal episode of the task's seed, then search its experiment's threshold (module docstring);
-    returns the seed's margin: ``passed`` (the margin, in ``unit``), ``failed_at`` (the smallest value
-    tried that failed; None: none failed up to the range's end), ``nominal`` and every ``trials``
-    episode. With a failing nominal episode, ``passed`` is None and nothing is searched."""
-    o, spec, cond, seed = task.options, task.policy, task.condition, task.seed
-    nominal = _nominal(spec, cond, seed)
-    h = physics_dt_s(spec, cond)
-    out: dict[str, Any] = {"policy": spec.name, "condition": cond.name, "model": cond.model, "seed": int(seed),
-                           "experiment": task.experiment, "unit": UNITS[task.experiment], "nominal": nominal,
-                           "bounds": bounds(nominal, o), "physics_dt_s": h, "passed": None, "failed_at": None,
-                           "trials": []}
-    if nominal["failed"]:
-        out["status"] = "nominal failed"
-        return out
-    trials: list[dict[str, Any]] = []
+class _Search:
+    """One seed's search of one experiment (its threshold_search and what it has flown)."""
 
-    def passes(value: float) -> bool:
-        if task.experiment == "delay":
-            record = fly(spec, cond, seed, delay_steps=int(value))
-            shown = value * h * 1e3
+    def __init__(self, out: dict[str, Any], options: MarginOptions, h: float) -> None:
+        self.out, self.h, self.trials = out, h, []
+        self.value: float | None = None
+        if out["experiment"] == "delay":
+            steps = max(1, int(round(options.delay_max_s / h)))
+            self.search = threshold_search(0, steps, 1.0, 1, integer=True)
         else:
-            record = fly(spec, cond, seed, gain=db_to_gain(value))
-            shown = value
-        why = verdict(record, out["bounds"])
-        trials.append({"value": shown, "passed": why == "", "verdict": why or "pass", **record})
-        return why == ""
+            limit = options.gain_max_db if out["experiment"] == "gain_up" else options.gain_min_db
+            self.search = threshold_search(0.0, limit, options.gain_tol_db, options.gain_step_db)
+        self._next(None)
 
-    if task.experiment == "delay":
-        steps = max(1, int(round(o.delay_max_s / h)))
-        passed, failed, _ = find_threshold(passes, 0, steps, 1.0, 1, integer=True)
-        out["passed"], out["failed_at"] = passed * h * 1e3, None if failed is None else failed * h * 1e3
-    else:
-        limit = o.gain_max_db if task.experiment == "gain_up" else o.gain_min_db
-        out["passed"], out["failed_at"], _ = find_threshold(passes, 0.0, limit, o.gain_tol_db, o.gain_step_db)
-    out["status"] = "bracketed" if out["failed_at"] is not None else "beyond range"
-    out["trials"] = trials
-    return out
+    def _next(self, passed: bool | None) -> None:
+        try:
+            self.value = next(self.search) if passed is None else self.search.send(passed)
+        except StopIteration as stop:
+            self.value = None
+            passed_at, failed, _ = stop.value
+            if self.out["experiment"] == "delay":
+                passed_at, failed = passed_at * self.h * 1e3, None if failed is None else failed * self.h * 1e3
+            self.out.update(passed=passed_at, failed_at=failed, trials=self.trials,
+                            status="bracketed" if failed is not None else "beyond range")
+
+    def row(self) -> tuple[float, int]:
+        """The gain [-] and the delay [physics steps] of the value to try."""
+        if self.out["experiment"] == "delay":
+            return 1.0, int(self.value)
+        return db_to_gain(self.value), 0
+
+    def tried(self, record: dict[str, Any]) -> None:
+        """The episode of the value tried: its verdict, then the next value (None: the search ended)."""
+        why = verdict(record, self.out["bounds"])
+        shown = self.value * self.h * 1e3 if self.out["experiment"] == "delay" else self.value
+        self.trials.append({"value": shown, "passed": why == "", "verdict": why or "pass", **record})
+        self._next(why == "")
+
+
+def run_margin_task(task: MarginTask) -> list[dict[str, Any]]:
+    """Fly the nominal episodes of the task's policies and seeds, then search every experiment's threshold
+    (module docstring), the searches side by side: each round flies the next value of every search that
+    goes on as the rows of one batched flight (:func:`~.runner.fly_block`; each row the single env's
+    episode with its gain or delay, :func:`~.perturb.fly`). Returns one result per policy, seed and
+    experiment, in that order: ``passed`` (the margin, in ``unit``), ``failed_at`` (the smallest value tried
+    that failed; None: none failed up to the range's end), ``nominal`` and every ``trials`` episode. With a
+    failing nominal episode, ``passed`` is None and nothing is searched."""
+    o, cond = task.options, task.condition
+    pairs = [(spec, int(seed)) for spec in task.policies for seed in task.seeds]
+    nominals = [summary(r) for r in fly_block(cond, pairs)]
+    results, searches = [], []
+    for (spec, seed), nominal in zip(pairs, nominals):
+        h = physics_dt_s(spec, cond)
+        for e in task.experiments:
+            out: dict[str, Any] = {"policy": spec.name, "condition": cond.name, "model": cond.model, "seed": seed,
+                                   "experiment": e, "unit": UNITS[e], "nominal": nominal, "bounds": bounds(nominal, o),
+                                   "physics_dt_s": h, "passed": None, "failed_at": None, "trials": []}
+            results.append(out)
+            if nominal["failed"]:
+                out["status"] = "nominal failed"
+            else:
+                searches.append((spec, seed, _Search(out, o, h)))
+    while True:
+        going = [(spec, seed, s) for spec, seed, s in searches if s.value is not None]
+        if not going:
+            return results
+        perturbed = [s.row() for _, _, s in going]
+        records = fly_block(cond, [(spec, seed) for spec, seed, _ in going], gains=[g for g, _ in perturbed],
+                            delay_steps=[d for _, d in perturbed])
+        for (_, _, s), record in zip(going, records):
+            s.tried(summary(record))
 
 
 def _describe(task: MarginTask) -> str:
-    return f"margin {task.experiment} of policy {task.policy.name!r} on {task.condition.name!r} seed {task.seed}"
+    return (f"margins {list(task.experiments)} of policies {[p.name for p in task.policies]} on "
+            f"{task.condition.name!r} seeds {list(task.seeds)}")
 
 
 def _conditions(where: Suite | Condition | Sequence[Condition]) -> list[Condition]:
@@ -234,11 +263,16 @@ def run_margins(policies: Sequence[PolicySpec], where: Suite | Condition | Seque
     conds, seed_list = _conditions(where), _seeds(where, seeds, seed_set)
     if not conds or not seed_list:
         raise ValueError("margins need at least one condition and one seed")
-    tasks = [MarginTask(p, c, s, e, options) for p in policies for c in conds for s in seed_list for e in experiments]
+    n_workers = 1 if executor == "serial" else (check_workers(workers) or default_workers())
+    parts = min(len(policies), max(1, math.ceil(n_workers / len(conds))))     # enough tasks for the workers
+    chunks = [tuple(policies[i::parts]) for i in range(parts)]
+    tasks = [MarginTask(chunk, c, tuple(seed_list), tuple(experiments), options) for c in conds for chunk in chunks]
     t0 = time.perf_counter()
-    done = run_map(run_margin_task, tasks, executor, workers, progress, desc="searches", unit="seed",
-                   describe=_describe)
+    flown = run_map(run_margin_task, tasks, executor, workers, progress, desc="searches", unit="task",
+                    describe=_describe)
     wall = time.perf_counter() - t0
+    found = {(r["policy"], r["condition"], r["seed"], r["experiment"]): r for part in flown for r in part}
+    done = [found[(p.name, c.name, s, e)] for p in policies for c in conds for s in seed_list for e in experiments]
     limits = {"gain_up": options.gain_max_db, "gain_down": options.gain_min_db, "delay": options.delay_max_s * 1e3}
     results = []
     for p in policies:

@@ -150,6 +150,18 @@ def episode_metrics(traj: Trajectory) -> dict[str, Any]:
     }
 
 
+def combined_record(v0: dict[str, Any], v1: dict[str, Any]) -> dict[str, Any]:
+    """An episode's record: protocol v0's :func:`episode_metrics` and, beside them, v1's
+    :func:`~.scoring.flight_metrics` (``score``, the per-phase rate errors, ...). ``rate_error_rad`` and the
+    failure fields are defined once (v0's): v1's must agree bit for bit (``AssertionError`` otherwise)."""
+    v1 = dict(v1)
+    for key in ("rate_error_rad", "failed", "failure_reason"):
+        value = v1.pop(key)
+        if value != v0[key]:
+            raise AssertionError(f"{key}: v1 {value!r} against v0 {v0[key]!r}")
+    return {**v0, **v1}
+
+
 def cvar(values: Sequence[float], level: float = CVAR_LEVEL, higher_is_worse: bool = True) -> float:
     """Conditional value at risk: the mean of the worst ``ceil(level * n)`` values (at least one).
     Worst is the largest when ``higher_is_worse``, else the smallest. NaN for no values."""

@@ -9,9 +9,12 @@ search that raises it until the flight fails.
   go into the row's servo delay (layout :data:`lvgym.simulator.layouts.ACTUATOR`, field ``delay``: the
   first so many physics steps of a control period follow the previous period's command), the same field
   the ``servo_delay`` dispersion sets. The gimbal command is held over a control period, so both are the
-  same pure shift of the command signal, and no equation is written twice.
+  same pure shift of the command signal, and no equation is written twice. :class:`RowDelay` is the
+  same for the rows of a batched env, each with its own delay (a batched flight scales each row's
+  actions by its own gain: :func:`lvgym.benchmark.rows.fly_rows`).
 - :func:`find_threshold`: the largest value that passes, searched outwards from one known to pass
-  (doubling steps), then bisected.
+  (doubling steps), then bisected; :func:`threshold_search` is the same search as a generator, so that
+  many go on side by side.
 - :func:`fly`: one episode of a policy spec on a condition with a gain and a delay, summarised.
 """
 
@@ -19,7 +22,7 @@ from __future__ import annotations
 
 import math
 from collections import deque
-from collections.abc import Callable
+from collections.abc import Callable, Generator
 from typing import Any
 
 import gymnasium as gym
@@ -31,7 +34,8 @@ from .policy import Policy
 from .runner import PolicySpec, episode_objects, play_episode
 from .suites import Condition
 
-__all__ = ["ActuatorDelay", "GainPolicy", "find_threshold", "db_to_gain", "fly", "gain_to_db"]
+__all__ = ["ActuatorDelay", "GainPolicy", "RowDelay", "SUMMARY", "db_to_gain", "find_threshold", "fly", "gain_to_db",
+           "summary", "threshold_search"]
 
 
 def db_to_gain(db: float) -> float:
@@ -114,6 +118,86 @@ class ActuatorDelay(gym.Wrapper):
         return self.env.step(action)
 
 
+class RowDelay:
+    """:class:`ActuatorDelay` for the rows of a batched lvgym TVC env, each its own delay: row ``b`` gets
+    ``steps[b]`` physics steps (0: none), split as the wrapper splits them (whole periods into a
+    first-in first-out buffer of actions that starts neutral; the rest added to the row's servo delay,
+    written here, right after the env's reset). :meth:`apply` takes the actions the policies gave every
+    row and returns those the env gets (float64, which holds every action's value exactly)."""
+
+    def __init__(self, env: Any, steps: Any) -> None:
+        u = env.unwrapped
+        task = u.task
+        if task.control != "tvc":
+            raise ValueError(f"control = {task.control!r}: an actuator delay needs a TVC env")
+        n = int(env.num_envs)
+        raw = np.asarray(steps).reshape(-1)
+        if raw.size != n or np.any(raw < 0) or np.any(raw != np.round(raw)):
+            raise ValueError(f"steps = {raw.tolist()!r}: {n} whole numbers of physics steps >= 0, one per row")
+        steps = raw.astype(np.int64)
+        per = int(task.substeps)
+        self.physics_dt_s = float(task.control_dt_s) / per
+        delay = ACTUATOR.view(u.state.sim.actuator, "delay")
+        self.length = np.zeros(n, dtype=np.int64)
+        for b in np.flatnonzero(steps).tolist():
+            periods, servo_steps = divmod(int(steps[b]), per)
+            more, delay[b, 0] = divmod(int(round(delay[b, 0])) + servo_steps, per)
+            self.length[b] = periods + more
+        self.rows = np.flatnonzero(self.length)
+        n_a = int(np.prod(u.single_action_space.shape))
+        self._buffer = np.zeros((n, max(1, int(self.length.max(initial=0))), n_a))
+        self._next = np.zeros(n, dtype=np.int64)
+
+    def apply(self, actions: np.ndarray) -> np.ndarray:
+        """The actions (n, n_a) the env gets this step: a buffered row's oldest action (its buffer takes
+        this one), the others' own."""
+        q = self.rows
+        if not q.size:
+            return actions
+        a = np.asarray(actions)
+        out = a.astype(np.float64)
+        k = self._next[q]
+        out[q] = self._buffer[q, k]
+        self._buffer[q, k] = a[q]
+        self._next[q] = (k + 1) % self.length[q]
+        return out
+
+
+def threshold_search(safe: float, limit: float, tol: float, first_step: float,
+                     integer: bool = False) -> Generator[float, bool, tuple[float, float | None, list[tuple[float, bool]]]]:
+    """:func:`find_threshold` as a generator: it yields each value to try and is sent whether it passed;
+    its return value (``StopIteration.value``) is ``(passed, failed, trials)``. Many searches can so go on
+    side by side, their trials flown together (the margins' seeds, :mod:`.margins`)."""
+    a, lim = float(safe), float(limit)
+    if integer:
+        a, lim, tol, first_step = float(round(a)), float(round(lim)), 1.0, max(1.0, float(round(abs(first_step))))
+    direction = 1.0 if lim >= a else -1.0
+    step = abs(float(first_step))
+    trials: list[tuple[float, bool]] = []
+    failed = None
+    while a != lim:                                   # outwards
+        x = a + direction * step
+        x = lim if (x - lim) * direction >= 0.0 else x
+        ok = bool((yield x))
+        trials.append((x, ok))
+        if not ok:
+            failed = x
+            break
+        a, step = x, 2.0 * step
+    if failed is None:
+        return a, None, trials
+    b = failed
+    while abs(b - a) > tol + 1e-12:                   # then bisection of the bracket [a, b]
+        m = a + (math.trunc((b - a) / 2.0) if integer else (b - a) / 2.0)
+        ok = bool((yield m))
+        trials.append((m, ok))
+        if ok:
+            a = m
+        else:
+            b = m
+    return a, b, trials
+
+
 def find_threshold(passes: Callable[[float], bool], safe: float, limit: float, tol: float, first_step: float,
                    integer: bool = False) -> tuple[float, float | None, list[tuple[float, bool]]]:
     """The largest value that passes, searched outwards from ``safe`` (known to pass, not tried) towards
@@ -124,41 +208,27 @@ def find_threshold(passes: Callable[[float], bool], safe: float, limit: float, t
     nominal, it finds the first failure on that grid and not a wider pass region further out. Returns
     ``(passed, failed, trials)``: the value that passed closest to the failure, the first value that
     failed (None: ``limit`` passed, the threshold lies beyond it) and every ``(value, passed)`` in the
-    order tried.
+    order tried (:func:`threshold_search` is the same search as a generator).
 
     >>> find_threshold(lambda x: x < 7.3, 0.0, 20.0, 0.25, 1.0)[:2]
     (7.25, 7.5)
     """
-    a, lim = float(safe), float(limit)
-    if integer:
-        a, lim, tol, first_step = float(round(a)), float(round(lim)), 1.0, max(1.0, float(round(abs(first_step))))
-    direction = 1.0 if lim >= a else -1.0
-    step = abs(float(first_step))
-    trials: list[tuple[float, bool]] = []
+    search = threshold_search(safe, limit, tol, first_step, integer)
+    try:
+        x = next(search)
+        while True:
+            x = search.send(bool(passes(x)))
+    except StopIteration as stop:
+        return stop.value
 
-    def tried(x: float) -> bool:
-        ok = bool(passes(x))
-        trials.append((x, ok))
-        return ok
 
-    failed = None
-    while a != lim:                                   # outwards
-        x = a + direction * step
-        x = lim if (x - lim) * direction >= 0.0 else x
-        if not tried(x):
-            failed = x
-            break
-        a, step = x, 2.0 * step
-    if failed is None:
-        return a, None, trials
-    b = failed
-    while abs(b - a) > tol + 1e-12:                   # then bisection of the bracket [a, b]
-        m = a + (math.trunc((b - a) / 2.0) if integer else (b - a) / 2.0)
-        if tried(m):
-            a = m
-        else:
-            b = m
-    return a, b, trials
+#: the fields of an episode's record a margin search reads and keeps (:func:`fly`)
+SUMMARY = ("failed", "failure_reason", "rate_error_rad", "score", "gimbal_rate_limit_s", "effort_rad_s", "duration_s")
+
+
+def summary(record: dict[str, Any]) -> dict[str, Any]:
+    """The :data:`SUMMARY` fields of an episode's record."""
+    return {key: record[key] for key in SUMMARY}
 
 
 def fly(policy_spec: PolicySpec, condition: Condition, seed: int, gain: float = 1.0,
@@ -173,6 +243,4 @@ def fly(policy_spec: PolicySpec, condition: Condition, seed: int, gain: float = 
         policy = GainPolicy(policy, gain)
     if delay_steps:
         env = ActuatorDelay(env, delay_steps)
-    record = play_episode(policy, env, seed)
-    return {key: record[key] for key in ("failed", "failure_reason", "rate_error_rad", "score", "gimbal_rate_limit_s",
-                                          "effort_rad_s", "duration_s")}
+    return summary(play_episode(policy, env, seed))

@@ -45,3 +45,22 @@ class ZeroPolicy:
         if self.discrete:
             return np.ones(self.n_actions, dtype=np.int64)
         return np.zeros(self.n_actions, dtype=np.float32)
+
+    def batch(self, n: int) -> ZeroBatch:
+        """The same for ``n`` rows of a batched env (:mod:`.batch`)."""
+        return ZeroBatch(self)
+
+
+class ZeroBatch:
+    """:class:`ZeroPolicy` for the rows of a batched env (the interface of :mod:`.batch`): every row's
+    action is the policy's own."""
+
+    def __init__(self, policy: ZeroPolicy) -> None:
+        self.name = policy.name
+        self._action = policy.act(np.zeros(0, np.float32), {})
+
+    def reset(self, rows: Any) -> None:
+        pass
+
+    def act(self, rows: Any, observations: np.ndarray, info: dict[str, Any]) -> np.ndarray:
+        return np.tile(self._action, (np.size(rows), 1))

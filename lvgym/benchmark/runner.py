@@ -2,25 +2,33 @@
 pool or on Ray, with a progress bar and results in a fixed order.
 
 A policy travels to a worker as a :class:`PolicySpec` (a name and an importable factory, never an
-object), a condition as its frozen :class:`~.suites.Condition`; :func:`run_episode` builds both there
-(cached per process: envs and policies are reused across episodes, ``reset`` with the seed makes each
-episode independent of what ran before) and returns a plain dict. The result of an evaluation does not
-depend on the executor, the number of workers or the order in which episodes finish.
+object), a condition as its frozen :class:`~.suites.Condition`; the worker builds both (cached per
+process: envs and policies are reused, ``reset`` with the seed makes each episode independent of what ran
+before) and returns plain dicts. :func:`run_episode` flies one episode on the single env
+(:func:`play_episode`); :func:`evaluate` flies the episodes of a condition together, as the rows of its
+batched env (:func:`run_block`, :mod:`.rows`), with the single env's records to the bit. The result of an
+evaluation does not depend on the executor, the number of workers, the block size or the order in which
+blocks finish.
 """
 
 from __future__ import annotations
 
 import inspect
+import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
-from lvgym.errors import ConfigError
-from lvgym.parallel import EXECUTORS, default_workers, run_map
+import numpy as np
 
+from lvgym.errors import ConfigError
+from lvgym.parallel import EXECUTORS, check_workers, default_workers, run_map
+
+from .batch import BatchPolicy, as_batch
 from .factory import load_factory
-from .metrics import TrajectoryBuilder, episode_metrics
+from .metrics import TrajectoryBuilder, combined_record, episode_metrics
 from .policy import Policy, ZeroPolicy
+from .rows import fly_rows
 from .scoring import FlightLog, flight_metrics
 from .suites import PROTOCOL_VERSION, Condition, Suite
 
@@ -92,6 +100,10 @@ def build_policy(spec: PolicySpec, env: Any) -> Policy:
 
 _ENVS: dict[Condition, Any] = {}
 _POLICIES: dict[tuple[PolicySpec, Condition], Policy] = {}
+_VEC_ENVS: dict[tuple[Condition, int], Any] = {}
+_BATCHES: dict[tuple[PolicySpec, Condition], tuple[int, BatchPolicy]] = {}
+#: batched envs kept per process (one per condition and row count; the oldest goes first)
+KEEP_VEC_ENVS = 8
 
 
 def _env(condition: Condition) -> Any:
@@ -118,13 +130,7 @@ def play_episode(policy: Policy, env: Any, seed: int) -> dict[str, Any]:
         log.step(env, obs, reward, info)
         if terminated or truncated:
             break
-    record = episode_metrics(traj.build())
-    v1 = flight_metrics(log)
-    for key in ("rate_error_rad", "failed", "failure_reason"):     # one definition, written once (v0's)
-        value = v1.pop(key)
-        if value != record[key]:
-            raise AssertionError(f"{key}: v1 {value!r} against v0 {record[key]!r}")
-    return {**record, **v1}
+    return combined_record(episode_metrics(traj.build()), flight_metrics(log))
 
 
 def episode_objects(policy_spec: PolicySpec, condition: Condition) -> tuple[Any, Policy]:
@@ -137,14 +143,56 @@ def episode_objects(policy_spec: PolicySpec, condition: Condition) -> tuple[Any,
     return env, _POLICIES[key]
 
 
+def vec_env(condition: Condition, n: int) -> Any:
+    """The batched env of ``n`` rows of ``condition``, cached per process (reset at every flight)."""
+    key = (condition, int(n))
+    if key not in _VEC_ENVS:
+        while len(_VEC_ENVS) >= KEEP_VEC_ENVS:
+            _VEC_ENVS.pop(next(iter(_VEC_ENVS))).close()
+        _VEC_ENVS[key] = condition.make_vec_env(int(n))
+    return _VEC_ENVS[key]
+
+
+def batch_objects(policy_spec: PolicySpec, condition: Condition, n: int) -> BatchPolicy:
+    """The batched policy of ``policy_spec`` for at least ``n`` rows of ``condition``'s batched env, cached
+    per process: the policy's own ``batch(n)``, else one policy per row built by its factory
+    (:func:`~.batch.as_batch`); its rows are reset at the start of every flight."""
+    key = (policy_spec, condition)
+    have = _BATCHES.get(key)
+    if have is None or have[0] < n:
+        env = _env(condition)
+        _BATCHES[key] = (int(n), as_batch(build_policy(policy_spec, env), int(n),
+                                          lambda: build_policy(policy_spec, env)))
+    return _BATCHES[key][1]
+
+
+def fly_block(condition: Condition, rows: Sequence[tuple[PolicySpec, int]], *, gains: Sequence[float] | None = None,
+              delay_steps: Sequence[int] | None = None,
+              first_observations: list[np.ndarray] | None = None) -> list[dict[str, Any]]:
+    """One episode per ``(policy spec, seed)`` of ``rows``, flown together as the rows of ``condition``'s
+    batched env (:func:`~.rows.fly_rows`; ``gains``, ``delay_steps``, ``first_observations`` as there);
+    the records in the order of ``rows``, each the :func:`play_episode` of its policy and seed on the
+    single env, to the bit. Envs and batched policies are cached per process."""
+    env = vec_env(condition, len(rows))
+    owners: dict[PolicySpec, list[int]] = {}
+    for i, (spec, _) in enumerate(rows):
+        owners.setdefault(spec, []).append(i)
+    groups = [(batch_objects(spec, condition, len(rows)), idx) for spec, idx in owners.items()]
+    return fly_rows(env, [int(seed) for _, seed in rows], groups, gains=gains, delay_steps=delay_steps,
+                    first_observations=first_observations)
+
+
+def _labels(policy_spec: PolicySpec, condition: Condition, seed: int) -> dict[str, Any]:
+    return {"policy": policy_spec.name, "condition": condition.name, "group": condition.group,
+            "env_id": condition.env_id, "model": condition.model, "wind": condition.wind, "seed": int(seed)}
+
+
 def run_episode(policy_spec: PolicySpec, condition: Condition, seed: int) -> dict[str, Any]:
     """One episode of ``policy_spec`` on ``condition``, reset with ``seed``; returns the record: the
     policy and condition labels, the seed and :func:`~.metrics.episode_metrics`. A function of its
     arguments only (envs and policies are cached per process, and reset every episode)."""
     env, policy = episode_objects(policy_spec, condition)
-    return {"policy": policy_spec.name, "condition": condition.name, "group": condition.group,
-            "env_id": condition.env_id, "model": condition.model, "wind": condition.wind, "seed": int(seed),
-            **play_episode(policy, env, seed)}
+    return {**_labels(policy_spec, condition, seed), **play_episode(policy, env, seed)}
 
 
 @dataclass(frozen=True)
@@ -187,21 +235,80 @@ def _describe(task: Task) -> str:
     return f"policy {task.policy.name!r} on {task.condition.name!r} seed {task.seed}"
 
 
-def evaluate(policies: Sequence[PolicySpec], suites: Sequence[Suite], episodes: int, seed_set: str = "test",
-             executor: str = "local", workers: int | None = None, progress: bool = True) -> list[dict[str, Any]]:
-    """Run ``episodes`` seeds of ``seed_set`` for every policy on every condition of every suite and return
-    the episode records in the order of :func:`make_tasks` (whatever the executor and worker count).
+@dataclass(frozen=True)
+class Block:
+    """Episodes flown together: tasks of one suite and condition (any policies and seeds), as the rows of
+    the condition's batched env."""
 
-    executor: ``local`` (a process pool of ``workers`` processes, default: the CPUs available),
-    ``serial`` (this process) or ``ray`` (one Ray task per episode: on the Ray already initialised in this
-    process, else on the cluster at ``$RAY_ADDRESS``, else on a local Ray of ``workers`` CPUs started and
-    stopped here). Ray workers import ``lvgym`` and the policy factories, so install the project on
-    every node."""
+    tasks: tuple[Task, ...]
+
+
+#: the most rows a block of :func:`evaluate` flies together by default (the memory of its steps grows with it)
+MAX_BLOCK_ROWS = 128
+
+
+def make_blocks(tasks: Sequence[Task], rows: int) -> list[Block]:
+    """``tasks`` in blocks of at most ``rows`` consecutive tasks of one suite and condition, in order."""
+    if int(rows) < 1:
+        raise ValueError(f"rows = {rows!r}: at least one row per block")
+    blocks: list[Block] = []
+    part: list[Task] = []
+    for t in tasks:
+        if part and (len(part) >= rows or (t.suite, t.condition) != (part[0].suite, part[0].condition)):
+            blocks.append(Block(tuple(part)))
+            part = []
+        part.append(t)
+    if part:
+        blocks.append(Block(tuple(part)))
+    return blocks
+
+
+def block_rows(n_tasks: int, workers: int) -> int:
+    """The default block size: at least two blocks per worker where there are enough episodes, at most
+    :data:`MAX_BLOCK_ROWS` rows (the results do not depend on it)."""
+    return max(1, min(MAX_BLOCK_ROWS, math.ceil(n_tasks / (2 * max(1, workers)))))
+
+
+def run_block(block: Block) -> list[dict[str, Any]]:
+    """The records of a block's tasks, in order, as :func:`run_task` gives each (flown together,
+    :func:`fly_block`)."""
+    first = block.tasks[0]
+    records = fly_block(first.condition, [(t.policy, t.seed) for t in block.tasks])
+    return [{"protocol": t.version, "suite": t.suite, "episode": t.episode, **_labels(t.policy, t.condition, t.seed),
+             **r} for t, r in zip(block.tasks, records)]
+
+
+def _describe_block(block: Block) -> str:
+    t = block.tasks
+    names = list(dict.fromkeys(x.policy.name for x in t))
+    return (f"policies {names} on {t[0].condition.name!r} seeds {t[0].seed}..{t[-1].seed} ({len(t)} episodes "
+            "flown together)")
+
+
+def evaluate(policies: Sequence[PolicySpec], suites: Sequence[Suite], episodes: int, seed_set: str = "test",
+             executor: str = "local", workers: int | None = None, progress: bool = True,
+             rows: int | None = None) -> list[dict[str, Any]]:
+    """Run ``episodes`` seeds of ``seed_set`` for every policy on every condition of every suite and return
+    the episode records in the order of :func:`make_tasks` (whatever the executor, worker count and block
+    size).
+
+    The episodes of a condition fly together as the rows of its batched env, in blocks of at most ``rows``
+    (default :func:`block_rows`) consecutive episodes (:func:`run_block`); each record is the single env's
+    episode of its seed (:func:`run_task`), to the bit. executor: ``local`` (a process pool of ``workers``
+    processes, default: the CPUs available), ``serial`` (this process) or ``ray`` (one Ray task per block:
+    on the Ray already initialised in this process, else on the cluster at ``$RAY_ADDRESS``, else on a local
+    Ray of ``workers`` CPUs started and stopped here). Ray workers import ``lvgym`` and the policy
+    factories, so install the project on every node."""
     if executor not in EXECUTORS:
         raise ValueError(f"executor = {executor!r}: one of {EXECUTORS}")
     tasks = make_tasks(policies, suites, episodes, seed_set)
-    return run_map(run_task, tasks, executor, workers, progress, desc="episodes", unit="ep", describe=_describe)
+    n_workers = 1 if executor == "serial" else (check_workers(workers) or default_workers())
+    blocks = make_blocks(tasks, block_rows(len(tasks), n_workers) if rows is None else rows)
+    done = run_map(run_block, blocks, executor, workers, progress, desc="blocks", unit="block",
+                   describe=_describe_block)
+    return [r for block in done for r in block]
 
 
-__all__ = ["EXECUTORS", "PROTOCOL_VERSION", "PolicyError", "PolicySpec", "Task", "ZERO", "build_policy", "default_workers",
-           "episode_objects", "evaluate", "make_tasks", "play_episode", "run_episode", "run_task", "zero_policy"]
+__all__ = ["Block", "EXECUTORS", "MAX_BLOCK_ROWS", "PROTOCOL_VERSION", "PolicyError", "PolicySpec", "Task", "ZERO",
+           "batch_objects", "block_rows", "build_policy", "default_workers", "episode_objects", "evaluate", "fly_block",
+           "make_blocks", "make_tasks", "play_episode", "run_block", "run_episode", "run_task", "vec_env", "zero_policy"]

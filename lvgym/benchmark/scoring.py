@@ -40,7 +40,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["FlightLog", "IDEAL_OBSERVATIONS", "MAX_Q_FRACTION", "PHASES", "QALPHA_COST_FRACTION", "flight_metrics"]
+__all__ = ["FlightColumns", "FlightLog", "IDEAL_OBSERVATIONS", "MAX_Q_FRACTION", "PHASES", "QALPHA_COST_FRACTION", "flight_metrics"]
 
 PHASES = ("boost", "max_q", "coast", "upper")
 #: the max-q region: dynamic pressure at least this fraction of its peak before the first burnout [-]
@@ -127,9 +127,10 @@ def _phase_masks(t: np.ndarray, qbar: np.ndarray, events: list[tuple[float, str]
     return {"boost": first & ~max_q, "max_q": max_q, "coast": (t > burnout) & (t <= ignition), "upper": t > ignition}
 
 
-def _peak(arrays: list[Any]) -> float:
-    """Largest absolute finite value of the recorded arrays (0.0 for none: no mode, no pendulum with mass)."""
-    if not arrays:
+def _peak(arrays: Any) -> float:
+    """Largest absolute finite value of the recorded arrays (a list of one array per step, or their stack;
+    0.0 for none: no mode, no pendulum with mass)."""
+    if len(arrays) == 0:
         return 0.0
     try:
         x = np.abs(np.asarray(arrays, dtype=float)).ravel()
@@ -139,35 +140,71 @@ def _peak(arrays: list[Any]) -> float:
     return float(x.max()) if x.size else 0.0
 
 
-def flight_metrics(log: FlightLog) -> dict[str, Any]:
-    """The v1 metrics of one episode (see the module docstring). ``rate_error_rad`` is summed as protocol
-    v0's :func:`~.metrics.episode_metrics` sums it (per axis, then pitch + yaw), so the two agree bit for bit."""
-    dt = float(log.dt_s)
+@dataclass
+class FlightColumns:
+    """One episode as arrays, one entry per control step (what :meth:`FlightLog.columns` gives, or a batched
+    flight's row, :mod:`.rows`): ``time_s`` (N,) [s], ``rate_error_radps`` (N, 3) [rad/s], ``qbar_pa`` (N,)
+    [Pa], ``qalpha_pa_deg`` (N,) [Pa deg], ``gimbal_rate_radps`` (N, n) [rad/s], ``gyro_minus_body_radps``
+    (N, 2) [rad/s] or None (no gyro), ``eta`` (N, ...) and ``slosh_angles_rad`` (N, ...) (or lists of one
+    array per step), ``events`` ((t [s], text) pairs) and ``termination``. Arrays C-contiguous as
+    ``np.array`` of the steps makes them: :func:`flight_metrics` then sums them in the same order."""
+
+    time_s: np.ndarray
+    rate_error_radps: np.ndarray
+    qbar_pa: np.ndarray
+    qalpha_pa_deg: np.ndarray
+    gimbal_rate_radps: np.ndarray
+    gyro_minus_body_radps: np.ndarray | None
+    eta: Any
+    slosh_angles_rad: Any
+    events: list[tuple[float, str]]
+    termination: str
+
+
+def _columns(log: FlightLog) -> FlightColumns:
+    """The steps of ``log`` as arrays."""
     n = len(log.rows)
     if n:
         cols = list(zip(*log.rows))
         t, qbar, qalpha = (np.array(cols[i], dtype=float) for i in (0, 2, 3))
         e = np.array(cols[1], dtype=float)
-        rate = np.abs(np.array(cols[4], dtype=float)).reshape(n, -1)
-        rate = rate.max(axis=1) if rate.shape[1] else np.zeros(n)
+        rate = np.array(cols[4], dtype=float)
     else:
         t = qbar = qalpha = rate = np.zeros(0)
         e = np.zeros((0, 3))
-    e = np.abs(np.nan_to_num(np.reshape(e, (n, 3)), nan=0.0))
+    gyro = np.array(log.gyro_rows, dtype=float) if log.gyro_rows else None
+    return FlightColumns(t, e, qbar, qalpha, rate, gyro, log.eta, log.slosh, log.events, log.termination)
+
+
+def flight_metrics(log: FlightLog, columns: FlightColumns | None = None) -> dict[str, Any]:
+    """The v1 metrics of one episode (see the module docstring): of ``log``'s steps, or of ``columns`` (the
+    same steps as arrays; ``log`` then gives only the task's facts). ``rate_error_rad`` is summed as
+    protocol v0's :func:`~.metrics.episode_metrics` sums it (per axis, then pitch + yaw), so the two agree
+    bit for bit."""
+    c = _columns(log) if columns is None else columns
+    dt = float(log.dt_s)
+    t, qbar, qalpha = c.time_s, c.qbar_pa, c.qalpha_pa_deg
+    n = len(t)
+    if n:
+        rate = np.abs(np.asarray(c.gimbal_rate_radps, dtype=float)).reshape(n, -1)
+        rate = rate.max(axis=1) if rate.shape[1] else np.zeros(n)
+    else:
+        rate = np.zeros(0)
+    e = np.abs(np.nan_to_num(np.reshape(c.rate_error_radps, (n, 3)), nan=0.0))
     integral = e.sum(axis=0) * dt if n else np.zeros(3)
     out: dict[str, Any] = {"rate_error_rad": float(integral[1] + integral[2])}
-    failed = bool(log.termination)
+    failed = bool(c.termination)
     t_end = float(t[-1]) if t.size else 0.0
     charge = log.failure_penalty_rad_per_s * max(log.mission_time_s - t_end, 0.0) if failed else 0.0
     out["score"] = out["rate_error_rad"] + charge
-    masks = _phase_masks(t, qbar, log.events) if t.size else {p: np.zeros(0, bool) for p in PHASES}
+    masks = _phase_masks(t, qbar, c.events) if t.size else {p: np.zeros(0, bool) for p in PHASES}
     pitch_yaw = e[:, 1] + e[:, 2]
     for name in PHASES:
         out[f"rate_error_{name}_rad"] = float(pitch_yaw[masks[name]].sum() * dt)
-    out["peak_eta"] = _peak(log.eta)
-    out["peak_slosh_deg"] = math.degrees(_peak(log.slosh))
-    if log.gyro_index is not None and log.gyro_rows:
-        g = np.abs(np.nan_to_num(np.array(log.gyro_rows, dtype=float), nan=0.0))
+    out["peak_eta"] = _peak(c.eta)
+    out["peak_slosh_deg"] = math.degrees(_peak(c.slosh_angles_rad))
+    if log.gyro_index is not None and c.gyro_minus_body_radps is not None and len(c.gyro_minus_body_radps):
+        g = np.abs(np.nan_to_num(np.asarray(c.gyro_minus_body_radps, dtype=float), nan=0.0))
         out["gyro_minus_body_rate_rad"] = float(g.sum() * dt)
     else:
         out["gyro_minus_body_rate_rad"] = 0.0
@@ -175,5 +212,5 @@ def flight_metrics(log: FlightLog) -> dict[str, Any]:
     out["gimbal_rate_limit_s"] = float(np.sum(rate >= 0.99 * lim) * dt) if lim > 0 else 0.0
     out["qalpha_cost_s"] = float(np.sum(np.nan_to_num(qalpha) > QALPHA_COST_FRACTION * log.qalpha_limit_pa_deg) * dt)
     out["failed"] = failed
-    out["failure_reason"] = log.termination
+    out["failure_reason"] = c.termination
     return out

@@ -85,18 +85,13 @@ def parse_args(argv: list[str] | None = None) -> Args:
 
 
 def _control_dt_s(condition: Condition) -> float:
-    """The control period of ``condition``'s env [s], from its registered class's defaults."""
-    import importlib
+    """The control period of ``condition``'s env [s], from its registered class's preset."""
+    import lvgym
+    from lvgym.envs.options import TimingOptions
 
-    import gymnasium
-
-    import lvgym  # noqa: F401  (registers the env ids)
-    from lvgym.envs.spec import TaskSpec
-
-    entry = gymnasium.spec(condition.env_id).entry_point
-    module, _, attr = entry.partition(":") if isinstance(entry, str) else (None, "", "")
-    defaults = getattr(importlib.import_module(module), attr).DEFAULTS if module else {}
-    return float(dict(condition.options).get("control_dt_s", defaults.get("control_dt_s", TaskSpec.control_dt_s)))
+    preset = lvgym.env_class(condition.env_id).PRESET
+    default = preset.control_dt_s if preset is not None else TimingOptions().control_dt_s
+    return float(dict(condition.options).get("control_dt_s", default))
 
 
 def main(argv: list[str] | None = None) -> list[dict[str, Any]]:

@@ -26,7 +26,11 @@ from .ascent import (AscentEnv, SlenderAscentEnv, SlenderAscentV1Env, SmileAscen
 from .functional import AscentFuncEnv, AscentParams, AscentState
 from .layouts import OBS_FLIGHT, OBS_SENSORS, OBS_STATE, OBSERVATIONS, REWARD_TERMS, TASK
 from .snapshot import EpisodeState
-from .spec import FLIGHT_DEFAULTS, RANDOMIZE, WIND_TIERS, TaskSpec
+from .dispersions import DISPERSIONS
+from .options import (ActuatorOptions, AtmosphereOptions, CoastOptions, DispersionOptions, GuidanceOptions, LaunchOptions,
+                      LimitOptions, PhysicsOptions, RewardOptions, SensorOptions, TimingOptions)
+from .presets import FLIGHT_DEFAULTS, FLIGHT_SENSORS
+from .spec import RANDOMIZE, WIND_TIERS, TaskSpec
 from .vector import AscentVectorEnv
 
 #: env id -> env class, for every id of the one table :data:`lvgym.ENV_IDS`
@@ -48,8 +52,10 @@ def __getattr__(name: str) -> Any:
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
-__all__ = ["ENVS", "FLIGHT_DEFAULTS", "OBSERVATIONS", "OBS_FLIGHT", "OBS_SENSORS", "OBS_STATE", "RANDOMIZE",
+__all__ = ["DISPERSIONS", "ENVS", "FLIGHT_DEFAULTS", "FLIGHT_SENSORS", "OBSERVATIONS", "OBS_FLIGHT", "OBS_SENSORS", "OBS_STATE", "RANDOMIZE",
            "REWARD_TERMS", "TASK", "WIND_TIERS",
+           "ActuatorOptions", "AtmosphereOptions", "CoastOptions", "DispersionOptions", "GuidanceOptions",
+           "LaunchOptions", "LimitOptions", "PhysicsOptions", "RewardOptions", "SensorOptions", "TimingOptions",
            "AscentEnv", "AscentFuncEnv", "AscentParams", "AscentSB3VecEnv", "AscentState", "AscentVectorEnv",
            "EpisodeState", "SlenderAscentEnv", "SlenderAscentV1Env", "SmileAscentEnv", "SmileAscentV1Env",
            "StratosIIIEnv", "StratosIIIV1Env", "TaskSpec", "env_class", "make_sb3_vec_env", "make_vector"]

@@ -6,7 +6,8 @@ explicit state; :class:`~.core.BatchCore` resets and steps its rows; these class
 :data:`~.functional.AscentState` value); ``env.unwrapped.flight`` reads its simulator rows by name
 (``flight.t[0]``, ``flight.conditions("qbar")[0]``, ``flight.state("omega_bi_b")[0]``,
 ``flight.gimbal[0]``: :class:`lvgym.simulator.SimView`); :meth:`AscentEnv.get_state` and
-:meth:`AscentEnv.set_state` capture and restore it whole (see :mod:`.snapshot`). Options are keywords (see :class:`~.spec.TaskSpec`), e.g.
+:meth:`AscentEnv.set_state` capture and restore it whole (see :mod:`.snapshot`). Each class flies its
+protocol preset (``PRESET``, :mod:`.presets`) updated by keywords (see :class:`~.spec.TaskSpec`), e.g.
 ``gymnasium.make("lvgym/SmileAscent-v0", model="rigid", wind="turbulence", randomize=True)``.
 
 Observation (``Box(-inf, inf, (14,), float32)``), for ``observation="state"`` (the ideal state of the
@@ -44,31 +45,35 @@ Version history: v0 (2026-11): first release.
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import replace
 from typing import Any
 
 import gymnasium as gym
 import numpy as np
 
+from lvgym.errors import ConfigError
+from lvgym.vehicle.slender import SlenderGeometry
+
 from .core import BatchCore, row_info
 from .functional import AscentFuncEnv, AscentState
 from .layouts import observation_table
+from .presets import DEFAULT_AERO_MACH, SLENDER_V0, SLENDER_V1, SMILE_V0, SMILE_V1, STRATOS3_V0, STRATOS3_V1
 from .snapshot import EpisodeState
-from .spec import FLIGHT_DEFAULTS, TaskSpec, check_reset_options
+from .spec import TaskSpec, check_reset_options
 from .views import FuncViews
 
 __doc__ = __doc__ % {"observation": "\n".join("    " + line for line in observation_table().splitlines())}
 
-#: Mach number at which SlenderAscent-v0 freezes the vehicle's aerodynamic tables by default [-]
-DEFAULT_AERO_MACH = 2.0
-
 
 class AscentEnv(FuncViews, gym.Env):
     """Base of the ascent envs: one row of an :class:`~.functional.AscentFuncEnv`. Subclasses set
-    ``DEFAULTS``. ``vehicles``: several vehicles (keys of :func:`~.functional.cached_vehicle`) of which
-    each reset draws one from the env's generator (the episode's *variant*, part of its state)."""
+    ``PRESET`` (without one, the keywords must name the ``vehicle``). ``vehicles``: several vehicles
+    (names, paths or :class:`~lvgym.vehicle.slender.SlenderGeometry` values) of which each reset draws one
+    from the env's generator (the episode's *variant*, part of its state)."""
 
     metadata = {"render_modes": ["human", "rgb_array"], "render_fps": 25}
-    DEFAULTS: dict[str, Any] = {}
+    #: the protocol preset the keywords update (:mod:`.presets`)
+    PRESET: TaskSpec | None = None
     #: the keywords the class takes beside the :class:`~.spec.TaskSpec` fields (an unknown keyword's hint)
     KEYWORDS: tuple[str, ...] = ("render_mode", "vehicles")
 
@@ -78,9 +83,9 @@ class AscentEnv(FuncViews, gym.Env):
             raise ValueError(f"render_mode = {render_mode!r}: one of {self.metadata['render_modes']} or None")
         self.render_mode = render_mode
         if vehicles is None:
-            self.specs = (TaskSpec.build(self.DEFAULTS, options, self.KEYWORDS),)
+            self.specs = (TaskSpec.build(self.PRESET, options, self.KEYWORDS),)
         else:
-            self.specs = tuple(TaskSpec.build(self.DEFAULTS, {**options, "vehicle": v}, self.KEYWORDS) for v in vehicles)
+            self.specs = tuple(TaskSpec.build(self.PRESET, {**options, "vehicle": v}, self.KEYWORDS) for v in vehicles)
         self._cores: dict[int, BatchCore] = {}
         self._select(0)
         self.action_space, self.observation_space = self.func.action_space, self.func.observation_space
@@ -168,12 +173,7 @@ class SmileAscentEnv(AscentEnv):
     limit 250 kPa deg, attitude limit 30 deg. See the module docstring for observation, reward and
     termination."""
 
-    DEFAULTS = {"vehicle": "smile", "site": "andoya", "mission_time_s": 60.0, "rate_weights": (0.0, 1.0, 1.0)}
-
-
-#: the physics and timing of protocol v1 that every v1 env shares (issue 16; docs/benchmark.md)
-V1_OPTIONS = {**FLIGHT_DEFAULTS, "reference_velocity": "earth", "action_delay_steps": 1, "aeroelastic": None,
-              "mode_interval_s": 2.0, "mode_basis": "projected", "slosh_frequency": "specific_force"}
+    PRESET = SMILE_V0
 
 
 class SmileAscentV1Env(SmileAscentEnv):
@@ -193,8 +193,7 @@ class SmileAscentV1Env(SmileAscentEnv):
     axial specific force (``slosh_frequency="specific_force"``) and the aeroelastic strip loads follow the
     vehicle file (``aeroelastic=None``; SMILE's flag is off). Everything else as ``SmileAscent-v0``."""
 
-    DEFAULTS = {**SmileAscentEnv.DEFAULTS, **V1_OPTIONS, "vehicle": "smile_v1", "mission_time_s": 70.0,
-                "coast_control": True, "settling_thrust_n": 18000.0}
+    PRESET = SMILE_V1
 
 
 class StratosIIIEnv(AscentEnv):
@@ -207,9 +206,7 @@ class StratosIIIEnv(AscentEnv):
     thrust after the drop stays above the drag and the N2O slosh mass is about 3 kg, so the nonrigid
     model does not depart at the drop as the thesis's did (docs/uncontrolled.md)."""
 
-    DEFAULTS = {"vehicle": "stratos3", "site": "el_arenosillo", "elevation_deg": 85.0, "rail_length_m": 10.0,
-                "mission_time_s": 30.0, "control": "rcs", "rate_weights": (1.0, 1.0, 1.0),
-                "qalpha_limit_pa_deg": 150e3, "controller_on_after_s": 1.0}
+    PRESET = STRATOS3_V0
 
 
 class SlenderAscentEnv(AscentEnv):
@@ -230,44 +227,37 @@ class SlenderAscentEnv(AscentEnv):
     Version history: v0 (2026-11): first release; before the first tagged release the default
     ``aero_mach`` became 2.0 (it flew the full tables, which no policy survives)."""
 
-    DEFAULTS = {"site": "andoya", "mission_time_s": 10.0, "rate_weights": (0.0, 1.0, 1.0)}
-    #: the tube's wall [m] when ``wall_thickness_m`` is not given (None: the thesis's 2 mm)
-    WALL_THICKNESS_M: float | None = None
-    #: the geometry keywords and their defaults: ``length`` [m], ``diameter`` [m] (or a ``(low, high)``
-    #: range), ``aero_mach`` [-] (None: the full tables), ``wall_thickness_m`` [m] (None: ``WALL_THICKNESS_M``)
-    GEOMETRY: dict[str, Any] = {"length": 8.5, "diameter": 0.3, "aero_mach": DEFAULT_AERO_MACH,
-                                "wall_thickness_m": None}
-    KEYWORDS = AscentEnv.KEYWORDS + tuple(GEOMETRY)
+    PRESET = SLENDER_V0
+    #: the geometry keywords (defaults: the preset's :class:`~lvgym.vehicle.slender.SlenderGeometry`):
+    #: ``length`` [m], ``diameter`` [m] (or a ``(low, high)`` range), ``aero_mach`` [-] (None: the full
+    #: tables), ``wall_thickness_m`` [m]
+    GEOMETRY = ("length", "diameter", "aero_mach", "wall_thickness_m")
+    KEYWORDS = AscentEnv.KEYWORDS + GEOMETRY
 
     def __init__(self, render_mode: str | None = None, **options: Any) -> None:
-        geometry = self.geometry(options)
-        diameter = geometry["diameter"]
+        geometry, diameter = self.geometry(options)
         d = np.atleast_1d(np.asarray(diameter, dtype=float))
-        if d.size not in (1, 2) or np.any(d <= 0):
-            raise ValueError(f"diameter = {diameter!r}: a diameter [m] > 0 or a (low, high) pair")
         self.diameters = tuple(np.linspace(d[0], d[-1], 4 if d.size == 2 else 1).tolist())
-        self.length = float(geometry["length"])
-        self.aero_mach = geometry["aero_mach"]
-        self.wall_thickness_m = geometry["wall_thickness_m"]
-        super().__init__(render_mode, vehicles=[slender_key(self.length, dia, self.aero_mach, self.wall_thickness_m)
-                                                for dia in self.diameters], **options)
+        self.length = geometry.length
+        self.aero_mach = geometry.aero_mach
+        self.wall_thickness_m = geometry.wall_thickness
+        super().__init__(render_mode, vehicles=[geometry.with_diameter(dia) for dia in self.diameters], **options)
 
     @classmethod
-    def geometry(cls, options: dict[str, Any]) -> dict[str, Any]:
-        """Pop the geometry keywords from ``options`` (the class's :data:`GEOMETRY` where absent):
-        ``aero_mach`` and ``wall_thickness_m`` as floats (or None; a missing wall is ``WALL_THICKNESS_M``)."""
-        g = {key: options.pop(key, default) for key, default in cls.GEOMETRY.items()}
-        g["aero_mach"] = None if g["aero_mach"] is None else float(g["aero_mach"])
-        wall = g["wall_thickness_m"]
-        g["wall_thickness_m"] = cls.WALL_THICKNESS_M if wall is None else float(wall)
-        return g
-
-
-def slender_key(length: float, diameter: float, aero_mach: float | None, wall_thickness_m: float | None = None) -> tuple:
-    """The vehicle key of :func:`~.functional.cached_vehicle` of one slender vehicle [m, m, -, m] (no wall:
-    the thesis's 2 mm, and the key v0 always had)."""
-    key = ("slender", float(length), float(diameter), aero_mach)
-    return key if wall_thickness_m is None else key + (float(wall_thickness_m),)
+    def geometry(cls, options: dict[str, Any]) -> tuple[SlenderGeometry, Any]:
+        """Pop the geometry keywords from ``options``: the geometry (the preset's where absent or None for
+        the wall; with a ``diameter`` range, its low end) and the ``diameter`` given (a diameter [m] or a
+        ``(low, high)`` range)."""
+        base = cls.PRESET.vehicle
+        given = {key: options.pop(key) for key in cls.GEOMETRY if key in options}
+        diameter = given.pop("diameter", base.diameter)
+        d = np.atleast_1d(np.asarray(diameter, dtype=float)) if np.ndim(diameter) <= 1 else np.zeros(0)
+        if d.size not in (1, 2) or not np.all(d > 0):
+            raise ConfigError("diameter", diameter, "a diameter [m] > 0 or a (low, high) pair")
+        wall = given.pop("wall_thickness_m", None)
+        if wall is not None:
+            given["wall_thickness"] = wall
+        return replace(base, **given, diameter=float(d[0])), diameter
 
 
 class StratosIIIV1Env(StratosIIIEnv):
@@ -275,7 +265,7 @@ class StratosIIIV1Env(StratosIIIEnv):
     ``StratosIII-v0``'s ``control="tvc"``) and protocol v1's physics and timing (frozen 2026-12-02): one control period of delay, modes recomputed every 2 s and projected, slosh dampers on
     the specific force. Reward weights pitch and yaw; roll is left to the vehicle."""
 
-    DEFAULTS = {**StratosIIIEnv.DEFAULTS, **V1_OPTIONS, "control": "tvc", "rate_weights": (0.0, 1.0, 1.0)}
+    PRESET = STRATOS3_V1
 
 
 class SlenderAscentV1Env(SlenderAscentEnv):
@@ -290,7 +280,4 @@ class SlenderAscentV1Env(SlenderAscentEnv):
     and keeps its first mode at 13.6 Hz (docs/aerodynamics.md, "Aeroelastic divergence";
     ``experiments/aeroelastic_divergence/divergence.py`` checks it independently). ``wall_thickness_m=0.002`` flies the thesis's tube."""
 
-    DEFAULTS = {**SlenderAscentEnv.DEFAULTS, **V1_OPTIONS}
-    WALL_THICKNESS_M = 0.0045
-    #: as :class:`SlenderAscentEnv`, with the ``slender-v1`` suite's geometry by default (L/D 30: 8.5 m, 0.2833 m)
-    GEOMETRY = {**SlenderAscentEnv.GEOMETRY, "diameter": 0.2833}
+    PRESET = SLENDER_V1

@@ -4,7 +4,7 @@ After Gymnasium's ``gymnasium.experimental.functional.FuncEnv`` (and brax, gymna
 holds only constants (the vehicle, its timeline, the simulator's models, the task's options); an
 episode's whole state is one :data:`AscentState` value, batched over rows::
 
-    func = AscentFuncEnv(TaskSpec.build(SmileAscentEnv.DEFAULTS, {"model": "rigid"}))
+    func = AscentFuncEnv(SMILE_V0.with_options(model="rigid"))    # lvgym.envs.presets
     rngs = [np.random.default_rng(s) for s in range(8)]
     state = func.initial(rngs)                               # 8 episodes on the pad
     state = func.transition(state, np.zeros((8, 2)), rngs)   # a new state; the old one is unchanged
@@ -42,12 +42,13 @@ from lvgym.simulator import (EnvironmentSpec, LaunchSpec, PhysicsSpec, SimData, 
 from lvgym.simulator import data as simdata
 from lvgym.simulator.core import Kernel
 from lvgym.simulator.imu import Imu
-from lvgym.simulator.layouts import ACTUATOR, CONDITIONS, DISPERSION
+from lvgym.simulator.layouts import ACTUATOR, CONDITIONS
 from lvgym.simulator.servo import Servo
 from lvgym.vehicle import MassModel, Vehicle, load_vehicle
-from lvgym.vehicle.slender import slender_vehicle
+from lvgym.vehicle.slender import SlenderGeometry
 
 from .coast import coast_moment
+from .dispersions import DispersionPlan
 from .history import HistoryStack, recorded_action
 from .layouts import ACTIONS, FLIGHT_DRAWS, NAV, OBSERVATIONS, REASONS, REWARD, REWARD_TERMS, SENSOR_NOISE, TASK
 from .signals import TaskData, reset_signals, step_signals_range
@@ -69,18 +70,15 @@ _SIGNALS = Kernel(step_signals_range)      # row ranges on the simulator's threa
 
 
 @functools.lru_cache(maxsize=32)
-def cached_vehicle(key: Any) -> Vehicle:
-    """A shipped vehicle by name or path, or ``("slender", length, diameter[, aero_mach[, wall_thickness]])``
-    for the parametric one (``aero_mach``: Mach number its aerodynamic tables are frozen at, None: full
-    tables; ``wall_thickness`` [m]: its tube's wall, default the thesis's 2 mm)."""
-    if isinstance(key, tuple) and len(key) in (3, 4, 5) and key[0] == "slender":
-        extra = {"wall_thickness": float(key[4])} if len(key) == 5 else {}
-        return slender_vehicle(length=float(key[1]), diameter=float(key[2]), aero_mach=key[3] if len(key) >= 4 else None,
-                               **extra)
+def cached_vehicle(key: str | SlenderGeometry) -> Vehicle:
+    """A shipped vehicle by name or path, or the parametric slender vehicle of a
+    :class:`~lvgym.vehicle.slender.SlenderGeometry` (a frozen, hashable value: equal geometries share
+    the vehicle)."""
+    if isinstance(key, SlenderGeometry):
+        return key.vehicle()
     if isinstance(key, str):
         return load_vehicle(key)
-    raise ValueError(f"vehicle = {key!r}: a shipped name, a YAML path or ('slender', length, diameter[, aero_mach"
-                     "[, wall_thickness]])")
+    raise ValueError(f"vehicle = {key!r}: a shipped name, a YAML path or a SlenderGeometry")
 
 
 @functools.lru_cache(maxsize=32)
@@ -130,7 +128,7 @@ class AscentFuncEnv(FuncEnv):
 
     def __init__(self, spec: TaskSpec) -> None:
         self.spec = s = spec
-        key = tuple(s.vehicle) if isinstance(s.vehicle, (list, tuple)) else str(s.vehicle)
+        key = s.vehicle                           # a name, a path or a SlenderGeometry (TaskSpec's vehicle_key)
         self.vehicle = vehicle = cached_vehicle(key)
         self.imu = s.imu_station_m if s.imu_station_m is not None else -0.25 * vehicle.length
         # the imu_station dispersion acts on the flight observation's IMU (the others have no IMU dynamics)
@@ -173,13 +171,7 @@ class AscentFuncEnv(FuncEnv):
         self._noise = [(getattr(s, key), self.sample_layout.slice(names[0]).start, len(names), per)
                        for key, names, per in SENSOR_NOISE if names[0] in self.sample_layout]
         lay = self.sim.layout
-        self._i_mb, self._i_J = lay.params["m_b"], lay.params["J_b"]
-        self._i_cg, self._i_om = lay.params["r_cg"], lay.params["omega_modes"]
-        self._i_zeta = [lay.slosh_param(j, "zeta") for j in range(self.sim.dynamics.n_slosh)]
-        self._i_slosh_m = [lay.slosh_param(j, "m") for j in range(self.sim.dynamics.n_slosh)]
-        self._i_slosh_f = [(lay.slosh_param(j, "length"), lay.slosh_param(j, "omega"))
-                           for j in range(self.sim.dynamics.n_slosh)]
-        self._i_zm = lay.params["zeta_modes"]
+        self._i_J = lay.params["J_b"]
         super().__init__()
 
     # ------------------------------------------------------------------------------ parameters
@@ -424,72 +416,19 @@ class AscentFuncEnv(FuncEnv):
         physics steps (the reward's ``effort`` term is minus ``effort_weight`` times it)."""
         return state.sim.actuator[:, ACTUATOR.index("effort")].copy()
 
+    @functools.cached_property
+    def dispersion_plan(self) -> DispersionPlan:
+        """The rows of :data:`~.dispersions.DISPERSIONS` this task draws, their targets resolved."""
+        return DispersionPlan(self.spec, self.sim.layout, self.sim.dynamics.n_slosh, self.vehicle)
+
     def dispersions(self, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray,
                                                              np.ndarray, float]:
-        """Parameter scale and offset, thrust misalignment, load dispersions (layout
-        :data:`~lvgym.simulator.layouts.DISPERSION`), servo dispersion (frequency factor, delay in
-        physics steps) and IMU station shift [m] along +x_b of one row, drawn from ``rng`` in this order;
-        every normal draw is clipped at 3 sigma.
-
-        Protocol v0's: mass: body mass x N(1, 1 %), CG station + N(0, 2 cm), inertia x N(1, 3 %);
-        slosh_damping: ratios x log-uniform [0.5, 2]; bending_frequency: x N(1, 5 %); thrust_misalignment:
-        N(0, 0.05 deg) per axis. Added for v1 (docs/benchmark.md gives the reasoning of each range):
-        aerodynamics: normal force and moment x N(1, 5 %), axial force x N(1, 5 %), centre of pressure
-        + N(0, 0.25 calibre); thrust_level: x N(1, 1 %); slosh_mass: pendulum masses x N(1, 5 %);
-        slosh_frequency: x N(1, 5 %) (pendulum lengths / f^2, and the tabulated damper frequency x f; with
-        ``slosh_frequency="specific_force"`` the damper's frequency follows from the dispersed length);
-        bending_damping: ratios x log-uniform [0.5, 2]; servo_bandwidth: natural frequency x N(1, 10 %);
-        servo_delay: 0 or 1 physics step (0 or 10 ms at the default step) with equal chances; imu_station:
-        the station + N(0, ``IMU_STATION_SIGMA`` x the vehicle's length) (0.5 %: 8.3 cm on SMILE), drawn
-        only with the ``flight`` observation (the others have no IMU dynamics; 0 otherwise)."""
-        n_p = self.sim.layout.n_p
-        scale, offset, mis = np.ones(n_p), np.zeros(n_p), np.zeros(2)
-        loads = DISPERSION.pack({"thrust_scale": 1.0, "normal_scale": 1.0, "axial_scale": 1.0})
-        r = self.spec.randomize
-
-        def normal(sigma: float, limit: float, n: int | None = None) -> Any:
-            return np.clip(rng.normal(0.0, sigma, n), -limit, limit)
-
-        if "mass" in r:
-            scale[self._i_mb] = 1.0 + normal(0.01, 0.03)
-            offset[self._i_cg.start] = normal(0.02, 0.06)
-            scale[self._i_J] = 1.0 + normal(0.03, 0.09)
-        if "slosh_damping" in r:
-            f = math.exp(rng.uniform(math.log(0.5), math.log(2.0)))
-            for sl in self._i_zeta:
-                scale[sl] = f
-        if "bending_frequency" in r:
-            scale[self._i_om] = 1.0 + normal(0.05, 0.15)
-        if "thrust_misalignment" in r:
-            mis = np.radians(normal(0.05, 0.15, 2))
-        if "aerodynamics" in r:
-            k = DISPERSION.index
-            loads[k("normal_scale")] = 1.0 + normal(0.05, 0.15)
-            loads[k("axial_scale")] = 1.0 + normal(0.05, 0.15)
-            calibre = self.vehicle.stages[0].outer_diameter
-            loads[k("cp_shift")] = normal(0.25 * calibre, 0.75 * calibre)
-        if "thrust_level" in r:
-            loads[DISPERSION.index("thrust_scale")] = 1.0 + normal(0.01, 0.03)
-        if "slosh_mass" in r:
-            f = 1.0 + normal(0.05, 0.15)
-            for sl in self._i_slosh_m:
-                scale[sl] *= f
-        if "slosh_frequency" in r:
-            f = 1.0 + normal(0.05, 0.15)
-            tabulated = self.spec.slosh_frequency == "vacuum_thrust"    # else the damper's comes from the length
-            for length, omega in self._i_slosh_f:
-                scale[length] /= f * f
-                if tabulated:
-                    scale[omega] *= f
-        if "bending_damping" in r:
-            scale[self._i_zm] = math.exp(rng.uniform(math.log(0.5), math.log(2.0)))
-        servo = np.array([1.0, 0.0])
-        if "servo_bandwidth" in r:
-            servo[0] = 1.0 + normal(0.1, 0.3)
-        if "servo_delay" in r:
-            servo[1] = float(rng.integers(0, 2))
-        station = float(normal(self._imu_sigma, 3.0 * self._imu_sigma)) if self._imu_sigma else 0.0
-        return scale, offset, mis, loads, servo, station
+        """Parameter scale and offset, thrust misalignment [rad], load dispersions (layout
+        :data:`~lvgym.simulator.layouts.DISPERSION`), servo dispersion (layout
+        :data:`~.dispersions.SERVO_DISPERSION`) and IMU station shift [m] along +x_b of one row: each row of
+        the table :data:`~.dispersions.DISPERSIONS` whose name is in ``randomize``, drawn from ``rng`` in
+        the table's order (docs/benchmark.md, "Dispersions", is generated from the table)."""
+        return self.dispersion_plan.draw(rng)
 
     def _draw_flight(self, sim: SimData, ts: TaskData, rows: Any, rngs: Sequence[np.random.Generator | None],
                      sigma: np.ndarray) -> None:

@@ -39,15 +39,19 @@ import math
 import threading
 from dataclasses import dataclass
 
-import matplotlib
-import numpy as np
-from matplotlib.backends.backend_agg import FigureCanvasAgg
-from matplotlib.collections import LineCollection, PatchCollection
-from matplotlib.figure import Figure
-from matplotlib.patches import Circle, Polygon
+from lvgym.errors import require
 
-from lvgym.cli.args import arg
-from lvgym.errors import ConfigError
+require("matplotlib", "benchmark", "rendering an ascent env")
+
+import matplotlib  # noqa: E402
+import numpy as np  # noqa: E402
+from matplotlib.backends.backend_agg import FigureCanvasAgg  # noqa: E402
+from matplotlib.collections import LineCollection, PatchCollection  # noqa: E402
+from matplotlib.figure import Figure  # noqa: E402
+from matplotlib.patches import Circle, Polygon  # noqa: E402
+
+from lvgym.cli.args import arg  # noqa: E402
+from lvgym.errors import ConfigError  # noqa: E402
 
 _DPI = 100.0
 _NONINTERACTIVE = {"agg", "cairo", "pdf", "pgf", "ps", "svg", "template"}

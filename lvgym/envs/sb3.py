@@ -13,12 +13,17 @@ from typing import Any
 
 import gymnasium as gym
 import numpy as np
-from stable_baselines3.common.vec_env.base_vec_env import VecEnv
 
-from .core import BatchCore, row_infos
-from .functional import AscentFuncEnv, AscentState
-from .spec import check_reset_options
-from .vector import batch_task
+from lvgym.errors import require
+
+require("stable_baselines3", "train", "the stable-baselines3 VecEnv of lvgym")
+
+from stable_baselines3.common.vec_env.base_vec_env import VecEnv  # noqa: E402
+
+from .core import BatchCore, row_infos  # noqa: E402
+from .functional import AscentFuncEnv, AscentState  # noqa: E402
+from .spec import check_reset_options  # noqa: E402
+from .vector import batch_task  # noqa: E402
 from .views import FuncViews
 
 __all__ = ["AscentSB3VecEnv"]

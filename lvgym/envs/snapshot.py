@@ -55,8 +55,9 @@ class EpisodeState:
     def check(self, spec: TaskSpec, n: int) -> None:
         """Raise ``ValueError`` unless this state fits ``n`` rows of an env with options ``spec``."""
         if spec != self.spec:
-            diff = sorted(k for k in TaskSpec.__dataclass_fields__ if getattr(spec, k) != getattr(self.spec, k))
-            raise ValueError(f"the state is of another task: options {diff} differ ({ {k: getattr(self.spec, k) for k in diff} })")
+            mine, theirs = self.spec.options(), spec.options()
+            diff = sorted(k for k in mine if mine[k] != theirs[k])
+            raise ValueError(f"the state is of another task: options {diff} differ ({ {k: mine[k] for k in diff} })")
         if n != self.n:
             raise ValueError(f"the state holds {self.n} rows for {n}")
 

@@ -18,7 +18,9 @@ import numpy as np
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
-from .ascent import SlenderAscentEnv, slender_key
+from lvgym.errors import ConfigError
+
+from .ascent import SlenderAscentEnv
 from .core import BatchCore, select_rows
 from .functional import AscentFuncEnv, AscentState
 from .snapshot import EpisodeState
@@ -30,13 +32,12 @@ def batch_task(env_cls: type, options: dict[str, Any]) -> TaskSpec:
     """The task of ``num_envs`` rows of ``env_cls`` with ``options`` (one vehicle for all rows)."""
     options = dict(options)
     if issubclass(env_cls, SlenderAscentEnv):
-        geometry = env_cls.geometry(options)                  # the class's GEOMETRY where not given
-        if np.size(geometry["diameter"]) != 1:
-            raise ValueError("diameter ranges are drawn per episode by the single SlenderAscent env only; "
-                             "a vector env flies one geometry (make one vector env per diameter)")
-        options["vehicle"] = slender_key(geometry["length"], float(np.ravel(geometry["diameter"])[0]),
-                                         geometry["aero_mach"], geometry["wall_thickness_m"])
-    return TaskSpec.build(env_cls.DEFAULTS, options, env_cls.KEYWORDS)
+        geometry, diameter = env_cls.geometry(options)        # the preset's geometry where not given
+        if np.size(diameter) != 1:
+            raise ConfigError("diameter", diameter, "one diameter [m]: ranges are drawn per episode by the single "
+                              "SlenderAscent env only; a vector env flies one geometry (one vector env per diameter)")
+        options["vehicle"] = geometry
+    return TaskSpec.build(env_cls.PRESET, options, env_cls.KEYWORDS)
 
 
 class AscentVectorEnv(FuncViews, VectorEnv):

@@ -36,7 +36,7 @@ lvgym.errors.ConfigError: slender_vehicle: fill = 1.2: must be in (0, 1]
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -47,7 +47,8 @@ from lvgym.errors import ConfigError
 from .config import Vehicle, parse_vehicle
 from .sections import MATERIALS, tube_area
 
-__all__ = ["DEFAULTS", "TABLE_6_3", "slender_mapping", "slender_vehicle", "slender_yaml"]
+__all__ = ["DEFAULTS", "TABLE_6_3", "WALL_THICKNESS", "SlenderGeometry", "slender_mapping", "slender_vehicle",
+           "slender_yaml"]
 
 #: defaults of the five study factors (Table 6.3's high levels, damping at its low level)
 DEFAULTS: dict[str, float] = {"length": 8.5, "diameter": 0.3, "fill": 1.0, "mass_flow": 30.0, "slosh_damping": 0.5}
@@ -64,6 +65,8 @@ ENGINE_MASS, ENGINE_INERTIA = 10.0, [0.112, 0.088, 0.088]         # Table 5.1 [k
 #: Stratos III fins (lvgym/vehicles/stratos3.yaml) [m]; the trailing edge sits FIN_GAP above the base
 FINS = {"count": 4, "root_chord": 0.50, "tip_chord": 0.20, "span": 0.25, "sweep": 0.30, "thickness": 0.006}
 FIN_GAP = 0.05
+#: the thesis's aluminium wall [m] (Table 6.4)
+WALL_THICKNESS = 0.002
 
 
 def _number(name: str, value: Any, lo: float, hi: float, lo_open: bool, allowed: str | None = None) -> float:
@@ -76,13 +79,27 @@ def _number(name: str, value: Any, lo: float, hi: float, lo_open: bool, allowed:
     return x
 
 
+def _geometry(length: Any, diameter: Any, wall_thickness: Any) -> tuple[float, float, float]:
+    """Length, diameter and wall [m] as floats, each in its range (else a :class:`ConfigError` naming it)."""
+    L = _number("length", length, 3.0, 30.0, False)
+    t = _number("wall_thickness", wall_thickness, 0.0, 0.05, True)
+    D = _number("diameter", diameter, 2.0 * t + 0.02, L / 5.0, True,
+                f"must be in ({2.0 * t + 0.02:g}, {L / 5.0:g}] m: more than twice the wall plus 2 cm and at "
+                f"most length / 5")
+    return L, D, t
+
+
+def _aero_mach(aero_mach: Any) -> float:
+    return _number("aero_mach", aero_mach, 0.0, 25.0, False)
+
+
 def _r(x: float) -> float:
     """Rounded to a micrometre / milligram so the YAML and the mapping agree exactly."""
     return round(float(x), 6)
 
 
 def slender_mapping(length: float = 8.5, diameter: float = 0.3, fill: float = 1.0, mass_flow: float = 30.0,
-                    slosh_damping: float = 0.5, *, wall_thickness: float = 0.002, material: str = "al_ansys",
+                    slosh_damping: float = 0.5, *, wall_thickness: float = WALL_THICKNESS, material: str = "al_ansys",
                     density: float = 800.0, isp: float = 220.0, name: str = "slender",
                     aero_mach: float | None = None) -> dict[str, Any]:
     """The vehicle-file mapping of the slender vehicle (see the module docstring).
@@ -102,11 +119,7 @@ def slender_mapping(length: float = 8.5, diameter: float = 0.3, fill: float = 1.
     aero_mach : if given, the Barrowman tables are frozen at this Mach number [-], in [0, 25] (the
         thesis's constant coefficients; ``SlenderAscent-v0`` uses 2.0); None: the full Mach tables.
     """
-    L = _number("length", length, 3.0, 30.0, False)
-    t = _number("wall_thickness", wall_thickness, 0.0, 0.05, True)
-    D = _number("diameter", diameter, 2.0 * t + 0.02, L / 5.0, True,
-                f"must be in ({2.0 * t + 0.02:g}, {L / 5.0:g}] m: more than twice the wall plus 2 cm and at "
-                f"most length / 5")
+    L, D, t = _geometry(length, diameter, wall_thickness)
     F = _number("fill", fill, 0.0, 1.0, True)
     mdot = _number("mass_flow", mass_flow, 0.0, 1000.0, True)
     zeta = _number("slosh_damping", slosh_damping, 0.0, 2.0, False)
@@ -114,7 +127,7 @@ def slender_mapping(length: float = 8.5, diameter: float = 0.3, fill: float = 1.
     isp_s = _number("isp", isp, 0.0, 1000.0, True)
     if material not in MATERIALS:
         raise ConfigError("material", material, f"one of {sorted(MATERIALS)}", SOURCE)
-    frozen = {} if aero_mach is None else {"mach": [_number("aero_mach", aero_mach, 0.0, 25.0, False)]}
+    frozen = {} if aero_mach is None else {"mach": [_aero_mach(aero_mach)]}
     if not isinstance(name, str) or not name:
         raise ConfigError("name", name, "must be a non-empty string", SOURCE)
 
@@ -165,6 +178,53 @@ def slender_vehicle(length: float = 8.5, diameter: float = 0.3, fill: float = 1.
                           "unknown option; allowed: wall_thickness, material, density, isp, name, aero_mach", SOURCE)
     mapping = slender_mapping(length, diameter, fill, mass_flow, slosh_damping, **options)
     return parse_vehicle(mapping, source=SOURCE)
+
+
+@dataclass(frozen=True)
+class SlenderGeometry:
+    """The geometry of one slender vehicle, as a value: what an env flies (``TaskSpec.vehicle``), the key
+    of its cached vehicle and timeline, and of a controller's schedule (``lvgym.baselines.pid.FLEX_SCHEDULES``).
+    Frozen and hashable; equal geometries are the same vehicle. The other factors of Table 6.3 keep
+    :func:`slender_mapping`'s defaults. A value out of range raises :class:`~lvgym.errors.ConfigError`
+    naming it.
+
+    >>> SlenderGeometry(8.5, 0.2833, aero_mach=2.0, wall_thickness=0.0045).vehicle().length
+    8.5
+    """
+
+    length: float
+    """overall length L [m], in [3, 30]"""
+    diameter: float
+    """outer diameter D [m], in (2 wall + 0.02, L / 5]"""
+    aero_mach: float | None = None
+    """the Mach number [-] the Barrowman tables are frozen at, in [0, 25] (the thesis's constant
+    coefficients); None: the full Mach-dependent tables"""
+    wall_thickness: float = WALL_THICKNESS
+    """the aluminium tube's wall [m], in (0, 0.05] (default the thesis's 2 mm)"""
+
+    def __post_init__(self) -> None:
+        L, D, t = _geometry(self.length, self.diameter, self.wall_thickness)
+        mach = None if self.aero_mach is None else _aero_mach(self.aero_mach)
+        for key, value in (("length", L), ("diameter", D), ("aero_mach", mach), ("wall_thickness", t)):
+            object.__setattr__(self, key, value)
+
+    def vehicle(self) -> Vehicle:
+        """The checked vehicle of this geometry (:func:`slender_vehicle`)."""
+        return slender_vehicle(length=self.length, diameter=self.diameter, aero_mach=self.aero_mach,
+                               wall_thickness=self.wall_thickness)
+
+    def with_diameter(self, diameter: float) -> SlenderGeometry:
+        """The same vehicle with another outer diameter [m]."""
+        return replace(self, diameter=diameter)
+
+    @classmethod
+    def from_key(cls, key: Any) -> SlenderGeometry:
+        """The geometry of a positional key ``("slender", length, diameter[, aero_mach[, wall_thickness]])``
+        (the form before this value; a missing ``aero_mach`` is None, a missing wall the thesis's 2 mm)."""
+        if not (isinstance(key, (tuple, list)) and 3 <= len(key) <= 5 and key[0] == "slender"):
+            raise ConfigError("vehicle", key, "a SlenderGeometry or ('slender', length, diameter[, aero_mach"
+                              "[, wall_thickness]])", SOURCE)
+        return cls(*key[1:])
 
 
 HEADER = """\

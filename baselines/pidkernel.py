@@ -1,0 +1,301 @@
+"""The compiled act of the PID family (:mod:`.pid`: fixed gains, a gain schedule, structural filters, load
+relief) for any number of rows: what :class:`.pidbatch.PIDBatch` runs for the rows of a batched env.
+
+The same floating-point operations in the same order as the per-row policy (:meth:`.pid.PIDPolicy.act`,
+:class:`.pid.DiscretePID`, :class:`.filters.FilterChain`), so that row ``b`` of a batch and a policy of its
+own give the same actions to the bit (``tests/test_policy_batch.py``). The blocks:
+
+* :class:`ObsColumns`: where the observation holds what the laws read (from the env's observation layout);
+* :class:`PIDTable`: the schedule's breakpoints and columns (layout :data:`GAINS`; a fixed-gain policy is
+  a one-row table) and the discrete structural filter of each row (layout :data:`COEFFS`);
+* :class:`PIDSetup`: the constants (control period, gimbal limit, how the schedule is read);
+* :class:`PIDState`: each row's state as two packed vectors, the PIDs' (:data:`PID_ROW`) and the
+  filters' (:data:`FILTER_ROW`). A kernel takes a row's vectors once and indexes them by their layouts'
+  offsets (numba counts a reference at every look-up of an array in a named block).
+
+:func:`interp_k` is ``np.interp`` of one value (numpy's ``arr_interp``: the interval by search, the
+slope, the retry from the right end when the left gives NaN); :func:`nearest_k` is
+:meth:`.pid.GainSchedule._nearest` (``argmin`` of the distance, the first of equals).
+
+The row layouts::
+
+{PID_ROW}
+
+{FILTER_ROW}
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numba as nb
+import numpy as np
+
+from lvgym.envs.layouts import G0
+from lvgym.packing import Field, Packed
+
+__all__ = ["COEFFS", "FILTERS_NONE", "FILTERS_ROWS", "FILTERS_TABLE", "FILTER_ROW", "GAINS", "ObsColumns", "PID_ROW",
+           "PIDSetup", "PIDState", "PIDTable", "SECTIONS", "TAPS", "VAR_FIXED", "VAR_MACH", "VAR_VALUE", "clip_k",
+           "interp_k", "nearest_k", "pid_act_k", "pid_row_k"]
+
+#: how a row's scheduling variable is read (:attr:`PIDSetup.variable`): fixed gains (no variable), a value
+#: per row handed in (``info["mass"]`` or ``info["time"]``), the observation's Mach entry times 10
+VAR_FIXED, VAR_VALUE, VAR_MACH = 0, 1, 2
+#: where the structural filter's coefficients come from (:attr:`PIDSetup.filters`): no filters, the
+#: schedule row in use (a nearest-row schedule), each row's own (set from Python, a linear schedule)
+FILTERS_NONE, FILTERS_TABLE, FILTERS_ROWS = 0, 1, 2
+#: sections of a structural filter (lead-lag, low-pass, notch: :meth:`.filters.StructuralFilter.discrete`)
+#: and coefficients per section's numerator and denominator
+SECTIONS, TAPS = 3, 3
+AXES = 2
+
+#: a schedule row's gains (the columns of :attr:`PIDTable.gains`)
+GAINS = Packed("PID gains", [
+    Field("kp", 1, "rad per rad/s", "proportional gain"),
+    Field("ki", 1, "rad per rad", "integral gain"),
+    Field("kd", 1, "rad per rad/s^2", "derivative gain"),
+    Field("n", 1, "rad/s", "derivative filter coefficient (inf: unfiltered)"),
+    Field("accel", 1, "rad/s per m/s^2", "load-relief gain (0: none)"),
+])
+
+#: one discrete structural filter: each section's ``b``, ``a`` in ``z`` and their sums
+COEFFS = Packed("structural filter coefficients", [
+    Field("b", SECTIONS * TAPS, "-", "numerator of each section (b0, b1, b2)", shape=(SECTIONS, TAPS)),
+    Field("a", SECTIONS * TAPS, "-", "denominator of each section (1, a1, a2)", shape=(SECTIONS, TAPS)),
+    Field("bsum", SECTIONS, "-", "sum of each section's numerator (a restart's steady state: x bsum / asum)"),
+    Field("asum", SECTIONS, "-", "sum of each section's denominator"),
+])
+
+#: a row's PIDs (both axes, pitch then yaw)
+PID_ROW = Packed("PID row", [
+    Field("integral", AXES, "rad", "integral term per axis"),
+    Field("deriv", AXES, "rad", "filtered derivative term per axis"),
+    Field("e_prev", AXES, "rad/s", "the last error per axis (where has_prev)"),
+    Field("has_prev", AXES, "-", "1: e_prev holds a sample (0 after a reset and while off)"),
+    Field("saturated", AXES, "-", "1: the last command was clipped"),
+    Field("filtering", 1, "-", "1: the structural filters run (since the controller switched on)"),
+    Field("filt", 1, "-", "the schedule row whose filter is in use (-1: none yet)"),
+    Field("gimbal", AXES, "rad", "the last command per axis (the policy's last_gimbal)"),
+])
+
+#: a row's structural filters: the sections' states per axis and the coefficients in use
+FILTER_ROW = Packed("structural filter row", [
+    Field("s1", AXES * SECTIONS, "-", "first state of each section, per axis", shape=(AXES, SECTIONS)),
+    Field("s2", AXES * SECTIONS, "-", "second state of each section, per axis", shape=(AXES, SECTIONS)),
+    Field("coeffs", COEFFS.size, "-", "the filter in use (layout COEFFS)", sub=COEFFS),
+])
+
+__doc__ = __doc__.format(PID_ROW=PID_ROW.table(), FILTER_ROW=FILTER_ROW.table())
+#: entries of a filter's coefficients (a compiled constant)
+N_COEFFS = COEFFS.size
+
+G = GAINS.at
+C = COEFFS.at
+P = PID_ROW.at
+F = FILTER_ROW.at
+
+
+class ObsColumns(NamedTuple):
+    """Indices into an observation row: ``err`` (2,) the pitch and yaw rate errors, ``acc`` (2,) the
+    accelerometers of load relief (``accel_z``, ``accel_y``; -1 where the observation has none), ``on`` the
+    controller-on flag, ``mach`` Mach / 10, ``ref`` the pitch rate reference (-1: none)."""
+
+    err: np.ndarray
+    acc: np.ndarray
+    on: int
+    mach: int
+    ref: int
+
+
+class PIDTable(NamedTuple):
+    """A gain schedule of ``m`` rows: ``x`` (m,) its breakpoints in the schedule's order, ``xs`` (m,) the
+    same ascending, ``rank`` (m,) the ascending position of each breakpoint, ``gains`` (GAINS.size, m) the
+    columns (layout :data:`GAINS`) in ascending order; ``coeffs`` (m, COEFFS.size) the discrete structural
+    filter of each row (layout :data:`COEFFS`)."""
+
+    x: np.ndarray
+    xs: np.ndarray
+    rank: np.ndarray
+    gains: np.ndarray
+    coeffs: np.ndarray
+
+
+class PIDSetup(NamedTuple):
+    """The constants: ``dt`` [s] the control period, ``limit`` [rad] the gimbal limit (the PID's output
+    limits and the action's scale), ``variable`` (:data:`VAR_FIXED` ...), ``nearest`` (the nearest row, else
+    linear interpolation), ``accel`` (the schedule has a load-relief column), ``filters``
+    (:data:`FILTERS_NONE` ...), ``signs`` (2,) the load-relief signs per axis."""
+
+    dt: float
+    limit: float
+    variable: int
+    nearest: bool
+    accel: bool
+    filters: int
+    signs: np.ndarray
+
+
+class PIDState(NamedTuple):
+    """The state of ``n`` rows: ``pid`` (n, PID_ROW.size), ``filters`` (n, FILTER_ROW.size)."""
+
+    pid: np.ndarray
+    filters: np.ndarray
+
+
+@nb.njit(cache=True, inline="always")
+def interp_k(x, xp, fp):
+    """``np.interp(x, xp, fp)`` of one value ``x`` on ascending breakpoints ``xp`` (the ends held)."""
+    m = xp.size
+    if m == 1:
+        return fp[0]
+    if np.isnan(x):
+        return x
+    if x > xp[m - 1]:
+        return fp[m - 1]
+    if x < xp[0]:
+        return fp[0]
+    j = 0
+    while j < m - 1 and x >= xp[j + 1]:
+        j += 1
+    if j == m - 1 or xp[j] == x:
+        return fp[j]
+    slope = (fp[j + 1] - fp[j]) / (xp[j + 1] - xp[j])
+    r = slope * (x - xp[j]) + fp[j]
+    if np.isnan(r):
+        r = slope * (x - xp[j + 1]) + fp[j + 1]
+        if np.isnan(r) and fp[j] == fp[j + 1]:
+            r = fp[j]
+    return r
+
+
+@nb.njit(cache=True, inline="always")
+def nearest_k(x, value):
+    """The index of the breakpoint of ``x`` nearest ``value`` (the first of equals)."""
+    best, dist = 0, abs(x[0] - value)
+    for i in range(1, x.size):
+        d = abs(x[i] - value)
+        if d < dist:
+            best, dist = i, d
+    return best
+
+
+@nb.njit(cache=True, inline="always")
+def clip_k(x, lo, hi):
+    """``np.clip`` of one value (NaN stays NaN)."""
+    if np.isnan(x):
+        return x
+    y = x if x > lo else lo
+    return y if y < hi else hi
+
+
+@nb.njit(cache=True, inline="always")
+def _filter_reset(f, ax, x0):
+    """The sections of the filter row ``f``'s axis ``ax`` in the steady state of the input ``x0``
+    (:meth:`.filters.FilterChain.reset`)."""
+    x = x0
+    for s in range(SECTIONS):
+        b, a = F.b + TAPS * s, F.a + TAPS * s
+        y = x * f[F.bsum + s] / f[F.asum + s]
+        s2 = f[b + 2] * x - f[a + 2] * y
+        f[F.s1 + SECTIONS * ax + s] = f[b + 1] * x - f[a + 1] * y + s2
+        f[F.s2 + SECTIONS * ax + s] = s2
+        x = y
+
+
+@nb.njit(cache=True, inline="always")
+def _filter_update(f, ax, x):
+    """One sample ``x`` through the filter row ``f``'s axis ``ax`` (:meth:`.filters.FilterChain.update`)."""
+    y = x
+    for s in range(SECTIONS):
+        b, a = F.b + TAPS * s, F.a + TAPS * s
+        i1, i2 = F.s1 + SECTIONS * ax + s, F.s2 + SECTIONS * ax + s
+        s1, s2 = f[i1], f[i2]
+        out = f[b] * y + s1
+        f[i1] = f[b + 1] * y - f[a + 1] * out + s2
+        f[i2] = f[b + 2] * y - f[a + 2] * out
+        y = out
+    return y
+
+
+@nb.njit(cache=True, inline="always")
+def _pid_update(su, r, ax, e, on, g):
+    """One step of the PID row ``r``'s axis ``ax`` on the error ``e`` with the gains ``g`` (kp, ki, kd, n)
+    (:meth:`.pid.DiscretePID.update`)."""
+    if not on:
+        r[P.deriv + ax], r[P.has_prev + ax], r[P.saturated + ax] = 0.0, 0.0, 0.0
+        return 0.0
+    kp, ki, kd, n = g
+    de = e - r[P.e_prev + ax] if r[P.has_prev + ax] != 0.0 else 0.0
+    if np.isinf(n):
+        d = kd * de / su.dt
+    else:
+        d = (r[P.deriv + ax] + kd * n * de) / (1.0 + n * su.dt)
+    p = kp * e
+    i = r[P.integral + ax] + ki * su.dt * e
+    v = p + i + d
+    if (v > su.limit and e * ki > 0.0) or (v < -su.limit and e * ki < 0.0):
+        i = r[P.integral + ax]                         # clamp: do not integrate further into the limit
+        v = p + i + d
+    r[P.integral + ax], r[P.deriv + ax], r[P.e_prev + ax], r[P.has_prev + ax] = i, d, e, 1.0
+    lo = -su.limit if -su.limit > v else v             # Python's max(v, u_min), min(., u_max)
+    u = su.limit if su.limit < lo else lo
+    r[P.saturated + ax] = 1.0 if u != v else 0.0
+    return u
+
+
+@nb.njit(cache=True, inline="always")
+def pid_row_k(tb, su, oc, r, f, obs, value):
+    """One act of a row (its PID row ``r``, filter row ``f``) on its observation ``obs`` (n_obs,) and
+    scheduling value ``value`` (mass [kg] or time [s]; unused for fixed gains and Mach): the commands
+    [rad] into ``r[P.gimbal:]``."""
+    on = float(obs[oc.on]) >= 0.5
+    if su.variable == VAR_MACH:
+        value = float(obs[oc.mach]) * 10.0
+    gains = tb.gains
+    if su.nearest:
+        i = nearest_k(tb.x, value)
+        k = tb.rank[i]
+        kp, ki, kd, n, acc = gains[G.kp, k], gains[G.ki, k], gains[G.kd, k], gains[G.n, k], gains[G.accel, k]
+        if su.filters == FILTERS_TABLE and i != r[P.filt]:      # the filter of another row: its coefficients
+            coeffs = tb.coeffs
+            for c in range(N_COEFFS):
+                f[F.coeffs + c] = coeffs[i, c]
+            r[P.filt] = i
+    else:
+        xs = tb.xs
+        kp, ki, kd = interp_k(value, xs, gains[G.kp]), interp_k(value, xs, gains[G.ki]), interp_k(value, xs, gains[G.kd])
+        n, acc = interp_k(value, xs, gains[G.n]), interp_k(value, xs, gains[G.accel])
+    if not su.accel:
+        acc = 0.0
+    err, acc_at = oc.err, oc.acc
+    e0 = -float(obs[err[0]])
+    e1 = -float(obs[err[1]])
+    if acc != 0.0:
+        signs = su.signs
+        e0 = e0 + acc * G0 * signs[0] * float(obs[acc_at[0]])
+        e1 = e1 + acc * G0 * signs[1] * float(obs[acc_at[1]])
+    if su.filters == FILTERS_NONE or not on:
+        r[P.filtering] = 0.0
+    else:
+        if r[P.filtering] == 0.0:                      # switched on: the filters start in steady state
+            _filter_reset(f, 0, e0)
+            _filter_reset(f, 1, e1)
+            r[P.filtering] = 1.0
+        e0 = _filter_update(f, 0, e0)
+        e1 = _filter_update(f, 1, e1)
+    g = (kp, ki, kd, n)
+    r[P.gimbal] = _pid_update(su, r, 0, e0, on, g)
+    r[P.gimbal + 1] = _pid_update(su, r, 1, e1, on, g)
+
+
+@nb.njit(cache=True)
+def pid_act_k(tb, su, oc, st, rows, obs, value, out):
+    """The actions ``out`` (k, 2) float32 of the rows ``rows`` (k,) for their observations ``obs`` (k, n_obs)
+    and the scheduling values ``value`` (n,) of every row: gimbal / limit, clipped to [-1, 1]."""
+    pid, filters = st.pid, st.filters
+    for j in range(rows.size):
+        b = rows[j]
+        r = pid[b]
+        pid_row_k(tb, su, oc, r, filters[b], obs[j], value[b])
+        for ax in range(AXES):
+            out[j, ax] = np.float32(clip_k(r[P.gimbal + ax] / su.limit, -1.0, 1.0))

@@ -1,0 +1,163 @@
+"""Episodes flown as rows of a batched env: one policy call per step for many seeds, the single env's records.
+
+:func:`fly_rows` resets a batched lvgym env (``Condition.make_vec_env(n)``, a Gymnasium ``VectorEnv``) with
+one seed per row (row ``i`` flies exactly the single env's episode of ``seeds[i]``) and steps every row
+together: each step, each :class:`~.batch.BatchPolicy` acts for its rows still flying; a row that ends
+(terminated or truncated) is masked out (no more policy calls, nothing more recorded; the env's autoreset
+flies it on with the neutral action, unseen) and the flight stops when every row has ended. Per row it can
+scale the actions by a gain and delay them by whole physics steps (the margins' perturbations,
+:mod:`.perturb`).
+
+:class:`RowsLog` keeps whole steps as arrays (one entry per row) and cuts each row's episode out at the end,
+so the records are those of :func:`~.runner.play_episode` on the single env, to the bit: the same
+:func:`~.metrics.episode_metrics` and :func:`~.scoring.flight_metrics` of the same arrays.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+from .batch import BatchPolicy
+from .metrics import Trajectory, combined_record, episode_metrics
+from .scoring import FlightColumns, FlightLog, flight_metrics
+
+__all__ = ["RowsLog", "fly_rows", "neutral_action"]
+
+#: the info entries kept per step (the single env's TrajectoryBuilder and FlightLog read these)
+STEP_KEYS = ("rate_error", "gimbal", "alpha_total", "qalpha_pa_deg", "time", "qbar", "gimbal_rate", "eta",
+             "slosh_angles")
+
+
+def neutral_action(space: Any) -> np.ndarray:
+    """The action of one row that commands nothing: zeros of a ``Box``, the middle of a ``MultiDiscrete``."""
+    if hasattr(space, "low"):
+        return np.zeros(space.shape, dtype=space.dtype)
+    return np.asarray(space.nvec, dtype=np.int64) // 2
+
+
+class RowsLog:
+    """The steps of every row of a batched env, kept whole (``add`` after each ``step``, ``end`` for the rows
+    that ended), and each row's record (:meth:`records`) as the single env's :func:`~.runner.play_episode`
+    gives it."""
+
+    def __init__(self, env: Any) -> None:
+        u = env.unwrapped
+        self.env, self.n = env, int(env.num_envs)
+        self.facts = FlightLog.for_env(env)                # the task's facts (control period, limits, gyro)
+        self.dt_s = float(u.task.control_dt_s)
+        self.steps: dict[str, list[np.ndarray]] = {key: [] for key in ("reward", "gyro", *STEP_KEYS)}
+        self.length = np.zeros(self.n, dtype=np.int64)
+        self.events: list[list[tuple[float, str]]] = [[] for _ in range(self.n)]
+        self.termination = [""] * self.n
+
+    def add(self, live: np.ndarray, observations: np.ndarray, reward: np.ndarray, info: dict[str, Any]) -> None:
+        """One step of every row; ``live``: the rows still flying before it (they count it)."""
+        steps = self.steps
+        steps["reward"].append(np.asarray(reward, dtype=float))
+        for key in STEP_KEYS:
+            steps[key].append(np.asarray(info[key]))
+        if self.facts.gyro_index is not None:        # the gyro's view against the body rate, as FlightLog.step
+            u = self.env.unwrapped
+            w = u.sim.state(u.state.sim, "omega_bi_b")
+            ip, iy, iref = self.facts.gyro_index
+            o = np.asarray(observations, dtype=np.float64)
+            steps["gyro"].append(np.stack([o[:, ip] + o[:, iref] - w[:, 1], o[:, iy] - w[:, 2]], axis=1))
+        self.length[live] += 1
+        events = info.get("events")
+        if events is not None:
+            for b in live.tolist():
+                if events[b]:
+                    self.events[b] += [(float(t), str(text)) for t, text in events[b]]
+
+    def end(self, rows: np.ndarray, info: dict[str, Any]) -> None:
+        """The rows ``rows`` ended with this step (their failure, if any, from ``info["termination"]``)."""
+        for b in rows.tolist():
+            reason = info["termination"][b]
+            if reason:
+                self.termination[b] = str(reason)
+
+    def records(self) -> list[dict[str, Any]]:
+        """Every row's record: :func:`~.metrics.episode_metrics` and :func:`~.scoring.flight_metrics` of its
+        steps (C-contiguous copies, as the single env's builders make them)."""
+        stacked = {key: np.stack(v) if v else None for key, v in self.steps.items()}
+        out = []
+        for b in range(self.n):
+            L = int(self.length[b])
+
+            def col(key: str) -> np.ndarray:
+                return np.ascontiguousarray(stacked[key][:L, b], dtype=float)
+
+            traj = Trajectory(self.dt_s, col("rate_error"), col("gimbal"), col("alpha_total"), col("qalpha_pa_deg"),
+                              col("reward"), col("time"), col("qbar"), self.termination[b])
+            gyro = col("gyro") if stacked["gyro"] is not None else None
+            columns = FlightColumns(traj.time_s, traj.rate_error_radps, traj.qbar_pa, traj.qalpha_pa_deg,
+                                    col("gimbal_rate"), gyro, col("eta"), col("slosh_angles"), self.events[b],
+                                    self.termination[b])
+            out.append(combined_record(episode_metrics(traj), flight_metrics(self.facts, columns)))
+        return out
+
+
+def _scaled(actions: np.ndarray, gains: np.ndarray, name: str) -> np.ndarray:
+    """``actions`` (m, n_a) times the rows' ``gains`` (m,), in the actions' own precision (as
+    :class:`~.perturb.GainPolicy` scales one row's)."""
+    if actions.dtype.kind not in "fc":
+        raise ValueError(f"policy {name!r} gave actions of dtype {actions.dtype}: a gain needs a Box (TVC) action")
+    return (actions * gains.astype(actions.dtype)[:, None]).astype(actions.dtype, copy=False)
+
+
+def fly_rows(env: Any, seeds: Sequence[int], groups: Sequence[tuple[BatchPolicy, Sequence[int]]], *,
+             gains: Sequence[float] | None = None, delay_steps: Sequence[int] | None = None,
+             first_observations: list[np.ndarray] | None = None) -> list[dict[str, Any]]:
+    """One episode per row of the batched lvgym env ``env`` (``env.num_envs == len(seeds)``), row ``i``
+    reset with ``seeds[i]``; ``groups``: (batch policy, its rows) pairs that cover every row once (a
+    policy's batch holds at least ``num_envs`` rows and is addressed by the env's row numbers). ``gains``
+    (per row, 1: none) scales each row's actions (:class:`~.perturb.GainPolicy`), ``delay_steps`` (per row,
+    0: none) delays them by whole physics steps (:class:`~.perturb.RowDelay`). Returns the rows' records in
+    row order, each as :func:`~.runner.play_episode` gives it for the single env with that seed (and
+    perturbation); ``first_observations``, if given, receives the reset's observation of every row."""
+    n = int(env.num_envs)
+    if len(seeds) != n:
+        raise ValueError(f"{len(seeds)} seeds for a batched env of {n} rows")
+    owned = np.zeros(n, dtype=np.int64)
+    groups = [(policy, np.asarray(rows, dtype=np.int64).reshape(-1)) for policy, rows in groups]
+    for _, rows in groups:
+        np.add.at(owned, rows, 1)
+    if np.any(owned != 1):
+        raise ValueError(f"the groups' rows must cover each of the {n} rows once (counts {owned.tolist()})")
+    gain = None if gains is None else np.asarray(gains, dtype=float).reshape(n)
+    obs, info = env.reset(seed=[int(s) for s in seeds])
+    if first_observations is not None:
+        first_observations.extend(np.array(o) for o in obs)
+    delay = None
+    if delay_steps is not None and np.any(np.asarray(delay_steps) != 0):
+        from .perturb import RowDelay
+
+        delay = RowDelay(env, delay_steps)
+    neutral = neutral_action(env.unwrapped.single_action_space)
+    log = RowsLog(env)
+    for policy, rows in groups:
+        policy.reset(rows)
+    done = np.zeros(n, dtype=bool)
+    while not done.all():
+        acted = []
+        for policy, rows in groups:
+            live = rows[~done[rows]]
+            if live.size:
+                a = np.asarray(policy.act(live, obs[live], info))
+                acted.append((live, a if gain is None else _scaled(a, gain[live], policy.name)))
+        dtype = np.result_type(neutral.dtype, *(a.dtype for _, a in acted))
+        actions = np.broadcast_to(neutral.astype(dtype), (n, *neutral.shape)).copy()
+        for live, a in acted:
+            actions[live] = a
+        if delay is not None:
+            actions = delay.apply(actions)
+        live = np.flatnonzero(~done)
+        obs, reward, terminated, truncated, info = env.step(actions)
+        log.add(live, obs, reward, info)
+        ended = live[(np.asarray(terminated) | np.asarray(truncated))[live]]
+        log.end(ended, info)
+        done[ended] = True
+    return log.records()
