@@ -266,12 +266,12 @@ def _alive(pid: int) -> bool:
 @pytest.mark.parametrize("sig, executor", [(signal.SIGKILL, "local"), (signal.SIGTERM, "serial")])
 def test_a_killed_evaluation_leaves_no_result_file(tmp_path, sig, executor):
     out = tmp_path / "results"
-    proc = subprocess.Popen(_evaluate_cmd(out, "--policies", "zero", "--episodes", "500", "--executor", executor,
+    proc = subprocess.Popen(_evaluate_cmd(out, "--policies", "zero", "--episodes", "2000", "--executor", executor,
                                           "--workers", "2"),
                             cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
     seen = b""
     deadline = time.time() + 60
-    while not re.search(rb" [1-9]\d*/1000 ", seen) and time.time() < deadline:   # episodes are finishing
+    while not re.search(rb" [1-9]\d*/\d+ \[", seen) and time.time() < deadline:   # blocks of episodes are finishing
         seen += proc.stderr.read1(1024)
     assert proc.poll() is None, seen.decode(errors="replace")
     workers = _children(proc.pid) if Path("/proc").is_dir() else []
