@@ -9,7 +9,7 @@ import pytest
 
 import lvgym.cli.policies  # noqa: F401  (registers the built-in policies: pid)
 from lvgym.benchmark import get_suite
-from lvgym.benchmark.margins import (RATE_ERROR_FLOOR_RADPS, RATE_LIMIT_FLOOR_S, MarginOptions, _summary, bounds,
+from lvgym.benchmark.margins import (EXPERIMENTS, RATE_ERROR_FLOOR_RADPS, RATE_LIMIT_FLOOR_S, MarginOptions, _summary, bounds,
                                      margins_table, time_domain_margins, verdict)
 from lvgym.benchmark.perturb import ActuatorDelay, GainPolicy, db_to_gain, find_threshold, gain_to_db
 from lvgym.benchmark.registry import POLICIES
@@ -201,6 +201,29 @@ def test_end_to_end_pid_margins_are_finite_and_seeded(short_rigid):
     assert again["conditions"][short_rigid.name]["delay_ms"] == delay
     table = margins_table([r])
     assert "| pid | smile-v1/rigid |" in table and "10 ms (the physics step)" in table
+
+
+def test_the_batched_searches_fly_the_single_env_episodes(short_rigid):
+    """Each round of the searches flies its trials as rows of one batched flight, with per-row gains and
+    delays: every trial's record is the single env's episode with that gain or delay (perturb.fly)."""
+    from lvgym.benchmark.margins import MarginTask, run_margin_task
+    from lvgym.benchmark.perturb import fly
+
+    opts = MarginOptions(gain_tol_db=2.0, delay_max_s=0.1)
+    specs = (POLICIES["pid"], POLICIES["lqg"])
+    results = run_margin_task(MarginTask(specs, short_rigid, (10000, 10001), EXPERIMENTS, opts))
+    assert len(results) == 2 * 2 * len(EXPERIMENTS)
+    checked = 0
+    for r in results:
+        spec = POLICIES[r["policy"]]
+        assert fly(spec, short_rigid, r["seed"]) == r["nominal"]
+        for trial in r["trials"]:
+            gain = db_to_gain(trial["value"]) if r["experiment"] != "delay" else 1.0
+            delay = int(round(trial["value"] / (1e3 * r["physics_dt_s"]))) if r["experiment"] == "delay" else 0
+            single = fly(spec, short_rigid, r["seed"], gain, delay)
+            assert {k: trial[k] for k in single} == single, (r["policy"], r["experiment"], trial["value"])
+            checked += 1
+    assert checked > len(results)
 
 
 def test_cli_refuses_bad_values_and_writes_its_files(tmp_path, capsys):

@@ -281,8 +281,11 @@ def run_block(block: Block) -> list[dict[str, Any]]:
 def _describe_block(block: Block) -> str:
     t = block.tasks
     names = list(dict.fromkeys(x.policy.name for x in t))
-    return (f"policies {names} on {t[0].condition.name!r} seeds {t[0].seed}..{t[-1].seed} ({len(t)} episodes "
-            "flown together)")
+    who = f"policy {names[0]!r}" if len(names) == 1 else "policies " + ", ".join(map(repr, names))
+    if len(t) == 1:
+        return f"{who} on {t[0].condition.name!r} seed {t[0].seed}"
+    seeds = f"seeds {min(x.seed for x in t)}..{max(x.seed for x in t)}"
+    return f"{who} on {t[0].condition.name!r} {seeds} ({len(t)} episodes flown together)"
 
 
 def evaluate(policies: Sequence[PolicySpec], suites: Sequence[Suite], episodes: int, seed_set: str = "test",
