@@ -1,17 +1,21 @@
 """Speed of the ascent envs: env steps per second (``lvgym bench-envs``, ``python -m lvgym.bench_envs``).
 
-``lvgym/SmileAscent-v0`` rigid and non-rigid at the defaults (50 Hz control over 100 Hz RK4: two RK4
-steps, nine evaluations of the flight loads, the servo, the task signals per env step), with zero
-actions from mid-flight states (the first 2 s on the pad and before the controller acts are skipped
-by a warm-up). Three ways: one env through ``gymnasium.make`` (with its wrappers), the native
-``VectorEnv`` of N rows (``gymnasium.make_vec``; rows split over the threads of the simulator), and the
-SB3 ``VecEnv`` adapter (which builds one info dict per row, as SB3 requires).
+SMILE's env of protocol v1 (``lvgym/SmileAscent-v1``; ``--protocol v0``: ``lvgym/SmileAscent-v0``), rigid
+and non-rigid, at the protocol's defaults (50 Hz control over 100 Hz RK4: two RK4 steps, eight evaluations
+of the flight loads, the servo and the task signals per env step; v1 also the IMU's filters, the flight
+computer, one period of action delay, the coast control and the settling thrust), with zero actions from
+mid-flight states (the first 5 s, on the pad and before the controller acts, are skipped by a warm-up).
+Three ways: one env through ``gymnasium.make`` (with its wrappers), the native ``VectorEnv`` of N rows
+(``gymnasium.make_vec``; rows split over the threads of the simulator), and the SB3 ``VecEnv`` adapter
+(which builds one info dict per row, as SB3 requires).
 
-Numbers from different machines differ (the same 2-core kind has given 60 % of another's). So the table also
-gives a ratio that does not depend on the machine: the cost of one env step (per simulator thread) in steps
-of the bare dynamics core (one RK4 step of the same vehicle size with held loads, :mod:`lvgym.bench`),
-measured in the same run. A SMILE env step does 2 RK4 steps, each with 4 evaluations of the flight loads,
-plus the servo, the events and the task signals, so the ratio is at least 2.
+Numbers from different machines differ (the same 2-core kind has given 60 % of another's). So every row of
+the table also gives a ratio that does not depend on the machine: the cost of one env step (per simulator
+thread) in steps of the bare dynamics core (one RK4 step of the same vehicle size with held loads,
+:mod:`lvgym.bench`), measured in the same run. A SMILE env step does 2 RK4 steps, each with 4 evaluations
+of the flight loads, plus the servo, the events and the task signals, so the ratio is at least 2.
+``--threads 1`` (``$LVGYM_THREADS``) runs the batched envs on one thread: on a shared machine the second
+thread's share varies with the other jobs, which the per-thread ratio then counts against the env.
 
 Construction (``--only construction``): wall time of starting a simulator, median of ``--repeats`` runs in one
 process after a warm-up (imports done, Numba's kernels loaded from its disk cache): **cold**, an empty timeline
@@ -48,7 +52,8 @@ import lvgym  # noqa: F401  (registers the envs)
 from lvgym.cli.args import arg, parse
 from lvgym.envs import make_sb3_vec_env
 
-ENV_ID = "lvgym/SmileAscent-v0"
+#: the env measured for each protocol (``--protocol``)
+ENV_IDS = {"v0": "lvgym/SmileAscent-v0", "v1": "lvgym/SmileAscent-v1"}
 
 
 def _timed(step, n_min: int, min_time: float) -> float:
@@ -60,8 +65,8 @@ def _timed(step, n_min: int, min_time: float) -> float:
     return n / (time.perf_counter() - start)
 
 
-def single(model: str, min_time: float) -> float:
-    env = gym.make(ENV_ID, model=model)
+def single(env_id: str, model: str, min_time: float) -> float:
+    env = gym.make(env_id, model=model)
     env.reset(seed=0)
     a = np.zeros(2, dtype=np.float32)
     for _ in range(250):                                   # 5 s: off the pad, controller on
@@ -74,8 +79,8 @@ def single(model: str, min_time: float) -> float:
     return _timed(step, 200, min_time)
 
 
-def vector(model: str, n: int, min_time: float) -> float:
-    env = gym.make_vec(ENV_ID, num_envs=n, vectorization_mode="vector_entry_point", model=model)
+def vector(env_id: str, model: str, n: int, min_time: float) -> float:
+    env = gym.make_vec(env_id, num_envs=n, vectorization_mode="vector_entry_point", model=model)
     env.reset(seed=0)
     a = np.zeros((n, 2), dtype=np.float32)
     for _ in range(250):
@@ -83,8 +88,8 @@ def vector(model: str, n: int, min_time: float) -> float:
     return n * _timed(lambda: env.step(a), 20, min_time)
 
 
-def sb3(model: str, n: int, min_time: float) -> float:
-    env = make_sb3_vec_env(ENV_ID, num_envs=n, seed=0, model=model)
+def sb3(env_id: str, model: str, n: int, min_time: float) -> float:
+    env = make_sb3_vec_env(env_id, num_envs=n, seed=0, model=model)
     env.reset()
     a = np.zeros((n, 2), dtype=np.float32)
     for _ in range(250):
@@ -92,7 +97,7 @@ def sb3(model: str, n: int, min_time: float) -> float:
     return n * _timed(lambda: env.step(a), 20, min_time)
 
 
-#: the dynamics core's size of each model of SmileAscent-v0 (slosh pendulums, modes per plane)
+#: the dynamics core's size of each model of SmileAscent-v0 and -v1 (slosh pendulums, modes per plane)
 CORE_SIZE = {"rigid": (0, 0), "nonrigid": (6, 2)}
 
 
@@ -110,17 +115,19 @@ def core(model: str, min_time: float) -> float:
                              20, min_time)
 
 
-def run(min_time: float = 2.0, batch: int = 1024) -> list[tuple[str, str, float, float]]:
-    """``(model, how, env-steps/s, core RK4 steps per env step and thread)`` rows."""
+def run(min_time: float = 2.0, batch: int = 1024, protocol: str = "v1") -> list[tuple[str, str, float, float]]:
+    """``(model, how, env-steps/s, core RK4 steps per env step and thread)`` rows of the env of ``protocol``
+    (:data:`ENV_IDS`)."""
     from lvgym.simulator.threads import default_threads
 
+    env_id = ENV_IDS[protocol]
     threads = default_threads()
     rows = []
     for model in ("rigid", "nonrigid"):
         base = core(model, min_time)
-        for how, rate, used in (("single env (gymnasium.make)", single(model, min_time), 1),
-                                (f"VectorEnv, {batch} rows", vector(model, batch, min_time), threads),
-                                (f"SB3 VecEnv, {batch} rows", sb3(model, batch, min_time), threads)):
+        for how, rate, used in (("single env (gymnasium.make)", single(env_id, model, min_time), 1),
+                                (f"VectorEnv, {batch} rows", vector(env_id, model, batch, min_time), threads),
+                                (f"SB3 VecEnv, {batch} rows", sb3(env_id, model, batch, min_time), threads)):
             rows.append((model, how, rate, base * used / rate))
         rows.append((model, "dynamics core alone, 256 vehicles, 1 thread [RK4 steps/s]", base, 1.0))
     return rows
@@ -282,6 +289,10 @@ class Args:
     """rows of the batched envs"""
     repeats: int = arg(5, lo=1, hi=10_000)
     """runs per construction case"""
+    protocol: Literal["v0", "v1"] = "v1"
+    """steps: the protocol whose SMILE env is measured (lvgym/SmileAscent-v1 or -v0)"""
+    threads: int | None = arg(None, lo=1, hi=1024)
+    """simulator threads of the batched envs (default $LVGYM_THREADS, else the CPUs)"""
     only: Literal["steps", "construction"] | None = None
     """one of the two tables (default: both)"""
     against: str | None = arg(None, metavar="DIR")
@@ -307,9 +318,11 @@ def main(argv: list[str] | None = None) -> None:
             print(f"| {label} | {measure.replace('_cpu', ', CPU')} | {other:.4f} | {this:.4f} | {other / this:.1f} |")
         return
     from lvgym.simulator.threads import default_threads
+    if args.threads is not None:
+        os.environ["LVGYM_THREADS"] = str(args.threads)
     if args.only != "construction":
-        rows = run(args.min_time, args.batch)
-        print(f"# {ENV_ID} env steps per second ({cpu_name()}, {os.cpu_count()} cores, {default_threads()} "
+        rows = run(args.min_time, args.batch, args.protocol)
+        print(f"# {ENV_IDS[args.protocol]} env steps per second ({cpu_name()}, {os.cpu_count()} cores, {default_threads()} "
               "simulator threads)\n")
         print("| model | how | env-steps/s | cost of an env step in core RK4 steps (per thread) |")
         print("|---|---|---|---|")
