@@ -35,8 +35,9 @@ from collections import namedtuple
 import numba as nb
 import numpy as np
 
+from lvgym.borrow import unowned_all
 from lvgym.dynamics.layout import STATE, X
-from lvgym.dynamics.stepper import make_workspace, rk4_vehicle_call, unowned
+from lvgym.dynamics.stepper import make_workspace, rk4_vehicle_call
 from lvgym.packing import at
 from lvgym.rotations import quat_to_dcm
 
@@ -54,6 +55,9 @@ from .timeline import held_k, interp_k, locate_k, params_k
 #: ``imu`` the IMU's parameters (layout IMU; ``on`` 0: no IMU)
 StepSetup = namedtuple("StepSetup", ["rail", "servo", "physics_dt", "n_slosh", "n_modes", "n_u", "slosh_frequency",
                                      "imu"])
+#: the scratch of :func:`advance_range`: the RK4 step's :data:`~lvgym.dynamics.stepper.Workspace`, the IMU's
+#: :data:`~.imu.ImuWork`, a piece's parameters (n_p,), a modal vector (K,) and a 3x3 matrix
+AdvanceWork = namedtuple("AdvanceWork", ["rk4", "imu", "params", "modal", "dcm"])
 XS = STATE.per_slosh
 _EPS = 1e-12
 
@@ -133,24 +137,30 @@ def advance_range(lo, hi, loads_fn, data, tables, setup, duration):
     module docstring), reading the timeline's ``tables`` and the simulator's ``setup``
     (:data:`StepSetup`). The actuator rows receive the integrals of |gimbal| [rad s] and |gimbal rate|
     [rad] over the period; the conditions rows the flight conditions at the end."""
+    n_modes = setup.n_modes
+    work = AdvanceWork(make_workspace(setup.n_slosh, n_modes, setup.n_u), make_imu_work(n_modes),
+                       np.empty(data.p.shape[1]), np.empty(n_modes), np.empty((3, 3)))
+    _advance_rows(lo, hi, loads_fn, data, tables, setup, duration, work)
+
+
+@nb.njit(cache=True, nogil=True)
+def _advance_rows(lo, hi, loads_fn, data, tables, setup, duration, work):
+    """:func:`advance_range` with its scratch ``work`` (:data:`AdvanceWork`). Every array is used through
+    a borrowed view (:mod:`lvgym.borrow`; the caller holds them all for the call): no atomic reference
+    count per row, piece or RK4 stage."""
+    data, tables, setup, work = unowned_all(data), unowned_all(tables), unowned_all(setup), unowned_all(work)
     x, p, t = data.x, data.p, data.t
     n_x = x.shape[1]
-    n_p = p.shape[1]
     n_slosh, n_modes = setup.n_slosh, setup.n_modes
-    ws = make_workspace(n_slosh, n_modes, setup.n_u)
-    pn = np.empty(n_p)
-    tmp = np.empty(n_modes)
+    ws, iw, pn, tmp, C = work.rk4, work.imu, work.params, work.modal, work.dcm
     ch_t, ch_T = tables.mode_change_t, tables.mode_transfer
     by_force = setup.slosh_frequency != 0 and n_slosh > 0
-    C = np.empty((3, 3))
     n = max(1, int(math.ceil(duration / setup.physics_dt - 1e-9)))
     h = duration / n
     rail, servo, ev_t = setup.rail, setup.servo, tables.event_times
     imu_on = setup.imu[IM.on] != 0.0
-    iw = make_imu_work(n_modes)
     for b in range(lo, hi):
-        # rows of the caller's arrays, passed on without reference counting (see unowned)
-        xb, pb, cb = unowned(x[b]), unowned(p[b]), unowned(data.ctx[b])
+        xb, pb, cb = x[b], p[b], data.ctx[b]
         rs, act = data.rail_state[b], data.actuator[b]
         scale, offset = data.scale[b], data.offset[b]
         act[A.effort] = 0.0

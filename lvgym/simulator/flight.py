@@ -44,7 +44,7 @@ import numba as nb
 import numpy as np
 
 from lvgym.dynamics.layout import LOADS, PARAMS, STATE
-from lvgym.dynamics.stepper import compile_loads
+from lvgym.dynamics.stepper import compile_loads, unowned
 from lvgym.environment.aerokernels import AeroAt, AirData, LoadsAt, TableAt, aero_loads_at
 from lvgym.environment.atmosphere import atmosphere_state_at
 from lvgym.environment.earth import SITE_SIZE, site_dcm_ni_latlon_at, site_geodetic_at, site_velocity_wrt_earth_at
@@ -150,7 +150,10 @@ def _flight_loads(t, x, p, ctx, u):
     """Loads of the dynamics core from the flight conditions: aerodynamic force (inertial) plus the
     commanded body force ``force_b`` turned to inertial axes, aerodynamic plus commanded moment about the
     CG, thrust in the engine frame, gravity; generalised modal forces from the aeroelastic strips when
-    they are on, else none."""
+    they are on, else none. The arrays are used through :func:`~lvgym.dynamics.kernels.unowned` views (the
+    caller holds them), so the views made from them (the scratch matrix, the models' blocks) count no
+    references: no atomic instruction per view."""
+    x, p, ctx, u = unowned(x), unowned(p), unowned(ctx), unowned(u)
     flight_conditions_at(ctx[CTX.time0] + t, x, p, ctx, ctx, CTX.scratch, False)
     sc = CTX.scratch
     for i in range(3):
