@@ -57,7 +57,6 @@ from lvgym.packing import at
 from lvgym.rotations import quat_to_dcm
 
 from .layouts import ACCEL_ORDER, CTX, D, GYRO_ORDER, IM, IMU, IMU_STATE, IMU_STATION, IS
-from .timeline import locate_k
 
 __all__ = ["IMU_OFF", "Imu", "ImuWork", "imu_begin_k", "imu_end_k", "imu_output_k", "imu_shift_k", "lti_step_k",
            "make_imu_work", "specific_force_k", "station_modes_k"]
@@ -287,16 +286,15 @@ def station_modes_k(st, tables, j, phi, dphi):
 
 
 @nb.njit(cache=True, nogil=True)
-def imu_end_k(prm, st, x, p, ctx, tables, t, h, w, n_slosh, n_modes):
+def imu_end_k(prm, st, x, p, ctx, tables, j, h, w, n_slosh, n_modes):
     """Advance a row's IMU filters ``st`` (layout IMU_STATE) over the physics step of ``h`` [s] that
-    ended at ``t`` [s] with the state ``x`` and parameters ``p`` (its start kept in ``w`` by
-    :func:`imu_begin_k`); ``prm`` the IMU block (layout IMU), ``ctx`` the row's context (gravity of
-    the latest RK4 stage), ``tables`` the timeline's (mode shapes and slopes at the sensor stations, taken
-    at the row's station by :func:`station_modes_k`)."""
+    ended with the state ``x`` and parameters ``p`` (its start kept in ``w`` by :func:`imu_begin_k`);
+    ``prm`` the IMU block (layout IMU), ``ctx`` the row's context (gravity of the latest RK4 stage),
+    ``tables`` the timeline's (mode shapes and slopes at the sensor stations, taken at the row's station
+    by :func:`station_modes_k` in the timeline's row ``j``, the one in force at the step's end:
+    :func:`~.timeline.row_in_force_k`)."""
     ow, ov, oq, oc = XF.omega_bi_b, XF.v_zw_i, XF.q_bi, PF.r_cg
     K = n_modes
-    i, wt = locate_k(tables.t, t)
-    j = i + 1 if wt >= 1.0 else i
     phi, dphi = w.phi, w.dphi
     station_modes_k(st, tables, j, phi, dphi)
     o_etad = at(X.eta_dot, n_modes, n_slosh)
