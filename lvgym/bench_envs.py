@@ -143,7 +143,9 @@ def _start(what: str) -> None:
     """Start the simulator of a :data:`CONSTRUCTION` case, with the processes' vehicle and timeline caches
     emptied (each run reads its vehicle file and looks its tables up again)."""
     from lvgym.envs import functional
+    from lvgym.vehicle import clear_vehicle_cache
 
+    clear_vehicle_cache()
     functional.cached_vehicle.cache_clear()
     functional.cached_timeline.cache_clear()
     if what == "stratos3":
@@ -200,10 +202,11 @@ def construction(repeats: int = 5) -> list[tuple[str, float, float, float, float
 CHILD = """
 import json, os, sys, tempfile, time, warnings
 warnings.simplefilter("ignore")
-import numpy as np, gymnasium as gym, lvgym
+import numpy as np, gymnasium as gym, lvgym, lvgym.vehicle
 from lvgym.envs import functional
 what, repeats = sys.argv[1], int(sys.argv[2])
 def start():
+    getattr(lvgym.vehicle, "clear_vehicle_cache", lambda: None)()      # (a checkout may not keep vehicles)
     functional.cached_vehicle.cache_clear()
     functional.cached_timeline.cache_clear()
     if what == "stratos3":
