@@ -19,7 +19,7 @@ from numba.core import cgutils, types
 from numba.extending import intrinsic
 from numba.np.arrayobj import make_array
 
-__all__ = ["unowned", "unowned_all"]
+__all__ = ["unowned", "unowned_all", "unowned_matrix"]
 
 
 def _borrowed(context, builder, ty, value):
@@ -73,3 +73,27 @@ def unowned_all(typingctx, tup):
         return _borrowed(context, builder, tup, args[0])
 
     return tup(tup), codegen
+
+
+@intrinsic
+def unowned_matrix(typingctx, a, start, rows, cols):
+    """The ``rows`` x ``cols`` row-major matrix over ``a[start:start + rows * cols]`` of the contiguous vector
+    ``a``, as a borrowed view (no bounds check: the caller keeps the stretch inside ``a`` and ``a`` alive)."""
+    if not (isinstance(a, types.Array) and a.ndim == 1 and a.layout == "C"
+            and all(isinstance(v, types.Integer) for v in (start, rows, cols))):
+        return None
+    matrix = types.Array(a.dtype, 2, "C")
+
+    def codegen(context, builder, sig, args):
+        src = make_array(a)(context, builder, value=args[0])
+        dst = make_array(matrix)(context, builder)
+        intp = context.get_value_type(types.intp)
+        o, r, c = (context.cast(builder, v, t, types.intp) for v, t in zip(args[1:], sig.args[1:]))
+        item = context.get_constant(types.intp, context.get_abi_sizeof(context.get_data_type(a.dtype)))
+        context.populate_array(dst, data=builder.gep(src.data, [o]),
+                               shape=cgutils.pack_array(builder, [r, c], ty=intp),
+                               strides=cgutils.pack_array(builder, [builder.mul(c, item), item], ty=intp),
+                               itemsize=item, meminfo=None)
+        return dst._getvalue()
+
+    return matrix(a, start, rows, cols), codegen
