@@ -14,8 +14,12 @@ the table also gives a ratio that does not depend on the machine: the cost of on
 thread) in steps of the bare dynamics core (one RK4 step of the same vehicle size with held loads,
 :mod:`lvgym.bench`), measured in the same run. A SMILE env step does 2 RK4 steps, each with 4 evaluations
 of the flight loads, plus the servo, the events and the task signals, so the ratio is at least 2.
-``--threads 1`` (``$LVGYM_THREADS``) runs the batched envs on one thread: on a shared machine the second
-thread's share varies with the other jobs, which the per-thread ratio then counts against the env.
+The ratio is given twice: from wall times (the core's RK4 steps per second times the simulator threads,
+over the env steps per second: a thread waiting for the Python part of a step counts) and from CPU times
+(``time.process_time``, every thread's: the CPU seconds of an env step over those of a core RK4 step). On a
+shared machine the wall-time ratio of the batched envs moves with the other jobs (the second thread's
+share of a core varies; runs of the same code gave 7.7-10.1 under a load of 4 on 2 cores), the CPU-time
+ratio much less. ``--threads 1`` (``$LVGYM_THREADS``) runs the batched envs on one thread.
 
 Construction (``--only construction``): wall time of starting a simulator, median of ``--repeats`` runs in one
 process after a warm-up (imports done, Numba's kernels loaded from its disk cache): **cold**, an empty timeline
@@ -56,16 +60,18 @@ from lvgym.envs import make_sb3_vec_env
 ENV_IDS = {"v0": "lvgym/SmileAscent-v0", "v1": "lvgym/SmileAscent-v1"}
 
 
-def _timed(step, n_min: int, min_time: float) -> float:
-    """Steps per second of ``step()`` over at least ``n_min`` calls and ``min_time`` seconds."""
-    n, start = 0, time.perf_counter()
+def _timed(step, n_min: int, min_time: float) -> tuple[float, float]:
+    """Calls per second of ``step()`` over at least ``n_min`` calls and ``min_time`` seconds (wall time),
+    and the CPU time of the process per call [s] (``time.process_time``: every thread's)."""
+    n, start, cpu = 0, time.perf_counter(), time.process_time()
     while n < n_min or time.perf_counter() - start < min_time:
         step()
         n += 1
-    return n / (time.perf_counter() - start)
+    return n / (time.perf_counter() - start), (time.process_time() - cpu) / n
 
 
-def single(env_id: str, model: str, min_time: float) -> float:
+def single(env_id: str, model: str, min_time: float) -> tuple[float, float]:
+    """Env steps per second and CPU seconds per env step of one env (:func:`_timed`)."""
     env = gym.make(env_id, model=model)
     env.reset(seed=0)
     a = np.zeros(2, dtype=np.float32)
@@ -79,31 +85,35 @@ def single(env_id: str, model: str, min_time: float) -> float:
     return _timed(step, 200, min_time)
 
 
-def vector(env_id: str, model: str, n: int, min_time: float) -> float:
+def vector(env_id: str, model: str, n: int, min_time: float) -> tuple[float, float]:
+    """Env steps per second and CPU seconds per env step of the native VectorEnv of ``n`` rows."""
     env = gym.make_vec(env_id, num_envs=n, vectorization_mode="vector_entry_point", model=model)
     env.reset(seed=0)
     a = np.zeros((n, 2), dtype=np.float32)
     for _ in range(250):
         env.step(a)
-    return n * _timed(lambda: env.step(a), 20, min_time)
+    rate, cpu = _timed(lambda: env.step(a), 20, min_time)
+    return n * rate, cpu / n
 
 
-def sb3(env_id: str, model: str, n: int, min_time: float) -> float:
+def sb3(env_id: str, model: str, n: int, min_time: float) -> tuple[float, float]:
+    """Env steps per second and CPU seconds per env step of the SB3 VecEnv of ``n`` rows."""
     env = make_sb3_vec_env(env_id, num_envs=n, seed=0, model=model)
     env.reset()
     a = np.zeros((n, 2), dtype=np.float32)
     for _ in range(250):
         env.step(a)
-    return n * _timed(lambda: env.step(a), 20, min_time)
+    rate, cpu = _timed(lambda: env.step(a), 20, min_time)
+    return n * rate, cpu / n
 
 
 #: the dynamics core's size of each model of SmileAscent-v0 and -v1 (slosh pendulums, modes per plane)
 CORE_SIZE = {"rigid": (0, 0), "nonrigid": (6, 2)}
 
 
-def core(model: str, min_time: float) -> float:
+def core(model: str, min_time: float) -> tuple[float, float]:
     """RK4 vehicle-steps per second of the bare dynamics core for the model's size (one thread, a batch
-    of 256 with held loads: :func:`lvgym.bench.vehicle`)."""
+    of 256 with held loads: :func:`lvgym.bench.vehicle`), and CPU seconds per vehicle-step."""
     from lvgym.bench import vehicle
     from lvgym.dynamics import step_batch, zoh_loads
 
@@ -111,25 +121,27 @@ def core(model: str, min_time: float) -> float:
     m, x, p, u = vehicle(n_slosh, n_modes, 256)
     n_u = m.layout.n_u
     step_batch(zoh_loads, x, p, u, 0.0, 1e-3, 20, n_slosh, n_modes, True, n_u)
-    return 256 * 20 * _timed(lambda: step_batch(zoh_loads, x, p, u, 0.0, 1e-3, 20, n_slosh, n_modes, True, n_u),
-                             20, min_time)
+    rate, cpu = _timed(lambda: step_batch(zoh_loads, x, p, u, 0.0, 1e-3, 20, n_slosh, n_modes, True, n_u), 20,
+                       min_time)
+    return 256 * 20 * rate, cpu / (256 * 20)
 
 
-def run(min_time: float = 2.0, batch: int = 1024, protocol: str = "v1") -> list[tuple[str, str, float, float]]:
-    """``(model, how, env-steps/s, core RK4 steps per env step and thread)`` rows of the env of ``protocol``
-    (:data:`ENV_IDS`)."""
+def run(min_time: float = 2.0, batch: int = 1024, protocol: str = "v1") -> list[tuple[str, str, float, float, float]]:
+    """``(model, how, env-steps/s, cost, CPU cost)`` rows of the env of ``protocol`` (:data:`ENV_IDS`): the
+    cost of an env step in core RK4 steps, per simulator thread from the wall times, and from the CPU
+    times (see the module docstring)."""
     from lvgym.simulator.threads import default_threads
 
     env_id = ENV_IDS[protocol]
     threads = default_threads()
     rows = []
     for model in ("rigid", "nonrigid"):
-        base = core(model, min_time)
-        for how, rate, used in (("single env (gymnasium.make)", single(env_id, model, min_time), 1),
-                                (f"VectorEnv, {batch} rows", vector(env_id, model, batch, min_time), threads),
-                                (f"SB3 VecEnv, {batch} rows", sb3(env_id, model, batch, min_time), threads)):
-            rows.append((model, how, rate, base * used / rate))
-        rows.append((model, "dynamics core alone, 256 vehicles, 1 thread [RK4 steps/s]", base, 1.0))
+        base, base_cpu = core(model, min_time)
+        for how, (rate, cpu), used in (("single env (gymnasium.make)", single(env_id, model, min_time), 1),
+                                       (f"VectorEnv, {batch} rows", vector(env_id, model, batch, min_time), threads),
+                                       (f"SB3 VecEnv, {batch} rows", sb3(env_id, model, batch, min_time), threads)):
+            rows.append((model, how, rate, base * used / rate, cpu / base_cpu))
+        rows.append((model, "dynamics core alone, 256 vehicles, 1 thread [RK4 steps/s]", base, 1.0, 1.0))
     return rows
 
 
@@ -327,10 +339,11 @@ def main(argv: list[str] | None = None) -> None:
         rows = run(args.min_time, args.batch, args.protocol)
         print(f"# {ENV_IDS[args.protocol]} env steps per second ({cpu_name()}, {os.cpu_count()} cores, {default_threads()} "
               "simulator threads)\n")
-        print("| model | how | env-steps/s | cost of an env step in core RK4 steps (per thread) |")
-        print("|---|---|---|---|")
-        for model, how, rate, ratio in rows:
-            print(f"| {model} | {how} | {rate:,.0f} | {ratio:.1f} |")
+        print("| model | how | env-steps/s | cost of an env step in core RK4 steps (per thread) | the same from "
+              "CPU times |")
+        print("|---|---|---|---|---|")
+        for model, how, rate, ratio, ratio_cpu in rows:
+            print(f"| {model} | {how} | {rate:,.0f} | {ratio:.2f} | {ratio_cpu:.2f} |")
     if args.only != "steps":
         print(f"\n# construction: starting a simulator [s], median of {args.repeats} ({cpu_name()})\n")
         print("| case | cold (tables built) | warm (tables from the cache) | cold, CPU | warm, CPU "
