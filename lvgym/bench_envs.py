@@ -1,17 +1,25 @@
 """Speed of the ascent envs: env steps per second (``lvgym bench-envs``, ``python -m lvgym.bench_envs``).
 
-``lvgym/SmileAscent-v0`` rigid and non-rigid at the defaults (50 Hz control over 100 Hz RK4: two RK4
-steps, nine evaluations of the flight loads, the servo, the task signals per env step), with zero
-actions from mid-flight states (the first 2 s on the pad and before the controller acts are skipped
-by a warm-up). Three ways: one env through ``gymnasium.make`` (with its wrappers), the native
-``VectorEnv`` of N rows (``gymnasium.make_vec``; rows split over the threads of the simulator), and the
-SB3 ``VecEnv`` adapter (which builds one info dict per row, as SB3 requires).
+SMILE's env of protocol v1 (``lvgym/SmileAscent-v1``; ``--protocol v0``: ``lvgym/SmileAscent-v0``), rigid
+and non-rigid, at the protocol's defaults (50 Hz control over 100 Hz RK4: two RK4 steps, eight evaluations
+of the flight loads, the servo and the task signals per env step; v1 also the IMU's filters, the flight
+computer, one period of action delay, the coast control and the settling thrust), with zero actions from
+mid-flight states (the first 5 s, on the pad and before the controller acts, are skipped by a warm-up).
+Three ways: one env through ``gymnasium.make`` (with its wrappers), the native ``VectorEnv`` of N rows
+(``gymnasium.make_vec``; rows split over the threads of the simulator), and the SB3 ``VecEnv`` adapter
+(which builds one info dict per row, as SB3 requires).
 
-Numbers from different machines differ (the same 2-core kind has given 60 % of another's). So the table also
-gives a ratio that does not depend on the machine: the cost of one env step (per simulator thread) in steps
-of the bare dynamics core (one RK4 step of the same vehicle size with held loads, :mod:`lvgym.bench`),
-measured in the same run. A SMILE env step does 2 RK4 steps, each with 4 evaluations of the flight loads,
-plus the servo, the events and the task signals, so the ratio is at least 2.
+Numbers from different machines differ (the same 2-core kind has given 60 % of another's). So every row of
+the table also gives a ratio that does not depend on the machine: the cost of one env step (per simulator
+thread) in steps of the bare dynamics core (one RK4 step of the same vehicle size with held loads,
+:mod:`lvgym.bench`), measured in the same run. A SMILE env step does 2 RK4 steps, each with 4 evaluations
+of the flight loads, plus the servo, the events and the task signals, so the ratio is at least 2.
+The ratio is given twice: from wall times (the core's RK4 steps per second times the simulator threads,
+over the env steps per second: a thread waiting for the Python part of a step counts) and from CPU times
+(``time.process_time``, every thread's: the CPU seconds of an env step over those of a core RK4 step). On a
+shared machine the wall-time ratio of the batched envs moves with the other jobs (the second thread's
+share of a core varies; runs of the same code gave 7.7-10.1 under a load of 4 on 2 cores), the CPU-time
+ratio much less. ``--threads 1`` (``$LVGYM_THREADS``) runs the batched envs on one thread.
 
 Construction (``--only construction``): wall time of starting a simulator, median of ``--repeats`` runs in one
 process after a warm-up (imports done, Numba's kernels loaded from its disk cache): **cold**, an empty timeline
@@ -48,20 +56,23 @@ import lvgym  # noqa: F401  (registers the envs)
 from lvgym.cli.args import arg, parse
 from lvgym.envs import make_sb3_vec_env
 
-ENV_ID = "lvgym/SmileAscent-v0"
+#: the env measured for each protocol (``--protocol``)
+ENV_IDS = {"v0": "lvgym/SmileAscent-v0", "v1": "lvgym/SmileAscent-v1"}
 
 
-def _timed(step, n_min: int, min_time: float) -> float:
-    """Steps per second of ``step()`` over at least ``n_min`` calls and ``min_time`` seconds."""
-    n, start = 0, time.perf_counter()
+def _timed(step, n_min: int, min_time: float) -> tuple[float, float]:
+    """Calls per second of ``step()`` over at least ``n_min`` calls and ``min_time`` seconds (wall time),
+    and the CPU time of the process per call [s] (``time.process_time``: every thread's)."""
+    n, start, cpu = 0, time.perf_counter(), time.process_time()
     while n < n_min or time.perf_counter() - start < min_time:
         step()
         n += 1
-    return n / (time.perf_counter() - start)
+    return n / (time.perf_counter() - start), (time.process_time() - cpu) / n
 
 
-def single(model: str, min_time: float) -> float:
-    env = gym.make(ENV_ID, model=model)
+def single(env_id: str, model: str, min_time: float) -> tuple[float, float]:
+    """Env steps per second and CPU seconds per env step of one env (:func:`_timed`)."""
+    env = gym.make(env_id, model=model)
     env.reset(seed=0)
     a = np.zeros(2, dtype=np.float32)
     for _ in range(250):                                   # 5 s: off the pad, controller on
@@ -74,31 +85,35 @@ def single(model: str, min_time: float) -> float:
     return _timed(step, 200, min_time)
 
 
-def vector(model: str, n: int, min_time: float) -> float:
-    env = gym.make_vec(ENV_ID, num_envs=n, vectorization_mode="vector_entry_point", model=model)
+def vector(env_id: str, model: str, n: int, min_time: float) -> tuple[float, float]:
+    """Env steps per second and CPU seconds per env step of the native VectorEnv of ``n`` rows."""
+    env = gym.make_vec(env_id, num_envs=n, vectorization_mode="vector_entry_point", model=model)
     env.reset(seed=0)
     a = np.zeros((n, 2), dtype=np.float32)
     for _ in range(250):
         env.step(a)
-    return n * _timed(lambda: env.step(a), 20, min_time)
+    rate, cpu = _timed(lambda: env.step(a), 20, min_time)
+    return n * rate, cpu / n
 
 
-def sb3(model: str, n: int, min_time: float) -> float:
-    env = make_sb3_vec_env(ENV_ID, num_envs=n, seed=0, model=model)
+def sb3(env_id: str, model: str, n: int, min_time: float) -> tuple[float, float]:
+    """Env steps per second and CPU seconds per env step of the SB3 VecEnv of ``n`` rows."""
+    env = make_sb3_vec_env(env_id, num_envs=n, seed=0, model=model)
     env.reset()
     a = np.zeros((n, 2), dtype=np.float32)
     for _ in range(250):
         env.step(a)
-    return n * _timed(lambda: env.step(a), 20, min_time)
+    rate, cpu = _timed(lambda: env.step(a), 20, min_time)
+    return n * rate, cpu / n
 
 
-#: the dynamics core's size of each model of SmileAscent-v0 (slosh pendulums, modes per plane)
+#: the dynamics core's size of each model of SmileAscent-v0 and -v1 (slosh pendulums, modes per plane)
 CORE_SIZE = {"rigid": (0, 0), "nonrigid": (6, 2)}
 
 
-def core(model: str, min_time: float) -> float:
+def core(model: str, min_time: float) -> tuple[float, float]:
     """RK4 vehicle-steps per second of the bare dynamics core for the model's size (one thread, a batch
-    of 256 with held loads: :func:`lvgym.bench.vehicle`)."""
+    of 256 with held loads: :func:`lvgym.bench.vehicle`), and CPU seconds per vehicle-step."""
     from lvgym.bench import vehicle
     from lvgym.dynamics import step_batch, zoh_loads
 
@@ -106,23 +121,27 @@ def core(model: str, min_time: float) -> float:
     m, x, p, u = vehicle(n_slosh, n_modes, 256)
     n_u = m.layout.n_u
     step_batch(zoh_loads, x, p, u, 0.0, 1e-3, 20, n_slosh, n_modes, True, n_u)
-    return 256 * 20 * _timed(lambda: step_batch(zoh_loads, x, p, u, 0.0, 1e-3, 20, n_slosh, n_modes, True, n_u),
-                             20, min_time)
+    rate, cpu = _timed(lambda: step_batch(zoh_loads, x, p, u, 0.0, 1e-3, 20, n_slosh, n_modes, True, n_u), 20,
+                       min_time)
+    return 256 * 20 * rate, cpu / (256 * 20)
 
 
-def run(min_time: float = 2.0, batch: int = 1024) -> list[tuple[str, str, float, float]]:
-    """``(model, how, env-steps/s, core RK4 steps per env step and thread)`` rows."""
+def run(min_time: float = 2.0, batch: int = 1024, protocol: str = "v1") -> list[tuple[str, str, float, float, float]]:
+    """``(model, how, env-steps/s, cost, CPU cost)`` rows of the env of ``protocol`` (:data:`ENV_IDS`): the
+    cost of an env step in core RK4 steps, per simulator thread from the wall times, and from the CPU
+    times (see the module docstring)."""
     from lvgym.simulator.threads import default_threads
 
+    env_id = ENV_IDS[protocol]
     threads = default_threads()
     rows = []
     for model in ("rigid", "nonrigid"):
-        base = core(model, min_time)
-        for how, rate, used in (("single env (gymnasium.make)", single(model, min_time), 1),
-                                (f"VectorEnv, {batch} rows", vector(model, batch, min_time), threads),
-                                (f"SB3 VecEnv, {batch} rows", sb3(model, batch, min_time), threads)):
-            rows.append((model, how, rate, base * used / rate))
-        rows.append((model, "dynamics core alone, 256 vehicles, 1 thread [RK4 steps/s]", base, 1.0))
+        base, base_cpu = core(model, min_time)
+        for how, (rate, cpu), used in (("single env (gymnasium.make)", single(env_id, model, min_time), 1),
+                                       (f"VectorEnv, {batch} rows", vector(env_id, model, batch, min_time), threads),
+                                       (f"SB3 VecEnv, {batch} rows", sb3(env_id, model, batch, min_time), threads)):
+            rows.append((model, how, rate, base * used / rate, cpu / base_cpu))
+        rows.append((model, "dynamics core alone, 256 vehicles, 1 thread [RK4 steps/s]", base, 1.0, 1.0))
     return rows
 
 
@@ -136,7 +155,9 @@ def _start(what: str) -> None:
     """Start the simulator of a :data:`CONSTRUCTION` case, with the processes' vehicle and timeline caches
     emptied (each run reads its vehicle file and looks its tables up again)."""
     from lvgym.envs import functional
+    from lvgym.vehicle import clear_vehicle_cache
 
+    clear_vehicle_cache()
     functional.cached_vehicle.cache_clear()
     functional.cached_timeline.cache_clear()
     if what == "stratos3":
@@ -193,10 +214,11 @@ def construction(repeats: int = 5) -> list[tuple[str, float, float, float, float
 CHILD = """
 import json, os, sys, tempfile, time, warnings
 warnings.simplefilter("ignore")
-import numpy as np, gymnasium as gym, lvgym
+import numpy as np, gymnasium as gym, lvgym, lvgym.vehicle
 from lvgym.envs import functional
 what, repeats = sys.argv[1], int(sys.argv[2])
 def start():
+    getattr(lvgym.vehicle, "clear_vehicle_cache", lambda: None)()      # (a checkout may not keep vehicles)
     functional.cached_vehicle.cache_clear()
     functional.cached_timeline.cache_clear()
     if what == "stratos3":
@@ -282,6 +304,10 @@ class Args:
     """rows of the batched envs"""
     repeats: int = arg(5, lo=1, hi=10_000)
     """runs per construction case"""
+    protocol: Literal["v0", "v1"] = "v1"
+    """steps: the protocol whose SMILE env is measured (lvgym/SmileAscent-v1 or -v0)"""
+    threads: int | None = arg(None, lo=1, hi=1024)
+    """simulator threads of the batched envs (default $LVGYM_THREADS, else the CPUs)"""
     only: Literal["steps", "construction"] | None = None
     """one of the two tables (default: both)"""
     against: str | None = arg(None, metavar="DIR")
@@ -307,14 +333,17 @@ def main(argv: list[str] | None = None) -> None:
             print(f"| {label} | {measure.replace('_cpu', ', CPU')} | {other:.4f} | {this:.4f} | {other / this:.1f} |")
         return
     from lvgym.simulator.threads import default_threads
+    if args.threads is not None:
+        os.environ["LVGYM_THREADS"] = str(args.threads)
     if args.only != "construction":
-        rows = run(args.min_time, args.batch)
-        print(f"# {ENV_ID} env steps per second ({cpu_name()}, {os.cpu_count()} cores, {default_threads()} "
+        rows = run(args.min_time, args.batch, args.protocol)
+        print(f"# {ENV_IDS[args.protocol]} env steps per second ({cpu_name()}, {os.cpu_count()} cores, {default_threads()} "
               "simulator threads)\n")
-        print("| model | how | env-steps/s | cost of an env step in core RK4 steps (per thread) |")
-        print("|---|---|---|---|")
-        for model, how, rate, ratio in rows:
-            print(f"| {model} | {how} | {rate:,.0f} | {ratio:.1f} |")
+        print("| model | how | env-steps/s | cost of an env step in core RK4 steps (per thread) | the same from "
+              "CPU times |")
+        print("|---|---|---|---|---|")
+        for model, how, rate, ratio, ratio_cpu in rows:
+            print(f"| {model} | {how} | {rate:,.0f} | {ratio:.2f} | {ratio_cpu:.2f} |")
     if args.only != "steps":
         print(f"\n# construction: starting a simulator [s], median of {args.repeats} ({cpu_name()})\n")
         print("| case | cold (tables built) | warm (tables from the cache) | cold, CPU | warm, CPU "

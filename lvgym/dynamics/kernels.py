@@ -41,10 +41,8 @@ from collections import namedtuple
 
 import numba as nb
 import numpy as np
-from numba.core import cgutils, types
-from numba.extending import intrinsic
-from numba.np.arrayobj import make_array
 
+from lvgym.borrow import unowned
 from lvgym.packing import at
 from lvgym.rotations import quat_to_dcm
 
@@ -88,33 +86,6 @@ def make_deriv_work(n_slosh, n_modes):
     nr = at(SIZES.speeds, K, N)
     return DerivWork(N, K, np.empty((nr, nr)), np.empty(nr), np.empty(nr), np.empty((_ATTITUDES_SIZE, 3, 3)),
                      np.zeros((max(N, 1), _SLOSH_WORK_SIZE)), np.empty((at(_WORK_SIZE, K, N), max(nr, 3))))
-
-
-@intrinsic
-def unowned(typingctx, a):
-    """A view of the array ``a`` that holds no reference to its memory (a null meminfo).
-
-    Numba increments and decrements the reference count of every array view it makes and of every
-    array argument of a compiled function it calls, with atomic instructions on the owner's counter;
-    rows of one batch share that counter, so the threads that step row ranges contend for it. Passing
-    unowned views of the rows to the per-stage functions (the loads, the derivative) makes those
-    updates no-ops. The caller must keep ``a``'s owner alive while the view is in use."""
-    if not isinstance(a, types.Array):
-        return None
-
-    def codegen(context, builder, sig, args):
-        src = make_array(a)(context, builder, value=args[0])
-        dst = make_array(a)(context, builder)
-        dst.meminfo = cgutils.get_null_value(dst.meminfo.type)
-        dst.parent = cgutils.get_null_value(dst.parent.type)
-        dst.nitems = src.nitems
-        dst.itemsize = src.itemsize
-        dst.data = src.data
-        dst.shape = src.shape
-        dst.strides = src.strides
-        return dst._getvalue()
-
-    return a(a), codegen
 
 
 # ---------------------------------------------------------------------------- small helpers

@@ -58,7 +58,8 @@ __all__ = ["AscentFuncEnv", "AscentParams", "AscentState", "RENDER_STATIONS", "c
            "imu_probe_offsets"]
 
 #: an episode's (or a batch of episodes') whole state: the simulator's rows (:class:`~lvgym.simulator.SimData`),
-#: the task's rows (:data:`~.signals.TaskData`) and the events of the last step (one list per row)
+#: the task's rows (:data:`~.signals.TaskData`) and the events of the last step (one tuple of ``(time, name)`` per
+#: row, as :meth:`~lvgym.simulator.Simulator.step` returns them)
 AscentState = namedtuple("AscentState", ["sim", "task", "events"])
 #: the explicit parameters: ``task`` (layout :data:`.layouts.TASK`), the timeline's
 #: :class:`~lvgym.simulator.Tables` and the simulator's step set-up
@@ -204,14 +205,14 @@ class AscentFuncEnv(FuncEnv):
                                         self._neutral),
                         nav=NAV.zeros(B), draws=FLIGHT_DRAWS.zeros(B),
                         history=self.history.zeros(B) if self.history else np.zeros((B, 0), np.float32))
-        return AscentState(sim=self.sim.new_data(B), task=task, events=[[] for _ in range(B)])
+        return AscentState(sim=self.sim.new_data(B), task=task, events=[()] * B)
 
     @staticmethod
     def take(state: AscentState, rows: Any = None) -> AscentState:
         """A copy of the rows ``rows`` (default all) of ``state``."""
         idx = np.arange(len(state.task.steps)) if rows is None else _rows(rows)
         return AscentState(sim=simdata.take(state.sim, idx), task=TaskData(*(a[idx].copy() for a in state.task)),
-                           events=[list(state.events[b]) for b in idx])
+                           events=[tuple(state.events[b]) for b in idx])
 
     @staticmethod
     def put(state: AscentState, rows: Any, src: AscentState) -> AscentState:
@@ -225,7 +226,7 @@ class AscentFuncEnv(FuncEnv):
             a[idx] = b
         events = list(state.events)
         for i, b in enumerate(idx):
-            events[b] = list(src.events[i])
+            events[b] = tuple(src.events[i])
         return AscentState(sim=sim, task=state.task, events=events)
 
     # ------------------------------------------------------------------------------ FuncEnv
@@ -277,7 +278,7 @@ class AscentFuncEnv(FuncEnv):
             self.history.reset(ts.history, rows, ts.obs[rows])
         events = list(state.events)
         for b in rows:
-            events[b] = []
+            events[b] = ()
         return AscentState(sim=sim, task=ts, events=events)
 
     def transition(self, state: AscentState, action: Any, rng: Sequence[np.random.Generator | None],

@@ -18,6 +18,7 @@ from collections import namedtuple
 import numba as nb
 import numpy as np
 
+from lvgym.borrow import unowned, unowned_all
 from lvgym.dynamics.layout import STATE, X
 from lvgym.packing import at
 from lvgym.rotations import quat_to_dcm
@@ -183,9 +184,18 @@ def step_signals_range(lo, hi, task, setup, sim, ts, tables):
     sets ``on`` for the next one; writes the observation without noise, the attitude error, the reward
     terms (layout REWARD) and their sum, the termination code, ``truncated``, q-alpha [Pa deg], the
     mass and the stage."""
+    _signals_rows(lo, hi, task, setup, sim, ts, tables, np.empty((3, 3)))
+
+
+@nb.njit(cache=True, nogil=True)
+def _signals_rows(lo, hi, task, setup, sim, ts, tables, C):
+    """:func:`step_signals_range` with a 3x3 scratch ``C``. Every array is used through a borrowed view
+    (:mod:`lvgym.borrow`; the caller holds them all): the per-row functions it calls take the named
+    blocks without an atomic reference count per array."""
+    task, C = unowned(task), unowned(C)
+    setup, sim, ts, tables = unowned_all(setup), unowned_all(sim), unowned_all(ts), unowned_all(tables)
     dt = task[T.dt]
     omega_e = setup.rail[RL.omega_e]
-    C = np.empty((3, 3))
     oq, ow = XF.q_bi, XF.omega_bi_b
     for b in range(lo, hi):
         xb, cond, a, t = sim.x[b], sim.conditions[b], ts.axis_ref_i[b], sim.t[b]

@@ -35,8 +35,9 @@ from collections import namedtuple
 import numba as nb
 import numpy as np
 
+from lvgym.borrow import unowned_all
 from lvgym.dynamics.layout import STATE, X
-from lvgym.dynamics.stepper import make_workspace, rk4_vehicle_call, unowned
+from lvgym.dynamics.stepper import make_workspace, rk4_vehicle_call
 from lvgym.packing import at
 from lvgym.rotations import quat_to_dcm
 
@@ -46,7 +47,7 @@ from .layouts import AEL, CTX, IM, RL, RS, A
 from .piece import axial_specific_force_k, project_at_k, slosh_frequency_k
 from .strips import strip_modes_k
 from .servo import servo_step_k
-from .timeline import held_k, interp_k, locate_k, params_k
+from .timeline import held_at_k, interp_at_k, locate_from_k, locate_k, params_at_k, row_in_force_k
 
 #: constants of a simulator's step: ``rail`` (layout RAIL), ``servo`` (layout SERVO), ``physics_dt`` [s]
 #: the largest RK4 step, ``n_slosh`` and ``n_modes`` of the dynamics model, ``n_u`` its loads' length,
@@ -54,6 +55,9 @@ from .timeline import held_k, interp_k, locate_k, params_k
 #: ``imu`` the IMU's parameters (layout IMU; ``on`` 0: no IMU)
 StepSetup = namedtuple("StepSetup", ["rail", "servo", "physics_dt", "n_slosh", "n_modes", "n_u", "slosh_frequency",
                                      "imu"])
+#: the scratch of :func:`advance_range`: the RK4 step's :data:`~lvgym.dynamics.stepper.Workspace`, the IMU's
+#: :data:`~.imu.ImuWork`, a piece's parameters (n_p,), a modal vector (K,) and a 3x3 matrix
+AdvanceWork = namedtuple("AdvanceWork", ["rk4", "imu", "params", "modal", "dcm"])
 XS = STATE.per_slosh
 _EPS = 1e-12
 
@@ -116,15 +120,14 @@ def constrain_k(x, t, rail, x_cg0, x_cg, rs):
 
 
 @nb.njit(cache=True, nogil=True, inline="always")
-def _piece_thrust_k(ctx, tables, t):
+def _piece_thrust_k(ctx, tables, i, w):
     """Thrust ``T_0``, exit area, aerodynamic block (and the mode shapes at the aeroelastic strips) of the
-    timeline at time ``t`` into the context."""
-    ctx[CTX.thrust0] = interp_k(tables.t, tables.thrust0, t)
-    ctx[CTX.exit_area] = interp_k(tables.t, tables.exit_area, t)
-    select_aero_k(ctx, held_k(tables.t, tables.stage, t))
+    timeline at the row ``i`` and weight ``w`` of a time (:func:`~.timeline.locate_k`) into the context."""
+    ctx[CTX.thrust0] = interp_at_k(tables.thrust0, i, w)
+    ctx[CTX.exit_area] = interp_at_k(tables.exit_area, i, w)
+    select_aero_k(ctx, held_at_k(tables.stage, i, w))
     if ctx[CTX.aeroelastic + AEL.on] != 0.0:
-        i, w = locate_k(tables.t, t)
-        strip_modes_k(ctx, tables.phi_strip, tables.dphi_strip, i + 1 if w >= 1.0 else i)
+        strip_modes_k(ctx, tables.phi_strip, tables.dphi_strip, row_in_force_k(i, w))
 
 
 @nb.njit(cache=True, nogil=True)
@@ -133,24 +136,30 @@ def advance_range(lo, hi, loads_fn, data, tables, setup, duration):
     module docstring), reading the timeline's ``tables`` and the simulator's ``setup``
     (:data:`StepSetup`). The actuator rows receive the integrals of |gimbal| [rad s] and |gimbal rate|
     [rad] over the period; the conditions rows the flight conditions at the end."""
+    n_modes = setup.n_modes
+    work = AdvanceWork(make_workspace(setup.n_slosh, n_modes, setup.n_u), make_imu_work(n_modes),
+                       np.empty(data.p.shape[1]), np.empty(n_modes), np.empty((3, 3)))
+    _advance_rows(lo, hi, loads_fn, data, tables, setup, duration, work)
+
+
+@nb.njit(cache=True, nogil=True)
+def _advance_rows(lo, hi, loads_fn, data, tables, setup, duration, work):
+    """:func:`advance_range` with its scratch ``work`` (:data:`AdvanceWork`). Every array is used through
+    a borrowed view (:mod:`lvgym.borrow`; the caller holds them all for the call): no atomic reference
+    count per row, piece or RK4 stage."""
+    data, tables, setup, work = unowned_all(data), unowned_all(tables), unowned_all(setup), unowned_all(work)
     x, p, t = data.x, data.p, data.t
     n_x = x.shape[1]
-    n_p = p.shape[1]
     n_slosh, n_modes = setup.n_slosh, setup.n_modes
-    ws = make_workspace(n_slosh, n_modes, setup.n_u)
-    pn = np.empty(n_p)
-    tmp = np.empty(n_modes)
+    ws, iw, pn, tmp, C = work.rk4, work.imu, work.params, work.modal, work.dcm
     ch_t, ch_T = tables.mode_change_t, tables.mode_transfer
     by_force = setup.slosh_frequency != 0 and n_slosh > 0
-    C = np.empty((3, 3))
     n = max(1, int(math.ceil(duration / setup.physics_dt - 1e-9)))
     h = duration / n
     rail, servo, ev_t = setup.rail, setup.servo, tables.event_times
     imu_on = setup.imu[IM.on] != 0.0
-    iw = make_imu_work(n_modes)
     for b in range(lo, hi):
-        # rows of the caller's arrays, passed on without reference counting (see unowned)
-        xb, pb, cb = unowned(x[b]), unowned(p[b]), unowned(data.ctx[b])
+        xb, pb, cb = x[b], p[b], data.ctx[b]
         rs, act = data.rail_state[b], data.actuator[b]
         scale, offset = data.scale[b], data.offset[b]
         act[A.effort] = 0.0
@@ -160,6 +169,7 @@ def advance_range(lo, hi, loads_fn, data, tables, setup, duration):
             continue
         t_start = t[b]
         first = True                  # the row's latest flight conditions: data.conditions, then the scratch
+        row = -1                      # the timeline row of the latest look-up (the next starts there)
         for k in range(n):
             if imu_on:
                 imu_begin_k(xb, n_slosh, n_modes, iw)
@@ -177,7 +187,8 @@ def advance_range(lo, hi, loads_fn, data, tables, setup, duration):
                     if ta + _EPS < e < te - _EPS:
                         te = e
                 tm = 0.5 * (ta + te)
-                params_k(tables.t, tables.params, tables.hold, scale, offset, tm, pn)
+                row, wm = locate_from_k(tables.t, tm, row)
+                params_at_k(tables.params, tables.hold, scale, offset, row, wm, pn)
                 if ch_t.size:
                     project_at_k(xb, ta, ch_t, ch_T, _EPS, n_slosh, n_modes, tmp)
                 if by_force:
@@ -195,7 +206,7 @@ def advance_range(lo, hi, loads_fn, data, tables, setup, duration):
                     if imu_on:
                         imu_shift_k(xb, iw, 1.0)
                 pb[:] = pn
-                _piece_thrust_k(cb, tables, tm)
+                _piece_thrust_k(cb, tables, row, wm)
                 cb[CTX.time0] = ta
                 rk4_vehicle_call(loads_fn, 0.0, te - ta, xb, pb, cb, True, ws)
                 ta = te
@@ -218,9 +229,12 @@ def advance_range(lo, hi, loads_fn, data, tables, setup, duration):
                 t[b] = t_start + duration
                 break
             if imu_on:
-                imu_end_k(setup.imu, data.imu[b], xb, pb, cb, tables, tb, h, iw, n_slosh, n_modes)
+                row, wb = locate_from_k(tables.t, tb, row)
+                imu_end_k(setup.imu, data.imu[b], xb, pb, cb, tables, row_in_force_k(row, wb), h, iw, n_slosh,
+                          n_modes)
         act[A.previous], act[A.previous + 1] = act[A.command], act[A.command + 1]
-        _piece_thrust_k(cb, tables, t[b])
+        row, wb = locate_from_k(tables.t, t[b], row)
+        _piece_thrust_k(cb, tables, row, wb)
         flight_conditions_k(t[b], xb, pb, cb, data.conditions[b])
 
 
@@ -229,7 +243,8 @@ def conditions_rows(rows, data, tables):
     """Flight conditions of the rows ``rows`` of ``data`` at their current times, thrust and
     aerodynamics at those times."""
     for b in rows:
-        _piece_thrust_k(data.ctx[b], tables, data.t[b])
+        i, w = locate_k(tables.t, data.t[b])
+        _piece_thrust_k(data.ctx[b], tables, i, w)
         flight_conditions_k(data.t[b], data.x[b], data.p[b], data.ctx[b], data.conditions[b])
 
 

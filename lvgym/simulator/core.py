@@ -315,12 +315,13 @@ class Simulator:
         list(pool(self.threads).map(lambda ch: fn(ch[0], ch[1], *args), chunks))
 
     def step(self, data: SimData, gimbal: Any, duration: float, moment: Any = None, *,
-             force: Any = None) -> list[list[tuple[float, str]]]:
+             force: Any = None) -> list[tuple[tuple[float, str], ...]]:
         """Advance every row by ``duration`` [s] with the gimbal command ``gimbal`` (B, 2) [rad]
         (pitch, yaw; see :mod:`.flight` for the signs), a commanded body moment ``moment`` (B, 3)
         [N m] (reaction control; default none) and a body force at the CG ``force`` (B, 3) [N], body
-        axes (settling thrust; default none) held; returns each row's events. ``data``: the rows,
-        changed in place.
+        axes (settling thrust; default none) held; returns each row's events, a tuple of ``(time [s],
+        name)`` in time order (the empty tuple for a row without: no object per row and step). ``data``:
+        the rows, changed in place.
 
         Without a servo the gimbal takes the command at once; with one (``servo=``) it moves towards
         it at every physics step. The actuator rows then hold the integrals of |gimbal| [rad s] and
@@ -344,7 +345,7 @@ class Simulator:
         i_on, i_lifted = RS.on, RS.lifted
         lifted0, on0 = rs[:, i_lifted].copy(), rs[:, i_on].copy()
         self.run_rows(_ADVANCE, B, flight_loads, d, self.tables, self.setup, float(duration))
-        events: list[list[tuple[float, str]]] = [[] for _ in range(B)]
+        events: list[tuple[tuple[float, str], ...]] = [()] * B      # a row without events: the empty tuple
         ev_t = self._event_times_all
         hit = (ev_t[None, :] > t0[:, None]) & (ev_t[None, :] <= d.t[:, None] + 1e-12)
         new_lift = rs[:, i_lifted] > lifted0
@@ -355,7 +356,7 @@ class Simulator:
                 evs.append((float(rs[b, RS.t_lift]), "lift-off"))
             if new_exit[b]:
                 evs.append((float(rs[b, RS.t_exit]), "rail exit"))
-            events[b] = sorted(evs, key=lambda e: e[0])
+            events[b] = tuple(sorted(evs, key=lambda e: e[0]))
         return events
 
     def update_conditions(self, data: SimData, rows: Any = None) -> None:

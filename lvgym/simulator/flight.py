@@ -44,6 +44,7 @@ import numba as nb
 import numpy as np
 
 from lvgym.dynamics.layout import LOADS, PARAMS, STATE
+from lvgym.borrow import unowned, unowned_matrix
 from lvgym.dynamics.stepper import compile_loads
 from lvgym.environment.aerokernels import AeroAt, AirData, LoadsAt, TableAt, aero_loads_at
 from lvgym.environment.atmosphere import atmosphere_state_at
@@ -80,7 +81,7 @@ def flight_conditions_at(t, x, p, ctx, cond, oc, full):
     w = oc + D.wind_n
     wind_ned_at(ctx, o_wind, alt, t, cond, w)
     wn0, wn1, wn2 = cond[w], cond[w + 1], cond[w + 2]
-    C = ctx[CTX.scratch_dcm:CTX.scratch_dcm + 9].reshape((3, 3))
+    C = unowned_matrix(ctx, CTX.scratch_dcm, 3, 3)
     site_dcm_ni_latlon_at(lat, lon, t, ctx, o_site, C)
     ov = XF.v_zw_i
     vx, vy, vz = site_velocity_wrt_earth_at(rx, ry, rz, x[ov], x[ov + 1], x[ov + 2], ctx, o_site)
@@ -150,7 +151,10 @@ def _flight_loads(t, x, p, ctx, u):
     """Loads of the dynamics core from the flight conditions: aerodynamic force (inertial) plus the
     commanded body force ``force_b`` turned to inertial axes, aerodynamic plus commanded moment about the
     CG, thrust in the engine frame, gravity; generalised modal forces from the aeroelastic strips when
-    they are on, else none."""
+    they are on, else none. The arrays are used through :func:`~lvgym.dynamics.kernels.unowned` views (the
+    caller holds them), so the views made from them (the scratch matrix, the models' blocks) count no
+    references: no atomic instruction per view."""
+    x, p, ctx, u = unowned(x), unowned(p), unowned(ctx), unowned(u)
     flight_conditions_at(ctx[CTX.time0] + t, x, p, ctx, ctx, CTX.scratch, False)
     sc = CTX.scratch
     for i in range(3):
@@ -160,7 +164,7 @@ def _flight_loads(t, x, p, ctx, u):
         u[UF.g_i + i] = ctx[sc + D.g_i + i]
     fb = CTX.force_b
     if ctx[fb] != 0.0 or ctx[fb + 1] != 0.0 or ctx[fb + 2] != 0.0:     # C_ib is in the scratch matrix
-        C = ctx[CTX.scratch_dcm:CTX.scratch_dcm + 9].reshape((3, 3))
+        C = unowned_matrix(ctx, CTX.scratch_dcm, 3, 3)
         for i in range(3):
             u[UF.f_b_i + i] += C[i, 0] * ctx[fb] + C[i, 1] * ctx[fb + 1] + C[i, 2] * ctx[fb + 2]
     for i in range(UF.f_eta, u.size):

@@ -52,12 +52,12 @@ from dataclasses import dataclass
 import numba as nb
 import numpy as np
 
+from lvgym.borrow import unowned_matrix
 from lvgym.dynamics.layout import PARAMS, STATE, X
 from lvgym.packing import at
 from lvgym.rotations import quat_to_dcm
 
 from .layouts import ACCEL_ORDER, CTX, D, GYRO_ORDER, IM, IMU, IMU_STATE, IMU_STATION, IS
-from .timeline import locate_k
 
 __all__ = ["IMU_OFF", "Imu", "ImuWork", "imu_begin_k", "imu_end_k", "imu_output_k", "imu_shift_k", "lti_step_k",
            "make_imu_work", "specific_force_k", "station_modes_k"]
@@ -68,6 +68,8 @@ IMU_OFF = IMU.zeros()
 _GO, _AO = GYRO_ORDER, ACCEL_ORDER
 _N_GA, _N_AA = IMU.field("gyro_a").size, IMU.field("accel_a").size
 _N_G, _N_A = IMU_STATE.field("gyro").size, IMU_STATE.field("accel").size
+# the filters' matrices and the axes' states, row-major over their fields (unowned_matrix)
+assert _N_GA == _GO * _GO and _N_AA == _AO * _AO and _N_G == 3 * _GO and _N_A == 2 * _AO
 
 
 def _second_order(wn: float, zeta: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -287,16 +289,15 @@ def station_modes_k(st, tables, j, phi, dphi):
 
 
 @nb.njit(cache=True, nogil=True)
-def imu_end_k(prm, st, x, p, ctx, tables, t, h, w, n_slosh, n_modes):
+def imu_end_k(prm, st, x, p, ctx, tables, j, h, w, n_slosh, n_modes):
     """Advance a row's IMU filters ``st`` (layout IMU_STATE) over the physics step of ``h`` [s] that
-    ended at ``t`` [s] with the state ``x`` and parameters ``p`` (its start kept in ``w`` by
-    :func:`imu_begin_k`); ``prm`` the IMU block (layout IMU), ``ctx`` the row's context (gravity of
-    the latest RK4 stage), ``tables`` the timeline's (mode shapes and slopes at the sensor stations, taken
-    at the row's station by :func:`station_modes_k`)."""
+    ended with the state ``x`` and parameters ``p`` (its start kept in ``w`` by :func:`imu_begin_k`);
+    ``prm`` the IMU block (layout IMU), ``ctx`` the row's context (gravity of the latest RK4 stage),
+    ``tables`` the timeline's (mode shapes and slopes at the sensor stations, taken at the row's station
+    by :func:`station_modes_k` in the timeline's row ``j``, the one in force at the step's end:
+    :func:`~.timeline.row_in_force_k`)."""
     ow, ov, oq, oc = XF.omega_bi_b, XF.v_zw_i, XF.q_bi, PF.r_cg
     K = n_modes
-    i, wt = locate_k(tables.t, t)
-    j = i + 1 if wt >= 1.0 else i
     phi, dphi = w.phi, w.dphi
     station_modes_k(st, tables, j, phi, dphi)
     o_etad = at(X.eta_dot, n_modes, n_slosh)
@@ -306,9 +307,9 @@ def imu_end_k(prm, st, x, p, ctx, tables, t, h, w, n_slosh, n_modes):
     for k in range(K):
         u[1] -= dphi[k] * 0.5 * (w.eta_dot0[K + k] + x[o_etad + K + k])
         u[2] += dphi[k] * 0.5 * (w.eta_dot0[k] + x[o_etad + k])
-    ga = prm[IM.gyro_a:IM.gyro_a + _N_GA].reshape((_GO, _GO))
+    ga = unowned_matrix(prm, IM.gyro_a, _GO, _GO)
     gb = prm[IM.gyro_b:IM.gyro_b + _GO]
-    gs = st[IS.gyro:IS.gyro + _N_G].reshape((3, _GO))
+    gs = unowned_matrix(st, IS.gyro, 3, _GO)
     for a in range(3):
         lti_step_k(ga, gb, gs[a], u[a], w.tmp)
     # accelerometers: the CG's mean acceleration and the lever arm, then the modal acceleration
@@ -324,9 +325,9 @@ def imu_end_k(prm, st, x, p, ctx, tables, t, h, w, n_slosh, n_modes):
     for k in range(K):
         w.f[1] += phi[k] * (x[o_etad + k] - w.eta_dot0[k]) / h
         w.f[2] += phi[k] * (x[o_etad + K + k] - w.eta_dot0[K + k]) / h
-    aa = prm[IM.accel_a:IM.accel_a + _N_AA].reshape((_AO, _AO))
+    aa = unowned_matrix(prm, IM.accel_a, _AO, _AO)
     ab = prm[IM.accel_b:IM.accel_b + _AO]
-    acs = st[IS.accel:IS.accel + _N_A].reshape((2, _AO))
+    acs = unowned_matrix(st, IS.accel, 2, _AO)
     for a in range(2):
         lti_step_k(aa, ab, acs[a], w.f[a + 1], w.tmp)
 
@@ -336,8 +337,8 @@ def imu_output_k(prm, st, rate_b, force_yz_b):
     """The filters' outputs: the sampled rates ``rate_b`` (3,) [rad/s] (body x, y, z) and lateral
     specific forces ``force_yz_b`` (2,) [m/s^2] (body y, z) of the row's IMU states ``st``."""
     gc, ac = prm[IM.gyro_c:IM.gyro_c + _GO], prm[IM.accel_c:IM.accel_c + _AO]
-    gs = st[IS.gyro:IS.gyro + _N_G].reshape((3, _GO))
-    acs = st[IS.accel:IS.accel + _N_A].reshape((2, _AO))
+    gs = unowned_matrix(st, IS.gyro, 3, _GO)
+    acs = unowned_matrix(st, IS.accel, 2, _AO)
     for a in range(3):
         s = 0.0
         for k in range(_GO):

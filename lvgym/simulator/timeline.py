@@ -168,16 +168,41 @@ Tables = namedtuple("Tables", ["t", "params", "hold", "thrust0", "exit_area", "s
 
 
 # ---------------------------------------------------------------------------- compiled look-ups (the only ones)
+_FORWARD = 8              # rows locate_from_k walks forward before it bisects
+
+
 @nb.njit(cache=True, nogil=True, inline="always")
 def locate_k(tl_t, t):
     """Row ``i`` and weight ``w`` of time ``t`` in the timeline rows ``tl_t``: value = (1-w) row i + w
     row i+1; a time equal to an event time (stored twice) takes the row after the event."""
     n = tl_t.size
     i = np.searchsorted(tl_t, t, side="right") - 1
-    i = min(max(i, 0), n - 2)
+    return _weight_k(tl_t, min(max(i, 0), n - 2), t)
+
+
+@nb.njit(cache=True, nogil=True, inline="always")
+def _weight_k(tl_t, i, t):
+    """``(i, w)`` of :func:`locate_k` for its row ``i``."""
     span = tl_t[i + 1] - tl_t[i]
     w = (t - tl_t[i]) / span if span > 0.0 else 0.0
     return i, min(max(w, 0.0), 1.0)
+
+
+@nb.njit(cache=True, nogil=True, inline="always")
+def locate_from_k(tl_t, t, hint):
+    """:func:`locate_k` (the same row and weight) searched forward from the row ``hint`` (the row of an
+    earlier, not later, time of the same flight: a step's pieces and sensors go forward a row or two at a
+    time); a bisection when ``hint`` is not at or before ``t`` (e.g. -1) or ``t`` lies more than a few rows
+    ahead."""
+    n = tl_t.size
+    i = hint
+    if i < 0 or i > n - 2 or not tl_t[i] <= t:
+        return locate_k(tl_t, t)
+    for _ in range(_FORWARD):
+        if i >= n - 2 or not tl_t[i + 1] <= t:         # the last row at or before t (at most n - 2)
+            return _weight_k(tl_t, i, t)
+        i += 1
+    return locate_k(tl_t, t)
 
 
 @nb.njit(cache=True, nogil=True, inline="always")
@@ -185,6 +210,12 @@ def params_k(tl_t, tl_p, hold, scale, offset, t, out):
     """Dynamics parameters at time ``t`` into ``out``: interpolated, held columns from the row in
     force, then ``* scale + offset``."""
     i, w = locate_k(tl_t, t)
+    params_at_k(tl_p, hold, scale, offset, i, w, out)
+
+
+@nb.njit(cache=True, nogil=True, inline="always")
+def params_at_k(tl_p, hold, scale, offset, i, w, out):
+    """:func:`params_k` at the row ``i`` and weight ``w`` of :func:`locate_k`."""
     j = i + 1 if w >= 1.0 else i
     for k in range(out.size):
         v = tl_p[j, k] if hold[k] else (1.0 - w) * tl_p[i, k] + w * tl_p[i + 1, k]
@@ -195,6 +226,12 @@ def params_k(tl_t, tl_p, hold, scale, offset, t, out):
 def interp_k(tl_t, values, t):
     """Linear interpolation of a timeline column ``values`` at time ``t``."""
     i, w = locate_k(tl_t, t)
+    return interp_at_k(values, i, w)
+
+
+@nb.njit(cache=True, nogil=True, inline="always")
+def interp_at_k(values, i, w):
+    """:func:`interp_k` at the row ``i`` and weight ``w`` of :func:`locate_k`."""
     return (1.0 - w) * values[i] + w * values[i + 1]
 
 
@@ -203,7 +240,20 @@ def held_k(tl_t, values, t):
     """The value of a piecewise-constant timeline column ``values`` in force at time ``t`` (the row
     after an event at an event time)."""
     i, w = locate_k(tl_t, t)
+    return held_at_k(values, i, w)
+
+
+@nb.njit(cache=True, nogil=True, inline="always")
+def held_at_k(values, i, w):
+    """:func:`held_k` at the row ``i`` and weight ``w`` of :func:`locate_k`."""
     return values[i + 1] if w >= 1.0 else values[i]
+
+
+@nb.njit(cache=True, nogil=True, inline="always")
+def row_in_force_k(i, w):
+    """The row in force (the row after an event at an event time) at the row ``i`` and weight ``w`` of
+    :func:`locate_k`."""
+    return i + 1 if w >= 1.0 else i
 
 
 @nb.njit(cache=True)

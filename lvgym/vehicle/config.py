@@ -10,6 +10,9 @@ what is allowed, e.g. ``smile.yaml, line 84: stages[0].tanks[1].fill_ratio = 1.3
 
 from __future__ import annotations
 
+import hashlib
+import threading
+from collections import OrderedDict
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -360,13 +363,30 @@ def shipped_vehicles() -> list[str]:
     return sorted(p.stem for p in VEHICLE_DIR.glob("*.yaml"))
 
 
+#: vehicles read by :func:`load_vehicle`, by (file, content digest), the latest last
+_LOADED: OrderedDict[tuple[str, bytes], Vehicle] = OrderedDict()
+_LOADED_MAX = 32
+_LOADED_LOCK = threading.Lock()
+
+
+def clear_vehicle_cache() -> None:
+    """Forget the vehicles :func:`load_vehicle` keeps (the next load of each file parses it again)."""
+    with _LOADED_LOCK:
+        _LOADED.clear()
+
+
 def load_vehicle(name_or_path: str | Path) -> Vehicle:
     """Read a vehicle: a shipped name (``"smile"``) or a path to a YAML file.
 
     Every problem is a :class:`ConfigError` naming the file (and, where it is known, the line), the key
     path, the value and what is allowed: a missing file (with the shipped vehicles), a YAML syntax error,
     an unsafe tag, a duplicate key (:mod:`.yamlfile`), an unknown, missing or out-of-range value, and
-    parts that do not fit the vehicle (:mod:`.checks`)."""
+    parts that do not fit the vehicle (:mod:`.checks`).
+
+    The process keeps the last few vehicles it read, by file and content: loading a file again whose
+    bytes have not changed returns the same (frozen) :class:`Vehicle` object without parsing it, and with
+    it the aerodynamic tables built for that object (:mod:`lvgym.simulator.vehicleaero`). Treat it as
+    read-only; :func:`clear_vehicle_cache` forgets them."""
     from .yamlfile import read_yaml, with_line
 
     path = Path(name_or_path)
@@ -379,11 +399,29 @@ def load_vehicle(name_or_path: str | Path) -> Vehicle:
         what = "it is a folder" if path.is_dir() else "there is no such file"
         raise ConfigError("vehicle", str(name_or_path), f"an existing YAML file ({what}) or one of the shipped "
                           f"vehicles {shipped_vehicles()}")
-    data, lines = read_yaml(path, source=path.name)
     try:
-        return parse_vehicle(data, source=path.name)
+        raw = path.read_bytes()
+        text = raw.decode("utf-8")
+    except (OSError, UnicodeDecodeError):
+        raw = text = None                           # read_yaml names the problem
+    key = None
+    if raw is not None:
+        key = (str(path.resolve()), hashlib.blake2b(raw, digest_size=16).digest())
+        with _LOADED_LOCK:
+            if key in _LOADED:
+                _LOADED.move_to_end(key)
+                return _LOADED[key]
+    data, lines = read_yaml(path, source=path.name, text=text)
+    try:
+        vehicle = parse_vehicle(data, source=path.name)
     except ConfigError as exc:
         raise with_line(exc, lines) from None
+    if key is not None:
+        with _LOADED_LOCK:
+            _LOADED[key] = vehicle
+            while len(_LOADED) > _LOADED_MAX:
+                _LOADED.popitem(last=False)
+    return vehicle
 
 
 def parse_vehicle(data: Any, source: str | None = None) -> Vehicle:

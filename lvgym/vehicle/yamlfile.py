@@ -57,15 +57,16 @@ def _walk(node: yaml.Node, path: str, source: str, lines: dict[str, int], loader
             _walk(item, sub, source, lines, loader)
 
 
-def read_yaml(path: str | Path, source: str | None = None) -> tuple[Any, dict[str, int]]:
+def read_yaml(path: str | Path, source: str | None = None, text: str | None = None) -> tuple[Any, dict[str, int]]:
     """The data of the YAML file ``path`` and the line (1-based) of every key path in it.
 
-    ``source``: the file's name in errors (default: ``path``). A file that does not exist or cannot be
-    read, a syntax error, an unsafe tag or a duplicate key raise :class:`ConfigError` naming the file
-    (and the line)."""
+    ``source``: the file's name in errors (default: ``path``); ``text``: the file's text when the caller
+    has read it already. A file that does not exist or cannot be read, a syntax error, an unsafe tag or a
+    duplicate key raise :class:`ConfigError` naming the file (and the line)."""
     src = source or str(path)
     try:
-        text = Path(path).read_text(encoding="utf-8")
+        if text is None:
+            text = Path(path).read_text(encoding="utf-8")
     except FileNotFoundError:
         raise ConfigError("file", str(path), "an existing YAML file (there is no such file)", src) from None
     except (OSError, UnicodeDecodeError) as exc:

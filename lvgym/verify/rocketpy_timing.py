@@ -5,9 +5,12 @@
 :mod:`.rocketpy_case` (85 deg, 10 m rail) twice in one process, after the imports and after Numba has
 loaded its compiled kernels (a warm-up flight of each, or the comparisons, ran first):
 
-* lvgym **cold**: an empty timeline cache (a fresh ``$LVGYM_CACHE_DIR``), so its set-up builds the mass and
-  mode tables, as for a new or dispersed vehicle; **warm**: the same folder again, the tables read from the
-  cache (:mod:`lvgym.simulator.cache`). Set-up: the :class:`~lvgym.simulator.Simulator` and its reset.
+* lvgym **cold**: an empty timeline cache (a fresh ``$LVGYM_CACHE_DIR``) and the process's vehicles
+  forgotten (:func:`lvgym.vehicle.clear_vehicle_cache`), so its set-up parses the vehicle file, builds its
+  aerodynamic tables and builds the mass and mode tables, as for a new or dispersed vehicle; **warm**: the
+  same folder again, the tables read from the cache (:mod:`lvgym.simulator.cache`), and the vehicle file,
+  unchanged, not parsed again (:func:`lvgym.vehicle.load_vehicle` keeps the vehicle, and with it its
+  aerodynamic tables, by the file's content). Set-up: the :class:`~lvgym.simulator.Simulator` and its reset.
 * RocketPy has no such cache: its two runs are its first and second flight of the launch. Set-up: the
   environment (lvgym's US76 as a table), the motor and the rocket, from lvgym's vehicle, mass split and
   aerodynamics (the lvgym simulator it reads them from is built beforehand, outside the timing); flight: its
@@ -28,6 +31,7 @@ from dataclasses import dataclass, replace
 
 from lvgym.cli.args import arg, parse
 from lvgym.simulator.cache import using
+from lvgym.vehicle import clear_vehicle_cache
 
 from .rocketpy_case import ELEVATION_DEG, RAIL_LENGTH, VEHICLE, Trajectory, fly_lvgym, fly_rocketpy, lvgym_simulator
 
@@ -41,6 +45,7 @@ def timings(elevation_deg: float = ELEVATION_DEG, rail_length: float = RAIL_LENG
             with using(os.path.join(root, "warm-up")):
                 fly_lvgym(elevation_deg, rail_length)
         with using(os.path.join(root, "timed")):
+            clear_vehicle_cache()                                       # cold: the vehicle file read again too
             lv_cold = fly_lvgym(elevation_deg, rail_length)
             lv_warm = fly_lvgym(elevation_deg, rail_length)
             start = time.perf_counter()
