@@ -49,7 +49,8 @@ INFO = {
     "attitude_error": ("rad", "attitude error (pitch, yaw) against the reference axis"),
     "mass": ("kg", "vehicle mass"),
     "termination": ("-", "why the episode ended (the termination table), empty while it flies"),
-    "events": ("-", "the events of the step (burnout, separation, ignition, lift-off, rail exit)"),
+    "events": ("-", "the events of the step (burnout, separation, ignition, lift-off, rail exit): a list of "
+                    "(time [s], text); in a batched info, a tuple per row"),
 }
 
 
