@@ -121,7 +121,7 @@ class CondensedQP:
 
         P = sp.triu(sp.csc_matrix(2.0 * self.limit ** 2 * self.H), format="csc")
         o = self.options
-        self._ok = (osqp.constant("OSQP_SOLVED"), osqp.constant("OSQP_SOLVED_INACCURATE"))
+        self._ok = (osqp.SolverStatus.OSQP_SOLVED, osqp.SolverStatus.OSQP_SOLVED_INACCURATE)
         self._solver = osqp.OSQP()
         self._solver.setup(P, q, self.A, self.lo, self.hi, eps_abs=o.eps, eps_rel=o.eps, max_iter=o.max_iter,
                            polishing=True, warm_starting=True, verbose=False)
@@ -145,7 +145,7 @@ class CondensedQP:
             self._solver.update(q=q, l=lo, u=hi)
         if self._last is not None:
             self._solver.warm_start(x=np.append(self._last[1:], self._last[-1]))
-        res = self._solver.solve()
+        res = self._solver.solve(raise_error=False)
         self.solves += 1
         self.iterations += int(res.info.iter)
         if res.info.status_val not in self._ok or res.x is None or not np.all(np.isfinite(res.x)):
