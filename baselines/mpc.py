@@ -8,7 +8,8 @@ weight, under the gimbal's angle limit and the servo's rate limit (both read fro
 control period, with the gyro sample ``y`` [rad/s] (the observation's rate error)::
 
     x_f = x_p + M (y - C x_p)              measurement update (the row's steady-state Kalman gain)
-    U   = argmin J(U; [x_f, xi])           the QP; u = U_0, |u| <= limit, |u - u_last| <= rate * dt
+    U   = argmin J(U; [x_f, xi])           the QP; u = U_0, |u_k| <= limit, the servo's predicted rate
+                                           within its limit (or |u_k - u_k-1| <= rate * dt)
     x_p <- A x_f + B u                     time update with the command sent
     xi  <- a xi - dt y                     leaky integral of the rate error (held as in ``lqg`` while the
                                            command is held by a limit and the integral would push further)
@@ -38,7 +39,8 @@ __all__ = ["MPCLaw", "MPCPolicy", "row_qp", "smile_mpc"]
 
 def row_qp(row: LQGRow, limit: float, rate_step: float, options: QPOptions = QPOptions()) -> CondensedQP:
     """The QP of one schedule row (:mod:`.mpcqp`) for the gimbal ``limit`` [rad] and ``rate_step`` [rad per
-    period]: the row's regulator problem rebuilt from its weights, checked against its gains."""
+    period]: the row's regulator problem rebuilt from its weights, checked against its gains; the rate limit
+    on the row's ``servo_rate`` state or on the command (``options.rate``)."""
     from .design.lqg_row import LQGWeights, regulator_problem
 
     if not row.weights:
@@ -50,7 +52,12 @@ def row_qp(row: LQGRow, limit: float, rate_step: float, options: QPOptions = QPO
     if abs(a - row.a) > 1e-12 or not np.allclose(ours, theirs, rtol=1e-6, atol=1e-6 * np.abs(theirs).max()):
         raise ConfigError(f"row {row.time_s:g} s.weights", row.weights, "the weights of the row's own gains "
                           f"(their Riccati gain differs from K_x, K_i by {np.abs(ours - theirs).max():.3g})")
-    H, F = condense(Aa, Ba, Q, R, P, options.horizon)
+    if options.rate == "servo":
+        if "servo_rate" not in row.labels:
+            raise ConfigError("mpc.rate", "servo", f"'command' (row {row.time_s:g} s has no servo_rate state)")
+        H, F, Gr, Pr = condense(Aa, Ba, Q, R, P, options.horizon, row.labels.index("servo_rate"))
+        return CondensedQP(H, F, limit, rate_step, options, Gr, Pr, row.dt)
+    H, F, _, _ = condense(Aa, Ba, Q, R, P, options.horizon)
     return CondensedQP(H, F, limit, rate_step, options)
 
 
@@ -107,17 +114,18 @@ class MPCPolicy:
     """Pitch and yaw MPC (module docstring) as a benchmark :class:`~lvgym.benchmark.policy.Policy` of the
     TVC envs. ``env``: the env it flies (gimbal limit [rad], rate limit, control period, delay and the
     observation's layout come from it, checked as :class:`.lqg.LQGPolicy` checks them); ``schedule``: an
-    :class:`.lqg.LQGSchedule`, a path or a name in ``baselines/schedules``; ``horizon`` [periods].
+    :class:`.lqg.LQGSchedule`, a path or a name in ``baselines/schedules``; ``horizon`` [periods];
+    ``rate``: the rate limit on the model's ``servo`` rate or on the ``command`` (:class:`.mpcqp.QPOptions`).
     ``act`` needs ``info["time"]``."""
 
     def __init__(self, *, env: Any, schedule: LQGSchedule | str | Path = "smile_lqg", name: str = "mpc",
-                 horizon: int = 15) -> None:
+                 horizon: int = 15, rate: str = "servo") -> None:
         require("osqp", "control", "the mpc policy")
         require("control", "control", "the mpc policy")
         lqg = LQGPolicy(env=env, schedule=schedule, name=name)         # its checks of the env and schedule
         self.name, self.schedule, self.limit, self.dt = name, lqg.schedule, lqg.limit, lqg.dt
         self._i_err, self._i_on = lqg._i_err, lqg._i_on
-        self.options = QPOptions(horizon=horizon)
+        self.options = QPOptions(horizon=horizon, rate=rate)
         rate = np.radians(float(env.unwrapped.task.gimbal_rate_limit_degps))     # rad/s
         self.rate_step = float(rate) * self.dt
         self.axes = [MPCLaw(self.schedule.rows[p], self.schedule, self.limit, self.rate_step, self.options)
@@ -144,11 +152,12 @@ class MPCPolicy:
                 "iterations": sum(q.iterations for q in qps)}
 
 
-def smile_mpc(env: Any, name: str = "mpc", schedule: str = "smile_lqg", horizon: int = 15) -> MPCPolicy:
+def smile_mpc(env: Any, name: str = "mpc", schedule: str = "smile_lqg", horizon: int = 15,
+              rate: str = "servo") -> MPCPolicy:
     """The MPC on the rows of SMILE v1's LQG schedule (``baselines/schedules/smile_lqg.npz``); the env must
     fly the ``smile_v1`` vehicle."""
     vehicle = getattr(env.unwrapped.task, "vehicle", None)
     if vehicle != "smile_v1":
         raise ConfigError("env vehicle", vehicle, "'smile_v1' (the MPC flies the LQG rows designed for SMILE v1, "
                           "lvgym/SmileAscent-v1)")
-    return MPCPolicy(env=env, schedule=schedule, name=name, horizon=horizon)
+    return MPCPolicy(env=env, schedule=schedule, name=name, horizon=horizon, rate=rate)

@@ -29,8 +29,8 @@ def _hold_qp(N: int = 8) -> CondensedQP:
     Aa = np.array([[0.0, 0.0], [0.0, 1.0]])
     Ba = np.array([[1.0], [0.0]])
     Q = np.array([[1.0, -1.0], [-1.0, 1.0]])
-    H, F = condense(Aa, Ba, Q, np.array([[1e-9]]), Q, N)
-    return CondensedQP(H, F, LIMIT, RATE_STEP, QPOptions(horizon=N, eps=1e-9))
+    H, F, _, _ = condense(Aa, Ba, Q, np.array([[1e-9]]), Q, N)
+    return CondensedQP(H, F, LIMIT, RATE_STEP, QPOptions(horizon=N, rate="command", eps=1e-9))
 
 
 def test_a_step_beyond_the_rate_limit_is_spread_over_periods():
@@ -77,14 +77,14 @@ def test_first_move_is_the_finite_horizon_lq_solution_on_a_shipped_row(terminal)
     Aa, Ba, Q, R, _ = regulator_problem(row.A, row.B, row.C, LQGWeights(*row.weights), row.dt, row.labels)
     P = terminal_weight(Aa, Ba, Q, R)[0] if terminal == "riccati" else Q
     N = 15
-    H, F = condense(Aa, Ba, Q, R, P, N)
+    H, F, _, _ = condense(Aa, Ba, Q, R, P, N)
     gain = -np.linalg.solve(H, F)[0]
     ref = -_riccati_first_gain(Aa, Ba, Q, R, P, N)[0]
     np.testing.assert_allclose(gain, ref, rtol=1e-7, atol=1e-9 * np.abs(ref).max())
     if terminal == "riccati":
         lqr = -np.append(row.Kx[0], row.Ki)
         np.testing.assert_allclose(gain, lqr, rtol=1e-5, atol=1e-7 * np.abs(lqr).max())
-        qp = row_qp(row, LIMIT, RATE_STEP, QPOptions(horizon=N))
+        qp = row_qp(row, LIMIT, RATE_STEP, QPOptions(horizon=N, rate="command"))
         z0 = 1e-4 * np.random.default_rng(0).standard_normal(Aa.shape[0])     # small: no limit active
         U = qp.solve(z0, float(lqr @ z0))
         assert U[0] == pytest.approx(float(lqr @ z0), rel=1e-5) and qp.solves == 0
