@@ -90,9 +90,29 @@ def test_first_move_is_the_finite_horizon_lq_solution_on_a_shipped_row(terminal)
         assert U[0] == pytest.approx(float(lqr @ z0), rel=1e-5) and qp.solves == 0
 
 
+def test_servo_rate_form_holds_the_predicted_servo_rate():
+    """The default form on the max-q row: from a state that asks for a fast move (a large rate error in the
+    filter's estimate), the plan's predicted servo rate stays within 30 deg/s at every period while the
+    unconstrained plan's exceeds it, and the commands within 5 deg."""
+    sched = LQGSchedule.load("smile_lqg")
+    row = sched.rows["pitch"][sched.index(28.8)]
+    qp = row_qp(row, LIMIT, RATE_STEP, QPOptions(horizon=15, eps=1e-8))
+    z0 = np.zeros(row.A.shape[0] + 1)
+    z0[row.labels.index("omega_y")] = math.radians(15.0)          # 15 deg/s body rate
+    free = qp.Pr @ z0 + qp.Gr @ (qp.gain @ z0)
+    assert np.max(np.abs(free)) > math.radians(30.0)
+    U = qp.solve(z0, 0.0)
+    rate = qp.Pr @ z0 + qp.Gr @ U
+    assert qp.solves == 1 and qp.fallbacks == 0
+    assert np.max(np.abs(rate)) <= math.radians(30.0) * (1 + 1e-4) and np.max(np.abs(U)) <= LIMIT * (1 + 1e-9)
+    assert np.max(np.abs(rate)) >= math.radians(30.0) * (1 - 1e-3)                    # the limit binds
+
+
 def test_bad_options_name_the_key():
     with pytest.raises(ConfigError, match="mpc.horizon"):
         QPOptions(horizon=0)
+    with pytest.raises(ConfigError, match="mpc.rate.*'servo', 'command'"):
+        QPOptions(rate="gimbal")
 
 
 def test_lqg_aw_rate_limit_and_back_calculation_by_hand():
