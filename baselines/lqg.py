@@ -13,7 +13,9 @@ sample ``y`` [rad/s] the observation's rate error, ``rate - reference``)::
     xi  <- a xi - dt y                     leaky integral of the rate error (held while the output is
                                            clipped and the integral would push it further)
 
-Without clipping this is exactly :func:`.lqg_design.compensator` (checked in the tests).
+Without clipping this is exactly :func:`.lqg_design.compensator` (checked in the tests). ``lqg-aw`` flies the
+same law with anti-windup (``back_gain``: the command also held to the servo's rate limit, the integral
+back-calculated; :class:`.lqgkernel.AntiWindup`, docs/mpc.md); ``lqg`` without.
 
 Scheduling: the row in use is the one whose interval (from the midpoints between the rows of a
 thrusting phase, :func:`.lqg_design.row_intervals`) holds ``info["time"]``; beyond the intervals the
