@@ -9,7 +9,7 @@ thesis's control study (docs/control-study.md).
 
 Importing this package registers its controllers with the benchmark by name
 (:func:`lvgym.benchmark.register_policy`): ``pid``, ``gs-pid``, ``gs-pid-flex``, ``aac``, ``pid-thesis``,
-``gs-pid-thesis``, ``lqg``, ``lqg-front`` (``evaluate.py --policies lqg``).
+``gs-pid-thesis``, ``lqg``, ``lqg-front``, ``lqg-aw``, ``mpc`` (``evaluate.py --policies lqg``).
 """
 
 from lvgym.benchmark.registry import register_policy
@@ -36,6 +36,12 @@ register_policy("lqg", smile_lqg, name="lqg")
 # lqg with its boost and max-q rows moved along the turbulence-against-margin trade: the design of lowest
 # turbulence rate error within 2 dB of gain margin and 60 % of the delay margin (experiments.lqg_headroom.headroom)
 register_policy("lqg-front", smile_lqg, name="lqg-front", schedule="smile_lqg_front")
+# lqg with anti-windup: the command held to the servo's rate limit as well, so that the filter carries what the
+# servo can follow, and the integral back-calculated (lvgym.baselines.lqgkernel.AntiWindup, docs/mpc.md)
+register_policy("lqg-aw", smile_lqg, name="lqg-aw", back_gain=0.1)
+# constrained linear MPC on lqg's rows (its plants, filters and cost) under the gimbal's angle and rate limits,
+# OSQP per control period (lvgym.baselines.mpc, docs/mpc.md; needs the control extra)
+register_policy("mpc", "lvgym.baselines.mpc:smile_mpc", name="mpc")
 
 __all__ = ["AACParams", "AdaptiveAugmentingPolicy", "BangBangRollPolicy", "DiscretePID", "GainSchedule",
            "GainScheduledPIDPolicy", "PIDPolicy", "smile_aac", "smile_scheduled_pid", "smile_single_pid"]

@@ -13,7 +13,9 @@ sample ``y`` [rad/s] the observation's rate error, ``rate - reference``)::
     xi  <- a xi - dt y                     leaky integral of the rate error (held while the output is
                                            clipped and the integral would push it further)
 
-Without clipping this is exactly :func:`.lqg_design.compensator` (checked in the tests).
+Without clipping this is exactly :func:`.lqg_design.compensator` (checked in the tests). ``lqg-aw`` flies the
+same law with anti-windup (``back_gain``: the command also held to the servo's rate limit, the integral
+back-calculated; :class:`.lqgkernel.AntiWindup`, docs/mpc.md); ``lqg`` without.
 
 Scheduling: the row in use is the one whose interval (from the midpoints between the rows of a
 thrusting phase, :func:`.lqg_design.row_intervals`) holds ``info["time"]``; beyond the intervals the
@@ -33,6 +35,7 @@ the tests).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
@@ -40,10 +43,10 @@ from typing import Any
 
 import numpy as np
 
-from lvgym.errors import ConfigError
+from lvgym.errors import ConfigError, check_number
 
 from .filecache import read_once
-from .lqgkernel import LQGState, LQGTables, lqg_act_k, lqg_step_k, lqg_tables, row_index
+from .lqgkernel import NO_ANTI_WINDUP, AntiWindup, LQGState, LQGTables, lqg_act_k, lqg_step_k, lqg_tables, row_index
 from .pidkernel import ObsColumns
 
 SCHEDULES = Path(__file__).resolve().parent / "schedules"
@@ -65,6 +68,8 @@ class LQGRow:
     a: float
     dt: float
     labels: tuple[str, ...]
+    weights: tuple[float, ...] = ()
+    """the design's :class:`.lqg_row.LQGWeights` in field order (empty if the file has none)"""
 
     def __post_init__(self) -> None:
         n = self.A.shape[0]
@@ -135,7 +140,8 @@ class LQGSchedule:
                 rows[plane] = tuple(LQGRow(
                     float(t), (float(lo), float(hi)), *(_read_only(z[f"{plane}_{i}_{k}"]) for k in ("A", "B", "C", "Kx")),
                     float(z[f"{plane}_{i}_Ki"]), _read_only(z[f"{plane}_{i}_M"]), float(z[f"{plane}_{i}_a"]),
-                    float(z[f"{plane}_{i}_dt"]), tuple(str(s) for s in z[f"{plane}_{i}_labels"]))
+                    float(z[f"{plane}_{i}_dt"]), tuple(str(s) for s in z[f"{plane}_{i}_labels"]),
+                    tuple(float(v) for v in z[f"{plane}_{i}_weights"]) if f"{plane}_{i}_weights" in z else ())
                     for i, (t, (lo, hi)) in enumerate(zip(times, intervals)))
         return cls(rows, str(p))
 
@@ -153,18 +159,20 @@ class LQGLaw:
     ``update(y, t, on, which) -> u`` [rad] steps the rows ``which`` with their gyro samples ``y`` [rad/s],
     flight times ``t`` [s] and switches ``on``. One row is :class:`LQGPolicy`; many are a residual
     policy's baselines in training (:meth:`LQGPolicy.batch`). Both run the compiled step
-    :func:`.lqgkernel.lqg_step_k` on the schedule's stacked tables."""
+    :func:`.lqgkernel.lqg_step_k` on the schedule's stacked tables; ``aw``: its anti-windup
+    (:class:`.lqgkernel.AntiWindup`; the default is ``lqg``'s plain law)."""
 
-    def __init__(self, rows: tuple[LQGRow, ...], schedule: LQGSchedule, u_limit: float, n: int = 1) -> None:
+    def __init__(self, rows: tuple[LQGRow, ...], schedule: LQGSchedule, u_limit: float, n: int = 1,
+                 aw: AntiWindup = NO_ANTI_WINDUP) -> None:
         if not u_limit > 0.0:
             raise ConfigError("u_limit", u_limit, "a gimbal limit > 0 rad")
         if int(n) < 1:
             raise ConfigError("n", n, "at least one row")
-        self.rows, self.schedule, self.u_limit, self.n = rows, schedule, float(u_limit), int(n)
+        self.rows, self.schedule, self.u_limit, self.n, self.aw = rows, schedule, float(u_limit), int(n), aw
         self.tables = schedule.tables(rows)
         N = self.tables.A.shape[1]
         self.state = LQGState(np.zeros((self.n, N)), np.zeros(self.n), np.full(self.n, -1, dtype=np.int64),
-                              np.zeros(self.n, bool), np.zeros(self.n, bool))
+                              np.zeros(self.n, bool), np.zeros(self.n, bool), np.zeros(self.n))
         self._all = np.arange(self.n, dtype=np.int64)
 
     @property
@@ -176,7 +184,7 @@ class LQGLaw:
         """Restart the rows ``which`` (None: all) as at the start of an episode."""
         w = slice(None) if which is None else np.asarray(which, dtype=np.int64)
         st = self.state
-        st.row[w], st.x[w], st.xi[w], st.was_on[w], st.saturated[w] = -1, 0.0, 0.0, False, False
+        st.row[w], st.x[w], st.xi[w], st.was_on[w], st.saturated[w], st.u[w] = -1, 0.0, 0.0, False, False, 0.0
 
     def update(self, y: Any, t: Any, on: Any, which: Any = None) -> np.ndarray:
         """The commands [rad] of the rows ``which`` (None: all) for their gyro samples ``y`` [rad/s] at
@@ -186,7 +194,7 @@ class LQGLaw:
         t = np.asarray(t, dtype=float).reshape(-1)
         on = np.asarray(on, dtype=bool).reshape(-1)
         u = np.empty(which.size)
-        lqg_step_k(self.tables, self.state, which, y, t, on, self.u_limit, u)
+        lqg_step_k(self.tables, self.state, which, y, t, on, self.u_limit, self.aw, u)
         return u
 
 
@@ -194,9 +202,12 @@ class LQGPolicy:
     """Pitch and yaw LQG (module docstring) as a benchmark :class:`~lvgym.benchmark.policy.Policy` of
     the TVC envs. ``env``: the lvgym env it flies (the gimbal limit, the control period, the delay and
     the observation's layout come from it); ``schedule``: an :class:`LQGSchedule`, a path or a name in
-    ``baselines/schedules``. ``act`` needs ``info["time"]``."""
+    ``baselines/schedules``; ``back_gain``: None for ``lqg``'s plain law, else the anti-windup of
+    ``lqg-aw`` with this back-calculation gain per period [-] in [0, 1] and the command held to the env's
+    gimbal rate limit (:class:`.lqgkernel.AntiWindup`). ``act`` needs ``info["time"]``."""
 
-    def __init__(self, *, env: Any, schedule: LQGSchedule | str | Path = "smile_lqg", name: str = "lqg") -> None:
+    def __init__(self, *, env: Any, schedule: LQGSchedule | str | Path = "smile_lqg", name: str = "lqg",
+                 back_gain: float | None = None) -> None:
         task = env.unwrapped
         self.name = name
         self.schedule = schedule if isinstance(schedule, LQGSchedule) else LQGSchedule.load(schedule)
@@ -209,10 +220,15 @@ class LQGPolicy:
         if delay != n_delay:
             raise ConfigError("env action_delay_steps", delay, f"the schedule's {n_delay} ({self.schedule.source})")
         self.limit = float(task.gimbal_limit)
+        self.aw = NO_ANTI_WINDUP
+        if back_gain is not None:
+            gain = check_number("back_gain", back_gain, 0.0, 1.0)
+            rate = math.radians(float(task.task.gimbal_rate_limit_degps))        # rad/s
+            self.aw = AntiWindup(True, rate * self.dt, gain)
         lay = task.observation_layout
         self._i_err = [lay.index("pitch_rate_error"), lay.index("yaw_rate_error")]
         self._i_on = lay.index("controller_on")
-        self.axes = [LQGLaw(self.schedule.rows[p], self.schedule, self.limit) for p in PLANES]
+        self.axes = [LQGLaw(self.schedule.rows[p], self.schedule, self.limit, aw=self.aw) for p in PLANES]
         self.last_gimbal = np.zeros(2)
 
     def reset(self) -> None:
@@ -241,8 +257,8 @@ class LQGBatch:
     ``last_gimbal``)."""
 
     def __init__(self, policy: LQGPolicy, n: int) -> None:
-        self.name, self.limit = policy.name, policy.limit
-        self.axes = [LQGLaw(policy.schedule.rows[p], policy.schedule, policy.limit, n) for p in PLANES]
+        self.name, self.limit, self.aw = policy.name, policy.limit, policy.aw
+        self.axes = [LQGLaw(policy.schedule.rows[p], policy.schedule, policy.limit, n, policy.aw) for p in PLANES]
         self.oc = ObsColumns(np.asarray(policy._i_err, dtype=np.int64), np.full(2, -1, np.int64), int(policy._i_on),
                              -1, -1)
         self.gimbal = np.zeros((int(n), 2))
@@ -261,15 +277,15 @@ class LQGBatch:
         out = np.empty((rows.size, 2), np.float32)
         pitch, yaw = self.axes
         lqg_act_k(pitch.tables, yaw.tables, pitch.state, yaw.state, self.oc, rows, obs,
-                  np.asarray(info["time"], dtype=np.float64), self.limit, self.gimbal, out)
+                  np.asarray(info["time"], dtype=np.float64), self.limit, self.aw, self.gimbal, out)
         return out
 
 
-def smile_lqg(env: Any, name: str = "lqg", schedule: str = "smile_lqg") -> LQGPolicy:
+def smile_lqg(env: Any, name: str = "lqg", schedule: str = "smile_lqg", back_gain: float | None = None) -> LQGPolicy:
     """The LQG schedule designed for SMILE v1 (``baselines/schedules/smile_lqg.npz``) on ``env``; the env
-    must fly the ``smile_v1`` vehicle."""
+    must fly the ``smile_v1`` vehicle. ``back_gain``: the anti-windup of ``lqg-aw`` (:class:`LQGPolicy`)."""
     vehicle = getattr(env.unwrapped.task, "vehicle", None)
     if vehicle != "smile_v1":
         raise ConfigError("env vehicle", vehicle, "'smile_v1' (the LQG schedule is designed for SMILE v1, "
                           "lvgym/SmileAscent-v1)")
-    return LQGPolicy(env=env, schedule=schedule, name=name)
+    return LQGPolicy(env=env, schedule=schedule, name=name, back_gain=back_gain)

@@ -4,7 +4,8 @@ all the env rows of a residual policy's baselines in training. One code path for
 The schedule's rows are stacked, zero-padded to the largest state (:class:`LQGTables`, built once per
 schedule and plane by :func:`lqg_tables`); a law's state is :class:`LQGState` (``x``: the predicted
 state ``x_p`` per row in the first ``dim`` entries of the row in use; ``xi``: the rate error's leaky
-integral; ``row``: the schedule row in use, -1 since the last engagement; ``was_on``; ``saturated``).
+integral; ``row``: the schedule row in use, -1 since the last engagement; ``was_on``; ``saturated``; ``u``:
+the last command sent [rad]).
 :func:`lqg_step_k` is the module docstring of :mod:`.lqg` row by row::
 
     x_f = x_p + M (y - C x_p);  v = -K_x x_f - K_i xi;  u = clip(v);  xi <- a xi - dt y (held while clipped
@@ -12,6 +13,12 @@ integral; ``row``: the schedule row in use, -1 since the last engagement; ``was_
 
 with the engagement restart, the schedule row chosen by flight time (the row whose interval holds it,
 else the nearest) and, at a switch, the states both rows name carried (``carry``) and the others zeroed.
+
+Anti-windup (:class:`AntiWindup`, the ``lqg-aw`` policy; ``lqg`` flies :data:`NO_ANTI_WINDUP`, which leaves
+the law above unchanged): the command is also held to ``rate_step`` [rad] from the last one (the servo's rate
+limit times the control period), so that the filter's time update carries the command the servo can follow,
+and the integral is back-calculated instead of held: ``xi <- a xi - dt y + back_gain (v - u) / K_i``, which
+moves the unclipped output ``v`` towards the command sent by the fraction ``back_gain`` per period.
 """
 
 from __future__ import annotations
@@ -23,7 +30,8 @@ import numpy as np
 
 from .pidkernel import clip_k
 
-__all__ = ["LQGState", "LQGTables", "lqg_act_k", "lqg_step_k", "lqg_tables", "row_index"]
+__all__ = ["NO_ANTI_WINDUP", "AntiWindup", "LQGState", "LQGTables", "lqg_act_k", "lqg_step_k", "lqg_tables",
+           "row_index"]
 
 
 class LQGTables(NamedTuple):
@@ -54,6 +62,21 @@ class LQGState(NamedTuple):
     row: np.ndarray
     was_on: np.ndarray
     saturated: np.ndarray
+    u: np.ndarray
+
+
+class AntiWindup(NamedTuple):
+    """The anti-windup of the law (module docstring): ``on`` (False: the plain law of ``lqg``), the
+    largest change of the command per period ``rate_step`` [rad] and the back-calculation gain
+    ``back_gain`` [-] per period (0: the integral is held as in ``lqg``)."""
+
+    on: bool
+    rate_step: float
+    back_gain: float
+
+
+#: the plain law (``lqg``): the command clipped to the gimbal limit only, the integral held while clipped
+NO_ANTI_WINDUP = AntiWindup(False, np.inf, 0.0)
 
 
 def lqg_tables(rows: Any) -> LQGTables:
@@ -94,10 +117,10 @@ def row_index(tb, t):
 
 
 @nb.njit(cache=True)
-def lqg_step_k(tb, st, which, y, t, on, u_limit, u):
+def lqg_step_k(tb, st, which, y, t, on, u_limit, aw, u):
     """Step the rows ``which`` (k,) of the law ``st`` (:class:`LQGState`) with the gyro samples ``y`` (k,)
     [rad/s] at flight times ``t`` (k,) [s], the law on where ``on`` (k,); their commands [rad] into ``u``
-    (k,). ``tb``: :class:`LQGTables`; ``u_limit``: the gimbal limit [rad]."""
+    (k,). ``tb``: :class:`LQGTables`; ``u_limit``: the gimbal limit [rad]; ``aw``: :class:`AntiWindup`."""
     N = tb.A.shape[1]
     xf = np.empty(N)
     old = np.empty(N)
@@ -106,12 +129,14 @@ def lqg_step_k(tb, st, which, y, t, on, u_limit, u):
         if not on[j]:
             st.was_on[b] = False
             st.saturated[b] = False
+            st.u[b] = 0.0
             u[j] = 0.0
             continue
         if not st.was_on[b]:                      # engagement: restart from zero
             st.row[b] = -1
             st.x[b, :] = 0.0
             st.xi[b] = 0.0
+            st.u[b] = 0.0
         st.was_on[b] = True
         i = row_index(tb, t[j])
         if i != st.row[b]:
@@ -132,9 +157,15 @@ def lqg_step_k(tb, st, which, y, t, on, u_limit, u):
             kx += tb.Kx[i, k] * xf[k]
         v = -kx - tb.Ki[i] * st.xi[b]
         uu = min(max(v, -u_limit), u_limit)
+        if aw.on:
+            uu = min(max(uu, st.u[b] - aw.rate_step), st.u[b] + aw.rate_step)
         sat = uu != v
         dxi = (tb.a[i] - 1.0) * st.xi[b] - tb.dt[i] * y[j]
-        if not (sat and (v - uu) * (-tb.Ki[i] * dxi) > 0.0):   # clamp: do not integrate into the limit
+        if aw.on:
+            if aw.back_gain > 0.0 and tb.Ki[i] != 0.0:   # back-calculation: v towards the command sent
+                dxi += aw.back_gain * (v - uu) / tb.Ki[i]
+            st.xi[b] += dxi
+        elif not (sat and (v - uu) * (-tb.Ki[i] * dxi) > 0.0):   # clamp: do not integrate into the limit
             st.xi[b] += dxi
         for r in range(m):
             acc = 0.0
@@ -144,16 +175,17 @@ def lqg_step_k(tb, st, which, y, t, on, u_limit, u):
         for r in range(m, N):
             st.x[b, r] = 0.0
         st.saturated[b] = sat
+        st.u[b] = uu
         u[j] = uu
 
 
 @nb.njit(cache=True)
-def lqg_act_k(pitch, yaw, sp, sy, oc, rows, obs, t, u_limit, gimbal, out):
+def lqg_act_k(pitch, yaw, sp, sy, oc, rows, obs, t, u_limit, aw, gimbal, out):
     """Both planes' laws (``pitch``, ``yaw``: :class:`LQGTables`; ``sp``, ``sy``: :class:`LQGState`) for
     the rows ``rows`` (k,) on their observations ``obs`` (k, n_obs) (``oc``: the columns of the rate errors
     and the controller-on flag, :class:`.pidkernel.ObsColumns`) at the flight times ``t`` (n,) [s] of every
-    row: :func:`lqg_step_k` of each plane; the commands [rad] into ``gimbal`` (n, 2), the actions ``out``
-    (k, 2) float32 (gimbal / limit, clipped to [-1, 1])."""
+    row: :func:`lqg_step_k` of each plane (anti-windup ``aw``); the commands [rad] into ``gimbal`` (n, 2),
+    the actions ``out`` (k, 2) float32 (gimbal / limit, clipped to [-1, 1])."""
     k = rows.size
     y, tk, u = np.empty(k), np.empty(k), np.empty(k)
     on = np.empty(k, np.bool_)
@@ -164,7 +196,7 @@ def lqg_act_k(pitch, yaw, sp, sy, oc, rows, obs, t, u_limit, gimbal, out):
         col = oc.err[ax]
         for j in range(k):
             y[j] = float(obs[j, col])
-        lqg_step_k(pitch if ax == 0 else yaw, sp if ax == 0 else sy, rows, y, tk, on, u_limit, u)
+        lqg_step_k(pitch if ax == 0 else yaw, sp if ax == 0 else sy, rows, y, tk, on, u_limit, aw, u)
         for j in range(k):
             gimbal[rows[j], ax] = u[j]
             out[j, ax] = np.float32(clip_k(u[j] / u_limit, -1.0, 1.0))

@@ -161,10 +161,12 @@ def _mode_rates(labels: tuple[str, ...]) -> list[int]:
     return [i for i, name in enumerate(labels) if name.startswith(("eta_dot_", "omega_s_"))]
 
 
-def regulator(A: np.ndarray, B: np.ndarray, C: np.ndarray, w: LQGWeights, dt: float,
-              labels: tuple[str, ...] = ()) -> tuple[np.ndarray, float, float]:
-    """LQR gains ``(K_x, K_i, a)`` on the plant augmented with the leaky integral of ``-y``;
-    ``q_modes`` weights the mode rates of ``labels``."""
+def regulator_problem(A: np.ndarray, B: np.ndarray, C: np.ndarray, w: LQGWeights, dt: float,
+                      labels: tuple[str, ...] = ()) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, float]:
+    """The regulator's problem (module docstring): the plant augmented with the leaky integral of ``-y``,
+    ``Aa`` (n+1, n+1), ``Ba`` (n+1, 1), its state weight ``Q`` (n+1, n+1) (``q_modes`` on the mode rates of
+    ``labels``), the command weight ``R`` (1, 1) [1/rad^2] and the integrator factor ``a``. The MPC
+    (:mod:`lvgym.baselines.mpc`) minimises the same cost under the gimbal's limits."""
     n = A.shape[0]
     a = math.exp(-dt / w.integrator_leak_s)
     Aa = np.block([[A, np.zeros((n, 1))], [-dt * C, np.array([[a]])]])
@@ -174,7 +176,16 @@ def regulator(A: np.ndarray, B: np.ndarray, C: np.ndarray, w: LQGWeights, dt: fl
     Q[n, n] = w.q_int
     for i in _mode_rates(labels):
         Q[i, i] += w.q_modes
-    K, _, _ = control.dlqr(Aa, Ba, Q, np.array([[w.r_gimbal]]))
+    return Aa, Ba, Q, np.array([[w.r_gimbal]]), a
+
+
+def regulator(A: np.ndarray, B: np.ndarray, C: np.ndarray, w: LQGWeights, dt: float,
+              labels: tuple[str, ...] = ()) -> tuple[np.ndarray, float, float]:
+    """LQR gains ``(K_x, K_i, a)`` on the plant augmented with the leaky integral of ``-y``
+    (:func:`regulator_problem`); ``q_modes`` weights the mode rates of ``labels``."""
+    n = A.shape[0]
+    Aa, Ba, Q, R, a = regulator_problem(A, B, C, w, dt, labels)
+    K, _, _ = control.dlqr(Aa, Ba, Q, R)
     K = np.asarray(K, float)
     return K[:, :n], float(K[0, n]), a
 
