@@ -11,12 +11,16 @@ from it. :func:`unowned_all` does the same for every array of a (named) tuple, n
 The caller must keep the owner alive while the views are in use: a compiled function may take borrowed
 views of its own arguments (its caller holds them for the call), not of arrays it allocates itself (numba
 frees a local the moment its last named use is past).
+
+Called from Python (the pure-Python path of a compiled function, e.g. a ``numba.cfunc`` such as the
+flight loads called by the linearisation), each returns the plain array, tuple or matrix view: the same
+numbers, with Python's own reference counting.
 """
 
 from __future__ import annotations
 
 from numba.core import cgutils, types
-from numba.extending import intrinsic
+from numba.extending import intrinsic, overload
 from numba.np.arrayobj import make_array
 
 __all__ = ["unowned", "unowned_all", "unowned_matrix"]
@@ -49,10 +53,28 @@ def _holds_arrays(ty) -> bool:
     return isinstance(ty, types.Array) or (isinstance(ty, types.BaseTuple) and any(_holds_arrays(t) for t in ty.types))
 
 
-@intrinsic
-def unowned(typingctx, a):
+def unowned(a):
     """A view of the array ``a`` that holds no reference to its memory (a null meminfo; see the module
-    docstring). The caller must keep ``a``'s owner alive while the view is in use."""
+    docstring). The caller must keep ``a``'s owner alive while the view is in use. In Python: ``a``."""
+    return a
+
+
+def unowned_all(tup):
+    """The (named) tuple ``tup`` with every array in it, at any depth, an :func:`unowned` view; its other
+    members as they are. The caller must keep ``tup``'s arrays alive while the views are in use. In
+    Python: ``tup``."""
+    return tup
+
+
+def unowned_matrix(a, start, rows, cols):
+    """The ``rows`` x ``cols`` row-major matrix over ``a[start:start + rows * cols]`` of the contiguous vector
+    ``a``, as a borrowed view (no bounds check: the caller keeps the stretch inside ``a`` and ``a`` alive).
+    In Python: the reshaped slice, a view."""
+    return a[start:start + rows * cols].reshape(rows, cols)
+
+
+@intrinsic
+def _unowned(typingctx, a):
     if not isinstance(a, types.Array):
         return None
 
@@ -63,9 +85,7 @@ def unowned(typingctx, a):
 
 
 @intrinsic
-def unowned_all(typingctx, tup):
-    """The (named) tuple ``tup`` with every array in it, at any depth, an :func:`unowned` view; its other
-    members as they are. The caller must keep ``tup``'s arrays alive while the views are in use."""
+def _unowned_all(typingctx, tup):
     if not isinstance(tup, types.BaseTuple):
         return None
 
@@ -76,9 +96,7 @@ def unowned_all(typingctx, tup):
 
 
 @intrinsic
-def unowned_matrix(typingctx, a, start, rows, cols):
-    """The ``rows`` x ``cols`` row-major matrix over ``a[start:start + rows * cols]`` of the contiguous vector
-    ``a``, as a borrowed view (no bounds check: the caller keeps the stretch inside ``a`` and ``a`` alive)."""
+def _unowned_matrix(typingctx, a, start, rows, cols):
     if not (isinstance(a, types.Array) and a.ndim == 1 and a.layout == "C"
             and all(isinstance(v, types.Integer) for v in (start, rows, cols))):
         return None
@@ -97,3 +115,24 @@ def unowned_matrix(typingctx, a, start, rows, cols):
         return dst._getvalue()
 
     return matrix(a, start, rows, cols), codegen
+
+
+@overload(unowned)
+def _unowned_compiled(a):
+    if isinstance(a, types.Array):
+        return lambda a: _unowned(a)
+    return None
+
+
+@overload(unowned_all)
+def _unowned_all_compiled(tup):
+    if isinstance(tup, types.BaseTuple):
+        return lambda tup: _unowned_all(tup)
+    return None
+
+
+@overload(unowned_matrix)
+def _unowned_matrix_compiled(a, start, rows, cols):
+    if isinstance(a, types.Array) and a.ndim == 1 and a.layout == "C":
+        return lambda a, start, rows, cols: _unowned_matrix(a, start, rows, cols)
+    return None
