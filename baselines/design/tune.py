@@ -153,8 +153,16 @@ def schedule(vehicle: Any = "smile", times=None, bandwidth: float = 75.0, pm_deg
                             "max_open_loop_pole_real_per_s": round(float(unstable), 5)})
             continue
         gains = res["gains"]
-        nonrigid = linearize(op=operating_point(vehicle, t, "nonrigid", protocol=protocol, policy=policy, **options))
-        mr, mn = loop_margins(rigid, gains, dt), loop_margins(nonrigid, gains, dt)
+        mr = loop_margins(rigid, gains, dt)
+        try:
+            nonrigid = linearize(op=operating_point(vehicle, t, "nonrigid", protocol=protocol, policy=policy, **options))
+            mn = loop_margins(nonrigid, gains, dt)
+        except RuntimeError as exc:                # the non-rigid flight ended before t (flown by the rows so far)
+            if policy is None:
+                raise
+            log(f"t = {t:g} s: the non-rigid flight did not reach the row ({exc}); its margins left out")
+            mn = {"gain_margin_db": float("nan"), "phase_margin_deg": float("nan"), "closed_loop_stable": None,
+                  "not_reached": str(exc)}
         row = {"time_s": float(t), "mass_kg": round(mass, 1), "kp": round(gains[0], 4), "ki": round(gains[1], 4),
                "kd": round(gains[2], 4), "n": gains[3], "crossover_radps": round(res["crossover_radps"], 2),
                "target_met": bool(res["target_met"]),
