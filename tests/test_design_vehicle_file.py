@@ -115,3 +115,19 @@ def test_a_bad_vehicle_path_is_one_line(tmp_path, capsys):
     with pytest.raises(SystemExit) as exc:                  # refused before any flight
         main(["design", "lqg", "--vehicle", str(SMILE_V1), "--rows", "3"])
     assert "--phases" in str(exc.value.code) and "required for vehicle" in str(exc.value.code)
+
+
+def test_margins_command_flies_the_suite_with_a_vehicle_file(stubby, tmp_path, capsys):
+    from lvgym.cli.flights import resolve_flights
+    from lvgym.cli.margins import parse_args
+
+    a = parse_args(["--vehicle", stubby, "--policies", "zero", "--seeds", "1"])
+    assert a.vehicle == stubby
+    _, suite, conds = resolve_flights("lvgym margins", a.policies, a.suite, vehicle=a.vehicle)
+    assert suite.version.endswith("+override") and dict(suite.overrides)["vehicle"] == stubby
+    assert conds and all(dict(c.options)["vehicle"] == stubby for c in conds)
+    env = conds[0].make_env()
+    assert env.unwrapped.task.vehicle == stubby
+    with pytest.raises(SystemExit):
+        parse_args(["--vehicle", str(tmp_path / "nowhere.yaml")])
+    assert "--vehicle" in capsys.readouterr().err
