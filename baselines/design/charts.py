@@ -30,6 +30,7 @@ from lvgym.cli.args import arg
 
 from .flightloop import flight_plant, frequency_response, mode_frequencies
 from .linearize import margins, operating_point, pid_tf
+from .target import vehicle_option
 from ..pid import GainSchedule
 
 
@@ -40,11 +41,12 @@ def open_loop(op, gains: tuple[float, float, float, float], plane: str = "pitch"
     return control.series(g, control.ss(pid_tf(*gains, dt=g.dt)))
 
 
-def row_loops(vehicle: str, protocol: str, t: float, gains) -> dict[str, Any] | None:
-    """Open loops, margins and plant modes at flight time ``t`` [s], or None in a coast."""
+def row_loops(vehicle: Any, protocol: str, t: float, gains, policy: Any = None, **options: Any) -> dict[str, Any] | None:
+    """Open loops, margins and plant modes at flight time ``t`` [s], or None in a coast; the operating
+    points flown with ``policy`` (None: the gimbal centred; :func:`.linearize.operating_point`)."""
     out: dict[str, Any] = {}
     for model in ("rigid", "nonrigid"):
-        op = operating_point(vehicle, t, model, protocol=protocol)
+        op = operating_point(vehicle, t, model, protocol=protocol, policy=policy, **options)
         if op.condition("thrust") <= 0.0:
             return None
         with warnings.catch_warnings():
@@ -102,14 +104,37 @@ def _chart(t: float, loops: dict[str, Any], path: Path) -> None:
     plt.close(fig)
 
 
-def charts(vehicle: str, protocol: str, schedule: str, out: Path, log=print) -> dict[str, Any]:
-    """Write the charts of every row of ``schedule`` into ``out``; returns the margins per row."""
+def charts(vehicle: Any, protocol: str, schedule: str, out: Path, log=print, fly: str = "auto",
+           **options: Any) -> dict[str, Any]:
+    """Write the charts of every row of ``schedule`` into ``out``; returns the margins per row.
+    ``vehicle``: a shipped name or a vehicle file (:func:`.target.design_env`; ``options``: env keywords).
+    ``fly``: how the rows' operating points are reached: ``centred``, ``schedule`` (the charted schedule
+    itself flies the vehicle), another schedule file; ``auto``: ``centred`` for a shipped vehicle,
+    ``schedule`` for a file. ``margins.json`` says how (``operating_points``) when not centred."""
+    from .target import check_fly, check_vehicle, describe, is_shipped, schedule_flyer
+
+    vehicle = check_vehicle(vehicle, protocol)
     sched = GainSchedule.load(schedule)
+    if fly == "auto":
+        fly = "centred" if is_shipped(vehicle, protocol) else "schedule"
+    policy = None
+    if fly == "schedule":
+        policy, how = schedule_flyer(sched), f"the charted schedule {schedule}"
+    else:
+        fly = check_fly(fly)
+        if fly not in ("centred", "rows", "pid"):
+            policy = schedule_flyer(fly)
+        elif fly != "centred":
+            raise ValueError(f"fly = {fly!r}: 'auto', 'centred', 'schedule' or a schedule file")
+        how = describe(fly)
+    log(f"operating points: {how}")
     out.mkdir(parents=True, exist_ok=True)
     doc: dict[str, Any] = {"vehicle": vehicle, "protocol": protocol, "schedule": str(schedule), "rows": []}
+    if policy is not None or options:
+        doc["operating_points"] = {"flown_with": how, **({"env_options": dict(options)} if options else {})}
     for row, value in zip(sched.meta["rows"], sched.points):
         t = float(row["time_s"])
-        loops = row_loops(vehicle, protocol, t, sched.gains(value))
+        loops = row_loops(vehicle, protocol, t, sched.gains(value), policy, **options)
         if loops is None:
             log(f"t = {t:g} s: no thrust (coast), skipped")
             continue
@@ -126,12 +151,15 @@ def charts(vehicle: str, protocol: str, schedule: str, out: Path, log=print) -> 
     return doc
 
 
-def _linearize_choices(which: str):
-    def choices() -> tuple[str, ...]:
-        from .linearize import ENV_IDS
+def _protocols() -> tuple[str, ...]:
+    from .target import ENV_IDS
 
-        return tuple(sorted(ENV_IDS["v1"] if which == "vehicle" else ENV_IDS))
-    return choices
+    return tuple(sorted(ENV_IDS))
+
+
+def _fly(option: str, value: str) -> str:
+    """``--fly``: auto, centred, schedule or a readable gain schedule."""
+    return value if value in ("auto", "centred", "schedule") else _readable(option, value)
 
 
 def _readable(option: str, schedule: str) -> str:
@@ -149,14 +177,18 @@ def _readable(option: str, schedule: str) -> str:
 class Args:
     """Command-line arguments (``lvgym design charts --help``)."""
 
-    vehicle: str = arg("smile", choices=_linearize_choices("vehicle"))
-    """the vehicle linearised"""
-    protocol: str = arg("v1", choices=_linearize_choices("protocol"))
+    vehicle: str = arg("smile", check=vehicle_option, metavar="NAME|PATH")
+    """the vehicle linearised: a shipped vehicle (smile, stratos3, slender) or the path of a vehicle YAML
+    file, flown in SMILE's env of the protocol (docs/vehicles.md)"""
+    protocol: str = arg("v1", choices=_protocols)
     """the protocol whose env is linearised"""
     schedule: str = arg("smile", check=_readable)
     """a schedule name in baselines/schedules or a YAML path"""
     out: str = "results/charts"
     """folder of the figures and margins.json (a subfolder per vehicle, protocol and schedule)"""
+    fly: str = arg("auto", check=_fly, metavar="MODE|SCHEDULE")
+    """how the rows' operating points are reached: centred (gimbal at zero), schedule (the charted schedule
+    flies the vehicle), another schedule file, or auto (centred for a shipped vehicle, schedule for a file)"""
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -164,8 +196,10 @@ def main(argv: list[str] | None = None) -> int:
     from lvgym.cli.args import parse
 
     a = parse(Args, argv, "python -m lvgym.baselines.design.charts", __doc__)
-    out = Path(a.out) / f"{a.vehicle}_{a.protocol}_{Path(a.schedule).stem}"
-    charts(a.vehicle, a.protocol, a.schedule, out)
+    from .target import stem
+
+    out = Path(a.out) / f"{stem(a.vehicle)}_{a.protocol}_{Path(a.schedule).stem}"
+    charts(a.vehicle, a.protocol, a.schedule, out, fly=a.fly)
     print(f"wrote {out}")
     return 0
 

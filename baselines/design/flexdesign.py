@@ -39,6 +39,7 @@ from .flextable import margin_table, row_line
 from .flightloop import flight_plant, frequency_response, mode_frequencies
 from .linearize import margins, operating_point
 from .noise import command_noise_rate, gyro_noise
+from .target import fly_option, stem, vehicle_option
 
 #: the flight times of the schedule per vehicle [s]: SMILE v1 boost (burnout 43 s) and upper stage
 #: (ignition 54 s, mission 70 s); Stratos III (30 s); the slender vehicle (10 s)
@@ -47,14 +48,15 @@ FLEX_TIMES = {"smile": (3.0, 10.0, 15.0, 20.0, 24.4, 28.8, 32.4, 36.0, 42.5, 54.
               "slender": (1.0, 3.0, 5.0, 7.0, 9.0)}
 
 
-def row_plants(vehicle: str, t: float, policy: Callable | None) -> tuple[dict, dict, dict]:
-    """Pitch and yaw ``flight_plant`` of the rigid and non-rigid v1 vehicle at ``t`` [s], flown there
-    with ``policy`` (None: the zero action), the non-rigid modes, and the thrust [N], the mass [kg] and
-    the gyro's noise with the servo's rate limit (:func:`.noise.gyro_noise`) there."""
+def row_plants(vehicle: Any, t: float, policy: Callable | None, **options: Any) -> tuple[dict, dict, dict]:
+    """Pitch and yaw ``flight_plant`` of the rigid and non-rigid v1 vehicle (a shipped name or a vehicle
+    file; ``options``: env keywords) at ``t`` [s], flown there with ``policy`` (None: the zero action),
+    the non-rigid modes, and the thrust [N], the mass [kg] and the gyro's noise with the servo's rate
+    limit (:func:`.noise.gyro_noise`) there."""
     plants: dict[str, dict[str, control.StateSpace]] = {"pitch": {}, "yaw": {}}
     thrust = None
     for model in ("rigid", "nonrigid"):
-        op = operating_point(vehicle, t, model, protocol="v1", policy=policy)
+        op = operating_point(vehicle, t, model, protocol="v1", policy=policy, **options)
         thrust = op.condition("thrust")
         for plane in plants:
             plants[plane][model] = flight_plant(op, plane)
@@ -174,9 +176,9 @@ def plain_schedule(schedule: Any) -> Any:
         for r in rows]})
 
 
-def design_schedule(vehicle: str = "smile", times=None, req: Requirements | None = None, starts: int = 2,
+def design_schedule(vehicle: Any = "smile", times=None, req: Requirements | None = None, starts: int = 2,
                     seed: int = 0, log=print, relief: tuple[float, float] | None = None,
-                    planes: tuple[str, ...] = ("pitch",)) -> dict[str, Any]:
+                    planes: tuple[str, ...] = ("pitch",), fly: str = "auto", **options: Any) -> dict[str, Any]:
     """Design every row of ``vehicle``'s schedule in time order. Each row flies the stretch between the
     midpoints to its neighbours in the same burn (the policy switches rows at the mass midpoints,
     ``interpolation: nearest``), and is designed to meet the requirements at its own time and at both
@@ -190,17 +192,41 @@ def design_schedule(vehicle: str = "smile", times=None, req: Requirements | None
     requirement, its slowest divergence [1/s] and its smallest gain margin [dB], worst over the
     stretch). ``planes``:
     the planes whose loops the optimiser holds to the requirements (the pitch loop's disturbance response
-    is the objective; every row is checked in both planes whatever it is). Returns the schedule document."""
+    is the objective; every row is checked in both planes whatever it is). ``vehicle``: a shipped name or a
+    vehicle file (:func:`.target.design_env`; ``times`` then required; ``options``: env keywords).
+    ``fly``: how a row with no designed row before it (the first) is flown to: ``centred``, ``pid`` (a
+    rigid PID schedule at the same times designed first, :func:`.tune.schedule` with ``fly="rows"``) or a
+    schedule file; ``auto``: ``centred`` for a shipped vehicle (its schedules unchanged), ``pid`` for a
+    file. A document not flown centred records how in ``operating_points``. Returns the schedule
+    document."""
+    from .target import check_fly, check_vehicle, describe, fly_mode, schedule_flyer
+    from .tune import default_times
+
+    vehicle = check_vehicle(vehicle, "v1")
+    fly = fly_mode(check_fly(fly), vehicle)
+    fly = "pid" if fly == "rows" else fly
     if not planes or any(p not in ("pitch", "yaw") for p in planes) or planes[0] != "pitch":
         raise ValueError(f"planes = {planes!r}: ('pitch',) or ('pitch', 'yaw')")
     req = req or Requirements()
-    times = tuple(sorted(FLEX_TIMES[vehicle] if times is None else times))
+    times = tuple(sorted(default_times(vehicle, FLEX_TIMES) if times is None else times))
+    first, rigid_doc = None, None
+    if fly == "pid":
+        from .tune import schedule as rigid_schedule
+
+        log("the rigid PID schedule that flies to the first row (lvgym design pid):")
+        rigid_doc = rigid_schedule(vehicle, times, log=log, protocol="v1", fly="rows", **options)
+        if not rigid_doc["rows"]:
+            raise RuntimeError(f"no rigid PID row of {vehicle} could be tuned at {list(times)} s")
+        first = schedule_flyer({k: rigid_doc[k] for k in ("variable", "rows")})
+    elif fly != "centred":
+        first = schedule_flyer(fly)
+    log(f"operating points: the gs-pid-flex rows designed so far; before the first: {describe(fly)}")
     rng = np.random.default_rng(seed)
     rows: list[dict[str, Any]] = []
     skipped: list[dict[str, Any]] = []
     warm, left = None, None
     for k, t in enumerate(times):
-        own = row_plants(vehicle, t, schedule_policy(rows) if rows else None)
+        own = row_plants(vehicle, t, schedule_policy(rows) if rows else first, **options)
         if own[2]["thrust_n"] <= 0.0:
             log(f"t = {t:g} s: no thrust (coast), skipped")
             skipped.append({"time_s": float(t), "reason": "coast"})
@@ -216,10 +242,10 @@ def design_schedule(vehicle: str = "smile", times=None, req: Requirements | None
         if k + 1 < len(times):
             t_r = 0.5 * (t + times[k + 1])
             gains, filt = controller(e["values"], notch)
-            first = rows + [{"time_s": t, "mass_kg": own[2]["mass_kg"], "kp": gains[0], "ki": gains[1], "kd": gains[2],
+            first_rows = rows + [{"time_s": t, "mass_kg": own[2]["mass_kg"], "kp": gains[0], "ki": gains[1], "kd": gains[2],
                              "filter": filt.as_dict(), **({} if relief is None else {"accel_gain": relief[1]})}]
             try:
-                case = row_plants(vehicle, t_r, schedule_policy(first))
+                case = row_plants(vehicle, t_r, schedule_policy(first_rows), **options)
                 right = (t_r, case) if case[2]["thrust_n"] > 0.0 else None
             except RuntimeError as exc:                  # the flight ended before the stretch's end
                 log(f"t = {t_r:g} s: not reached ({exc}); the row is designed without its right end")
@@ -248,20 +274,31 @@ def design_schedule(vehicle: str = "smile", times=None, req: Requirements | None
         rows.append(row)
         log(row_line(row) + "".join(f"\n    end {row_line(c)}" for c in checks[1:]))
         left = right
-    return {"vehicle": vehicle, "protocol": "v1",
-            "source": "python -m lvgym.baselines.design.flexdesign (non-rigid v1 flight loop, discrete)",
-            "variable": "mass", "interpolation": "nearest", "requirements": asdict(req),
-            "design": {"starts": starts, "seed": seed, "planes": list(planes), **({} if relief is None else
-                                                          {"ki_scale": relief[0], "accel_gain": relief[1]})},
-            "rows": rows, "skipped": skipped}
+    doc = {"vehicle": vehicle, "protocol": "v1",
+           "source": "python -m lvgym.baselines.design.flexdesign (non-rigid v1 flight loop, discrete)",
+           "variable": "mass", "interpolation": "nearest", "requirements": asdict(req),
+           "design": {"starts": starts, "seed": seed, "planes": list(planes), **({} if relief is None else
+                                                         {"ki_scale": relief[0], "accel_gain": relief[1]})},
+           "rows": rows, "skipped": skipped}
+    if fly != "centred" or options:                     # the shipped schedules' documents unchanged
+        doc["operating_points"] = {"flown_with": f"the gs-pid-flex rows designed so far; before the first: {describe(fly)}",
+                                   **({"env_options": dict(options)} if options else {}),
+                                   **({"rigid_pid_rows": [{k: r[k] for k in ("time_s", "mass_kg", "kp", "ki", "kd", "n")}
+                                                          for r in rigid_doc["rows"]]} if rigid_doc else {})}
+    return doc
 
 
 @dataclass
 class Args:
     """Command-line arguments (``lvgym design pid-flex --help``)."""
 
-    vehicle: str = arg("smile", choices=tuple(sorted(FLEX_TIMES)))
-    """the vehicle whose schedule is designed"""
+    vehicle: str = arg("smile", check=vehicle_option, metavar="NAME|PATH")
+    """the vehicle whose schedule is designed: a shipped vehicle (smile, stratos3, slender) or the path of a
+    vehicle YAML file, flown in SMILE's v1 env (docs/vehicles.md; give --times)"""
+    fly: str = arg("auto", check=fly_option, metavar="MODE|SCHEDULE")
+    """how the first row's operating points are reached (the later rows: with the rows designed so far):
+    centred (gimbal at zero), pid (a rigid PID schedule designed first at the same times), a schedule file,
+    or auto (centred for a shipped vehicle, pid for a file)"""
     out: str | None = None
     """YAML file (default results/schedules/<vehicle>_flex.yaml; with --overwrite: the shipped
     baselines/schedules/<vehicle>_flex.yaml)"""
@@ -293,17 +330,19 @@ def main(argv: list[str] | None = None) -> int:
     from lvgym.cli.args import command_name, parse
     from lvgym.errors import ConfigError
 
-    from .tune import SCHEDULES, output_path
+    from .tune import SCHEDULES, default_times, output_path
 
     prog = "python -m lvgym.baselines.design.flexdesign"
     a = parse(Args, argv, prog, __doc__)
+    name = stem(a.vehicle)
     try:                                             # refused before the (slow) design
-        out = output_path(a.vehicle, a.out, a.overwrite, stem=f"{a.vehicle}_flex")
+        out = output_path(name, a.out, a.overwrite, stem=f"{name}_flex")
+        times = default_times(a.vehicle, FLEX_TIMES, "--times") if not a.times else a.times
     except ConfigError as exc:
         fail(command_name(prog), exc)
     planes = tuple(dict.fromkeys(["pitch", *a.planes]))
-    doc = design_schedule(a.vehicle, a.times, Requirements(noise_rate_fraction=a.noise_rate), starts=a.starts,
-                          seed=a.seed, relief=a.load_relief, planes=planes)
+    doc = design_schedule(a.vehicle, times, Requirements(noise_rate_fraction=a.noise_rate), starts=a.starts,
+                          seed=a.seed, relief=a.load_relief, planes=planes, fly=a.fly)
     if not doc["rows"]:
         print(f"no flight time of {a.vehicle} could be designed; nothing written", file=sys.stderr)
         return 1
@@ -313,6 +352,7 @@ def main(argv: list[str] | None = None) -> int:
              + ("" if not a.times else " --times " + " ".join(f"{t:g}" for t in a.times))
              + ("" if planes == ("pitch",) else " --planes " + " ".join(planes))
              + ("" if a.noise_rate is None else f" --noise-rate {a.noise_rate:g}")
+             + ("" if a.fly == "auto" else f" --fly {a.fly}")
              + (" --overwrite" if shipped else f" --out {out}"))
     out.parent.mkdir(parents=True, exist_ok=True)
     atomic_write_text(out, f"# gs-pid-flex schedule of {a.vehicle}, regenerated by: {again}\n"

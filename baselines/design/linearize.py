@@ -43,9 +43,8 @@ from lvgym.simulator import CONDITIONS, CONTEXT
 from lvgym.simulator import data as simdata
 from lvgym.simulator.flight import flight_conditions_batch
 
-#: the env of each vehicle per protocol version (the vehicle's own file in v1: ``smile_v1`` for SMILE)
-ENV_IDS = {"v0": {"smile": "lvgym/SmileAscent-v0", "stratos3": "lvgym/StratosIII-v0", "slender": "lvgym/SlenderAscent-v0"},
-           "v1": {"smile": "lvgym/SmileAscent-v1", "stratos3": "lvgym/StratosIII-v1", "slender": "lvgym/SlenderAscent-v1"}}
+from .target import ENV_IDS, design_env  # noqa: F401  (ENV_IDS: the shipped vehicles' envs, here as before)
+
 #: the planes of :func:`linearize`: the state entries kept, the input and the rate output of each
 PLANES = {"pitch": ("v_z", "theta_y", "omega_y", "z", "y", "gimbal_pitch", "omega_y"),
           "yaw": ("v_y", "theta_z", "omega_z", "y", "z", "gimbal_yaw", "omega_z"),
@@ -79,29 +78,26 @@ class OperatingPoint:
         return float(value) if np.ndim(value) == 0 else np.array(value)
 
 
-def operating_point(vehicle: str = "smile", t: float = 28.8, model: str = "rigid", protocol: str = "v0",
+def operating_point(vehicle: Any = "smile", t: float = 28.8, model: str = "rigid", protocol: str = "v0",
                     policy: Any = None, **options: Any) -> OperatingPoint:
     """The state of ``vehicle``'s env of ``protocol`` (``v0``, ``v1``) flown with the gimbal centred and
-    no wind up to time ``t`` [s]. In v0 the simulator flies alone; in v1 the env flies its zero action
-    control period by control period, so that its coast control and settling thrust hold the stack
-    through the staging coast as they do in the benchmark.
+    no wind up to time ``t`` [s]. ``vehicle``: a shipped name or the path of a vehicle YAML file, flown in
+    :data:`.target.FILE_ENV` of the protocol (:func:`.target.design_env`; a missing or invalid file is a
+    one-line ``ConfigError``); ``options``: env keywords. In v0 the simulator flies alone; in v1 the env
+    flies its zero action control period by control period, so that its coast control and settling
+    thrust hold the stack through the staging coast as they do in the benchmark.
 
-    ``policy`` (v1 only): fly up to ``t`` with this controller instead of the zero action, a callable
-    ``env -> policy`` (a benchmark policy factory such as :func:`.pid.smile_scheduled_pid`) or a policy
-    (``reset()``, ``act(observation, info)``). The upper stage of ``smile_v1`` needs one: flown with
-    the zero action it tumbles and the episode ends at 60.7 s. The linearisation is still taken about
-    the gimbal centred at the state reached."""
-    ids = ENV_IDS.get(protocol)
-    if ids is None:
-        raise ValueError(f"protocol = {protocol!r}: one of {sorted(ENV_IDS)}")
-    env_id = ids.get(vehicle)
-    if env_id is None:
-        raise ValueError(f"vehicle = {vehicle!r}: one of {sorted(ids)}")
-    opts = {"model": model, "wind": "none", **options}
-    if vehicle == "stratos3" and protocol == "v0":
+    ``policy``: fly up to ``t`` with this controller instead of the gimbal centred, a callable
+    ``env -> policy`` (a benchmark policy factory such as :func:`.pid.smile_scheduled_pid`, or
+    :func:`.target.schedule_flyer` of a schedule) or a policy (``reset()``, ``act(observation, info)``);
+    the env then flies control period by control period in v0 too. The upper stage of ``smile_v1`` needs
+    one: flown with the zero action it tumbles and the episode ends at 60.7 s; so does a vehicle that is
+    unstable without control. The linearisation is still taken about the gimbal centred at the state
+    reached."""
+    env_id, file_opts = design_env(vehicle, protocol)
+    opts = {"model": model, "wind": "none", **file_opts, **options}
+    if env_id == ENV_IDS["v0"]["stratos3"]:
         opts.setdefault("control", "tvc")
-    if policy is not None and protocol == "v0":
-        raise ValueError("policy: flies the v1 env only (v0 points are flown with the gimbal centred)")
     env = gym.make(env_id, **opts)
     obs, info = env.reset(seed=0)
     task = env.unwrapped
@@ -110,7 +106,7 @@ def operating_point(vehicle: str = "smile", t: float = 28.8, model: str = "rigid
     if policy is not None:
         policy.reset()
     sim = task.sim
-    if protocol == "v0":
+    if protocol == "v0" and policy is None:
         if t > 0:
             sim.step(task.state.sim, np.zeros((1, 2)), float(t))
     else:
@@ -120,8 +116,9 @@ def operating_point(vehicle: str = "smile", t: float = 28.8, model: str = "rigid
             action = zero if policy is None else policy.act(obs, info)
             obs, _, term, trunc, info = env.step(action)
             if term or trunc:
-                raise RuntimeError(f"{env_id} ({model}) ended at {info['time']:.2f} s before t = {t} s: "
-                                   f"{info.get('termination', '')}")
+                how = "with the gimbal centred" if policy is None else f"with {getattr(policy, 'name', 'the policy')}"
+                raise RuntimeError(f"{env_id} ({model}, vehicle {vehicle}) flown {how} ended at {info['time']:.2f} s "
+                                   f"before t = {t} s: {info.get('termination', '')}")
     d = task.state.sim
     return OperatingPoint(float(d.t[0]), d.x[0].copy(), d.p[0].copy(), d.ctx[0].copy(), sim, opts, task.task,
                           simdata.take(d, [0]))
@@ -253,7 +250,7 @@ def plane_states(names: list[str], plane: str) -> list[int]:
     return keep
 
 
-def linearize(vehicle: str = "smile", t: float = 28.8, model: str = "rigid", op: OperatingPoint | None = None,
+def linearize(vehicle: Any = "smile", t: float = 28.8, model: str = "rigid", op: OperatingPoint | None = None,
               full: bool = False, plane: str = "pitch", **options: Any) -> control.StateSpace:
     """State space from the gimbal angle in force [rad] (roll: the roll moment [N m]) to the body rate
     [rad/s] of ``plane`` (``pitch``, ``yaw``, ``roll``) at flight time ``t``: the rigid body, and in the

@@ -19,7 +19,7 @@ import sys
 import warnings
 from dataclasses import asdict, dataclass, fields, replace
 from pathlib import Path
-from typing import Any, Literal
+from typing import Any
 
 import control
 import numpy as np
@@ -32,6 +32,7 @@ from .flightloop import flight_plant, mode_frequencies
 from .linearize import OperatingPoint, operating_point
 from .lqg_row import (LQGWeights, RowDesign, closed_loop, closed_loop_growth, delayed_plant, design_row,
                       frequency_grid, gain_at, margins_from_response, open_loop, plant_labels, response)
+from .target import fly_option, vehicle_option
 
 SCHEDULES = Path(__file__).resolve().parents[1] / "schedules"
 #: the schedule rows [s] of SMILE v1: the boost (burnout 43 s) and the upper stage (ignition 54 s)
@@ -217,40 +218,81 @@ def row_intervals(rows: tuple[float, ...], phases: tuple[tuple[float, float], ..
     return out
 
 
-def _op(vehicle: str, t: float, model: str, upper_after_s: float) -> OperatingPoint:
-    """The v1 operating point; past ``upper_after_s`` flown with the rigid gain-scheduled PID (the zero
-    action tumbles the SMILE v1 upper stage), before it with the gimbal centred."""
+def _op(vehicle: Any, t: float, model: str, upper_after_s: float, fly: Any = None, **options: Any) -> OperatingPoint:
+    """The v1 operating point: flown with ``fly`` (a policy factory) when given; else past
+    ``upper_after_s`` with the rigid gain-scheduled PID (the zero action tumbles the SMILE v1 upper stage),
+    before it with the gimbal centred."""
+    if fly is not None:
+        return operating_point(vehicle, t, model, protocol="v1", policy=fly, **options)
     if t > upper_after_s:
         from ..pid import smile_scheduled_pid
-        return operating_point(vehicle, t, model, protocol="v1", policy=lambda env: smile_scheduled_pid(env, "smile"))
-    return operating_point(vehicle, t, model, protocol="v1")
+        return operating_point(vehicle, t, model, protocol="v1", policy=lambda env: smile_scheduled_pid(env, "smile"),
+                               **options)
+    return operating_point(vehicle, t, model, protocol="v1", **options)
 
 
-def row_neighbours(vehicle: str, t: float, interval: tuple[float, float], op_nonrigid: OperatingPoint,
-                   upper_after_s: float) -> dict[str, OperatingPoint]:
+def row_neighbours(vehicle: Any, t: float, interval: tuple[float, float], op_nonrigid: OperatingPoint,
+                   upper_after_s: float, fly: Any = None, **options: Any) -> dict[str, OperatingPoint]:
     """The robustness plants a row must stay stable on: the non-rigid points at the ends of its
     ``interval`` [s] (those more than 0.05 s from ``t``) and the row's own with its slosh dispersed
     (:data:`DISPERSED_SLOSH`)."""
-    near = {f"t={x:.1f}": _op(vehicle, x, "nonrigid", upper_after_s) for x in interval if abs(x - t) > 0.05}
+    near = {f"t={x:.1f}": _op(vehicle, x, "nonrigid", upper_after_s, fly, **options)
+            for x in interval if abs(x - t) > 0.05}
     near.update({f"slosh f x{f:g} zeta x{z:g}": dispersed(op_nonrigid, f, z) for f, z in DISPERSED_SLOSH})
     return near
 
 
-def design_schedule(vehicle: str = "smile", rows: tuple[float, ...] = SMILE_ROWS_S,
-                    phases: tuple[tuple[float, float], ...] = SMILE_PHASES_S, tg: MarginTargets = MarginTargets(),
-                    grid: dict = SEARCH_GRID, planes: tuple[str, ...] = PLANE_NAMES, log=print) -> dict[str, Any]:
+def design_schedule(vehicle: Any = "smile", rows: tuple[float, ...] | None = None,
+                    phases: tuple[tuple[float, float], ...] | None = None, tg: MarginTargets = MarginTargets(),
+                    grid: dict = SEARCH_GRID, planes: tuple[str, ...] = PLANE_NAMES, log=print, fly: str = "auto",
+                    **options: Any) -> dict[str, Any]:
     """Design every row and plane (:func:`search_row`); the neighbours of a row are the non-rigid plants
     at the ends of its interval (:func:`row_intervals`) and at the row with its slosh dispersed
-    (:data:`DISPERSED_SLOSH`)."""
-    if vehicle != "smile":
-        raise ConfigError("vehicle", vehicle, "'smile' (the LQG schedule is designed for SMILE v1 only)")
-    intervals = row_intervals(tuple(rows), phases)
+    (:data:`DISPERSED_SLOSH`). ``vehicle``: ``smile`` (rows and phases default to SMILE v1's) or any
+    vehicle a v1 env flies, a shipped name or a vehicle file (:func:`.target.design_env`; ``options``: env
+    keywords), with its ``rows`` and thrusting ``phases`` [s]. ``fly``: how the operating points are
+    reached (:data:`.target.FLY_MODES`): ``centred`` (SMILE: its upper stage with the shipped rigid
+    ``gs-pid`` schedule, as the shipped design), ``pid`` (a rigid PID schedule designed first at the rows,
+    :func:`.tune.schedule` with ``fly="rows"``) or a schedule file; ``auto``: ``centred`` for a shipped
+    vehicle, ``pid`` for a file. A document not flown as the shipped design records how in
+    ``operating_points``."""
+    from .target import check_fly, check_vehicle, describe, fly_mode, schedule_flyer
+
+    vehicle = check_vehicle(vehicle, "v1")
+    if vehicle == "smile":
+        rows = SMILE_ROWS_S if rows is None else rows
+        phases = SMILE_PHASES_S if phases is None else phases
+    elif rows is None or phases is None:
+        raise ConfigError("phases" if rows is not None else "rows", None,
+                          f"the rows and thrusting phases [s] of vehicle {vehicle!r} (SMILE v1's are the defaults)")
+    rows = tuple(rows)
+    intervals = row_intervals(rows, tuple(phases))
     upper_after = phases[0][1] + 0.5
+    fly = fly_mode(check_fly(fly), vehicle)
+    fly = "pid" if fly == "rows" else fly
+    flyer, rigid_doc = None, None
+    if fly == "pid":
+        from .tune import schedule as rigid_schedule
+
+        log("the rigid PID schedule that flies to the rows (lvgym design pid):")
+        rigid_doc = rigid_schedule(vehicle, tuple(sorted({*rows, *(x for iv in intervals for x in iv)})),
+                                   log=log, protocol="v1", fly="rows", **options)
+        flyer = schedule_flyer({k: rigid_doc[k] for k in ("variable", "rows")})
+    elif fly != "centred":
+        flyer = schedule_flyer(fly)
+    how = describe(fly) if fly != "centred" or vehicle != "smile" else \
+        "gimbal centred up to the first stage's burnout, then the shipped rigid gs-pid schedule 'smile'"
+    log(f"operating points: {how}")
     out: dict[str, Any] = {"vehicle": vehicle, "rows": [], "targets": asdict(tg), "grid": {k: list(v) for k, v in grid.items()}}
+    if fly != "centred" or vehicle != "smile" or options:
+        out["operating_points"] = {"flown_with": how, **({"env_options": dict(options)} if options else {}),
+                                   **({"rigid_pid_rows": [{k: r[k] for k in ("time_s", "mass_kg", "kp", "ki", "kd", "n")}
+                                                          for r in rigid_doc["rows"]]} if rigid_doc else {})}
     for t, (lo, hi) in zip(rows, intervals):
         log(f"t = {t:g} s (used {lo:g}-{hi:g} s)")
-        op_n, op_r = _op(vehicle, t, "nonrigid", upper_after), _op(vehicle, t, "rigid", upper_after)
-        near = row_neighbours(vehicle, t, (lo, hi), op_n, upper_after)
+        op_n = _op(vehicle, t, "nonrigid", upper_after, flyer, **options)
+        op_r = _op(vehicle, t, "rigid", upper_after, flyer, **options)
+        near = row_neighbours(vehicle, t, (lo, hi), op_n, upper_after, flyer, **options)
         entry: dict[str, Any] = {"time_s": float(op_n.t), "interval_s": [lo, hi]}
         chosen = None
         for plane in planes:                 # the first plane's search; the others fly its weights (axisymmetric)
@@ -314,14 +356,21 @@ def margin_table(doc: dict[str, Any]) -> str:
 class Args:
     """Command-line arguments (``lvgym design lqg --help``)."""
 
-    vehicle: Literal["smile"] = "smile"
-    """the vehicle (the LQG schedule is designed for SMILE v1 only)"""
+    vehicle: str = arg("smile", check=vehicle_option, metavar="NAME|PATH")
+    """the vehicle: smile (SMILE v1, the rows and phases below by default) or the path of a vehicle YAML
+    file flown in SMILE's v1 env (docs/vehicles.md; give --rows and --phases)"""
     out: str = "results/schedules"
-    """folder of <vehicle>_lqg.npz and <vehicle>_lqg_margins.md"""
+    """folder of <vehicle>_lqg.npz and <vehicle>_lqg_margins.md (a file: its stem)"""
     overwrite: bool = False
     """write into the shipped baselines/schedules instead of --out"""
-    rows: list[float] = arg(default_factory=lambda: list(SMILE_ROWS_S), lo=0.0, hi=3600.0)
-    """flight times [s] of the rows"""
+    rows: list[float] | None = arg(None, lo=0.0, hi=3600.0)
+    """flight times [s] of the rows (default: SMILE v1's, 3 10 20 28.8 36 41 56 62 68)"""
+    phases: list[float] | None = arg(None, lo=0.0, hi=3600.0, metavar="START END")
+    """the thrusting phases with the controller on [s], pairs START END (default: SMILE v1's, 2 42.5 54.5 69.5)"""
+    fly: str = arg("auto", check=fly_option, metavar="MODE|SCHEDULE")
+    """how the operating points are reached: centred (SMILE: gimbal centred, its upper stage with gs-pid),
+    pid (a rigid PID schedule designed first at the rows), a schedule file, or auto (centred for a shipped
+    vehicle, pid for a file)"""
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -329,25 +378,43 @@ def main(argv: list[str] | None = None) -> int:
     from lvgym.cli import fail
     from lvgym.cli.args import command_name, parse
 
+    from .target import stem
+
     prog = "python -m lvgym.baselines.design.lqg_design"
     a = parse(Args, argv, prog, __doc__)
+    smile = a.vehicle == "smile"
     try:
-        row_intervals(tuple(a.rows), SMILE_PHASES_S)        # every row in a thrusting phase, before the design
+        if a.phases is not None and len(a.phases) % 2:
+            raise ConfigError("--phases", a.phases, "pairs START END [s]")
+        phases = tuple(zip(a.phases[::2], a.phases[1::2])) if a.phases else (SMILE_PHASES_S if smile else None)
+        rows = tuple(a.rows) if a.rows else (SMILE_ROWS_S if smile else None)
+        if rows is None or phases is None:
+            raise ConfigError("--rows" if rows is None else "--phases", None,
+                              f"required for vehicle {a.vehicle} (SMILE v1's are the defaults)")
+        try:
+            row_intervals(rows, phases)                  # every row in a thrusting phase, before the design
+        except ConfigError as exc:
+            raise ConfigError("--rows", exc.value, exc.allowed) from None
     except ConfigError as exc:
-        fail(command_name(prog), ConfigError("--rows", exc.value, exc.allowed))
+        fail(command_name(prog), exc)
     out = SCHEDULES if a.overwrite else Path(a.out)
+    name = stem(a.vehicle)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        doc = design_schedule(a.vehicle, tuple(a.rows))
-    save_schedule(doc, out / f"{a.vehicle}_lqg.npz")
-    head = (f"# LQG schedule of {a.vehicle} v1: margins per row\n\nWritten by `lvgym design lqg "
-            f"--vehicle {a.vehicle}`. Loop broken at the plant input; GM / GRM: gain and gain-reduction margin, "
+        doc = design_schedule(a.vehicle, rows, phases, fly=a.fly)
+    save_schedule(doc, out / f"{name}_lqg.npz")
+    again = (f"lvgym design lqg --vehicle {a.vehicle}" + ("" if not a.rows else " --rows " + " ".join(f"{t:g}" for t in rows))
+             + ("" if not a.phases else " --phases " + " ".join(f"{t:g}" for p in phases for t in p))
+             + ("" if a.fly == "auto" else f" --fly {a.fly}"))
+    flown = f"Operating points: {doc['operating_points']['flown_with']}. " if "operating_points" in doc else ""
+    head = (f"# LQG schedule of {name} v1: margins per row\n\nWritten by `{again}`. {flown}Loop broken at the plant "
+            "input; GM / GRM: gain and gain-reduction margin, "
             "PM: phase margin at the gain crossover of smallest |PM|, CL: closed-loop stability; slosh and "
             "bending: the non-rigid loop's |L| at each mode (bending modes above Nyquist folded). Targets: "
             f"{doc['targets']}.\n\n")
-    (out / f"{a.vehicle}_lqg_margins.md").write_text(head + margin_table(doc))
+    (out / f"{name}_lqg_margins.md").write_text(head + margin_table(doc))
     print(margin_table(doc))
-    print(f"wrote {out / (a.vehicle + '_lqg.npz')} and {out / (a.vehicle + '_lqg_margins.md')}")
+    print(f"wrote {out / (name + '_lqg.npz')} and {out / (name + '_lqg_margins.md')}")
     return 0
 
 

@@ -32,6 +32,7 @@ import yaml
 from lvgym.cli.args import arg
 
 from .linearize import linearize, loop, margins, operating_point
+from .target import fly_option, is_shipped, stem, vehicle_option
 from ..pid import SCHEDULES
 
 #: flight times of the schedule per vehicle [s] (smile: those of Table 6.10) and their env options
@@ -96,14 +97,47 @@ def _rounded(m: dict) -> dict:
     return {k: (round(v, 5 if k.startswith("max_pole") else 2) if isinstance(v, float) else v) for k, v in m.items()}
 
 
-def schedule(vehicle: str = "smile", times=None, bandwidth: float = 75.0, pm_deg: float = 35.0, dt: float = 0.02,
-             n: float = 500.0, ki_ratio: float = 3.0, log=print) -> dict[str, Any]:
-    """Tune at each time and return the schedule document (variable: vehicle mass)."""
-    times = VEHICLE_TIMES.get(vehicle, VEHICLE_TIMES["smile"]) if times is None else times
+def default_times(vehicle: Any, table: dict[str, tuple[float, ...]], option: str = "times") -> tuple[float, ...]:
+    """The rows' flight times of a shipped ``vehicle`` in ``table``; a vehicle file has none: a
+    ``ConfigError`` asking for them."""
+    from lvgym.errors import ConfigError
+
+    from .target import is_shipped
+
+    if is_shipped(vehicle) and vehicle in table:
+        return table[vehicle]
+    if is_shipped(vehicle):
+        return table["smile"]
+    raise ConfigError(option, None, f"the flight times [s] of the rows: a vehicle file ({vehicle}) has no default "
+                      f"(the shipped vehicles': {table})")
+
+
+def schedule(vehicle: Any = "smile", times=None, bandwidth: float = 75.0, pm_deg: float = 35.0, dt: float = 0.02,
+             n: float = 500.0, ki_ratio: float = 3.0, log=print, protocol: str = "v0", fly: str = "auto",
+             **options: Any) -> dict[str, Any]:
+    """Tune at each time and return the schedule document (variable: vehicle mass). ``vehicle``: a shipped
+    name or a vehicle file (:func:`.target.design_env`; ``options``: env keywords), flown in ``protocol``'s
+    env. ``fly``: how each row's operating point is reached (:data:`.target.FLY_MODES`): ``centred`` (the
+    gimbal at zero), ``rows`` (the schedule of the rows tuned so far, so a vehicle unstable without
+    control reaches every row: rows are tuned in time order, the first flown centred) or a schedule file;
+    ``auto`` (and ``pid``) is ``centred`` for a shipped vehicle (its schedules unchanged) and ``rows`` for a
+    file. A document of a flight not flown centred records how in ``operating_points``."""
+    from .target import check_fly, check_vehicle, describe, fly_mode, schedule_flyer
+
+    vehicle = check_vehicle(vehicle, protocol)
+    fly = fly_mode(check_fly(fly), vehicle)
+    fly = "rows" if fly == "pid" else fly
+    times = default_times(vehicle, VEHICLE_TIMES) if times is None else tuple(sorted(times))
+    log(f"operating points: {describe(fly)}")
     rows: list[dict[str, Any]] = []
     skipped: list[dict[str, Any]] = []
     for t in times:
-        op = operating_point(vehicle, t, "rigid")
+        policy = None
+        if fly == "rows" and rows:
+            policy = schedule_flyer({"variable": "mass", "rows": rows})
+        elif fly not in ("rows", "centred"):
+            policy = schedule_flyer(fly)
+        op = operating_point(vehicle, t, "rigid", protocol=protocol, policy=policy, **options)
         tl = op.sim.timeline
         if op.condition("thrust") <= 0.0:
             log(f"t = {t:g} s: no thrust (coast), skipped")
@@ -119,8 +153,16 @@ def schedule(vehicle: str = "smile", times=None, bandwidth: float = 75.0, pm_deg
                             "max_open_loop_pole_real_per_s": round(float(unstable), 5)})
             continue
         gains = res["gains"]
-        nonrigid = linearize(op=operating_point(vehicle, t, "nonrigid"))
-        mr, mn = loop_margins(rigid, gains, dt), loop_margins(nonrigid, gains, dt)
+        mr = loop_margins(rigid, gains, dt)
+        try:
+            nonrigid = linearize(op=operating_point(vehicle, t, "nonrigid", protocol=protocol, policy=policy, **options))
+            mn = loop_margins(nonrigid, gains, dt)
+        except RuntimeError as exc:                # the non-rigid flight ended before t (flown by the rows so far)
+            if policy is None:
+                raise
+            log(f"t = {t:g} s: the non-rigid flight did not reach the row ({exc}); its margins left out")
+            mn = {"gain_margin_db": float("nan"), "phase_margin_deg": float("nan"), "closed_loop_stable": None,
+                  "not_reached": str(exc)}
         row = {"time_s": float(t), "mass_kg": round(mass, 1), "kp": round(gains[0], 4), "ki": round(gains[1], 4),
                "kd": round(gains[2], 4), "n": gains[3], "crossover_radps": round(res["crossover_radps"], 2),
                "target_met": bool(res["target_met"]),
@@ -130,10 +172,14 @@ def schedule(vehicle: str = "smile", times=None, bandwidth: float = 75.0, pm_deg
             f"w_c {res['crossover_radps']:.1f} rad/s  rigid GM {mr['gain_margin_db']:.1f} dB PM "
             f"{mr['phase_margin_deg']:.1f} deg  nonrigid GM {mn['gain_margin_db']:.1f} dB PM "
             f"{mn['phase_margin_deg']:.1f} deg stable {mn['closed_loop_stable']}")
-    return {"vehicle": vehicle, "source": "python -m lvgym.baselines.design.tune (rigid linearisation, discrete loop)",
-            "variable": "mass", "target": {"bandwidth_radps": bandwidth, "phase_margin_deg": pm_deg,
-                                           "control_dt_s": dt, "ki_ratio": ki_ratio},
-            "rows": rows, "skipped": skipped}
+    doc = {"vehicle": vehicle, "source": "python -m lvgym.baselines.design.tune (rigid linearisation, discrete loop)",
+           "variable": "mass", "target": {"bandwidth_radps": bandwidth, "phase_margin_deg": pm_deg,
+                                          "control_dt_s": dt, "ki_ratio": ki_ratio},
+           "rows": rows, "skipped": skipped}
+    if fly != "centred" or protocol != "v0" or options:        # the shipped schedules' documents unchanged
+        doc["operating_points"] = {"protocol": protocol, "flown_with": describe(fly),
+                                   **({"env_options": {k: v for k, v in options.items()}} if options else {})}
+    return doc
 
 
 #: where a tuned schedule goes unless --out says otherwise
@@ -164,8 +210,14 @@ def output_path(vehicle: str, out: str | None, overwrite: bool, stem: str | None
 class Args:
     """Command-line arguments (``lvgym design pid --help``)."""
 
-    vehicle: str = arg("smile", choices=tuple(sorted(VEHICLE_TIMES)))
-    """the vehicle whose schedule is tuned"""
+    vehicle: str = arg("smile", check=vehicle_option, metavar="NAME|PATH")
+    """the vehicle whose schedule is tuned: a shipped vehicle (smile, stratos3, slender) or the path of a
+    vehicle YAML file (docs/vehicles.md; give --times)"""
+    protocol: str = arg("v0", choices=("v0", "v1"))
+    """the protocol whose env flies the vehicle to each row (a file: in SMILE's env of it)"""
+    fly: str = arg("auto", check=fly_option, metavar="MODE|SCHEDULE")
+    """how each row's operating point is reached: centred (gimbal at zero), rows (the schedule of the rows
+    tuned so far), a schedule file, or auto (centred for a shipped vehicle, rows for a file)"""
     out: str | None = None
     """YAML file (default results/schedules/<vehicle>.yaml; with --overwrite: the shipped
     baselines/schedules/<vehicle>.yaml)"""
@@ -193,22 +245,27 @@ def main(argv: list[str] | None = None) -> int:
 
     a = parse(Args, argv, "python -m lvgym.baselines.design.tune", __doc__)
     try:                                             # refused before the (slow) tuning
-        out = output_path(a.vehicle, a.out, a.overwrite)
+        out = output_path(stem(a.vehicle), a.out, a.overwrite)
+        times = default_times(a.vehicle, VEHICLE_TIMES, "--times") if not a.times else a.times
     except ConfigError as exc:
         fail(command_name("python -m lvgym.baselines.design.tune"), exc)
-    doc = schedule(a.vehicle, a.times, a.bandwidth, a.phase_margin, a.dt or None, a.n, a.ki_ratio)
+    doc = schedule(a.vehicle, times, a.bandwidth, a.phase_margin, a.dt or None, a.n, a.ki_ratio, protocol=a.protocol,
+                   fly=a.fly)
     if len(doc["rows"]) < 1:
         print(f"no flight time of {a.vehicle} could be tuned; nothing written", file=sys.stderr)
         return 1
     from lvgym.benchmark.results import atomic_write_text
 
-    again = f"lvgym design pid --vehicle {a.vehicle}" + (" --overwrite" if out.parent.resolve() ==
-                                                         SCHEDULES.resolve() else f" --out {out}")
+    again = (f"lvgym design pid --vehicle {a.vehicle}" + ("" if a.protocol == "v0" else f" --protocol {a.protocol}")
+             + ("" if a.fly == "auto" else f" --fly {a.fly}")
+             + ("" if not a.times else " --times " + " ".join(f"{t:g}" for t in a.times))
+             + (" --overwrite" if out.parent.resolve() == SCHEDULES.resolve() else f" --out {out}"))
     out.parent.mkdir(parents=True, exist_ok=True)
     atomic_write_text(out, f"# Gain schedule of {a.vehicle}, regenerated by: {again}\n"
                       "# Gains: rad of gimbal per rad/s of rate error (kp), per rad (ki), per rad/s^2 (kd); n [rad/s].\n"
                       + yaml.safe_dump(doc, sort_keys=False, default_flow_style=None, width=120))
-    print(f"wrote {out}" + ("" if out.parent.resolve() == SCHEDULES.resolve() else
+    shipped = out.parent.resolve() == SCHEDULES.resolve() or not is_shipped(a.vehicle)
+    print(f"wrote {out}" + ("" if shipped else
                             f" (the shipped schedule that gs-pid reads is {SCHEDULES / (a.vehicle + '.yaml')}; "
                             "replace it with --overwrite)"))
     return 0

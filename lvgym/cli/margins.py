@@ -4,6 +4,7 @@ nonlinear simulation, gain up and down [dB] and delay [ms] (:mod:`lvgym.benchmar
     lvgym margins                                          # the default policies on smile-v1, 5 test seeds
     lvgym margins --policies zero pid gs-pid ppo --seeds 10 --models rigid
     lvgym margins --policies runs/ppo_smile --physics-dt-s 0.005   # 5 ms delay resolution
+    lvgym margins --policies zero pid --vehicle my_rocket.yaml     # the suite's conditions, your vehicle
 
 Seeds: the ``test`` seeds by default: a margin is a measurement, not tuning (``--seed-set validation`` for
 design loops). Policies are registered names, SB3 ``.zip`` paths or ``train.py`` run folders, as
@@ -37,6 +38,19 @@ _OPTIONS = ("error_ratio", "rate_limit_ratio", "gain_max_db", "gain_min_db", "ga
             "delay_max_s")
 
 
+def _vehicle(option: str, value: str) -> str:
+    """``--vehicle``: a vehicle that reads (a missing or invalid file names itself in one line)."""
+    from lvgym.vehicle.config import load_vehicle
+
+    try:
+        load_vehicle(value)
+    except ConfigError as exc:
+        if exc.key == "vehicle":
+            raise ConfigError(option, exc.value, exc.allowed) from None
+        raise
+    return value
+
+
 @dataclass
 class Args(FlightArgs):
     """Command-line arguments (``lvgym margins --help``)."""
@@ -67,6 +81,9 @@ class Args(FlightArgs):
     """first step of the outward gain search [dB], doubling"""
     delay_max_s: float = _D.delay_max_s
     """delay searched up to [s]"""
+    vehicle: str | None = arg(None, check=_vehicle, metavar="NAME|PATH")
+    """fly every condition with this vehicle in place of the suite's: a shipped vehicle or the path of a
+    vehicle YAML file (docs/vehicles.md); the results are then not protocol numbers (version +override)"""
     physics_dt_s: float | None = arg(None, lo=0.0, lo_open=True, hi=0.05)
     """physics step [s], the delay's resolution (default: the env's, 0.01; it also changes the integration
     step and the servo_delay dispersion's quantum)"""
@@ -100,7 +117,8 @@ def main(argv: list[str] | None = None) -> list[dict[str, Any]]:
     prog = command_name(PROG)
     exit_on_sigterm()
     policies, suite, conds = resolve_flights(prog, args.policies, args.suite, args.models,
-                                             mission_time_s=args.mission_time_s, physics_dt_s=args.physics_dt_s)
+                                             mission_time_s=args.mission_time_s, physics_dt_s=args.physics_dt_s,
+                                             vehicle=args.vehicle)
     if args.physics_dt_s is not None:
         for c in conds:
             n = _control_dt_s(c) / args.physics_dt_s
