@@ -14,6 +14,8 @@ the table also gives a ratio that does not depend on the machine: the cost of on
 thread) in steps of the bare dynamics core (one RK4 step of the same vehicle size with held loads,
 :mod:`lvgym.bench`), measured in the same run. A SMILE env step does 2 RK4 steps, each with 4 evaluations
 of the flight loads, plus the servo, the events and the task signals, so the ratio is at least 2.
+A row "the floor" measures that physics alone on the batched env's own rows (:func:`floor`): the 2 RK4 steps
+of a control period with their 8 load evaluations, nothing else.
 The ratio is given twice: from wall times (the core's RK4 steps per second times the simulator threads,
 over the env steps per second: a thread waiting for the Python part of a step counts) and from CPU times
 (``time.process_time``, every thread's: the CPU seconds of an env step over those of a core RK4 step). On a
@@ -126,6 +128,35 @@ def core(model: str, min_time: float) -> tuple[float, float]:
     return 256 * 20 * rate, cpu / (256 * 20)
 
 
+def floor(env_id: str, model: str, n: int, min_time: float) -> tuple[float, float]:
+    """The physics of an env step alone, per row: the 2 RK4 steps of one control period, with their 8
+    evaluations of the flight loads (:data:`lvgym.simulator.flight.flight_loads`: gravity, atmosphere,
+    wind, aerodynamics, thrust), on the rows of the native VectorEnv of ``n`` rows at mid-flight (after
+    the warm-up of :func:`vector`), on one thread; no servo, sensors, events, timeline look-up or task
+    signals. Rows per second and CPU seconds per row. Each call starts from the same states."""
+    from lvgym.dynamics import step_batch
+    from lvgym.simulator.flight import flight_loads
+
+    env = gym.make_vec(env_id, num_envs=n, vectorization_mode="vector_entry_point", model=model)
+    env.reset(seed=0)
+    a = np.zeros((n, 2), dtype=np.float32)
+    for _ in range(250):
+        env.step(a)
+    sim, data = env.unwrapped.func.sim, env.unwrapped.core.state.sim
+    s, spec = sim.setup, env.unwrapped.func.spec
+    n_rk4, h = spec.substeps, spec.timing.physics_dt_s
+    x0, p, ctx = data.x.copy(), data.p.copy(), data.ctx.copy()
+    x = x0.copy()
+
+    def physics() -> None:
+        x[:] = x0
+        step_batch(flight_loads, x, p, ctx, 0.0, h, n_rk4, s.n_slosh, s.n_modes, True, s.n_u)
+
+    physics()
+    rate, cpu = _timed(physics, 20, min_time)
+    return n * rate, cpu / n
+
+
 def run(min_time: float = 2.0, batch: int = 1024, protocol: str = "v1") -> list[tuple[str, str, float, float, float]]:
     """``(model, how, env-steps/s, cost, CPU cost)`` rows of the env of ``protocol`` (:data:`ENV_IDS`): the
     cost of an env step in core RK4 steps, per simulator thread from the wall times, and from the CPU
@@ -141,6 +172,9 @@ def run(min_time: float = 2.0, batch: int = 1024, protocol: str = "v1") -> list[
                                        (f"VectorEnv, {batch} rows", vector(env_id, model, batch, min_time), threads),
                                        (f"SB3 VecEnv, {batch} rows", sb3(env_id, model, batch, min_time), threads)):
             rows.append((model, how, rate, base * used / rate, cpu / base_cpu))
+        rate, cpu = floor(env_id, model, batch, min_time)
+        rows.append((model, f"the floor: 2 RK4 steps with 8 flight-load evaluations, {batch} rows, 1 thread",
+                     rate, base / rate, cpu / base_cpu))
         rows.append((model, "dynamics core alone, 256 vehicles, 1 thread [RK4 steps/s]", base, 1.0, 1.0))
     return rows
 
