@@ -19,6 +19,7 @@ from lvgym.benchmark.registry import resolve_policy
 from lvgym.benchmark.rows import fly_rows
 from lvgym.benchmark.runner import build_policy, play_episode, zero_policy
 from lvgym.benchmark.suites import condition
+from lvgym.benchmark.tables import flyability_table
 
 R = math.radians(30.0)          # the rate limit [rad/s]
 DT = 0.02                       # the SMILE control period [s]
@@ -112,6 +113,9 @@ def test_v2_ranks_an_unflyable_policy_like_a_failing_one_and_v1_ranks_as_before(
     chatter = rows[2]
     assert chatter["unflyable_rate"] == 1.0 and chatter["failure_rate_v2"] == 1.0 and chatter["failure_rate"] == 0.0
     assert rows[1]["failure_rate_v2"] == 0.5 and rows[0]["score_v2_mean"] == rows[0]["score_mean"] == 2.0
+    table = flyability_table(rows)                       # v2 rows: one line each, in rank order
+    assert [line.split("|")[2].strip() for line in table[2:]] == ["smooth", "failing", "chatter"]
+    assert "| 100 % |" in table[-1] and flyability_table(summarize(v1)) == []
 
 
 class WhiteChatter:
