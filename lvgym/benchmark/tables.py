@@ -84,8 +84,8 @@ def flyability_table(summary: Sequence[Row]) -> list[str]:
     out = ["| condition | policy | rank | failed or unflyable [95 % CI] | unflyable | score_v2 [rad] "
            "| commanded rate RMS [% of limit] | 2 s peak [% of limit] |", "|---|---|---:|---:|---:|---:|---:|---:|"]
     for r in rank([dict(r) for r in summary]):
-        either = _interval(100.0 * r["failure_rate_v2"], 100.0 * r["failure_rate_v2_ci_low"],
-                           100.0 * r["failure_rate_v2_ci_high"], ".0f")
+        either = (f"{_pct(r['failure_rate_v2'])} [{100.0 * r['failure_rate_v2_ci_low']:.0f}, "
+                  f"{100.0 * r['failure_rate_v2_ci_high']:.0f}]")
         out.append(f"| {_short(r['condition'])} | {r['policy']} | {r['rank']} | {either} | {_pct(r['unflyable_rate'])} "
                    f"| {_ci(r, 'score_v2')} | {_ci(r, 'cmd_rate_rms', '.1f', 100.0)} "
                    f"| {_ci(r, 'cmd_rate_peak', '.1f', 100.0)} |")
