@@ -18,9 +18,9 @@ cmd_reversal_hz             1/s     sign changes of the command's increment per 
 flyable                     -       neither part of the rule below is broken
 unflyable_at_s              s       when the rule was first broken (NaN: never)
 score_v2                    rad     the v2 headline: ``score`` for a flyable flight; an unflyable flight is
-                                    charged as a failure at ``unflyable_at_s`` (or at its failure, if that
-                                    came first): its rate error up to then plus ``failure_penalty_rad_per_s``
-                                    times the mission time left
+                                    charged as a failure at ``unflyable_at_s`` (a step it flew, so never
+                                    after a failure of its own): its rate error up to then plus
+                                    ``failure_penalty_rad_per_s`` times the mission time left
 ==========================  ======  =================================================================
 
 The rule (docs/benchmark.md, "Flyability (protocol v2)", has the reasons and the sources):
