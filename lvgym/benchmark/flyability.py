@@ -124,8 +124,9 @@ def command_metrics(command_rad: np.ndarray | None, on: np.ndarray, time_s: np.n
 def v2_score(rate_error_radps: np.ndarray, time_s: np.ndarray, dt: float, score: float,
              unflyable_at_s: float, mission_time_s: float, penalty_rad_per_s: float) -> float:
     """The v2 headline of one flight: ``score`` (v1's) when ``unflyable_at_s`` is NaN (flyable); else (a
-    breach is a step of the flight, so never after a failure) the pitch + yaw rate error of the steps up to ``unflyable_at_s`` [s] (``rate_error_radps``
-    (N, 3) [rad/s], summed as v1 sums it) plus ``penalty_rad_per_s`` times the mission time left [rad]."""
+    breach is a step of the flight, so never after a failure) the pitch + yaw rate error of the steps up to
+    ``unflyable_at_s`` [s] (``rate_error_radps`` (N, 3) [rad/s], summed as v1 sums it) plus
+    ``penalty_rad_per_s`` times the mission time left [rad]."""
     if math.isnan(unflyable_at_s):
         return float(score)
     t = np.asarray(time_s, dtype=float)
@@ -144,5 +145,6 @@ def flyability_metrics(facts: Any, columns: Any, record: dict[str, Any]) -> dict
     t = np.asarray(columns.time_s, dtype=float)
     on = columns.controller_on if columns.controller_on is not None else np.ones(len(t), dtype=bool)
     m = command_metrics(columns.command_rad, on, t, dt, float(facts.gimbal_rate_limit_radps))
-    m["score_v2"] = v2_score(columns.rate_error_radps, t, dt, record["score"], m["unflyable_at_s"], facts.mission_time_s, facts.failure_penalty_rad_per_s)
+    m["score_v2"] = v2_score(columns.rate_error_radps, t, dt, record["score"], m["unflyable_at_s"],
+                             facts.mission_time_s, facts.failure_penalty_rad_per_s)
     return m

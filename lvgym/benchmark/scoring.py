@@ -40,7 +40,8 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["FlightColumns", "FlightLog", "IDEAL_OBSERVATIONS", "gimbal_command", "MAX_Q_FRACTION", "PHASES", "QALPHA_COST_FRACTION", "flight_metrics"]
+__all__ = ["FlightColumns", "FlightLog", "IDEAL_OBSERVATIONS", "MAX_Q_FRACTION", "PHASES", "QALPHA_COST_FRACTION",
+           "flight_metrics", "gimbal_command"]
 
 PHASES = ("boost", "max_q", "coast", "upper")
 #: the max-q region: dynamic pressure at least this fraction of its peak before the first burnout [-]
@@ -198,8 +199,11 @@ def _columns(log: FlightLog) -> FlightColumns:
         e = np.zeros((0, 3))
         on = np.zeros(0, dtype=bool)
     gyro = np.array(log.gyro_rows, dtype=float) if log.gyro_rows else None
-    command = gimbal_command(np.array(log.actions, dtype=float), log.gimbal_limit_rad) if len(log.actions) == n and n else None
-    return FlightColumns(t, e, qbar, qalpha, rate, gyro, log.eta, log.slosh, log.events, log.termination, command, on)
+    command = None
+    if n and len(log.actions) == n:                    # every step's action (a v2 record's gimbal command)
+        command = gimbal_command(np.array(log.actions, dtype=float), log.gimbal_limit_rad)
+    return FlightColumns(t, e, qbar, qalpha, rate, gyro, log.eta, log.slosh, log.events, log.termination, command,
+                         on)
 
 
 def flight_metrics(log: FlightLog, columns: FlightColumns | None = None) -> dict[str, Any]:
