@@ -35,7 +35,8 @@ Per suite, for each (suite, condition, policy) (:func:`summarize`): ``mean``, ``
 10 %: the mean of the worst ``ceil(0.1 n)`` episodes, at least one; worst is the largest value, the
 smallest for ``episode_return``), ``failure_rate`` (failed episodes over episodes, with its interval),
 ``n`` and ``rank``: the place of the policy within its (suite, condition), by failure rate, then by mean
-``score`` (lower is better for both; :func:`rank_key`).
+``score`` (lower is better for both; :func:`rank_key`). Protocol v2's records (:mod:`.flyability`) add
+``unflyable_rate`` and ``failure_rate_v2`` (failed or unflyable) and rank by that, then by ``score_v2``.
 
 Degradation (:func:`degradation`), per policy, for each condition against the ``rigid`` condition of its
 group (same env, wind, randomisation and seeds; only the flight model differs):
@@ -55,6 +56,7 @@ from typing import Any
 
 import numpy as np
 
+from .flyability import V2_METRICS
 from .scoring import PHASES
 from .stats import bootstrap_ci, paired
 
@@ -178,7 +180,11 @@ def _std(x: np.ndarray) -> float:
 
 def rank_key(row: dict[str, Any]) -> tuple[float, float]:
     """The order of the tables: failure rate first, then the mean ``score`` (``rate_error_rad`` for
-    records without it); lower is better for both."""
+    records without it); lower is better for both. Rows of protocol v2 records (with ``score_v2_mean``)
+    rank by ``failure_rate_v2`` (an unflyable flight counts as a failure, :mod:`.flyability`), then by the
+    mean ``score_v2``."""
+    if "score_v2_mean" in row:
+        return (float(row["failure_rate_v2"]), float(row["score_v2_mean"]))
     return (float(row["failure_rate"]), float(row.get("score_mean", row["rate_error_rad_mean"])))
 
 
@@ -203,14 +209,17 @@ def summarize(records: Iterable[dict[str, Any]], metrics: Sequence[str] | None =
     """One row per (suite, condition, policy), in order of first appearance: ``n``, ``failure_rate``
     with its interval, the failure reasons with their counts, ``<metric>_mean``, ``_ci_low``,
     ``_ci_high``, ``_std``, ``_cvar10`` of every metric (default: :data:`SUMMARY_METRICS` and those of
-    :data:`V1_METRICS` the records carry) and ``rank`` (:func:`rank`)."""
+    :data:`V1_METRICS` and :data:`~.flyability.V2_METRICS` the records carry) and ``rank`` (:func:`rank`).
+    Records of protocol v2 (with ``flyable``) add ``unflyable_rate`` and ``failure_rate_v2`` (failed or
+    unflyable), each with its interval."""
     groups: dict[tuple[Any, ...], list[dict[str, Any]]] = {}
     for r in records:
         groups.setdefault(tuple(r[k] for k in GROUP_KEYS), []).append(r)
     rows = []
     for key, recs in groups.items():
         first = recs[0]
-        names = metrics if metrics is not None else SUMMARY_METRICS + tuple(m for m in V1_METRICS if m in first)
+        names = metrics if metrics is not None else SUMMARY_METRICS + tuple(m for m in V1_METRICS + V2_METRICS
+                                                                              if m in first)
         row: dict[str, Any] = dict(zip(GROUP_KEYS, key))
         for k in ("group", "model", "wind"):
             if k in first:
@@ -224,6 +233,13 @@ def summarize(records: Iterable[dict[str, Any]], metrics: Sequence[str] | None =
             if r["failed"]:
                 reasons[r["failure_reason"]] = reasons.get(r["failure_reason"], 0) + 1
         row["failure_reasons"] = "; ".join(f"{k}: {v}" for k, v in sorted(reasons.items()))
+        if "flyable" in first:
+            unflyable = np.array([not r["flyable"] for r in recs], dtype=float)
+            row["unflyable_rate"] = float(np.mean(unflyable))
+            row["unflyable_rate_ci_low"], row["unflyable_rate_ci_high"] = bootstrap_ci(unflyable)
+            either = np.maximum(failed, unflyable)
+            row["failure_rate_v2"] = float(np.mean(either))
+            row["failure_rate_v2_ci_low"], row["failure_rate_v2_ci_high"] = bootstrap_ci(either)
         for m in names:
             x = np.array([r[m] for r in recs], dtype=float)
             row[f"{m}_mean"] = float(np.mean(x))

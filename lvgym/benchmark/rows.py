@@ -22,13 +22,14 @@ import numpy as np
 
 from .batch import BatchPolicy
 from .metrics import Trajectory, combined_record, episode_metrics
-from .scoring import FlightColumns, FlightLog, flight_metrics
+from .flyability import flyability_metrics
+from .scoring import FlightColumns, FlightLog, flight_metrics, gimbal_command
 
 __all__ = ["RowsLog", "fly_rows", "neutral_action"]
 
 #: the info entries kept per step (the single env's TrajectoryBuilder and FlightLog read these)
 STEP_KEYS = ("rate_error", "gimbal", "alpha_total", "qalpha_pa_deg", "time", "qbar", "gimbal_rate", "eta",
-             "slosh_angles")
+             "slosh_angles", "controller_on")
 
 
 def neutral_action(space: Any) -> np.ndarray:
@@ -48,15 +49,19 @@ class RowsLog:
         self.env, self.n = env, int(env.num_envs)
         self.facts = FlightLog.for_env(env)                # the task's facts (control period, limits, gyro)
         self.dt_s = float(u.task.control_dt_s)
-        self.steps: dict[str, list[np.ndarray]] = {key: [] for key in ("reward", "gyro", *STEP_KEYS)}
+        self.steps: dict[str, list[np.ndarray]] = {key: [] for key in ("reward", "gyro", "action", *STEP_KEYS)}
         self.length = np.zeros(self.n, dtype=np.int64)
         self.events: list[list[tuple[float, str]]] = [[] for _ in range(self.n)]
         self.termination = [""] * self.n
 
-    def add(self, live: np.ndarray, observations: np.ndarray, reward: np.ndarray, info: dict[str, Any]) -> None:
-        """One step of every row; ``live``: the rows still flying before it (they count it)."""
+    def add(self, live: np.ndarray, observations: np.ndarray, reward: np.ndarray, info: dict[str, Any],
+            actions: np.ndarray | None = None) -> None:
+        """One step of every row; ``live``: the rows still flying before it (they count it); ``actions``:
+        the policies' actions of the step (before any delay; kept with a gimbal, as ``FlightLog.step``)."""
         steps = self.steps
         steps["reward"].append(np.asarray(reward, dtype=float))
+        if actions is not None and self.facts.gimbal_limit_rad > 0.0:
+            steps["action"].append(np.array(actions, dtype=float))
         for key in STEP_KEYS:
             steps[key].append(np.asarray(info[key]))
         if self.facts.gyro_index is not None:        # the gyro's view against the body rate, as FlightLog.step
@@ -79,9 +84,10 @@ class RowsLog:
             if reason:
                 self.termination[b] = str(reason)
 
-    def records(self) -> list[dict[str, Any]]:
+    def records(self, flyability: bool = False) -> list[dict[str, Any]]:
         """Every row's record: :func:`~.metrics.episode_metrics` and :func:`~.scoring.flight_metrics` of its
-        steps (C-contiguous copies, as the single env's builders make them)."""
+        steps (C-contiguous copies, as the single env's builders make them); with ``flyability`` (protocol
+        v2) also :func:`~.flyability.flyability_metrics`."""
         stacked = {key: np.stack(v) if v else None for key, v in self.steps.items()}
         out = []
         for b in range(self.n):
@@ -93,10 +99,17 @@ class RowsLog:
             traj = Trajectory(self.dt_s, col("rate_error"), col("gimbal"), col("alpha_total"), col("qalpha_pa_deg"),
                               col("reward"), col("time"), col("qbar"), self.termination[b])
             gyro = col("gyro") if stacked["gyro"] is not None else None
+            command = None
+            if stacked["action"] is not None and L:
+                command = gimbal_command(col("action"), self.facts.gimbal_limit_rad)
+            on = np.ascontiguousarray(stacked["controller_on"][:L, b], dtype=bool)
             columns = FlightColumns(traj.time_s, traj.rate_error_radps, traj.qbar_pa, traj.qalpha_pa_deg,
                                     col("gimbal_rate"), gyro, col("eta"), col("slosh_angles"), self.events[b],
-                                    self.termination[b])
-            out.append(combined_record(episode_metrics(traj), flight_metrics(self.facts, columns)))
+                                    self.termination[b], command, on)
+            record = combined_record(episode_metrics(traj), flight_metrics(self.facts, columns))
+            if flyability:
+                record.update(flyability_metrics(self.facts, columns, record))
+            out.append(record)
         return out
 
 
@@ -110,14 +123,15 @@ def _scaled(actions: np.ndarray, gains: np.ndarray, name: str) -> np.ndarray:
 
 def fly_rows(env: Any, seeds: Sequence[int], groups: Sequence[tuple[BatchPolicy, Sequence[int]]], *,
              gains: Sequence[float] | None = None, delay_steps: Sequence[int] | None = None,
-             first_observations: list[np.ndarray] | None = None) -> list[dict[str, Any]]:
+             first_observations: list[np.ndarray] | None = None, flyability: bool = False) -> list[dict[str, Any]]:
     """One episode per row of the batched lvgym env ``env`` (``env.num_envs == len(seeds)``), row ``i``
     reset with ``seeds[i]``; ``groups``: (batch policy, its rows) pairs that cover every row once (a
     policy's batch holds at least ``num_envs`` rows and is addressed by the env's row numbers). ``gains``
     (per row, 1: none) scales each row's actions (:class:`~.perturb.GainPolicy`), ``delay_steps`` (per row,
     0: none) delays them by whole physics steps (:class:`~.perturb.RowDelay`). Returns the rows' records in
     row order, each as :func:`~.runner.play_episode` gives it for the single env with that seed (and
-    perturbation); ``first_observations``, if given, receives the reset's observation of every row."""
+    perturbation); ``first_observations``, if given, receives the reset's observation of every row;
+    ``flyability``: add protocol v2's flyability fields (:mod:`.flyability`) to every record."""
     n = int(env.num_envs)
     if len(seeds) != n:
         raise ValueError(f"{len(seeds)} seeds for a batched env of {n} rows")
@@ -152,12 +166,13 @@ def fly_rows(env: Any, seeds: Sequence[int], groups: Sequence[tuple[BatchPolicy,
         actions = np.broadcast_to(neutral.astype(dtype), (n, *neutral.shape)).copy()
         for live, a in acted:
             actions[live] = a
+        asked = actions
         if delay is not None:
             actions = delay.apply(actions)
         live = np.flatnonzero(~done)
         obs, reward, terminated, truncated, info = env.step(actions)
-        log.add(live, obs, reward, info)
+        log.add(live, obs, reward, info, asked)
         ended = live[(np.asarray(terminated) | np.asarray(truncated))[live]]
         log.end(ended, info)
         done[ended] = True
-    return log.records()
+    return log.records(flyability)

@@ -26,6 +26,7 @@ from lvgym.parallel import EXECUTORS, check_workers, default_workers, run_map
 
 from .batch import BatchPolicy, as_batch
 from .factory import load_factory
+from .flyability import applies, flyability_metrics
 from .metrics import TrajectoryBuilder, combined_record, episode_metrics
 from .policy import Policy, ZeroPolicy
 from .rows import fly_rows
@@ -112,13 +113,14 @@ def _env(condition: Condition) -> Any:
     return _ENVS[condition]
 
 
-def play_episode(policy: Policy, env: Any, seed: int) -> dict[str, Any]:
+def play_episode(policy: Policy, env: Any, seed: int, *, flyability: bool = False) -> dict[str, Any]:
     """Fly one episode of a policy object on an lvgym env reset with ``seed``; returns protocol v0's
     :func:`~.metrics.episode_metrics` (frozen) and, beside them, the v1 metrics of
     :func:`~.scoring.flight_metrics` (``score``, the per-phase rate errors, the flexibility metrics,
-    ``qalpha_cost_s``; its ``rate_error_rad`` and failure fields are v0's, bit for bit). In-process (e.g.
-    a validation callback during training: ``play_episode(policy, condition.make_env(), seed)`` over
-    ``suite.seeds("validation", n)``)."""
+    ``qalpha_cost_s``; its ``rate_error_rad`` and failure fields are v0's, bit for bit); with
+    ``flyability`` (protocol v2), also :func:`~.flyability.flyability_metrics` (``flyable``, ``score_v2``,
+    the commanded gimbal rate). In-process (e.g. a validation callback during training:
+    ``play_episode(policy, condition.make_env(), seed)`` over ``suite.seeds("validation", n)``)."""
     obs, info = env.reset(seed=int(seed))
     policy.reset()
     traj = TrajectoryBuilder(float(env.unwrapped.task.control_dt_s))
@@ -127,10 +129,13 @@ def play_episode(policy: Policy, env: Any, seed: int) -> dict[str, Any]:
         action = policy.act(obs, info)
         obs, reward, terminated, truncated, info = env.step(action)
         traj.add(reward, info)
-        log.step(env, obs, reward, info)
+        log.step(env, obs, reward, info, action)
         if terminated or truncated:
             break
-    return combined_record(episode_metrics(traj.build()), flight_metrics(log))
+    record = combined_record(episode_metrics(traj.build()), flight_metrics(log))
+    if flyability:
+        record.update(flyability_metrics(log, log.columns(), record))
+    return record
 
 
 def episode_objects(policy_spec: PolicySpec, condition: Condition) -> tuple[Any, Policy]:
@@ -167,10 +172,11 @@ def batch_objects(policy_spec: PolicySpec, condition: Condition, n: int) -> Batc
 
 
 def fly_block(condition: Condition, rows: Sequence[tuple[PolicySpec, int]], *, gains: Sequence[float] | None = None,
-              delay_steps: Sequence[int] | None = None,
-              first_observations: list[np.ndarray] | None = None) -> list[dict[str, Any]]:
+              delay_steps: Sequence[int] | None = None, first_observations: list[np.ndarray] | None = None,
+              flyability: bool = False) -> list[dict[str, Any]]:
     """One episode per ``(policy spec, seed)`` of ``rows``, flown together as the rows of ``condition``'s
-    batched env (:func:`~.rows.fly_rows`; ``gains``, ``delay_steps``, ``first_observations`` as there);
+    batched env (:func:`~.rows.fly_rows`; ``gains``, ``delay_steps``, ``first_observations``, ``flyability``
+    as there);
     the records in the order of ``rows``, each the :func:`play_episode` of its policy and seed on the
     single env, to the bit. Envs and batched policies are cached per process."""
     env = vec_env(condition, len(rows))
@@ -179,7 +185,7 @@ def fly_block(condition: Condition, rows: Sequence[tuple[PolicySpec, int]], *, g
         owners.setdefault(spec, []).append(i)
     groups = [(batch_objects(spec, condition, len(rows)), idx) for spec, idx in owners.items()]
     return fly_rows(env, [int(seed) for _, seed in rows], groups, gains=gains, delay_steps=delay_steps,
-                    first_observations=first_observations)
+                    first_observations=first_observations, flyability=flyability)
 
 
 def _labels(policy_spec: PolicySpec, condition: Condition, seed: int) -> dict[str, Any]:
@@ -187,12 +193,13 @@ def _labels(policy_spec: PolicySpec, condition: Condition, seed: int) -> dict[st
             "env_id": condition.env_id, "model": condition.model, "wind": condition.wind, "seed": int(seed)}
 
 
-def run_episode(policy_spec: PolicySpec, condition: Condition, seed: int) -> dict[str, Any]:
+def run_episode(policy_spec: PolicySpec, condition: Condition, seed: int, flyability: bool = False) -> dict[str, Any]:
     """One episode of ``policy_spec`` on ``condition``, reset with ``seed``; returns the record: the
-    policy and condition labels, the seed and :func:`~.metrics.episode_metrics`. A function of its
-    arguments only (envs and policies are cached per process, and reset every episode)."""
+    policy and condition labels, the seed and :func:`play_episode`'s metrics (``flyability``: protocol v2's
+    too). A function of its arguments only (envs and policies are cached per process, and reset every
+    episode)."""
     env, policy = episode_objects(policy_spec, condition)
-    return {**_labels(policy_spec, condition, seed), **play_episode(policy, env, seed)}
+    return {**_labels(policy_spec, condition, seed), **play_episode(policy, env, seed, flyability=flyability)}
 
 
 @dataclass(frozen=True)
@@ -209,8 +216,9 @@ class Task:
 
 
 def run_task(task: Task) -> dict[str, Any]:
-    """:func:`run_episode` of a task, labelled with the suite, the protocol version and the episode."""
-    record = run_episode(task.policy, task.condition, task.seed)
+    """:func:`run_episode` of a task, labelled with the suite, the protocol version and the episode (with
+    the flyability fields from protocol v2 on, :func:`~.flyability.applies`)."""
+    record = run_episode(task.policy, task.condition, task.seed, applies(task.version))
     return {"protocol": task.version, "suite": task.suite, "episode": task.episode, **record}
 
 
@@ -273,7 +281,7 @@ def run_block(block: Block) -> list[dict[str, Any]]:
     """The records of a block's tasks, in order, as :func:`run_task` gives each (flown together,
     :func:`fly_block`)."""
     first = block.tasks[0]
-    records = fly_block(first.condition, [(t.policy, t.seed) for t in block.tasks])
+    records = fly_block(first.condition, [(t.policy, t.seed) for t in block.tasks], flyability=applies(first.version))
     return [{"protocol": t.version, "suite": t.suite, "episode": t.episode, **_labels(t.policy, t.condition, t.seed),
              **r} for t, r in zip(block.tasks, records)]
 

@@ -40,7 +40,8 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["FlightColumns", "FlightLog", "IDEAL_OBSERVATIONS", "MAX_Q_FRACTION", "PHASES", "QALPHA_COST_FRACTION", "flight_metrics"]
+__all__ = ["FlightColumns", "FlightLog", "IDEAL_OBSERVATIONS", "MAX_Q_FRACTION", "PHASES", "QALPHA_COST_FRACTION",
+           "flight_metrics", "gimbal_command"]
 
 PHASES = ("boost", "max_q", "coast", "upper")
 #: the max-q region: dynamic pressure at least this fraction of its peak before the first burnout [-]
@@ -57,9 +58,10 @@ GYRO_ENTRIES = ("pitch_rate_error", "yaw_rate_error", "pitch_rate_reference")
 class FlightLog:
     """One episode, step by step (``add(reward, info)``, or :meth:`step` with the env and observation),
     with the task's facts: ``dt_s`` control period, ``mission_time_s``, ``failure_penalty_rad_per_s``,
-    ``qalpha_limit_pa_deg``, ``gimbal_rate_limit_radps`` (0: not counted) and ``gyro_index``: the
-    observation's indices of :data:`GYRO_ENTRIES` (None: an ideal-state observation, no gyro). Build it from
-    an lvgym env with :meth:`for_env`."""
+    ``qalpha_limit_pa_deg``, ``gimbal_rate_limit_radps`` (0: not counted), ``gyro_index``: the
+    observation's indices of :data:`GYRO_ENTRIES` (None: an ideal-state observation, no gyro) and
+    ``gimbal_limit_rad`` (0: no gimbal, an RCS task; else the actions are kept as gimbal commands for
+    protocol v2's :mod:`.flyability`). Build it from an lvgym env with :meth:`for_env`."""
 
     dt_s: float
     mission_time_s: float
@@ -67,8 +69,10 @@ class FlightLog:
     qalpha_limit_pa_deg: float
     gimbal_rate_limit_radps: float = 0.0
     gyro_index: tuple[int, int, int] | None = None
+    gimbal_limit_rad: float = 0.0
     rows: list[tuple[Any, ...]] = field(default_factory=list)
     gyro_rows: list[tuple[float, float]] = field(default_factory=list)
+    actions: list[np.ndarray] = field(default_factory=list)
     eta: list[Any] = field(default_factory=list)
     slosh: list[Any] = field(default_factory=list)
     events: list[tuple[float, str]] = field(default_factory=list)
@@ -81,17 +85,21 @@ class FlightLog:
         gyro = None
         if s.observation not in IDEAL_OBSERVATIONS:
             gyro = tuple(u.observation_layout.index(name) for name in GYRO_ENTRIES)
+        limit = float(u.gimbal_limit) if s.control == "tvc" else 0.0
         return cls(s.control_dt_s, s.mission_time_s, s.failure_penalty_rad_per_s, s.qalpha_limit_pa_deg,
-                   math.radians(s.gimbal_rate_limit_degps), gyro)
+                   math.radians(s.gimbal_rate_limit_degps), gyro, limit)
 
-    def add(self, reward: float, info: dict[str, Any], gyro_minus_body_radps: tuple[float, float] | None = None) -> None:
-        """Record one step's info (and, with a gyro, the step's gyro minus body rate, pitch and yaw [rad/s]).
-        Arrays are kept as they come (an env's info holds fresh arrays every step) and reduced by
-        :func:`flight_metrics`."""
+    def add(self, reward: float, info: dict[str, Any], gyro_minus_body_radps: tuple[float, float] | None = None,
+            action: Any = None) -> None:
+        """Record one step's info (and, with a gyro, the step's gyro minus body rate, pitch and yaw [rad/s];
+        with a gimbal, the step's ``action``: the policy's, before the env clips it). Arrays are kept as
+        they come (an env's info holds fresh arrays every step) and reduced by :func:`flight_metrics`."""
         self.rows.append((info["time"], info["rate_error"], info["qbar"], info["qalpha_pa_deg"],
-                          info.get("gimbal_rate", (0.0, 0.0))))
+                          info.get("gimbal_rate", (0.0, 0.0)), info.get("controller_on", True)))
         if gyro_minus_body_radps is not None:
             self.gyro_rows.append(gyro_minus_body_radps)
+        if action is not None and self.gimbal_limit_rad > 0.0:
+            self.actions.append(np.asarray(action, dtype=float))
         if "eta" in info:
             self.eta.append(info["eta"])
         if "slosh_angles" in info:
@@ -101,16 +109,21 @@ class FlightLog:
         if info.get("termination"):
             self.termination = str(info["termination"])
 
-    def step(self, env: Any, observation: np.ndarray, reward: float, info: dict[str, Any]) -> None:
+    def step(self, env: Any, observation: np.ndarray, reward: float, info: dict[str, Any], action: Any = None) -> None:
         """Record one ``env.step``'s result: :meth:`add`, with the gyro's view read from ``observation``
-        against the body rate of the env's state (lvgym envs) when the observation has a gyro."""
+        against the body rate of the env's state (lvgym envs) when the observation has a gyro, and the
+        ``action`` the step was given."""
         diff = None
         if self.gyro_index is not None:
             u = env.unwrapped
             w = u.flight.state("omega_bi_b")[0]
             ip, iy, iref = self.gyro_index
             diff = (float(observation[ip]) + float(observation[iref]) - w[1], float(observation[iy]) - w[2])
-        self.add(reward, info, diff)
+        self.add(reward, info, diff, action)
+
+    def columns(self) -> FlightColumns:
+        """The steps so far as arrays (:class:`FlightColumns`)."""
+        return _columns(self)
 
 
 def _phase_masks(t: np.ndarray, qbar: np.ndarray, events: list[tuple[float, str]]) -> dict[str, np.ndarray]:
@@ -146,8 +159,11 @@ class FlightColumns:
     flight's row, :mod:`.rows`): ``time_s`` (N,) [s], ``rate_error_radps`` (N, 3) [rad/s], ``qbar_pa`` (N,)
     [Pa], ``qalpha_pa_deg`` (N,) [Pa deg], ``gimbal_rate_radps`` (N, n) [rad/s], ``gyro_minus_body_radps``
     (N, 2) [rad/s] or None (no gyro), ``eta`` (N, ...) and ``slosh_angles_rad`` (N, ...) (or lists of one
-    array per step), ``events`` ((t [s], text) pairs) and ``termination``. Arrays C-contiguous as
-    ``np.array`` of the steps makes them: :func:`flight_metrics` then sums them in the same order."""
+    array per step), ``events`` ((t [s], text) pairs) and ``termination``; for protocol v2's
+    :mod:`.flyability`, ``command_rad`` (N, 2) [rad] the policy's gimbal command (its action clipped to
+    [-1, 1] times the gimbal limit; None: no gimbal or not recorded) and ``controller_on`` (N,) whether the
+    controller acted in the step (None: always). Arrays C-contiguous as ``np.array`` of the steps makes
+    them: :func:`flight_metrics` then sums them in the same order."""
 
     time_s: np.ndarray
     rate_error_radps: np.ndarray
@@ -159,6 +175,14 @@ class FlightColumns:
     slosh_angles_rad: Any
     events: list[tuple[float, str]]
     termination: str
+    command_rad: np.ndarray | None = None
+    controller_on: np.ndarray | None = None
+
+
+def gimbal_command(actions: np.ndarray, gimbal_limit_rad: float) -> np.ndarray:
+    """The gimbal command [rad] of TVC ``actions`` (N, 2) [-]: clipped to [-1, 1] (as the env clips them)
+    times the gimbal limit [rad]."""
+    return np.clip(np.asarray(actions, dtype=float), -1.0, 1.0) * float(gimbal_limit_rad)
 
 
 def _columns(log: FlightLog) -> FlightColumns:
@@ -169,11 +193,17 @@ def _columns(log: FlightLog) -> FlightColumns:
         t, qbar, qalpha = (np.array(cols[i], dtype=float) for i in (0, 2, 3))
         e = np.array(cols[1], dtype=float)
         rate = np.array(cols[4], dtype=float)
+        on = np.array(cols[5], dtype=bool).reshape(n)
     else:
         t = qbar = qalpha = rate = np.zeros(0)
         e = np.zeros((0, 3))
+        on = np.zeros(0, dtype=bool)
     gyro = np.array(log.gyro_rows, dtype=float) if log.gyro_rows else None
-    return FlightColumns(t, e, qbar, qalpha, rate, gyro, log.eta, log.slosh, log.events, log.termination)
+    command = None
+    if n and len(log.actions) == n:                    # every step's action (a v2 record's gimbal command)
+        command = gimbal_command(np.array(log.actions, dtype=float), log.gimbal_limit_rad)
+    return FlightColumns(t, e, qbar, qalpha, rate, gyro, log.eta, log.slosh, log.events, log.termination, command,
+                         on)
 
 
 def flight_metrics(log: FlightLog, columns: FlightColumns | None = None) -> dict[str, Any]:

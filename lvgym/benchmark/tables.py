@@ -3,7 +3,8 @@ rigid-to-non-rigid degradation and the paired comparison of the policies.
 
 Every mean is printed with its 95 % bootstrap interval over the seeds as ``mean [low, high]``
 (:func:`.metrics.summarize`). Rows of a condition are in the order of :func:`.metrics.rank`: failure
-rate, then mean score (lower is better).
+rate, then mean score (lower is better); protocol v2's rows by failed or unflyable, then ``score_v2``
+(:func:`flyability_table`).
 """
 
 from __future__ import annotations
@@ -15,8 +16,8 @@ from typing import Any
 from .metrics import rank
 from .scoring import PHASES
 
-__all__ = ["comparison_table", "degradation_table", "markdown_table", "phase_table", "run_groups_table",
-           "summary_table"]
+__all__ = ["comparison_table", "degradation_table", "flyability_table", "markdown_table", "phase_table",
+           "run_groups_table", "summary_table"]
 
 Row = Mapping[str, Any]
 
@@ -71,6 +72,23 @@ def summary_table(summary: Sequence[Row]) -> list[str]:
                    f"| {_ci(r, 'rate_error_rad')} | {r['rate_error_rad_cvar10']:.4f} "
                    f"| {_ci(r, 'max_rate_radps', '.2f', deg(1.0))} | {_ci(r, 'effort_rad_s', '.1f', deg(1.0))} "
                    f"| {_ci(r, 'max_alpha_rad', '.2f', deg(1.0))} | {_ci(r, 'max_qalpha_pa_deg', '.1f', 1e-3)} |")
+    return out
+
+
+def flyability_table(summary: Sequence[Row]) -> list[str]:
+    """Lines of one suite's table of protocol v2's flyability (:mod:`.flyability`) in rank order: failed or
+    unflyable, unflyable, ``score_v2``, the commanded gimbal rate's RMS and 2 s peak in % of the rate limit;
+    none when the rows are not v2's."""
+    if not summary or "score_v2_mean" not in summary[0]:
+        return []
+    out = ["| condition | policy | rank | failed or unflyable [95 % CI] | unflyable | score_v2 [rad] "
+           "| commanded rate RMS [% of limit] | 2 s peak [% of limit] |", "|---|---|---:|---:|---:|---:|---:|---:|"]
+    for r in rank([dict(r) for r in summary]):
+        either = (f"{_pct(r['failure_rate_v2'])} [{100.0 * r['failure_rate_v2_ci_low']:.0f}, "
+                  f"{100.0 * r['failure_rate_v2_ci_high']:.0f}]")
+        out.append(f"| {_short(r['condition'])} | {r['policy']} | {r['rank']} | {either} | {_pct(r['unflyable_rate'])} "
+                   f"| {_ci(r, 'score_v2')} | {_ci(r, 'cmd_rate_rms', '.1f', 100.0)} "
+                   f"| {_ci(r, 'cmd_rate_peak', '.1f', 100.0)} |")
     return out
 
 
@@ -172,6 +190,9 @@ def markdown_table(summary: Sequence[Row], degradation: Sequence[Row], meta: Map
         out += [head, "", "Ranked by failure rate, then by score (a failed episode's rate error plus the failure "
                 "penalty for the mission left); means with 95 % bootstrap intervals over the seeds.", "",
                 *summary_table(rows)]
+        out += _section(f"Flyability ({suite}, protocol v2): the rank is by failed or unflyable (the commanded "
+                        "gimbal rate over the rate limit, docs/benchmark.md), then by score_v2 (an unflyable "
+                        "flight charged as a failure from the breach)", flyability_table(rows))
         out += _section(f"Cumulative pitch + yaw rate error per flight phase ({suite}): boost to max q, the max-q "
                         "region, the staging coast, the upper stage; the phases add up to the total",
                         phase_table(rows))
