@@ -9,7 +9,7 @@
    wind ``w`` flies at an angle of attack ``atan(w / V)`` (SMILE climbs vertically, so all of the wind is normal
    to its axis). The wind that alone reaches the structural limit ``QA`` is ``w_lim = V tan(QA / q)``; at max q
    it is the smallest.
-3. **The maxq-gust draws.** For the test seeds of ``smile-v1-maxq-gust`` (non-rigid), the wind each seed draws
+3. **The maxq-gust draws.** For the validation seeds of ``smile-v1-maxq-gust`` (non-rigid), the wind each seed draws
    (the suite's own model, captured at the env's reset, so the episode is the protocol's) evaluated along the
    calm trajectory: the q-alpha it alone would cause, ``max_t q(t) atan(|w(h(t))| / V(t))``, against the limit;
    then each policy flies the seed, and its failure and largest q-alpha are recorded.
@@ -41,13 +41,13 @@ PROG = "python -m experiments.protocol_v2_design.design_wind"
 def _fly(env: Any, policy: Any, seed: int, wind_probe: list | None = None) -> dict[str, np.ndarray]:
     obs, info = env.reset(seed=int(seed))
     policy.reset()
-    sim = env.unwrapped.sim
     rows: dict[str, list] = {k: [] for k in ("t", "alt", "airspeed", "mach", "qbar", "qalpha")}
     while True:
         obs, _, terminated, truncated, info = env.step(policy.act(obs, info))
         rows["t"].append(float(info["time"]))
-        rows["alt"].append(float(sim.conditions("altitude")[0]))
-        rows["airspeed"].append(float(sim.conditions("airspeed")[0]))
+        flight = env.unwrapped.flight                  # the view of the current state
+        rows["alt"].append(float(flight.conditions("altitude")[0]))
+        rows["airspeed"].append(float(flight.conditions("airspeed")[0]))
         rows["mach"].append(float(info["mach"]))
         rows["qbar"].append(float(info["qbar"]))
         rows["qalpha"].append(float(info["qalpha_pa_deg"]))
@@ -137,7 +137,7 @@ class Args:
     """Command-line arguments (``python -m experiments.protocol_v2_design.design_wind --help``)."""
 
     seeds: int = arg(20, lo=1, hi=1000)
-    """test seeds of smile-v1-maxq-gust (from 10000)"""
+    """validation seeds of smile-v1-maxq-gust (from 0; a design study never flies the test seeds)"""
     policies: list[str] = arg(default_factory=lambda: ["lqg", "gs-pid-flex"], metavar="POLICY")
     """policies flown on each seed"""
     qalpha_limit_kpa_deg: float = arg(250.0, lo=1.0)
@@ -163,8 +163,8 @@ def main(argv: Sequence[str] | None = None) -> int:
       f"{traj['t'][band][0]:.1f} to {traj['t'][band][-1]:.1f} s ({traj['alt'][band][0] / 1e3:.1f}-{traj['alt'][band][-1] / 1e3:.1f} km); "
       f"smallest wind at the limit {np.min(lim):.1f} m/s\n\n")
     names = list(a.policies)
-    recs = maxq_draws(traj, range(10000, 10000 + a.seeds), names)
-    w("## smile-v1-maxq-gust, non-rigid: each test seed's wind along the calm trajectory, and the flights\n\n")
+    recs = maxq_draws(traj, range(a.seeds), names)
+    w("## smile-v1-maxq-gust, non-rigid: each validation seed's wind along the calm trajectory, and the flights\n\n")
     head = "| seed | jet peak [m/s] at [km] | gust [m/s] at [km] | wind's own q-alpha [kPa deg] at [s] | " + \
         " | ".join(f"{p}: failed / max q-alpha" for p in names) + " |\n"
     w(head + "|---:|---:|---:|---:|" + "---|" * len(names) + "\n")

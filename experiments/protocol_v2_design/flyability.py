@@ -1,6 +1,6 @@
 """Candidate flyability metrics of protocol v2, computed for the shipped policies from what the env records.
 
-    python -m experiments.protocol_v2_design.flyability                       # the shipped policies, smile-v1, 3 test seeds
+    python -m experiments.protocol_v2_design.flyability                       # the shipped policies, smile-v1, 3 validation seeds
     python -m experiments.protocol_v2_design.flyability --policies lqg gs-pid-flex --seeds 5 --models nonrigid
 
 Each episode is flown twice on the same seed: as the protocol flies it and with the gyro's angle random walk
@@ -171,7 +171,7 @@ def flyability_episode(task: FlyTask) -> dict[str, Any]:
     return rec
 
 
-def run_flyability(policies: Sequence[PolicySpec], suite: str = "smile-v1", seeds: int = 3, seed_set: str = "test",
+def run_flyability(policies: Sequence[PolicySpec], suite: str = "smile-v1", seeds: int = 3, seed_set: str = "validation",
                    models: Sequence[str] | None = None, hf_hz: float = 5.0, executor: str = "local",
                    workers: int | None = None, progress: bool = True) -> list[dict[str, Any]]:
     """:func:`flyability_episode` of every policy, condition (``models``: all when None) and seed."""
@@ -218,7 +218,7 @@ class Args:
     """the suite flown"""
     seeds: int = arg(3, lo=1, hi=10_000)
     """seeds per policy and condition"""
-    seed_set: str = arg("test", choices=SEED_SETS)
+    seed_set: str = arg("validation", choices=SEED_SETS)
     """test or validation"""
     models: list[str] | None = arg(None, metavar="MODEL")
     """the conditions' flight models (default: all of the suite)"""
