@@ -402,9 +402,13 @@ def smile_scheduled_pid(env: Any, schedule: str = "smile_thesis", name: str | No
 FLEX_SCHEDULES: dict = {"smile_v1": "smile_flex", "stratos3": "stratos3_flex", SLENDER_V1.vehicle: "slender_flex"}
 
 
-def flex_pid(env: Any, name: str = "gs-pid-flex") -> GainScheduledPIDPolicy:
+def flex_pid(env: Any, name: str = "gs-pid-flex", schedule: str | None = None) -> GainScheduledPIDPolicy:
     """``gs-pid-flex``: the filtered gain-scheduled PID designed on the non-rigid v1 flight loop of the
-    vehicle ``env`` flies (:data:`FLEX_SCHEDULES`); a vehicle without a flex design is refused."""
+    vehicle ``env`` flies (:data:`FLEX_SCHEDULES`); a vehicle without a flex design is refused.
+    ``schedule``: another flex schedule of that vehicle instead (a name in ``baselines/schedules`` or a
+    YAML path), e.g. ``smile_flex_quiet`` (``gs-pid-flex-quiet``)."""
+    if schedule is not None:
+        return GainScheduledPIDPolicy(schedule, env=env, name=name)
     vehicle = getattr(env.unwrapped.task, "vehicle", None)
     if not isinstance(vehicle, Hashable) or vehicle not in FLEX_SCHEDULES:
         raise ConfigError("env vehicle", vehicle, f"one of {list(FLEX_SCHEDULES)}: the vehicles of a v1 env "

@@ -173,9 +173,19 @@ def dispersions() -> str:
     return _table(["name", "what is drawn", "law", "clip", "why this range"], rows)
 
 
+def faults() -> str:
+    """The kinds of in-flight fault (lvgym.envs.faults.FAULT_KINDS)."""
+    from lvgym.envs.faults import FAULT_KINDS
+
+    rows = [[f"`{k.name}`", k.what, "-" if k.high == k.low == 0.0 else
+             (f"{k.low * 100:g}-{k.high * 100:g} %" if k.unit == "-" else f"{k.low:g}-{k.high:g} {k.unit}"),
+             "pitch or yaw" if k.one_axis else "-", k.source] for k in FAULT_KINDS]
+    return _table(["kind", "what", "size", "axis", "why this range"], rows)
+
+
 BLOCKS: dict[str, Callable[[], str]] = {"options": options, "presets": presets, "observation": observation,
                                         "action": action, "reward": reward, "termination": termination, "info": info,
-                                        "dispersions": dispersions}
+                                        "dispersions": dispersions, "faults": faults}
 _BLOCK = re.compile(r"(<!-- generated: (\w+) -->\n)(.*?)(<!-- end: \2 -->)", re.S)
 
 

@@ -77,12 +77,16 @@ def reference_dispersions(func, rng):
     return scale, offset, mis, loads, servo, station
 
 
+#: every randomisation but protocol v2's fault, whose rows came after the hand-written law
+BEFORE_FAULTS = tuple(r for r in RANDOMIZE if r != "fault")
+
+
 @pytest.mark.parametrize("env_id, options", [
-    ("lvgym/SmileAscent-v1", {"randomize": RANDOMIZE}),
-    ("lvgym/SmileAscent-v1", {"randomize": RANDOMIZE, "slosh_frequency": "vacuum_thrust"}),
+    ("lvgym/SmileAscent-v1", {"randomize": BEFORE_FAULTS}),
+    ("lvgym/SmileAscent-v1", {"randomize": BEFORE_FAULTS, "slosh_frequency": "vacuum_thrust"}),
     ("lvgym/SmileAscent-v0", {"randomize": True, "observation": "sensors"}),
     ("lvgym/SmileAscent-v0", {"randomize": ["imu_station", "slosh_frequency", "mass"]}),
-    ("lvgym/SlenderAscent-v1", {"randomize": RANDOMIZE}),
+    ("lvgym/SlenderAscent-v1", {"randomize": BEFORE_FAULTS}),
 ])
 def test_the_table_draws_what_the_hand_written_law_drew(env_id, options):
     func = gym.make(env_id, model="nonrigid", mission_time_s=1.0, **options).unwrapped.func
@@ -93,7 +97,23 @@ def test_the_table_draws_what_the_hand_written_law_drew(env_id, options):
         for a, b in zip(new[:5], old[:5]):
             assert a.tobytes() == b.tobytes(), seed
         assert new[5] == old[5] and type(new[5]) is float
+        assert not new[6].any()                                             # no fault drawn
         assert g_new.bit_generator.state == g_old.bit_generator.state      # the same calls, in the same order
+
+
+def test_the_fault_rows_draw_last_and_move_nothing_else():
+    """With ``fault`` added, every other draw of a seed is what it was, and the fault's five draws follow."""
+    make = gym.make
+    func = make("lvgym/SmileAscent-v1", mission_time_s=1.0, randomize=BEFORE_FAULTS).unwrapped.func
+    with_fault = make("lvgym/SmileAscent-v1", mission_time_s=1.0, randomize=RANDOMIZE).unwrapped.func
+    for seed in range(20):
+        g0, g1 = np.random.default_rng(seed), np.random.default_rng(seed)
+        a, b = func.dispersions(g0), with_fault.dispersions(g1)
+        for x, y in zip(a[:5], b[:5]):
+            assert x.tobytes() == y.tobytes()
+        assert a[5] == b[5]
+        want = [g0.uniform(0.0, 1.0), g0.uniform(0.0, 1.0), g0.uniform(0.0, 1.0), g0.integers(0, 2), g0.integers(0, 2)]
+        np.testing.assert_array_equal(b[6], want)
 
 
 @pytest.mark.parametrize("row", DISPERSIONS, ids=lambda r: f"{r.name}:{r.what[:20]}")
@@ -119,6 +139,10 @@ def test_each_row_draws_its_law(row):
         assert lx.mean() == pytest.approx((lo + hi) / 2, abs=0.02)
         assert lx.std() == pytest.approx((hi - lo) / math.sqrt(12.0), rel=0.03)
         assert x.min() < row.low * 1.01 and x.max() > row.high * 0.99
+    elif row.law == "uniform":
+        assert x.min() >= row.low and x.max() < row.high
+        assert x.mean() == pytest.approx((row.low + row.high) / 2, abs=0.01 * (row.high - row.low))
+        assert x.std() == pytest.approx((row.high - row.low) / math.sqrt(12.0), rel=0.03)
     else:
         values = set(np.unique(x).tolist())
         assert values == set(float(k) for k in range(int(row.low), int(row.high) + 1))

@@ -43,14 +43,15 @@ def test_randomize_true_keeps_the_v0_set():
     assert spec.randomize == frozenset(RANDOMIZE_V0)
     assert set(RANDOMIZE) - set(RANDOMIZE_V0) == {"aerodynamics", "thrust_level", "slosh_mass", "slosh_frequency",
                                                   "bending_damping", "servo_bandwidth", "servo_delay",
-                                                  "imu_station"}
+                                                  "imu_station", "fault"}
 
 
 @pytest.mark.parametrize("name", ["aerodynamics", "thrust_level", "slosh_mass", "slosh_frequency", "bending_damping"])
 def test_each_v1_randomisation_draws_what_it_names(name):
     env = gym.make("lvgym/SmileAscent-v0", model="nonrigid", mission_time_s=1.0, randomize=[name]).unwrapped
     func = env.func
-    scale, offset, mis, loads, servo, station = func.dispersions(np.random.default_rng(5))
+    scale, offset, mis, loads, servo, station, fault = func.dispersions(np.random.default_rng(5))
+    assert not fault.any()
     again = func.dispersions(np.random.default_rng(5))
     assert station == 0.0
     for a, b in zip((scale, offset, mis, loads, servo), again):
@@ -157,7 +158,7 @@ def test_imu_station_draw_law_and_determinism():
     assert abs(draws.mean()) < 4.0 * sigma / np.sqrt(draws.size)
     again = np.array([func.dispersions(np.random.default_rng(s))[5] for s in range(20)])
     np.testing.assert_array_equal(again, draws[:20])                   # seeded
-    scale, offset, mis, loads, servo, _ = func.dispersions(np.random.default_rng(1))
+    scale, offset, mis, loads, servo, _, _ = func.dispersions(np.random.default_rng(1))
     assert np.all(scale == 1.0) and not offset.any() and not mis.any()  # it draws nothing else
     np.testing.assert_array_equal(servo, [1.0, 0.0])
     # the tabulated stations cover the clipped range, evenly, the nominal one among them

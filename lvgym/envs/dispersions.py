@@ -2,7 +2,8 @@
 
 A row names the ``randomize`` switch that draws it, the parameters it moves (:class:`Move`), its law
 (``normal``: a deviation N(0, sigma) clipped at ``clip``; ``log_uniform``: a factor whose logarithm is
-uniform over ``[low, high]``; ``integers``: a whole number uniform over ``low..high``), whether the value
+uniform over ``[low, high]``; ``integers``: a whole number uniform over ``low..high``; ``uniform``: a number
+uniform over ``[low, high)``), whether the value
 multiplies the parameters (``factor``: ``1 + d`` for a normal deviation) or is added to them (``offset``),
 its unit, and where its range comes from (``source``, the column "why this range" of docs/benchmark.md,
 which is generated from this table). A row whose unit is a dimension of the vehicle (``calibre``: the
@@ -27,6 +28,8 @@ import numpy as np
 from lvgym.packing import Field, Packed
 from lvgym.simulator.layouts import DISPERSION
 
+from .faults import FAULT_DRAW
+
 __all__ = ["DISPERSIONS", "IMU_STATION_INTERVALS", "IMU_STATION_SIGMA", "OTHER_RANDOMIZATIONS", "RANDOMIZE",
            "RANDOMIZE_V0", "SERVO_DISPERSION", "Dispersion", "DispersionPlan", "Move"]
 
@@ -40,7 +43,7 @@ SERVO_DISPERSION = Packed("servo dispersion", [
     Field("frequency_scale", 1, "-", "factor on the servo's natural frequency"),
     Field("delay_steps", 1, "physics steps", "transport delay of the servo"),
 ], interface=True)
-LAWS = ("normal", "log_uniform", "integers")
+LAWS = ("normal", "log_uniform", "integers", "uniform")
 EFFECTS = ("factor", "offset")
 #: the units a row's sigma may be given in that are a dimension of the vehicle
 VEHICLE_UNITS = ("calibre", "length")
@@ -54,7 +57,8 @@ class Move:
     """A parameter a dispersion moves: ``target`` is ``block.name`` with block ``params`` (the dynamics
     parameters, layout ``PARAMS``; ``name[i]`` its entry i), ``slosh`` (that parameter of every pendulum),
     ``loads`` (layout :data:`~lvgym.simulator.layouts.DISPERSION`), ``servo`` (:data:`SERVO_DISPERSION`),
-    ``thrust.misalignment`` (pitch, yaw) or ``imu.station``; ``power``: a factor acts as its ``power``-th
+    ``thrust.misalignment`` (pitch, yaw), ``imu.station`` or ``fault`` (the row's fault draw, layout
+    :data:`~.faults.FAULT_DRAW`); ``power``: a factor acts as its ``power``-th
     power (-2: the parameter is divided by its square); ``only``: a key of :data:`CONDITIONS`, or None."""
 
     target: str
@@ -73,7 +77,7 @@ class Dispersion:
     moves: tuple[Move, ...]
     """the parameters the one draw moves"""
     law: str
-    """``normal``, ``log_uniform`` or ``integers``"""
+    """``normal``, ``log_uniform``, ``integers`` or ``uniform``"""
     effect: str
     """``factor`` (the parameters are multiplied by it, ``1 + d`` for a normal deviation) or ``offset``"""
     sigma: float = 0.0
@@ -81,9 +85,9 @@ class Dispersion:
     clip: float = 0.0
     """``normal``: the largest deviation drawn, in ``unit`` (3 sigma throughout)"""
     low: float = 0.0
-    """``log_uniform``, ``integers``: the range's low end"""
+    """``log_uniform``, ``integers``, ``uniform``: the range's low end"""
     high: float = 0.0
-    """``log_uniform``, ``integers``: the range's high end (drawn too)"""
+    """``log_uniform``, ``integers``: the range's high end (drawn too); ``uniform``: its open end"""
     unit: str = "-"
     """of sigma and clip: ``-`` (a fraction), a unit (``m``, ``deg``: converted to rad), ``physics step``
     or a dimension of the vehicle (:data:`VEHICLE_UNITS`)"""
@@ -118,6 +122,8 @@ class Dispersion:
             return 1.0 + d if self.effect == "factor" else d
         if self.law == "log_uniform":
             return math.exp(rng.uniform(math.log(self.low), math.log(self.high)))
+        if self.law == "uniform":
+            return float(rng.uniform(self.low, self.high))
         return float(rng.integers(int(self.low), int(self.high) + 1))
 
     def _amount(self, x: float) -> str:
@@ -133,7 +139,10 @@ class Dispersion:
             return f"x N(1, {sigma})" if self.effect == "factor" else f"+ N(0, {sigma})"
         if self.law == "log_uniform":
             return f"x log-uniform [{self.low:g}, {self.high:g}]"
-        return f"+ {' or '.join(str(k) for k in range(int(self.low), int(self.high) + 1))} {self.unit}"
+        if self.law == "uniform":
+            return f"uniform [{self.low:g}, {self.high:g})"
+        unit = "" if self.unit == "-" else f" {self.unit}"
+        return f"+ {' or '.join(str(k) for k in range(int(self.low), int(self.high) + 1))}{unit}"
 
     def clip_text(self) -> str:
         """The clip in words (the docs table's column; a range's ends for the other laws)."""
@@ -147,6 +156,7 @@ def _normal(name: str, what: str, moves: tuple, sigma: float, clip: float, sourc
 
 
 _TWO = "the damping of a baffled tank is known to a factor of two at best"
+_FAULTS = "the kinds and their ranges: `lvgym.envs.faults.FAULT_KINDS` (below, \"In-flight faults\")"
 _SLOSH = "the equivalent-mechanical-model masses against tests"
 #: the dispersions, in the order a reset draws them (v0's first, then v1's)
 DISPERSIONS: tuple[Dispersion, ...] = (
@@ -192,6 +202,17 @@ DISPERSIONS: tuple[Dispersion, ...] = (
             "mounting tolerance (millimetres) plus the mode-shape uncertainty expressed as an equivalent "
             "station shift: SMILE 8.25 cm (3 sigma 0.25 m), Stratos III 4.1 cm, slender 4.25 cm; reasoned, see "
             "below", effect="offset", unit="length", only="flight_observation"),
+    # protocol v2's in-flight fault (lvgym.envs.faults): one per episode, what and when drawn here
+    Dispersion("fault", "the fault's kind, one of `fault_kinds` (an equal share each)", (Move("fault.kind"),),
+               "uniform", "offset", low=0.0, high=1.0, source=_FAULTS),
+    Dispersion("fault", "the fault's onset, its place in the `fault_onset_s` window", (Move("fault.onset"),),
+               "uniform", "offset", low=0.0, high=1.0, source="unannounced: any time in the window"),
+    Dispersion("fault", "the fault's size, its place in the kind's range", (Move("fault.severity"),), "uniform",
+               "offset", low=0.0, high=1.0, source=_FAULTS),
+    Dispersion("fault", "the fault's axis: pitch (0) or yaw (1)", (Move("fault.axis"),), "integers", "offset",
+               low=0, high=1, source="the vehicle is axisymmetric: either axis alike"),
+    Dispersion("fault", "the gyro bias step's sign: negative (0) or positive (1)", (Move("fault.sign"),),
+               "integers", "offset", low=0, high=1, source="either sign alike"),
 )
 #: the randomisations drawn elsewhere: what they draw, and where it is documented
 OTHER_RANDOMIZATIONS = {
@@ -224,13 +245,15 @@ class DispersionPlan:
         """The arrays of an undispersed row."""
         return {"scale": np.ones(self.n_p), "offset": np.zeros(self.n_p), "misalignment": np.zeros(2),
                 "loads": DISPERSION.pack({"thrust_scale": 1.0, "normal_scale": 1.0, "axial_scale": 1.0}),
-                "servo": SERVO_DISPERSION.pack({"frequency_scale": 1.0}), "station": np.zeros(1)}
+                "servo": SERVO_DISPERSION.pack({"frequency_scale": 1.0}), "station": np.zeros(1),
+                "fault": FAULT_DRAW.zeros()}
 
     def draw(self, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray,
-                                                      float]:
+                                                      float, np.ndarray]:
         """One row's parameter scale and offset (n_p,), thrust misalignment (2,) [rad], load dispersions
-        (layout DISPERSION), servo dispersion (layout :data:`SERVO_DISPERSION`) and IMU station shift [m],
-        drawn from ``rng`` row by row in the table's order."""
+        (layout DISPERSION), servo dispersion (layout :data:`SERVO_DISPERSION`), IMU station shift [m] and
+        fault draw (layout :data:`~.faults.FAULT_DRAW`), drawn from ``rng`` row by row in the table's
+        order."""
         out = self.neutral()
         for row, scale, targets in self.rows:
             value = row.sample(rng, scale)
@@ -244,7 +267,7 @@ class DispersionPlan:
                 else:
                     a[idx] += value
         return (out["scale"], out["offset"], out["misalignment"], out["loads"], out["servo"],
-                float(out["station"][0]))
+                float(out["station"][0]), out["fault"])
 
 
 def _power(x: Any, n: int) -> Any:
@@ -276,7 +299,9 @@ def _entries(target: str, layout: Any, n_slosh: int) -> list[Any]:
         return [DISPERSION.index(name)]
     if block == "servo":
         return [SERVO_DISPERSION.index(name)]
+    if block == "fault":
+        return [FAULT_DRAW.index(name)]
     if target in ("thrust.misalignment", "imu.station"):
         return [slice(None)]
     raise ValueError(f"dispersion target {target!r}: params.<name>[i], slosh.<name>, loads.<name>, servo.<name>, "
-                     "thrust.misalignment or imu.station")
+                     "fault.<name>, thrust.misalignment or imu.station")

@@ -49,6 +49,7 @@ from lvgym.vehicle.slender import SlenderGeometry
 
 from .coast import coast_moment
 from .dispersions import DispersionPlan
+from .faults import FAULT, apply_faults, decode, fault_names
 from .history import HistoryStack, recorded_action
 from .layouts import ACTIONS, FLIGHT_DRAWS, NAV, OBSERVATIONS, REASONS, REWARD, REWARD_TERMS, SENSOR_NOISE, TASK
 from .signals import TaskData, reset_signals, step_signals_range
@@ -158,6 +159,7 @@ class AscentFuncEnv(FuncEnv):
         self.observation_space = spaces.Box(-np.inf, np.inf, (self.observation_layout.size,), np.float32)
         self._noisy = s.observation == "sensors" and "sensor_noise" in s.randomize
         self._flight_noisy = s.observation == "flight" and "sensor_noise" in s.randomize
+        self._faults = "fault" in s.randomize
         # the draws' standard deviations, field by field (a row draws them in one call, whatever the layout's padding)
         arw = s.gyro_arw_rad_per_sqrt_s / math.sqrt(s.control_dt_s)
         step = s.gyro_bias_rw_radps_per_sqrt_s * math.sqrt(s.control_dt_s)
@@ -204,7 +206,8 @@ class AscentFuncEnv(FuncEnv):
                         pending=np.full((B, max(self.spec.action_delay_steps, 1), self.action_space.shape[0]),
                                         self._neutral),
                         nav=NAV.zeros(B), draws=FLIGHT_DRAWS.zeros(B),
-                        history=self.history.zeros(B) if self.history else np.zeros((B, 0), np.float32))
+                        history=self.history.zeros(B) if self.history else np.zeros((B, 0), np.float32),
+                        fault=FAULT.zeros(B))
         return AscentState(sim=self.sim.new_data(B), task=task, events=[()] * B)
 
     @staticmethod
@@ -250,7 +253,9 @@ class AscentFuncEnv(FuncEnv):
         for b, g in zip(rows, rngs):
             wind_rng = g if "wind" in s.randomize else np.random.default_rng(12345)
             winds.append((wind_spec(s.wind, s.mission_time_s), wind_rng))
-            sc, of, m, ld, sv, st = self.dispersions(g)
+            sc, of, m, ld, sv, st, fd = self.dispersions(g)
+            if self._faults:
+                ts.fault[b] = decode(fd, s.fault_kinds, s.fault_onset_s)
             servos.append(sv)
             stations.append(st)
             scales.append(sc)
@@ -300,6 +305,8 @@ class AscentFuncEnv(FuncEnv):
             q[:, :-1] = q[:, 1:]
             q[:, -1] = a
             a = now
+        if self._faults:
+            apply_faults(self.sim, sim, ts.fault, ts.gyro_bias)
         moment = force = None
         if s.control == "tvc":
             a = a.astype(float)
@@ -399,7 +406,14 @@ class AscentFuncEnv(FuncEnv):
                 "gimbal": self.gimbal(next_state), "gimbal_rate": ACTUATOR.view(sim.actuator, "gimbal_rate").copy(),
                 "effort_rad_s": self.effort(next_state),
                 "attitude_error": ts.att.copy(), "mass": ts.mass.copy(),
-                "termination": _REASONS[ts.reason], "events": next_state.events}
+                "termination": _REASONS[ts.reason], "events": next_state.events,
+                **({"fault": self.ended_faults(next_state)} if self._faults else {})}
+
+    def ended_faults(self, state: AscentState) -> np.ndarray:
+        """The name of each row's fault (B,) where its episode has just ended (terminated or truncated), ``""``
+        elsewhere and for a row without one: a fault is named only after its episode (:mod:`.faults`)."""
+        ts = state.task
+        return np.where((ts.reason != 0) | ts.truncated, fault_names(ts.fault), "")
 
     def state_info(self, state: AscentState, params: AscentParams | None = None) -> dict[str, Any]:
         """The per-row arrays of the Gymnasium ``info`` after a reset."""
@@ -423,10 +437,11 @@ class AscentFuncEnv(FuncEnv):
         return DispersionPlan(self.spec, self.sim.layout, self.sim.dynamics.n_slosh, self.vehicle)
 
     def dispersions(self, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray,
-                                                             np.ndarray, float]:
+                                                             np.ndarray, float, np.ndarray]:
         """Parameter scale and offset, thrust misalignment [rad], load dispersions (layout
         :data:`~lvgym.simulator.layouts.DISPERSION`), servo dispersion (layout
-        :data:`~.dispersions.SERVO_DISPERSION`) and IMU station shift [m] along +x_b of one row: each row of
+        :data:`~.dispersions.SERVO_DISPERSION`), IMU station shift [m] along +x_b and fault draw (layout
+        :data:`~.faults.FAULT_DRAW`) of one row: each row of
         the table :data:`~.dispersions.DISPERSIONS` whose name is in ``randomize``, drawn from ``rng`` in
         the table's order (docs/benchmark.md, "Dispersions", is generated from the table)."""
         return self.dispersion_plan.draw(rng)

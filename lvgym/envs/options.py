@@ -11,6 +11,7 @@ name says so.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field, fields
 from typing import Any
 
@@ -19,10 +20,11 @@ from lvgym.simulator import MODE_BASES, SITES, SLOSH_FREQUENCIES
 from lvgym.simulator.spec import LaunchSite
 
 from .dispersions import RANDOMIZE, RANDOMIZE_V0
+from .faults import FAULT_NAMES
 
-__all__ = ["ActuatorOptions", "AtmosphereOptions", "CoastOptions", "DispersionOptions", "GuidanceOptions",
-           "LaunchOptions", "LimitOptions", "Options", "PhysicsOptions", "RewardOptions", "Rule", "SensorOptions",
-           "TimingOptions", "option", "rule_of", "CONTROLS", "OBSERVATIONS", "REFERENCES", "REFERENCE_VELOCITIES",
+__all__ = ["ActuatorOptions", "AtmosphereOptions", "CoastOptions", "DispersionOptions", "FaultOptions",
+           "GuidanceOptions", "LaunchOptions", "LimitOptions", "Options", "PhysicsOptions", "RewardOptions", "Rule",
+           "SensorOptions", "TimingOptions", "option", "rule_of", "CONTROLS", "OBSERVATIONS", "REFERENCES", "REFERENCE_VELOCITIES",
            "WIND_TIERS"]
 
 #: protocol v0's wind tiers, then v1's, then ``random_gust`` (v1's gust alone, for the error budget)
@@ -334,3 +336,27 @@ class CoastOptions(Options):
     settling_thrust_n: float = option(0.0, lo=0.0, hi=1e7)
     """ullage motors' axial thrust [N] along +x_b through the coast, so that the propellant stays settled
     against the drag (0: none)"""
+
+
+@dataclass(frozen=True)
+class FaultOptions(Options):
+    """The in-flight fault each reset draws when ``randomize`` holds ``fault`` (:mod:`.faults`)."""
+
+    fault_kinds: tuple = FAULT_NAMES
+    """the kinds a fault is drawn from, an equal share each: names of ``FAULT_KINDS`` (``effectiveness``,
+    ``bandwidth``, ``stuck``, ``thrust``, ``gyro_bias``)"""
+    fault_onset_s: tuple = (5.0, 40.0)
+    """the window of flight time [s] the onset is drawn in, uniformly (low, high)"""
+
+    def check(self) -> None:
+        kinds = (self.fault_kinds,) if isinstance(self.fault_kinds, str) else tuple(self.fault_kinds)
+        if not kinds or any(k not in FAULT_NAMES for k in kinds) or len(set(kinds)) != len(kinds):
+            raise ConfigError("fault_kinds", self.fault_kinds, f"distinct names of {FAULT_NAMES}, at least one")
+        object.__setattr__(self, "fault_kinds", kinds)
+        try:
+            lo, hi = (float(v) for v in self.fault_onset_s)
+        except (TypeError, ValueError):
+            lo, hi = math.nan, math.nan
+        if not 0.0 <= lo <= hi <= 1e5:
+            raise ConfigError("fault_onset_s", self.fault_onset_s, "two times 0 <= low <= high [s]")
+        object.__setattr__(self, "fault_onset_s", (lo, hi))

@@ -23,8 +23,8 @@ from lvgym.vehicle.slender import SlenderGeometry
 
 from .dispersions import IMU_STATION_INTERVALS, IMU_STATION_SIGMA, RANDOMIZE, RANDOMIZE_V0
 from .options import (CONTROLS, OBSERVATIONS, REFERENCE_VELOCITIES, REFERENCES, WIND_TIERS, ActuatorOptions,
-                      AtmosphereOptions, CoastOptions, DispersionOptions, GuidanceOptions, LaunchOptions, LimitOptions,
-                      PhysicsOptions, RewardOptions, SensorOptions, TimingOptions)
+                      AtmosphereOptions, CoastOptions, DispersionOptions, FaultOptions, GuidanceOptions, LaunchOptions,
+                      LimitOptions, PhysicsOptions, RewardOptions, SensorOptions, TimingOptions)
 
 __all__ = ["CONTROLS", "GROUPS", "IMU_STATION_INTERVALS", "IMU_STATION_SIGMA", "KEYWORDS", "MAXQ_GUST_ONSET_M",
            "OBSERVATIONS", "OPTION_GROUP", "REFERENCES", "REFERENCE_VELOCITIES", "RANDOMIZE", "RANDOMIZE_V0",
@@ -72,7 +72,7 @@ def wind_spec(tier: str, mission_time: float) -> Any:
 GROUPS: dict[str, type] = {"launch": LaunchOptions, "timing": TimingOptions, "physics": PhysicsOptions,
                            "atmosphere": AtmosphereOptions, "dispersions": DispersionOptions, "sensors": SensorOptions,
                            "actuator": ActuatorOptions, "guidance": GuidanceOptions, "reward": RewardOptions,
-                           "limits": LimitOptions, "coast": CoastOptions}
+                           "limits": LimitOptions, "coast": CoastOptions, "faults": FaultOptions}
 #: every flat option (a field of a group) and its group
 OPTION_GROUP: dict[str, str] = {f.name: group for group, cls in GROUPS.items() for f in fields(cls)}
 #: what a vehicle may be (a bad one's error says so)
@@ -146,6 +146,8 @@ class TaskSpec:
     """the limits that terminate an episode"""
     coast: CoastOptions = CoastOptions()
     """what holds the vehicle through a staging coast"""
+    faults: FaultOptions = FaultOptions()
+    """the in-flight fault drawn when ``randomize`` holds ``fault``"""
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "vehicle", vehicle_key(self.vehicle))

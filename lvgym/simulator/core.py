@@ -383,6 +383,13 @@ class Simulator:
         return ACTUATOR.view(data.actuator, "command")
 
     @staticmethod
+    def load_dispersion(data: SimData, name: str) -> np.ndarray:
+        """The rows' load dispersion ``name`` (B,) (layout :data:`.layouts.DISPERSION`: ``thrust_scale``,
+        ``axial_scale``, ``normal_scale``, ``cp_shift``), a view: writing it changes the loads from the next
+        step on (a thrust loss in flight)."""
+        return data.ctx[:, CONTEXT.slice("dispersion").start + DISPERSION.index(name)]
+
+    @staticmethod
     def effort(data: SimData) -> np.ndarray:
         """Integrals of |gimbal| [rad s] and |gimbal rate| [rad] over the last period (B, 2)."""
         a = data.actuator

@@ -171,6 +171,12 @@ ACTUATOR = Packed("actuator", [
           "previous command (dispersion; 0 nominal)"),
     Field("frequency_shift", 1, "-", "the row's servo natural frequency is the servo's times 1 + this (dispersion; "
           "0 nominal)"),
+    Field("effectiveness_loss", 2, "-", "per axis, the share of the command the actuator no longer reaches: it "
+          "drives towards (1 - this) times the command (a fault; 0 nominal)"),
+    Field("bandwidth_loss", 2, "-", "per axis, the share of the servo's natural frequency lost (a fault; 0 "
+          "nominal)"),
+    Field("stuck", 2, "-", "per axis, 1: the actuator is jammed, the gimbal stays where it is (a fault; 0 "
+          "nominal)"),
 ])
 
 #: states of one gyro axis's filters (the second-order sensor bandwidth, then the second-order

@@ -7,6 +7,11 @@ against it). Integrated with semi-implicit Euler at the simulator's physics step
 the defaults 15 rad/s and 10 ms). The simulator integrates it inside its compiled step
 (:mod:`.advance`), so the gimbal moves between the RK4 steps of one control period. The parameters
 have the layout :data:`.layouts.SERVO`, a row's command and servo state :data:`.layouts.ACTUATOR`.
+
+Actuator faults, per row and axis (the row's ``ACTUATOR`` fields, zero nominal; set by the env's fault draws):
+``effectiveness_loss`` ``l``: the servo drives towards ``(1 - l)`` times the (clipped) command;
+``bandwidth_loss`` ``b``: its natural frequency is ``(1 - b) w``; ``stuck``: the gimbal holds its angle, rate
+zero. Without a servo the gimbal takes ``(1 - l)`` times the command, or holds when stuck.
 """
 
 from __future__ import annotations
@@ -61,14 +66,23 @@ def servo_step_k(s, act, h, k):
     o = A.previous if k < act[A.delay] else A.command
     if s[SV.on] == 0.0:
         for i in range(2):
-            act[A.gimbal + i] = act[o + i]
             act[A.gimbal_rate + i] = 0.0
+            if act[A.stuck + i] == 0.0:
+                act[A.gimbal + i] = act[o + i] * (1.0 - act[A.effectiveness_loss + i])
         return
-    w, z, lim, rl = s[SV.frequency], s[SV.damping], s[SV.limit], s[SV.rate_limit]
+    w0, z, lim, rl = s[SV.frequency], s[SV.damping], s[SV.limit], s[SV.rate_limit]
     if act[A.frequency_shift] != 0.0:
-        w = w * (1.0 + act[A.frequency_shift])
+        w0 = w0 * (1.0 + act[A.frequency_shift])
     for i in range(2):
+        if act[A.stuck + i] != 0.0:                     # a jammed axis holds its angle
+            act[A.gimbal_rate + i] = 0.0
+            continue
         c = _clip(act[o + i], -lim, lim)
+        if act[A.effectiveness_loss + i] != 0.0:
+            c = c * (1.0 - act[A.effectiveness_loss + i])
+        w = w0
+        if act[A.bandwidth_loss + i] != 0.0:
+            w = w0 * (1.0 - act[A.bandwidth_loss + i])
         pos, rate = act[A.gimbal + i], act[A.gimbal_rate + i]
         acc = w * w * (c - pos) - 2.0 * z * w * rate
         r = _clip(rate + h * acc, -rl, rl)

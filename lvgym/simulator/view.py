@@ -60,6 +60,10 @@ class SimView:
         """State entry ``name`` of every row (:meth:`Simulator.state`)."""
         return self.sim.state(self.data, name)
 
+    def load_dispersion(self, name: str) -> np.ndarray:
+        """Load dispersion ``name`` of every row (B,) (:meth:`Simulator.load_dispersion`)."""
+        return self.sim.load_dispersion(self.data, name)
+
     def slosh_angles(self) -> np.ndarray:
         """Pendulum deflections (B, N, 2) [rad] (:meth:`Simulator.slosh_angles`)."""
         return self.sim.slosh_angles(self.data)
