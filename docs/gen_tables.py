@@ -24,7 +24,7 @@ from typing import Any, Callable
 PAGE = Path(__file__).resolve().parent / "rl.md"
 #: the pages with generated blocks, and their blocks
 PAGES = {PAGE: ("options", "presets", "observation", "action", "reward", "termination", "info"),
-         PAGE.parent / "benchmark.md": ("dispersions",)}
+         PAGE.parent / "benchmark.md": ("dispersions", "faults")}
 
 #: the keys of a step's ``info`` (``AscentFuncEnv.transition_info``): unit and meaning. After a reset the
 #: ``info`` holds ``time``, ``cumulative_rate_error``, ``mass`` and ``controller_on`` only.
@@ -51,6 +51,9 @@ INFO = {
     "termination": ("-", "why the episode ended (the termination table), empty while it flies"),
     "events": ("-", "the events of the step (burnout, separation, ignition, lift-off, rail exit): a list of "
                     "(time [s], text); in a batched info, a tuple per row"),
+    "fault": ("-", "only when `randomize` holds `fault`: at the step that ends the episode, the in-flight fault it "
+                   "flew (e.g. `stuck pitch`); empty at every other step ([benchmark](benchmark.md), \"In-flight "
+                   "faults\")"),
 }
 
 

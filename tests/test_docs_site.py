@@ -73,8 +73,11 @@ def test_info_table_is_the_envs_info():
     env = gym.make("lvgym/SmileAscent-v1", mission_time_s=1.0)
     _, reset_info = env.reset(seed=0)
     _, _, _, _, info = env.step(env.action_space.sample())
-    assert list(info) == list(gen_tables.INFO)
+    assert list(info) == [k for k in gen_tables.INFO if k != "fault"]
     assert set(reset_info) == {"time", "cumulative_rate_error", "mass", "controller_on"}
+    faulty = gym.make("lvgym/SmileAscent-v1", mission_time_s=1.0, randomize={"fault"})     # the key of faults
+    faulty.reset(seed=0)
+    assert list(faulty.step(faulty.action_space.sample())[4]) == list(gen_tables.INFO)
 
 
 def _requirement_names(reqs: list[str]) -> set[str]:

@@ -195,3 +195,26 @@ def test_the_fault_comes_from_the_env_generator_and_rows_fly_as_single_envs():
             assert info["time"] == t[b] and np.array_equal(info["gimbal"], g[b]) and info["fault"] == names[b]
             if term or trunc:
                 break
+
+
+def test_the_record_names_the_fault_batched_as_single():
+    """A condition whose env draws faults: the batched rows and play_episode give the same records, each
+    naming the fault it flew; a condition without faults has no ``fault`` field."""
+    from dataclasses import replace
+
+    from lvgym.benchmark.batch import as_batch
+    from lvgym.benchmark.rows import fly_rows
+    from lvgym.benchmark.runner import play_episode, zero_policy
+    from lvgym.benchmark.suites import condition
+
+    base = condition("smile-v1", "rigid").with_options(mission_time_s=6.0)
+    cond = replace(base, randomize=tuple(base.randomize) + ("fault",)).with_options(fault_onset_s=(2.0, 5.0))
+    seeds = [0, 1, 2]
+    env = cond.make_vec_env(len(seeds))
+    rows = fly_rows(env, seeds, [(as_batch(zero_policy(cond.make_env()), len(seeds)), list(range(len(seeds))))])
+    for seed, rec in zip(seeds, rows):
+        single = cond.make_env()
+        assert play_episode(zero_policy(single), single, seed) == rec and rec["fault"]
+    plain_env = base.make_vec_env(1)
+    plain = fly_rows(plain_env, [0], [(as_batch(zero_policy(base.make_env()), 1), [0])])[0]
+    assert "fault" not in plain

@@ -53,6 +53,7 @@ class RowsLog:
         self.length = np.zeros(self.n, dtype=np.int64)
         self.events: list[list[tuple[float, str]]] = [[] for _ in range(self.n)]
         self.termination = [""] * self.n
+        self.fault: list[str] | None = None               # the rows' faults, when the env draws them
 
     def add(self, live: np.ndarray, observations: np.ndarray, reward: np.ndarray, info: dict[str, Any],
             actions: np.ndarray | None = None) -> None:
@@ -78,11 +79,16 @@ class RowsLog:
                     self.events[b] += [(float(t), str(text)) for t, text in events[b]]
 
     def end(self, rows: np.ndarray, info: dict[str, Any]) -> None:
-        """The rows ``rows`` ended with this step (their failure, if any, from ``info["termination"]``)."""
+        """The rows ``rows`` ended with this step (their failure, if any, from ``info["termination"]``; the
+        fault they flew, when the env draws faults, from ``info["fault"]``)."""
+        if "fault" in info and self.fault is None:
+            self.fault = [""] * self.n
         for b in rows.tolist():
             reason = info["termination"][b]
             if reason:
                 self.termination[b] = str(reason)
+            if self.fault is not None:
+                self.fault[b] = str(info["fault"][b])
 
     def records(self, flyability: bool = False) -> list[dict[str, Any]]:
         """Every row's record: :func:`~.metrics.episode_metrics` and :func:`~.scoring.flight_metrics` of its
@@ -109,6 +115,8 @@ class RowsLog:
             record = combined_record(episode_metrics(traj), flight_metrics(self.facts, columns))
             if flyability:
                 record.update(flyability_metrics(self.facts, columns, record))
+            if self.fault is not None:
+                record["fault"] = self.fault[b]
             out.append(record)
         return out
 

@@ -119,7 +119,8 @@ def play_episode(policy: Policy, env: Any, seed: int, *, flyability: bool = Fals
     :func:`~.scoring.flight_metrics` (``score``, the per-phase rate errors, the flexibility metrics,
     ``qalpha_cost_s``; its ``rate_error_rad`` and failure fields are v0's, bit for bit); with
     ``flyability`` (protocol v2), also :func:`~.flyability.flyability_metrics` (``flyable``, ``score_v2``,
-    the commanded gimbal rate). In-process (e.g. a validation callback during training:
+    the commanded gimbal rate); with an env that draws in-flight faults, ``fault`` (its name, ``""`` for
+    none; :mod:`lvgym.envs.faults`). In-process (e.g. a validation callback during training:
     ``play_episode(policy, condition.make_env(), seed)`` over ``suite.seeds("validation", n)``)."""
     obs, info = env.reset(seed=int(seed))
     policy.reset()
@@ -135,6 +136,8 @@ def play_episode(policy: Policy, env: Any, seed: int, *, flyability: bool = Fals
     record = combined_record(episode_metrics(traj.build()), flight_metrics(log))
     if flyability:
         record.update(flyability_metrics(log, log.columns(), record))
+    if "fault" in info:                       # an env that draws faults names the episode's at its end
+        record["fault"] = str(info["fault"])
     return record
 
 
