@@ -8,8 +8,9 @@ the shipped one in ``schedules/``); ``python -m experiments.control_study.study`
 thesis's control study (docs/control-study.md).
 
 Importing this package registers its controllers with the benchmark by name
-(:func:`lvgym.benchmark.register_policy`): ``pid``, ``gs-pid``, ``gs-pid-flex``, ``aac``, ``pid-thesis``,
-``gs-pid-thesis``, ``lqg``, ``lqg-front``, ``lqg-aw``, ``mpc`` (``evaluate.py --policies lqg``).
+(:func:`lvgym.benchmark.register_policy`): ``pid``, ``gs-pid``, ``gs-pid-flex``, ``aac``,
+``gs-pid-flex-quiet``, ``aac-quiet``, ``pid-thesis``, ``gs-pid-thesis``, ``lqg``, ``lqg-front``, ``lqg-aw``,
+``mpc`` (``evaluate.py --policies lqg``).
 """
 
 from lvgym.benchmark.registry import register_policy
@@ -28,6 +29,10 @@ register_policy("gs-pid", smile_scheduled_pid, name="gs-pid", schedule="smile")
 register_policy("gs-pid-flex", flex_pid, name="gs-pid-flex")
 # adaptive augmenting control on gs-pid-flex (lvgym.baselines.aac, docs/adaptive-control.md)
 register_policy("aac", flex_aac, name="aac")
+# the same design held to protocol v2's flyability: the gyro noise's commanded gimbal rate at most 20 % of the
+# rate limit (flexdesign --noise-rate 0.2; docs/flex-design.md), and aac on it
+register_policy("gs-pid-flex-quiet", flex_pid, name="gs-pid-flex-quiet", schedule="smile_flex_quiet")
+register_policy("aac-quiet", flex_aac, name="aac-quiet", schedule="smile_flex_quiet")
 # the thesis's gains (6.3.1) and its Table 6.10 schedule, as published
 register_policy("pid-thesis", smile_single_pid)
 register_policy("gs-pid-thesis", smile_scheduled_pid, name="gs-pid-thesis", schedule="smile_thesis")
