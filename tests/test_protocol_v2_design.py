@@ -53,3 +53,33 @@ def test_the_wind_at_the_qalpha_limit():
     traj = {"qbar": np.array([500.0, 125e3]), "airspeed": np.array([50.0, 800.0])}
     lim = budget(traj, 250e3)
     assert lim[0] == math.inf and lim[1] == pytest.approx(800.0 * math.tan(math.radians(2.0)))
+
+
+def test_fault_suites_add_one_kind_each_and_keep_v1_otherwise():
+    from experiments.protocol_v2_design.fault_suite import fault_suites
+    from lvgym.benchmark.suites import get_suite
+
+    base = get_suite("smile-v1")
+    suites = fault_suites(["none", "stuck"], (10.0, 20.0), models=["nonrigid"])
+    assert [s.name for s in suites] == ["smile-v1+none", "smile-v1+stuck"] and {s.version for s in suites} == {"v2-draft"}
+    none, stuck = suites[0].conditions[0], suites[1].conditions[0]
+    v1 = [c for c in base.conditions if c.model == "nonrigid"][0]
+    assert none.env_kwargs() == v1.env_kwargs()
+    kw = stuck.env_kwargs()
+    assert set(kw["randomize"]) == set(v1.randomize) | {"fault"}
+    assert kw["fault_kinds"] == ("stuck",) and kw["fault_onset_s"] == (10.0, 20.0)
+
+
+def test_normalise_puts_zero_at_0_and_the_reference_at_1():
+    from lvgym.benchmark.metrics import normalise
+
+    scores = {"zero": [5.0, 4.0, 6.0], "lqg": [1.0, 1.0, 1.0], "mine": [3.0, 2.5, 3.5]}
+    records = [{"suite": "s", "condition": "s/rigid", "policy": p, "seed": i, "score_v2": v}
+               for p, vs in scores.items() for i, v in enumerate(vs)]
+    summary = [{"suite": "s", "condition": "s/rigid", "policy": p} for p in scores]
+    normalise(summary, records, {"s": "lqg"})
+    got = {r["policy"]: r["score_v2_norm"] for r in summary}
+    assert got["zero"] == 0.0 and got["lqg"] == 1.0 and got["mine"] == pytest.approx(0.5)
+    assert all(r["score_v2_norm_ci_low"] <= r["score_v2_norm"] <= r["score_v2_norm_ci_high"] for r in summary)
+    untouched = [{"suite": "t", "condition": "t/rigid", "policy": "mine"}]
+    assert "score_v2_norm" not in normalise(untouched, records, {"s": "lqg"})[0]

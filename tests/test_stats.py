@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from lvgym.benchmark.stats import bootstrap_ci, iqm, paired, probability_of_improvement
+from lvgym.benchmark.stats import bootstrap_ci, iqm, normalised, paired, probability_of_improvement
 
 
 def test_bootstrap_interval_covers_the_mean_and_shrinks_with_n():
@@ -131,3 +131,29 @@ def test_other_draws_than_rliable_within_the_monte_carlo_error(case):
         assert ours[name][0] == pytest.approx(point, rel=0, abs=1e-12)
         tol = 5 * np.sqrt(2) * rel * (hi - lo) + 1e-12
         assert abs(ours[name][1] - lo) <= tol and abs(ours[name][2] - hi) <= tol, (name, ours[name], (lo, hi), tol)
+
+
+def test_normalised_score_by_hand():
+    zero, ref = np.array([4.0, 6.0, 5.0]), np.array([1.0, 1.2, 0.8])          # means 5 and 1
+    pol = np.array([2.0, 3.5, 3.5])                                             # mean 3: half way
+    v, lo, hi = normalised(pol, zero, ref)
+    assert v == pytest.approx(0.5) and lo <= 0.5 <= hi
+    assert normalised(zero, zero, ref)[0] == 0.0 and normalised(ref, zero, ref)[0] == pytest.approx(1.0)
+    assert normalised(ref - 0.5, zero, ref)[0] == pytest.approx(1.125)          # better than the reference
+    assert np.isnan(normalised(pol, ref, zero)[0])                               # the reference no better than zero
+    with pytest.raises(ValueError, match="one value per common seed"):
+        normalised(pol, zero[:2], ref)
+
+
+def test_normalised_interval_shrinks_with_seeds_and_is_seeded():
+    rng = np.random.default_rng(0)
+    widths = []
+    for n in (10, 160):
+        zero = 5.0 + rng.normal(0.0, 1.0, n)
+        ref = 1.0 + 0.1 * (zero - 5.0) + rng.normal(0.0, 0.1, n)
+        pol = 2.0 + 0.1 * (zero - 5.0) + rng.normal(0.0, 0.1, n)
+        v, lo, hi = normalised(pol, zero, ref)
+        assert lo < v < hi and v == pytest.approx(0.75, abs=0.1)
+        widths.append(hi - lo)
+        assert normalised(pol, zero, ref) == (v, lo, hi)
+    assert widths[1] < 0.5 * widths[0]

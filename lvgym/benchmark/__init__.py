@@ -17,7 +17,7 @@
 
 from .compare import compare, run_groups
 from .metrics import (CVAR_LEVEL, SUMMARY_METRICS, V1_METRICS, Trajectory, TrajectoryBuilder, cvar, degradation,
-                      episode_metrics, rank, summarize)
+                      episode_metrics, normalise, rank, summarize)
 from .policy import Policy, ZeroPolicy
 from .results import atomic_write, atomic_write_text, markdown_table, write_results
 from .registry import register_policy, register_policy_loader
@@ -30,5 +30,5 @@ __all__ = ["CVAR_LEVEL", "Condition", "DEFAULT_SUITE", "EXECUTORS", "PROTOCOL_VE
            "SEED_SETS", "SUITES", "SUMMARY_METRICS", "Suite", "TEST_SEED0", "Trajectory", "TrajectoryBuilder",
            "V1_METRICS", "VALIDATION_SEED0", "ZERO", "ZeroPolicy", "atomic_write", "atomic_write_text", "build_policy",
            "compare", "condition", "cvar", "degradation", "episode_metrics", "evaluate", "get_suite", "make_tasks",
-           "markdown_table", "play_episode", "rank", "register_policy", "register_policy_loader", "run_episode",
+           "markdown_table", "normalise", "play_episode", "rank", "register_policy", "register_policy_loader", "run_episode",
            "run_groups", "summarize", "write_results", "PolicyError"]

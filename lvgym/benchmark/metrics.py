@@ -251,6 +251,29 @@ def summarize(records: Iterable[dict[str, Any]], metrics: Sequence[str] | None =
     return rows
 
 
+def normalise(summary: Sequence[dict[str, Any]], records: Iterable[dict[str, Any]], references: dict[str, str],
+              metric: str = "score_v2") -> Sequence[dict[str, Any]]:
+    """Add to each row of ``summary`` whose suite names a reference policy in ``references`` (suite name ->
+    policy label) the normalised ``metric``: ``<metric>_norm`` with ``_norm_ci_low``, ``_norm_ci_high``
+    (:func:`~.stats.normalised`: the zero policy 0, the reference 1, higher is better), over the seeds the
+    row's policy, ``zero`` and the reference all flew in its condition. Rows without those flights are left
+    as they are. Returns ``summary``."""
+    from .stats import normalised
+
+    values = per_seed([r for r in records if metric in r], metric)
+    for row in summary:
+        ref = references.get(row["suite"])
+        key = (row["suite"], row["condition"])
+        z, r, x = (values.get((*key, p)) for p in ("zero", ref, row["policy"]))
+        if not ref or not (z and r and x):
+            continue
+        common = sorted(set(z) & set(r) & set(x))
+        if common:
+            v, lo, hi = normalised([x[i] for i in common], [z[i] for i in common], [r[i] for i in common])
+            row[f"{metric}_norm"], row[f"{metric}_norm_ci_low"], row[f"{metric}_norm_ci_high"] = v, lo, hi
+    return summary
+
+
 def per_seed(records: Iterable[dict[str, Any]], metric: str) -> dict[tuple[Any, ...], dict[int, float]]:
     """``{(suite, condition, policy): {seed: value}}`` of ``metric``."""
     out: dict[tuple[Any, ...], dict[int, float]] = {}

@@ -10,6 +10,8 @@ probability of improvement) for results over several training seeds.
   (``scipy.stats.bootstrap``).
 - :func:`paired`: two policies on the same seeds: the mean difference with its bootstrap interval, the
   wins, the Wilcoxon signed-rank test and the paired t-test (``scipy.stats``).
+- :func:`normalised`: a policy's score on a scale where the zero policy is 0 and a named reference 1, with
+  a paired bootstrap interval over the seeds (all three flown on the same seeds).
 - :func:`iqm` and :func:`probability_of_improvement`: the interquartile mean (``scipy.stats.trim_mean``)
   and the probability of improvement (the Mann-Whitney U statistic over ``m n``, ``scipy.stats.mannwhitneyu``)
   over ``(runs, episodes)`` score matrices, with stratified-bootstrap percentile intervals that resample
@@ -31,7 +33,7 @@ from typing import Any
 import numpy as np
 from scipy import stats
 
-__all__ = ["PairedResult", "bootstrap_ci", "iqm", "paired", "probability_of_improvement"]
+__all__ = ["PairedResult", "bootstrap_ci", "iqm", "normalised", "paired", "probability_of_improvement"]
 
 LEVEL = 0.95
 REPS = 2000
@@ -95,6 +97,30 @@ def paired(a: Sequence[float], b: Sequence[float], level: float = LEVEL, reps: i
     p_t = float(stats.ttest_rel(x, y).pvalue) if d.size > 1 and np.std(d) > 0 else (1.0 if np.all(d == 0) else 0.0)
     return PairedResult(int(d.size), float(x.mean()), float(y.mean()), float(d.mean()), lo, hi,
                         int(np.sum(d < 0)), int(np.sum(d == 0)), p_w, p_t)
+
+
+def normalised(policy: Sequence[float], zero: Sequence[float], reference: Sequence[float], level: float = LEVEL,
+               reps: int = REPS, seed: int = 0) -> tuple[float, float, float]:
+    """``(value, low, high)``: the normalised score ``(mean(zero) - mean(policy)) / (mean(zero) -
+    mean(reference))`` of per-seed scores (lower is better) flown on the same seeds, so that the zero policy
+    scores 0, the reference 1 and a policy better than the reference more than 1; its interval is the
+    percentile interval of the same ratio over ``reps`` resamplings of the seeds (the three policies' values
+    of a seed kept together, so the interval holds the uncertainty of all three means). NaNs when the
+    reference does not beat the zero policy (no scale)."""
+    x, z, r = (np.asarray(v, dtype=float) for v in (policy, zero, reference))
+    if not x.shape == z.shape == r.shape or x.ndim != 1 or x.size == 0:
+        raise ValueError(f"per-seed scores of shapes {x.shape}, {z.shape}, {r.shape}: one value per common seed each")
+    scale = z.mean() - r.mean()
+    if not scale > 0.0:
+        return math.nan, math.nan, math.nan
+    value = float((z.mean() - x.mean()) / scale)
+    idx = np.random.default_rng(seed).integers(0, x.size, (reps, x.size))
+    zs, rs, xs = z[idx].mean(axis=1), r[idx].mean(axis=1), x[idx].mean(axis=1)
+    with np.errstate(all="ignore"):
+        ratio = (zs - xs) / (zs - rs)
+    ratio = ratio[np.isfinite(ratio) & (zs - rs > 0.0)]
+    lo, hi = _percentile_interval(ratio, level) if ratio.size else (math.nan, math.nan)
+    return value, lo, hi
 
 
 def _matrix(scores: Any) -> np.ndarray:

@@ -138,6 +138,9 @@ class Suite:
     conditions: tuple[Condition, ...]
     version: str = PROTOCOL_VERSION
     overrides: tuple[tuple[str, Any], ...] = field(default=())
+    reference: str = ""
+    """the named classical policy of the normalised score (the zero policy 0, it 1; :func:`~.metrics.normalise`);
+    empty: none (v0 and v1)"""
 
     def seeds(self, seed_set: str, n: int) -> list[int]:
         """The first ``n`` seeds of ``seed_set`` (``"test"`` or ``"validation"``)."""

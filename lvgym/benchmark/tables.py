@@ -81,13 +81,20 @@ def flyability_table(summary: Sequence[Row]) -> list[str]:
     none when the rows are not v2's."""
     if not summary or "score_v2_mean" not in summary[0]:
         return []
+    norm = any("score_v2_norm" in r for r in summary)        # the suite names a reference (metrics.normalise)
     out = ["| condition | policy | rank | failed or unflyable [95 % CI] | unflyable | score_v2 [rad] "
-           "| commanded rate RMS [% of limit] | 2 s peak [% of limit] |", "|---|---|---:|---:|---:|---:|---:|---:|"]
+           + ("| normalised (zero 0, reference 1) " if norm else "")
+           + "| commanded rate RMS [% of limit] | 2 s peak [% of limit] |",
+           "|---|---|---:|---:|---:|---:|" + ("---:|" if norm else "") + "---:|---:|"]
     for r in rank([dict(r) for r in summary]):
         either = (f"{_pct(r['failure_rate_v2'])} [{100.0 * r['failure_rate_v2_ci_low']:.0f}, "
                   f"{100.0 * r['failure_rate_v2_ci_high']:.0f}]")
+        normalised = ""
+        if norm:
+            normalised = (f"| {_interval(r['score_v2_norm'], r['score_v2_norm_ci_low'], r['score_v2_norm_ci_high'], '.2f')} "
+                          if "score_v2_norm" in r else "| - ")
         out.append(f"| {_short(r['condition'])} | {r['policy']} | {r['rank']} | {either} | {_pct(r['unflyable_rate'])} "
-                   f"| {_ci(r, 'score_v2')} | {_ci(r, 'cmd_rate_rms', '.1f', 100.0)} "
+                   f"| {_ci(r, 'score_v2')} {normalised}| {_ci(r, 'cmd_rate_rms', '.1f', 100.0)} "
                    f"| {_ci(r, 'cmd_rate_peak', '.1f', 100.0)} |")
     return out
 

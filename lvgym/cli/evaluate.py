@@ -47,7 +47,7 @@ from pathlib import Path
 from typing import Any
 
 from lvgym.benchmark import (EXECUTORS, PROTOCOL_VERSION, SEED_SETS, SUITES, PolicySpec, compare, degradation, evaluate,
-                             get_suite, markdown_table, run_groups, summarize, write_results)
+                             get_suite, markdown_table, normalise, run_groups, summarize, write_results)
 from lvgym.cli.policies import POLICIES, resolve_policy  # (registers the built-in policies)
 from lvgym.errors import ConfigError
 from lvgym.parallel import TaskFailed, exit_on_sigterm
@@ -143,6 +143,7 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
         raise
     wall = time.perf_counter() - t0
     summary = summarize(records)
+    normalise(summary, records, {s.name: s.reference for s in suites if s.reference})
     deg = degradation(summary, "score", records=records) + degradation(summary, "rate_error_rad", records=records)
     comparison = compare(records, summary, "score", args.reference)
     groups = run_groups(records, "score")
