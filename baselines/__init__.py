@@ -10,7 +10,7 @@ thesis's control study (docs/control-study.md).
 Importing this package registers its controllers with the benchmark by name
 (:func:`lvgym.benchmark.register_policy`): ``pid``, ``gs-pid``, ``gs-pid-flex``, ``aac``,
 ``gs-pid-flex-quiet``, ``aac-quiet``, ``pid-thesis``, ``gs-pid-thesis``, ``lqg``, ``lqg-front``, ``lqg-aw``,
-``mpc`` (``evaluate.py --policies lqg``).
+``mpc``, ``privileged`` (``evaluate.py --policies lqg``).
 """
 
 from lvgym.benchmark.registry import register_policy
@@ -33,6 +33,8 @@ register_policy("aac", flex_aac, name="aac")
 # rate limit (flexdesign --noise-rate 0.2; docs/flex-design.md), and aac on it
 register_policy("gs-pid-flex-quiet", flex_pid, name="gs-pid-flex-quiet", schedule="smile_flex_quiet")
 register_policy("aac-quiet", flex_aac, name="aac-quiet", schedule="smile_flex_quiet")
+# protocol v2's privileged reference: the true state and the aerodynamic moment known (not a flyable design)
+register_policy("privileged", "lvgym.baselines.privileged:privileged", name="privileged")
 # the thesis's gains (6.3.1) and its Table 6.10 schedule, as published
 register_policy("pid-thesis", smile_single_pid)
 register_policy("gs-pid-thesis", smile_scheduled_pid, name="gs-pid-thesis", schedule="smile_thesis")

@@ -177,4 +177,4 @@ def test_the_built_in_names_are_the_registered_ones():
                                                           (("file", "ppo_res_lqg_smile_v1"), ("name", "ppo-res-lqg")))
     assert sorted(registry.POLICIES) == ["aac", "aac-quiet", "gs-pid", "gs-pid-flex", "gs-pid-flex-quiet",
                                          "gs-pid-thesis", "lqg", "lqg-aw", "lqg-front", "mpc", "pid", "pid-thesis",
-                                         "ppo", "ppo-res-lqg", "zero"]
+                                         "ppo", "ppo-res-lqg", "privileged", "zero"]

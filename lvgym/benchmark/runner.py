@@ -228,17 +228,21 @@ def run_task(task: Task) -> dict[str, Any]:
 def make_tasks(policies: Sequence[PolicySpec], suites: Sequence[Suite], episodes: int,
                seed_set: str = "test") -> list[Task]:
     """Every episode of every policy on every condition of every suite, in the order of the results:
-    suite, condition, policy, episode."""
+    suite, condition, policy, episode. A policy whose factory has ``privileged = True`` flies each condition
+    with ``privileged_info=True`` (the same flight, with the true state in the info)."""
     names = [p.name for p in policies]
     if len(set(names)) != len(names):
         raise ValueError(f"policy names {names}: each must be distinct (they label the results)")
+    privileged = {p.name: bool(getattr(p.resolve(), "privileged", False)) for p in policies}
     tasks: list[Task] = []
     for suite in suites:
         seeds = suite.seeds(seed_set, episodes)
         for cond in suite.conditions:
             for pol in policies:
+                # a privileged reference (its factory's ``privileged``) reads the true state from the info
+                c = cond.with_options(privileged_info=True) if privileged[pol.name] else cond
                 for i, seed in enumerate(seeds):
-                    tasks.append(Task(len(tasks), suite.name, suite.version, i, pol, cond, seed))
+                    tasks.append(Task(len(tasks), suite.name, suite.version, i, pol, c, seed))
     return tasks
 
 

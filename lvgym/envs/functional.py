@@ -160,6 +160,7 @@ class AscentFuncEnv(FuncEnv):
         self._noisy = s.observation == "sensors" and "sensor_noise" in s.randomize
         self._flight_noisy = s.observation == "flight" and "sensor_noise" in s.randomize
         self._faults = "fault" in s.randomize
+        self._privileged = bool(s.privileged_info)
         # the draws' standard deviations, field by field (a row draws them in one call, whatever the layout's padding)
         arw = s.gyro_arw_rad_per_sqrt_s / math.sqrt(s.control_dt_s)
         step = s.gyro_bias_rw_radps_per_sqrt_s * math.sqrt(s.control_dt_s)
@@ -407,7 +408,24 @@ class AscentFuncEnv(FuncEnv):
                 "effort_rad_s": self.effort(next_state),
                 "attitude_error": ts.att.copy(), "mass": ts.mass.copy(),
                 "termination": _REASONS[ts.reason], "events": next_state.events,
-                **({"fault": self.ended_faults(next_state)} if self._faults else {})}
+                **({"fault": self.ended_faults(next_state)} if self._faults else {}),
+                **(self.privileged_info(next_state) if self._privileged else {})}
+
+    def privileged_info(self, state: AscentState) -> dict[str, np.ndarray]:
+        """What no flight sensor gives, per row (the ``privileged_info`` option): the true body rates
+        ``omega_bi_b`` (B, 3) [rad/s] (of the rigid body, no bending, no noise), the aerodynamic moment about
+        the CG ``m_aero_b`` (B, 3) [N m] (the wind's included), the thrust (B,) [N], the gimbal's lever arm
+        ``gimbal_arm`` (B,) [m] (CG station minus gimbal station along x_b), the body's principal inertias
+        ``J_b_diag`` (B, 3) [kg m^2] and the velocity relative to the air in body axes ``v_air_b`` (B, 3)
+        [m/s]."""
+        sim = state.sim
+        cond, lay = self.sim.conditions, self.sim.layout
+        J = sim.p[:, lay.params["J_b"]].reshape(-1, 3, 3)
+        r_cg, r_gimbal = sim.p[:, lay.params["r_cg"]], sim.p[:, lay.params["r_gimbal"]]
+        return {"omega_bi_b": self.sim.state(sim, "omega_bi_b").copy(), "m_aero_b": cond(sim, "m_aero_b").copy(),
+                "thrust": cond(sim, "thrust").copy(), "gimbal_arm": r_cg[:, 0] - r_gimbal[:, 0],
+                "J_b_diag": np.stack([J[:, 0, 0], J[:, 1, 1], J[:, 2, 2]], axis=1),
+                "v_air_b": cond(sim, "v_air_b").copy()}
 
     def ended_faults(self, state: AscentState) -> np.ndarray:
         """The name of each row's fault (B,) where its episode has just ended (terminated or truncated), ``""``

@@ -246,6 +246,10 @@ class SensorOptions(Options):
     gyro_bias_rw_radps_per_sqrt_s: float = option(1.5e-6, lo=0.0, hi=0.1)
     """``flight``: the gyro bias's random walk [rad/s/sqrt(s)] (a 1-sigma wander of 3 deg/h over a 100 s
     flight: the bias instability of a tactical-grade gyro, 1-10 deg/h)"""
+    privileged_info: bool = option(False, boolean=True)
+    """the step's ``info`` also holds what no flight sensor gives (``omega_bi_b``, ``m_aero_b``, ``thrust``,
+    ``gimbal_arm``, ``J_b_diag``, ``v_air_b``): for a privileged reference or a teacher policy, never for a
+    scored causal one"""
 
 
 @dataclass(frozen=True)

@@ -1,0 +1,97 @@
+"""A privileged reference for protocol v2: a controller that knows what no flight computer knows.
+
+``privileged`` is not a design a vehicle could fly. It reads the env's ``privileged_info``
+(:meth:`lvgym.envs.functional.AscentFuncEnv.privileged_info`): the true rigid-body rates (no gyro, no noise,
+no bending in them), the true attitude error, and the aerodynamic moment about the CG that the wind and the
+flow cause at this instant, with the thrust, its lever arm and the inertia. Per axis it commands the gimbal
+angle whose thrust moment cancels that aerodynamic moment and adds the moment of a second-order attitude loop
+(natural frequency ``bandwidth_radps``, damping ``damping``) on the true rate and attitude errors (dynamic
+inversion of the rigid body)::
+
+    delta = (J (-2 z w e_rate - w^2 e_att) - M_aero) / (T l)
+
+(pitch about +y_b, yaw about +z_b; a positive gimbal angle turns the vehicle positively about its axis). It
+flies the protocol's actuator path like every policy: the action's period of delay, the servo and its
+limits. It knows the disturbance as it acts, not ahead, and nothing of the slosh and the bending, so it is a
+reference, not a bound: the room it shows is what knowing the state and the wind's moment is worth to a
+controller on the same actuator (docs/benchmark.md). The runner flies it on its conditions with
+``privileged_info=True`` (the ``privileged`` attribute of its factory, :func:`privileged`); that option adds
+keys to the info and changes nothing of the flight.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from lvgym.errors import ConfigError
+
+__all__ = ["PrivilegedPolicy", "privileged"]
+
+#: (bandwidth [rad/s], damping) of the attitude loop per flight model, chosen on smile-v1's validation seeds
+#: 0-5 (the lowest mean score of a sweep; docs/benchmark.md, "The privileged reference"): the rigid vehicle
+#: takes a rate gain of 8 /s, the non-rigid one only 2 /s before the true rates' slosh content destabilises
+#: the loop (the law knows nothing of the slosh)
+GAINS = {"rigid": (2.0, 2.0), "nonrigid": (1.0, 1.0)}
+#: the info keys the policy reads (the env's privileged_info)
+KEYS = ("omega_bi_b", "m_aero_b", "thrust", "gimbal_arm", "J_b_diag", "attitude_error", "controller_on")
+
+
+class PrivilegedPolicy:
+    """The privileged reference (module docstring) for a TVC env of the ascent task: ``bandwidth_radps`` [rad/s]
+    and ``damping`` [-] of its attitude loop (default: :data:`GAINS` of the env's flight model); ``env``: the
+    env it flies (its gimbal limit, its observation's reference pitch rate, its model)."""
+
+    def __init__(self, env: Any, bandwidth_radps: float | None = None, damping: float | None = None,
+                 name: str = "privileged") -> None:
+        func = env.unwrapped.func
+        w0, z0 = GAINS["rigid" if func.spec.model == "rigid" else "nonrigid"]
+        bandwidth_radps = w0 if bandwidth_radps is None else bandwidth_radps
+        damping = z0 if damping is None else damping
+        for key, value, lo, hi in (("bandwidth_radps", bandwidth_radps, 0.0, 100.0), ("damping", damping, 0.0, 10.0)):
+            if not (isinstance(value, (int, float)) and math.isfinite(value) and lo < value <= hi):
+                raise ConfigError(f"privileged.{key}", value, f"a number in ({lo:g}, {hi:g}]")
+        if func.spec.control != "tvc":
+            raise ConfigError("privileged env control", func.spec.control, "tvc (the reference commands the gimbal)")
+        if not func.spec.privileged_info:
+            raise ConfigError("privileged env privileged_info", False, "True: the reference reads the true state "
+                              "from the step's info (the benchmark's runner sets it for this policy)")
+        self.name = name
+        self.w, self.z = float(bandwidth_radps), float(damping)
+        self.limit = float(func.gimbal_limit)
+        names = list(func.observation_layout.names)
+        self._i_ref = names.index("pitch_rate_reference") if "pitch_rate_reference" in names else None
+
+    def reset(self) -> None:
+        """Nothing to forget: the law has no state."""
+
+    def act(self, observation: np.ndarray, info: dict[str, Any]) -> np.ndarray:
+        """The gimbal action (pitch, yaw) in [-1, 1] from the step's privileged info (zero before the first step,
+        whose info holds none)."""
+        if "m_aero_b" not in info:                          # the reset's info
+            return np.zeros(2, dtype=np.float32)
+        lever = float(info["thrust"]) * float(info["gimbal_arm"])
+        if lever < 1.0:                                     # no thrust: no moment to command
+            return np.zeros(2, dtype=np.float32)
+        w = np.asarray(info["omega_bi_b"], dtype=float)
+        att = np.asarray(info["attitude_error"], dtype=float)
+        m_aero = np.asarray(info["m_aero_b"], dtype=float)
+        J = np.asarray(info["J_b_diag"], dtype=float)
+        ref = float(observation[self._i_ref]) if self._i_ref is not None else 0.0
+        e_rate = np.array([w[1] - ref, w[2]])
+        alpha = -2.0 * self.z * self.w * e_rate - self.w * self.w * att
+        delta = (J[1:] * alpha - m_aero[1:]) / lever
+        return np.clip(delta / self.limit, -1.0, 1.0).astype(np.float32)
+
+
+def privileged(env: Any, bandwidth_radps: float | None = None, damping: float | None = None,
+               name: str = "privileged") -> PrivilegedPolicy:
+    """``privileged``: the reference of :class:`PrivilegedPolicy` (module docstring), at :data:`GAINS` unless
+    given."""
+    return PrivilegedPolicy(env, bandwidth_radps, damping, name)
+
+
+#: the runner flies this factory's policies with the env option privileged_info=True
+privileged.privileged = True  # type: ignore[attr-defined]

@@ -1,0 +1,75 @@
+"""The privileged reference (lvgym/baselines/privileged.py) and the env's privileged_info: the law against
+hand numbers, the info against the simulator's state, and the runner flying it with the option set."""
+
+from __future__ import annotations
+
+import gymnasium as gym
+import numpy as np
+import pytest
+
+import lvgym  # noqa: F401
+from lvgym.baselines.privileged import GAINS, PrivilegedPolicy, privileged
+from lvgym.errors import ConfigError
+
+
+def test_the_info_holds_the_true_state_only_when_asked():
+    env = gym.make("lvgym/SmileAscent-v1", mission_time_s=3.0, privileged_info=True)
+    env.reset(seed=0)
+    info = env.step(np.array([0.1, -0.1], np.float32))[4]
+    u = env.unwrapped
+    np.testing.assert_array_equal(info["omega_bi_b"], u.flight.state("omega_bi_b")[0])
+    np.testing.assert_array_equal(info["m_aero_b"], u.flight.conditions("m_aero_b")[0])
+    assert info["thrust"] == u.flight.conditions("thrust")[0] > 0.0 and 0.0 < info["gimbal_arm"] < 16.5
+    assert info["J_b_diag"].shape == (3,) and info["J_b_diag"][1] > info["J_b_diag"][0] > 0.0
+    plain = gym.make("lvgym/SmileAscent-v1", mission_time_s=3.0)
+    plain.reset(seed=0)
+    other = plain.step(np.array([0.1, -0.1], np.float32))[4]
+    assert "m_aero_b" not in other and other["time"] == info["time"]
+    np.testing.assert_array_equal(other["gimbal"], info["gimbal"])          # the same flight
+
+
+def test_the_law_cancels_the_aerodynamic_moment_and_closes_the_attitude_loop():
+    env = gym.make("lvgym/SmileAscent-v1", privileged_info=True, model="rigid")
+    pol = PrivilegedPolicy(env, bandwidth_radps=2.0, damping=0.5)
+    limit = env.unwrapped.func.gimbal_limit
+    obs = np.zeros(env.observation_space.shape, np.float32)
+    info = {"omega_bi_b": np.array([0.0, 0.01, -0.02]), "attitude_error": np.array([0.03, 0.0]),
+            "m_aero_b": np.array([0.0, 500.0, -300.0]), "thrust": 4e5, "gimbal_arm": 5.0,
+            "J_b_diag": np.array([700.0, 1e5, 1e5])}
+    a = pol.act(obs, info)
+    want_p = (1e5 * (-2 * 0.5 * 2.0 * 0.01 - 4.0 * 0.03) - 500.0) / 2e6
+    want_y = (1e5 * (-2 * 0.5 * 2.0 * -0.02) + 300.0) / 2e6
+    np.testing.assert_allclose(a, np.array([want_p, want_y]) / limit, rtol=1e-6)
+    assert not pol.act(obs, {**info, "thrust": 0.0}).any()                  # no thrust, no command
+    assert not pol.act(obs, {"time": 0.0}).any()                            # the reset's info
+
+
+def test_it_refuses_an_env_without_the_true_state_and_bad_gains():
+    with pytest.raises(ConfigError, match="privileged_info"):
+        privileged(gym.make("lvgym/SmileAscent-v1"))
+    with pytest.raises(ConfigError, match="bandwidth_radps"):
+        privileged(gym.make("lvgym/SmileAscent-v1", privileged_info=True), bandwidth_radps=-1.0)
+    pol = privileged(gym.make("lvgym/SmileAscent-v1", privileged_info=True, model="rigid"))
+    assert (pol.w, pol.z) == GAINS["rigid"]
+
+
+def test_the_runner_flies_it_with_the_true_state_batched_as_single():
+    from dataclasses import replace
+
+    from lvgym.benchmark.registry import resolve_policy
+    from lvgym.benchmark.runner import evaluate, make_tasks, run_episode
+    from lvgym.benchmark.suites import get_suite
+
+    import lvgym.cli.policies  # noqa: F401
+
+    s = get_suite("smile-v1").with_options(mission_time_s=8.0)
+    s = replace(s, conditions=s.conditions[:1])
+    spec, lqg = resolve_policy("privileged"), resolve_policy("lqg")
+    tasks = make_tasks([spec, lqg], [s], 2, "validation")
+    assert [dict(t.condition.options).get("privileged_info", False) for t in tasks] == [True, True, False, False]
+    recs = evaluate([spec], [s], 2, "validation", executor="serial", progress=False)
+    for r, t in zip(recs, tasks):
+        single = run_episode(spec, t.condition, t.seed)
+        assert {k: single[k] for k in ("score", "failed", "rate_error_rad")} == {k: r[k] for k in ("score", "failed",
+                                                                                                    "rate_error_rad")}
+        assert not r["failed"]
