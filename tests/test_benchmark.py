@@ -125,7 +125,8 @@ def test_suites_are_frozen_and_seed_sets_disjoint():
     assert not set(s.seeds("test", 10_000)) & set(s.seeds("validation", 10_000))
     for suite in SUITES.values():
         assert suite.version in ("v0", "v1", "v2-draft") and {c.model for c in suite.conditions} == {"rigid", "nonrigid"}
-        assert bool(suite.reference) == (suite.version == "v2-draft")           # v0 and v1 name no reference
+        assert not suite.reference or suite.version == "v2-draft"               # v0 and v1 name no reference
+    assert get_suite("smile-v2").reference == get_suite("smile-v2-faults").reference == "lqg"
     assert {n for n, s in SUITES.items() if s.version == "v0"} == {"smile-calm", "smile-windy", "smile-dispersed",
                                                                    "slender-ld30"}
     assert get_suite("smile-v1").with_options(mission_time_s=1.0).version == "v1+override"

@@ -257,7 +257,8 @@ def normalise(summary: Sequence[dict[str, Any]], records: Iterable[dict[str, Any
     policy label) the normalised ``metric``: ``<metric>_norm`` with ``_norm_ci_low``, ``_norm_ci_high``
     (:func:`~.stats.normalised`: the zero policy 0, the reference 1, higher is better), over the seeds the
     row's policy, ``zero`` and the reference all flew in its condition. Rows without those flights are left
-    as they are. Returns ``summary``."""
+    as they are, and so is every row of a condition whose reference does not beat the zero policy (no
+    scale). Returns ``summary``."""
     from .stats import normalised
 
     values = per_seed([r for r in records if metric in r], metric)
@@ -270,7 +271,8 @@ def normalise(summary: Sequence[dict[str, Any]], records: Iterable[dict[str, Any
         common = sorted(set(z) & set(r) & set(x))
         if common:
             v, lo, hi = normalised([x[i] for i in common], [z[i] for i in common], [r[i] for i in common])
-            row[f"{metric}_norm"], row[f"{metric}_norm_ci_low"], row[f"{metric}_norm_ci_high"] = v, lo, hi
+            if math.isfinite(v):                  # NaN: the reference does not beat the zero policy (no scale)
+                row[f"{metric}_norm"], row[f"{metric}_norm_ci_low"], row[f"{metric}_norm_ci_high"] = v, lo, hi
     return summary
 
 
