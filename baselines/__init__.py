@@ -29,10 +29,10 @@ register_policy("gs-pid", smile_scheduled_pid, name="gs-pid", schedule="smile")
 register_policy("gs-pid-flex", flex_pid, name="gs-pid-flex")
 # adaptive augmenting control on gs-pid-flex (lvgym.baselines.aac, docs/adaptive-control.md)
 register_policy("aac", flex_aac, name="aac")
-# the same design held to protocol v2's flyability: the gyro noise's commanded gimbal rate at most 20 % of the
-# rate limit (flexdesign --noise-rate 0.2; docs/flex-design.md), and aac on it
-register_policy("gs-pid-flex-quiet", flex_pid, name="gs-pid-flex-quiet", schedule="smile_flex_quiet")
-register_policy("aac-quiet", flex_aac, name="aac-quiet", schedule="smile_flex_quiet")
+# the same designs held to protocol v2's flyability: the gyro noise's commanded gimbal rate at most 20 % of the
+# rate limit (flexdesign --noise-rate 0.2; lvgym.baselines.pid.QUIET_SCHEDULES, docs/flex-design.md), and aac on it
+register_policy("gs-pid-flex-quiet", flex_pid, name="gs-pid-flex-quiet", quiet=True)
+register_policy("aac-quiet", flex_aac, name="aac-quiet", quiet=True)
 # protocol v2's privileged reference: the true state and the aerodynamic moment known (not a flyable design)
 register_policy("privileged", "lvgym.baselines.privileged:privileged", name="privileged")
 # the thesis's gains (6.3.1) and its Table 6.10 schedule, as published

@@ -320,10 +320,10 @@ def smile_aac(env: Any, schedule: str = "smile", name: str = "aac", record: bool
 FLEX_AAC = {"damper_deadzone_rad2": 3e-3}
 
 
-def flex_aac(env: Any, name: str = "aac", record: bool = False, schedule: str | None = None,
+def flex_aac(env: Any, name: str = "aac", record: bool = False, schedule: str | None = None, quiet: bool = False,
              **params: Any) -> AdaptiveAugmentingPolicy:
-    """``aac``: AAC on ``gs-pid-flex`` (:func:`.pid.flex_pid`, the vehicle's flex schedule, or
-    ``schedule``) with :data:`FLEX_AAC`; keywords of :class:`AACParams` override them."""
+    """``aac``: AAC on ``gs-pid-flex`` (:func:`.pid.flex_pid`: the vehicle's flex schedule, its quiet one with
+    ``quiet``, or ``schedule``) with :data:`FLEX_AAC`; keywords of :class:`AACParams` override them."""
     _check_keywords(params)
-    return AdaptiveAugmentingPolicy(flex_pid(env, schedule=schedule), env=env, params=AACParams(**{**FLEX_AAC, **params}), name=name,
+    return AdaptiveAugmentingPolicy(flex_pid(env, schedule=schedule, quiet=quiet), env=env, params=AACParams(**{**FLEX_AAC, **params}), name=name,
                                     record=record)

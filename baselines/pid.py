@@ -400,20 +400,25 @@ def smile_scheduled_pid(env: Any, schedule: str = "smile_thesis", name: str | No
 #: SlenderGeometry: ``SlenderAscent-v1``'s default 8.5 m x 0.2833 m, 4.5 mm tube, with load relief;
 #: docs/flex-design.md)
 FLEX_SCHEDULES: dict = {"smile_v1": "smile_flex", "stratos3": "stratos3_flex", SLENDER_V1.vehicle: "slender_flex"}
+#: the same designs held to protocol v2's flyability (``flexdesign --noise-rate 0.2``: the gyro noise's
+#: commanded gimbal rate at most 20 % of the rate limit), for ``gs-pid-flex-quiet`` and ``aac-quiet``
+QUIET_SCHEDULES: dict = {"smile_v1": "smile_flex_quiet"}
 
 
-def flex_pid(env: Any, name: str = "gs-pid-flex", schedule: str | None = None) -> GainScheduledPIDPolicy:
+def flex_pid(env: Any, name: str = "gs-pid-flex", schedule: str | None = None,
+             quiet: bool = False) -> GainScheduledPIDPolicy:
     """``gs-pid-flex``: the filtered gain-scheduled PID designed on the non-rigid v1 flight loop of the
-    vehicle ``env`` flies (:data:`FLEX_SCHEDULES`); a vehicle without a flex design is refused.
-    ``schedule``: another flex schedule of that vehicle instead (a name in ``baselines/schedules`` or a
-    YAML path), e.g. ``smile_flex_quiet`` (``gs-pid-flex-quiet``)."""
+    vehicle ``env`` flies (:data:`FLEX_SCHEDULES`; ``quiet``: :data:`QUIET_SCHEDULES`, ``gs-pid-flex-quiet``);
+    a vehicle without such a design is refused. ``schedule``: another flex schedule of that vehicle instead
+    (a name in ``baselines/schedules`` or a YAML path)."""
     if schedule is not None:
         return GainScheduledPIDPolicy(schedule, env=env, name=name)
+    table = QUIET_SCHEDULES if quiet else FLEX_SCHEDULES
     vehicle = getattr(env.unwrapped.task, "vehicle", None)
-    if not isinstance(vehicle, Hashable) or vehicle not in FLEX_SCHEDULES:
-        raise ConfigError("env vehicle", vehicle, f"one of {list(FLEX_SCHEDULES)}: the vehicles of a v1 env "
-                          "with a gs-pid-flex schedule (python -m lvgym.baselines.design.flexdesign --vehicle ...)")
-    return GainScheduledPIDPolicy(FLEX_SCHEDULES[vehicle], env=env, name=name)
+    if not isinstance(vehicle, Hashable) or vehicle not in table:
+        raise ConfigError("env vehicle", vehicle, f"one of {list(table)}: the vehicles of a v1 env with a "
+                          f"{name} schedule (python -m lvgym.baselines.design.flexdesign --vehicle ...)")
+    return GainScheduledPIDPolicy(table[vehicle], env=env, name=name)
 
 
 def smile_tuned_pid(env: Any, schedule: str = "smile", t_design: float = 28.8, name: str = "pid") -> PIDPolicy:
