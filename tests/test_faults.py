@@ -218,3 +218,25 @@ def test_the_record_names_the_fault_batched_as_single():
     plain_env = base.make_vec_env(1)
     plain = fly_rows(plain_env, [0], [(as_batch(zero_policy(base.make_env()), 1), [0])])[0]
     assert "fault" not in plain
+
+
+def test_a_snapshot_before_the_onset_replays_the_fault_bit_for_bit():
+    env = gym.make("lvgym/SmileAscent-v1", randomize={"fault", "wind"}, fault_kinds=("effectiveness", "gyro_bias"),
+                   fault_onset_s=(3.0, 3.5), mission_time_s=5.0)
+    env.reset(seed=7)
+    a = np.array([0.05, -0.05], np.float32)
+    for _ in range(100):                                   # 2 s: before the onset
+        env.step(a)
+    snap = env.unwrapped.get_state()
+
+    def rest():
+        out = []
+        while True:
+            _, _, term, trunc, info = env.step(a)
+            out.append((info["time"], info["gimbal"].tobytes(), info["fault"]))
+            if term or trunc:
+                return out
+
+    first = rest()
+    env.unwrapped.set_state(snap)
+    assert rest() == first and first[-1][2]
