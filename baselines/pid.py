@@ -400,9 +400,10 @@ def smile_scheduled_pid(env: Any, schedule: str = "smile_thesis", name: str | No
 #: SlenderGeometry: ``SlenderAscent-v1``'s default 8.5 m x 0.2833 m, 4.5 mm tube, with load relief;
 #: docs/flex-design.md)
 FLEX_SCHEDULES: dict = {"smile_v1": "smile_flex", "stratos3": "stratos3_flex", SLENDER_V1.vehicle: "slender_flex"}
-#: the same designs held to protocol v2's flyability (``flexdesign --noise-rate 0.2``: the gyro noise's
-#: commanded gimbal rate at most 20 % of the rate limit), for ``gs-pid-flex-quiet`` and ``aac-quiet``
-QUIET_SCHEDULES: dict = {"smile_v1": "smile_flex_quiet"}
+#: the same designs held to protocol v2's flyability (``flexdesign --noise-rate``: the gyro noise's commanded
+#: gimbal rate at most 20 % of the rate limit for SMILE, 10 % for Stratos III, whose turbulence response asks
+#: more), for ``gs-pid-flex-quiet`` and ``aac-quiet``; the slender vehicle has none (docs/benchmark.md)
+QUIET_SCHEDULES: dict = {"smile_v1": "smile_flex_quiet", "stratos3": "stratos3_flex_quiet"}
 
 
 def flex_pid(env: Any, name: str = "gs-pid-flex", schedule: str | None = None,

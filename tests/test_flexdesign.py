@@ -278,15 +278,16 @@ def test_the_noise_requirement_is_reported_and_held_when_asked(row288):
     assert len(v_tight) == len(v_loose) + 1 and v_tight[-1] > 1.0 and v_tight[:-1] == v_loose
 
 
-def test_the_quiet_schedule_holds_the_noise_in_every_loop():
-    """``gs-pid-flex-quiet``'s schedule (flexdesign --noise-rate 0.2): every row meets every requirement,
-    and the gimbal rate the gyro noise commands is at most 20 % of the rate limit in every loop, at its row
-    and at both ends of its stretch (the shipped schedule commands up to six times the limit)."""
-    quiet = GainSchedule.load("smile_flex_quiet")
-    assert quiet.meta["requirements"]["noise_rate_fraction"] == 0.2
-    assert len(quiet.meta["rows"]) == len(GainSchedule.load("smile_flex").meta["rows"]) == 12
+@pytest.mark.parametrize("vehicle, fraction, rows", [("smile", 0.2, 12), ("stratos3", 0.1, 7)])
+def test_the_quiet_schedule_holds_the_noise_in_every_loop(vehicle, fraction, rows):
+    """``gs-pid-flex-quiet``'s schedules (flexdesign --noise-rate): every row meets every requirement, and
+    the gimbal rate the gyro noise commands is at most the fraction of the rate limit in every loop, at its
+    row and at both ends of its stretch (the shipped flex schedules command several times the limit)."""
+    quiet = GainSchedule.load(f"{vehicle}_flex_quiet")
+    assert quiet.meta["requirements"]["noise_rate_fraction"] == fraction
+    assert len(quiet.meta["rows"]) == len(GainSchedule.load(f"{vehicle}_flex").meta["rows"]) == rows
     for row in quiet.meta["rows"]:
         assert row["meets"] and all(c["meets"] for c in row["ends"])
         for chk in [row] + row["ends"]:
             noise = [m["noise_rate_fraction"] for m in chk["margins"].values() if "noise_rate_fraction" in m]
-            assert noise and max(noise) <= 0.2 * 1.005, (row["time_s"], noise)
+            assert noise and max(noise) <= fraction * 1.005, (row["time_s"], noise)
