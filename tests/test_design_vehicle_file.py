@@ -59,8 +59,12 @@ def test_rigid_pid_flies_an_unstable_file_vehicle_past_where_centred_fails(stubb
     assert all(r["kp"] > 0 and r["ki"] > 0 for r in doc["rows"])
     assert doc["operating_points"]["flown_with"].startswith("the rigid PID schedule of the rows designed so far")
     assert lines[0].startswith("operating points: the rigid PID schedule")
-    with pytest.raises(ConfigError, match="times"):
-        tune.default_times(stubby, tune.VEHICLE_TIMES)
+    # a file's default rows: 8 equal parts of its burning flight after the switch-on, the staging coast skipped
+    times = tune.default_times(stubby, tune.VEHICLE_TIMES)
+    assert len(times) == 8 and list(times) == sorted(times) and 2.0 < times[0] < times[-1] < 70.0
+    assert times == (5.6, 12.7, 19.8, 26.9, 34.1, 41.2, 59.3, 66.4)                      # as smile_v1's
+    assert not any(43.0 < t < 58.0 for t in times)
+    assert tune.default_times("smile", tune.VEHICLE_TIMES) == tune.VEHICLE_TIMES["smile"]
 
 
 def test_command_lines_design_for_a_file_vehicle(stubby, tmp_path, capsys):
@@ -112,9 +116,9 @@ def test_a_bad_vehicle_path_is_one_line(tmp_path, capsys):
             main([*cmd, "--vehicle", str(missing), "--out", str(tmp_path / "o")])
         msg = capsys.readouterr().err.strip()
         assert "--vehicle" in msg and str(missing) in msg and "no such file" in msg and len(msg.splitlines()) <= 3
-    with pytest.raises(SystemExit) as exc:                  # refused before any flight
-        main(["design", "lqg", "--vehicle", str(SMILE_V1), "--rows", "3"])
-    assert "--phases" in str(exc.value.code) and "required for vehicle" in str(exc.value.code)
+    with pytest.raises(SystemExit) as exc:                  # a row in the staging coast: refused before any flight
+        main(["design", "lqg", "--vehicle", str(SMILE_V1), "--rows", "50"])
+    assert "--rows" in str(exc.value.code) and "50" in str(exc.value.code)
 
 
 def test_margins_command_flies_the_suite_with_a_vehicle_file(stubby, tmp_path, capsys):
@@ -131,3 +135,14 @@ def test_margins_command_flies_the_suite_with_a_vehicle_file(stubby, tmp_path, c
     with pytest.raises(SystemExit):
         parse_args(["--vehicle", str(tmp_path / "nowhere.yaml")])
     assert "--vehicle" in capsys.readouterr().err
+
+
+def test_a_files_burning_flight_gives_the_lqg_phases_and_rows(stubby):
+    from lvgym.baselines.design import target
+
+    phases = target.burn_phases(stubby)
+    assert phases == ((2.0, 43.0), (54.0, 70.0))          # SMILE v1's stages: the staging coast left out
+    rows = target.file_times(stubby)
+    assert all(any(a < t < b for a, b in phases) for t in rows)
+    from lvgym.baselines.design.lqg_design import row_intervals
+    assert len(row_intervals(rows, phases)) == len(rows)   # every row inside a phase, as the design needs

@@ -294,7 +294,8 @@ class Args:
 
     vehicle: str = arg("smile", check=vehicle_option, metavar="NAME|PATH")
     """the vehicle whose schedule is designed: a shipped vehicle (smile, stratos3, slender) or the path of a
-    vehicle YAML file, flown in SMILE's v1 env (docs/vehicles.md; give --times)"""
+    vehicle YAML file, flown in SMILE's v1 env (docs/vehicles.md; default --times: 8 equal parts of its burning
+    flight)"""
     fly: str = arg("auto", check=fly_option, metavar="MODE|SCHEDULE")
     """how the first row's operating points are reached (the later rows: with the rows designed so far):
     centred (gimbal at zero), pid (a rigid PID schedule designed first at the same times), a schedule file,

@@ -250,21 +250,22 @@ def design_schedule(vehicle: Any = "smile", rows: tuple[float, ...] | None = Non
     at the ends of its interval (:func:`row_intervals`) and at the row with its slosh dispersed
     (:data:`DISPERSED_SLOSH`). ``vehicle``: ``smile`` (rows and phases default to SMILE v1's) or any
     vehicle a v1 env flies, a shipped name or a vehicle file (:func:`.target.design_env`; ``options``: env
-    keywords), with its ``rows`` and thrusting ``phases`` [s]. ``fly``: how the operating points are
+    keywords), with its ``rows`` and thrusting ``phases`` [s] (a file's default: :func:`.target.burn_phases`
+    and :func:`.target.file_times`). ``fly``: how the operating points are
     reached (:data:`.target.FLY_MODES`): ``centred`` (SMILE: its upper stage with the shipped rigid
     ``gs-pid`` schedule, as the shipped design), ``pid`` (a rigid PID schedule designed first at the rows,
     :func:`.tune.schedule` with ``fly="rows"``) or a schedule file; ``auto``: ``centred`` for a shipped
     vehicle, ``pid`` for a file. A document not flown as the shipped design records how in
     ``operating_points``."""
-    from .target import check_fly, check_vehicle, describe, fly_mode, schedule_flyer
+    from .target import burn_phases, check_fly, check_vehicle, describe, file_times, fly_mode, schedule_flyer
 
     vehicle = check_vehicle(vehicle, "v1")
     if vehicle == "smile":
         rows = SMILE_ROWS_S if rows is None else rows
         phases = SMILE_PHASES_S if phases is None else phases
-    elif rows is None or phases is None:
-        raise ConfigError("phases" if rows is not None else "rows", None,
-                          f"the rows and thrusting phases [s] of vehicle {vehicle!r} (SMILE v1's are the defaults)")
+    else:                                    # a file: its burning flight (target.burn_phases, target.file_times)
+        phases = burn_phases(vehicle, "v1", "phases") if phases is None else phases
+        rows = file_times(vehicle, protocol="v1", option="rows") if rows is None else rows
     rows = tuple(rows)
     intervals = row_intervals(rows, tuple(phases))
     upper_after = phases[0][1] + 0.5
@@ -358,13 +359,15 @@ class Args:
 
     vehicle: str = arg("smile", check=vehicle_option, metavar="NAME|PATH")
     """the vehicle: smile (SMILE v1, the rows and phases below by default) or the path of a vehicle YAML
-    file flown in SMILE's v1 env (docs/vehicles.md; give --rows and --phases)"""
+    file flown in SMILE's v1 env (docs/vehicles.md; by default its burning flight's phases and 8 rows over
+    them)"""
     out: str = "results/schedules"
     """folder of <vehicle>_lqg.npz and <vehicle>_lqg_margins.md (a file: its stem)"""
     overwrite: bool = False
     """write into the shipped baselines/schedules instead of --out"""
     rows: list[float] | None = arg(None, lo=0.0, hi=3600.0)
-    """flight times [s] of the rows (default: SMILE v1's, 3 10 20 28.8 36 41 56 62 68)"""
+    """flight times [s] of the rows (default: SMILE v1's, 3 10 20 28.8 36 41 56 62 68; a file's: 8 equal
+    parts of its burning flight)"""
     phases: list[float] | None = arg(None, lo=0.0, hi=3600.0, metavar="START END")
     """the thrusting phases with the controller on [s], pairs START END (default: SMILE v1's, 2 42.5 54.5 69.5)"""
     fly: str = arg("auto", check=fly_option, metavar="MODE|SCHEDULE")
@@ -378,7 +381,7 @@ def main(argv: list[str] | None = None) -> int:
     from lvgym.cli import fail
     from lvgym.cli.args import command_name, parse
 
-    from .target import stem
+    from .target import burn_phases, file_times, stem
 
     prog = "python -m lvgym.baselines.design.lqg_design"
     a = parse(Args, argv, prog, __doc__)
@@ -386,11 +389,9 @@ def main(argv: list[str] | None = None) -> int:
     try:
         if a.phases is not None and len(a.phases) % 2:
             raise ConfigError("--phases", a.phases, "pairs START END [s]")
-        phases = tuple(zip(a.phases[::2], a.phases[1::2])) if a.phases else (SMILE_PHASES_S if smile else None)
-        rows = tuple(a.rows) if a.rows else (SMILE_ROWS_S if smile else None)
-        if rows is None or phases is None:
-            raise ConfigError("--rows" if rows is None else "--phases", None,
-                              f"required for vehicle {a.vehicle} (SMILE v1's are the defaults)")
+        phases = (tuple(zip(a.phases[::2], a.phases[1::2])) if a.phases else
+                  SMILE_PHASES_S if smile else burn_phases(a.vehicle, "v1", "--phases"))
+        rows = tuple(a.rows) if a.rows else (SMILE_ROWS_S if smile else file_times(a.vehicle, option="--rows"))
         try:
             row_intervals(rows, phases)                  # every row in a thrusting phase, before the design
         except ConfigError as exc:

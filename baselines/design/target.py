@@ -135,3 +135,44 @@ def vehicle_option(option: str, value: str) -> str:
 def fly_option(option: str, value: str) -> str:
     """A command line's ``--fly`` (an :func:`lvgym.cli.args.arg` check): :func:`check_fly`."""
     return check_fly(value, option)
+
+
+#: rows of a vehicle file's default schedule (:func:`file_times`)
+FILE_ROWS = 8
+
+
+def burn_phases(vehicle: Any, protocol: str = "v1", option: str = "times") -> tuple[tuple[float, float], ...]:
+    """The thrusting phases ``(start, end)`` [s] of ``vehicle`` with the controller on, in ``protocol``'s env
+    (:func:`design_env`): the stretches of its timeline where an engine burns, between the controller's
+    switch-on and the end of the mission. Fewer than 1 s of them: a ``ConfigError`` naming ``option``."""
+    import gymnasium as gym
+    import numpy as np
+
+    env_id, kw = design_env(vehicle, protocol)
+    func = gym.make(env_id, **kw).unwrapped.func
+    t = np.asarray(func.timeline.tables.t, dtype=float)
+    spec = func.spec
+    on = (np.asarray(func.timeline.tables.burning) != 0.0) & (t >= spec.controller_on_after_s) & \
+        (t <= spec.mission_time_s)
+    edges = np.flatnonzero(np.diff(np.concatenate([[0], on.astype(np.int8), [0]])))
+    phases = tuple((round(float(t[a]), 2), round(float(t[b - 1]), 2)) for a, b in zip(edges[::2], edges[1::2])
+                   if t[b - 1] > t[a])
+    if sum(b - a for a, b in phases) < 1.0:
+        raise ConfigError(option, None, f"the flight times [s] of the rows: {vehicle} burns for less than 1 s "
+                          f"between {spec.controller_on_after_s:g} s and {spec.mission_time_s:g} s, give them")
+    return phases
+
+
+def file_times(vehicle: Any, n: int = FILE_ROWS, protocol: str = "v1", option: str = "times") -> tuple[float, ...]:
+    """``n`` flight times [s] for the rows of a vehicle file's schedule: the centres of ``n`` equal parts of
+    its :func:`burn_phases` taken end to end (a coast counts for nothing), to 0.1 s."""
+    import numpy as np
+
+    phases = burn_phases(vehicle, protocol, option)
+    lengths = np.array([b - a for a, b in phases])
+    ends = np.cumsum(lengths)
+    out = []
+    for x in (np.arange(n) + 0.5) / n * ends[-1]:
+        k = min(int(np.searchsorted(ends, x)), len(phases) - 1)
+        out.append(round(float(phases[k][0] + x - (ends[k] - lengths[k])), 1))
+    return tuple(sorted(set(out)))

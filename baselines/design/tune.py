@@ -97,19 +97,18 @@ def _rounded(m: dict) -> dict:
     return {k: (round(v, 5 if k.startswith("max_pole") else 2) if isinstance(v, float) else v) for k, v in m.items()}
 
 
-def default_times(vehicle: Any, table: dict[str, tuple[float, ...]], option: str = "times") -> tuple[float, ...]:
-    """The rows' flight times of a shipped ``vehicle`` in ``table``; a vehicle file has none: a
-    ``ConfigError`` asking for them."""
-    from lvgym.errors import ConfigError
-
-    from .target import is_shipped
+def default_times(vehicle: Any, table: dict[str, tuple[float, ...]], option: str = "times",
+                  protocol: str = "v1") -> tuple[float, ...]:
+    """The rows' flight times of a shipped ``vehicle`` in ``table`` (another shipped vehicle: SMILE's); a
+    vehicle file's: :func:`.target.file_times` in ``protocol``'s env (``option``: the option that gives them
+    instead, named in an error)."""
+    from .target import file_times, is_shipped
 
     if is_shipped(vehicle) and vehicle in table:
         return table[vehicle]
     if is_shipped(vehicle):
         return table["smile"]
-    raise ConfigError(option, None, f"the flight times [s] of the rows: a vehicle file ({vehicle}) has no default "
-                      f"(the shipped vehicles': {table})")
+    return file_times(vehicle, protocol=protocol, option=option)
 
 
 def schedule(vehicle: Any = "smile", times=None, bandwidth: float = 75.0, pm_deg: float = 35.0, dt: float = 0.02,
@@ -212,7 +211,7 @@ class Args:
 
     vehicle: str = arg("smile", check=vehicle_option, metavar="NAME|PATH")
     """the vehicle whose schedule is tuned: a shipped vehicle (smile, stratos3, slender) or the path of a
-    vehicle YAML file (docs/vehicles.md; give --times)"""
+    vehicle YAML file (docs/vehicles.md; default --times: 8 equal parts of its burning flight)"""
     protocol: str = arg("v0", choices=("v0", "v1"))
     """the protocol whose env flies the vehicle to each row (a file: in SMILE's env of it)"""
     fly: str = arg("auto", check=fly_option, metavar="MODE|SCHEDULE")
