@@ -257,15 +257,19 @@ def design_schedule(vehicle: Any = "smile", rows: tuple[float, ...] | None = Non
     :func:`.tune.schedule` with ``fly="rows"``) or a schedule file; ``auto``: ``centred`` for a shipped
     vehicle, ``pid`` for a file. A document not flown as the shipped design records how in
     ``operating_points``."""
-    from .target import burn_phases, check_fly, check_vehicle, describe, file_times, fly_mode, schedule_flyer
+    from .target import (burn_phases, check_fly, check_vehicle, describe, file_times, fly_mode, is_shipped,
+                         schedule_flyer)
 
     vehicle = check_vehicle(vehicle, "v1")
     if vehicle == "smile":
         rows = SMILE_ROWS_S if rows is None else rows
         phases = SMILE_PHASES_S if phases is None else phases
-    else:                                    # a file: its burning flight (target.burn_phases, target.file_times)
+    elif not is_shipped(vehicle):            # a file: its burning flight (target.burn_phases, target.file_times)
         phases = burn_phases(vehicle, "v1", "phases") if phases is None else phases
         rows = file_times(vehicle, protocol="v1", option="rows") if rows is None else rows
+    elif rows is None or phases is None:
+        raise ConfigError("phases" if rows is not None else "rows", None,
+                          f"the rows and thrusting phases [s] of vehicle {vehicle!r} (SMILE v1's are the defaults)")
     rows = tuple(rows)
     intervals = row_intervals(rows, tuple(phases))
     upper_after = phases[0][1] + 0.5
@@ -381,7 +385,7 @@ def main(argv: list[str] | None = None) -> int:
     from lvgym.cli import fail
     from lvgym.cli.args import command_name, parse
 
-    from .target import burn_phases, file_times, stem
+    from .target import burn_phases, file_times, is_shipped, stem
 
     prog = "python -m lvgym.baselines.design.lqg_design"
     a = parse(Args, argv, prog, __doc__)
@@ -389,9 +393,14 @@ def main(argv: list[str] | None = None) -> int:
     try:
         if a.phases is not None and len(a.phases) % 2:
             raise ConfigError("--phases", a.phases, "pairs START END [s]")
+        file = not smile and not is_shipped(a.vehicle)
         phases = (tuple(zip(a.phases[::2], a.phases[1::2])) if a.phases else
-                  SMILE_PHASES_S if smile else burn_phases(a.vehicle, "v1", "--phases"))
-        rows = tuple(a.rows) if a.rows else (SMILE_ROWS_S if smile else file_times(a.vehicle, option="--rows"))
+                  SMILE_PHASES_S if smile else burn_phases(a.vehicle, "v1", "--phases") if file else None)
+        rows = (tuple(a.rows) if a.rows else SMILE_ROWS_S if smile else
+                file_times(a.vehicle, option="--rows") if file else None)
+        if rows is None or phases is None:
+            raise ConfigError("--rows" if rows is None else "--phases", None,
+                              f"required for vehicle {a.vehicle} (SMILE v1's and a file's have defaults)")
         try:
             row_intervals(rows, phases)                  # every row in a thrusting phase, before the design
         except ConfigError as exc:
