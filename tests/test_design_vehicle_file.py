@@ -146,3 +146,36 @@ def test_a_files_burning_flight_gives_the_lqg_phases_and_rows(stubby):
     assert all(any(a < t < b for a, b in phases) for t in rows)
     from lvgym.baselines.design.lqg_design import row_intervals
     assert len(row_intervals(rows, phases)) == len(rows)   # every row inside a phase, as the design needs
+
+
+def test_a_relative_table_path_is_read_beside_the_yaml_file(tmp_path, monkeypatch):
+    """``aerodynamics: {model: axisymmetric, table: aero.csv}`` in a vehicle file reads ``aero.csv`` from
+    the file's folder, whatever the working directory; the tables equal the generator's they were written
+    from; an absolute path stays as it is."""
+    import yaml
+
+    from lvgym.environment import make
+    from lvgym.vehicle import clear_vehicle_cache, load_vehicle
+
+    barrowman = make("aerodynamics", load_vehicle("smile_v1").aerodynamics)
+    folder = tmp_path / "rocket"
+    folder.mkdir()
+    barrowman.to_csv(folder / "aero.csv")
+    data = yaml.safe_load(SMILE_V1.read_text())
+    data["aerodynamics"] = {"model": "axisymmetric", "table": "aero.csv", "ref_area": barrowman.ref_area,
+                            "ref_length": barrowman.ref_length, "x_ref": barrowman.x_ref}
+    (folder / "rocket.yaml").write_text(yaml.safe_dump(data))
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    monkeypatch.chdir(elsewhere)
+    clear_vehicle_cache()
+    v = load_vehicle(str(folder / "rocket.yaml"))
+    assert v.aerodynamics["table"] == str(folder.resolve() / "aero.csv")
+    tables = make("aerodynamics", v.aerodynamics)
+    got, want = tables.coefficients(1.5, np.radians(4.0)), barrowman.coefficients(1.5, np.radians(4.0))
+    assert want["CN"] > 0.0 and set(got) >= {"CA", "CN", "Cm"}
+    for key in ("CA", "CN", "Cm"):
+        assert got[key] == pytest.approx(want[key], rel=1e-6)
+    data["aerodynamics"]["table"] = str(folder / "aero.csv")
+    (folder / "absolute.yaml").write_text(yaml.safe_dump(data))
+    assert load_vehicle(str(folder / "absolute.yaml")).aerodynamics["table"] == str(folder / "aero.csv")

@@ -412,6 +412,7 @@ def load_vehicle(name_or_path: str | Path) -> Vehicle:
                 _LOADED.move_to_end(key)
                 return _LOADED[key]
     data, lines = read_yaml(path, source=path.name, text=text)
+    _tables_beside(data, path.resolve().parent)
     try:
         vehicle = parse_vehicle(data, source=path.name)
     except ConfigError as exc:
@@ -422,6 +423,29 @@ def load_vehicle(name_or_path: str | Path) -> Vehicle:
             while len(_LOADED) > _LOADED_MAX:
                 _LOADED.popitem(last=False)
     return vehicle
+
+
+def _tables_beside(data: Any, folder: Path) -> None:
+    """Resolve, in place, every relative ``table`` path of the file's aerodynamics (the top level's and each
+    stage's, nested models included) against ``folder``, the folder of the YAML file that names it; an
+    absolute path, or a table given inline as a mapping, stays as it is."""
+    def walk(node: Any) -> None:
+        if isinstance(node, dict):
+            table = node.get("table")
+            if isinstance(table, str) and table and not Path(table).is_absolute():
+                node["table"] = str(folder / table)
+            for value in node.values():
+                walk(value)
+        elif isinstance(node, list):
+            for value in node:
+                walk(value)
+
+    if not isinstance(data, dict):
+        return
+    walk(data.get("aerodynamics"))
+    for stage in data.get("stages") or []:
+        if isinstance(stage, dict):
+            walk(stage.get("aerodynamics"))
 
 
 def parse_vehicle(data: Any, source: str | None = None) -> Vehicle:
