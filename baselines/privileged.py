@@ -35,8 +35,6 @@ __all__ = ["PrivilegedPolicy", "privileged"]
 #: takes a rate gain of 8 /s, the non-rigid one only 2 /s before the true rates' slosh content destabilises
 #: the loop (the law knows nothing of the slosh)
 GAINS = {"rigid": (2.0, 2.0), "nonrigid": (1.0, 1.0)}
-#: the info keys the policy reads (the env's privileged_info)
-KEYS = ("omega_bi_b", "m_aero_b", "thrust", "gimbal_arm", "J_b_diag", "attitude_error", "controller_on")
 
 
 class PrivilegedPolicy:
