@@ -37,6 +37,10 @@ slender-v1          the L/D 30 slender vehicle with its aeroelastic loads (Slend
                     on validation seeds 0-9 the gimbal at zero fails 2/10 rigid and 4/10 non-rigid on q-alpha)
 ==================  ===============================================================================
 
+Protocol v2 is a draft (version ``v2-draft``, not frozen; :data:`SUITES_V2_DRAFT`): ``smile-v2``,
+``smile-v2-faults``, ``stratos-tvc-v2`` and ``slender-v2``, v1's suites under the flyability rule, SMILE's
+also with in-flight faults (docs/benchmark.md).
+
 ``slender-ld30`` is provisional: there is no slender baseline yet. SlenderAscent-v0 freezes the vehicle's
 aerodynamics at Mach 2 (the thesis's constant coefficients; with the full tables the vehicle turns
 statically unstable above Mach 3.85 and no policy survives). Dynamic pressure reaches 500-700 kPa, so
@@ -218,7 +222,7 @@ SUITES_V1: dict[str, Suite] = {s.name: s for s in (
 SUITES.update(SUITES_V1)
 
 #: protocol v2's draft (not frozen: its numbers carry ``v2-draft``, and its definitions may still change before
-#: the freeze; docs/benchmark.md, "Protocol v2 (draft)"): v1's suites under the flyability rule and SMILE with
+#: the freeze; docs/benchmark.md, "v2 (draft, not frozen)"): v1's suites under the flyability rule and SMILE with
 #: in-flight faults; SMILE's name lqg as the reference of the normalised score, Stratos III's its quiet flex
 #: design, the slender vehicle's none yet (no design of it meets the flyability rule)
 PROTOCOL_V2_DRAFT = "v2-draft"
