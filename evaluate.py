@@ -4,8 +4,8 @@ The command is :mod:`lvgym.cli.evaluate`, installed as ``lvgym evaluate``; this 
 checkout (``python evaluate.py --policies zero lqg --episodes 10``) and keeps its names importable.
 """
 
-from lvgym.cli.evaluate import (DEFAULT_EPISODES, DEFAULT_POLICIES, DEFAULT_SUITES, POLICIES, Args, main,  # noqa: F401
-                                parse_args, resolve_policy)
+from lvgym.cli.evaluate import (DEFAULT_EPISODES, DEFAULT_POLICIES, DEFAULT_SUITE, DEFAULT_SUITES, POLICIES, Args,  # noqa: F401
+                                main, parse_args, resolve_policy)
 
 if __name__ == "__main__":
     main()

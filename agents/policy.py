@@ -357,6 +357,10 @@ def load_policy(path: str | Path, name: str | None = None, env: Any = None) -> A
     return adapt(SB3Policy(path, name), env)
 
 
+#: their kind in protocol v2's headline (lvgym.benchmark.headline): trained models
+shipped_policy.kind = load_policy.kind = "learned"  # type: ignore[attr-defined]
+
+
 def adapt(policy: SB3Policy, env: Any) -> Any:
     """``policy`` as the env flies it: on its baseline when its meta records a residual run (built on
     ``env``, which must then be given), else itself."""

@@ -21,6 +21,10 @@ from .lqg import smile_lqg
 from .pid import (DiscretePID, GainSchedule, GainScheduledPIDPolicy, PIDPolicy, flex_pid, smile_scheduled_pid,
                   smile_single_pid, smile_tuned_pid)
 
+# their kind in protocol v2's headline (lvgym.benchmark.headline): classical designs
+for _factory in (smile_tuned_pid, smile_scheduled_pid, smile_single_pid, flex_pid, flex_aac, smile_aac, smile_lqg):
+    _factory.kind = "classical"  # type: ignore[attr-defined]
+
 # our tuning on the rigid linearisation (lvgym.baselines.design.tune): one gain set, and the schedule on mass
 register_policy("pid", smile_tuned_pid)
 register_policy("gs-pid", smile_scheduled_pid, name="gs-pid", schedule="smile")

@@ -161,3 +161,7 @@ def smile_mpc(env: Any, name: str = "mpc", schedule: str = "smile_lqg", horizon:
         raise ConfigError("env vehicle", vehicle, "'smile_v1' (the MPC flies the LQG rows designed for SMILE v1, "
                           "lvgym/SmileAscent-v1)")
     return MPCPolicy(env=env, schedule=schedule, name=name, horizon=horizon, rate=rate)
+
+
+#: its kind in protocol v2's headline (lvgym.benchmark.headline): a classical design
+smile_mpc.kind = "classical"  # type: ignore[attr-defined]

@@ -8,7 +8,11 @@ angle whose thrust moment cancels that aerodynamic moment and adds the moment of
 (natural frequency ``bandwidth_radps``, damping ``damping``) on the true rate and attitude errors (dynamic
 inversion of the rigid body)::
 
-    delta = (J (-2 z w e_rate - w^2 e_att) - M_aero) / (T l)
+    delta = (J (-2 z w e_rate - h w^2 e_att) - h M_aero) / (T l)
+
+where ``h`` is 1 up to half the q-alpha limit and falls linearly to 0 at 90 % of it (:data:`RELIEF`, the
+``qalpha_pa_deg`` of the step's info): load relief, which lets the vehicle turn into the relative wind
+when the structural load nears its limit, as a launch vehicle's load-relief mode does.
 
 (pitch about +y_b, yaw about +z_b; a positive gimbal angle turns the vehicle positively about its axis). It
 flies the protocol's actuator path like every policy: the action's period of delay, the servo and its
@@ -30,11 +34,17 @@ from lvgym.errors import ConfigError
 
 __all__ = ["PrivilegedPolicy", "privileged"]
 
-#: (bandwidth [rad/s], damping) of the attitude loop per flight model, chosen on smile-v1's validation seeds
-#: 0-5 (the lowest mean score of a sweep; docs/benchmark.md, "The privileged reference"): the rigid vehicle
-#: takes a rate gain of 8 /s, the non-rigid one only 2 /s before the true rates' slosh content destabilises
-#: the loop (the law knows nothing of the slosh)
-GAINS = {"rigid": (2.0, 2.0), "nonrigid": (1.0, 1.0)}
+#: (bandwidth [rad/s], damping) of the attitude loop per flight model, with :data:`RELIEF`: the lowest mean
+#: ``score_v2`` over protocol v2's three SMILE suites on validation seeds 0-19 of a sweep of bandwidths 1, 1.5
+#: and 2 /s (damping equal) and reliefs none, (0.5, 0.9) and (0.3, 0.7)
+#: (``python -m experiments.protocol_v2_design.privileged_sweep``; docs/benchmark.md, "The privileged
+#: reference"). The non-rigid vehicle takes a rate gain of only about 2 /s before the true rates' slosh content
+#: destabilises the loop (the law knows nothing of the slosh)
+GAINS = {"rigid": (1.5, 1.5), "nonrigid": (1.0, 1.0)}
+#: load relief (onset, full) as shares of the env's q-alpha limit: between them the attitude loop and the
+#: cancellation of the aerodynamic moment fade out linearly, and the statically stable vehicle turns into the
+#: relative wind (module docstring)
+RELIEF = (0.5, 0.9)
 
 
 class PrivilegedPolicy:
@@ -43,7 +53,7 @@ class PrivilegedPolicy:
     env it flies (its gimbal limit, its observation's reference pitch rate, its model)."""
 
     def __init__(self, env: Any, bandwidth_radps: float | None = None, damping: float | None = None,
-                 name: str = "privileged") -> None:
+                 name: str = "privileged", relief: tuple[float, float] | None = None) -> None:
         func = env.unwrapped.func
         w0, z0 = GAINS["rigid" if func.spec.model == "rigid" else "nonrigid"]
         bandwidth_radps = w0 if bandwidth_radps is None else bandwidth_radps
@@ -56,8 +66,14 @@ class PrivilegedPolicy:
         if not func.spec.privileged_info:
             raise ConfigError("privileged env privileged_info", False, "True: the reference reads the true state "
                               "from the step's info (the benchmark's runner sets it for this policy)")
+        relief = RELIEF if relief is None else tuple(relief)
+        if not (len(relief) == 2 and all(isinstance(x, (int, float)) and math.isfinite(x) for x in relief)
+                and 0.0 < relief[0] < relief[1]):
+            raise ConfigError("privileged.relief", relief, "two shares of the q-alpha limit, 0 < onset < full")
         self.name = name
         self.w, self.z = float(bandwidth_radps), float(damping)
+        self.relief = (float(relief[0]), float(relief[1]))
+        self.qalpha_limit = float(func.spec.qalpha_limit_pa_deg)
         self.limit = float(func.gimbal_limit)
         names = list(func.observation_layout.names)
         self._i_ref = names.index("pitch_rate_reference") if "pitch_rate_reference" in names else None
@@ -79,16 +95,21 @@ class PrivilegedPolicy:
         J = np.asarray(info["J_b_diag"], dtype=float)
         ref = float(observation[self._i_ref]) if self._i_ref is not None else 0.0
         e_rate = np.array([w[1] - ref, w[2]])
-        alpha = -2.0 * self.z * self.w * e_rate - self.w * self.w * att
-        delta = (J[1:] * alpha - m_aero[1:]) / lever
+        # load relief: from ``onset`` to ``full`` of the q-alpha limit the law lets go of the attitude and of the
+        # aerodynamic moment (the statically stable vehicle turns into the relative wind); the rate damping stays
+        onset, full = self.relief
+        share = float(info.get("qalpha_pa_deg", 0.0)) / self.qalpha_limit
+        hold = 1.0 - min(1.0, max(0.0, (share - onset) / (full - onset)))
+        alpha = -2.0 * self.z * self.w * e_rate - hold * self.w * self.w * att
+        delta = (J[1:] * alpha - hold * m_aero[1:]) / lever
         return np.clip(delta / self.limit, -1.0, 1.0).astype(np.float32)
 
 
 def privileged(env: Any, bandwidth_radps: float | None = None, damping: float | None = None,
-               name: str = "privileged") -> PrivilegedPolicy:
-    """``privileged``: the reference of :class:`PrivilegedPolicy` (module docstring), at :data:`GAINS` unless
-    given."""
-    return PrivilegedPolicy(env, bandwidth_radps, damping, name)
+               name: str = "privileged", relief: tuple[float, float] | None = None) -> PrivilegedPolicy:
+    """``privileged``: the reference of :class:`PrivilegedPolicy` (module docstring), at :data:`GAINS` and
+    :data:`RELIEF` unless given."""
+    return PrivilegedPolicy(env, bandwidth_radps, damping, name, relief)
 
 
 #: the runner flies this factory's policies with the env option privileged_info=True

@@ -124,8 +124,8 @@ def test_suites_are_frozen_and_seed_sets_disjoint():
     assert s.seeds("validation", 2) == [VALIDATION_SEED0, VALIDATION_SEED0 + 1]
     assert not set(s.seeds("test", 10_000)) & set(s.seeds("validation", 10_000))
     for suite in SUITES.values():
-        assert suite.version in ("v0", "v1", "v2-draft") and {c.model for c in suite.conditions} == {"rigid", "nonrigid"}
-        assert not suite.reference or suite.version == "v2-draft"               # v0 and v1 name no reference
+        assert suite.version in ("v0", "v1", "v2") and {c.model for c in suite.conditions} == {"rigid", "nonrigid"}
+        assert not suite.reference or suite.version == "v2"               # v0 and v1 name no reference
     assert get_suite("smile-v2").reference == get_suite("smile-v2-faults").reference == "lqg"
     assert {n for n, s in SUITES.items() if s.version == "v0"} == {"smile-calm", "smile-windy", "smile-dispersed",
                                                                    "slender-ld30"}
@@ -234,7 +234,12 @@ def test_registry_names_what_is_missing(monkeypatch):
         ev.resolve_policy("not-a-policy")
     assert ev.resolve_policy("zero") == ZERO
     args = ev.parse_args([])
-    assert args.policies == ["zero", "gs-pid", "gs-pid-flex", "lqg", "lqg-front", "aac", "ppo-res-lqg"] and args.suites == ["smile-v1"]
+    # the default: protocol v2's suites, each flying its own policies (a v0 or v1 suite: DEFAULT_POLICIES);
+    # with --policies alone, the main suite smile-v2
+    assert args.policies is None and args.suites is None and ev.DEFAULT_SUITE == "smile-v2"
+    assert ev.DEFAULT_SUITES == ["smile-v2", "smile-v2-maxq-gust", "smile-v2-faults", "stratos-tvc-v2", "slender-v2"]
+    assert all(get_suite(n).policies and get_suite(n).version == "v2" for n in ev.DEFAULT_SUITES)
+    assert ev.DEFAULT_POLICIES == ["zero", "gs-pid", "gs-pid-flex", "lqg", "lqg-front", "aac", "ppo-res-lqg"]
     assert args.executor == "local"
     assert args.reference is None and ev.parse_args(["--reference", "pid"]).reference == "pid"
     with pytest.raises(SystemExit, match="--reference = 'ghost'"):          # refused before any episode runs

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import lvgym  # noqa: F401
-from lvgym.baselines.privileged import GAINS, PrivilegedPolicy, privileged
+from lvgym.baselines.privileged import GAINS, RELIEF, PrivilegedPolicy, privileged
 from lvgym.errors import ConfigError
 
 
@@ -42,6 +42,16 @@ def test_the_law_cancels_the_aerodynamic_moment_and_closes_the_attitude_loop():
     np.testing.assert_allclose(a, np.array([want_p, want_y]) / limit, rtol=1e-6)
     assert not pol.act(obs, {**info, "thrust": 0.0}).any()                  # no thrust, no command
     assert not pol.act(obs, {"time": 0.0}).any()                            # the reset's info
+    # load relief: from onset to full of the q-alpha limit the attitude term and the cancellation fade out
+    relief = PrivilegedPolicy(env, bandwidth_radps=2.0, damping=0.5, relief=(0.4, 0.8))
+    np.testing.assert_allclose(relief.act(obs, {**info, "qalpha_pa_deg": 0.3 * 250e3}), a, rtol=1e-6)
+    half = relief.act(obs, {**info, "qalpha_pa_deg": 0.6 * 250e3})
+    want_half = [(1e5 * (-2 * 0.5 * 2.0 * 0.01 - 0.5 * 4.0 * 0.03) - 0.5 * 500.0) / 2e6,
+                 (1e5 * (-2 * 0.5 * 2.0 * -0.02) + 0.5 * 300.0) / 2e6]
+    np.testing.assert_allclose(half, np.array(want_half) / limit, rtol=1e-6)
+    damping_only = relief.act(obs, {**info, "qalpha_pa_deg": 0.9 * 250e3})
+    want_damp = [1e5 * (-2 * 0.5 * 2.0 * 0.01) / 2e6, 1e5 * (-2 * 0.5 * 2.0 * -0.02) / 2e6]
+    np.testing.assert_allclose(damping_only, np.array(want_damp) / limit, rtol=1e-6)
 
 
 def test_it_refuses_an_env_without_the_true_state_and_bad_gains():
@@ -49,8 +59,10 @@ def test_it_refuses_an_env_without_the_true_state_and_bad_gains():
         privileged(gym.make("lvgym/SmileAscent-v1"))
     with pytest.raises(ConfigError, match="bandwidth_radps"):
         privileged(gym.make("lvgym/SmileAscent-v1", privileged_info=True), bandwidth_radps=-1.0)
+    with pytest.raises(ConfigError, match=r"privileged.relief = \(0.8, 0.4\): two shares"):
+        privileged(gym.make("lvgym/SmileAscent-v1", privileged_info=True), relief=(0.8, 0.4))
     pol = privileged(gym.make("lvgym/SmileAscent-v1", privileged_info=True, model="rigid"))
-    assert (pol.w, pol.z) == GAINS["rigid"]
+    assert (pol.w, pol.z) == GAINS["rigid"] and pol.relief == RELIEF
 
 
 def test_the_runner_flies_it_with_the_true_state_batched_as_single():

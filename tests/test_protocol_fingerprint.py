@@ -40,7 +40,7 @@ def test_the_probe_is_a_function_of_time_and_unknown_versions_are_refused():
         fp.fingerprint("v9")
 
 
-@pytest.mark.parametrize("version", ["v0", "v1"])
+@pytest.mark.parametrize("version", ["v0", "v1", "v2"])
 def test_a_frozen_protocol_flies_its_stored_episodes(version):
     stored = fp.stored(version)
     assert {r["suite"] for r in stored} == {s.name for s in fp._suites(version)}

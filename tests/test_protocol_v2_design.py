@@ -83,3 +83,12 @@ def test_normalise_puts_zero_at_0_and_the_reference_at_1():
     assert all(r["score_v2_norm_ci_low"] <= r["score_v2_norm"] <= r["score_v2_norm_ci_high"] for r in summary)
     untouched = [{"suite": "t", "condition": "t/rigid", "policy": "mine"}]
     assert "score_v2_norm" not in normalise(untouched, records, {"s": "lqg"})[0]
+
+
+def test_the_privileged_sweep_names_its_variants_by_their_gains_and_relief():
+    from experiments.protocol_v2_design.privileged_sweep import OFF, _variants
+
+    specs = _variants([1.0, 1.5], ["off", "0.5,0.9"])
+    assert [s.name for s in specs] == ["priv-w1-roff", "priv-w1-r0.5-0.9", "priv-w1.5-roff", "priv-w1.5-r0.5-0.9"]
+    assert dict(specs[1].kwargs) == {"bandwidth_radps": 1.0, "damping": 1.0, "relief": (0.5, 0.9)}
+    assert dict(specs[2].kwargs)["relief"] == OFF and OFF[0] > 1.0       # onset beyond the limit: no relief

@@ -5,7 +5,10 @@
 - :mod:`.metrics`: per-episode metrics of v0, per-suite mean with its interval / std / CVaR10 / failure
   rate, ranks, degradation;
 - :mod:`.scoring`: v1's per-episode metrics (failure-charged score, phases, flexibility, q-alpha cost);
-- :mod:`.stats`: bootstrap intervals, paired tests, the IQM and probability of improvement (stratified bootstrap);
+- :mod:`.stats`: bootstrap intervals, paired tests, the IQM and probability of improvement (stratified bootstrap),
+  the normalised score and the room;
+- :mod:`.flyability`, :mod:`.headline`: protocol v2's flyability rule and ``score_v2``; its headline (the
+  best causal classical and learned policies, the privileged reference and the room between them);
 - :mod:`.compare`: the paired comparison of policies and agents over training runs;
 - :mod:`.runner`: :func:`run_episode` and :func:`evaluate` (serial, local process pool or Ray);
 - :mod:`.tables`, :mod:`.results`: the Markdown tables; atomic CSV / JSON / Markdown / PNG result files;

@@ -26,6 +26,7 @@ from typing import Any
 import numpy as np
 
 from .batch import as_batch
+from .flyability import applies
 from .rows import fly_rows
 from .runner import zero_policy
 from .suites import SUITES, Suite
@@ -40,6 +41,9 @@ FINGERPRINTS = Path(__file__).resolve().parent / "data"
 RTOL = 1e-3
 NUMBERS = ("score", "rate_error_rad", "max_qalpha_pa_deg", "duration_s")
 EXACT = ("failed", "failure_reason")
+#: what a protocol that charges flyability (v2 on) adds to each episode, compared where the stored file has it
+V2_NUMBERS = ("score_v2", "cmd_rate_rms", "cmd_rate_peak")
+V2_EXACT = ("flyable", "fault")
 
 
 def _suites(version: str) -> list[Suite]:
@@ -81,10 +85,14 @@ POLICIES = {"zero": zero_policy, "probe": ProbePolicy}
 
 def _record(suite: Suite, condition: Any, seed: int, policy: str, first: np.ndarray, m: dict[str, Any]) -> dict[str, Any]:
     reason = m.get("failure_reason") or ""
-    return {"suite": suite.name, "condition": condition.name, "seed": int(seed), "policy": policy, "first_obs": _first(first),
-            "score": float(m["score"]), "rate_error_rad": float(m["rate_error_rad"]),
-            "max_qalpha_pa_deg": float(m["max_qalpha_pa_deg"]), "failed": bool(m["failed"]),
-            "failure_reason": str(reason), "duration_s": float(m["duration_s"])}
+    out = {"suite": suite.name, "condition": condition.name, "seed": int(seed), "policy": policy, "first_obs": _first(first),
+           "score": float(m["score"]), "rate_error_rad": float(m["rate_error_rad"]),
+           "max_qalpha_pa_deg": float(m["max_qalpha_pa_deg"]), "failed": bool(m["failed"]),
+           "failure_reason": str(reason), "duration_s": float(m["duration_s"])}
+    if applies(suite.version):                  # v2 on: the flyability fields and the fault drawn
+        out.update({f: float(m[f]) for f in V2_NUMBERS})
+        out.update({"flyable": bool(m["flyable"]), "fault": str(m.get("fault") or "")})
+    return out
 
 
 def _condition_records(suite: Suite, condition: Any, seeds: list[int]) -> list[dict[str, Any]]:
@@ -97,7 +105,8 @@ def _condition_records(suite: Suite, condition: Any, seeds: list[int]) -> list[d
         mine = [i for i, (_, n) in enumerate(rows) if n == name]
         groups.append((as_batch(make(env), len(rows), lambda make=make: make(env)), mine))
     first: list[np.ndarray] = []
-    records = fly_rows(condition.make_vec_env(len(rows)), [seed for seed, _ in rows], groups, first_observations=first)
+    records = fly_rows(condition.make_vec_env(len(rows)), [seed for seed, _ in rows], groups, first_observations=first,
+                       flyability=applies(suite.version))
     return [_record(suite, condition, seed, name, obs0, m) for (seed, name), obs0, m in zip(rows, first, records)]
 
 
@@ -123,11 +132,13 @@ def compare(fresh: list[dict[str, Any]], reference: list[dict[str, Any]], rtol: 
         if old is None:
             out.append(f"{key(r)}: not in the stored fingerprint")
             continue
-        out += [f"{key(r)} {f}: {r[f]!r} against {old[f]!r}" for f in EXACT if r[f] != old[f]]
+        exact = EXACT + tuple(f for f in V2_EXACT if f in old)
+        numbers = NUMBERS + tuple(f for f in V2_NUMBERS if f in old)
+        out += [f"{key(r)} {f}: {r.get(f)!r} against {old[f]!r}" for f in exact if r.get(f) != old[f]]
         a, b = np.asarray(r["first_obs"], float), np.asarray(old["first_obs"], float)
         if a.shape != b.shape or not np.allclose(a, b, rtol=rtol, atol=1e-9):
             out.append(f"{key(r)} first_obs: differs (largest difference "
                        f"{np.max(np.abs(a - b)) if a.shape == b.shape else 'in shape'})")
-        out += [f"{key(r)} {f}: {r[f]!r} against {old[f]!r}" for f in NUMBERS
-                if not np.isclose(r[f], old[f], rtol=rtol, atol=0.0)]
+        out += [f"{key(r)} {f}: {r.get(f)!r} against {old[f]!r}" for f in numbers
+                if f not in r or not np.isclose(r[f], old[f], rtol=rtol, atol=0.0)]
     return out

@@ -30,6 +30,7 @@ from typing import IO, Any
 import numpy as np
 
 from ..errors import require
+from .headline import flat
 from .tables import markdown_table
 
 __all__ = ["atomic_path", "atomic_write", "atomic_write_text", "csv_text", "json_text", "markdown_table",
@@ -208,9 +209,11 @@ def plot_degradation(degradation: Sequence[Mapping[str, Any]], write_to: IO[byte
 def write_results(out: str | os.PathLike[str], records: Sequence[Mapping[str, Any]],
                   summary: Sequence[Mapping[str, Any]], degradation: Sequence[Mapping[str, Any]],
                   meta: Mapping[str, Any], plots: bool = True, comparison: Sequence[Mapping[str, Any]] = (),
-                  groups: Sequence[Mapping[str, Any]] = ()) -> dict[str, Path]:
+                  groups: Sequence[Mapping[str, Any]] = (), headline: Sequence[Mapping[str, Any]] = ()
+                  ) -> dict[str, Path]:
     """Write every result file into ``out`` (created if missing), each atomically; ``results.json``
-    last. Returns the paths by name."""
+    last (``headline``: protocol v2's rows, :func:`~.headline.headline`, also as ``headline.csv``). Returns
+    the paths by name."""
     folder = Path(out)
     folder.mkdir(parents=True, exist_ok=True)
     remove_stale_temporaries(folder)
@@ -222,8 +225,10 @@ def write_results(out: str | os.PathLike[str], records: Sequence[Mapping[str, An
         paths["comparison.csv"] = atomic_write_text(folder / "comparison.csv", csv_text(comparison))
     if groups:
         paths["run_groups.csv"] = atomic_write_text(folder / "run_groups.csv", csv_text(groups))
+    if headline:
+        paths["headline.csv"] = atomic_write_text(folder / "headline.csv", csv_text(flat(headline)))
     paths["table.md"] = atomic_write_text(folder / "table.md",
-                                          markdown_table(summary, degradation, meta, comparison, groups))
+                                          markdown_table(summary, degradation, meta, comparison, groups, headline))
     if plots:
         paths["rate_error.png"] = atomic_write(folder / "rate_error.png", lambda f: plot_rate_error(records, f), True)
         if degradation:
@@ -231,5 +236,5 @@ def write_results(out: str | os.PathLike[str], records: Sequence[Mapping[str, An
                                                     lambda f: plot_degradation(degradation, f), True)
     paths["results.json"] = atomic_write_text(folder / "results.json", json_text(
         {"meta": meta, "summary": summary, "degradation": degradation, "comparison": list(comparison),
-         "run_groups": list(groups), "episodes": records}))
+         "run_groups": list(groups), **({"headline": list(headline)} if headline else {}), "episodes": records}))
     return paths

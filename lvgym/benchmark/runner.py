@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import inspect
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -69,6 +69,8 @@ def zero_policy(env: Any) -> ZeroPolicy:
     return ZeroPolicy(int(space.shape[0]) if space.shape else 1, discrete)
 
 
+#: its kind in protocol v2's headline (:func:`~.headline.policy_kind`): no control
+zero_policy.kind = "none"  # type: ignore[attr-defined]
 ZERO = PolicySpec("zero", "lvgym.benchmark.runner:zero_policy")
 
 
@@ -225,20 +227,36 @@ def run_task(task: Task) -> dict[str, Any]:
     return {"protocol": task.version, "suite": task.suite, "episode": task.episode, **record}
 
 
-def make_tasks(policies: Sequence[PolicySpec], suites: Sequence[Suite], episodes: int,
-               seed_set: str = "test") -> list[Task]:
+def _per_suite(policies: Sequence[PolicySpec] | Mapping[str, Sequence[PolicySpec]],
+               suites: Sequence[Suite]) -> dict[str, list[PolicySpec]]:
+    """``{suite name: its policies}``: the same list for every suite, or a mapping's own (every suite named)."""
+    if not isinstance(policies, Mapping):
+        return {s.name: list(policies) for s in suites}
+    missing = [s.name for s in suites if s.name not in policies]
+    if missing:
+        raise ValueError(f"policies per suite: none given for {missing}")
+    return {s.name: list(policies[s.name]) for s in suites}
+
+
+def make_tasks(policies: Sequence[PolicySpec] | Mapping[str, Sequence[PolicySpec]], suites: Sequence[Suite],
+               episodes: int, seed_set: str = "test") -> list[Task]:
     """Every episode of every policy on every condition of every suite, in the order of the results:
-    suite, condition, policy, episode. A policy whose factory has ``privileged = True`` flies each condition
-    with ``privileged_info=True`` (the same flight, with the true state in the info)."""
-    names = [p.name for p in policies]
-    if len(set(names)) != len(names):
-        raise ValueError(f"policy names {names}: each must be distinct (they label the results)")
-    privileged = {p.name: bool(getattr(p.resolve(), "privileged", False)) for p in policies}
+    suite, condition, policy, episode. ``policies``: one list for every suite, or a mapping of suite name to
+    that suite's own list. A policy whose factory has ``privileged = True`` flies each condition with
+    ``privileged_info=True`` (the same flight, with the true state in the info)."""
+    per_suite = _per_suite(policies, suites)
+    privileged: dict[str, bool] = {}
+    for suite in suites:
+        names = [p.name for p in per_suite[suite.name]]
+        if len(set(names)) != len(names):
+            raise ValueError(f"policy names {names}: each must be distinct (they label the results)")
+        privileged.update({p.name: bool(getattr(p.resolve(), "privileged", False))
+                           for p in per_suite[suite.name] if p.name not in privileged})
     tasks: list[Task] = []
     for suite in suites:
         seeds = suite.seeds(seed_set, episodes)
         for cond in suite.conditions:
-            for pol in policies:
+            for pol in per_suite[suite.name]:
                 # a privileged reference (its factory's ``privileged``) reads the true state from the info
                 c = cond.with_options(privileged_info=True) if privileged[pol.name] else cond
                 for i, seed in enumerate(seeds):
@@ -303,11 +321,11 @@ def _describe_block(block: Block) -> str:
     return f"{who} on {t[0].condition.name!r} {seeds} ({len(t)} episodes flown together)"
 
 
-def evaluate(policies: Sequence[PolicySpec], suites: Sequence[Suite], episodes: int, seed_set: str = "test",
+def evaluate(policies: Sequence[PolicySpec] | Mapping[str, Sequence[PolicySpec]], suites: Sequence[Suite], episodes: int, seed_set: str = "test",
              executor: str = "local", workers: int | None = None, progress: bool = True,
              rows: int | None = None) -> list[dict[str, Any]]:
-    """Run ``episodes`` seeds of ``seed_set`` for every policy on every condition of every suite and return
-    the episode records in the order of :func:`make_tasks` (whatever the executor, worker count and block
+    """Run ``episodes`` seeds of ``seed_set`` for every policy on every condition of every suite (``policies``:
+    one list, or a list per suite name, :func:`make_tasks`) and return the episode records in the order of :func:`make_tasks` (whatever the executor, worker count and block
     size).
 
     The episodes of a condition fly together as the rows of its batched env, in blocks of at most ``rows``

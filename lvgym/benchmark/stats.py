@@ -12,6 +12,8 @@ probability of improvement) for results over several training seeds.
   wins, the Wilcoxon signed-rank test and the paired t-test (``scipy.stats``).
 - :func:`normalised`: a policy's score on a scale where the zero policy is 0 and a named reference 1, with
   a paired bootstrap interval over the seeds (all three flown on the same seeds).
+- :func:`room`: the share of the best causal score that a privileged reference does without, with a
+  paired bootstrap interval over the seeds.
 - :func:`iqm` and :func:`probability_of_improvement`: the interquartile mean (``scipy.stats.trim_mean``)
   and the probability of improvement (the Mann-Whitney U statistic over ``m n``, ``scipy.stats.mannwhitneyu``)
   over ``(runs, episodes)`` score matrices, with stratified-bootstrap percentile intervals that resample
@@ -33,7 +35,7 @@ from typing import Any
 import numpy as np
 from scipy import stats
 
-__all__ = ["PairedResult", "bootstrap_ci", "iqm", "normalised", "paired", "probability_of_improvement"]
+__all__ = ["PairedResult", "bootstrap_ci", "iqm", "normalised", "paired", "probability_of_improvement", "room"]
 
 LEVEL = 0.95
 REPS = 2000
@@ -120,6 +122,26 @@ def normalised(policy: Sequence[float], zero: Sequence[float], reference: Sequen
         ratio = (zs - xs) / (zs - rs)
     ratio = ratio[np.isfinite(ratio) & (zs - rs > 0.0)]
     lo, hi = _percentile_interval(ratio, level) if ratio.size else (math.nan, math.nan)
+    return value, lo, hi
+
+
+def room(best: Sequence[float], reference: Sequence[float], level: float = LEVEL, reps: int = REPS,
+         seed: int = 0) -> tuple[float, float, float]:
+    """``(value, low, high)``: the room ``(mean(best) - mean(reference)) / mean(best)`` of per-seed scores
+    (lower is better) flown on the same seeds: the share of the best causal score that a privileged
+    ``reference`` does without (0: none; negative: the reference is worse). Its interval is the percentile
+    interval of the same ratio over ``reps`` resamplings of the seeds (both values of a seed kept together).
+    NaNs when ``mean(best)`` is not positive."""
+    b, r = (np.asarray(v, dtype=float) for v in (best, reference))
+    if not b.shape == r.shape or b.ndim != 1 or b.size == 0:
+        raise ValueError(f"per-seed scores of shapes {b.shape}, {r.shape}: one value per common seed each")
+    if not b.mean() > 0.0:
+        return math.nan, math.nan, math.nan
+    value = float((b.mean() - r.mean()) / b.mean())
+    idx = np.random.default_rng(seed).integers(0, b.size, (reps, b.size))
+    bs, rs = b[idx].mean(axis=1), r[idx].mean(axis=1)
+    ok = bs > 0.0
+    lo, hi = _percentile_interval((bs[ok] - rs[ok]) / bs[ok], level) if ok.any() else (math.nan, math.nan)
     return value, lo, hi
 
 

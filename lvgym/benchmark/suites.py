@@ -37,9 +37,17 @@ slender-v1          the L/D 30 slender vehicle with its aeroelastic loads (Slend
                     on validation seeds 0-9 the gimbal at zero fails 2/10 rigid and 4/10 non-rigid on q-alpha)
 ==================  ===============================================================================
 
-Protocol v2 is a draft (version ``v2-draft``, not frozen; :data:`SUITES_V2_DRAFT`): ``smile-v2``,
-``smile-v2-faults``, ``stratos-tvc-v2`` and ``slender-v2``, v1's suites under the flyability rule, SMILE's
-also with in-flight faults (docs/benchmark.md).
+Protocol v2 (version ``v2``, frozen on 2026-12-05; :data:`SUITES_V2`, evaluate.py's default) charges the
+flyability rule (``score_v2``) and names per suite a reference of the normalised score and the policies it
+reports; docs/benchmark.md, "Protocol v2":
+
+==================  ===============================================================================
+smile-v2            smile-v1's conditions under the flyability rule (the main suite)
+smile-v2-maxq-gust  smile-v1-maxq-gust's: 35 s through max q, a random jet stream and gust at 8-11.5 km
+smile-v2-faults     smile-v1's with one in-flight fault per episode (``V2_FAULT_KINDS``), onset in 5-40 s
+stratos-tvc-v2      stratos-tvc-v1's under the flyability rule
+slender-v2          slender-v1's under the flyability rule
+==================  ===============================================================================
 
 ``slender-ld30`` is provisional: there is no slender baseline yet. SlenderAscent-v0 freezes the vehicle's
 aerodynamics at Mach 2 (the thesis's constant coefficients; with the full tables the vehicle turns
@@ -64,8 +72,8 @@ N_VALIDATION_SEEDS = 10_000
 TEST_SEED0 = 10_000
 N_TEST_SEEDS = 10_000
 SEED_SETS = ("test", "validation")
-#: the main suite (evaluate.py's default): protocol v1's SMILE ascent
-DEFAULT_SUITE = "smile-v1"
+#: the main suite: protocol v2's SMILE ascent (the conditions of v1's ``smile-v1``, under the flyability rule)
+DEFAULT_SUITE = "smile-v2"
 
 
 def _freeze(options: Mapping[str, Any]) -> tuple[tuple[str, Any], ...]:
@@ -145,6 +153,9 @@ class Suite:
     reference: str = ""
     """the named classical policy of the normalised score (the zero policy 0, it 1; :func:`~.metrics.normalise`);
     empty: none (v0 and v1)"""
+    policies: tuple[str, ...] = ()
+    """the registered policies the protocol reports on this suite (``evaluate.py``'s default for it; empty: the
+    command's default list, as for v0 and v1)"""
 
     def seeds(self, seed_set: str, n: int) -> list[int]:
         """The first ``n`` seeds of ``seed_set`` (``"test"`` or ``"validation"``)."""
@@ -221,29 +232,44 @@ SUITES_V1: dict[str, Suite] = {s.name: s for s in (
 )}
 SUITES.update(SUITES_V1)
 
-#: protocol v2's draft (not frozen: its numbers carry ``v2-draft``, and its definitions may still change before
-#: the freeze; docs/benchmark.md, "v2 (draft, not frozen)"): v1's suites under the flyability rule and SMILE with
-#: in-flight faults; SMILE's name lqg as the reference of the normalised score, Stratos III's its quiet flex
-#: design, the slender vehicle's none yet (no design of it meets the flyability rule)
-PROTOCOL_V2_DRAFT = "v2-draft"
+#: protocol v2, frozen on 2026-12-05 (results before that carry ``v2-draft``: a draft's numbers);
+#: ``lvgym/benchmark/data/v2.json`` is its fingerprint. What it adds to v1 (docs/benchmark.md, "Protocol v2"):
+#: the flyability rule (``score_v2``, :mod:`.flyability`), in-flight faults, a named reference per suite for the
+#: normalised score, and the policies each suite reports (``policies``: evaluate.py's default for it)
+PROTOCOL_V2 = "v2"
 #: the kinds of fault of smile-v2-faults: ``stuck`` is left out (no design flies it: SMILE has no other
 #: effector on a jammed axis; experiments/protocol_v2_design, part 5)
 V2_FAULT_KINDS = ("effectiveness", "bandwidth", "thrust", "gyro_bias")
-SUITES_V2_DRAFT: dict[str, Suite] = {s.name: s for s in (
+#: the policies v2 reports on SMILE: no control, the flex design that breaks the flyability rule and its quiet
+#: redesigns, the LQG family, the shipped learned policy and the privileged reference
+V2_SMILE_POLICIES = ("zero", "gs-pid-flex", "gs-pid-flex-quiet", "aac-quiet", "lqg", "lqg-front", "ppo-res-lqg",
+                     "privileged")
+#: ... on Stratos III (no LQG or learned policy is made for it)
+V2_STRATOS_POLICIES = ("zero", "gs-pid-flex", "gs-pid-flex-quiet", "aac-quiet", "privileged")
+#: ... on the slender vehicle (its one design, the load-relief gs-pid-flex, has no quiet version that flies)
+V2_SLENDER_POLICIES = ("zero", "gs-pid-flex", "privileged")
+SUITES_V2: dict[str, Suite] = {s.name: s for s in (
     Suite("smile-v2", "smile-v1 under protocol v2's flyability rule",
-          _pair("smile-v2", SMILE_V1, "turbulence_gust", V1_DISPERSIONS), version=PROTOCOL_V2_DRAFT, reference="lqg"),
+          _pair("smile-v2", SMILE_V1, "turbulence_gust", V1_DISPERSIONS), version=PROTOCOL_V2, reference="lqg",
+          policies=V2_SMILE_POLICIES),
+    Suite("smile-v2-maxq-gust", "smile-v1-maxq-gust under protocol v2's flyability rule: 35 s through max q, a "
+          "random jet stream and a random 1-cosine gust at 8-11.5 km, where holding the rate and holding the "
+          "structural load conflict",
+          _pair("smile-v2-maxq-gust", SMILE_V1, "maxq_gust", V1_DISPERSIONS, mission_time_s=35.0),
+          version=PROTOCOL_V2, reference="lqg", policies=V2_SMILE_POLICIES),
     Suite("smile-v2-faults", "smile-v1 with one in-flight fault per episode (a loss of actuator effectiveness or "
           "bandwidth on one axis, a thrust loss or a gyro bias step), its onset unannounced in 5-40 s",
           _pair("smile-v2-faults", SMILE_V1, "turbulence_gust", (*V1_DISPERSIONS, "fault"),
-                fault_kinds=V2_FAULT_KINDS, fault_onset_s=(5.0, 40.0)), version=PROTOCOL_V2_DRAFT, reference="lqg"),
+                fault_kinds=V2_FAULT_KINDS, fault_onset_s=(5.0, 40.0)), version=PROTOCOL_V2, reference="lqg",
+          policies=V2_SMILE_POLICIES),
     Suite("stratos-tvc-v2", "stratos-tvc-v1 under protocol v2's flyability rule",
-          _pair("stratos-tvc-v2", "lvgym/StratosIII-v1", "turbulence", V1_DISPERSIONS), version=PROTOCOL_V2_DRAFT,
-          reference="gs-pid-flex-quiet"),
+          _pair("stratos-tvc-v2", "lvgym/StratosIII-v1", "turbulence", V1_DISPERSIONS), version=PROTOCOL_V2,
+          reference="gs-pid-flex-quiet", policies=V2_STRATOS_POLICIES),
     Suite("slender-v2", "slender-v1 under protocol v2's flyability rule",
           _pair("slender-v2", "lvgym/SlenderAscent-v1", "turbulence", V1_DISPERSIONS, length=8.5, diameter=0.2833),
-          version=PROTOCOL_V2_DRAFT),
+          version=PROTOCOL_V2, policies=V2_SLENDER_POLICIES),
 )}
-SUITES.update(SUITES_V2_DRAFT)
+SUITES.update(SUITES_V2)
 
 
 def get_suite(name: str) -> Suite:

@@ -99,6 +99,30 @@ def flyability_table(summary: Sequence[Row]) -> list[str]:
     return out
 
 
+def _headline_cell(cell: Mapping[str, Any] | None, named: bool = True) -> str:
+    if not cell:
+        return "-"
+    failed = round(cell["failed_or_unflyable"] * cell["n"])
+    who = f"`{cell['policy']}` " if named else ""
+    return f"{who}{_interval(cell['mean'], cell['low'], cell['high'], '.3f')}, {failed}/{cell['n']}"
+
+
+def headline_table(headline: Sequence[Row]) -> list[str]:
+    """Lines of protocol v2's headline (:func:`~.headline.headline`): per suite and model the best causal
+    classical, the best learned and the privileged ``score_v2`` (mean [95 % CI], failed or unflyable of the
+    seeds) and the room with its interval; none without rows."""
+    if not headline:
+        return []
+    out = ["| suite | model | best causal classical | best learned | privileged reference | room [95 % CI] of the best causal |",
+           "|---|---|---|---|---|---:|"]
+    for h in headline:
+        room = "-" if not math.isfinite(h["room"]) else (
+            f"{100.0 * h['room']:.0f} % [{100.0 * h['room_low']:.0f}, {100.0 * h['room_high']:.0f}] of `{h['causal']}`")
+        out.append(f"| {h['suite']} | {h['model']} | {_headline_cell(h['classical'])} | {_headline_cell(h['learned'])} "
+                   f"| {_headline_cell(h['privileged'])} | {room} |")
+    return out
+
+
 def phase_table(summary: Sequence[Row]) -> list[str]:
     """Lines of one suite's table of the cumulative pitch + yaw rate error per flight phase (policy x
     model; the phases add up to the total), or none when the rows lack the phases."""
@@ -181,12 +205,18 @@ def _section(title: str, lines: list[str]) -> list[str]:
 
 
 def markdown_table(summary: Sequence[Row], degradation: Sequence[Row], meta: Mapping[str, Any] | None = None,
-                   comparison: Sequence[Row] = (), groups: Sequence[Row] = ()) -> str:
-    """The comparison as Markdown, per suite: the ranked summary (:func:`summary_table`), the rate
+                   comparison: Sequence[Row] = (), groups: Sequence[Row] = (), headline: Sequence[Row] = ()) -> str:
+    """The comparison as Markdown: protocol v2's headline over every suite (:func:`headline_table`, when
+    ``headline`` has rows), then per suite: the ranked summary (:func:`summary_table`), the rate
     error per phase (:func:`phase_table`), the degradation (:func:`degradation_table`), the paired
     comparison (:func:`comparison_table`) and the agents over training runs (:func:`run_groups_table`)."""
     meta = dict(meta or {})
     out: list[str] = []
+    if headline:
+        out += ["### Headline (protocol v2)", "", "score_v2 [rad] (lower is better): mean [95 % CI], failed or "
+                "unflyable of the seeds; the room is the best causal policy's score minus the privileged "
+                "reference's, of the former, on the same seeds (under 10 %: solved by design)", "",
+                *headline_table(headline), ""]
     for suite in _suites(summary):
         rows = _of_suite(summary, suite)
         info = meta.get("suites", {}).get(suite, {}) if isinstance(meta.get("suites"), Mapping) else {}

@@ -1,6 +1,7 @@
 """Compare TVC policies on the frozen benchmark protocol (``lvgym.benchmark``).
 
-    lvgym evaluate                                       # the default comparison (see DEFAULT_*)
+    lvgym evaluate                                       # protocol v2: every suite, each with its policies
+    lvgym evaluate --suites smile-v1 --policies zero gs-pid lqg ppo-res-lqg   # v1's main suite
     lvgym evaluate --policies zero pid gs-pid runs/ppo_smile.zip --suites smile-windy --episodes 50   # v0
     lvgym evaluate --executor ray --workers 4            # Ray (pip install 'lvgym[ray]'): a local Ray
     RAY_ADDRESS=auto lvgym evaluate --executor ray        # ... or the running cluster (``ray start``)
@@ -14,14 +15,18 @@ stable-baselines3 models (``.zip``; an optional ``<stem>_vecnormalize.pkl`` next
 observations) or of ``train.py`` run folders, or your own policy: ``module:factory`` or
 ``path/to/my_policy.py:factory`` (a function of the env, or of nothing, that returns an object with
 ``name``, ``reset()`` and ``act(observation, info)``; the file is loaded by path in every worker and needs
-no ``__main__`` guard); ``label=...`` in front names any of them in the tables. Suites are names of
-``lvgym.benchmark.SUITES``. Episodes
+no ``__main__`` guard); ``label=...`` in front names any of them in the tables. Without ``--policies`` each
+suite flies the policies its protocol reports on it (``Suite.policies``; :data:`DEFAULT_POLICIES` for a v0
+or v1 suite). Suites are names of ``lvgym.benchmark.SUITES``; the default is protocol v2's five
+(:data:`DEFAULT_SUITES`), or its main suite ``smile-v2`` when ``--policies`` is given. Episodes
 run on a local process pool by default; the Markdown table is printed, and CSV, JSON, the table and PNG
 plots go to ``--out`` (each file written atomically: an interrupted run leaves no half-written file).
 ``--seed-set validation`` evaluates on the training seeds; reported numbers use the ``test`` seeds (the
 default).
 
-The tables (per suite; every mean with its 95 % bootstrap interval over the seeds, lower is better):
+The tables (every mean with its 95 % bootstrap interval over the seeds, lower is better): for protocol v2,
+first the headline over every suite (the best causal classical, the best learned and the privileged
+``score_v2`` and the room between them, :mod:`lvgym.benchmark.headline`); then per suite:
   1. summary: condition x policy, ranked by failure rate, then by score (the rate error plus, for a failed
      episode, the env's failure penalty for the mission left), with the rate error, CVaR10, max rate,
      effort, max alpha and q-alpha;
@@ -46,8 +51,10 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any
 
-from lvgym.benchmark import (EXECUTORS, PROTOCOL_VERSION, SEED_SETS, SUITES, PolicySpec, compare, degradation, evaluate,
-                             get_suite, markdown_table, normalise, run_groups, summarize, write_results)
+from lvgym.benchmark import (DEFAULT_SUITE, EXECUTORS, PROTOCOL_VERSION, SEED_SETS, SUITES, PolicySpec, compare,
+                             degradation, evaluate, get_suite, markdown_table, normalise, run_groups, summarize,
+                             write_results)
+from lvgym.benchmark.headline import headline, policy_kind
 from lvgym.cli.policies import POLICIES, resolve_policy  # (registers the built-in policies)
 from lvgym.errors import ConfigError
 from lvgym.parallel import TaskFailed, exit_on_sigterm
@@ -55,16 +62,17 @@ from lvgym.parallel import TaskFailed, exit_on_sigterm
 from . import fail
 from .args import arg, command_name, parse
 
-__all__ = ["Args", "DEFAULT_EPISODES", "DEFAULT_POLICIES", "DEFAULT_SUITES", "POLICIES", "main", "parse_args",
+__all__ = ["Args", "DEFAULT_EPISODES", "DEFAULT_POLICIES", "DEFAULT_SUITE", "DEFAULT_SUITES", "POLICIES", "main", "parse_args",
            "resolve_policy"]
 
 PROG = "evaluate.py"
-#: the default comparison (issue 17): no control, the rigid-designed gs-pid (the thesis's question), the
-#: designs for the flexible vehicle (gs-pid-flex, lqg, lqg-front, aac) and the shipped learned policy
+#: the policies of a suite that names none (v0, v1): no control, the rigid-designed gs-pid (the thesis's
+#: question), the designs for the flexible vehicle (gs-pid-flex, lqg, lqg-front, aac) and the shipped learned
+#: policy. A v2 suite flies its own (``Suite.policies``)
 DEFAULT_POLICIES = ["zero", "gs-pid", "gs-pid-flex", "lqg", "lqg-front", "aac", "ppo-res-lqg"]
-#: the main suite of protocol v1 (``smile-windy`` is v0's)
-DEFAULT_SUITES = ["smile-v1"]
-#: episodes per condition and policy of the default run (2 conditions x 6 policies x 50 = 600 episodes of 70 s)
+#: protocol v2's suites (v1's main suite is ``smile-v1``, v0's ``smile-windy``)
+DEFAULT_SUITES = ["smile-v2", "smile-v2-maxq-gust", "smile-v2-faults", "stratos-tvc-v2", "slender-v2"]
+#: episodes per condition and policy of the default run
 DEFAULT_EPISODES = 50
 #: the longest episode an env takes (``lvgym.envs.TaskSpec.mission_time_s``) [s]
 MAX_MISSION_TIME_S = 3600.0
@@ -74,13 +82,13 @@ MAX_MISSION_TIME_S = 3600.0
 class Args:
     """Command-line arguments (``lvgym evaluate --help``)."""
 
-    policies: list[str] = arg(default_factory=lambda: list(DEFAULT_POLICIES), metavar="POLICY")
+    policies: list[str] | None = arg(None, metavar="POLICY")
     """registered policy names (zero, pid, gs-pid, gs-pid-flex, lqg, aac, ppo-res-lqg, ...), module:factory,
     path/to/file.py:factory, paths of stable-baselines3 .zip models or train.py run folders (runs/<name>: its
-    best model); label=... in front names any of them"""
-    suites: list[str] = arg(default_factory=lambda: list(DEFAULT_SUITES), metavar="SUITE",
-                            choices=lambda: sorted(SUITES))
-    """suite names of the protocol"""
+    best model); label=... in front names any of them (default: each suite's own, Suite.policies)"""
+    suites: list[str] | None = arg(None, metavar="SUITE", choices=lambda: sorted(SUITES))
+    """suite names of the protocol (default: protocol v2's suites; with --policies, its main suite smile-v2,
+    since a policy made for one vehicle flies no other)"""
     episodes: int = arg(DEFAULT_EPISODES, lo=1, hi=10**6, allowed="an integer >= 1")
     """episodes (seeds) per condition and policy"""
     executor: str = arg("local", choices=EXECUTORS)
@@ -123,19 +131,24 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
     args = parse_args(argv)
     prog = command_name(PROG)
     exit_on_sigterm()                                # clean up temporary files on kill (SIGTERM)
-    policies = _unique([resolve_policy(n, prog) for n in args.policies])
-    if args.reference is not None and args.reference not in [p.name for p in policies]:
-        raise SystemExit(f"{prog}: --reference = {args.reference!r}: one of the policy labels "
-                         f"{[p.name for p in policies]}")
+    if args.suites is None:
+        args.suites = list(DEFAULT_SUITES) if args.policies is None else [DEFAULT_SUITE]
     try:
         suites = [get_suite(n) for n in args.suites]
     except ValueError as exc:
         fail(prog, exc)
+    names = {s.name: args.policies or list(s.policies) or DEFAULT_POLICIES for s in suites}
+    resolved = {n: resolve_policy(n, prog) for n in dict.fromkeys(n for v in names.values() for n in v)}
+    per_suite = {s: _unique([resolved[n] for n in v]) for s, v in names.items()}
+    policies = list({p.name: p for v in per_suite.values() for p in v}.values())
+    if args.reference is not None and args.reference not in [p.name for p in policies]:
+        raise SystemExit(f"{prog}: --reference = {args.reference!r}: one of the policy labels "
+                         f"{[p.name for p in policies]}")
     if args.mission_time_s is not None:
         suites = [s.with_options(mission_time_s=float(args.mission_time_s)) for s in suites]
     t0 = time.perf_counter()
     try:
-        records = evaluate(policies, suites, args.episodes, args.seed_set, args.executor, args.workers,
+        records = evaluate(per_suite, suites, args.episodes, args.seed_set, args.executor, args.workers,
                            args.progress)
     except TaskFailed as exc:                        # a bad value met in a worker: its message, in one line
         if isinstance(exc.__cause__, ConfigError):
@@ -147,6 +160,7 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
     deg = degradation(summary, "score", records=records) + degradation(summary, "rate_error_rad", records=records)
     comparison = compare(records, summary, "score", args.reference)
     groups = run_groups(records, "score")
+    rows = headline(summary, records, {p.name: policy_kind(p) for p in policies})
     meta = {
         "protocol": PROTOCOL_VERSION, "seed_set": args.seed_set, "episodes": args.episodes, "args": asdict(args),
         "suites": {s.name: {"version": s.version, "description": s.description, "overrides": dict(s.overrides),
@@ -154,16 +168,17 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
                             "last_seed": s.seeds(args.seed_set, args.episodes)[-1],
                             "conditions": [c.to_dict() for c in s.conditions]} for s in suites},
         "policies": [{"name": p.name, "factory": p.factory, "kwargs": dict(p.kwargs)} for p in policies],
+        "policies_per_suite": {s: [p.name for p in v] for s, v in per_suite.items()},
         "wall_time_s": round(wall, 3), "created_utc": dt.datetime.now(dt.timezone.utc).isoformat(timespec="seconds"),
     }
-    table = markdown_table(summary, deg, meta, comparison, groups)
+    table = markdown_table(summary, deg, meta, comparison, groups, rows)
     paths = write_results(args.out, records, summary, deg, meta, plots=args.plots, comparison=comparison,
-                          groups=groups)
+                          groups=groups, headline=rows)
     print(table)
     print(f"{len(records)} episodes in {wall:.1f} s ({args.executor}); results in {Path(args.out)}/: "
           f"{', '.join(sorted(paths))}", file=sys.stderr)
     return {"records": records, "summary": summary, "degradation": deg, "comparison": comparison,
-            "run_groups": groups, "meta": meta, "table": table}
+            "run_groups": groups, "headline": rows, "meta": meta, "table": table}
 
 
 if __name__ == "__main__":

@@ -1,0 +1,62 @@
+"""The privileged reference's gains and load relief, chosen on validation seeds (part 6 of README.md).
+
+    python -m experiments.protocol_v2_design.privileged_sweep --seeds 20
+
+Flies ``privileged`` (lvgym/baselines/privileged.py) at each attitude-loop bandwidth of ``--bandwidths``
+(damping equal to it, as :data:`~lvgym.baselines.privileged.GAINS` has them) with each load relief of
+``--reliefs`` (onset and full share of the q-alpha limit; ``off``: none) on protocol v2's SMILE suites,
+rigid and non-rigid, validation seeds ``0 .. seeds - 1``, and prints per flight model the mean ``score_v2``
+of every variant on every suite and over the three, with its failures. A study: it flies no test seed.
+"""
+
+from __future__ import annotations
+
+import argparse
+from collections import defaultdict
+
+import numpy as np
+
+from lvgym.benchmark import evaluate, get_suite
+from lvgym.benchmark.runner import PolicySpec
+
+SUITES = ("smile-v2", "smile-v2-maxq-gust", "smile-v2-faults")
+FACTORY = "lvgym.baselines.privileged:privileged"
+OFF = (10.0, 11.0)          # onset beyond the limit: no relief (a flight above the limit has failed)
+
+
+def _variants(bandwidths: list[float], reliefs: list[str]) -> list[PolicySpec]:
+    out = []
+    for w in bandwidths:
+        for r in reliefs:
+            relief = OFF if r == "off" else tuple(float(x) for x in r.split(","))
+            out.append(PolicySpec(f"priv-w{w:g}-r{r.replace(',', '-')}", FACTORY,
+                                  (("bandwidth_radps", w), ("damping", w), ("relief", relief))))
+    return out
+
+
+def main(argv: list[str] | None = None) -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--seeds", type=int, default=20)
+    ap.add_argument("--bandwidths", type=float, nargs="+", default=[1.0, 1.5, 2.0])
+    ap.add_argument("--reliefs", nargs="+", default=["off", "0.5,0.9", "0.3,0.7"])
+    args = ap.parse_args(argv)
+    specs = _variants(args.bandwidths, args.reliefs)
+    records = evaluate(specs, [get_suite(s) for s in SUITES], args.seeds, "validation", progress=False)
+    score: dict[tuple[str, str, str], list[float]] = defaultdict(list)
+    failed: dict[tuple[str, str, str], int] = defaultdict(int)
+    for r in records:
+        key = (r["condition"].rsplit("/", 1)[1], r["policy"], r["suite"])
+        score[key].append(r["score_v2"])
+        failed[key] += int(r["failed"] or not r["flyable"])
+    for model in ("rigid", "nonrigid"):
+        print(f"\n{model}, validation seeds 0-{args.seeds - 1}: mean score_v2 [rad] (failed or unflyable)\n")
+        print("| variant | " + " | ".join(SUITES) + " | mean of the three |")
+        print("|---|" + "---:|" * (len(SUITES) + 1))
+        for spec in specs:
+            cells = [f"{np.mean(score[(model, spec.name, s)]):.3f} ({failed[(model, spec.name, s)]})" for s in SUITES]
+            mean = np.mean([np.mean(score[(model, spec.name, s)]) for s in SUITES])
+            print(f"| {spec.name} | " + " | ".join(cells) + f" | {mean:.3f} |")
+
+
+if __name__ == "__main__":
+    main()
