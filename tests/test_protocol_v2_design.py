@@ -92,3 +92,6 @@ def test_the_privileged_sweep_names_its_variants_by_their_gains_and_relief():
     assert [s.name for s in specs] == ["priv-w1-roff", "priv-w1-r0.5-0.9", "priv-w1.5-roff", "priv-w1.5-r0.5-0.9"]
     assert dict(specs[1].kwargs) == {"bandwidth_radps": 1.0, "damping": 1.0, "relief": (0.5, 0.9)}
     assert dict(specs[2].kwargs)["relief"] == OFF and OFF[0] > 1.0       # onset beyond the limit: no relief
+    from lvgym.errors import ConfigError
+    with pytest.raises(ConfigError, match=r"reliefs = '0.5': off, or ONSET,FULL"):
+        _variants([1.0], ["0.5"])

@@ -11,13 +11,16 @@ of every variant on every suite and over the three, with its failures. A study: 
 
 from __future__ import annotations
 
-import argparse
 from collections import defaultdict
+from collections.abc import Sequence
+from dataclasses import dataclass
 
 import numpy as np
 
 from lvgym.benchmark import evaluate, get_suite
 from lvgym.benchmark.runner import PolicySpec
+from lvgym.cli.args import arg, parse
+from lvgym.errors import ConfigError
 
 SUITES = ("smile-v2", "smile-v2-maxq-gust", "smile-v2-faults")
 FACTORY = "lvgym.baselines.privileged:privileged"
@@ -28,18 +31,32 @@ def _variants(bandwidths: list[float], reliefs: list[str]) -> list[PolicySpec]:
     out = []
     for w in bandwidths:
         for r in reliefs:
-            relief = OFF if r == "off" else tuple(float(x) for x in r.split(","))
+            try:
+                relief = OFF if r == "off" else tuple(float(x) for x in r.split(","))
+            except ValueError:
+                relief = ()
+            if len(relief) != 2:
+                raise ConfigError("reliefs", r, "off, or ONSET,FULL: two shares of the q-alpha limit")
             out.append(PolicySpec(f"priv-w{w:g}-r{r.replace(',', '-')}", FACTORY,
                                   (("bandwidth_radps", w), ("damping", w), ("relief", relief))))
     return out
 
 
-def main(argv: list[str] | None = None) -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--seeds", type=int, default=20)
-    ap.add_argument("--bandwidths", type=float, nargs="+", default=[1.0, 1.5, 2.0])
-    ap.add_argument("--reliefs", nargs="+", default=["off", "0.5,0.9", "0.3,0.7"])
-    args = ap.parse_args(argv)
+@dataclass
+class Args:
+    """Command-line arguments (``python -m experiments.protocol_v2_design.privileged_sweep --help``)."""
+
+    seeds: int = arg(20, lo=1, hi=10_000)
+    """validation seeds per variant and condition"""
+    bandwidths: list[float] = arg(default_factory=lambda: [1.0, 1.5, 2.0], lo=0.0, lo_open=True, hi=100.0,
+                                  metavar="RADPS")
+    """attitude-loop bandwidths [rad/s] (the damping equal to each)"""
+    reliefs: list[str] = arg(default_factory=lambda: ["off", "0.5,0.9", "0.3,0.7"], metavar="ONSET,FULL")
+    """load reliefs: onset and full share of the q-alpha limit, or off"""
+
+
+def main(argv: Sequence[str] | None = None) -> None:
+    args = parse(Args, argv, "python -m experiments.protocol_v2_design.privileged_sweep", __doc__)
     specs = _variants(args.bandwidths, args.reliefs)
     records = evaluate(specs, [get_suite(s) for s in SUITES], args.seeds, "validation", progress=False)
     score: dict[tuple[str, str, str], list[float]] = defaultdict(list)
