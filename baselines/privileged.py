@@ -86,7 +86,7 @@ class PrivilegedPolicy:
         whose info holds none)."""
         if "m_aero_b" not in info:                          # the reset's info
             return np.zeros(2, dtype=np.float32)
-        lever = float(info["thrust"]) * float(info["gimbal_arm"])
+        lever = float(info["thrust"]) * float(info.get("vectored_share", 1.0)) * float(info["gimbal_arm"])
         if lever < 1.0:                                     # no thrust: no moment to command
             return np.zeros(2, dtype=np.float32)
         w = np.asarray(info["omega_bi_b"], dtype=float)

@@ -301,11 +301,12 @@ def aero_slopes(op: OperatingPoint, dw: float = 0.1) -> tuple[float, float, floa
 def analytic_rigid(op: OperatingPoint) -> control.StateSpace:
     """Textbook rigid pitch-plane model, states ``(w, theta, q)``::
 
-        m w_dot = T (delta - theta) + D theta - N_a alpha      alpha = theta + w / V
-        J q_dot = T l delta + M_a alpha                         theta_dot = q
+        m w_dot = s T delta - T theta + D theta - N_a alpha      alpha = theta + w / V
+        J q_dot = s T l delta + M_a alpha                         theta_dot = q
 
-    with mass ``m``, pitch inertia ``J`` about the CG, thrust ``T``, arm ``l`` from the gimbal to the CG,
-    axial drag ``D``, normal-force and moment slopes ``N_a``, ``M_a`` from the aerodynamic model."""
+    with mass ``m``, pitch inertia ``J`` about the CG, thrust ``T`` and the share ``s`` of it the gimbal
+    turns (the vehicle's ``vectored_share``, 1 for the shipped vehicles), arm ``l`` from the gimbal to the
+    CG, axial drag ``D``, normal-force and moment slopes ``N_a``, ``M_a`` from the aerodynamic model."""
     tl = op.sim.timeline
     m = float(tl.interp("mass", [op.t])[0])
     J = float(tl.interp("inertia", [op.t])[0][1, 1])
@@ -313,10 +314,11 @@ def analytic_rigid(op: OperatingPoint) -> control.StateSpace:
     lay = op.sim.layout
     gimbal = float(op.p[lay.params["r_gimbal"]][0])
     T = op.condition("thrust")
+    s = float(tl.interp("vectored_share", [op.t])[0])
     n_a, m_a, V, D = aero_slopes(op)
     l = cg - gimbal
     A = np.array([[-n_a / (m * V), (-T + D - n_a) / m, 0.0], [0.0, 0.0, 1.0], [m_a / (J * V), m_a / J, 0.0]])
-    B = np.array([[T / m], [0.0], [T * l / J]])
+    B = np.array([[s * T / m], [0.0], [s * T * l / J]])
     return control.ss(A, B, [[0.0, 0.0, 1.0]], 0.0)
 
 

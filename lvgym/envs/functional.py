@@ -415,15 +415,16 @@ class AscentFuncEnv(FuncEnv):
         """What no flight sensor gives, per row (the ``privileged_info`` option): the true body rates
         ``omega_bi_b`` (B, 3) [rad/s] (of the rigid body, no bending, no noise), the aerodynamic moment about
         the CG ``m_aero_b`` (B, 3) [N m] (the wind's included), the thrust (B,) [N], the gimbal's lever arm
-        ``gimbal_arm`` (B,) [m] (CG station minus gimbal station along x_b), the body's principal inertias
-        ``J_b_diag`` (B, 3) [kg m^2] and the velocity relative to the air in body axes ``v_air_b`` (B, 3)
-        [m/s]."""
+        ``gimbal_arm`` (B,) [m] (CG station minus gimbal station along x_b), the share of the thrust the gimbal
+        turns ``vectored_share`` (B,) [-], the body's principal inertias ``J_b_diag`` (B, 3) [kg m^2] and the
+        velocity relative to the air in body axes ``v_air_b`` (B, 3) [m/s]."""
         sim = state.sim
         cond, lay = self.sim.conditions, self.sim.layout
         J = sim.p[:, lay.params["J_b"]].reshape(-1, 3, 3)
         r_cg, r_gimbal = sim.p[:, lay.params["r_cg"]], sim.p[:, lay.params["r_gimbal"]]
         return {"omega_bi_b": self.sim.state(sim, "omega_bi_b").copy(), "m_aero_b": cond(sim, "m_aero_b").copy(),
                 "thrust": cond(sim, "thrust").copy(), "gimbal_arm": r_cg[:, 0] - r_gimbal[:, 0],
+                "vectored_share": self.sim.vectored_share(sim),
                 "J_b_diag": np.stack([J[:, 0, 0], J[:, 1, 1], J[:, 2, 2]], axis=1),
                 "v_air_b": cond(sim, "v_air_b").copy()}
 

@@ -125,6 +125,7 @@ def _piece_thrust_k(ctx, tables, i, w):
     timeline at the row ``i`` and weight ``w`` of a time (:func:`~.timeline.locate_k`) into the context."""
     ctx[CTX.thrust0] = interp_at_k(tables.thrust0, i, w)
     ctx[CTX.exit_area] = interp_at_k(tables.exit_area, i, w)
+    ctx[CTX.vectored_share] = interp_at_k(tables.vectored_share, i, w)
     select_aero_k(ctx, held_at_k(tables.stage, i, w))
     if ctx[CTX.aeroelastic + AEL.on] != 0.0:
         strip_modes_k(ctx, tables.phi_strip, tables.dphi_strip, row_in_force_k(i, w))

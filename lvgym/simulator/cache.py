@@ -32,7 +32,7 @@ from lvgym import packing
 
 __all__ = ["SUFFIX", "cache_dir", "cached", "key", "using"]
 
-_ARRAYS = ("t", "params", "hold", "thrust0", "exit_area", "mass", "cg", "inertia", "slosh_mass", "burning", "stage",
+_ARRAYS = ("t", "params", "hold", "thrust0", "exit_area", "vectored_share", "mass", "cg", "inertia", "slosh_mass", "burning", "stage",
            "sensor_stations", "phi_sensor", "dphi_sensor", "strip_stations", "phi_strip", "dphi_strip", "mode_change_t",
            "mode_transfer")
 

@@ -390,6 +390,12 @@ class Simulator:
         return data.ctx[:, CONTEXT.slice("dispersion").start + DISPERSION.index(name)]
 
     @staticmethod
+    def vectored_share(data: SimData) -> np.ndarray:
+        """The share of the thrust the gimbal turns (B,) of the rows' current timeline piece (the vehicle's
+        ``vectored_share``, :meth:`~lvgym.vehicle.MassModel.vectored_share`; 0 before the first step)."""
+        return data.ctx[:, CONTEXT.index("vectored_share")].copy()
+
+    @staticmethod
     def effort(data: SimData) -> np.ndarray:
         """Integrals of |gimbal| [rad s] and |gimbal rate| [rad] over the last period (B, 2)."""
         a = data.actuator

@@ -136,9 +136,16 @@ def flight_conditions_at(t, x, p, ctx, cond, oc, full):
         ctx[tg + TG.pitch], ctx[tg + TG.yaw] = dp, dy
         ctx[tg + TG.cos_pitch], ctx[tg + TG.sin_pitch] = math.cos(dp), math.sin(dp)
         ctx[tg + TG.cos_yaw], ctx[tg + TG.sin_yaw] = math.cos(dy), math.sin(dy)
-    cond[oc + D.thrust_b] = thrust * ctx[tg + TG.cos_pitch] * ctx[tg + TG.cos_yaw]
-    cond[oc + D.thrust_b + 1] = -thrust * ctx[tg + TG.sin_yaw]
-    cond[oc + D.thrust_b + 2] = thrust * ctx[tg + TG.sin_pitch] * ctx[tg + TG.cos_yaw]
+    share = ctx[CTX.vectored_share]
+    if share == 1.0:                                              # every engine gimballed (the shipped vehicles)
+        cond[oc + D.thrust_b] = thrust * ctx[tg + TG.cos_pitch] * ctx[tg + TG.cos_yaw]
+        cond[oc + D.thrust_b + 1] = -thrust * ctx[tg + TG.sin_yaw]
+        cond[oc + D.thrust_b + 2] = thrust * ctx[tg + TG.sin_pitch] * ctx[tg + TG.cos_yaw]
+    else:                                                         # the gimbal turns a share, the rest acts on x_b
+        turned = share * thrust
+        cond[oc + D.thrust_b] = turned * ctx[tg + TG.cos_pitch] * ctx[tg + TG.cos_yaw] + (thrust - turned)
+        cond[oc + D.thrust_b + 1] = -turned * ctx[tg + TG.sin_yaw]
+        cond[oc + D.thrust_b + 2] = turned * ctx[tg + TG.sin_pitch] * ctx[tg + TG.cos_yaw]
 
 
 @nb.njit(cache=True, error_model="numpy")

@@ -112,6 +112,7 @@ CONTEXT = Packed("simulator context", [
           "period"),
     Field("thrust0", 1, "N", "vacuum thrust T_0 of the current piece (timeline, at its middle)"),
     Field("exit_area", 1, "m^2", "total nozzle exit area of the current piece"),
+    Field("vectored_share", 1, "-", "share of the thrust the gimbal turns (the rest along x_b) of the current piece"),
     Field("time0", 1, "s", "start time of the current piece: the stepper's time is relative to it"),
     Field("aero_on", 1, "-", "1: aerodynamic loads, 0: none (flow angles only)"),
     Field("dispersion", DISPERSION.size, "-", "the row's load dispersions (layout DISPERSION)", sub=DISPERSION),

@@ -56,7 +56,8 @@ class Timeline:
 
     ``params`` (n, n_p): dynamics parameters (:class:`~lvgym.dynamics.NonRigidModel` layout of
     ``model``); ``hold`` (n_p,) columns that are piecewise constant (mode data); ``thrust0`` (n,) [N]
-    and ``exit_area`` (n,) [m^2]: thrust ``max(T_0 - A_e p_amb, 0)``; ``mass`` (n,) [kg], ``cg`` (n, 3)
+    and ``exit_area`` (n,) [m^2]: thrust ``max(T_0 - A_e p_amb, 0)``; ``vectored_share`` (n,) the share of
+    it the gimbal turns (:meth:`~lvgym.vehicle.MassModel.vectored_share`); ``mass`` (n,) [kg], ``cg`` (n, 3)
     [m], ``inertia`` (n, 3, 3) [kg m^2] of the whole stack; ``slosh_mass`` (n, N) [kg];
     ``burning`` (n,) any engine burning; ``stage`` (n,) index of the lowest attached stage;
     ``phi_sensor`` (n, S, K) mode shapes and ``dphi_sensor`` (n, S, K) slopes at the sensor stations
@@ -75,6 +76,7 @@ class Timeline:
     hold: np.ndarray
     thrust0: np.ndarray
     exit_area: np.ndarray
+    vectored_share: np.ndarray
     mass: np.ndarray
     cg: np.ndarray
     inertia: np.ndarray
@@ -143,6 +145,7 @@ class Timeline:
         return Tables(t=np.ascontiguousarray(self.t, dtype=float), params=np.ascontiguousarray(self.params),
                       hold=np.ascontiguousarray(self.hold), thrust0=np.ascontiguousarray(self.thrust0, dtype=float),
                       exit_area=np.ascontiguousarray(self.exit_area, dtype=float),
+                      vectored_share=np.ascontiguousarray(self.vectored_share, dtype=float),
                       stage=np.ascontiguousarray(self.stage, dtype=float),
                       burning=np.ascontiguousarray(self.burning, dtype=float),
                       mass=np.ascontiguousarray(self.mass, dtype=float),
@@ -156,13 +159,14 @@ class Timeline:
 
 
 #: the timeline's columns as compiled code reads them: ``t`` (n,) [s] rows; ``params`` (n, n_p);
-#: ``hold`` (n_p,) bool; ``thrust0`` (n,) [N]; ``exit_area`` (n,) [m^2]; ``stage`` (n,) lowest attached
+#: ``hold`` (n_p,) bool; ``thrust0`` (n,) [N]; ``exit_area`` (n,) [m^2]; ``vectored_share`` (n,) [-] the
+#: share of the thrust the gimbal turns; ``stage`` (n,) lowest attached
 #: stage; ``burning`` (n,) 1 while an engine burns; ``mass`` (n,) [kg]; ``phi_sensor`` (n, S, K)
 #: [1/sqrt(kg)] and ``dphi_sensor`` (n, S, K) [1/(m sqrt(kg))] mode shapes and slopes at the sensor stations;
 #: ``phi_strip``, ``dphi_strip`` (n, K, n_strip) at the aeroelastic strips;
 #: ``event_times`` (E,) [s], each once; ``mode_change_t`` (C,) [s] and ``mode_transfer``
 #: (C, K, K) the changes of the mode basis the step projects the modal state across (none: held)
-Tables = namedtuple("Tables", ["t", "params", "hold", "thrust0", "exit_area", "stage", "burning", "mass",
+Tables = namedtuple("Tables", ["t", "params", "hold", "thrust0", "exit_area", "vectored_share", "stage", "burning", "mass",
                                "phi_sensor", "dphi_sensor", "phi_strip", "dphi_strip", "event_times", "mode_change_t",
                                "mode_transfer"])
 
@@ -377,7 +381,7 @@ def _tabulate(mm: MassModel, model: str, t_end: float, dt: float, n_modes: int |
     schedule = (ModeSchedule(mm, n_modes=K, recompute_interval=mode_interval, sensor_stations=meshed,
                              probe_stations=probes) if K > 0 else None)
     times, events = _grid(mm, t_end, dt)
-    cols: dict[str, list] = {k: [] for k in ("t", "T0", "Ae", "burn", "stage", "modes", "m_b", "r_cg", "J_b",
+    cols: dict[str, list] = {k: [] for k in ("t", "T0", "Ae", "Vs", "burn", "stage", "modes", "m_b", "r_cg", "J_b",
                                              "gimbal", "m", "cg", "J", "ms", "L", "hinge", "zeta")}
     for row_t, state in _pieces(mm, times, {t for t, _ in events}):
         props = mm.properties(state)
@@ -388,6 +392,7 @@ def _tabulate(mm: MassModel, model: str, t_end: float, dt: float, n_modes: int |
         cols["T0"].append(T0)
         cols["Ae"].append(np.full(b, float(sum(em.engine.nozzle_exit_area
                                                for (_, em), on in zip(mm.engines, state.engine_on) if on))))
+        cols["Vs"].append(np.broadcast_to(mm.vectored_share(state), (b,)))
         cols["burn"].append((BURNING in state.phase) & (T0 > 0.0))
         cols["stage"].append(np.full(b, min(attached) if attached else len(state.phase) - 1))
         cols["modes"] += schedule.modes_rows(state, props) if schedule is not None else [None] * b
@@ -418,6 +423,7 @@ def _tabulate(mm: MassModel, model: str, t_end: float, dt: float, n_modes: int |
         hold[lay.slosh_param(j, "phi")] = True
     changes = md["changes"]
     return Timeline(model=model, dynamics=dyn, t=c["t"], params=p, hold=hold, thrust0=c["T0"], exit_area=c["Ae"],
+                    vectored_share=c["Vs"],
                     mass=c["m"], cg=c["cg"], inertia=c["J"], slosh_mass=c["ms"], burning=c["burn"], stage=c["stage"],
                     stage_names=tuple(s.name for s in vehicle.stages), slosh_names=mm.slosh_names,
                     sensor_stations=sensors, phi_sensor=md["phi_sensor"].reshape(n, sensors.size, K),

@@ -95,7 +95,9 @@ class Engine:
     ``T = mdot Isp g0 + A_e (p_e - p_0)``); or ``thrust_table``: rows ``[t since ignition (s),
     thrust (N)]`` and then ``mass_flow`` is the flow at the table's mean thrust, scaled with thrust;
     ``mixture_ratio``: O/F of the oxidiser and fuel flows (None: one propellant); ``throttle``:
-    [min, max] of the flow scale; ``gimbal_limit``: maximum deflection [rad]."""
+    [min, max] of the flow scale; ``gimbal_limit``: maximum deflection [rad]; ``vectored_share``: the share
+    of this engine's thrust that the gimbal turns (1: all of it; 0: a fixed engine; between: e.g. a cluster
+    whose outer nozzles are fixed), the rest acting along the body axis."""
 
     name: str
     part: RigidPart
@@ -109,6 +111,7 @@ class Engine:
     throttle: tuple[float, float]
     gimbal_limit: float
     key: str
+    vectored_share: float = 1.0
 
     @staticmethod
     def read(r: Reader) -> Engine:
@@ -131,7 +134,8 @@ class Engine:
             nozzle_exit_area=r.number("nozzle_exit_area", 0.0, lo=0.0, hi=np.pi * MAX_DIAMETER**2 / 4),
             nozzle_exit_pressure=r.number("nozzle_exit_pressure", 0.0, lo=0.0, hi=1e8),
             throttle=r.pair("throttle", [1.0, 1.0], lo=0.0, hi=2.0),
-            gimbal_limit=np.radians(r.number("gimbal_limit_deg", 5.0, lo=0.0, hi=45.0)), key=r.path)
+            gimbal_limit=np.radians(r.number("gimbal_limit_deg", 5.0, lo=0.0, hi=45.0)), key=r.path,
+            vectored_share=r.number("vectored_share", 1.0, lo=0.0, hi=1.0))
         if table is not None and engine.throttle != (1.0, 1.0):
             raise r.error("throttle", list(engine.throttle), "a thrust-table engine cannot be throttled: [1, 1]")
         r.done()

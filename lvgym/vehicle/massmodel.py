@@ -384,6 +384,15 @@ class MassModel:
         """Total thrust magnitude of the burning engines [N] at ambient pressure ``p_ambient`` [Pa]."""
         return self._sum_engines(state, lambda em, tau: em.thrust(tau, throttle, p_ambient))
 
+    def vectored_share(self, state: MassState, throttle: float = 1.0):
+        """The share of the burning engines' vacuum thrust that their gimbals turn (each engine's
+        ``vectored_share`` weighted by its vacuum thrust; 1 when nothing burns): the share the flight
+        loads vector, exact for one engine or engines of one exit-area-to-thrust ratio."""
+        total = self.thrust(state, throttle, 0.0)
+        turned = self._sum_engines(state, lambda em, tau: em.engine.vectored_share * em.thrust(tau, throttle, 0.0))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return np.where(np.asarray(total) > 0.0, turned / np.where(np.asarray(total) > 0.0, total, 1.0), 1.0)[()]
+
     def properties(self, state: MassState, throttle: float = 1.0) -> MassProperties:
         """Mass properties of the stack in ``state`` (see :class:`MassProperties`; a batched state gives
         them with its leading axis)."""
