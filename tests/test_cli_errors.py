@@ -39,6 +39,8 @@ def _one_line(exc: pytest.ExceptionInfo, capsys) -> str:
     (["--workers", "0"], r"error: --workers = 0: an integer >= 1"),
     (["--episodes", "0"], r"--episodes = 0: an integer >= 1"),
     (["--executor", "threads"], r"argument --executor: invalid choice: 'threads'"),
+    (["--vehicle", "no_such_rocket.yaml", "--policies", "zero"], r"--vehicle = 'no_such_rocket\.yaml': an existing YAML"),
+    (["--vehicle", "smile_v1"], r"--vehicle smile_v1: give --policies too: the shipped designs are made for the shipped"),
 ])
 def test_evaluate_refuses_bad_values_before_any_episode(tmp_path, capsys, argv, message):
     import re

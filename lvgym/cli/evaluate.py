@@ -2,6 +2,7 @@
 
     lvgym evaluate                                       # protocol v2: every suite, each with its policies
     lvgym evaluate --suites smile-v1 --policies zero gs-pid lqg ppo-res-lqg   # v1's main suite
+    lvgym evaluate --vehicle my_rocket.yaml --policies zero my_policy.py:make    # smile-v2's conditions, your vehicle
     lvgym evaluate --policies zero pid gs-pid runs/ppo_smile.zip --suites smile-windy --episodes 50   # v0
     lvgym evaluate --executor ray --workers 4            # Ray (pip install 'lvgym[ray]'): a local Ray
     RAY_ADDRESS=auto lvgym evaluate --executor ray        # ... or the running cluster (``ray start``)
@@ -61,6 +62,7 @@ from lvgym.parallel import TaskFailed, exit_on_sigterm
 
 from . import fail
 from .args import arg, command_name, parse
+from .flights import check_vehicle
 
 __all__ = ["Args", "DEFAULT_EPISODES", "DEFAULT_POLICIES", "DEFAULT_SUITE", "DEFAULT_SUITES", "POLICIES", "main", "parse_args",
            "resolve_policy"]
@@ -101,6 +103,10 @@ class Args:
     """test (reported numbers) or validation (training and tuning)"""
     reference: str | None = arg(None, metavar="POLICY")
     """policy label every policy is compared with (default: the best-ranked policy of each condition)"""
+    vehicle: str | None = arg(None, check=check_vehicle, metavar="NAME|PATH")
+    """fly every condition with this vehicle in place of the suite's: a shipped vehicle or the path of a
+    vehicle YAML file (docs/vehicles.md), with your own --policies (the shipped designs are made for the
+    shipped vehicles); the results are then not protocol numbers (version +override)"""
     mission_time_s: float | None = arg(None, lo=0.0, lo_open=True, hi=MAX_MISSION_TIME_S,
                                        allowed=f"a number of seconds in (0, {MAX_MISSION_TIME_S:g}]")
     """shorten every episode to this many seconds (smoke tests only; results are marked '+override')"""
@@ -131,6 +137,9 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
     args = parse_args(argv)
     prog = command_name(PROG)
     exit_on_sigterm()                                # clean up temporary files on kill (SIGTERM)
+    if args.vehicle is not None and args.policies is None:
+        fail(prog, f"--vehicle {args.vehicle}: give --policies too: the shipped designs are made for the shipped "
+                   "vehicles (yours: module:factory or path/to/file.py:factory; zero and privileged fly any vehicle)")
     if args.suites is None:
         args.suites = list(DEFAULT_SUITES) if args.policies is None else [DEFAULT_SUITE]
     try:
@@ -144,8 +153,9 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
     if args.reference is not None and args.reference not in [p.name for p in policies]:
         raise SystemExit(f"{prog}: --reference = {args.reference!r}: one of the policy labels "
                          f"{[p.name for p in policies]}")
-    if args.mission_time_s is not None:
-        suites = [s.with_options(mission_time_s=float(args.mission_time_s)) for s in suites]
+    overrides = {k: v for k, v in (("mission_time_s", args.mission_time_s), ("vehicle", args.vehicle)) if v is not None}
+    if overrides:
+        suites = [s.with_options(**overrides) for s in suites]
     t0 = time.perf_counter()
     try:
         records = evaluate(per_suite, suites, args.episodes, args.seed_set, args.executor, args.workers,

@@ -26,7 +26,22 @@ from lvgym.parallel import EXECUTORS
 from . import fail
 from .args import arg
 
-__all__ = ["FlightArgs", "resolve_flights"]
+__all__ = ["FlightArgs", "check_vehicle", "resolve_flights"]
+
+
+def check_vehicle(option: str, value: str) -> str:
+    """A ``--vehicle`` option's value: a shipped vehicle's name or a vehicle file that reads (a missing or
+    invalid file stops the command in one line naming the option, or the file, line, key and value)."""
+    from lvgym.errors import ConfigError
+    from lvgym.vehicle.config import load_vehicle
+
+    try:
+        load_vehicle(value)
+    except ConfigError as exc:
+        if exc.key == "vehicle":
+            raise ConfigError(option, exc.value, exc.allowed) from None
+        raise
+    return value
 
 
 @dataclass

@@ -28,7 +28,7 @@ from lvgym.parallel import TaskFailed, exit_on_sigterm
 
 from . import fail
 from .args import arg, command_name, parse
-from .flights import FlightArgs, resolve_flights
+from .flights import FlightArgs, check_vehicle, resolve_flights
 
 __all__ = ["Args", "main", "parse_args"]
 
@@ -36,19 +36,6 @@ PROG = "lvgym margins"
 _D = MarginOptions()
 _OPTIONS = ("error_ratio", "rate_limit_ratio", "gain_max_db", "gain_min_db", "gain_tol_db", "gain_step_db",
             "delay_max_s")
-
-
-def _vehicle(option: str, value: str) -> str:
-    """``--vehicle``: a vehicle that reads (a missing or invalid file names itself in one line)."""
-    from lvgym.vehicle.config import load_vehicle
-
-    try:
-        load_vehicle(value)
-    except ConfigError as exc:
-        if exc.key == "vehicle":
-            raise ConfigError(option, exc.value, exc.allowed) from None
-        raise
-    return value
 
 
 @dataclass
@@ -81,7 +68,7 @@ class Args(FlightArgs):
     """first step of the outward gain search [dB], doubling"""
     delay_max_s: float = _D.delay_max_s
     """delay searched up to [s]"""
-    vehicle: str | None = arg(None, check=_vehicle, metavar="NAME|PATH")
+    vehicle: str | None = arg(None, check=check_vehicle, metavar="NAME|PATH")
     """fly every condition with this vehicle in place of the suite's: a shipped vehicle or the path of a
     vehicle YAML file (docs/vehicles.md); the results are then not protocol numbers (version +override)"""
     physics_dt_s: float | None = arg(None, lo=0.0, lo_open=True, hi=0.05)
