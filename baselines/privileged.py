@@ -2,13 +2,17 @@
 
 ``privileged`` is not a design a vehicle could fly. It reads the env's ``privileged_info``
 (:meth:`lvgym.envs.functional.AscentFuncEnv.privileged_info`): the true rigid-body rates (no gyro, no noise,
-no bending in them), the true attitude error, and the aerodynamic moment about the CG that the wind and the
-flow cause at this instant, with the thrust, its lever arm and the inertia. Per axis it commands the gimbal
-angle whose thrust moment cancels that aerodynamic moment and adds the moment of a second-order attitude loop
-(natural frequency ``bandwidth_radps``, damping ``damping``) on the true rate and attitude errors (dynamic
-inversion of the rigid body)::
+no bending in them), the true attitude error, the thrust, its lever arm, the inertia, the true thrust
+misalignment and the share of the command each actuator still reaches (both moved by faults), and the wind
+ahead of the vehicle: the aerodynamic moment about the CG that the wind and air it is about to fly into would
+cause, up to :data:`~lvgym.envs.functional.PREVIEW_PERIODS` control periods ahead (the turbulence is a frozen
+field along the climb, so the wind ahead is known exactly). Per axis it commands the gimbal angle whose
+thrust moment cancels the moment :data:`PREVIEW` periods ahead (the period of delay and the servo's lag
+between a command and its moment) and adds the moment of a second-order attitude loop (natural frequency
+``bandwidth_radps``, damping ``damping``) on the true rate and attitude errors (dynamic inversion of the
+rigid body), then takes off the misalignment and divides by the actuator's effectiveness::
 
-    delta = (J (-2 z w e_rate - h w^2 e_att) - h M_aero) / (T l)
+    delta = ((J (-2 z w e_rate - h w^2 e_att) - h M_aero_ahead) / (T l) - mis) / eff
 
 where ``h`` is 1 up to half the q-alpha limit and falls linearly to 0 at 90 % of it (:data:`RELIEF`, the
 ``qalpha_pa_deg`` of the step's info): load relief, which lets the vehicle turn into the relative wind
@@ -16,11 +20,11 @@ when the structural load nears its limit, as a launch vehicle's load-relief mode
 
 (pitch about +y_b, yaw about +z_b; a positive gimbal angle turns the vehicle positively about its axis). It
 flies the protocol's actuator path like every policy: the action's period of delay, the servo and its
-limits. It knows the disturbance as it acts, not ahead, and nothing of the slosh and the bending, so it is a
-reference, not a bound: the room it shows is what knowing the state and the wind's moment is worth to a
-controller on the same actuator (docs/benchmark.md). The runner flies it on its conditions with
-``privileged_info=True`` (the ``privileged`` attribute of its factory, :func:`privileged`); that option adds
-keys to the info and changes nothing of the flight.
+limits. It knows nothing of the slosh and the bending, and nothing of a fault but the misalignment and the
+effectiveness, so it is a reference, not a bound: the room it shows is what knowing the state, the plant and
+the wind ahead is worth to a controller on the same actuator (docs/benchmark.md). The runner flies it on its
+conditions with ``privileged_info=True`` (the ``privileged`` attribute of its factory, :func:`privileged`);
+that option adds keys to the info and changes nothing of the flight.
 """
 
 from __future__ import annotations
@@ -30,6 +34,7 @@ from typing import Any
 
 import numpy as np
 
+from lvgym.envs.functional import PREVIEW_PERIODS
 from lvgym.errors import ConfigError
 
 __all__ = ["PrivilegedPolicy", "privileged"]
@@ -39,21 +44,31 @@ __all__ = ["PrivilegedPolicy", "privileged"]
 #: and 2 /s (damping equal) and reliefs none, (0.5, 0.9) and (0.3, 0.7)
 #: (``python -m experiments.protocol_v2_design.privileged_sweep``; docs/benchmark.md, "The privileged
 #: reference"). The non-rigid vehicle takes a rate gain of only about 2 /s before the true rates' slosh content
-#: destabilises the loop (the law knows nothing of the slosh)
+#: destabilises the loop (the law knows nothing of the slosh). The sweep again with the preview and the plant
+#: knowledge (bandwidths 1 and 1.5 /s at relief (0.5, 0.9)) kept them
 GAINS = {"rigid": (1.5, 1.5), "nonrigid": (1.0, 1.0)}
 #: load relief (onset, full) as shares of the env's q-alpha limit: between them the attitude loop and the
 #: cancellation of the aerodynamic moment fade out linearly, and the statically stable vehicle turns into the
 #: relative wind (module docstring)
 RELIEF = (0.5, 0.9)
+#: how many control periods ahead the law reads the aerodynamic moment (the info's ``m_aero_ahead_b``; 0: the
+#: moment as it acts), per flight model: the lowest mean ``score_v2`` of the same sweep with previews 0, 5, 7
+#: and 10 at the bandwidths of :data:`GAINS` (previews 1, 2, 3 and 5 lowered it step by step on both models;
+#: 10 raised it again). About the delay plus the servo's lag: 0.1-0.14 s
+PREVIEW = {"rigid": 7, "nonrigid": 5}
 
 
 class PrivilegedPolicy:
     """The privileged reference (module docstring) for a TVC env of the ascent task: ``bandwidth_radps`` [rad/s]
-    and ``damping`` [-] of its attitude loop (default: :data:`GAINS` of the env's flight model); ``env``: the
-    env it flies (its gimbal limit, its observation's reference pitch rate, its model)."""
+    and ``damping`` [-] of its attitude loop (default: :data:`GAINS` of the env's flight model), ``relief``
+    (default :data:`RELIEF`), ``preview_periods``: how many control periods ahead it reads the aerodynamic moment
+    (default :data:`PREVIEW`; 0: as it acts), ``plant``: whether it uses the true misalignment and actuator
+    effectiveness; ``env``: the env it flies (its gimbal limit, its observation's reference pitch rate, its
+    model)."""
 
     def __init__(self, env: Any, bandwidth_radps: float | None = None, damping: float | None = None,
-                 name: str = "privileged", relief: tuple[float, float] | None = None) -> None:
+                 name: str = "privileged", relief: tuple[float, float] | None = None,
+                 preview_periods: int | None = None, plant: bool = True) -> None:
         func = env.unwrapped.func
         w0, z0 = GAINS["rigid" if func.spec.model == "rigid" else "nonrigid"]
         bandwidth_radps = w0 if bandwidth_radps is None else bandwidth_radps
@@ -66,6 +81,13 @@ class PrivilegedPolicy:
         if not func.spec.privileged_info:
             raise ConfigError("privileged env privileged_info", False, "True: the reference reads the true state "
                               "from the step's info (the benchmark's runner sets it for this policy)")
+        model = "rigid" if func.spec.model == "rigid" else "nonrigid"
+        preview_periods = PREVIEW[model] if preview_periods is None else preview_periods
+        if not (isinstance(preview_periods, int) and 0 <= preview_periods <= PREVIEW_PERIODS):
+            raise ConfigError("privileged.preview_periods", preview_periods,
+                              f"an integer from 0 (the moment as it acts) to {PREVIEW_PERIODS}")
+        self.preview = int(preview_periods)
+        self.plant = bool(plant)
         relief = RELIEF if relief is None else tuple(relief)
         if not (len(relief) == 2 and all(isinstance(x, (int, float)) and math.isfinite(x) for x in relief)
                 and 0.0 < relief[0] < relief[1]):
@@ -91,7 +113,8 @@ class PrivilegedPolicy:
             return np.zeros(2, dtype=np.float32)
         w = np.asarray(info["omega_bi_b"], dtype=float)
         att = np.asarray(info["attitude_error"], dtype=float)
-        m_aero = np.asarray(info["m_aero_b"], dtype=float)
+        m_aero = np.asarray(info["m_aero_b"] if self.preview == 0 else info["m_aero_ahead_b"][self.preview - 1],
+                            dtype=float)
         J = np.asarray(info["J_b_diag"], dtype=float)
         ref = float(observation[self._i_ref]) if self._i_ref is not None else 0.0
         e_rate = np.array([w[1] - ref, w[2]])
@@ -102,14 +125,18 @@ class PrivilegedPolicy:
         hold = 1.0 - min(1.0, max(0.0, (share - onset) / (full - onset)))
         alpha = -2.0 * self.z * self.w * e_rate - hold * self.w * self.w * att
         delta = (J[1:] * alpha - hold * m_aero[1:]) / lever
+        if self.plant:                                      # the true thrust direction and actuator authority
+            delta = (delta - np.asarray(info.get("misalignment", 0.0), dtype=float)) / np.maximum(
+                np.asarray(info.get("actuator_effectiveness", 1.0), dtype=float), 0.1)
         return np.clip(delta / self.limit, -1.0, 1.0).astype(np.float32)
 
 
 def privileged(env: Any, bandwidth_radps: float | None = None, damping: float | None = None,
-               name: str = "privileged", relief: tuple[float, float] | None = None) -> PrivilegedPolicy:
-    """``privileged``: the reference of :class:`PrivilegedPolicy` (module docstring), at :data:`GAINS` and
-    :data:`RELIEF` unless given."""
-    return PrivilegedPolicy(env, bandwidth_radps, damping, name, relief)
+               name: str = "privileged", relief: tuple[float, float] | None = None,
+               preview_periods: int | None = None, plant: bool = True) -> PrivilegedPolicy:
+    """``privileged``: the reference of :class:`PrivilegedPolicy` (module docstring), at :data:`GAINS`,
+    :data:`RELIEF` and :data:`PREVIEW` unless given."""
+    return PrivilegedPolicy(env, bandwidth_radps, damping, name, relief, preview_periods, plant)
 
 
 #: the runner flies this factory's policies with the env option privileged_info=True

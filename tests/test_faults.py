@@ -84,9 +84,10 @@ def test_the_decoded_fault_lies_in_its_window_and_range():
         kind = FAULT_KINDS[int(f[F.kind]) - 1]
         seen[kind.name] += 1
         assert 12.0 <= f[F.onset_s] <= 30.0 and f[F.axis] in (0.0, 1.0) and f[F.active] == 0.0
-        lo, hi = (math.radians(kind.low), math.radians(kind.high)) if kind.unit == "deg/s" else (kind.low, kind.high)
+        lo, hi = ((math.radians(kind.low), math.radians(kind.high)) if kind.unit in ("deg", "deg/s")
+                  else (kind.low, kind.high))
         assert lo - 1e-15 <= abs(f[F.size]) <= hi + 1e-15
-        if kind.name != "gyro_bias":
+        if kind.name not in ("gyro_bias", "misalignment"):
             assert f[F.size] >= 0.0
     assert all(abs(n / 5000 - 1 / len(kinds)) < 0.03 for n in seen.values())          # an equal share each
     assert not decode(FAULT_DRAW.zeros(), (), (0.0, 1.0)).any()                          # no kinds: none
@@ -169,6 +170,30 @@ def test_a_gyro_bias_step_moves_the_bias_of_its_axis():
     want = b0.copy()
     want[1 + int(f[F.axis])] += f[F.size]
     np.testing.assert_array_equal(task.gyro_bias[0], want)
+
+
+def test_a_misalignment_step_turns_the_thrust_of_its_axis_from_the_onset():
+    env = gym.make("lvgym/SmileAscent-v1", randomize={"fault"}, fault_kinds=("misalignment",),
+                   fault_onset_s=(3.0, 3.0), mission_time_s=4.0)
+    env.reset(seed=4)
+    u = env.unwrapped
+    sim, data = u.func.sim, u.core.state.sim
+    m0 = sim.misalignment(data)[0].copy()
+    for _ in range(150):                                   # to 3.0 s: not struck yet
+        env.step(np.zeros(2, np.float32))
+    np.testing.assert_array_equal(sim.misalignment(u.core.state.sim)[0], m0)
+    env.step(np.zeros(2, np.float32))
+    f = u.core.state.task.fault[0]
+    axis = int(f[F.axis])
+    assert math.radians(0.5) <= abs(f[F.size]) <= math.radians(1.5)
+    want = m0.copy()
+    want[axis] += f[F.size]
+    np.testing.assert_array_equal(sim.misalignment(u.core.state.sim)[0], want)
+    # the thrust turns by it: with the gimbal centred, its lateral share on that axis is sin(misalignment)
+    thrust_b = sim.conditions(u.core.state.sim, "thrust_b")[0]
+    lateral = thrust_b[2] if axis == 0 else -thrust_b[1]
+    assert lateral / np.linalg.norm(thrust_b) == pytest.approx(math.sin(want[axis] + u.func.gimbal(u.core.state)[0, axis]),
+                                                               abs=1e-3)
 
 
 def test_the_fault_comes_from_the_env_generator_and_rows_fly_as_single_envs():

@@ -7,8 +7,9 @@ import gymnasium as gym
 import numpy as np
 import pytest
 
-import lvgym  # noqa: F401
-from lvgym.baselines.privileged import GAINS, RELIEF, PrivilegedPolicy, privileged
+import lvgym
+from lvgym.baselines.privileged import GAINS, PREVIEW, RELIEF, PrivilegedPolicy, privileged
+from lvgym.envs.functional import PREVIEW_PERIODS
 from lvgym.errors import ConfigError
 
 
@@ -30,7 +31,7 @@ def test_the_info_holds_the_true_state_only_when_asked():
 
 def test_the_law_cancels_the_aerodynamic_moment_and_closes_the_attitude_loop():
     env = gym.make("lvgym/SmileAscent-v1", privileged_info=True, model="rigid")
-    pol = PrivilegedPolicy(env, bandwidth_radps=2.0, damping=0.5)
+    pol = PrivilegedPolicy(env, bandwidth_radps=2.0, damping=0.5, preview_periods=0)
     limit = env.unwrapped.func.gimbal_limit
     obs = np.zeros(env.observation_space.shape, np.float32)
     info = {"omega_bi_b": np.array([0.0, 0.01, -0.02]), "attitude_error": np.array([0.03, 0.0]),
@@ -43,7 +44,7 @@ def test_the_law_cancels_the_aerodynamic_moment_and_closes_the_attitude_loop():
     assert not pol.act(obs, {**info, "thrust": 0.0}).any()                  # no thrust, no command
     assert not pol.act(obs, {"time": 0.0}).any()                            # the reset's info
     # load relief: from onset to full of the q-alpha limit the attitude term and the cancellation fade out
-    relief = PrivilegedPolicy(env, bandwidth_radps=2.0, damping=0.5, relief=(0.4, 0.8))
+    relief = PrivilegedPolicy(env, bandwidth_radps=2.0, damping=0.5, relief=(0.4, 0.8), preview_periods=0)
     np.testing.assert_allclose(relief.act(obs, {**info, "qalpha_pa_deg": 0.3 * 250e3}), a, rtol=1e-6)
     half = relief.act(obs, {**info, "qalpha_pa_deg": 0.6 * 250e3})
     want_half = [(1e5 * (-2 * 0.5 * 2.0 * 0.01 - 0.5 * 4.0 * 0.03) - 0.5 * 500.0) / 2e6,
@@ -54,6 +55,52 @@ def test_the_law_cancels_the_aerodynamic_moment_and_closes_the_attitude_loop():
     np.testing.assert_allclose(damping_only, np.array(want_damp) / limit, rtol=1e-6)
 
 
+def test_the_preview_is_the_wind_the_vehicle_then_meets():
+    """The info's wind ahead, k control periods on, against the wind the flight then meets: the turbulence is a
+    frozen field in altitude, so they differ only by the path's curvature over k periods."""
+    env = lvgym.make_env("smile-v2", model="rigid", privileged_info=True)
+    env.reset(seed=5)
+    for _ in range(1000):                                              # to 20 s: in the turbulence
+        info = env.step(np.zeros(2, np.float32))[4]
+    u = env.unwrapped
+    ahead, m_ahead = info["wind_ahead_n"], info["m_aero_ahead_b"]
+    assert ahead.shape == m_ahead.shape == (PREVIEW_PERIODS, 3)
+    np.testing.assert_array_equal(info["actuator_effectiveness"], [1.0, 1.0])
+    np.testing.assert_array_equal(info["misalignment"], u.func.sim.misalignment(u.core.state.sim)[0])
+    assert 0.0 < np.abs(info["misalignment"]).max() < np.radians(0.16)      # the dispersion's draw
+    sim, data = u.func.sim, u.core.state.sim
+    np.testing.assert_array_equal(sim.conditions_ahead(data, [0.0])[0], data.conditions)     # horizon 0: now
+    now, met = u.flight.conditions("wind_n")[0].copy(), []
+    for _ in range(PREVIEW_PERIODS):
+        env.step(np.zeros(2, np.float32))
+        met.append(u.flight.conditions("wind_n")[0].copy())
+    change, miss = np.abs(np.array(met) - now).max(), np.abs(ahead - np.array(met)).max()
+    assert change > 0.1 and miss < 0.03 * change, (change, miss)      # it moves; the preview follows it
+
+
+def test_the_law_reads_the_moment_at_its_preview():
+    env = gym.make("lvgym/SmileAscent-v1", privileged_info=True, model="rigid")
+    obs = np.zeros(env.observation_space.shape, np.float32)
+    m_ahead = np.zeros((PREVIEW_PERIODS, 3))
+    m_ahead[1] = [0.0, 800.0, -100.0]
+    info = {"omega_bi_b": np.zeros(3), "attitude_error": np.zeros(2), "m_aero_b": np.array([0.0, 500.0, -300.0]),
+            "m_aero_ahead_b": m_ahead, "thrust": 4e5, "gimbal_arm": 5.0, "J_b_diag": np.array([700.0, 1e5, 1e5])}
+    limit = env.unwrapped.func.gimbal_limit
+    np.testing.assert_allclose(PrivilegedPolicy(env, preview_periods=0).act(obs, info),
+                               np.array([-500.0, 300.0]) / 2e6 / limit, rtol=1e-6)
+    np.testing.assert_allclose(PrivilegedPolicy(env, preview_periods=2).act(obs, info),
+                               np.array([-800.0, 100.0]) / 2e6 / limit, rtol=1e-6)
+    with pytest.raises(ConfigError, match=f"privileged.preview_periods = {PREVIEW_PERIODS + 1}: an integer from 0"):
+        PrivilegedPolicy(env, preview_periods=PREVIEW_PERIODS + 1)
+    # it knows the true thrust direction and what the actuator still reaches: it takes the misalignment off and
+    # divides by the effectiveness (plant=False: it does not)
+    faulty = {**info, "misalignment": np.array([0.001, -0.002]), "actuator_effectiveness": np.array([1.0, 0.5])}
+    want = (np.array([-500.0, 300.0]) / 2e6 - [0.001, -0.002]) / [1.0, 0.5]
+    np.testing.assert_allclose(PrivilegedPolicy(env, preview_periods=0).act(obs, faulty), want / limit, rtol=1e-6)
+    np.testing.assert_allclose(PrivilegedPolicy(env, preview_periods=0, plant=False).act(obs, faulty),
+                               np.array([-500.0, 300.0]) / 2e6 / limit, rtol=1e-6)
+
+
 def test_it_refuses_an_env_without_the_true_state_and_bad_gains():
     with pytest.raises(ConfigError, match="privileged_info"):
         privileged(gym.make("lvgym/SmileAscent-v1"))
@@ -62,7 +109,7 @@ def test_it_refuses_an_env_without_the_true_state_and_bad_gains():
     with pytest.raises(ConfigError, match=r"privileged.relief = \(0.8, 0.4\): two shares"):
         privileged(gym.make("lvgym/SmileAscent-v1", privileged_info=True), relief=(0.8, 0.4))
     pol = privileged(gym.make("lvgym/SmileAscent-v1", privileged_info=True, model="rigid"))
-    assert (pol.w, pol.z) == GAINS["rigid"] and pol.relief == RELIEF
+    assert (pol.w, pol.z) == GAINS["rigid"] and pol.relief == RELIEF and pol.preview == PREVIEW["rigid"]
 
 
 def test_the_runner_flies_it_with_the_true_state_batched_as_single():

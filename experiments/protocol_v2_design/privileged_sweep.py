@@ -4,7 +4,8 @@
 
 Flies ``privileged`` (lvgym/baselines/privileged.py) at each attitude-loop bandwidth of ``--bandwidths``
 (damping equal to it, as :data:`~lvgym.baselines.privileged.GAINS` has them) with each load relief of
-``--reliefs`` (onset and full share of the q-alpha limit; ``off``: none) on protocol v2's SMILE suites,
+``--reliefs`` (onset and full share of the q-alpha limit; ``off``: none) and each preview of ``--previews``
+(control periods ahead at which it reads the aerodynamic moment) on protocol v2's SMILE suites,
 rigid and non-rigid, validation seeds ``0 .. seeds - 1``, and prints per flight model the mean ``score_v2``
 of every variant on every suite and over the three, with its failures. A study: it flies no test seed.
 """
@@ -27,18 +28,17 @@ FACTORY = "lvgym.baselines.privileged:privileged"
 OFF = (10.0, 11.0)          # onset beyond the limit: no relief (a flight above the limit has failed)
 
 
-def _variants(bandwidths: list[float], reliefs: list[str]) -> list[PolicySpec]:
+def _variants(bandwidths: list[float], reliefs: list[str], previews: list[int]) -> list[PolicySpec]:
     out = []
-    for w in bandwidths:
-        for r in reliefs:
-            try:
-                relief = OFF if r == "off" else tuple(float(x) for x in r.split(","))
-            except ValueError:
-                relief = ()
-            if len(relief) != 2:
-                raise ConfigError("reliefs", r, "off, or ONSET,FULL: two shares of the q-alpha limit")
-            out.append(PolicySpec(f"priv-w{w:g}-r{r.replace(',', '-')}", FACTORY,
-                                  (("bandwidth_radps", w), ("damping", w), ("relief", relief))))
+    for w, r, k in ((w, r, k) for w in bandwidths for r in reliefs for k in previews):
+        try:
+            relief = OFF if r == "off" else tuple(float(x) for x in r.split(","))
+        except ValueError:
+            relief = ()
+        if len(relief) != 2:
+            raise ConfigError("reliefs", r, "off, or ONSET,FULL: two shares of the q-alpha limit")
+        out.append(PolicySpec(f"priv-w{w:g}-r{r.replace(',', '-')}-p{k}", FACTORY,
+                              (("bandwidth_radps", w), ("damping", w), ("relief", relief), ("preview_periods", k))))
     return out
 
 
@@ -53,11 +53,13 @@ class Args:
     """attitude-loop bandwidths [rad/s] (the damping equal to each)"""
     reliefs: list[str] = arg(default_factory=lambda: ["off", "0.5,0.9", "0.3,0.7"], metavar="ONSET,FULL")
     """load reliefs: onset and full share of the q-alpha limit, or off"""
+    previews: list[int] = arg(default_factory=lambda: [0], lo=0, hi=10, metavar="PERIODS")
+    """how many control periods ahead the law reads the aerodynamic moment (0: as it acts)"""
 
 
 def main(argv: Sequence[str] | None = None) -> None:
     args = parse(Args, argv, "python -m experiments.protocol_v2_design.privileged_sweep", __doc__)
-    specs = _variants(args.bandwidths, args.reliefs)
+    specs = _variants(args.bandwidths, args.reliefs, args.previews)
     records = evaluate(specs, [get_suite(s) for s in SUITES], args.seeds, "validation", progress=False)
     score: dict[tuple[str, str, str], list[float]] = defaultdict(list)
     failed: dict[tuple[str, str, str], int] = defaultdict(int)

@@ -239,7 +239,7 @@ SUITES.update(SUITES_V1)
 PROTOCOL_V2 = "v2"
 #: the kinds of fault of smile-v2-faults: ``stuck`` is left out (no design flies it: SMILE has no other
 #: effector on a jammed axis; experiments/protocol_v2_design, part 5)
-V2_FAULT_KINDS = ("effectiveness", "bandwidth", "thrust", "gyro_bias")
+V2_FAULT_KINDS = ("effectiveness", "bandwidth", "thrust", "gyro_bias", "misalignment")
 #: the policies v2 reports on SMILE: no control, the flex design that breaks the flyability rule and its quiet
 #: redesigns, the LQG family, the shipped learned policy and the privileged reference
 V2_SMILE_POLICIES = ("zero", "gs-pid-flex", "gs-pid-flex-quiet", "aac-quiet", "lqg", "lqg-front", "ppo-res-lqg",
@@ -258,7 +258,8 @@ SUITES_V2: dict[str, Suite] = {s.name: s for s in (
           _pair("smile-v2-maxq-gust", SMILE_V1, "maxq_gust", V1_DISPERSIONS, mission_time_s=35.0),
           version=PROTOCOL_V2, reference="lqg", policies=V2_SMILE_POLICIES),
     Suite("smile-v2-faults", "smile-v1 with one in-flight fault per episode (a loss of actuator effectiveness or "
-          "bandwidth on one axis, a thrust loss or a gyro bias step), its onset unannounced in 5-40 s",
+          "bandwidth on one axis, a thrust loss, a gyro bias step or a thrust-direction step), its onset "
+          "unannounced in 5-40 s",
           _pair("smile-v2-faults", SMILE_V1, "turbulence_gust", (*V1_DISPERSIONS, "fault"),
                 fault_kinds=V2_FAULT_KINDS, fault_onset_s=(5.0, 40.0)), version=PROTOCOL_V2, reference="lqg",
           policies=V2_SMILE_POLICIES),

@@ -211,8 +211,8 @@ DISPERSIONS: tuple[Dispersion, ...] = (
                "offset", low=0.0, high=1.0, source=_FAULTS),
     Dispersion("fault", "the fault's axis: pitch (0) or yaw (1)", (Move("fault.axis"),), "integers", "offset",
                low=0, high=1, source="the vehicle is axisymmetric: either axis alike"),
-    Dispersion("fault", "the gyro bias step's sign: negative (0) or positive (1)", (Move("fault.sign"),),
-               "integers", "offset", low=0, high=1, source="either sign alike"),
+    Dispersion("fault", "the sign of a gyro bias or misalignment step: negative (0) or positive (1)",
+               (Move("fault.sign"),), "integers", "offset", low=0, high=1, source="either sign alike"),
 )
 #: the randomisations drawn elsewhere: what they draw, and where it is documented
 OTHER_RANDOMIZATIONS = {

@@ -19,7 +19,9 @@ The kinds, as they act on the flight (the actuator faults act in the simulator's
 - ``thrust``: loss of thrust, the thrust times ``(1 - size)`` from the onset (the mass flow is the
   timeline's: a combustion or nozzle fault);
 - ``gyro_bias``: a step in the rate gyro's bias on one axis, ``size`` [rad/s] of either sign: the rate the
-  policy sees is off by it, and the attitude the flight computer integrates from it drifts.
+  policy sees is off by it, and the attitude the flight computer integrates from it drifts;
+- ``misalignment``: a step in the thrust's direction on one axis, ``size`` [rad] of either sign, added to the
+  row's thrust misalignment (a nozzle damaged in flight: its thrust turns off the gimbal's axis).
 """
 
 from __future__ import annotations
@@ -52,7 +54,7 @@ class FaultKind:
     def size(self, severity: float) -> float:
         """The fault's size in SI (a fraction, or rad/s) at ``severity`` in [0, 1] of the range."""
         x = self.low + severity * (self.high - self.low)
-        return math.radians(x) if self.unit == "deg/s" else x
+        return math.radians(x) if self.unit in ("deg", "deg/s") else x
 
 
 #: the kinds of fault, in code order (code = index + 1; 0 is no fault)
@@ -70,21 +72,27 @@ FAULT_KINDS = (
     FaultKind("gyro_bias", "a rate-gyro bias step on one axis", 0.05, 0.25, "deg/s", True,
               "58 to 290 times the flight gyro's bias sigma (1.5e-5 rad/s); 0.5 deg/s failed every shipped policy "
               "(experiments/protocol_v2_design); to be tuned on validation seeds with the suite"),
+    FaultKind("misalignment", "a thrust-direction step on one axis (a damaged nozzle)", 0.5, 1.5, "deg", True,
+              "Ariane 5 flight 157 (11 December 2002): a leak in the Vulcain 2 nozzle's cooling circuit overheated "
+              "the nozzle, and its deterioration caused a major thrust imbalance and the loss of control (Arianespace "
+              "inquiry board, January 2003); sized here at 3 to 10 times the 0.15 deg alignment tolerance, within a "
+              "third of SMILE's 5 deg gimbal range, so that a design can hold it"),
 )
 FAULT_NAMES = tuple(k.name for k in FAULT_KINDS)
+_SIGNED = ("gyro_bias", "misalignment")            # kinds of either sign (the draw's ``sign``)
 #: what the dispersion table draws for a row's fault (:data:`.dispersions.DISPERSIONS`, in this order)
 FAULT_DRAW = Packed("fault draw", [
     Field("kind", 1, "-", "uniform [0, 1): picks one of the task's fault_kinds"),
     Field("onset", 1, "-", "uniform [0, 1]: the onset's place in the fault_onset_s window"),
     Field("severity", 1, "-", "uniform [0, 1]: the size's place in the kind's range"),
     Field("axis", 1, "-", "0 or 1: pitch or yaw"),
-    Field("sign", 1, "-", "0 or 1: the gyro bias step negative or positive"),
+    Field("sign", 1, "-", "0 or 1: the gyro bias step or the misalignment step negative or positive"),
 ], interface=True)
 #: a row's fault in the task's rows (``TaskData.fault``)
 FAULT = Packed("fault", [
     Field("kind", 1, "-", "code of the kind: 0 none, else the index in FAULT_KINDS plus 1"),
     Field("onset_s", 1, "s", "flight time from which it acts"),
-    Field("size", 1, "- or rad/s", "its size (a fraction, or the gyro bias step)"),
+    Field("size", 1, "-, rad/s or rad", "its size (a fraction, the gyro bias step or the misalignment step)"),
     Field("axis", 1, "-", "0 pitch, 1 yaw (unused by a kind on no axis)"),
     Field("active", 1, "-", "1 once it has struck"),
 ], interface=True)
@@ -103,7 +111,7 @@ def decode(draw: np.ndarray, kinds: tuple[str, ...], window: tuple[float, float]
     out[_F.kind] = FAULT_NAMES.index(name) + 1
     out[_F.onset_s] = window[0] + float(draw[d.onset]) * (window[1] - window[0])
     size = kind.size(float(draw[d.severity]))
-    out[_F.size] = -size if kind.name == "gyro_bias" and draw[d.sign] == 0.0 else size
+    out[_F.size] = -size if kind.name in _SIGNED and draw[d.sign] == 0.0 else size
     out[_F.axis] = float(draw[d.axis])
     return out
 
@@ -121,7 +129,7 @@ def fault_names(fault: np.ndarray) -> np.ndarray:
 def apply_faults(sim: Any, data: Any, fault: np.ndarray, gyro_bias: np.ndarray) -> np.ndarray:
     """Let strike, in place, the faults of the rows whose onset has come (``data.t`` at or after it) and that
     have not struck yet: the actuator's fault fields (``data.actuator``), the thrust scale of the row's loads
-    (``sim.load_dispersion``) or the gyro bias (``gyro_bias`` (B, 3) [rad/s], roll, pitch, yaw); marks them
+    (``sim.load_dispersion``), the row's thrust misalignment (``sim.misalignment``) or the gyro bias (``gyro_bias`` (B, 3) [rad/s], roll, pitch, yaw); marks them
     active. Returns the rows that struck."""
     kind = fault[:, _F.kind]
     rows = np.flatnonzero((kind > 0) & (fault[:, _F.active] == 0.0) & (data.t >= fault[:, _F.onset_s] - 1e-9))
@@ -138,6 +146,8 @@ def apply_faults(sim: Any, data: Any, fault: np.ndarray, gyro_bias: np.ndarray) 
             ACTUATOR.view(data.actuator, "stuck")[b, axis] = 1.0
         elif name == "thrust":
             sim.load_dispersion(data, "thrust_scale")[b] *= 1.0 - size
+        elif name == "misalignment":
+            sim.misalignment(data)[b, axis] += size
         else:                                                    # gyro_bias: body y (pitch) or z (yaw)
             gyro_bias[b, 1 + axis] += size
     fault[rows, _F.active] = 1.0

@@ -67,6 +67,8 @@ AscentState = namedtuple("AscentState", ["sim", "task", "events"])
 AscentParams = namedtuple("AscentParams", ["task", "tables", "setup"])
 #: stations along the vehicle where the timeline also tabulates the mode shapes, for the rendered view
 RENDER_STATIONS = 21
+#: the privileged info's preview of the wind ahead: 1 to this many control periods
+PREVIEW_PERIODS = 10
 _REASONS = np.array(REASONS, dtype=object)
 _SIGNALS = Kernel(step_signals_range)      # row ranges on the simulator's threads
 
@@ -417,16 +419,26 @@ class AscentFuncEnv(FuncEnv):
         the CG ``m_aero_b`` (B, 3) [N m] (the wind's included), the thrust (B,) [N], the gimbal's lever arm
         ``gimbal_arm`` (B,) [m] (CG station minus gimbal station along x_b), the share of the thrust the gimbal
         turns ``vectored_share`` (B,) [-], the body's principal inertias ``J_b_diag`` (B, 3) [kg m^2] and the
-        velocity relative to the air in body axes ``v_air_b`` (B, 3) [m/s]."""
+        velocity relative to the air in body axes ``v_air_b`` (B, 3) [m/s]; the true thrust misalignment
+        ``misalignment`` (B, 2) [rad] (pitch, yaw: the dispersion's and a fault's) and the share of the command
+        each gimbal axis still reaches ``actuator_effectiveness`` (B, 2) [-] (1 but after a fault); and the wind
+        ahead of the vehicle over the next :data:`PREVIEW_PERIODS` control periods (the horizons ``k`` periods,
+        ``k`` = 1, 2, ..., :meth:`~lvgym.simulator.Simulator.conditions_ahead`): the wind it flies into
+        ``wind_ahead_n`` (B, K, 3) [m/s] (local north-east-down) and the aerodynamic moment that wind and air
+        would cause at the present attitude and rates ``m_aero_ahead_b`` (B, K, 3) [N m]."""
         sim = state.sim
         cond, lay = self.sim.conditions, self.sim.layout
+        ahead = self.sim.conditions_ahead(sim, [k * self.spec.control_dt_s for k in range(1, PREVIEW_PERIODS + 1)])
+        preview = {"wind_ahead_n": CONDITIONS.view(ahead, "wind_n").transpose(1, 0, 2).copy(),
+                   "m_aero_ahead_b": CONDITIONS.view(ahead, "m_aero_b").transpose(1, 0, 2).copy()}
         J = sim.p[:, lay.params["J_b"]].reshape(-1, 3, 3)
         r_cg, r_gimbal = sim.p[:, lay.params["r_cg"]], sim.p[:, lay.params["r_gimbal"]]
         return {"omega_bi_b": self.sim.state(sim, "omega_bi_b").copy(), "m_aero_b": cond(sim, "m_aero_b").copy(),
                 "thrust": cond(sim, "thrust").copy(), "gimbal_arm": r_cg[:, 0] - r_gimbal[:, 0],
                 "vectored_share": self.sim.vectored_share(sim),
                 "J_b_diag": np.stack([J[:, 0, 0], J[:, 1, 1], J[:, 2, 2]], axis=1),
-                "v_air_b": cond(sim, "v_air_b").copy()}
+                "v_air_b": cond(sim, "v_air_b").copy(), "misalignment": self.sim.misalignment(sim).copy(),
+                "actuator_effectiveness": 1.0 - ACTUATOR.view(sim.actuator, "effectiveness_loss"), **preview}
 
     def ended_faults(self, state: AscentState) -> np.ndarray:
         """The name of each row's fault (B,) where its episode has just ended (terminated or truncated), ``""``

@@ -348,7 +348,7 @@ class FaultOptions(Options):
 
     fault_kinds: tuple = FAULT_NAMES
     """the kinds a fault is drawn from, an equal share each: names of ``FAULT_KINDS`` (``effectiveness``,
-    ``bandwidth``, ``stuck``, ``thrust``, ``gyro_bias``)"""
+    ``bandwidth``, ``stuck``, ``thrust``, ``gyro_bias``, ``misalignment``)"""
     fault_onset_s: tuple = (5.0, 40.0)
     """the window of flight time [s] the onset is drawn in, uniformly (low, high)"""
 

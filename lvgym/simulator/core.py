@@ -56,7 +56,7 @@ from lvgym.vehicle import MassModel, Vehicle, load_vehicle
 from . import data as simdata
 from .advance import StepSetup, advance_range, conditions_rows, constrain_k, slosh_angles_range
 from .data import SimData
-from .flight import flight_loads, pack_context, stack_contexts
+from .flight import flight_conditions_batch, flight_loads, pack_context, stack_contexts
 from .imu import IMU_OFF, Imu
 from .layouts import ACTUATOR, CONDITIONS, CONTEXT, DISPERSION, IMU_STATE, RAIL, RAIL_STATE, RS
 from .piece import SLOSH_FREQUENCIES
@@ -365,6 +365,20 @@ class Simulator:
         idx = np.arange(data.t.size) if rows is None else np.atleast_1d(np.asarray(rows, dtype=np.int64))
         conditions_rows(idx.astype(np.int64), data, self.tables)
 
+    def conditions_ahead(self, data: SimData, horizons_s: Sequence[float]) -> np.ndarray:
+        """The flight conditions (K, B, N_COND) (layout :data:`.layouts.CONDITIONS`) that the rows of ``data``
+        meet ``horizons_s`` (K,) [s] ahead with their attitude, rates, structure and thrust as they are now:
+        the CG carried on along its inertial velocity and the clock advanced, so that the wind (the frozen
+        turbulence field, the gust) and the air are those the vehicle is about to fly into. A preview, not a
+        prediction of the flight: it reads ``data`` and writes nothing of it."""
+        out = np.empty((len(horizons_s),) + data.conditions.shape)
+        v_zw_i = self.state(data, "v_zw_i")
+        for k, h in enumerate(horizons_s):
+            x, ctx = data.x.copy(), data.ctx.copy()                  # the models' scratch lives in ctx
+            self.layout.view(x, "state", "r_zw_i")[:] += float(h) * v_zw_i
+            flight_conditions_batch(data.t + float(h), x, data.p, ctx, out[k])
+        return out
+
     # ------------------------------------------------------------------------------ read-outs
     # of explicit rows ``data`` (views: writing them writes the rows); SimView holds them by name
     @staticmethod
@@ -388,6 +402,12 @@ class Simulator:
         ``axial_scale``, ``normal_scale``, ``cp_shift``), a view: writing it changes the loads from the next
         step on (a thrust loss in flight)."""
         return data.ctx[:, CONTEXT.slice("dispersion").start + DISPERSION.index(name)]
+
+    @staticmethod
+    def misalignment(data: SimData) -> np.ndarray:
+        """The rows' fixed thrust misalignment (B, 2) [rad] (pitch, yaw), a view: writing it turns the thrust from
+        the next step on (a nozzle damaged in flight)."""
+        return CONTEXT.view(data.ctx[:, :CONTEXT.size], "misalignment")
 
     @staticmethod
     def vectored_share(data: SimData) -> np.ndarray:
