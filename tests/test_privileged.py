@@ -78,6 +78,25 @@ def test_the_preview_is_the_wind_the_vehicle_then_meets():
     assert change > 0.1 and miss < 0.03 * change, (change, miss)      # it moves; the preview follows it
 
 
+@pytest.mark.parametrize("suite", ["smile-v2", "slender-v2"])
+def test_the_privileged_info_changes_nothing_of_the_flight(suite):
+    """The preview evaluates the models in the rows' context (their scratch): the flight is the same to the bit."""
+    records = []
+    for privileged_info in (False, True):
+        env = lvgym.make_env(suite, model="nonrigid", privileged_info=privileged_info, mission_time_s=12.0)
+        env.reset(seed=7)
+        rng = np.random.default_rng(0)
+        rows = []
+        for _ in range(600):
+            obs, _, term, trunc, info = env.step(rng.uniform(-0.3, 0.3, 2).astype(np.float32))
+            u = env.unwrapped
+            rows.append(np.concatenate([u.core.state.sim.x[0], u.core.state.sim.conditions[0], obs]))
+            if term or trunc:
+                break
+        records.append(np.array(rows))
+    np.testing.assert_array_equal(records[0], records[1])
+
+
 def test_the_law_reads_the_moment_at_its_preview():
     env = gym.make("lvgym/SmileAscent-v1", privileged_info=True, model="rigid")
     obs = np.zeros(env.observation_space.shape, np.float32)

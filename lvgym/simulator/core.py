@@ -370,13 +370,18 @@ class Simulator:
         meet ``horizons_s`` (K,) [s] ahead with their attitude, rates, structure and thrust as they are now:
         the CG carried on along its inertial velocity and the clock advanced, so that the wind (the frozen
         turbulence field, the gust) and the air are those the vehicle is about to fly into. A preview, not a
-        prediction of the flight: it reads ``data`` and writes nothing of it."""
+        prediction of the flight: it writes nothing of the rows' state, conditions or parameters; the models'
+        scratch in their context (the scratch matrix, the gravity kernel's work block, the thrust angle cache,
+        keyed on the angles) is overwritten as at every evaluation of the loads, and the flight stays the same
+        to the bit (tests/test_privileged.py)."""
         out = np.empty((len(horizons_s),) + data.conditions.shape)
         v_zw_i = self.state(data, "v_zw_i")
+        x = data.x.copy()
+        r_zw_i = self.layout.view(x, "state", "r_zw_i")
+        r0 = r_zw_i.copy()
         for k, h in enumerate(horizons_s):
-            x, ctx = data.x.copy(), data.ctx.copy()                  # the models' scratch lives in ctx
-            self.layout.view(x, "state", "r_zw_i")[:] += float(h) * v_zw_i
-            flight_conditions_batch(data.t + float(h), x, data.p, ctx, out[k])
+            r_zw_i[:] = r0 + float(h) * v_zw_i
+            flight_conditions_batch(data.t + float(h), x, data.p, data.ctx, out[k])
         return out
 
     # ------------------------------------------------------------------------------ read-outs
