@@ -52,10 +52,10 @@ GAINS = {"rigid": (1.5, 1.5), "nonrigid": (1.0, 1.0)}
 #: relative wind (module docstring)
 RELIEF = (0.5, 0.9)
 #: how many control periods ahead the law reads the aerodynamic moment (the info's ``m_aero_ahead_b``; 0: the
-#: moment as it acts), per flight model: the lowest mean ``score_v2`` of the same sweep with previews 0, 5, 7
-#: and 10 at the bandwidths of :data:`GAINS` (previews 1, 2, 3 and 5 lowered it step by step on both models;
-#: 10 raised it again). About the delay plus the servo's lag: 0.1-0.14 s
-PREVIEW = {"rigid": 7, "nonrigid": 5}
+#: moment as it acts): the lowest mean ``score_v2`` over protocol v2's five suites on validation seeds 0-19, at
+#: the bandwidths of :data:`GAINS`, of previews 0, 5 and 7 on every suite (10 on the SMILE suites did worse
+#: than 5), on both flight models; 0.1 s, about the period of delay plus the servo's lag
+PREVIEW = 5
 
 
 class PrivilegedPolicy:
@@ -81,8 +81,7 @@ class PrivilegedPolicy:
         if not func.spec.privileged_info:
             raise ConfigError("privileged env privileged_info", False, "True: the reference reads the true state "
                               "from the step's info (the benchmark's runner sets it for this policy)")
-        model = "rigid" if func.spec.model == "rigid" else "nonrigid"
-        preview_periods = PREVIEW[model] if preview_periods is None else preview_periods
+        preview_periods = PREVIEW if preview_periods is None else preview_periods
         if not (isinstance(preview_periods, int) and 0 <= preview_periods <= PREVIEW_PERIODS):
             raise ConfigError("privileged.preview_periods", preview_periods,
                               f"an integer from 0 (the moment as it acts) to {PREVIEW_PERIODS}")

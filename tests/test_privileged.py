@@ -128,7 +128,7 @@ def test_it_refuses_an_env_without_the_true_state_and_bad_gains():
     with pytest.raises(ConfigError, match=r"privileged.relief = \(0.8, 0.4\): two shares"):
         privileged(gym.make("lvgym/SmileAscent-v1", privileged_info=True), relief=(0.8, 0.4))
     pol = privileged(gym.make("lvgym/SmileAscent-v1", privileged_info=True, model="rigid"))
-    assert (pol.w, pol.z) == GAINS["rigid"] and pol.relief == RELIEF and pol.preview == PREVIEW["rigid"]
+    assert (pol.w, pol.z) == GAINS["rigid"] and pol.relief == RELIEF and pol.preview == PREVIEW
 
 
 def test_the_runner_flies_it_with_the_true_state_batched_as_single():

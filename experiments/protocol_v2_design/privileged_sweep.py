@@ -53,6 +53,8 @@ class Args:
     """attitude-loop bandwidths [rad/s] (the damping equal to each)"""
     reliefs: list[str] = arg(default_factory=lambda: ["off", "0.5,0.9", "0.3,0.7"], metavar="ONSET,FULL")
     """load reliefs: onset and full share of the q-alpha limit, or off"""
+    suites: list[str] = arg(default_factory=lambda: list(SUITES), metavar="SUITE")
+    """v2 suites to fly (default: the three SMILE ones)"""
     previews: list[int] = arg(default_factory=lambda: [0], lo=0, hi=10, metavar="PERIODS")
     """how many control periods ahead the law reads the aerodynamic moment (0: as it acts)"""
 
@@ -60,7 +62,8 @@ class Args:
 def main(argv: Sequence[str] | None = None) -> None:
     args = parse(Args, argv, "python -m experiments.protocol_v2_design.privileged_sweep", __doc__)
     specs = _variants(args.bandwidths, args.reliefs, args.previews)
-    records = evaluate(specs, [get_suite(s) for s in SUITES], args.seeds, "validation", progress=False)
+    suites = args.suites
+    records = evaluate(specs, [get_suite(s) for s in suites], args.seeds, "validation", progress=False)
     score: dict[tuple[str, str, str], list[float]] = defaultdict(list)
     failed: dict[tuple[str, str, str], int] = defaultdict(int)
     for r in records:
@@ -69,11 +72,11 @@ def main(argv: Sequence[str] | None = None) -> None:
         failed[key] += int(r["failed"] or not r["flyable"])
     for model in ("rigid", "nonrigid"):
         print(f"\n{model}, validation seeds 0-{args.seeds - 1}: mean score_v2 [rad] (failed or unflyable)\n")
-        print("| variant | " + " | ".join(SUITES) + " | mean of the three |")
-        print("|---|" + "---:|" * (len(SUITES) + 1))
+        print("| variant | " + " | ".join(suites) + " | mean of the suites |")
+        print("|---|" + "---:|" * (len(suites) + 1))
         for spec in specs:
-            cells = [f"{np.mean(score[(model, spec.name, s)]):.3f} ({failed[(model, spec.name, s)]})" for s in SUITES]
-            mean = np.mean([np.mean(score[(model, spec.name, s)]) for s in SUITES])
+            cells = [f"{np.mean(score[(model, spec.name, s)]):.3f} ({failed[(model, spec.name, s)]})" for s in suites]
+            mean = np.mean([np.mean(score[(model, spec.name, s)]) for s in suites])
             print(f"| {spec.name} | " + " | ".join(cells) + f" | {mean:.3f} |")
 
 
