@@ -248,7 +248,8 @@ class SensorOptions(Options):
     flight: the bias instability of a tactical-grade gyro, 1-10 deg/h)"""
     privileged_info: bool = option(False, boolean=True)
     """the step's ``info`` also holds what no flight sensor gives (``omega_bi_b``, ``m_aero_b``, ``thrust``,
-    ``gimbal_arm``, ``vectored_share``, ``J_b_diag``, ``v_air_b``): for a privileged reference or a teacher
+    ``gimbal_arm``, ``vectored_share``, ``J_b_diag``, ``v_air_b``, ``misalignment``, ``actuator_effectiveness``
+    and the wind ahead, ``wind_ahead_n`` and ``m_aero_ahead_b``): for a privileged reference or a teacher
     policy, never for a scored causal one"""
 
 
