@@ -192,8 +192,8 @@ def test_a_misalignment_step_turns_the_thrust_of_its_axis_from_the_onset():
     # the thrust turns by it: with the gimbal centred, its lateral share on that axis is sin(misalignment)
     thrust_b = sim.conditions(u.core.state.sim, "thrust_b")[0]
     lateral = thrust_b[2] if axis == 0 else -thrust_b[1]
-    assert lateral / np.linalg.norm(thrust_b) == pytest.approx(math.sin(want[axis] + u.func.gimbal(u.core.state)[0, axis]),
-                                                               abs=1e-3)
+    turned = want[axis] + u.func.gimbal(u.core.state)[0, axis]
+    assert lateral / np.linalg.norm(thrust_b) == pytest.approx(math.sin(turned), abs=1e-3)
 
 
 def test_the_fault_comes_from_the_env_generator_and_rows_fly_as_single_envs():

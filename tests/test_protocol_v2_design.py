@@ -88,10 +88,13 @@ def test_normalise_puts_zero_at_0_and_the_reference_at_1():
 def test_the_privileged_sweep_names_its_variants_by_their_gains_and_relief():
     from experiments.protocol_v2_design.privileged_sweep import OFF, _variants
 
-    specs = _variants([1.0, 1.5], ["off", "0.5,0.9"])
-    assert [s.name for s in specs] == ["priv-w1-roff", "priv-w1-r0.5-0.9", "priv-w1.5-roff", "priv-w1.5-r0.5-0.9"]
-    assert dict(specs[1].kwargs) == {"bandwidth_radps": 1.0, "damping": 1.0, "relief": (0.5, 0.9)}
+    specs = _variants([1.0, 1.5], ["off", "0.5,0.9"], [0])
+    assert [s.name for s in specs] == ["priv-w1-roff-p0", "priv-w1-r0.5-0.9-p0", "priv-w1.5-roff-p0",
+                                       "priv-w1.5-r0.5-0.9-p0"]
+    assert dict(specs[1].kwargs) == {"bandwidth_radps": 1.0, "damping": 1.0, "relief": (0.5, 0.9),
+                                     "preview_periods": 0}
     assert dict(specs[2].kwargs)["relief"] == OFF and OFF[0] > 1.0       # onset beyond the limit: no relief
+    assert [dict(s.kwargs)["preview_periods"] for s in _variants([1.0], ["off"], [0, 5])] == [0, 5]
     from lvgym.errors import ConfigError
     with pytest.raises(ConfigError, match=r"reliefs = '0.5': off, or ONSET,FULL"):
-        _variants([1.0], ["0.5"])
+        _variants([1.0], ["0.5"], [0])

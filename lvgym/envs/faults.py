@@ -129,8 +129,8 @@ def fault_names(fault: np.ndarray) -> np.ndarray:
 def apply_faults(sim: Any, data: Any, fault: np.ndarray, gyro_bias: np.ndarray) -> np.ndarray:
     """Let strike, in place, the faults of the rows whose onset has come (``data.t`` at or after it) and that
     have not struck yet: the actuator's fault fields (``data.actuator``), the thrust scale of the row's loads
-    (``sim.load_dispersion``), the row's thrust misalignment (``sim.misalignment``) or the gyro bias (``gyro_bias`` (B, 3) [rad/s], roll, pitch, yaw); marks them
-    active. Returns the rows that struck."""
+    (``sim.load_dispersion``), the row's thrust misalignment (``sim.misalignment``) or the gyro bias
+    (``gyro_bias`` (B, 3) [rad/s], roll, pitch, yaw); marks them active. Returns the rows that struck."""
     kind = fault[:, _F.kind]
     rows = np.flatnonzero((kind > 0) & (fault[:, _F.active] == 0.0) & (data.t >= fault[:, _F.onset_s] - 1e-9))
     if rows.size == 0:
