@@ -5,7 +5,7 @@
 no bending in them), the true attitude error, the thrust, its lever arm, the inertia, the true thrust
 misalignment and the share of the command each actuator still reaches (both moved by faults), and the wind
 ahead of the vehicle: the aerodynamic moment about the CG that the wind and air it is about to fly into would
-cause, up to :data:`~lvgym.envs.functional.PREVIEW_PERIODS` control periods ahead (the turbulence is a frozen
+cause, up to :data:`~lvgym.envs.privileged.PREVIEW_PERIODS` control periods ahead (the turbulence is a frozen
 field along the climb, so the wind ahead is known exactly). Per axis it commands the gimbal angle whose
 thrust moment cancels the moment :data:`PREVIEW` periods ahead (the period of delay and the servo's lag
 between a command and its moment) and adds the moment of a second-order attitude loop (natural frequency
@@ -34,7 +34,7 @@ from typing import Any
 
 import numpy as np
 
-from lvgym.envs.functional import PREVIEW_PERIODS
+from lvgym.envs.privileged import PREVIEW_PERIODS
 from lvgym.errors import ConfigError
 
 __all__ = ["PrivilegedPolicy", "privileged"]
@@ -120,7 +120,7 @@ class PrivilegedPolicy:
         # load relief: from ``onset`` to ``full`` of the q-alpha limit the law lets go of the attitude and of the
         # aerodynamic moment (the statically stable vehicle turns into the relative wind); the rate damping stays
         onset, full = self.relief
-        share = float(info.get("qalpha_pa_deg", 0.0)) / self.qalpha_limit
+        share = float(info.get("qalpha_pa_deg", 0.0)) / float(info.get("qalpha_limit_pa_deg", self.qalpha_limit))
         hold = 1.0 - min(1.0, max(0.0, (share - onset) / (full - onset)))
         alpha = -2.0 * self.z * self.w * e_rate - hold * self.w * self.w * att
         delta = (J[1:] * alpha - hold * m_aero[1:]) / lever

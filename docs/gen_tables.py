@@ -36,6 +36,9 @@ INFO = {
     "mach": ("-", "Mach number"),
     "alpha_total": ("rad", "total angle of attack"),
     "qalpha_pa_deg": ("Pa deg", "dynamic pressure times total angle of attack (the structural load measure)"),
+    "qalpha_limit_pa_deg": ("Pa deg", "the structural limit of `qalpha_pa_deg` at this step: the option "
+                                      "`qalpha_limit_pa_deg`, or the vehicle file's `qalpha_limit` over Mach or time "
+                                      "([vehicle files](vehicles.md))"),
     "time": ("s", "flight time"),
     "stage": ("-", "index of the lowest attached stage"),
     "controller_on": ("-", "whether the controller acted in the step (off before `controller_on_after_s` "

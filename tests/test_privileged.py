@@ -9,7 +9,7 @@ import pytest
 
 import lvgym
 from lvgym.baselines.privileged import GAINS, PREVIEW, RELIEF, PrivilegedPolicy, privileged
-from lvgym.envs.functional import PREVIEW_PERIODS
+from lvgym.envs.privileged import PREVIEW_PERIODS
 from lvgym.errors import ConfigError
 
 

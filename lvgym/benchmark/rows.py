@@ -29,7 +29,7 @@ __all__ = ["RowsLog", "fly_rows", "neutral_action"]
 
 #: the info entries kept per step (the single env's TrajectoryBuilder and FlightLog read these)
 STEP_KEYS = ("rate_error", "gimbal", "alpha_total", "qalpha_pa_deg", "time", "qbar", "gimbal_rate", "eta",
-             "slosh_angles", "controller_on")
+             "slosh_angles", "controller_on", "qalpha_limit_pa_deg")
 
 
 def neutral_action(space: Any) -> np.ndarray:
@@ -111,7 +111,7 @@ class RowsLog:
             on = np.ascontiguousarray(stacked["controller_on"][:L, b], dtype=bool)
             columns = FlightColumns(traj.time_s, traj.rate_error_radps, traj.qbar_pa, traj.qalpha_pa_deg,
                                     col("gimbal_rate"), gyro, col("eta"), col("slosh_angles"), self.events[b],
-                                    self.termination[b], command, on)
+                                    self.termination[b], command, on, col("qalpha_limit_pa_deg"))
             record = combined_record(episode_metrics(traj), flight_metrics(self.facts, columns))
             if flyability:
                 record.update(flyability_metrics(self.facts, columns, record))

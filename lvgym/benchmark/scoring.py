@@ -95,7 +95,8 @@ class FlightLog:
         with a gimbal, the step's ``action``: the policy's, before the env clips it). Arrays are kept as
         they come (an env's info holds fresh arrays every step) and reduced by :func:`flight_metrics`."""
         self.rows.append((info["time"], info["rate_error"], info["qbar"], info["qalpha_pa_deg"],
-                          info.get("gimbal_rate", (0.0, 0.0)), info.get("controller_on", True)))
+                          info.get("gimbal_rate", (0.0, 0.0)), info.get("controller_on", True),
+                          info.get("qalpha_limit_pa_deg", self.qalpha_limit_pa_deg)))
         if gyro_minus_body_radps is not None:
             self.gyro_rows.append(gyro_minus_body_radps)
         if action is not None and self.gimbal_limit_rad > 0.0:
@@ -162,7 +163,8 @@ class FlightColumns:
     array per step), ``events`` ((t [s], text) pairs) and ``termination``; for protocol v2's
     :mod:`.flyability`, ``command_rad`` (N, 2) [rad] the policy's gimbal command (its action clipped to
     [-1, 1] times the gimbal limit; None: no gimbal or not recorded) and ``controller_on`` (N,) whether the
-    controller acted in the step (None: always). Arrays C-contiguous as ``np.array`` of the steps makes
+    controller acted in the step (None: always); ``qalpha_limit_pa_deg`` (N,) the structural limit at each step
+    (None: the log's constant one). Arrays C-contiguous as ``np.array`` of the steps makes
     them: :func:`flight_metrics` then sums them in the same order."""
 
     time_s: np.ndarray
@@ -177,6 +179,7 @@ class FlightColumns:
     termination: str
     command_rad: np.ndarray | None = None
     controller_on: np.ndarray | None = None
+    qalpha_limit_pa_deg: np.ndarray | None = None
 
 
 def gimbal_command(actions: np.ndarray, gimbal_limit_rad: float) -> np.ndarray:
@@ -194,8 +197,9 @@ def _columns(log: FlightLog) -> FlightColumns:
         e = np.array(cols[1], dtype=float)
         rate = np.array(cols[4], dtype=float)
         on = np.array(cols[5], dtype=bool).reshape(n)
+        limit = np.array(cols[6], dtype=float)
     else:
-        t = qbar = qalpha = rate = np.zeros(0)
+        t = qbar = qalpha = rate = limit = np.zeros(0)
         e = np.zeros((0, 3))
         on = np.zeros(0, dtype=bool)
     gyro = np.array(log.gyro_rows, dtype=float) if log.gyro_rows else None
@@ -203,7 +207,7 @@ def _columns(log: FlightLog) -> FlightColumns:
     if n and len(log.actions) == n:                    # every step's action (a v2 record's gimbal command)
         command = gimbal_command(np.array(log.actions, dtype=float), log.gimbal_limit_rad)
     return FlightColumns(t, e, qbar, qalpha, rate, gyro, log.eta, log.slosh, log.events, log.termination, command,
-                         on)
+                         on, limit)
 
 
 def flight_metrics(log: FlightLog, columns: FlightColumns | None = None) -> dict[str, Any]:
@@ -240,7 +244,8 @@ def flight_metrics(log: FlightLog, columns: FlightColumns | None = None) -> dict
         out["gyro_minus_body_rate_rad"] = 0.0
     lim = float(log.gimbal_rate_limit_radps)
     out["gimbal_rate_limit_s"] = float(np.sum(rate >= 0.99 * lim) * dt) if lim > 0 else 0.0
-    out["qalpha_cost_s"] = float(np.sum(np.nan_to_num(qalpha) > QALPHA_COST_FRACTION * log.qalpha_limit_pa_deg) * dt)
+    limit = log.qalpha_limit_pa_deg if c.qalpha_limit_pa_deg is None else np.asarray(c.qalpha_limit_pa_deg, float)
+    out["qalpha_cost_s"] = float(np.sum(np.nan_to_num(qalpha) > QALPHA_COST_FRACTION * limit) * dt)
     out["failed"] = failed
     out["failure_reason"] = c.termination
     return out

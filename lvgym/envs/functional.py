@@ -52,7 +52,9 @@ from .dispersions import DispersionPlan
 from .faults import FAULT, apply_faults, decode, fault_names
 from .history import HistoryStack, recorded_action
 from .layouts import ACTIONS, FLIGHT_DRAWS, NAV, OBSERVATIONS, REASONS, REWARD, REWARD_TERMS, SENSOR_NOISE, TASK
-from .signals import TaskData, reset_signals, step_signals_range
+from .signals import TaskData, qalpha_limit_rows, reset_signals, step_signals_range
+from .limits import qalpha_task_entries, resolve_qalpha_limit
+from .privileged import privileged_info
 from .spec import IMU_STATION_INTERVALS, IMU_STATION_SIGMA, TaskSpec, wind_spec
 
 __all__ = ["AscentFuncEnv", "AscentParams", "AscentState", "RENDER_STATIONS", "cached_timeline", "cached_vehicle",
@@ -67,8 +69,6 @@ AscentState = namedtuple("AscentState", ["sim", "task", "events"])
 AscentParams = namedtuple("AscentParams", ["task", "tables", "setup"])
 #: stations along the vehicle where the timeline also tabulates the mode shapes, for the rendered view
 RENDER_STATIONS = 21
-#: the privileged info's preview of the wind ahead: 1 to this many control periods
-PREVIEW_PERIODS = 10
 _REASONS = np.array(REASONS, dtype=object)
 _SIGNALS = Kernel(step_signals_range)      # row ranges on the simulator's threads
 
@@ -178,6 +178,7 @@ class AscentFuncEnv(FuncEnv):
                        for key, names, per in SENSOR_NOISE if names[0] in self.sample_layout]
         lay = self.sim.layout
         self._i_J = lay.params["J_b"]
+        self.qalpha_limit = resolve_qalpha_limit(s, vehicle)
         super().__init__()
 
     # ------------------------------------------------------------------------------ parameters
@@ -188,13 +189,21 @@ class AscentFuncEnv(FuncEnv):
         task = TASK.pack({"on_after": s.controller_on_after_s, "dt": s.control_dt_s, "mission": s.mission_time_s,
                           "rate_weights": s.rate_weights, "effort_weight": s.effort_weight,
                           "effort_rate_weight": s.effort_rate_weight, "failure_penalty": s.failure_penalty_rad_per_s,
-                          "qalpha_limit": s.qalpha_limit_pa_deg, "attitude_limit": s.attitude_limit_deg,
+                          **qalpha_task_entries(self.qalpha_limit), "attitude_limit": s.attitude_limit_deg,
                           "gimbal_limit": self.gimbal_limit, "gravity_turn": float(s.reference == "gravity_turn"),
                           "earth_velocity": float(s.reference_velocity == "earth"),
                           "kick_start": s.kick_start_s, "kick_end": s.kick_end_s,
                           "kick_angle": math.radians(s.kick_angle_deg), "sensors": float(s.observation == "sensors"),
                           "n_steps": self.n_steps, "flight": float(s.observation == "flight")})
         return AscentParams(task=task, tables=self.sim.tables, setup=self.sim.setup)
+
+    def qalpha_limits(self, state: AscentState, params: AscentParams | None = None) -> np.ndarray:
+        """The structural q-alpha limit [Pa deg] of every row at its time and Mach number (B,)."""
+        params = self.default_params if params is None else params
+        sim = state.sim
+        out = np.empty(sim.t.size)
+        qalpha_limit_rows(params.task, sim.t, self.sim.conditions(sim, "mach"), out)
+        return out
 
     # ------------------------------------------------------------------------------ state
     def new_state(self, batch: int) -> AscentState:
@@ -403,7 +412,8 @@ class AscentFuncEnv(FuncEnv):
         return {"reward_terms": dict(zip(REWARD_TERMS, ts.terms.T.copy())),
                 "cumulative_rate_error": ts.cum_error.copy(), "rate_error": ts.rate_error.copy(),
                 "qbar": cond(sim, "qbar").copy(), "mach": cond(sim, "mach").copy(),
-                "alpha_total": cond(sim, "alpha_total").copy(), "qalpha_pa_deg": ts.qalpha.copy(), "time": sim.t.copy(),
+                "alpha_total": cond(sim, "alpha_total").copy(), "qalpha_pa_deg": ts.qalpha.copy(),
+                "qalpha_limit_pa_deg": self.qalpha_limits(next_state, params), "time": sim.t.copy(),
                 "stage": ts.stage.copy(), "controller_on": ts.on_step.copy(),
                 "slosh_angles": self.sim.slosh_angles(sim), "eta": self.sim.state(sim, "eta").copy(),
                 "gimbal": self.gimbal(next_state), "gimbal_rate": ACTUATOR.view(sim.actuator, "gimbal_rate").copy(),
@@ -414,31 +424,8 @@ class AscentFuncEnv(FuncEnv):
                 **(self.privileged_info(next_state) if self._privileged else {})}
 
     def privileged_info(self, state: AscentState) -> dict[str, np.ndarray]:
-        """What no flight sensor gives, per row (the ``privileged_info`` option): the true body rates
-        ``omega_bi_b`` (B, 3) [rad/s] (of the rigid body, no bending, no noise), the aerodynamic moment about
-        the CG ``m_aero_b`` (B, 3) [N m] (the wind's included), the thrust (B,) [N], the gimbal's lever arm
-        ``gimbal_arm`` (B,) [m] (CG station minus gimbal station along x_b), the share of the thrust the gimbal
-        turns ``vectored_share`` (B,) [-], the body's principal inertias ``J_b_diag`` (B, 3) [kg m^2] and the
-        velocity relative to the air in body axes ``v_air_b`` (B, 3) [m/s]; the true thrust misalignment
-        ``misalignment`` (B, 2) [rad] (pitch, yaw: the dispersion's and a fault's) and the share of the command
-        each gimbal axis still reaches ``actuator_effectiveness`` (B, 2) [-] (1 but after a fault); and the wind
-        ahead of the vehicle over the next :data:`PREVIEW_PERIODS` control periods (the horizons ``k`` periods,
-        ``k`` = 1, 2, ..., :meth:`~lvgym.simulator.Simulator.conditions_ahead`): the wind it flies into
-        ``wind_ahead_n`` (B, K, 3) [m/s] (local north-east-down) and the aerodynamic moment that wind and air
-        would cause at the present attitude and rates ``m_aero_ahead_b`` (B, K, 3) [N m]."""
-        sim = state.sim
-        cond, lay = self.sim.conditions, self.sim.layout
-        ahead = self.sim.conditions_ahead(sim, [k * self.spec.control_dt_s for k in range(1, PREVIEW_PERIODS + 1)])
-        preview = {"wind_ahead_n": CONDITIONS.view(ahead, "wind_n").transpose(1, 0, 2).copy(),
-                   "m_aero_ahead_b": CONDITIONS.view(ahead, "m_aero_b").transpose(1, 0, 2).copy()}
-        J = sim.p[:, lay.params["J_b"]].reshape(-1, 3, 3)
-        r_cg, r_gimbal = sim.p[:, lay.params["r_cg"]], sim.p[:, lay.params["r_gimbal"]]
-        return {"omega_bi_b": self.sim.state(sim, "omega_bi_b").copy(), "m_aero_b": cond(sim, "m_aero_b").copy(),
-                "thrust": cond(sim, "thrust").copy(), "gimbal_arm": r_cg[:, 0] - r_gimbal[:, 0],
-                "vectored_share": self.sim.vectored_share(sim),
-                "J_b_diag": np.stack([J[:, 0, 0], J[:, 1, 1], J[:, 2, 2]], axis=1),
-                "v_air_b": cond(sim, "v_air_b").copy(), "misalignment": self.sim.misalignment(sim).copy(),
-                "actuator_effectiveness": 1.0 - ACTUATOR.view(sim.actuator, "effectiveness_loss"), **preview}
+        """What no flight sensor gives, per row (the ``privileged_info`` option; :func:`.privileged.privileged_info`)."""
+        return privileged_info(self.sim, state.sim, self.spec.control_dt_s)
 
     def ended_faults(self, state: AscentState) -> np.ndarray:
         """The name of each row's fault (B,) where its episode has just ended (terminated or truncated), ``""``

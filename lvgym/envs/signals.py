@@ -49,6 +49,32 @@ TaskData = namedtuple("TaskData", ["steps", "on", "on_step", "axis_ref_i", "cum_
 XF = STATE.fixed
 
 
+@nb.njit(cache=True, nogil=True, inline="always")
+def qalpha_limit_k(task, t, mach):
+    """The structural q-alpha limit [Pa deg] at time ``t`` [s] and Mach ``mach``: ``qalpha_limit`` (layout
+    TASK), or its table over Mach or time, linear between the rows and held beyond (as ``numpy.interp``)."""
+    over = task[T.qalpha_over]
+    if over == 0.0:
+        return task[T.qalpha_limit]
+    x = mach if over == 1.0 else t
+    n = int(task[T.qalpha_n])
+    ox, oy = T.qalpha_x, T.qalpha_y
+    if x <= task[ox]:
+        return task[oy]
+    for i in range(1, n):
+        if x < task[ox + i]:
+            x0, y0 = task[ox + i - 1], task[oy + i - 1]
+            return y0 + (task[oy + i] - y0) / (task[ox + i] - x0) * (x - x0)
+    return task[oy + n - 1]
+
+
+@nb.njit(cache=True)
+def qalpha_limit_rows(task, t, mach, out):
+    """:func:`qalpha_limit_k` of every row: ``t``, ``mach`` (B,) into ``out`` (B,) [Pa deg]."""
+    for b in range(t.shape[0]):
+        out[b] = qalpha_limit_k(task, t[b], mach[b])
+
+
 @nb.njit(cache=True, nogil=True)
 def controller_on_k(task, tl_t, tl_burning, t):
     """Whether the controller acts at time ``t``: after ``on_after`` and while an engine burns."""
@@ -238,7 +264,7 @@ def _signals_rows(lo, hi, task, setup, sim, ts, tables, C):
         code = 0
         if math.degrees(math.sqrt(ts.att[b, 0] ** 2 + ts.att[b, 1] ** 2)) > task[T.attitude_limit]:
             code = 1
-        if qalpha > task[T.qalpha_limit]:
+        if qalpha > qalpha_limit_k(task, t, cond[D.mach]):
             code = 2
         if failed:
             code = 3

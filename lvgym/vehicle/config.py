@@ -21,6 +21,7 @@ import numpy as np
 
 from lvgym.errors import ConfigError
 
+from .limits import QAlphaLimit, read_qalpha_limit
 from .reader import Reader
 
 #: standard gravity used by the thrust equation [m/s^2]
@@ -350,6 +351,8 @@ class Vehicle:
     structure: StructureOptions
     aerodynamics: dict[str, Any] = field(default_factory=dict)
     source: str | None = None
+    #: the structural q-alpha limit the file gives (constant or over the flight), or None: the env's
+    qalpha_limit: QAlphaLimit | None = None
 
     @property
     def length(self) -> float:
@@ -475,7 +478,7 @@ def parse_vehicle(data: Any, source: str | None = None) -> Vehicle:
                       payload=payload, fairing=fairing, fairing_jettison=jettison,
                       staging=tuple(StagingStep.read(s) for s in r.children("staging")),
                       structure=StructureOptions.read(r.child("structure", None)), aerodynamics=aero,
-                      source=source)
+                      source=source, qalpha_limit=read_qalpha_limit(r))
     r.done()
     check_vehicle(vehicle)
     return vehicle
