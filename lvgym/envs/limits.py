@@ -37,5 +37,6 @@ def qalpha_task_entries(limit: QAlphaLimit) -> dict[str, Any]:
     xs, ys = np.zeros(MAX_ROWS), np.zeros(MAX_ROWS)
     n = len(limit.table)
     xs[:n], ys[:n] = np.array(limit.table).T
-    return {"qalpha_limit": limit.table[0][1], "qalpha_over": 0.0 if limit.is_constant else 1.0 + OVER.index(limit.over),
-            "qalpha_n": float(n), "qalpha_x": xs, "qalpha_y": ys}
+    over = 0.0 if limit.is_constant else 1.0 + OVER.index(limit.over)
+    return {"qalpha_limit": limit.table[0][1], "qalpha_over": over, "qalpha_n": float(n), "qalpha_x": xs,
+            "qalpha_y": ys}
