@@ -1,0 +1,130 @@
+"""Rollouts of the benchmark's policies as Minari datasets, for offline RL and imitation (the ``datasets``
+extra: ``pip install "lvgym[datasets]"``).
+
+    python -m lvgym.agents.datasets --policies lqg-front gs-pid-flex-quiet --suites smile-v2 --episodes 50
+
+For each policy, suite and flight model it flies ``--episodes`` episodes of the suite's condition on its
+**validation** seeds (the seeds training and tuning may use; the test seeds stay unseen) with Minari's
+the env, and writes one dataset, ``lvgym/<suite>-<model>/<policy>-v0``, into
+Minari's local folder (``MINARI_DATASETS_PATH``, default ``~/.minari/datasets``): the observations the
+policy saw, its actions, the rewards and the ends of the episodes, loadable with ``minari.load_dataset``.
+Its provenance is in the dataset's own fields: ``algorithm_name`` (the policy), ``author`` (lvgym and its
+version), ``code_permalink`` and a ``description`` that names the suite, the model, the protocol, the seed
+set and the seeds. A policy that needs the privileged info (the reference) is refused: its observations do
+not hold what it acted on.
+
+The episodes are recorded as Minari's episode buffers (Minari's ``DataCollector`` needs JAX for its tree
+utilities; the buffers do not) and written in Minari's Arrow format. The env's registration carries a
+callable ``vector_entry_point`` (its native ``VectorEnv``), which Minari cannot serialise into the dataset's
+environment spec; the dataset gets the spec without it (it names the env id and its options, and
+``recover_environment`` rebuilds the env).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import gymnasium
+import numpy as np
+
+import lvgym.cli.policies  # noqa: F401  (registers the built-in policies by name)
+from lvgym.benchmark.registry import resolve_policy
+from lvgym.benchmark.suites import SEED_SETS, condition, get_suite
+from lvgym.cli.args import arg, parse
+from lvgym.errors import ConfigError
+
+__all__ = ["collect", "dataset_id"]
+
+PROG = "python -m lvgym.agents.datasets"
+PERMALINK = "https://github.com/lvgym/lvgym"
+
+
+def dataset_id(policy: str, suite: str, model: str) -> str:
+    """The Minari id of ``policy``'s rollouts on ``suite``'s ``model`` condition."""
+    return f"lvgym/{suite}-{model}/{policy}-v0"
+
+
+class _Serialisable(gymnasium.Wrapper):
+    """The env with a spec Minari can write: no callable ``vector_entry_point`` (module docstring)."""
+
+    @property
+    def spec(self) -> Any:
+        spec = self.env.spec
+        return None if spec is None else dataclasses.replace(spec, vector_entry_point=None)
+
+
+def collect(policy: str, suite: str = "smile-v2", model: str = "nonrigid", episodes: int = 20,
+            seed_set: str = "validation", **overrides: Any) -> Any:
+    """Fly ``episodes`` episodes of ``policy`` (a registered name, or a factory reference) on ``suite``'s
+    ``model`` condition (``overrides``: env options, e.g. a shorter ``mission_time_s`` for a test) on the
+    ``seed_set`` seeds and return the Minari dataset written (module docstring)."""
+    import minari
+    from minari.data_collector.episode_buffer import EpisodeBuffer
+
+    if seed_set != "validation":
+        raise ConfigError("seed_set", seed_set, "validation: a dataset is training data, and the test seeds stay "
+                          f"unseen (the seed sets: {list(SEED_SETS)})")
+    spec = resolve_policy(policy, PROG)
+    factory = spec.resolve()
+    if getattr(factory, "privileged", False):
+        raise ConfigError("policies", policy, "a causal policy: the privileged reference acts on what its "
+                          "observations do not hold")
+    suite_obj = get_suite(suite)
+    seeds = suite_obj.seeds(seed_set, episodes)
+    env = condition(suite, model, **overrides).make_env()
+    pol = factory(env, **dict(spec.kwargs))
+    buffers = []
+    for i, seed in enumerate(seeds):
+        obs, info = env.reset(seed=int(seed))
+        pol.reset()
+        steps: dict[str, list[Any]] = {"observations": [obs], "actions": [], "rewards": [], "terminations": [],
+                                       "truncations": []}
+        while True:
+            action = np.asarray(pol.act(obs, info), dtype=env.action_space.dtype)
+            obs, reward, terminated, truncated, info = env.step(action)
+            for key, value in zip(("observations", "actions", "rewards", "terminations", "truncations"),
+                                  (obs, action, float(reward), bool(terminated), bool(truncated))):
+                steps[key].append(value)
+            if terminated or truncated:
+                break
+        buffers.append(EpisodeBuffer(id=i, seed=int(seed), **steps))
+    description = (f"{spec.name} flying lvgym's {suite} ({suite_obj.description}; protocol {suite_obj.version}), "
+                   f"{model} model, {len(seeds)} episodes on the {seed_set} seeds {seeds[0]}-{seeds[-1]}"
+                   + (f", env options {overrides}" if overrides else ""))
+    from lvgym import __version__
+
+    return minari.create_dataset_from_buffers(
+        dataset_id=dataset_id(spec.name, suite, model), buffer=buffers, env=_Serialisable(env).spec,
+        eval_env=_Serialisable(env).spec,
+        algorithm_name=spec.name, author=f"lvgym {__version__}", author_email="lvgym@users.noreply.github.com",
+        code_permalink=PERMALINK, description=description, data_format="arrow")
+
+
+@dataclass
+class Args:
+    """Command-line arguments (``python -m lvgym.agents.datasets --help``)."""
+
+    policies: list[str] = arg(default_factory=lambda: ["lqg-front"], metavar="POLICY")
+    """the policies whose rollouts to record (registered names or factory references)"""
+    suites: list[str] = arg(default_factory=lambda: ["smile-v2"], metavar="SUITE")
+    """the suites to fly"""
+    models: list[str] = arg(default_factory=lambda: ["rigid", "nonrigid"], metavar="MODEL")
+    """the flight models"""
+    episodes: int = arg(20, lo=1, hi=10_000)
+    """episodes per policy, suite and model (the first validation seeds)"""
+
+
+def main(argv: Sequence[str] | None = None) -> None:
+    args = parse(Args, argv, PROG, __doc__)
+    for policy in args.policies:
+        for suite in args.suites:
+            for model in args.models:
+                ds = collect(policy, suite, model, args.episodes)
+                print(f"{ds.spec.dataset_id}: {ds.total_episodes} episodes, {ds.total_steps} steps")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,78 @@
+"""Minari datasets of the benchmark's policies (lvgym/agents/datasets.py) and behaviour cloning from them
+(lvgym/agents/bc.py): written, loaded by Minari's own API, the same steps as a single env's flight to the bit,
+with their provenance; the cloned policy trains, flies and refuses an env it was not cloned on."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import lvgym
+from lvgym.errors import ConfigError
+
+minari = pytest.importorskip("minari")
+
+
+@pytest.fixture
+def datasets(tmp_path, monkeypatch):
+    monkeypatch.setenv("MINARI_DATASETS_PATH", str(tmp_path / "minari"))
+    return tmp_path
+
+
+def test_a_dataset_holds_the_flights_as_a_single_env_flies_them(datasets):
+    from lvgym.agents.datasets import collect, dataset_id
+    from lvgym.benchmark.registry import resolve_policy
+
+    collect("lqg", "smile-v2", "rigid", episodes=2, mission_time_s=3.0)
+    data = minari.load_dataset(dataset_id("lqg", "smile-v2", "rigid"))
+    assert data.total_episodes == 2
+    meta = data.storage.metadata
+    assert meta["algorithm_name"] == "lqg" and "validation seeds 0-1" in meta["description"]
+    assert "protocol v2" in meta["description"]
+    env = lvgym.make_env("smile-v2", "rigid", mission_time_s=3.0)
+    spec = resolve_policy("lqg")
+    pol = spec.resolve()(env, **dict(spec.kwargs))
+    for seed, ep in zip((0, 1), data.iterate_episodes()):
+        obs, info = env.reset(seed=seed)
+        pol.reset()
+        observations, actions = [obs], []
+        done = False
+        while not done:
+            action = pol.act(obs, info)
+            obs, _, terminated, truncated, info = env.step(action)
+            observations.append(obs)
+            actions.append(action)
+            done = terminated or truncated
+        np.testing.assert_array_equal(ep.observations, np.array(observations))
+        np.testing.assert_array_equal(ep.actions, np.array(actions))
+        assert ep.truncations[-1] and not ep.terminations.any()
+    assert data.recover_environment().spec.id == "lvgym/SmileAscent-v1"
+
+
+def test_the_reference_and_a_bad_seed_set_are_refused(datasets):
+    from lvgym.agents.datasets import collect
+
+    with pytest.raises(ConfigError, match="privileged"):
+        collect("privileged", "smile-v2", "rigid", episodes=1)
+    with pytest.raises(ConfigError, match="seed_set = 'test'"):
+        collect("lqg", "smile-v2", "rigid", episodes=1, seed_set="test")
+
+
+def test_behaviour_cloning_trains_and_flies_and_knows_its_observation(datasets):
+    pytest.importorskip("torch")
+    from lvgym.agents.bc import features, policy, train
+    from lvgym.agents.datasets import collect
+
+    np.testing.assert_array_equal(features(np.array([[1.0, 2.0], [3.0, 4.0]]), 2),
+                                  [[0.0, 0.0, 1.0, 2.0], [1.0, 2.0, 3.0, 4.0]])
+    collect("lqg", "smile-v2", "rigid", episodes=2, mission_time_s=3.0)
+    out = datasets / "bc.pt"
+    content = train("lvgym/smile-v2-rigid/lqg-v0", out, history=4, hidden=16, epochs=3)
+    assert content["steps"] == 300 and len(content["loss"]) == 3 and content["loss"][-1] < content["loss"][0]
+    env = lvgym.make_env("smile-v2", "rigid", mission_time_s=1.0)
+    pol = policy(env, out)
+    obs, info = env.reset(seed=10_000)
+    pol.reset()
+    assert pol.act(obs, info).shape == (2,)
+    with pytest.raises(ConfigError, match="bc path"):
+        policy(lvgym.make_env("smile-v2", "rigid", history=2), out)          # a stacked observation: 32 entries
