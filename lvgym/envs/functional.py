@@ -52,9 +52,9 @@ from .dispersions import DispersionPlan
 from .faults import FAULT, apply_faults, decode, fault_names
 from .history import HistoryStack, recorded_action
 from .layouts import ACTIONS, FLIGHT_DRAWS, NAV, OBSERVATIONS, REASONS, REWARD, REWARD_TERMS, SENSOR_NOISE, TASK
-from .signals import TaskData, qalpha_limit_rows, reset_signals, step_signals_range
 from .limits import qalpha_task_entries, resolve_qalpha_limit
 from .privileged import privileged_info
+from .signals import TaskData, qalpha_limit_rows, reset_signals, step_signals_range
 from .spec import IMU_STATION_INTERVALS, IMU_STATION_SIGMA, TaskSpec, wind_spec
 
 __all__ = ["AscentFuncEnv", "AscentParams", "AscentState", "RENDER_STATIONS", "cached_timeline", "cached_vehicle",
