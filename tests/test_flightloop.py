@@ -97,3 +97,24 @@ def test_charts_write_figures_and_margins(tmp_path):
         m = L.margins(charts.open_loop(op, (0.0491, 0.3526, 0.1196, 500.0)))
     assert doc["rows"][0]["rigid"]["gain_margin_db"] == pytest.approx(m["gain_margin_db"], abs=1e-3)
     assert 0.0 < m["gain_margin_db"] < 2.0
+
+
+def test_the_charts_of_a_flex_schedule_close_the_loop_through_its_filters(tmp_path):
+    """A gs-pid-flex schedule's charts include each row's structural filter: they give the margins its
+    design recorded (SMILE's shipped flex schedule, its first row), which the bare PID does not."""
+    from lvgym.baselines.design import charts
+    from lvgym.baselines.pid import GainSchedule
+
+    sched = GainSchedule.load("smile_flex")
+    row, value = sched.meta["rows"][0], sched.points[0]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        filtered = charts.row_loops("smile", "v1", float(row["time_s"]), sched.gains(value), None,
+                                    sched.filter_at(value))
+        bare = charts.row_loops("smile", "v1", float(row["time_s"]), sched.gains(value), None, None)
+    for model in ("rigid", "nonrigid"):
+        want = row["margins"][f"{model}_pitch"]
+        got = filtered[model]["margins"]
+        assert got["gain_margin_db"] == pytest.approx(want["gain_margin_db"], abs=0.01)
+        assert got["phase_margin_deg"] == pytest.approx(want["phase_margin_deg"], abs=0.01)
+    assert abs(bare["nonrigid"]["margins"]["gain_margin_db"] - row["margins"]["nonrigid_pitch"]["gain_margin_db"]) > 1.0
