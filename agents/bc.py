@@ -1,7 +1,7 @@
 """Behaviour cloning from a Minari dataset of lvgym rollouts (:mod:`.datasets`): the minimal offline baseline.
 
-    python -m lvgym.agents.datasets --policies lqg-front --suites smile-v2 --models nonrigid --episodes 50
-    python -m lvgym.agents.bc --dataset lvgym/smile-v2-nonrigid/lqg-front-v0 --out runs/bc_lqg_front.pt
+    lvgym dataset --policies lqg-front --suites smile-v2 --models nonrigid --episodes 50
+    lvgym bc --dataset lvgym/smile-v2-nonrigid/lqg-front-v0 --out runs/bc_lqg_front.pt
     python evaluate.py --suites smile-v2 --policies lqg-front bc=lvgym.agents.bc:policy
 
 A multilayer perceptron (torch; two hidden layers of ``--hidden`` units, tanh) maps the last ``--history``
@@ -27,7 +27,7 @@ from lvgym.errors import ConfigError
 
 __all__ = ["BCPolicy", "features", "policy", "train"]
 
-PROG = "python -m lvgym.agents.bc"
+PROG = "lvgym bc"
 
 
 def features(observations: np.ndarray, history: int) -> np.ndarray:
@@ -128,10 +128,10 @@ policy.kind = "learned"  # type: ignore[attr-defined]
 
 @dataclass
 class Args:
-    """Command-line arguments (``python -m lvgym.agents.bc --help``)."""
+    """Command-line arguments (``lvgym bc --help``)."""
 
     dataset: str = arg("lvgym/smile-v2-nonrigid/lqg-front-v0", metavar="DATASET_ID")
-    """the Minari dataset to clone (python -m lvgym.agents.datasets writes them)"""
+    """the Minari dataset to clone (lvgym dataset writes them)"""
     out: str = arg("runs/bc.pt", metavar="FILE")
     """where to save the cloned policy"""
     history: int = arg(8, lo=1, hi=1000)
@@ -147,7 +147,8 @@ class Args:
 def main(argv: Sequence[str] | None = None) -> None:
     a = parse(Args, argv, PROG, __doc__)
     content = train(a.dataset, a.out, a.history, a.hidden, a.epochs, seed=a.seed)
-    print(f"{a.out}: {content['steps']} steps of {a.dataset}, loss {content['loss'][0]:.3g} -> {content['loss'][-1]:.3g}")
+    loss = content["loss"]
+    print(f"{a.out}: {content['steps']} steps of {a.dataset}, loss {loss[0]:.3g} -> {loss[-1]:.3g}")
 
 
 if __name__ == "__main__":

@@ -1,7 +1,7 @@
 """Rollouts of the benchmark's policies as Minari datasets, for offline RL and imitation (the ``datasets``
 extra: ``pip install "lvgym[datasets]"``).
 
-    python -m lvgym.agents.datasets --policies lqg-front gs-pid-flex-quiet --suites smile-v2 --episodes 50
+    lvgym dataset --policies lqg-front gs-pid-flex-quiet --suites smile-v2 --episodes 50
 
 For each policy, suite and flight model it flies ``--episodes`` episodes of the suite's condition on its
 **validation** seeds (the seeds training and tuning may use; the test seeds stay unseen) with Minari's
@@ -27,7 +27,6 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
-import gymnasium
 import numpy as np
 
 import lvgym.cli.policies  # noqa: F401  (registers the built-in policies by name)
@@ -38,7 +37,7 @@ from lvgym.errors import ConfigError
 
 __all__ = ["collect", "dataset_id"]
 
-PROG = "python -m lvgym.agents.datasets"
+PROG = "lvgym dataset"
 PERMALINK = "https://github.com/lvgym/lvgym"
 
 
@@ -47,13 +46,9 @@ def dataset_id(policy: str, suite: str, model: str) -> str:
     return f"lvgym/{suite}-{model}/{policy}-v0"
 
 
-class _Serialisable(gymnasium.Wrapper):
-    """The env with a spec Minari can write: no callable ``vector_entry_point`` (module docstring)."""
-
-    @property
-    def spec(self) -> Any:
-        spec = self.env.spec
-        return None if spec is None else dataclasses.replace(spec, vector_entry_point=None)
+def _writable_spec(env: Any) -> Any:
+    """The env's spec as Minari can write it: no callable ``vector_entry_point`` (module docstring)."""
+    return None if env.spec is None else dataclasses.replace(env.spec, vector_entry_point=None)
 
 
 def collect(policy: str, suite: str = "smile-v2", model: str = "nonrigid", episodes: int = 20,
@@ -96,16 +91,16 @@ def collect(policy: str, suite: str = "smile-v2", model: str = "nonrigid", episo
                    + (f", env options {overrides}" if overrides else ""))
     from lvgym import __version__
 
+    env_spec = _writable_spec(env)
     return minari.create_dataset_from_buffers(
-        dataset_id=dataset_id(spec.name, suite, model), buffer=buffers, env=_Serialisable(env).spec,
-        eval_env=_Serialisable(env).spec,
+        dataset_id=dataset_id(spec.name, suite, model), buffer=buffers, env=env_spec, eval_env=env_spec,
         algorithm_name=spec.name, author=f"lvgym {__version__}", author_email="lvgym@users.noreply.github.com",
         code_permalink=PERMALINK, description=description, data_format="arrow")
 
 
 @dataclass
 class Args:
-    """Command-line arguments (``python -m lvgym.agents.datasets --help``)."""
+    """Command-line arguments (``lvgym dataset --help``)."""
 
     policies: list[str] = arg(default_factory=lambda: ["lqg-front"], metavar="POLICY")
     """the policies whose rollouts to record (registered names or factory references)"""

@@ -176,7 +176,7 @@ def test_the_console_script_has_every_command_with_its_help(capsys):
     assert main(["--help"]) == 0
     listed = [line.split("  ")[1] for line in capsys.readouterr().out.splitlines() if line.startswith("  ")]
     expected = ["evaluate", "train", "margins", "fingerprint", "verify", "verify rocketpy", "verify rocketpy-timing",
-                "bench", "bench-envs", "studies", "render", "export-policy", "design pid", "design pid-flex",
+                "bench", "bench-envs", "studies", "render", "export-policy", "dataset", "bc", "design pid", "design pid-flex",
                 "design lqg", "design charts"]
     assert listed == expected
     for name in expected:

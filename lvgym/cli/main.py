@@ -47,6 +47,10 @@ COMMANDS: tuple[Command, ...] = (
             ("matplotlib",)),
     Command("export-policy", "lvgym.agents.policy:export_main", "copy a training run's policy to a stem "
             "(STEM.zip, STEM_vecnormalize.pkl, STEM.json)", "train", ("stable_baselines3", "torch")),
+    Command("dataset", "lvgym.agents.datasets:main", "record policies' flights as Minari datasets (offline RL)",
+            "datasets", ("minari", "pyarrow")),
+    Command("bc", "lvgym.agents.bc:main", "behaviour cloning of a policy from its Minari dataset", "datasets",
+            ("minari", "pyarrow", "torch")),
     Command("design", None, "the classical controllers' offline design tools", sub=(
         Command("pid", "lvgym.baselines.design.tune:main", "tune the rigid PID gain schedule (gs-pid)", "control",
                 _CONTROL),

@@ -236,8 +236,7 @@ class Simulator:
         d.scale[rows] = 1.0 if param_scale is None else np.broadcast_to(param_scale, (R, n_p))
         d.offset[rows] = 0.0 if param_offset is None else np.broadcast_to(param_offset, (R, n_p))
         if misalignment is not None:
-            CONTEXT.view(d.ctx[:, :CONTEXT.size], "misalignment")[rows] = np.broadcast_to(
-                np.asarray(misalignment, float), (R, 2))
+            self.misalignment(d)[rows] = np.broadcast_to(np.asarray(misalignment, float), (R, 2))
         if dispersion is not None:
             CONTEXT.view(d.ctx[:, :CONTEXT.size], "dispersion")[rows] = np.broadcast_to(
                 np.asarray(dispersion, float), (R, DISPERSION.size))
