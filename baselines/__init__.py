@@ -50,6 +50,11 @@ register_policy("lqg-front", smile_lqg, name="lqg-front", schedule="smile_lqg_fr
 # lqg with anti-windup: the command held to the servo's rate limit as well, so that the filter carries what the
 # servo can follow, and the integral back-calculated (lvgym.baselines.lqgkernel.AntiWindup, docs/mpc.md)
 register_policy("lqg-aw", smile_lqg, name="lqg-aw", back_gain=0.1)
+# the automatic designs of the env's vehicle file (lvgym.baselines.design.auto; the control extra): the rigid
+# design, the flexible design and the LQG, made the same way for any vehicle (a launcher family's baselines)
+register_policy("auto-gs-pid", "lvgym.baselines.designed:auto_policy", name="auto-gs-pid", kind="gs-pid")
+register_policy("auto-gs-pid-flex", "lvgym.baselines.designed:auto_policy", name="auto-gs-pid-flex", kind="gs-pid-flex")
+register_policy("auto-lqg", "lvgym.baselines.designed:auto_policy", name="auto-lqg", kind="lqg")
 # constrained linear MPC on lqg's rows (its plants, filters and cost) under the gimbal's angle and rate limits,
 # OSQP per control period (lvgym.baselines.mpc, docs/mpc.md; needs the control extra)
 register_policy("mpc", "lvgym.baselines.mpc:smile_mpc", name="mpc")

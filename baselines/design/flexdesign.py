@@ -37,7 +37,7 @@ from .flexproblem import (PARAMETERS, START, Requirements, RowProblem, _controll
                           _to_unit, controller, controller_tf, design_row, folded, notch_frequency, open_loop_growth)
 from .flextable import margin_table, row_line
 from .flightloop import flight_plant, frequency_response, mode_frequencies
-from .linearize import margins, operating_point
+from .linearize import margins, operating_point, reused_flights
 from .noise import command_noise_rate, gyro_noise
 from .target import fly_option, stem, vehicle_option
 
@@ -46,6 +46,10 @@ from .target import fly_option, stem, vehicle_option
 FLEX_TIMES = {"smile": (3.0, 10.0, 15.0, 20.0, 24.4, 28.8, 32.4, 36.0, 42.5, 54.1, 62.0, 69.5),
               "stratos3": (2.0, 6.0, 10.0, 14.0, 18.0, 24.0, 29.0),
               "slender": (1.0, 3.0, 5.0, 7.0, 9.0)}
+
+
+#: the optimiser's iterations per start (Nelder-Mead, :func:`.flexproblem.design_row`) of the shipped designs
+MAXITER = 3000
 
 
 def row_plants(vehicle: Any, t: float, policy: Callable | None, **options: Any) -> tuple[dict, dict, dict]:
@@ -176,9 +180,11 @@ def plain_schedule(schedule: Any) -> Any:
         for r in rows]})
 
 
+@reused_flights()
 def design_schedule(vehicle: Any = "smile", times=None, req: Requirements | None = None, starts: int = 2,
                     seed: int = 0, log=print, relief: tuple[float, float] | None = None,
-                    planes: tuple[str, ...] = ("pitch",), fly: str = "auto", **options: Any) -> dict[str, Any]:
+                    planes: tuple[str, ...] = ("pitch",), fly: str = "auto", maxiter: int = MAXITER,
+                    **options: Any) -> dict[str, Any]:
     """Design every row of ``vehicle``'s schedule in time order. Each row flies the stretch between the
     midpoints to its neighbours in the same burn (the policy switches rows at the mass midpoints,
     ``interpolation: nearest``), and is designed to meet the requirements at its own time and at both
@@ -196,10 +202,12 @@ def design_schedule(vehicle: Any = "smile", times=None, req: Requirements | None
     vehicle file (:func:`.target.design_env`; ``times`` then required; ``options``: env keywords).
     ``fly``: how a row with no designed row before it (the first) is flown to: ``centred``, ``pid`` (a
     rigid PID schedule at the same times designed first, :func:`.tune.schedule` with ``fly="rows"``) or a
-    schedule file; ``auto``: ``centred`` for a shipped vehicle (its schedules unchanged), ``pid`` for a
-    file. A document not flown centred records how in ``operating_points``. Returns the schedule
+    schedule file; ``privileged``: every operating point with the privileged reference; ``auto``: ``centred``
+    for a shipped vehicle (its schedules unchanged), ``pid`` for a file. ``maxiter``: the optimiser's
+    iterations per start (fewer: a faster, less converged design). A document not flown centred records how
+    in ``operating_points``. Returns the schedule
     document."""
-    from .target import check_fly, check_vehicle, describe, fly_mode, schedule_flyer
+    from .target import check_fly, check_vehicle, describe, fly_mode, flyer, schedule_flyer
     from .tune import default_times
 
     vehicle = check_vehicle(vehicle, "v1")
@@ -218,15 +226,16 @@ def design_schedule(vehicle: Any = "smile", times=None, req: Requirements | None
         if not rigid_doc["rows"]:
             raise RuntimeError(f"no rigid PID row of {vehicle} could be tuned at {list(times)} s")
         first = schedule_flyer({k: rigid_doc[k] for k in ("variable", "rows")})
-    elif fly != "centred":
-        first = schedule_flyer(fly)
-    log(f"operating points: the gs-pid-flex rows designed so far; before the first: {describe(fly)}")
+    else:
+        first = flyer(fly)
+    how = describe(fly) if fly == "privileged" else f"the gs-pid-flex rows designed so far; before the first: {describe(fly)}"
+    log(f"operating points: {how}")
     rng = np.random.default_rng(seed)
     rows: list[dict[str, Any]] = []
     skipped: list[dict[str, Any]] = []
     warm, left = None, None
     for k, t in enumerate(times):
-        own = row_plants(vehicle, t, schedule_policy(rows) if rows else first, **options)
+        own = row_plants(vehicle, t, schedule_policy(rows) if rows and fly != "privileged" else first, **options)
         if own[2]["thrust_n"] <= 0.0:
             log(f"t = {t:g} s: no thrust (coast), skipped")
             skipped.append({"time_s": float(t), "reason": "coast"})
@@ -236,7 +245,7 @@ def design_schedule(vehicle: Any = "smile", times=None, req: Requirements | None
         cases = [(t, own)] + ([left] if left is not None else [])
         loops = [(c[0][p], c[1]) for _, c in cases for p in planes]
         noise = own[2]["noise"]
-        plain = design_row(RowProblem(loops, req, noise=noise), warm, rng, starts)
+        plain = design_row(RowProblem(loops, req, noise=noise), warm, rng, starts, maxiter)
         e = plain if relief is None else relief_row(loops, req, plain, relief[0], noise=noise)
         right = None
         if k + 1 < len(times):
@@ -245,14 +254,14 @@ def design_schedule(vehicle: Any = "smile", times=None, req: Requirements | None
             first_rows = rows + [{"time_s": t, "mass_kg": own[2]["mass_kg"], "kp": gains[0], "ki": gains[1], "kd": gains[2],
                              "filter": filt.as_dict(), **({} if relief is None else {"accel_gain": relief[1]})}]
             try:
-                case = row_plants(vehicle, t_r, schedule_policy(first_rows), **options)
+                case = row_plants(vehicle, t_r, first if fly == "privileged" else schedule_policy(first_rows), **options)
                 right = (t_r, case) if case[2]["thrust_n"] > 0.0 else None
             except RuntimeError as exc:                  # the flight ended before the stretch's end
                 log(f"t = {t_r:g} s: not reached ({exc}); the row is designed without its right end")
         if right is not None:
             cases.append(right)
             loops = [(c[0][p], c[1]) for _, c in cases for p in planes]
-            plain = design_row(RowProblem(loops, req, noise=noise), plain["values"], rng, starts=0)
+            plain = design_row(RowProblem(loops, req, noise=noise), plain["values"], rng, starts=0, maxiter=maxiter)
             e = plain if relief is None else relief_row(loops, req, plain, relief[0], [e["values"]], noise=noise)
         warm = plain["values"]
         gains, filt = controller(e["values"], notch)
@@ -277,11 +286,12 @@ def design_schedule(vehicle: Any = "smile", times=None, req: Requirements | None
     doc = {"vehicle": vehicle, "protocol": "v1",
            "source": "python -m lvgym.baselines.design.flexdesign (non-rigid v1 flight loop, discrete)",
            "variable": "mass", "interpolation": "nearest", "requirements": asdict(req),
-           "design": {"starts": starts, "seed": seed, "planes": list(planes), **({} if relief is None else
+           "design": {"starts": starts, "seed": seed, "planes": list(planes),
+                      **({} if maxiter == MAXITER else {"maxiter": maxiter}), **({} if relief is None else
                                                          {"ki_scale": relief[0], "accel_gain": relief[1]})},
            "rows": rows, "skipped": skipped}
     if fly != "centred" or options:                     # the shipped schedules' documents unchanged
-        doc["operating_points"] = {"flown_with": f"the gs-pid-flex rows designed so far; before the first: {describe(fly)}",
+        doc["operating_points"] = {"flown_with": how,
                                    **({"env_options": dict(options)} if options else {}),
                                    **({"rigid_pid_rows": [{k: r[k] for k in ("time_s", "mass_kg", "kp", "ki", "kd", "n")}
                                                           for r in rigid_doc["rows"]]} if rigid_doc else {})}
@@ -298,8 +308,8 @@ class Args:
     flight)"""
     fly: str = arg("auto", check=fly_option, metavar="MODE|SCHEDULE")
     """how the first row's operating points are reached (the later rows: with the rows designed so far):
-    centred (gimbal at zero), pid (a rigid PID schedule designed first at the same times), a schedule file,
-    or auto (centred for a shipped vehicle, pid for a file)"""
+    centred (gimbal at zero), pid (a rigid PID schedule designed first at the same times), privileged (every
+    row's with the privileged reference, which needs no design), a schedule file, or auto (centred for a shipped vehicle, pid for a file)"""
     out: str | None = None
     """YAML file (default results/schedules/<vehicle>_flex.yaml; with --overwrite: the shipped
     baselines/schedules/<vehicle>_flex.yaml)"""
@@ -311,6 +321,8 @@ class Args:
     """random starts of the optimiser per row (besides the warm one)"""
     seed: int = 0
     """seed of the random starts"""
+    maxiter: int = arg(MAXITER, lo=10, hi=100000)
+    """the optimiser's iterations per start (fewer: faster, less converged)"""
     load_relief: tuple[float, float] | None = arg(None, lo=0.0, hi=1.0, metavar=("KI_SCALE", "ACCEL_GAIN"))
     """load relief: scale every row's integral gain by KI_SCALE and add ACCEL_GAIN [rad/s per m/s^2]"""
     planes: list[str] = arg(default_factory=lambda: ["pitch"], choices=("pitch", "yaw"))
@@ -343,7 +355,7 @@ def main(argv: list[str] | None = None) -> int:
         fail(command_name(prog), exc)
     planes = tuple(dict.fromkeys(["pitch", *a.planes]))
     doc = design_schedule(a.vehicle, times, Requirements(noise_rate_fraction=a.noise_rate), starts=a.starts,
-                          seed=a.seed, relief=a.load_relief, planes=planes, fly=a.fly)
+                          seed=a.seed, relief=a.load_relief, planes=planes, fly=a.fly, maxiter=a.maxiter)
     if not doc["rows"]:
         print(f"no flight time of {a.vehicle} could be designed; nothing written", file=sys.stderr)
         return 1
@@ -354,6 +366,7 @@ def main(argv: list[str] | None = None) -> int:
              + ("" if planes == ("pitch",) else " --planes " + " ".join(planes))
              + ("" if a.noise_rate is None else f" --noise-rate {a.noise_rate:g}")
              + ("" if a.fly == "auto" else f" --fly {a.fly}")
+             + ("" if a.maxiter == MAXITER else f" --maxiter {a.maxiter}")
              + (" --overwrite" if shipped else f" --out {out}"))
     out.parent.mkdir(parents=True, exist_ok=True)
     atomic_write_text(out, f"# gs-pid-flex schedule of {a.vehicle}, regenerated by: {again}\n"

@@ -217,11 +217,13 @@ class RowProblem:
         """The optimiser's vector of the free parameters of ``values``."""
         return _to_unit(values, self.params)
 
-    def growth(self, b: np.ndarray, a: np.ndarray, model: str, case: int = 0) -> float:
+    def growth(self, b: np.ndarray, a: np.ndarray, model: str, case: int = 0,
+               realised: tuple[np.ndarray, ...] | None = None) -> float:
         """The fastest closed-loop growth rate [1/s] (the integrator's pole at z = 1 cancelling the plant's
-        zero at z = 1 left out, as :func:`.linearize.margins` does)."""
+        zero at z = 1 left out, as :func:`.linearize.margins` does); ``realised``: the controller's
+        ``signal.tf2ss(b, a)`` when the caller has it."""
         A, B, C = self.cases[case][2][model]
-        Ac, Bc, Cc, Dc = signal.tf2ss(b, a)
+        Ac, Bc, Cc, Dc = signal.tf2ss(b, a) if realised is None else realised
         M = np.block([[A - B @ Dc @ C, B @ Cc], [-Bc @ C, Ac]])
         ev = np.linalg.eigvals(M)
         ev = ev[np.abs(ev - 1.0) > 1e-6]
@@ -256,13 +258,14 @@ class RowProblem:
         gains, filt = controller(values, self.notch_radps)
         b, a = _controller_poly(gains, filt, self.dt)
         C = np.polyval(b, self.z) / np.polyval(a, self.z)
+        realised = signal.tf2ss(b, a)
         out: dict[str, Any] = {"values": values, "higher_db": -99.0, "drift_excess": {}, "noise": 0.0}
         for i, (G, band, _) in enumerate(self.cases):
             for model, g in G.items():
                 L = C * g
                 if self._noise_held:
                     out["noise"] = max(out["noise"], noise_rate_on_grid(C, g, self.w, self.dt, *self.noise))
-                m = self.grid_margins(L) + (self.growth(b, a, model, i),)
+                m = self.grid_margins(L) + (self.growth(b, a, model, i, realised),)
                 w = out.get(model)
                 out[model] = m if w is None else (min(w[0], m[0]), max(w[1], m[1]), min(w[2], m[2]), max(w[3], m[3]))
                 x = m[3] - self.allowed_growth[i][model]

@@ -31,6 +31,7 @@ import control
 import numpy as np
 
 from .linearize import PLANES, OperatingPoint, linearize
+from .response import frequency_response  # noqa: F401  (the design tools' import of it, here as before)
 
 #: sign of the bending slope rate in each plane's gyro (see the module docstring) and the plane of modes
 _SLOPE = {"pitch": (-1.0, "z"), "yaw": (1.0, "y")}
@@ -191,9 +192,3 @@ def mode_frequencies(op: OperatingPoint, plane: str = "pitch") -> dict[str, list
     return {k: sorted(v) for k, v in out.items()}
 
 
-def frequency_response(sys_: Any, w: np.ndarray) -> np.ndarray:
-    """Complex response of ``sys_`` (SISO, continuous or discrete) at the angular frequencies ``w`` [rad/s]."""
-    w = np.asarray(w, float)
-    if sys_.dt:
-        return np.asarray(sys_(np.exp(1j * w * sys_.dt)), complex).ravel()
-    return np.asarray(sys_(1j * w), complex).ravel()

@@ -27,6 +27,8 @@ validate the numerical one.
 from __future__ import annotations
 
 import math
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 from functools import lru_cache
 from typing import Any
@@ -34,6 +36,7 @@ from typing import Any
 import control
 import gymnasium as gym
 import numpy as np
+from scipy import optimize
 
 import lvgym  # noqa: F401  (registers the envs)
 from lvgym.simulator import flight_loads
@@ -43,6 +46,7 @@ from lvgym.simulator import CONDITIONS, CONTEXT
 from lvgym.simulator import data as simdata
 from lvgym.simulator.flight import flight_conditions_batch
 
+from .response import frequency_response
 from .target import ENV_IDS, design_env  # noqa: F401  (ENV_IDS: the shipped vehicles' envs, here as before)
 
 #: the planes of :func:`linearize`: the state entries kept, the input and the rate output of each
@@ -78,6 +82,47 @@ class OperatingPoint:
         return float(value) if np.ndim(value) == 0 else np.array(value)
 
 
+#: the flights :func:`operating_point` continues inside :func:`reused_flights` (None: outside)
+_FLIGHTS: dict[tuple, "_Flight"] | None = None
+
+
+@dataclass
+class _Flight:
+    """An env flown up to some time with a policy: its last observation and info."""
+
+    env: Any
+    policy: Any
+    obs: Any
+    info: dict
+
+    @classmethod
+    def start(cls, env_id: str, opts: dict[str, Any], policy: Any) -> "_Flight":
+        env = gym.make(env_id, **opts)
+        obs, info = env.reset(seed=0)
+        if policy is not None and not hasattr(policy, "act"):
+            policy = policy(env)
+        if policy is not None:
+            policy.reset()
+        return cls(env, policy, obs, info)
+
+
+@contextmanager
+def reused_flights() -> Iterator[None]:
+    """Inside it, :func:`operating_point` flown with a policy factory that has a ``reuse_key`` (one that
+    flies every design the same way, :func:`.target.privileged_flyer`) continues the flight it flew for an
+    earlier operating point of the same env and options when the new time is not earlier, instead of
+    flying again from lift-off: the same steps, so the same state to the bit, and a design's operating
+    points cost one flight per flight model. Nested uses share the outer one's flights."""
+    global _FLIGHTS
+    outer = _FLIGHTS
+    _FLIGHTS = {} if outer is None else outer
+    try:
+        yield
+    finally:
+        if outer is None:
+            _FLIGHTS = None
+
+
 def operating_point(vehicle: Any = "smile", t: float = 28.8, model: str = "rigid", protocol: str = "v0",
                     policy: Any = None, **options: Any) -> OperatingPoint:
     """The state of ``vehicle``'s env of ``protocol`` (``v0``, ``v1``) flown with the gimbal centred and
@@ -93,18 +138,20 @@ def operating_point(vehicle: Any = "smile", t: float = 28.8, model: str = "rigid
     the env then flies control period by control period in v0 too. The upper stage of ``smile_v1`` needs
     one: flown with the zero action it tumbles and the episode ends at 60.7 s; so does a vehicle that is
     unstable without control. The linearisation is still taken about the gimbal centred at the state
-    reached."""
+    reached. A factory's ``env_options`` (a mapping, e.g. :func:`.target.privileged_flyer`'s) are added to the
+    env's keywords; inside :func:`reused_flights` a factory's flight may be continued."""
     env_id, file_opts = design_env(vehicle, protocol)
-    opts = {"model": model, "wind": "none", **file_opts, **options}
+    opts = {"model": model, "wind": "none", **file_opts, **getattr(policy, "env_options", {}), **options}
     if env_id == ENV_IDS["v0"]["stratos3"]:
         opts.setdefault("control", "tvc")
-    env = gym.make(env_id, **opts)
-    obs, info = env.reset(seed=0)
-    task = env.unwrapped
-    if policy is not None and not hasattr(policy, "act"):
-        policy = policy(env)
-    if policy is not None:
-        policy.reset()
+    key = (env_id, repr(sorted(opts.items())), policy.reuse_key) \
+        if _FLIGHTS is not None and getattr(policy, "reuse_key", None) else None
+    flight = _FLIGHTS.get(key) if key is not None else None
+    if flight is None or float(flight.env.unwrapped.state.sim.t[0]) > float(t) + 1e-9:
+        flight = _Flight.start(env_id, opts, policy)
+        if key is not None:
+            _FLIGHTS[key] = flight
+    env, task, policy = flight.env, flight.env.unwrapped, flight.policy
     sim = task.sim
     if protocol == "v0" and policy is None:
         if t > 0:
@@ -113,12 +160,14 @@ def operating_point(vehicle: Any = "smile", t: float = 28.8, model: str = "rigid
         zero = np.zeros(env.action_space.shape, env.action_space.dtype)
         dt = float(task.task.control_dt_s)
         while float(task.state.sim.t[0]) < float(t) - 0.5 * dt:
-            action = zero if policy is None else policy.act(obs, info)
-            obs, _, term, trunc, info = env.step(action)
-            if term or trunc:
+            action = zero if policy is None else policy.act(flight.obs, flight.info)
+            flight.obs, _, term, trunc, flight.info = env.step(action)
+            if term or (trunc and float(task.state.sim.t[0]) < float(t) - 0.5 * dt):   # the mission's end
+                if key is not None:                                                        # may be a row's time
+                    del _FLIGHTS[key]
                 how = "with the gimbal centred" if policy is None else f"with {getattr(policy, 'name', 'the policy')}"
-                raise RuntimeError(f"{env_id} ({model}, vehicle {vehicle}) flown {how} ended at {info['time']:.2f} s "
-                                   f"before t = {t} s: {info.get('termination', '')}")
+                raise RuntimeError(f"{env_id} ({model}, vehicle {vehicle}) flown {how} ended at "
+                                   f"{flight.info['time']:.2f} s before t = {t} s: {flight.info.get('termination', '')}")
     d = task.state.sim
     return OperatingPoint(float(d.t[0]), d.x[0].copy(), d.p[0].copy(), d.ctx[0].copy(), sim, opts, task.task,
                           simdata.take(d, [0]))
@@ -359,6 +408,33 @@ def margin_grid(dt: float, n: int = 20000) -> np.ndarray:
     return np.geomspace(1e-3, 0.9999 * math.pi / dt, n)
 
 
+def crossings(L: control.StateSpace) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """``(gm, pm, wpc, wgc)`` of the discrete open loop ``L``, as python-control's
+    ``stability_margins(..., returnall=True)`` gives them for a frequency response: the gain margins
+    ``1/|L|`` [-] at the phase crossovers ``wpc`` [rad/s] (where the phase of ``L`` crosses -180 deg with a
+    negative real part) and the phase margins [deg, in [-180, 180)] at the gain crossovers ``wgc``
+    [rad/s]. The crossings are bracketed on :func:`margin_grid` and each is solved (Brent's method) on
+    ``L`` itself, not on an interpolant of its response."""
+    L = L if isinstance(L, control.StateSpace) else control.ss(L)
+    w = margin_grid(L.dt)
+
+    def at(wk: float) -> complex:
+        return complex(frequency_response(L, np.array([wk]))[0])
+
+    resp = frequency_response(L, w)
+    arg = np.angle(-resp)                      # zero where the phase of L crosses -180 deg
+    i_pc = np.where(np.diff(np.sign(arg)))[0]
+    i_pc = i_pc[resp[i_pc].real <= 0.0]
+    wpc = np.array([optimize.brentq(lambda x: np.angle(-at(x)), w[i], w[i + 1], xtol=1e-12) for i in i_pc])
+    mag = np.abs(resp) - 1.0
+    i_gc = np.where(np.diff(np.sign(mag)))[0]
+    wgc = np.array([optimize.brentq(lambda x: abs(at(x)) - 1.0, w[i], w[i + 1], xtol=1e-12) for i in i_gc])
+    with np.errstate(divide="ignore"):
+        gm = np.array([1.0 / abs(at(x)) for x in wpc])
+    pm = np.array([np.remainder(np.angle(at(x), deg=True), 360.0) - 180.0 for x in wgc])
+    return gm, pm, wpc, wgc
+
+
 def margins(L: control.LTI) -> dict[str, float]:
     """Margins of the open loop ``L`` (negative feedback).
 
@@ -371,9 +447,7 @@ def margins(L: control.LTI) -> dict[str, float]:
     loop leaves the attitude neutral); ``max_pole_real_per_s``: the largest real part of the closed-loop
     poles (continuous equivalents ``ln z / dt``), the growth rate of the slowest divergence."""
     if L.dt:                                   # python-control's polynomial method is unreliable for
-        w = margin_grid(L.dt)                  # discrete loops of this order: interpolate a dense response
-        resp = np.asarray(L(np.exp(1j * w * L.dt)), complex).ravel()
-        gm, pm, _, wpc, wgc, _ = control.stability_margins(control.frd(resp, w, smooth=True), returnall=True)
+        gm, pm, wpc, wgc = crossings(L)        # discrete loops of this order: a dense response, refined
     else:
         gm, pm, _, wpc, wgc, _ = control.stability_margins(L, returnall=True)
     gm, pm, wpc, wgc = (np.atleast_1d(np.asarray(a, float)) for a in (gm, pm, wpc, wgc))

@@ -29,7 +29,7 @@ from lvgym.cli.args import arg
 from lvgym.errors import ConfigError, check_number
 
 from .flightloop import flight_plant, mode_frequencies
-from .linearize import OperatingPoint, operating_point
+from .linearize import OperatingPoint, operating_point, reused_flights
 from .lqg_row import (LQGWeights, RowDesign, closed_loop, closed_loop_growth, delayed_plant, design_row,
                       frequency_grid, gain_at, margins_from_response, open_loop, plant_labels, response)
 from .target import fly_option, vehicle_option
@@ -242,6 +242,7 @@ def row_neighbours(vehicle: Any, t: float, interval: tuple[float, float], op_non
     return near
 
 
+@reused_flights()
 def design_schedule(vehicle: Any = "smile", rows: tuple[float, ...] | None = None,
                     phases: tuple[tuple[float, float], ...] | None = None, tg: MarginTargets = MarginTargets(),
                     grid: dict = SEARCH_GRID, planes: tuple[str, ...] = PLANE_NAMES, log=print, fly: str = "auto",
@@ -254,11 +255,12 @@ def design_schedule(vehicle: Any = "smile", rows: tuple[float, ...] | None = Non
     and :func:`.target.file_times`). ``fly``: how the operating points are
     reached (:data:`.target.FLY_MODES`): ``centred`` (SMILE: its upper stage with the shipped rigid
     ``gs-pid`` schedule, as the shipped design), ``pid`` (a rigid PID schedule designed first at the rows,
-    :func:`.tune.schedule` with ``fly="rows"``) or a schedule file; ``auto``: ``centred`` for a shipped
-    vehicle, ``pid`` for a file. A document not flown as the shipped design records how in
+    :func:`.tune.schedule` with ``fly="rows"``), ``privileged`` (the privileged reference) or a schedule
+    file; ``auto``: ``centred`` for a shipped vehicle, ``pid`` for a file. A document not flown as the shipped design records how in
     ``operating_points``."""
-    from .target import (burn_phases, check_fly, check_vehicle, describe, file_times, fly_mode, is_shipped,
-                         schedule_flyer)
+    from .target import burn_phases, check_fly, check_vehicle, describe, file_times, fly_mode, is_shipped
+    from .target import flyer as fly_with
+    from .target import schedule_flyer
 
     vehicle = check_vehicle(vehicle, "v1")
     if vehicle == "smile":
@@ -283,8 +285,8 @@ def design_schedule(vehicle: Any = "smile", rows: tuple[float, ...] | None = Non
         rigid_doc = rigid_schedule(vehicle, tuple(sorted({*rows, *(x for iv in intervals for x in iv)})),
                                    log=log, protocol="v1", fly="rows", **options)
         flyer = schedule_flyer({k: rigid_doc[k] for k in ("variable", "rows")})
-    elif fly != "centred":
-        flyer = schedule_flyer(fly)
+    else:
+        flyer = fly_with(fly)
     how = describe(fly) if fly != "centred" or vehicle != "smile" else \
         "gimbal centred up to the first stage's burnout, then the shipped rigid gs-pid schedule 'smile'"
     log(f"operating points: {how}")
@@ -376,7 +378,8 @@ class Args:
     """the thrusting phases with the controller on [s], pairs START END (default: SMILE v1's, 2 42.5 54.5 69.5)"""
     fly: str = arg("auto", check=fly_option, metavar="MODE|SCHEDULE")
     """how the operating points are reached: centred (SMILE: gimbal centred, its upper stage with gs-pid),
-    pid (a rigid PID schedule designed first at the rows), a schedule file, or auto (centred for a shipped
+    pid (a rigid PID schedule designed first at the rows), privileged (the privileged reference, which needs
+    no design), a schedule file, or auto (centred for a shipped
     vehicle, pid for a file)"""
 
 

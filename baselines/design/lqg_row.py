@@ -45,6 +45,8 @@ is not reliable at the 50-55 states of these loops; the grid method is checked a
 from __future__ import annotations
 
 import math
+from collections import OrderedDict
+from collections.abc import Callable
 from dataclasses import dataclass, fields
 from typing import Any
 
@@ -115,6 +117,10 @@ def plant_labels(op: OperatingPoint, plane: str = "pitch") -> tuple[str, ...]:
     """Names of the states of :func:`delayed_plant`, in order: the servo's ``servo_position`` and
     ``servo_rate``, the vehicle's (:func:`.flightloop.vehicle_with_gyro_output`), the gyro filters'
     ``gyro_filter_<i>``, the delay's ``command_delay_<i>``."""
+    return _once("plant_labels", op, plane, lambda: _plant_labels(op, plane))
+
+
+def _plant_labels(op: OperatingPoint, plane: str) -> tuple[str, ...]:
     servo = servo_discrete(op, float(op.task.physics_dt_s)).nstates
     vehicle = list(vehicle_with_gyro_output(op, plane).state_labels)
     f = gyro_filter_ss(op)
@@ -124,11 +130,38 @@ def plant_labels(op: OperatingPoint, plane: str = "pitch") -> tuple[str, ...]:
                  + [f"command_delay_{i}" for i in range(steps)])
 
 
+#: what :func:`_once` keeps: (function, id of the operating point, plane) -> (the operating point, value)
+_KEPT: OrderedDict = OrderedDict()
+_KEEP = 64
+
+
+def _once(kind: str, op: OperatingPoint, plane: str, make: Callable[[], Any]) -> Any:
+    """``make()``, or its value for the same operating point object and plane made before (the last
+    :data:`_KEEP` of them): a row's search designs hundreds of weight sets on the same plants, and each
+    plant is a numerical linearisation (:func:`.linearize.linearize`). An operating point is not changed
+    after it is made (:func:`dispersed` makes a new one), so its object identifies its plants."""
+    key = (kind, id(op), plane)
+    hit = _KEPT.get(key)
+    if hit is not None and hit[0] is op:
+        _KEPT.move_to_end(key)
+        return hit[1]
+    value = make()
+    _KEPT[key] = (op, value)
+    while len(_KEPT) > _KEEP:
+        _KEPT.popitem(last=False)
+    return value
+
+
 def delayed_plant(op: OperatingPoint, plane: str = "pitch") -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """``A, B, C`` of :func:`.flightloop.flight_plant` with the delay as its last states
     (``d_{k+1} = u_k`` for one period; a chain for more) and ``G_w`` (n, 1), the gimbal disturbance's
     input matrix (after the delay). The state order is :func:`plant_labels`' (python-control's
-    ``series`` stacks the first system's states first; checked here on the servo's block)."""
+    ``series`` stacks the first system's states first; checked here on the servo's block). Made once per
+    operating point and plane (:func:`_once`); the arrays returned are copies."""
+    return tuple(m.copy() for m in _once("delayed_plant", op, plane, lambda: _delayed_plant(op, plane)))
+
+
+def _delayed_plant(op: OperatingPoint, plane: str) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     g0 = flight_plant(op, plane, delay_steps=0)
     A0, B0, C0 = (np.asarray(m, float) for m in (g0.A, g0.B, g0.C))
     if np.any(np.asarray(g0.D, float) != 0.0):
@@ -314,10 +347,12 @@ def gain_at(L: control.StateSpace, freqs: list[float], width: float = 0.05) -> l
     """The largest ``20 log|L|`` [dB] within ``+-width`` (relative) of each frequency [rad/s]; a
     frequency above Nyquist is folded back (the sampled loop sees its alias)."""
     nyq = math.pi / L.dt
-    out = []
+    grids = []
     for f in freqs:
         fa = f % (2 * nyq)
         fa = 2 * nyq - fa if fa > nyq else fa
-        ww = np.linspace(fa * (1 - width), min(fa * (1 + width), nyq * 0.9999), 400)
-        out.append(float(20 * np.log10(np.abs(response(L, ww)).max())))
-    return out
+        grids.append(np.linspace(fa * (1 - width), min(fa * (1 + width), nyq * 0.9999), 400))
+    if not grids:
+        return []
+    mag = np.abs(response(L, np.concatenate(grids))).reshape(len(grids), -1)    # one evaluation for all
+    return [float(20 * np.log10(m.max())) for m in mag]

@@ -27,7 +27,10 @@ from __future__ import annotations
 import math
 from typing import Any
 
+import control
 import numpy as np
+
+from .response import ss_response
 
 __all__ = ["gyro_noise", "noise_rate_on_grid", "command_noise_rate"]
 
@@ -66,6 +69,6 @@ def command_noise_rate(C: Any, G: Any, sigma: float, rate_limit: float, n: int =
     dt = float(G.dt)
     w = np.geomspace(1e-3, 0.99999 * math.pi / dt, n)
     z = np.exp(1j * w * dt)
-    c = np.asarray(C(z), complex).ravel()
-    g = np.asarray(G(z), complex).ravel()
+    c, g = (ss_response(s, z) if isinstance(s, control.StateSpace) else np.asarray(s(z), complex).ravel()
+            for s in (C, G))
     return noise_rate_on_grid(c, g, w, dt, sigma, rate_limit)

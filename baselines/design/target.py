@@ -11,7 +11,8 @@ of that protocol; env keywords change any of them).
 
 An operating point is flown up to its flight time either with the gimbal centred (``fly="centred"``, what
 the shipped designs do) or with a stabilising controller (:func:`schedule_flyer`: a gain-scheduled PID of a
-rigid schedule): a vehicle that is unstable without control (a launcher in the atmosphere with its centre
+rigid schedule; :func:`privileged_flyer`: the privileged reference, which needs no design for the vehicle
+since it reads the true state, and so flies every operating point of every design the same way): a vehicle that is unstable without control (a launcher in the atmosphere with its centre
 of pressure ahead of its centre of mass) tumbles with the gimbal centred and never reaches max q.
 :func:`fly_mode` says which a tool uses by default: centred for a shipped vehicle (its results unchanged),
 a stabilising controller for a file.
@@ -31,9 +32,9 @@ ENV_IDS = {"v0": {"smile": "lvgym/SmileAscent-v0", "stratos3": "lvgym/StratosIII
 #: the env a vehicle file is flown in, per protocol (its preset with the file as the vehicle)
 FILE_ENV = {"v0": "lvgym/SmileAscent-v0", "v1": "lvgym/SmileAscent-v1"}
 #: how operating points are flown: ``centred`` (the gimbal at zero), ``rows`` (the rigid PID schedule of
-#: the rows designed so far, :mod:`.tune`), ``pid`` (a rigid PID schedule designed first), or a schedule
-#: file or shipped schedule name
-FLY_MODES = ("auto", "centred", "rows", "pid")
+#: the rows designed so far, :mod:`.tune`), ``pid`` (a rigid PID schedule designed first), ``privileged``
+#: (the privileged reference, :func:`privileged_flyer`), or a schedule file or shipped schedule name
+FLY_MODES = ("auto", "centred", "rows", "pid", "privileged")
 
 
 def _allowed(protocol: str) -> str:
@@ -113,11 +114,37 @@ def schedule_flyer(schedule: Any, name: str = "gs-pid") -> Callable[[Any], Any]:
     return lambda env: GainScheduledPIDPolicy(schedule, env=env, name=name)
 
 
+def privileged_flyer() -> Callable[[Any], Any]:
+    """A policy factory ``env -> policy`` flying the privileged reference (:mod:`lvgym.baselines.privileged`),
+    as :func:`.linearize.operating_point` takes it; its ``env_options`` (``privileged_info=True``, which
+    adds keys to the info and changes nothing of the flight) are the env keywords it needs."""
+    from ..privileged import PrivilegedPolicy
+
+    def factory(env: Any) -> Any:
+        return PrivilegedPolicy(env)
+
+    factory.env_options = {"privileged_info": True}
+    factory.reuse_key = "privileged"                 # the same flight for every design (linearize.reused_flights)
+    return factory
+
+
+def flyer(fly: str) -> Callable[[Any], Any] | None:
+    """The policy factory of a resolved ``fly`` mode that flies every operating point the same way: None
+    for ``centred``, :func:`privileged_flyer` for ``privileged``, :func:`schedule_flyer` for a schedule
+    (``rows`` and ``pid`` depend on the tool's own rows: the tools build those)."""
+    if fly == "centred":
+        return None
+    if fly == "privileged":
+        return privileged_flyer()
+    return schedule_flyer(fly)
+
+
 def describe(fly: str) -> str:
     """One line saying how the operating points were flown (the outputs carry it)."""
     return {"centred": "gimbal centred (no control) up to each flight time",
             "rows": "the rigid PID schedule of the rows designed so far (the first row with the gimbal centred)",
-            "pid": "a rigid PID schedule designed first (lvgym design pid on the same vehicle and times)"}.get(
+            "pid": "a rigid PID schedule designed first (lvgym design pid on the same vehicle and times)",
+            "privileged": "the privileged reference (true state, no design needed) up to each flight time"}.get(
         fly, f"the gain-scheduled PID of the schedule {fly}")
 
 

@@ -31,7 +31,7 @@ import yaml
 
 from lvgym.cli.args import arg
 
-from .linearize import linearize, loop, margins, operating_point
+from .linearize import linearize, loop, margins, operating_point, reused_flights
 from .target import fly_option, is_shipped, stem, vehicle_option
 from ..pid import SCHEDULES
 
@@ -111,6 +111,7 @@ def default_times(vehicle: Any, table: dict[str, tuple[float, ...]], option: str
     return file_times(vehicle, protocol=protocol, option=option)
 
 
+@reused_flights()
 def schedule(vehicle: Any = "smile", times=None, bandwidth: float = 75.0, pm_deg: float = 35.0, dt: float = 0.02,
              n: float = 500.0, ki_ratio: float = 3.0, log=print, protocol: str = "v0", fly: str = "auto",
              **options: Any) -> dict[str, Any]:
@@ -118,10 +119,11 @@ def schedule(vehicle: Any = "smile", times=None, bandwidth: float = 75.0, pm_deg
     name or a vehicle file (:func:`.target.design_env`; ``options``: env keywords), flown in ``protocol``'s
     env. ``fly``: how each row's operating point is reached (:data:`.target.FLY_MODES`): ``centred`` (the
     gimbal at zero), ``rows`` (the schedule of the rows tuned so far, so a vehicle unstable without
-    control reaches every row: rows are tuned in time order, the first flown centred) or a schedule file;
+    control reaches every row: rows are tuned in time order, the first flown centred), ``privileged`` (the
+    privileged reference, which needs no design) or a schedule file;
     ``auto`` (and ``pid``) is ``centred`` for a shipped vehicle (its schedules unchanged) and ``rows`` for a
     file. A document of a flight not flown centred records how in ``operating_points``."""
-    from .target import check_fly, check_vehicle, describe, fly_mode, schedule_flyer
+    from .target import check_fly, check_vehicle, describe, fly_mode, flyer, schedule_flyer
 
     vehicle = check_vehicle(vehicle, protocol)
     fly = fly_mode(check_fly(fly), vehicle)
@@ -134,8 +136,8 @@ def schedule(vehicle: Any = "smile", times=None, bandwidth: float = 75.0, pm_deg
         policy = None
         if fly == "rows" and rows:
             policy = schedule_flyer({"variable": "mass", "rows": rows})
-        elif fly not in ("rows", "centred"):
-            policy = schedule_flyer(fly)
+        elif fly != "rows":
+            policy = flyer(fly)
         op = operating_point(vehicle, t, "rigid", protocol=protocol, policy=policy, **options)
         tl = op.sim.timeline
         if op.condition("thrust") <= 0.0:
@@ -216,7 +218,7 @@ class Args:
     """the protocol whose env flies the vehicle to each row (a file: in SMILE's env of it)"""
     fly: str = arg("auto", check=fly_option, metavar="MODE|SCHEDULE")
     """how each row's operating point is reached: centred (gimbal at zero), rows (the schedule of the rows
-    tuned so far), a schedule file, or auto (centred for a shipped vehicle, rows for a file)"""
+    tuned so far), privileged (the privileged reference, which needs no design), a schedule file, or auto (centred for a shipped vehicle, rows for a file)"""
     out: str | None = None
     """YAML file (default results/schedules/<vehicle>.yaml; with --overwrite: the shipped
     baselines/schedules/<vehicle>.yaml)"""

@@ -60,6 +60,8 @@ COMMANDS: tuple[Command, ...] = (
                 "(lqg)", "control", _CONTROL),
         Command("charts", "lvgym.baselines.design.charts:main", "Bode and Nichols charts of a gain schedule's "
                 "open loops", "control", _CONTROL),
+        Command("auto", "lvgym.baselines.design.auto:main", "design gs-pid, gs-pid-flex and lqg for a vehicle file "
+                "in about a minute, cached by its content", "control", _CONTROL),
     )),
 )
 
