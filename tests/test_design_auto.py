@@ -93,9 +93,9 @@ def test_a_continued_flight_gives_the_operating_point_of_a_new_one():
     assert again.env_options["privileged_info"] is True
 
 
-def test_the_automatic_design_of_a_vehicle_file(stubby, tmp_path, monkeypatch):
+def test_the_automatic_design_of_a_vehicle_file(stubby, tmp_path):
     import lvgym
-    from lvgym.baselines.design.auto import Budget, design_vehicle, summary_text
+    from lvgym.baselines.design.auto import Budget, design_vehicle, latest_design, summary_text
     from lvgym.baselines.designed import auto_policy
     from lvgym.simulator.cache import using
 
@@ -114,14 +114,14 @@ def test_the_automatic_design_of_a_vehicle_file(stubby, tmp_path, monkeypatch):
         assert again.cached and again.summary == s and (tmp_path / "copy" / "lqg.npz").is_file()
         assert "read from the cache" in summary_text(again)
         env = lvgym.make_env("smile-v2", model="nonrigid", vehicle=stubby, mission_time_s=3.0)
-        monkeypatch.setattr("lvgym.baselines.design.auto.design_vehicle",          # the test's budget
-                            lambda vehicle: design_vehicle(vehicle, budget, grid=ONE_WEIGHT))
+        assert latest_design(stubby).folder == d.folder            # the policies fly the last design
         for kind in ("gs-pid", "gs-pid-flex", "lqg"):
             policy = auto_policy(env, kind)
             obs, info = env.reset(seed=0)
             policy.reset()
             obs, _, _, _, info = env.step(policy.act(obs, info))
             assert np.isfinite(obs).all() and policy.name == f"auto-{kind}"
+        assert latest_design(SMILE_V1) is None
     with pytest.raises(ConfigError, match="vehicle YAML file"):
         design_vehicle("smile")
     with pytest.raises(ConfigError, match="budget.flex_maxiter"):

@@ -4,6 +4,7 @@ policy file, the margins and the benchmark's conditions, in order in one folder,
 
 from __future__ import annotations
 
+import os
 import re
 import shlex
 import subprocess
@@ -25,6 +26,9 @@ SHORTEN = {
         "--seeds 1 --mission-time-s 4 --models nonrigid --executor serial --no-progress",
     "lvgym evaluate --vehicle kestrel.yaml --policies zero privileged kestrel-flex=kestrel_policy.py:make --episodes 20":
         "--episodes 2 --mission-time-s 4 --executor serial --no-plots --no-progress",
+    "lvgym design auto --vehicle kestrel.yaml --out results/kestrel_auto": "--rows 2 --flex-maxiter 20 --workers 1",
+    "lvgym evaluate --vehicle kestrel.yaml --policies zero privileged auto-gs-pid auto-gs-pid-flex auto-lqg "
+    "--episodes 20": "--episodes 1 --mission-time-s 4 --executor serial --no-plots --no-progress",
 }
 
 
@@ -40,7 +44,8 @@ def _commands() -> list[str]:
 def _run(command: str, cwd: Path) -> subprocess.CompletedProcess:
     argv = shlex.split(command) + shlex.split(SHORTEN[command])
     argv = [sys.executable, "-m", "lvgym.cli.main", *argv[1:]]
-    proc = subprocess.run(argv, cwd=cwd, capture_output=True, text=True, timeout=600)
+    env = {**os.environ, "LVGYM_CACHE_DIR": str(cwd / "cache")}        # the automatic design's cache: the test's
+    proc = subprocess.run(argv, cwd=cwd, capture_output=True, text=True, timeout=600, env=env)
     assert proc.returncode == 0, f"{command}\n{proc.stdout[-2000:]}\n{proc.stderr[-3000:]}"
     return proc
 
@@ -56,7 +61,6 @@ def test_the_tutorial_runs_from_the_vehicle_file_to_the_benchmark(tmp_path, caps
     namespace: dict = {}
     old = Path.cwd()
     try:
-        import os
         os.chdir(tmp_path)
         exec(compile(check, "own-launcher.md (check)", "exec"), namespace)
         out = capsys.readouterr().out
@@ -66,7 +70,7 @@ def test_the_tutorial_runs_from_the_vehicle_file_to_the_benchmark(tmp_path, caps
     finally:
         os.chdir(old)
     (tmp_path / "kestrel_policy.py").write_text(policy, encoding="utf-8")
-    design_pid, design_flex, margins, evaluate = _commands()
+    design_pid, design_flex, margins, evaluate, design_auto, evaluate_auto = _commands()
     _run(design_pid, tmp_path)
     _run(design_flex, tmp_path)
     flex = tmp_path / "results" / "kestrel_flex.yaml"
@@ -74,6 +78,12 @@ def test_the_tutorial_runs_from_the_vehicle_file_to_the_benchmark(tmp_path, caps
     assert "kestrel-flex" in _run(margins, tmp_path).stdout
     table = _run(evaluate, tmp_path).stdout
     for label in ("| rigid | kestrel-flex |", "| nonrigid | privileged |", "| nonrigid | zero |"):
+        assert label in table, table[-3000:]
+    assert "designed in" in _run(design_auto, tmp_path).stdout
+    for name in ("gs-pid.yaml", "gs-pid-flex.yaml", "lqg.npz", "design.json"):
+        assert (tmp_path / "results" / "kestrel_auto" / name).is_file()
+    table = _run(evaluate_auto, tmp_path).stdout                 # the policies fly that design (the cache's last)
+    for label in ("| nonrigid | auto-gs-pid |", "| nonrigid | auto-gs-pid-flex |", "| nonrigid | auto-lqg |"):
         assert label in table, table[-3000:]
 
 

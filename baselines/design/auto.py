@@ -35,7 +35,8 @@ how long each design took, and per design and row whether it meets its requireme
 margins. The cache's key is a SHA-256 of the vehicle's content (its parsed, frozen dataclasses without the
 file's name, as the timeline cache keys it: :mod:`lvgym.simulator.cache`), the env keywords, the budget and
 the source of the design tools, so an edited vehicle or an edited tool designs again; the folder is
-``$LVGYM_CACHE_DIR/designs`` (default ``~/.cache/lvgym/designs``).
+``$LVGYM_CACHE_DIR/designs`` (default ``~/.cache/lvgym/designs``). :func:`latest_design` finds the last
+design of a vehicle whatever its budget (what the ``auto-*`` policies fly).
 """
 
 from __future__ import annotations
@@ -60,7 +61,7 @@ from lvgym.errors import ConfigError, check_number
 
 from .target import vehicle_option
 
-__all__ = ["AUTO_GRID", "Budget", "NOISE_RATE", "VehicleDesign", "design_vehicle", "designs_folder"]
+__all__ = ["AUTO_GRID", "Budget", "NOISE_RATE", "VehicleDesign", "design_vehicle", "designs_folder", "latest_design"]
 
 #: the LQG weights the automatic design searches (a subset of :data:`.lqg_design.SEARCH_GRID`: the two
 #: integral weights, four of the five gimbal weights, both gimbal noises, and the low and high mode weights)
@@ -125,14 +126,35 @@ def _source_digest() -> str:
     return h.hexdigest()
 
 
-def design_key(vehicle: str, budget: Budget, options: dict[str, Any]) -> str:
-    """The cache key of the design of the vehicle file ``vehicle`` (module docstring)."""
+def vehicle_key(vehicle: str) -> str:
+    """A key of the vehicle file's content and of the design tools' source (module docstring)."""
     from lvgym.vehicle.config import load_vehicle
 
     content = dataclasses.replace(load_vehicle(vehicle), source=None)
-    h = hashlib.sha256(pickle.dumps((content, sorted(options.items()), asdict(budget), VERSION), protocol=4))
+    h = hashlib.sha256(pickle.dumps((content, VERSION), protocol=4))
     h.update(_source_digest().encode())
     return h.hexdigest()[:32]
+
+
+def design_key(vehicle: str, budget: Budget, options: dict[str, Any]) -> str:
+    """The cache key of the design of the vehicle file ``vehicle`` with ``budget`` and the env keywords
+    ``options`` (module docstring)."""
+    h = hashlib.sha256(vehicle_key(vehicle).encode())
+    h.update(pickle.dumps((sorted(options.items()), asdict(budget)), protocol=4))
+    return h.hexdigest()[:32]
+
+
+def latest_design(vehicle: str | os.PathLike[str]) -> VehicleDesign | None:
+    """The cache's last design of the vehicle file ``vehicle`` (whatever its budget and options: the one
+    ``lvgym design auto`` made last), or None."""
+    root = designs_folder()
+    if root is None:
+        return None
+    index = root / f"{vehicle_key(os.fspath(vehicle))}.latest"
+    folder = root / index.read_text().strip() if index.is_file() else None
+    if folder is None or not (folder / FILES["summary"]).is_file():
+        return None
+    return VehicleDesign(folder, json.loads((folder / FILES["summary"]).read_text()), cached=True)
 
 
 def _rigid_then_lqg(vehicle: str, folder: str, options: dict[str, Any], budget: Budget,
@@ -229,6 +251,8 @@ def design_vehicle(vehicle: str | os.PathLike[str], budget: Budget = Budget(), o
         design = VehicleDesign(folder, json.loads(summary_file.read_text()), cached=True)
     else:
         design = _design(path, folder, budget, grid, options)
+    if root is not None:
+        (root / f"{vehicle_key(path)}.latest").write_text(folder.name)
     if out is not None and Path(out).resolve() != folder.resolve():
         shutil.copytree(folder, out, dirs_exist_ok=True)
         design = VehicleDesign(Path(out), design.summary, design.cached)

@@ -1,0 +1,84 @@
+"""The automatic design (``lvgym design auto``) of the launcher family's first test vehicles: how long each
+takes on this machine, how many rows of each schedule meet their requirements, and how the three designs
+fly the vehicle against the privileged reference on validation seeds of smile-v2's conditions.
+
+``python -m experiments.family_design.design_family --vehicles 5 --episodes 10`` writes
+``results/family_design/`` (the vehicle files, ``designs.json`` and ``flights.md``). The designs go to the
+design cache (``$LVGYM_CACHE_DIR/designs``); a second run reads them from it (say so with ``--fresh`` to
+design again into a fresh cache folder).
+"""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+import tempfile
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import yaml
+
+from lvgym.cli.args import arg, parse
+
+POLICIES = ("zero", "privileged", "auto-gs-pid", "auto-gs-pid-flex", "auto-lqg")
+
+
+@dataclass
+class Args:
+    """Command-line arguments."""
+
+    vehicles: int = arg(5, lo=1, hi=50)
+    """how many test vehicles (the test split's first seeds that fly)"""
+    episodes: int = arg(10, lo=0, hi=200)
+    """validation episodes per vehicle, model and policy (0: design only)"""
+    out: str = "results/family_design"
+    """output folder"""
+    fresh: bool = False
+    """design into a fresh cache folder (the timing of a first design)"""
+
+
+def main(argv: list[str] | None = None) -> int:
+    from lvgym.baselines.design.auto import design_vehicle, summary_text
+    from lvgym.baselines.family import generate_flyable
+    from lvgym.simulator.cache import using
+    from lvgym.vehicle.generator import SPLITS
+
+    a = parse(Args, argv, "python -m experiments.family_design.design_family", __doc__)
+    out = Path(a.out)
+    out.mkdir(parents=True, exist_ok=True)
+    fresh = tempfile.mkdtemp(prefix="lvgym-designs-") if a.fresh else None
+    records, lines = [], []
+    seed = SPLITS["test"][0]
+    while len(records) < a.vehicles:
+        g = generate_flyable(seed)
+        path = out / f"family_{seed}.yaml"
+        path.write_text(yaml.safe_dump(g.data, sort_keys=False))
+        start = time.perf_counter()
+        if fresh:
+            with using(fresh):
+                d = design_vehicle(path)
+        else:
+            d = design_vehicle(path)
+        wall = time.perf_counter() - start
+        print(f"vehicle {seed} (L/D {g.design['slenderness']:.1f}, T/W {g.design['thrust_to_weight']:.2f}, "
+              f"{'finned' if g.design['finned'] else 'finless'}): {wall:.1f} s\n{summary_text(d)}", flush=True)
+        records.append({"seed": seed, "design": g.design, "wall_s": round(wall, 2), "summary": d.summary})
+        if a.episodes:
+            env = {} if not fresh else {"LVGYM_CACHE_DIR": fresh}
+            import os
+            proc = subprocess.run([sys.executable, "-m", "lvgym.cli.main", "evaluate", "--vehicle", str(path),
+                                   "--policies", *POLICIES, "--episodes", str(a.episodes), "--seed-set", "validation",
+                                   "--no-plots", "--no-progress", "--out", str(out / f"eval_{seed}")],
+                                  capture_output=True, text=True, env={**os.environ, **env})
+            lines.append(f"## vehicle {seed}\n\n{proc.stdout[-4000:]}\n")
+            print(proc.stdout[-3000:], proc.stderr[-2000:], flush=True)
+        seed += 1
+    (out / "designs.json").write_text(json.dumps(records, indent=1))
+    (out / "flights.md").write_text("\n".join(lines))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
