@@ -162,9 +162,10 @@ def operating_point(vehicle: Any = "smile", t: float = 28.8, model: str = "rigid
         while float(task.state.sim.t[0]) < float(t) - 0.5 * dt:
             action = zero if policy is None else policy.act(flight.obs, flight.info)
             flight.obs, _, term, trunc, flight.info = env.step(action)
-            if term or (trunc and float(task.state.sim.t[0]) < float(t) - 0.5 * dt):   # the mission's end
-                if key is not None:                                                        # may be a row's time
-                    del _FLIGHTS[key]
+            if (term or trunc) and key is not None:
+                del _FLIGHTS[key]                  # an ended flight is not continued; the mission's end may
+                #                                    be a row's time (a truncation there reached it)
+            if term or (trunc and float(task.state.sim.t[0]) < float(t) - 0.5 * dt):
                 how = "with the gimbal centred" if policy is None else f"with {getattr(policy, 'name', 'the policy')}"
                 raise RuntimeError(f"{env_id} ({model}, vehicle {vehicle}) flown {how} ended at "
                                    f"{flight.info['time']:.2f} s before t = {t} s: {flight.info.get('termination', '')}")

@@ -12,8 +12,9 @@ of that protocol; env keywords change any of them).
 An operating point is flown up to its flight time either with the gimbal centred (``fly="centred"``, what
 the shipped designs do) or with a stabilising controller (:func:`schedule_flyer`: a gain-scheduled PID of a
 rigid schedule; :func:`privileged_flyer`: the privileged reference, which needs no design for the vehicle
-since it reads the true state, and so flies every operating point of every design the same way): a vehicle that is unstable without control (a launcher in the atmosphere with its centre
-of pressure ahead of its centre of mass) tumbles with the gimbal centred and never reaches max q.
+since it reads the true state, and so flies every operating point of every design the same way): a vehicle
+that is unstable without control (a launcher in the atmosphere with its centre of pressure ahead of its
+centre of mass) tumbles with the gimbal centred and never reaches max q.
 :func:`fly_mode` says which a tool uses by default: centred for a shipped vehicle (its results unchanged),
 a stabilising controller for a file.
 """
