@@ -250,7 +250,7 @@ def design_vehicle(vehicle: str | os.PathLike[str], budget: Budget = Budget(), o
     if root is not None and summary_file.exists():
         design = VehicleDesign(folder, json.loads(summary_file.read_text()), cached=True)
     else:
-        design = _design(path, folder, budget, grid, options)
+        design = _design(path, folder, budget, grid, options, shared=root is not None)
     if root is not None:
         (root / f"{vehicle_key(path)}.latest").write_text(folder.name)
     if out is not None and Path(out).resolve() != folder.resolve():
@@ -259,7 +259,9 @@ def design_vehicle(vehicle: str | os.PathLike[str], budget: Budget = Budget(), o
     return design
 
 
-def _design(path: str, folder: Path, budget: Budget, grid: dict, options: dict[str, Any]) -> VehicleDesign:
+def _design(path: str, folder: Path, budget: Budget, grid: dict, options: dict[str, Any], shared: bool) -> VehicleDesign:
+    """Design into ``folder`` (through a partial folder renamed at the end); ``shared``: a cache entry,
+    which another process may be making at the same time (the first one made is kept)."""
     work = folder.with_name(folder.name + f".partial-{os.getpid()}")
     work.mkdir(parents=True, exist_ok=True)
     start = time.perf_counter()
@@ -275,9 +277,15 @@ def _design(path: str, folder: Path, budget: Budget, grid: dict, options: dict[s
                "seconds": round(time.perf_counter() - start, 2), "operating_points": "the privileged reference",
                **{k: v for r in results for k, v in r.items()}}
     (work / FILES["summary"]).write_text(json.dumps(summary, indent=1))
-    if folder.exists():
-        shutil.rmtree(folder)
-    work.rename(folder)
+    if shared and (folder / FILES["summary"]).exists():   # another process (an evaluation's worker) was first
+        shutil.rmtree(work)
+        return VehicleDesign(folder, json.loads((folder / FILES["summary"]).read_text()), cached=True)
+    shutil.rmtree(folder, ignore_errors=True)        # an unfinished entry
+    try:
+        work.rename(folder)
+    except OSError:                                  # ... or it finished just now
+        shutil.rmtree(work)
+        return VehicleDesign(folder, json.loads((folder / FILES["summary"]).read_text()), cached=True)
     return VehicleDesign(folder, summary, cached=False)
 
 
