@@ -19,7 +19,12 @@ orthogonal to the rigid ones, so the relief is built in)
 
 negative (weathercock stable, ``m0 < 0``) for a stable vehicle at low pressure. It passes zero where
 ``det [[m0, -s e^T], [b, Omega^2 - s A]] = 0``, linear in ``s``: the smallest positive real eigenvalue of
-that pencil is the divergence dynamic pressure ``q_div = s / S`` (:func:`divergence_qbar`).
+that pencil is the loss of weathercock stiffness. With the attitude held (by the thrust vector control),
+the modes alone diverge where ``Omega^2 - s A`` becomes singular (the smallest positive real eigenvalue of
+the pencil ``(Omega^2, A)``): the static deflection per angle of attack grows without bound. The divergence
+dynamic pressure ``q_div = s / S`` (:func:`divergence_qbar`) is the lower of the two; a weathercock-unstable
+vehicle (``m0 >= 0``, e.g. finless, held by its thrust vector control) has only the second. On the slender
+vehicle and the family's finned vehicles the first is 6-14 times lower than the second.
 
 This is the aerodynamics-only divergence, the same quantity as ``divergence_qbar`` of the independent study
 ``experiments/aeroelastic_divergence/divergence.py`` ("aero only" in docs/aerodynamics.md). The follower
@@ -69,8 +74,8 @@ def pitch_stiffness_ratio(qbar: float, x_strip: Any, cna: Any, s_ref: float, x_c
 
 def divergence_qbar(x_strip: Any, cna: Any, s_ref: float, x_cg: float, phi: Any, dphi: Any, omega: Any) -> float:
     """The dynamic pressure [Pa] where the inertia-relieved pitch stiffness of the statically deflected
-    modes passes zero (module docstring); ``inf`` if it never does (or the rigid vehicle is not
-    weathercock stable, ``m0 >= 0``: then there is no stiffness to lose and this check says nothing).
+    modes passes zero, or where the modes diverge at a held attitude, whichever is lower (module docstring);
+    ``inf`` if neither happens (a weathercock-unstable vehicle, ``m0 >= 0``, has only the second).
 
     ``x_strip`` (n) strip stations [m] (<= 0, from the nose tip); ``cna`` (n) each strip's share of CN-alpha
     [1/rad] on ``s_ref`` [m^2]; ``x_cg`` the CG's station [m]; ``phi``, ``dphi`` (K, n) the mass-normalised
@@ -80,18 +85,24 @@ def divergence_qbar(x_strip: Any, cna: Any, s_ref: float, x_cg: float, phi: Any,
     om = np.asarray(omega, float)
     if not (np.all(np.isfinite(om)) and np.all(om > 0.0)) or len(om) != len(b):
         raise ConfigError("omega", np.asarray(omega).tolist(), f"{len(b)} finite frequencies [rad/s] > 0")
-    if m0 >= 0.0:
-        return math.inf
     K = len(b)
+    s_modes = _smallest_positive(np.diag(om ** 2), A)
+    if m0 >= 0.0:
+        return s_modes / float(s_ref)
     B0 = np.zeros((K + 1, K + 1))
     B1 = np.zeros((K + 1, K + 1))
     B0[0, 0], B0[1:, 0], B0[1:, 1:] = m0, b, np.diag(om ** 2)
     B1[0, 1:], B1[1:, 1:] = -e, -A
+    return min(_smallest_positive(B0, -B1), s_modes) / float(s_ref)
+
+
+def _smallest_positive(a: np.ndarray, b: np.ndarray) -> float:
+    """The smallest positive real finite eigenvalue ``s`` of ``a v = s b v`` (``inf`` if none)."""
     with np.errstate(all="ignore"):
-        s = linalg.eigvals(B0, -B1)
+        s = linalg.eigvals(a, b)
     s = s[np.isfinite(s)]
     real = s[(np.abs(s.imag) <= 1e-9 * np.abs(s)) & (s.real > 0.0)].real
-    return float(real.min()) / float(s_ref) if real.size else math.inf
+    return float(real.min()) if real.size else math.inf
 
 
 def flight_divergence_qbar(vehicle: str | Vehicle, times: Any, mach: Any, mode_interval: float = 2.0,
