@@ -1,4 +1,5 @@
-"""A family of small launchers: from a seed, a physically consistent single-stage LOX/RP-1 vehicle file.
+"""A family of small launchers: from a seed, a physically consistent vehicle file: one or two stages, each
+LOX/RP-1 or a solid motor (:mod:`.familystages`; shares ``two_stage_share`` and ``solid_share``).
 
 Each draw picks, uniformly within :class:`FamilyRanges`, the diameter, the slenderness L/D, the share of the
 length the two tanks fill and their fill, the lift-off thrust-to-weight, the wall's safety factor on its
