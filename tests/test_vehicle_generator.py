@@ -62,3 +62,48 @@ def test_the_splits_are_disjoint_and_bad_values_name_the_key():
         generate(-1)
     with pytest.raises(ConfigError, match=r"slenderness = \(40.0, 10.0\)"):
         FamilyRanges(slenderness=(40.0, 10.0))
+
+
+def _first(kind, seeds=range(20_000, 20_040)):
+    for seed in seeds:
+        g = generate(seed)
+        if kind(g.design):
+            return g
+    raise AssertionError("no such vehicle among the seeds")
+
+
+def test_the_kinds_stay_in_their_ranges_and_are_reproducible(tmp_path):
+    r = FamilyRanges()
+    kinds = set()
+    for seed in split_seeds("test", 20):
+        g = generate(seed)
+        d = g.design
+        kinds.add((d["stages"], tuple(d["motors"])))
+        assert r.slenderness[0] <= d["slenderness"] <= r.slenderness[1]
+        assert r.thrust_to_weight[0] <= d["thrust_to_weight"] <= r.thrust_to_weight[1]
+        assert all(r.burn_time_s[0] <= b <= r.burn_time_s[1] for b in d["burn_times_s"])
+        assert len(d["motors"]) == d["stages"] == len(g.data["stages"]) == len(g.data["staging"])
+        if d["stages"] == 2:
+            assert r.upper_share[0] <= d["upper_share"] <= r.upper_share[1]
+            assert r.upper_thrust_to_weight[0] <= d["upper_thrust_to_weight"] <= r.upper_thrust_to_weight[1]
+        mm = MassModel(load_vehicle(g.write(tmp_path)))
+        lift_off = mm.initial_state()
+        assert mm.properties(lift_off).mass == pytest.approx(d["lift_off_mass_kg"], rel=2e-3)
+        assert mm.next_event(lift_off) == pytest.approx(d["burn_times_s"][0], rel=0.02)
+        assert (tmp_path / f"family_{seed}.yaml").read_text() == generate(seed).write(tmp_path / "again").read_text()
+    assert {(1, ("liquid",)), (1, ("solid",))} <= kinds and any(k[0] == 2 for k in kinds)
+    only_liquid = FamilyRanges(two_stage_share=0.0, solid_share=0.0)
+    assert all(generate(s, only_liquid).design["motors"] == ["liquid"] for s in range(5))
+
+
+def test_a_two_stage_and_a_solid_vehicle_pass_the_checks_and_fly():
+    from lvgym.baselines.family import flies_nominal, nominal_flight
+
+    solid = _first(lambda d: d["stages"] == 1 and d["motors"] == ["solid"])
+    assert "thrust_table" in solid.data["stages"][0]["engines"][0]
+    assert flies_nominal(solid.data, seconds=30.0)
+    two = _first(lambda d: d["stages"] == 2 and d["burn_times_s"][0] < 70.0)
+    seconds = two.design["upper_ignition_s"] + 10.0
+    r = nominal_flight(two.data, seconds=seconds)
+    assert r["duration_s"] > two.design["upper_ignition_s"]            # separated and lit the second stage
+    assert flies_nominal(two.data, seconds=seconds)

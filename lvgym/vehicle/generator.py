@@ -1,4 +1,5 @@
-"""A family of small launchers: from a seed, a physically consistent single-stage LOX/RP-1 vehicle file.
+"""A family of small launchers: from a seed, a physically consistent vehicle file: one or two stages, each
+LOX/RP-1 or a solid motor (:mod:`.familystages`; shares ``two_stage_share`` and ``solid_share``).
 
 Each draw picks, uniformly within :class:`FamilyRanges`, the diameter, the slenderness L/D, the share of the
 length the two tanks fill and their fill, the lift-off thrust-to-weight, the wall's safety factor on its
@@ -36,22 +37,17 @@ import yaml
 from lvgym.errors import ConfigError
 
 from .config import parse_vehicle
+from .familystages import G0, stage_file, stage_geometry, stage_masses
 
 __all__ = ["FamilyRanges", "GeneratedVehicle", "SPLITS", "generate", "split_seeds"]
 
-G0 = 9.80665
 #: the seeds of each split of the family (disjoint)
 SPLITS = {"train": (0, 10_000), "validation": (10_000, 20_000), "test": (20_000, 30_000)}
-#: the wall's allowed axial stress before the safety factor [Pa] (2219-T87 yields at about 390 MPa; a thin
-#: tube buckles first, so a preliminary sizing takes much less)
-WALL_STRESS_PA = 120e6
-MIN_WALL_M = 0.0015
-STRUCTURE_FACTOR = 1.6
-ENGINE_THRUST_TO_WEIGHT = 60.0
-ISP_S, EXIT_PRESSURE_PA, SEA_LEVEL_PA = 255.0, 70e3, 101325.0
-EXIT_AREA_PER_FLOW = 0.07 / 15.6            # [m^2 per kg/s], a small pressure-fed-class engine
-MIXTURE, RHO_LOX, RHO_RP1 = 2.35, 1141.0, 810.0
 MAX_ATTEMPTS = 50
+#: a two-stage vehicle's coast from first-stage burnout to separation, and from separation to the second
+#: stage's ignition [s]
+SEPARATION_DELAY_S, IGNITION_DELAY_S = 0.5, 0.5
+_SHARES = ("finned_share", "two_stage_share", "solid_share")
 
 
 @dataclass(frozen=True)
@@ -71,12 +67,17 @@ class FamilyRanges:
     fin_span_calibres: tuple[float, float] = (0.5, 0.9)
     finned_share: float = 0.5
     burn_time_s: tuple[float, float] = (30.0, 200.0)
+    two_stage_share: float = 0.3
+    solid_share: float = 0.3
+    upper_share: tuple[float, float] = (0.3, 0.45)
+    upper_thrust_to_weight: tuple[float, float] = (1.0, 1.8)
+    solid_tail: tuple[float, float] = (0.5, 1.0)
 
     def __post_init__(self) -> None:
         for key, value in asdict(self).items():
-            if key == "finned_share":
+            if key in _SHARES:
                 if not 0.0 <= value <= 1.0:
-                    raise ConfigError("finned_share", value, "a share in [0, 1]")
+                    raise ConfigError(key, value, "a share in [0, 1]")
             elif not (len(value) == 2 and 0.0 < value[0] <= value[1]):
                 raise ConfigError(key, value, "(low, high) with 0 < low <= high")
 
@@ -114,71 +115,78 @@ def _u(rng: np.random.Generator, pair: tuple[float, float]) -> float:
 
 
 def _draw(rng: np.random.Generator, r: FamilyRanges, seed: int) -> tuple[dict[str, Any], dict[str, Any]]:
-    """One draw: the vehicle file (a mapping) and its design numbers."""
+    """One draw: the vehicle file (a mapping) and its design numbers. The draws of the single-stage liquid
+    vehicle come first and in their original order, then those of the kinds (stages, motors), always all of
+    them: a draw that comes out single-stage and liquid is the vehicle the generator gave before the kinds."""
     D, ld, tw = _u(rng, r.diameter_m), _u(rng, r.slenderness), _u(rng, r.thrust_to_weight)
     share, fill, safety = _u(rng, r.tank_share), _u(rng, r.fill_ratio), _u(rng, r.wall_safety)
     zeta, nose, pay_share = _u(rng, r.slosh_damping), _u(rng, r.nose_calibres) * D, _u(rng, r.payload_share)
     finned = bool(rng.uniform() < r.finned_share)
     span = _u(rng, r.fin_span_calibres) * D
-    L, r_in = ld * D, 0.48 * D
-    h = share * L
-    h_lox = h * (MIXTURE / RHO_LOX) / (MIXTURE / RHO_LOX + 1.0 / RHO_RP1)
-    h_rp1 = h - h_lox
-    m_prop = fill * math.pi * r_in ** 2 * (h_lox * RHO_LOX + h_rp1 * RHO_RP1)
-    thrust_per_flow = ISP_S * G0 - (SEA_LEVEL_PA - EXIT_PRESSURE_PA) * EXIT_AREA_PER_FLOW
-    m0, wall = 1.2 * m_prop, MIN_WALL_M
+    two = bool(rng.uniform() < r.two_stage_share)
+    solid = [bool(rng.uniform() < r.solid_share) for _ in range(2)]
+    upper, tw2 = _u(rng, r.upper_share), _u(rng, r.upper_thrust_to_weight)
+    tails = [_u(rng, r.solid_tail) for _ in range(2)]
+    L = ld * D
+    L2 = nose + upper * (L - nose) if two else 0.0
+    # the stages from the bottom: (name, top station, length, has the nose, solid, tail)
+    stages = [("stage1", -L2, L - L2, not two, solid[0], tails[0])]
+    if two:
+        stages.append(("stage2", 0.0, L2, True, solid[1], tails[1]))
+    # the tanks fill ``share`` of a single stage's length (nose included, as before the kinds), of the
+    # first stage's, and of the second stage's below the nose
+    geo = [stage_geometry(D, top, length, nose if has_nose else 0.0,
+                          share * (length - (nose if two and has_nose else 0.0)), fill, is_solid)
+           for _, top, length, has_nose, is_solid, _ in stages]
+    m0 = 1.2 * sum(g["propellant"] for g in geo)
+    m_up = 1.2 * geo[-1]["propellant"] if two else m0
     for _ in range(50):                                     # the sizing's fixed point (a contraction)
-        thrust = tw * m0 * G0
-        wall = max(MIN_WALL_M, safety * thrust / (math.pi * D * WALL_STRESS_PA))
-        m_struct = STRUCTURE_FACTOR * 2840.0 * math.pi * D * wall * L
-        m_engine = thrust / (G0 * ENGINE_THRUST_TO_WEIGHT)
-        m0 = (m_struct + m_prop + m_engine) / (1.0 - pay_share)
+        thrusts = [tw * m0 * G0] + ([tw2 * m_up * G0] if two else [])
+        loads = [thrusts[0]] + ([max(thrusts[0] * m_up / m0, thrusts[1])] if two else [])
+        parts = [stage_masses(D, g, loads[i], thrusts[i], safety) for i, g in enumerate(geo)]
+        dry = [p["structure"] + g["propellant"] + p["engine"] for p, g in zip(parts, geo)]
+        m0 = sum(dry) / (1.0 - pay_share)
+        m_up = pay_share * m0 + dry[-1] if two else m0
     m_pay = pay_share * m0
-    flow = tw * m0 * G0 / thrust_per_flow
-    top_lox = -(nose + 0.1 * D)
-    top_rp1 = top_lox - h_lox - 0.05 * D
-    bay = L + top_rp1 - h_rp1                               # below the tanks: the engine bay [m]
-    j_engine = m_engine / 60.0 * (D / 0.6) ** 2              # scaled from a 60 kg engine of a 0.6 m vehicle
-    engine = {"name": "main", "mass": round(m_engine, 3), "cg": round(-(L - 0.2 * bay), 4),
-              "inertia": [round(1.5 * j_engine, 4), round(3.0 * j_engine, 4), round(3.0 * j_engine, 4)],
-              "gimbal": round(-(L - 0.3 * bay), 4), "gimbal_limit_deg": 6.0, "mass_flow": round(flow, 4),
-              "isp": ISP_S, "nozzle_exit_area": round(EXIT_AREA_PER_FLOW * flow, 6),
-              "nozzle_exit_pressure": EXIT_PRESSURE_PA, "mixture_ratio": MIXTURE}
-    tank = {"engine": "main", "inner_radius": round(r_in, 4), "fill_ratio": round(fill, 4), "slip_factor": 0.95,
-            "slosh_damping": round(zeta, 5)}
+    thrusts = [tw * m0 * G0] + ([tw2 * m_up * G0] if two else [])       # of the sized masses
+    built = [stage_file(name, D, g, p, thrusts[i], tail, zeta, i == 1)
+             for i, ((name, _, _, _, is_solid, tail), g, p) in enumerate(zip(stages, geo, parts))]
+    kind = ("two-stage " if two else "") + "/".join("solid" if st[4] else "liquid" for st in stages)
     data: dict[str, Any] = {
         "name": f"family_{seed}",
         "description": f"lvgym's launcher family, seed {seed}: L/D {ld:.1f}, thrust-to-weight {tw:.2f}"
-                       f"{', four fins' if finned else ', finless'}",
-        "stages": [{
-            "name": "stage1", "top": 0.0, "length": round(L, 4), "outer_diameter": round(D, 4),
-            "structure": {"mass": round(m_struct, 3), "cg": round(-0.52 * L, 4),
-                          "inertia": [round(m_struct * (D / 2) ** 2, 3),
-                                      *[round(m_struct * (L ** 2 / 12 + D ** 2 / 8), 3)] * 2]},
-            "sections": [{"top": 0.0, "bottom": round(-L, 4), "material": "al2219_t87",
-                          "wall_thickness": round(wall, 6)}],
-            "engines": [engine],
-            "tanks": [{"name": "lox", "role": "oxidiser", "height": round(h_lox, 4), "top": round(top_lox, 4),
-                       "density": RHO_LOX, **tank},
-                      {"name": "rp1", "role": "fuel", "height": round(h_rp1, 4), "top": round(top_rp1, 4),
-                       "density": RHO_RP1, **tank}]}],
+                       f"{', four fins' if finned else ', finless'}" + (f", {kind}" if kind != "liquid" else ""),
+        "stages": [b[0] for b in built],
         "payload": {"mass": round(m_pay, 3), "cg": round(-0.6 * nose, 4),
                     "inertia": [round(0.5 * m_pay * (0.4 * D) ** 2, 4),
                                 *[round(m_pay * ((0.6 * nose) ** 2 / 12 + (0.4 * D) ** 2 / 4), 4)] * 2]},
-        "staging": [{"stage": "stage1"}],
+        "staging": ([{"stage": "stage1", "separation_delay": SEPARATION_DELAY_S},
+                     {"stage": "stage2", "ignition_delay": IGNITION_DELAY_S}] if two else [{"stage": "stage1"}]),
         "structure": {"n_modes": 2, "damping": 0.01},
         "aerodynamics": {"model": "barrowman", "nose": {"shape": "ogive", "length": round(nose, 4)},
                          "body": {"diameter": round(D, 4), "length": round(L - nose, 4)}},
     }
+    if two:                                                  # the upper stack after separation: no fins
+        data["stages"][1]["aerodynamics"] = {"model": "barrowman",
+                                             "nose": {"shape": "ogive", "length": round(nose, 4)},
+                                             "body": {"diameter": round(D, 4), "length": round(L2 - nose, 4)}}
     if finned:
         root = D
         data["aerodynamics"]["fins"] = {"count": 4, "root_chord": round(root, 4), "tip_chord": round(0.5 * root, 4),
                                         "span": round(span, 4), "sweep": round(0.5 * span, 4),
                                         "station": round(-(L - root - 0.05 * D), 4),
                                         "thickness": round(0.01 * D / 0.6, 5)}
+    burn = [b[1] for b in built]
     design = {"slenderness": ld, "thrust_to_weight": tw, "diameter_m": D, "length_m": L, "lift_off_mass_kg": m0,
-              "propellant_kg": m_prop, "structure_kg": m_struct, "engine_kg": m_engine, "payload_kg": m_pay,
-              "burn_time_s": m_prop / flow, "wall_thickness_m": wall, "finned": finned}
+              "propellant_kg": sum(g["propellant"] for g in geo), "structure_kg": sum(p["structure"] for p in parts),
+              "engine_kg": sum(p["engine"] for p in parts), "payload_kg": m_pay, "burn_time_s": burn[0],
+              "wall_thickness_m": parts[0]["wall"], "finned": finned, "stages": len(stages),
+              "motors": ["solid" if st[4] else "liquid" for st in stages], "burn_times_s": burn,
+              "walls_m": [p["wall"] for p in parts]}
+    if two:
+        design |= {"upper_share": upper, "upper_thrust_to_weight": tw2, "upper_stack_kg": m_up,
+                   "separation_s": burn[0] + SEPARATION_DELAY_S,
+                   "upper_ignition_s": burn[0] + SEPARATION_DELAY_S + IGNITION_DELAY_S}
     return data, design
 
 
@@ -194,7 +202,7 @@ def generate(seed: int, ranges: FamilyRanges | None = None,
     for attempt in range(MAX_ATTEMPTS):
         rng = np.random.default_rng(np.random.SeedSequence((int(seed), attempt)))
         data, design = _draw(rng, r, int(seed))
-        if not r.burn_time_s[0] <= design["burn_time_s"] <= r.burn_time_s[1]:
+        if not all(r.burn_time_s[0] <= b <= r.burn_time_s[1] for b in design["burn_times_s"]):
             continue
         try:
             parse_vehicle(data, source=f"family_{seed}.yaml")
