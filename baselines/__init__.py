@@ -55,6 +55,9 @@ register_policy("lqg-aw", smile_lqg, name="lqg-aw", back_gain=0.1)
 register_policy("auto-gs-pid", "lvgym.baselines.designed:auto_policy", name="auto-gs-pid", kind="gs-pid")
 register_policy("auto-gs-pid-flex", "lvgym.baselines.designed:auto_policy", name="auto-gs-pid-flex", kind="gs-pid-flex")
 register_policy("auto-lqg", "lvgym.baselines.designed:auto_policy", name="auto-lqg", kind="lqg")
+# the family's fixed baseline: the automatic design of the launcher family's nominal member on any vehicle
+register_policy("fixed-gs-pid-flex", "lvgym.baselines.designed:fixed_policy", name="fixed-gs-pid-flex", kind="gs-pid-flex")
+register_policy("fixed-lqg", "lvgym.baselines.designed:fixed_policy", name="fixed-lqg", kind="lqg")
 # constrained linear MPC on lqg's rows (its plants, filters and cost) under the gimbal's angle and rate limits,
 # OSQP per control period (lvgym.baselines.mpc, docs/mpc.md; needs the control extra)
 register_policy("mpc", "lvgym.baselines.mpc:smile_mpc", name="mpc")

@@ -139,3 +139,27 @@ def test_the_cache_key_is_the_vehicles_content(stubby, tmp_path):
     assert design_key(stubby, Budget(rows=4), {}) != design_key(stubby, Budget(), {})
     copy.write_text(Path(stubby).read_text().replace("span: 0.5,", "span: 0.6,"))
     assert design_key(str(copy), Budget(), {}) != design_key(stubby, Budget(), {})
+
+
+def test_the_fixed_baseline_flies_the_nominal_members_design_on_another_vehicle(stubby, tmp_path):
+    import lvgym
+    from lvgym.baselines.design.auto import Budget, design_vehicle
+    from lvgym.baselines.designed import fixed_policy, nominal_file
+    from lvgym.simulator.cache import using
+    from lvgym.vehicle.generator import nominal
+
+    g = nominal()
+    assert (g.design["slenderness"], g.design["thrust_to_weight"], g.design["diameter_m"]) == (25.0, 1.85, 0.7)
+    assert not g.design["finned"] and g.design["stages"] == 1 and g.design["motors"] == ["liquid"]
+    assert nominal().data == g.data and g.data["name"] == "family_nominal"
+    with using(tmp_path / "cache"):
+        path = nominal_file()
+        assert path.parent == tmp_path / "cache" / "designs" and path.read_text() == nominal_file().read_text()
+        design_vehicle(path, Budget(flex_maxiter=20, workers=1, rows=2), grid=ONE_WEIGHT)
+        env = lvgym.make_env("smile-v2", model="nonrigid", vehicle=stubby, mission_time_s=3.0)
+        for kind in ("gs-pid-flex", "lqg"):
+            policy = fixed_policy(env, kind)
+            obs, info = env.reset(seed=0)
+            policy.reset()
+            obs, _, _, _, info = env.step(policy.act(obs, info))
+            assert np.isfinite(obs).all() and policy.name == f"fixed-{kind}"

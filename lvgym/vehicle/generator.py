@@ -39,7 +39,7 @@ from lvgym.errors import ConfigError
 from .config import parse_vehicle
 from .familystages import G0, stage_file, stage_geometry, stage_masses
 
-__all__ = ["FamilyRanges", "GeneratedVehicle", "SPLITS", "generate", "split_seeds"]
+__all__ = ["FamilyRanges", "GeneratedVehicle", "SPLITS", "generate", "nominal", "nominal_ranges", "split_seeds"]
 
 #: the seeds of each split of the family (disjoint)
 SPLITS = {"train": (0, 10_000), "validation": (10_000, 20_000), "test": (20_000, 30_000)}
@@ -188,6 +188,24 @@ def _draw(rng: np.random.Generator, r: FamilyRanges, seed: int) -> tuple[dict[st
                    "separation_s": burn[0] + SEPARATION_DELAY_S,
                    "upper_ignition_s": burn[0] + SEPARATION_DELAY_S + IGNITION_DELAY_S}
     return data, design
+
+
+def nominal_ranges(ranges: FamilyRanges | None = None) -> FamilyRanges:
+    """``ranges`` (default the family's) with every range drawn from collapsed to its middle (the burn times
+    accepted stay as they are), finless, single-stage and liquid-fuelled: the family's nominal member, whose design the ``fixed`` baselines fly on every vehicle
+    (most launchers fly without fins; SMILE is the finned exception)."""
+    r = FamilyRanges() if ranges is None else ranges
+    mid = {k: (0.5 * (v[0] + v[1]),) * 2 for k, v in asdict(r).items() if k not in (*_SHARES, "burn_time_s")}
+    return FamilyRanges(**mid, finned_share=0.0, two_stage_share=0.0, solid_share=0.0)
+
+
+def nominal(ranges: FamilyRanges | None = None) -> GeneratedVehicle:
+    """The family's nominal member (:func:`nominal_ranges`), seed 0 (every draw is then its range's middle)."""
+    g = generate(0, nominal_ranges(ranges))
+    data = {**g.data, "name": "family_nominal",
+            "description": "lvgym's launcher family, the nominal member: every range at its middle, "
+                           f"L/D {g.design['slenderness']:.1f}, thrust-to-weight {g.design['thrust_to_weight']:.2f}, finless"}
+    return GeneratedVehicle(g.seed, g.attempt, data, g.design)
 
 
 def generate(seed: int, ranges: FamilyRanges | None = None,
