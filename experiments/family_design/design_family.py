@@ -1,6 +1,7 @@
 """The automatic design (``lvgym design auto``) of the launcher family's first test vehicles: how long each
 takes on this machine, how many rows of each schedule meet their requirements, and how the three designs
-fly the vehicle against the privileged reference on validation seeds of smile-v2's conditions.
+fly the vehicle against the privileged reference and the family's fixed baseline (the nominal member's
+design) on validation seeds of smile-v2's conditions.
 
 ``python -m experiments.family_design.design_family --vehicles 5 --episodes 10`` writes
 ``results/family_design/`` (the vehicle files, ``designs.json`` and ``flights.md``). The designs go to the
@@ -11,6 +12,7 @@ design again into a fresh cache folder).
 from __future__ import annotations
 
 import json
+import os
 import subprocess
 import sys
 import tempfile
@@ -22,7 +24,7 @@ import yaml
 
 from lvgym.cli.args import arg, parse
 
-POLICIES = ("zero", "privileged", "auto-gs-pid", "auto-gs-pid-flex", "auto-lqg")
+POLICIES = ("zero", "privileged", "auto-gs-pid", "auto-gs-pid-flex", "auto-lqg", "fixed-gs-pid-flex", "fixed-lqg")
 
 
 @dataclass
@@ -50,6 +52,14 @@ def main(argv: list[str] | None = None) -> int:
     out.mkdir(parents=True, exist_ok=True)
     fresh = tempfile.mkdtemp(prefix="lvgym-designs-") if a.fresh else None
     records, lines = [], []
+    if a.episodes:                                  # the fixed baseline's design, once, before the evaluations
+        from lvgym.baselines.designed import nominal_file
+
+        if fresh:
+            with using(fresh):
+                print(summary_text(design_vehicle(nominal_file())), flush=True)
+        else:
+            print(summary_text(design_vehicle(nominal_file())), flush=True)
     seed = SPLITS["test"][0]
     while len(records) < a.vehicles:
         g = generate_flyable(seed)
@@ -67,7 +77,6 @@ def main(argv: list[str] | None = None) -> int:
         records.append({"seed": seed, "design": g.design, "wall_s": round(wall, 2), "summary": d.summary})
         if a.episodes:
             env = {} if not fresh else {"LVGYM_CACHE_DIR": fresh}
-            import os
             proc = subprocess.run([sys.executable, "-m", "lvgym.cli.main", "evaluate", "--vehicle", str(path),
                                    "--policies", *POLICIES, "--episodes", str(a.episodes), "--seed-set", "validation",
                                    "--no-plots", "--no-progress", "--out", str(out / f"eval_{seed}")],
