@@ -6,8 +6,10 @@ run would take minutes (:data:`SHORTEN`: options each command documents, such as
 from __future__ import annotations
 
 import importlib.util
+import os
 import re
 import shlex
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -37,6 +39,7 @@ SHORTEN = {
     "lvgym design pid-flex --vehicle smile": "--times 28.8 --starts 0",
     "lvgym design lqg --vehicle smile": "--rows 28.8",
     "lvgym margins --policies gs-pid-flex lqg": "--seeds 1 --mission-time-s 5",
+    "lvgym design auto --vehicle my_rocket.yaml": "--rows 2 --flex-maxiter 20 --workers 1",
 }
 
 
@@ -54,8 +57,9 @@ def _sh(n: int) -> list[str]:
     return _commands([code for lang, code in BLOCKS if lang == "sh"][n])
 
 
-def _run(command: str, cwd: Path) -> subprocess.CompletedProcess:
-    """One README command, shortened, run in ``cwd`` (the repository's scripts and files by their path)."""
+def _run(command: str, cwd: Path, cache: Path | None = None) -> subprocess.CompletedProcess:
+    """One README command, shortened, run in ``cwd`` (the repository's scripts and files by their path);
+    ``cache``: its ``$LVGYM_CACHE_DIR``."""
     argv = shlex.split(command) + shlex.split(SHORTEN[command])
     if argv[0] == "python":
         argv = [sys.executable, *[str(ROOT / a) if a.endswith(".py") and (ROOT / a).exists() else a for a in argv[1:]]]
@@ -63,7 +67,8 @@ def _run(command: str, cwd: Path) -> subprocess.CompletedProcess:
         argv = ["cp", str(ROOT / argv[1]), *argv[2:]]
     elif argv[0] == "lvgym":
         argv = [sys.executable, "-m", "lvgym.cli.main", *argv[1:]]
-    proc = subprocess.run(argv, cwd=cwd, capture_output=True, text=True, timeout=600)
+    env = None if cache is None else {**os.environ, "LVGYM_CACHE_DIR": str(cache)}
+    proc = subprocess.run(argv, cwd=cwd, capture_output=True, text=True, timeout=600, env=env)
     assert proc.returncode == 0, f"{command}: exit {proc.returncode}\n{proc.stdout[-2000:]}\n{proc.stderr[-3000:]}"
     return proc
 
@@ -145,5 +150,8 @@ def test_linearise():
 
 
 def test_design_and_margins(tmp_path):
+    shutil.copy(ROOT / "lvgym" / "vehicles" / "smile_v1.yaml", tmp_path / "my_rocket.yaml")   # the cp above
     for command in _sh(5):
-        _run(command, tmp_path)
+        auto = command.startswith("lvgym design auto")
+        proc = _run(command, tmp_path, cache=tmp_path / "cache" if auto else None)   # the test's design cache
+        assert not auto or "designed in" in proc.stdout
