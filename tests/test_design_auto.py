@@ -163,3 +163,18 @@ def test_the_fixed_baseline_flies_the_nominal_members_design_on_another_vehicle(
             policy.reset()
             obs, _, _, _, info = env.step(policy.act(obs, info))
             assert np.isfinite(obs).all() and policy.name == f"fixed-{kind}"
+
+
+def test_a_vehicle_without_slosh_designs_too(tmp_path):
+    """A solid motor has no liquid to slosh: the designs and their margin tables say '-' for its slosh."""
+    from lvgym.baselines.design.auto import Budget, design_vehicle
+    from lvgym.simulator.cache import using
+    from lvgym.vehicle.generator import generate
+
+    g = generate(20002)                                   # a single-stage solid of the test split
+    assert g.design["motors"] == ["solid"]
+    path = g.write(tmp_path)
+    with using(tmp_path / "cache"):
+        d = design_vehicle(path, Budget(flex_maxiter=20, workers=1, rows=2), grid=ONE_WEIGHT)
+    table = (d.folder / "lqg_margins.md").read_text().splitlines()
+    assert len(table) == 2 + 2 * 2 and all(row.split("|")[6].strip() == "-" for row in table[2:])

@@ -339,6 +339,11 @@ def _m(m: dict[str, Any]) -> str:
             f"{m['gain_crossover_radps']:.3g} / {st}")
 
 
+def _slosh(gains_db: list[float]) -> str:
+    """The largest loop gain at a slosh mode [dB], or ``-`` for a vehicle without slosh (a solid motor)."""
+    return f"{max(gains_db):.1f}" if gains_db else "-"
+
+
 def margin_table(doc: dict[str, Any]) -> str:
     """The margins per row and plane as a Markdown table."""
     lines = ["| t [s] | plane | q_int, r_gimbal, w_gimbal, q_modes, w_modes | rigid GM / GRM [dB] / PM [deg] at [rad/s] / CL | "
@@ -354,7 +359,7 @@ def margin_table(doc: dict[str, Any]) -> str:
                              if isinstance(v, dict) and k not in ("rigid", "nonrigid"))
             wt = d.weights
             lines.append(f"| {r['time_s']:g} | {plane} | {wt.q_int:g}, {wt.r_gimbal:g}, {wt.w_gimbal:g}, {wt.q_modes:g}, {wt.w_modes:g} "
-                         f"| {_m(a['rigid'])} | {_m(a['nonrigid'])} | {max(a['slosh_db']):.1f} | "
+                         f"| {_m(a['rigid'])} | {_m(a['nonrigid'])} | {_slosh(a['slosh_db'])} | "
                          f"{', '.join(f'{x:.1f}' for x in a['bending_db'])} | {a['gust_h2']:.4f} | {ends} |")
     return "\n".join(lines) + "\n"
 
