@@ -25,8 +25,6 @@ period and its delay, so the model is of the loop the benchmark flies.
 
 from __future__ import annotations
 
-from typing import Any
-
 import control
 import numpy as np
 

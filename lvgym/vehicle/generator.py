@@ -25,7 +25,6 @@ ranges (:data:`SPLITS`).
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable
 from dataclasses import asdict, dataclass
 from pathlib import Path
