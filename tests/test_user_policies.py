@@ -175,6 +175,11 @@ def test_the_built_in_names_are_the_registered_ones():
                                                      (("name", "gs-pid"), ("schedule", "smile")))
     assert registry.POLICIES["ppo-res-lqg"] == PolicySpec("ppo-res-lqg", "lvgym.agents.policy:shipped_policy",
                                                           (("file", "ppo_res_lqg_smile_v1"), ("name", "ppo-res-lqg")))
-    assert sorted(registry.POLICIES) == ["aac", "aac-quiet", "gs-pid", "gs-pid-flex", "gs-pid-flex-quiet",
-                                         "gs-pid-thesis", "lqg", "lqg-aw", "lqg-front", "mpc", "pid", "pid-thesis",
-                                         "ppo", "ppo-res-lqg", "privileged", "zero"]
+    assert registry.POLICIES["auto-lqg"] == PolicySpec("auto-lqg", "lvgym.baselines.designed:auto_policy",
+                                                       (("kind", "lqg"), ("name", "auto-lqg")))
+    assert registry.POLICIES["fixed-gs-pid-flex"] == PolicySpec(
+        "fixed-gs-pid-flex", "lvgym.baselines.designed:fixed_policy", (("kind", "gs-pid-flex"), ("name", "fixed-gs-pid-flex")))
+    assert sorted(registry.POLICIES) == ["aac", "aac-quiet", "auto-gs-pid", "auto-gs-pid-flex", "auto-lqg",
+                                         "fixed-gs-pid-flex", "fixed-lqg", "gs-pid", "gs-pid-flex",
+                                         "gs-pid-flex-quiet", "gs-pid-thesis", "lqg", "lqg-aw", "lqg-front", "mpc",
+                                         "pid", "pid-thesis", "ppo", "ppo-res-lqg", "privileged", "zero"]
