@@ -86,7 +86,35 @@ def main(argv: list[str] | None = None) -> int:
         seed += 1
     (out / "designs.json").write_text(json.dumps(records, indent=1))
     (out / "flights.md").write_text("\n".join(lines))
+    if a.episodes:
+        table = summary_table(sorted(out.glob("eval_*/episodes.csv")))
+        (out / "summary.md").write_text(table + "\n")
+        print(table)
     return 0
+
+
+def summary_table(files: list[Path]) -> str:
+    """Over the vehicles' evaluations (their ``episodes.csv``): per policy and model, the vehicles with no
+    failed or unflyable flight, the failed-or-unflyable flights of all, and the median over the vehicles of
+    each vehicle's mean ``score_v2`` with its range, as a markdown table."""
+    import pandas as pd
+
+    frames = [pd.read_csv(f).assign(vehicle=f.parent.name.removeprefix("eval_")) for f in files]
+    df = pd.concat(frames)
+    df["bad"] = df["failed"].astype(bool) | ~df["flyable"].astype(bool)
+    lines = [f"{len(files)} vehicles, {df['seed'].nunique()} validation seeds each: vehicles held (no failed or "
+             "unflyable flight), bad flights of all, and the median [min, max] over the vehicles of the mean "
+             "score_v2 [rad]", "", "| model | policy | vehicles held | bad flights | score_v2 |", "|---|---|---:|---:|---:|"]
+    for model in ("rigid", "nonrigid"):
+        for policy in POLICIES:
+            d = df[(df["model"] == model) & (df["policy"] == policy)]
+            if d.empty:
+                continue
+            per = d.groupby("vehicle").agg(bad=("bad", "sum"), score=("score_v2", "mean"))
+            lines.append(f"| {model} | {policy} | {int((per['bad'] == 0).sum())} of {len(per)} | "
+                         f"{int(d['bad'].sum())} of {len(d)} | {per['score'].median():.3f} "
+                         f"[{per['score'].min():.3f}, {per['score'].max():.3f}] |")
+    return "\n".join(lines)
 
 
 if __name__ == "__main__":
