@@ -304,7 +304,13 @@ def design_schedule(vehicle: Any = "smile", rows: tuple[float, ...] | None = Non
         chosen = None
         for plane in planes:                 # the first plane's search; the others fly its weights (axisymmetric)
             g = grid if chosen is None else {k: (v,) for k, v in asdict(chosen).items()}
-            d, a, table = search_row(op_n, op_r, near, plane, tg, g, log)
+            try:
+                d, a, table = search_row(op_n, op_r, near, plane, tg, g, log)
+            except RuntimeError:
+                if g is grid:
+                    raise
+                log(f"  {plane}: the first plane's weights give no design here; the plane's own search")
+                d, a, table = search_row(op_n, op_r, near, plane, tg, grid, log)
             chosen = chosen or d.weights
             entry[plane] = {"design": d, "assessment": a, "search": table,
                             "modes_radps": mode_frequencies(op_n, plane)}
