@@ -91,3 +91,33 @@ def flies_nominal(data: dict[str, Any], seconds: float = 60.0) -> bool:
 def generate_flyable(seed: int, ranges: FamilyRanges | None = None, seconds: float = 60.0) -> GeneratedVehicle:
     """The vehicle of ``seed`` that also passes :func:`flies_nominal` over ``seconds`` [s]."""
     return generate(seed, ranges, check=partial(flies_nominal, seconds=seconds))
+
+
+def write_family(split: str, count: int, folder: str | Path) -> list[Path]:
+    """The first ``count`` vehicles of ``split``'s seeds (:data:`lvgym.vehicle.generator.SPLITS`) that pass
+    the family's checks (:func:`generate_flyable`; a seed none of whose draws passes is skipped), written to
+    ``folder`` as ``<split>_<seed>.yaml`` with a header naming the seed and the attempt. The shipped family
+    vehicles (``lvgym/vehicles/family``) were written by it: they are frozen data of the family's suites, so
+    a later change of the generator changes none of them."""
+    from lvgym.errors import ConfigError
+    from lvgym.vehicle.generator import SPLITS
+
+    out = Path(folder)
+    out.mkdir(parents=True, exist_ok=True)
+    paths: list[Path] = []
+    seed, end = SPLITS[split] if split in SPLITS else (None, None)
+    if seed is None:
+        raise ConfigError("split", split, f"one of {sorted(SPLITS)}")
+    while len(paths) < count and seed < end:
+        try:
+            g = generate_flyable(seed)
+        except ConfigError:
+            seed += 1
+            continue
+        path = out / f"{split}_{seed}.yaml"
+        header = (f"# lvgym's launcher family: the {split} vehicle of seed {seed} (generator attempt {g.attempt}),\n"
+                  "# written by lvgym.baselines.family.write_family: frozen data of the family's suites\n")
+        path.write_text(header + yaml.safe_dump(g.data, sort_keys=False))
+        paths.append(path)
+        seed += 1
+    return paths

@@ -272,6 +272,40 @@ SUITES_V2: dict[str, Suite] = {s.name: s for s in (
 )}
 SUITES.update(SUITES_V2)
 
+#: the launcher family's suites: not frozen yet (results carry ``v2-family-draft``). Each test vehicle
+#: (``lvgym/vehicles/family``: the first 20 test seeds of :mod:`lvgym.vehicle.generator` whose vehicles
+#: pass the family's checks, written once by ``lvgym.baselines.family.write_family``) is a pair of
+#: conditions, rigid and non-rigid, in smile-v2's conditions for 60 s; a policy flies every vehicle on the
+#: same wind seeds. ``family-v2`` is the ``blind`` track (the flight computer's signals only),
+#: ``family-v2-informed`` the ``informed`` one (the observation ends with the vehicle's design
+#: parameters: the env option ``vehicle_info``). docs/family.md
+PROTOCOL_FAMILY = "v2-family-draft"
+FAMILY_VEHICLES = tuple(f"family/test_{seed}" for seed in range(20_000, 20_020))
+#: the family's baselines: none, the privileged reference, the nominal member's designs on every vehicle
+#: (fixed), the per-vehicle rigid-body design (the thesis's practice) and flexible designs (the field's)
+FAMILY_POLICIES = ("zero", "privileged", "fixed-gs-pid-flex", "fixed-lqg", "auto-gs-pid", "auto-gs-pid-flex",
+                   "auto-lqg")
+FAMILY_MISSION_S = 60.0
+
+
+def _family(suite: str, **options: Any) -> tuple[Condition, ...]:
+    """The conditions of a family suite: a rigid and a non-rigid one per vehicle of :data:`FAMILY_VEHICLES`
+    (grouped per vehicle: ``<suite>/<seed>``)."""
+    return tuple(c for v in FAMILY_VEHICLES for c in _pair(f"{suite}/{v.rsplit('_', 1)[1]}", SMILE_V1,
+                                                           "turbulence_gust", V1_DISPERSIONS, vehicle=v,
+                                                           mission_time_s=FAMILY_MISSION_S, **options))
+
+
+SUITES_FAMILY: dict[str, Suite] = {s.name: s for s in (
+    Suite("family-v2", "the launcher family's 20 test vehicles, blind: each in smile-v2's conditions for 60 s, "
+          "rigid and non-rigid, under the flyability rule", _family("family-v2"), version=PROTOCOL_FAMILY,
+          reference="auto-lqg", policies=FAMILY_POLICIES),
+    Suite("family-v2-informed", "family-v2 with the vehicle's design parameters at the end of the observation "
+          "(vehicle_info)", _family("family-v2-informed", vehicle_info=True), version=PROTOCOL_FAMILY,
+          reference="auto-lqg", policies=FAMILY_POLICIES),
+)}
+SUITES.update(SUITES_FAMILY)
+
 
 def get_suite(name: str) -> Suite:
     """The suite called ``name``; a :class:`~lvgym.errors.ConfigError` (a ``ValueError``) lists the known

@@ -55,6 +55,7 @@ from typing import Any
 from lvgym.benchmark import (DEFAULT_SUITE, EXECUTORS, PROTOCOL_VERSION, SEED_SETS, SUITES, PolicySpec, compare,
                              degradation, evaluate, get_suite, markdown_table, normalise, run_groups, summarize,
                              write_results)
+from lvgym.benchmark.family import family_rows, family_table
 from lvgym.benchmark.headline import headline, policy_kind
 from lvgym.cli.policies import POLICIES, resolve_policy  # (registers the built-in policies)
 from lvgym.errors import ConfigError
@@ -182,13 +183,19 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
         "wall_time_s": round(wall, 3), "created_utc": dt.datetime.now(dt.timezone.utc).isoformat(timespec="seconds"),
     }
     table = markdown_table(summary, deg, meta, comparison, groups, rows)
+    family = family_rows(records)
+    if family:                                      # a family suite: its vehicles gathered first
+        table = "\n".join(["### The launcher family, over its vehicles", "", "Each vehicle flies the same wind "
+                           "seeds; 95 % intervals by resampling the vehicles and the seeds (lvgym.benchmark.family); "
+                           "held: no failed or unflyable flight of the vehicle. Per vehicle: the tables below.", "",
+                           *family_table(family), "", table])
     paths = write_results(args.out, records, summary, deg, meta, plots=args.plots, comparison=comparison,
                           groups=groups, headline=rows)
     print(table)
     print(f"{len(records)} episodes in {wall:.1f} s ({args.executor}); results in {Path(args.out)}/: "
           f"{', '.join(sorted(paths))}", file=sys.stderr)
     return {"records": records, "summary": summary, "degradation": deg, "comparison": comparison,
-            "run_groups": groups, "headline": rows, "meta": meta, "table": table}
+            "run_groups": groups, "headline": rows, "meta": meta, "table": table, "family": family}
 
 
 if __name__ == "__main__":

@@ -45,13 +45,15 @@ from lvgym.simulator.imu import Imu
 from lvgym.simulator.layouts import ACTUATOR, CONDITIONS
 from lvgym.simulator.servo import Servo
 from lvgym.vehicle import MassModel, Vehicle, load_vehicle
+from lvgym.vehicle.designinfo import design_vector
 from lvgym.vehicle.slender import SlenderGeometry
 
 from .coast import coast_moment
 from .dispersions import DispersionPlan
 from .faults import FAULT, apply_faults, decode, fault_names
 from .history import HistoryStack, recorded_action
-from .layouts import ACTIONS, FLIGHT_DRAWS, NAV, OBSERVATIONS, REASONS, REWARD, REWARD_TERMS, SENSOR_NOISE, TASK
+from .layouts import (ACTIONS, FLIGHT_DRAWS, NAV, OBSERVATIONS, REASONS, REWARD, REWARD_TERMS, SENSOR_NOISE, TASK,
+                      informed_layout)
 from .limits import qalpha_task_entries, resolve_qalpha_limit
 from .privileged import privileged_info
 from .signals import TaskData, qalpha_limit_rows, reset_signals, step_signals_range
@@ -154,7 +156,10 @@ class AscentFuncEnv(FuncEnv):
                              physics=PhysicsSpec(s.physics_dt_s, s.slosh_frequency), servo=servo, imu=imu)
         self.n_steps = int(round(s.mission_time_s / s.control_dt_s))
         #: the layout of one sample of the observation mode (the observation itself without ``history``)
-        self.sample_layout = OBSERVATIONS[s.observation]
+        self.sample_layout = (informed_layout(OBSERVATIONS[s.observation]) if s.vehicle_info
+                              else OBSERVATIONS[s.observation])
+        #: the ``vehicle_info`` block (the vehicle's design parameters) and where it starts, or None
+        self._info = (design_vector(vehicle), OBSERVATIONS[s.observation].size) if s.vehicle_info else None
         self.history = HistoryStack(self.sample_layout, ACTIONS[s.control], s.history) if s.history else None
         self.observation_layout = self.history.layout if self.history else self.sample_layout
         self.action_space = (spaces.Box(-1.0, 1.0, (2,), np.float32) if s.control == "tvc" else spaces.MultiDiscrete([3]))
@@ -291,6 +296,7 @@ class AscentFuncEnv(FuncEnv):
         self._draw_flight(sim, ts, rows, rngs, self._draw_sigma_reset)
         reset_signals(rows, params.task, params.setup, sim, ts, params.tables)
         self._add_noise(sim, ts, rows, rngs)
+        self._add_info(sim, ts, rows)
         if self.history:
             self.history.reset(ts.history, rows, ts.obs[rows])
         events = list(state.events)
@@ -336,6 +342,7 @@ class AscentFuncEnv(FuncEnv):
         self.sim.run_rows(_SIGNALS, B, params.task, params.setup, sim, ts, params.tables)
         if self._noisy:
             self._add_noise(sim, ts, range(B), rng)
+        self._add_info(sim, ts, slice(None))
         if self.history:
             self.history.push(ts.history, ts.obs, recorded_action(s.control, sampled))
         return AscentState(sim=sim, task=ts, events=events)
@@ -480,6 +487,16 @@ class AscentFuncEnv(FuncEnv):
             for sl in self._draw_slices:
                 d[b, sl] = z[o:o + sl.stop - sl.start]
                 o += sl.stop - sl.start
+
+    def _add_info(self, sim: SimData, ts: TaskData, rows: Any) -> None:
+        """The ``vehicle_info`` block of the observation of ``rows`` (an index array or a slice): the
+        vehicle's design parameters, except on a row whose flight failed (its observation stays zero)."""
+        if self._info is None:
+            return
+        vector, start = self._info
+        idx = np.arange(ts.obs.shape[0])[rows]
+        idx = idx[~sim.failed[idx]]
+        ts.obs[idx, start:] = vector
 
     def _add_noise(self, sim: SimData, ts: TaskData, rows: Any, rngs: Sequence[np.random.Generator | None]) -> None:
         """Sensor noise on the observation of ``rows`` (layout SENSOR_NOISE), each row from its own

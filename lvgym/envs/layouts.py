@@ -16,11 +16,13 @@ The env docstrings print these tables (:func:`observation_table`), so the docs a
 
 from __future__ import annotations
 
+import functools
+
 from lvgym.packing import Field, Packed, rst_table
 
 __all__ = ["ACTIONS", "FLIGHT_DRAWS", "FLIGHT_SOURCE", "G0", "NAV", "OBSERVATIONS", "OBS_FLIGHT", "OBS_SENSORS", "OBS_STATE",
            "REASONS", "REWARD", "REWARD_TERMS", "SENSOR_NOISE",
-           "TASK", "FD", "NV", "O", "OF", "OS", "RW", "T", "observation_table"]
+           "TASK", "VEHICLE_INFO", "informed_layout", "FD", "NV", "O", "OF", "OS", "RW", "T", "observation_table"]
 
 G0 = 9.80665
 
@@ -100,6 +102,25 @@ OBS_FLIGHT = Packed("observation (flight)", [
     Field("accel_y", 1, "g0", "the same along body y"),
 ] + _COMMON_TAIL, interface=True)
 OBSERVATIONS = {"state": OBS_STATE, "sensors": OBS_SENSORS, "flight": OBS_FLIGHT}
+#: ``vehicle_info=True``: the vehicle's design parameters at lift-off after the observation mode's entries
+#: (:mod:`lvgym.vehicle.designinfo`; the nominal vehicle file's, not an episode's dispersed draw)
+VEHICLE_INFO = Packed("vehicle design parameters", [
+    Field("vehicle_mass_t", 1, "t", "lift-off mass"),
+    Field("vehicle_pitch_inertia_log10", 1, "log10 kg m^2", "lift-off pitch inertia about the CG, as log10"),
+    Field("vehicle_slenderness_over_10", 1, "-", "length over the largest outer diameter, over 10"),
+    Field("vehicle_thrust_to_weight", 1, "-", "lift-off thrust at sea level over the lift-off weight"),
+    Field("vehicle_control_power_over_10", 1, "1/s^2", "pitch control power T_v (x_cg - x_gimbal) / J_yy, over 10"),
+    Field("vehicle_bending_hz_over_10", 1, "Hz", "first free-free bending frequency at lift-off, over 10"),
+    Field("vehicle_slosh_mass_share", 1, "-", "slosh pendulum masses over the lift-off mass"),
+    Field("vehicle_slosh_hz", 1, "Hz", "the largest slosh pendulum's frequency at the lift-off thrust acceleration"),
+], interface=True)
+
+
+@functools.lru_cache(maxsize=8)
+def informed_layout(base: Packed) -> Packed:
+    """The observation ``base`` followed by :data:`VEHICLE_INFO` (the option ``vehicle_info``): ``base``'s
+    entries keep their names and indices."""
+    return Packed(f"{base.title}, vehicle design parameters", [*base.fields, *VEHICLE_INFO.fields], interface=True)
 #: the action as an observation with ``history`` records it (:mod:`.history`), per ``control``: the TVC
 #: command clipped to [-1, 1] (what the flight computer sent, before the controller-off gating and the
 #: ``action_delay_steps`` queue), the RCS pulse as the action minus 1 (so that the zero of a reset is "no pulse")

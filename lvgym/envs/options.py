@@ -251,6 +251,11 @@ class SensorOptions(Options):
     ``gimbal_arm``, ``vectored_share``, ``J_b_diag``, ``v_air_b``, ``misalignment``, ``actuator_effectiveness``
     and the wind ahead, ``wind_ahead_n`` and ``m_aero_ahead_b``): for a privileged reference or a teacher
     policy, never for a scored causal one"""
+    vehicle_info: bool = option(False, boolean=True)
+    """the observation ends with the vehicle's design parameters at lift-off, constant over the episode
+    (:data:`~.layouts.VEHICLE_INFO`: mass, pitch inertia, L/D, thrust-to-weight, control power, the first
+    bending and slosh frequencies, the slosh mass share; :mod:`lvgym.vehicle.designinfo`): what a flight
+    computer can be loaded with, the ``informed`` track of the launcher family's suite"""
 
 
 @dataclass(frozen=True)

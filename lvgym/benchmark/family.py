@@ -1,0 +1,77 @@
+"""The launcher family's table: a family suite's flights (:data:`~.suites.SUITES_FAMILY`: a rigid and a
+non-rigid condition per test vehicle) gathered over its vehicles, per model and policy.
+
+Per (suite, model, policy), over the vehicles x wind seeds the policy flew: the share of failed flights, the
+share of failed or unflyable ones (v2's flyability rule), the mean ``score_v2``, each with a 95 % interval,
+and the vehicles it held (no failed or unflyable flight). The intervals come from a crossed bootstrap that
+resamples the vehicles and the wind seeds (every vehicle flies the same seeds): a family's spread between
+vehicles is most of the uncertainty, and an interval over the seeds alone would hide it.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Mapping, Sequence
+from typing import Any
+
+import numpy as np
+
+from .suites import SUITES_FAMILY
+
+__all__ = ["REPS", "crossed_interval", "family_rows", "family_table"]
+
+#: bootstrap replicates of the crossed intervals
+REPS = 2000
+
+
+def crossed_interval(values: np.ndarray, reps: int = REPS, level: float = 0.95, seed: int = 0) -> tuple[float, float]:
+    """The ``level`` percentile interval of the mean of ``values`` (vehicles x seeds) under a bootstrap that
+    resamples the rows (vehicles) and the columns (seeds) independently."""
+    v = np.asarray(values, float)
+    rng = np.random.RandomState(seed)
+    n_v, n_s = v.shape
+    means = np.empty(reps)
+    for k in range(reps):
+        means[k] = v[np.ix_(rng.randint(0, n_v, n_v), rng.randint(0, n_s, n_s))].mean()
+    a = (1.0 - level) / 2.0
+    return float(np.quantile(means, a)), float(np.quantile(means, 1.0 - a))
+
+
+def family_rows(records: Iterable[Mapping[str, Any]]) -> list[dict[str, Any]]:
+    """One row per (family suite, model, policy) of ``records`` (others are left out), in order of
+    appearance: ``suite``, ``model``, ``policy``, ``vehicles``, ``seeds``; ``failed``, ``bad`` (failed or
+    unflyable) and ``score_v2``, each as the mean with ``_low`` and ``_high``; ``held`` (vehicles without a
+    bad flight). Only the seeds every vehicle flew count (a crossed design)."""
+    cells: dict[tuple[str, str, str], dict[str, dict[int, Mapping[str, Any]]]] = {}
+    for r in records:
+        if r.get("suite") in SUITES_FAMILY and "score_v2" in r:
+            cells.setdefault((r["suite"], r["model"], r["policy"]), {}).setdefault(r["group"], {})[int(r["seed"])] = r
+    out = []
+    for (suite, model, policy), per_vehicle in cells.items():
+        seeds = sorted(set.intersection(*(set(v) for v in per_vehicle.values())))
+        vehicles = list(per_vehicle)
+        grid = [[per_vehicle[v][s] for s in seeds] for v in vehicles]
+        metrics = {"failed": np.array([[bool(r["failed"]) for r in row] for row in grid], float),
+                   "bad": np.array([[bool(r["failed"]) or not bool(r.get("flyable", True)) for r in row]
+                                    for row in grid], float),
+                   "score_v2": np.array([[float(r["score_v2"]) for r in row] for row in grid])}
+        row: dict[str, Any] = {"suite": suite, "model": model, "policy": policy, "vehicles": len(vehicles),
+                               "seeds": len(seeds), "held": int((metrics["bad"].sum(axis=1) == 0).sum())}
+        for name, m in metrics.items():
+            lo, hi = crossed_interval(m) if m.size else (float("nan"), float("nan"))
+            row.update({name: float(m.mean()) if m.size else float("nan"), f"{name}_low": lo, f"{name}_high": hi})
+        out.append(row)
+    return out
+
+
+def family_table(rows: Sequence[Mapping[str, Any]]) -> list[str]:
+    """:func:`family_rows` as Markdown lines, ranked per suite and model by the bad share, then score_v2."""
+    lines = ["| suite | model | policy | vehicles held | failed [95 % CI] | failed or unflyable [95 % CI] | "
+             "score_v2 [rad] [95 % CI] |", "|---|---|---|---:|---:|---:|---:|"]
+    order = sorted(rows, key=lambda r: (r["suite"], r["model"] != "rigid", r["bad"], r["score_v2"]))
+    for r in order:
+        pct = "{:.0f} % [{:.0f}, {:.0f}]".format
+        lines.append(f"| {r['suite']} | {r['model']} | {r['policy']} | {r['held']} of {r['vehicles']} | "
+                     f"{pct(100 * r['failed'], 100 * r['failed_low'], 100 * r['failed_high'])} | "
+                     f"{pct(100 * r['bad'], 100 * r['bad_low'], 100 * r['bad_high'])} | "
+                     f"{r['score_v2']:.3f} [{r['score_v2_low']:.3f}, {r['score_v2_high']:.3f}] |")
+    return lines
