@@ -178,3 +178,11 @@ def test_a_vehicle_without_slosh_designs_too(tmp_path):
         d = design_vehicle(path, Budget(flex_maxiter=20, workers=1, rows=2), grid=ONE_WEIGHT)
     table = (d.folder / "lqg_margins.md").read_text().splitlines()
     assert len(table) == 2 + 2 * 2 and all(row.split("|")[6].strip() == "-" for row in table[2:])
+
+
+def test_a_crossing_bracket_without_a_sign_change_takes_its_nearer_end():
+    from lvgym.baselines.design.linearize import _root
+
+    assert _root(lambda x: x - 0.3, 0.0, 1.0) == pytest.approx(0.3, abs=1e-12)
+    assert _root(lambda x: (x - 0.9) ** 2 + 1e-9, 0.0, 1.0) == 1.0     # touches zero near 0.9: the nearer end
+    assert _root(lambda x: x, 0.0, 1.0) == 0.0

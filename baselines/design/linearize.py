@@ -426,14 +426,24 @@ def crossings(L: control.StateSpace) -> tuple[np.ndarray, np.ndarray, np.ndarray
     arg = np.angle(-resp)                      # zero where the phase of L crosses -180 deg
     i_pc = np.where(np.diff(np.sign(arg)))[0]
     i_pc = i_pc[resp[i_pc].real <= 0.0]
-    wpc = np.array([optimize.brentq(lambda x: np.angle(-at(x)), w[i], w[i + 1], xtol=1e-12) for i in i_pc])
+    wpc = np.array([_root(lambda x: np.angle(-at(x)), w[i], w[i + 1]) for i in i_pc])
     mag = np.abs(resp) - 1.0
     i_gc = np.where(np.diff(np.sign(mag)))[0]
-    wgc = np.array([optimize.brentq(lambda x: abs(at(x)) - 1.0, w[i], w[i + 1], xtol=1e-12) for i in i_gc])
+    wgc = np.array([_root(lambda x: abs(at(x)) - 1.0, w[i], w[i + 1]) for i in i_gc])
     with np.errstate(divide="ignore"):
         gm = np.array([1.0 / abs(at(x)) for x in wpc])
     pm = np.array([np.remainder(np.angle(at(x), deg=True), 360.0) - 180.0 for x in wgc])
     return gm, pm, wpc, wgc
+
+
+def _root(f: Any, a: float, b: float) -> float:
+    """The root of ``f`` in the grid's bracket ``[a, b]`` (Brent's method); where ``f`` evaluated point by
+    point does not change sign over the bracket (the grid's response and the point's differ in the last
+    digits at a crossing that touches a grid point), the end where ``|f|`` is smaller."""
+    fa, fb = f(a), f(b)
+    if fa * fb > 0.0:
+        return a if abs(fa) <= abs(fb) else b
+    return optimize.brentq(f, a, b, xtol=1e-12)
 
 
 def margins(L: control.LTI) -> dict[str, float]:
