@@ -130,3 +130,16 @@ def test_the_family_table_by_hand():
     assert crossed_interval(np.ones((3, 5))) == (1.0, 1.0)
     lo, hi = crossed_interval(np.array([[0.0] * 5, [1.0] * 5, [2.0] * 5]))
     assert lo < 0.7 and hi > 1.3
+
+
+def test_the_familys_room_by_hand():
+    from lvgym.benchmark.family import family_room
+
+    recs = _records({("a", 0): [], ("a", 1): [], ("ref", 0): [], ("ref", 1): [], ("zero", 0): [], ("zero", 1): []})
+    for r in recs:                                       # the reference scores half of a, zero scores 0
+        r["score_v2"] = {"a": 1.0 + r["seed"], "ref": 0.5 * (1.0 + r["seed"]), "zero": 0.0}[r["policy"]]
+    (room,) = family_room(recs, {"a": "classical", "ref": "privileged", "zero": "none"})
+    assert (room["best"], room["reference"]) == ("a", "ref")
+    assert room["room"] == pytest.approx(0.5) and room["room_low"] == pytest.approx(0.5)
+    lines = family_table(family_rows(recs), [room])
+    assert lines[-1] == "| family-v2 | nonrigid | a | 50 % [50, 50] |"

@@ -10,30 +10,67 @@ vehicles is most of the uncertainty, and an interval over the seeds alone would 
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from typing import Any
 
 import numpy as np
 
 from .suites import SUITES_FAMILY
 
-__all__ = ["REPS", "crossed_interval", "family_rows", "family_table"]
+__all__ = ["REPS", "crossed_interval", "family_room", "family_rows", "family_table"]
 
 #: bootstrap replicates of the crossed intervals
 REPS = 2000
 
 
-def crossed_interval(values: np.ndarray, reps: int = REPS, level: float = 0.95, seed: int = 0) -> tuple[float, float]:
-    """The ``level`` percentile interval of the mean of ``values`` (vehicles x seeds) under a bootstrap that
-    resamples the rows (vehicles) and the columns (seeds) independently."""
-    v = np.asarray(values, float)
+def crossed_interval(values: np.ndarray | Sequence[np.ndarray], statistic: Callable[..., float] | None = None,
+                     reps: int = REPS, level: float = 0.95, seed: int = 0) -> tuple[float, float]:
+    """The ``level`` percentile interval of ``statistic`` (default: the mean) of ``values`` (vehicles x seeds,
+    or a sequence of such matrices paired cell by cell, ``statistic`` then taking one resample of each) under
+    a bootstrap that resamples the rows (vehicles) and the columns (seeds) independently."""
+    mats = [np.asarray(values, float)] if isinstance(values, np.ndarray) else [np.asarray(m, float) for m in values]
+    stat = statistic or (lambda m: float(m.mean()))
     rng = np.random.RandomState(seed)
-    n_v, n_s = v.shape
-    means = np.empty(reps)
+    n_v, n_s = mats[0].shape
+    out = np.empty(reps)
     for k in range(reps):
-        means[k] = v[np.ix_(rng.randint(0, n_v, n_v), rng.randint(0, n_s, n_s))].mean()
+        cells = np.ix_(rng.randint(0, n_v, n_v), rng.randint(0, n_s, n_s))
+        out[k] = stat(*(m[cells] for m in mats))
     a = (1.0 - level) / 2.0
-    return float(np.quantile(means, a)), float(np.quantile(means, 1.0 - a))
+    return float(np.quantile(out, a)), float(np.quantile(out, 1.0 - a))
+
+
+def _matrix(per_vehicle: Mapping[str, Mapping[int, Mapping[str, Any]]], vehicles: Sequence[str], seeds: Sequence[int],
+            key: str) -> np.ndarray:
+    return np.array([[float(per_vehicle[v][s][key]) for s in seeds] for v in vehicles])
+
+
+def family_room(records: Iterable[Mapping[str, Any]], kinds: Mapping[str, str]) -> list[dict[str, Any]]:
+    """Per (family suite, model): the best causal policy (``kinds``: label -> kind, as
+    :func:`~.headline.policy_kind`; causal: neither ``privileged`` nor ``none``, the zero policy's; the best: the
+    fewest failed or unflyable flights, then the lowest mean score_v2), the privileged reference, and the room
+    ``1 - score(privileged) / score(best)`` on the vehicles and seeds both flew, with its crossed interval."""
+    rows = family_rows(records)
+    recs = [r for r in records if r.get("suite") in SUITES_FAMILY and "score_v2" in r]
+    out = []
+    for suite, model in dict.fromkeys((r["suite"], r["model"]) for r in rows):
+        here = [r for r in rows if (r["suite"], r["model"]) == (suite, model)]
+        causal = [r for r in here if kinds.get(r["policy"], "other") not in ("privileged", "none")]
+        ref = [r for r in here if kinds.get(r["policy"]) == "privileged"]
+        if not causal or not ref:
+            continue
+        best = min(causal, key=lambda r: (r["bad"], r["score_v2"]))
+        per = {p: {} for p in (best["policy"], ref[0]["policy"])}
+        for r in recs:
+            if (r["suite"], r["model"]) == (suite, model) and r["policy"] in per:
+                per[r["policy"]].setdefault(r["group"], {})[int(r["seed"])] = r
+        vehicles = sorted(set(per[best["policy"]]) & set(per[ref[0]["policy"]]))
+        seeds = sorted(set.intersection(*(set(p[v]) for p in per.values() for v in vehicles)))
+        b, p = (_matrix(per[name], vehicles, seeds, "score_v2") for name in (best["policy"], ref[0]["policy"]))
+        lo, hi = crossed_interval((b, p), lambda x, y: 1.0 - float(y.mean()) / float(x.mean()))
+        out.append({"suite": suite, "model": model, "best": best["policy"], "reference": ref[0]["policy"],
+                    "room": 1.0 - float(p.mean()) / float(b.mean()), "room_low": lo, "room_high": hi})
+    return out
 
 
 def family_rows(records: Iterable[Mapping[str, Any]]) -> list[dict[str, Any]]:
@@ -63,8 +100,9 @@ def family_rows(records: Iterable[Mapping[str, Any]]) -> list[dict[str, Any]]:
     return out
 
 
-def family_table(rows: Sequence[Mapping[str, Any]]) -> list[str]:
-    """:func:`family_rows` as Markdown lines, ranked per suite and model by the bad share, then score_v2."""
+def family_table(rows: Sequence[Mapping[str, Any]], rooms: Sequence[Mapping[str, Any]] = ()) -> list[str]:
+    """:func:`family_rows` as Markdown lines, ranked per suite and model by the bad share, then score_v2;
+    then the room of each suite and model (:func:`family_room`), when given."""
     lines = ["| suite | model | policy | vehicles held | failed [95 % CI] | failed or unflyable [95 % CI] | "
              "score_v2 [rad] [95 % CI] |", "|---|---|---|---:|---:|---:|---:|"]
     order = sorted(rows, key=lambda r: (r["suite"], r["model"] != "rigid", r["bad"], r["score_v2"]))
@@ -74,4 +112,9 @@ def family_table(rows: Sequence[Mapping[str, Any]]) -> list[str]:
                      f"{pct(100 * r['failed'], 100 * r['failed_low'], 100 * r['failed_high'])} | "
                      f"{pct(100 * r['bad'], 100 * r['bad_low'], 100 * r['bad_high'])} | "
                      f"{r['score_v2']:.3f} [{r['score_v2_low']:.3f}, {r['score_v2_high']:.3f}] |")
+    if rooms:
+        lines += ["", "| suite | model | best causal | room [95 % CI] against the privileged reference |",
+                  "|---|---|---|---:|"]
+        lines += [f"| {r['suite']} | {r['model']} | {r['best']} | {100 * r['room']:.0f} % [{100 * r['room_low']:.0f}, "
+                  f"{100 * r['room_high']:.0f}] |" for r in rooms]
     return lines

@@ -55,7 +55,7 @@ from typing import Any
 from lvgym.benchmark import (DEFAULT_SUITE, EXECUTORS, PROTOCOL_VERSION, SEED_SETS, SUITES, PolicySpec, compare,
                              degradation, evaluate, get_suite, markdown_table, normalise, run_groups, summarize,
                              write_results)
-from lvgym.benchmark.family import family_rows, family_table
+from lvgym.benchmark.family import family_room, family_rows, family_table
 from lvgym.benchmark.headline import headline, policy_kind
 from lvgym.cli.policies import POLICIES, resolve_policy  # (registers the built-in policies)
 from lvgym.errors import ConfigError
@@ -188,7 +188,8 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
         table = "\n".join(["### The launcher family, over its vehicles", "", "Each vehicle flies the same wind "
                            "seeds; 95 % intervals by resampling the vehicles and the seeds (lvgym.benchmark.family); "
                            "held: no failed or unflyable flight of the vehicle. Per vehicle: the tables below.", "",
-                           *family_table(family), "", table])
+                           *family_table(family, family_room(records, {p.name: policy_kind(p) for p in policies})),
+                           "", table])
     paths = write_results(args.out, records, summary, deg, meta, plots=args.plots, comparison=comparison,
                           groups=groups, headline=rows)
     print(table)
