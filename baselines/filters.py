@@ -130,12 +130,15 @@ class FilterSeries:
         return self.filters[i]
 
     @classmethod
-    def from_dict(cls, data: list) -> "FilterSeries":
-        """From a list of filter mappings (:meth:`StructuralFilter.from_dict` each)."""
+    def from_dict(cls, data: list, key: str = "filter") -> "FilterSeries":
+        """From a list of filter mappings (:meth:`StructuralFilter.from_dict` each; ``key``: the list's name
+        in an error)."""
         if not isinstance(data, (list, tuple)) or not data:
-            raise ConfigError("filter", data, "a non-empty list of filter mappings (keys: "
+            raise ConfigError(key, data, "a non-empty list of filter mappings (keys: "
                               f"{', '.join(FILTER_KEYS)})")
-        return cls(tuple(filter_from_yaml(d, f"filter[{i}]") for i, d in enumerate(data)))
+        if any(isinstance(d, (list, tuple)) for d in data):
+            raise ConfigError(key, data, "a list of filter mappings (a flat list, no list in it)")
+        return cls(tuple(filter_from_yaml(d, f"{key}[{i}]") for i, d in enumerate(data)))
 
     def as_dict(self) -> list[dict[str, float]]:
         """The YAML form: a list of the filters' mappings."""
@@ -167,7 +170,7 @@ def filter_from_yaml(data: Any, key: str = "filter") -> Filter:
     """A schedule row's ``filter`` entry: a mapping gives a :class:`StructuralFilter`, a list of mappings a
     :class:`FilterSeries` (``key``: the entry's name in an error)."""
     if isinstance(data, (list, tuple)):
-        return FilterSeries.from_dict(list(data))
+        return FilterSeries.from_dict(list(data), key)
     if not isinstance(data, dict):
         raise ConfigError(key, data, f"a filter mapping (keys: {', '.join(FILTER_KEYS)}) or a list of them")
     unknown = sorted(set(data) - set(FILTER_KEYS))
