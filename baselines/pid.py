@@ -33,7 +33,7 @@ control period, and the observation layout; at every step the env's ``info`` giv
 stack's mass, and the observation the controller-on flag (off before the controller starts and during
 staging coasts).
 
-Scheduling (:class:`GainSchedule`): gains interpolated linearly on a monotonic scheduling variable,
+Scheduling (:class:`GainSchedule`, :mod:`.gainschedule`): gains interpolated linearly on a monotonic scheduling variable,
 ``mass`` (the default, as the thesis: ``info["mass"]``, the vehicle's mass at the current time), ``time``
 [s] or ``mach``; beyond the table the end gains are held. ``interpolation: nearest`` takes the nearest
 row instead (switching at the midpoints between breakpoints): each row is then a design for its own
@@ -42,7 +42,16 @@ stretch of the flight, as ``gs-pid-flex``'s are.
 Structural filters (``gs-pid-flex``, :mod:`.flexdesign`): a schedule whose rows carry a ``filter``
 (:class:`.filters.StructuralFilter`, its parameters interpolated like the gains) filters each axis's
 error before the PID, ``u = PID(F(e))``; the filter starts in the steady state of the error whenever
-the controller switches on.
+the controller switches on. A row's ``filter`` may also be a list of filters applied in series,
+``F = F_1 F_2 ...`` (:class:`.filters.FilterSeries`: a second notch for the second bending mode, a slosh
+notch), the same number in every row, each filter's parameters interpolated on their own.
+
+Attitude channel: a schedule whose rows carry ``attitude_gain`` ``k_theta`` [rad/s of rate command per rad
+of attitude error] subtracts the attitude error from each axis's error, ``e = -(rate error) - k_theta
+(attitude error)`` (the observation's ``pitch_attitude_error``, ``yaw_attitude_error`` [rad]), before the
+accelerometer term, the structural filter and the PID: the rate loop then commands a turn back to the
+reference attitude, ``-k_theta`` times its error, and no longer leaves the attitude to drift
+(``tests/test_schedule_channels.py`` checks the sign in flight).
 
 Load relief (:data:`ACCEL_SIGNS`): a schedule whose rows carry ``accel_gain`` ``k_a`` [rad/s of rate
 command per m/s^2 of lateral specific force] adds the IMU's accelerometers to each axis's error,
@@ -53,6 +62,26 @@ proportional to the sensed normal load, and its integral, which otherwise holds 
 where the lateral specific force is zero: the vehicle weathercocks at low frequency and the rate loop
 still damps it at high frequency (the accelerometer load relief of the max-q region:
 docs/flex-design.md, "The slender vehicle").
+
+The schedule's YAML (:mod:`.gainschedule`; docs/flex-design.md, "The schedule file"), a row with two
+filters in series and both channels::
+
+    variable: mass
+    interpolation: nearest
+    rows:
+    - mass_kg: 10164.7
+      kp: 0.42                  # rad of gimbal per rad/s
+      ki: 0.68                  # rad per rad
+      kd: 0.016                 # rad per rad/s^2
+      attitude_gain: 0.5        # rad/s per rad (optional, every row or none)
+      accel_gain: 0.002         # rad/s per m/s^2 (optional, every row or none)
+      filter:                   # one mapping, or a list of them applied in series
+      - {lead_zero_radps: 8.4, lead_pole_radps: 1400.0, lowpass_radps: 126.0, lowpass_damping: 0.41,
+         notch_radps: 59.7, notch_damping: 0.51, notch_depth: 0.022}
+      - {lowpass_radps: 5000.0, notch_radps: 140.0, notch_damping: 0.2, notch_depth: 0.1}
+
+The compiled batch (:mod:`.pidbatch`) flies up to :data:`.pidkernel.FILTERS_MAX` filters per row; a schedule
+with more flies as one copy of the policy per row.
 """
 
 from __future__ import annotations
