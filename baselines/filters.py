@@ -175,7 +175,8 @@ def filter_from_yaml(data: Any, key: str = "filter") -> Filter:
         raise ConfigError(key, data, f"a filter mapping (keys: {', '.join(FILTER_KEYS)}) or a list of them")
     unknown = sorted(set(data) - set(FILTER_KEYS))
     if unknown:
-        raise ConfigError(f"{key}.{unknown[0]}", data[unknown[0]], f"not a filter key; allowed: {', '.join(FILTER_KEYS)}")
+        raise ConfigError(f"{key}.{unknown[0]}", data[unknown[0]],
+                          f"not a filter key; allowed: {', '.join(FILTER_KEYS)}")
     try:
         return StructuralFilter.from_dict(data)
     except (TypeError, ValueError) as exc:

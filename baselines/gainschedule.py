@@ -210,7 +210,8 @@ class GainSchedule:
         for name in CHANNELS:
             present = [(name in r) for r in rows]
             if any(present) and not all(present):
-                raise ConfigError(name, [i for i, f in enumerate(present) if not f], "rows without it: in every row or none")
+                raise ConfigError(name, [i for i, f in enumerate(present) if not f],
+                                  "rows without it: in every row or none")
             channels[name] = tuple(_number(r[name], f"rows[{i}].{name}") for i, r in enumerate(rows)) \
                 if all(present) and rows else None
         return cls(var, get(key), get("kp"), get("ki"), get("kd"), get("n", math.inf), meta, filters,

@@ -1,5 +1,6 @@
 """The compiled act of the PID family (:mod:`.pid`: fixed gains, a gain schedule, structural filters, load
-relief, the attitude channel) for any number of rows: what :class:`.pidbatch.PIDBatch` runs for the rows of a batched env.
+relief, the attitude channel) for any number of rows: what :class:`.pidbatch.PIDBatch` runs for the rows of
+a batched env.
 
 The same floating-point operations in the same order as the per-row policy (:meth:`.pid.PIDPolicy.act`,
 :class:`.pid.DiscretePID`, :class:`.filters.FilterChain`), so that row ``b`` of a batch and a policy of its
@@ -36,7 +37,8 @@ from lvgym.envs.layouts import G0
 from lvgym.packing import Field, Packed
 
 __all__ = ["COEFFS", "FILTERS_MAX", "FILTERS_NONE", "FILTERS_ROWS", "FILTERS_TABLE", "FILTER_ROW", "GAINS", "ObsColumns",
-           "PID_ROW", "PIDSetup", "PIDState", "PIDTable", "SECTIONS", "SECTIONS_PER_FILTER", "TAPS", "VAR_FIXED", "VAR_MACH", "VAR_VALUE", "clip_k",
+           "PID_ROW", "PIDSetup", "PIDState", "PIDTable", "SECTIONS", "SECTIONS_PER_FILTER", "TAPS", "VAR_FIXED",
+           "VAR_MACH", "VAR_VALUE", "clip_k",
            "interp_k", "nearest_k", "pid_act_k", "pid_row_k"]
 
 #: how a row's scheduling variable is read (:attr:`PIDSetup.variable`): fixed gains (no variable), a value

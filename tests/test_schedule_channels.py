@@ -87,7 +87,8 @@ def test_yaml_round_trip_of_several_filters_and_the_attitude_channel(tmp_path):
     flex = GainSchedule.load("smile_flex")
     assert isinstance(flex.filters[0], StructuralFilter) and flex.filter_count == 1
     again = GainSchedule.load(flex.save(tmp_path / "flex.yaml"))
-    assert again == flex and again.filters == flex.filters and again.meta["rows"][0]["margins"] == flex.meta["rows"][0]["margins"]
+    assert again == flex and again.filters == flex.filters
+    assert again.meta["rows"][0]["margins"] == flex.meta["rows"][0]["margins"]
 
 
 def test_the_filters_of_a_series_interpolate_filter_by_filter():
@@ -95,7 +96,8 @@ def test_the_filters_of_a_series_interpolate_filter_by_filter():
     mid = 0.5 * (lin.points[0] + lin.points[1])
     f = lin.filter_at(mid)
     assert isinstance(f, FilterSeries) and len(f) == 2
-    assert f[0].notch_radps == pytest.approx(0.5 * (60.0 + 66.0)) and f[1].notch_radps == pytest.approx(0.5 * (140.0 + 154.0))
+    assert f[0].notch_radps == pytest.approx(0.5 * (60.0 + 66.0))
+    assert f[1].notch_radps == pytest.approx(0.5 * (140.0 + 154.0))
     assert f[0].lowpass_radps == pytest.approx(120.0) and f[1].lowpass_radps == pytest.approx(5000.0)
     assert lin.attitude_gain_at(mid) == pytest.approx(0.5) and lin.attitude_gain_at(1e9) == pytest.approx(0.4)
     near = GainSchedule.from_dict(_doc("nearest"))
