@@ -15,6 +15,13 @@ and a filter started in steady state passes a constant through unchanged):
 discrete filter sample by sample (direct form II transposed per section), with coefficients that may
 change between samples (a scheduled filter); :meth:`StructuralFilter.tf` is the same discrete filter
 as a python-control transfer function, for the linear design and the tests.
+
+:class:`FilterSeries` is several structural filters in series (a second notch for the second bending
+mode, a slosh notch, ...): the same interface (:meth:`~FilterSeries.continuous`,
+:meth:`~FilterSeries.discrete`, :meth:`~FilterSeries.tf`), its sections those of its filters in order,
+so :class:`FilterChain` runs either. In a gain schedule's YAML a row's ``filter`` is one mapping (a
+:class:`StructuralFilter`) or a list of mappings (a :class:`FilterSeries`, applied first to last):
+:func:`filter_from_yaml`, :func:`filter_to_yaml`.
 """
 
 from __future__ import annotations
@@ -25,9 +32,10 @@ from typing import Any
 
 import numpy as np
 
-from lvgym.errors import require
+from lvgym.errors import ConfigError, require
 
-__all__ = ["StructuralFilter", "FilterChain", "FILTER_KEYS"]
+__all__ = ["StructuralFilter", "FilterSeries", "FilterChain", "FILTER_KEYS", "Filter", "filter_count",
+           "filter_from_yaml", "filter_to_yaml"]
 
 
 @dataclass(frozen=True)
@@ -91,16 +99,104 @@ class StructuralFilter:
     def tf(self, dt: float) -> Any:
         """The discrete filter chain as a python-control transfer function at ``dt`` [s] (a design tool's
         view: needs python-control, ``pip install 'lvgym[control]'``; flying the filter does not)."""
-        require("control", "control", "StructuralFilter.tf")
-        import control
-
-        g = control.tf([1.0], [1.0], dt)
-        for b, a in self.discrete(dt):
-            g = g * control.tf(b, a, dt)
-        return g
+        return _sections_tf(self.discrete(dt), dt, "StructuralFilter.tf")
 
 
 FILTER_KEYS = tuple(f.name for f in fields(StructuralFilter))
+
+
+@dataclass(frozen=True)
+class FilterSeries:
+    """Structural filters applied in series, first to last (``filters``: one or more
+    :class:`StructuralFilter`); its sections are its filters' sections in that order, so it has their
+    interface and :class:`FilterChain` runs it. Each filter has unit gain at zero frequency, so the series
+    does too."""
+
+    filters: tuple[StructuralFilter, ...]
+
+    def __post_init__(self) -> None:
+        fs = tuple(self.filters) if isinstance(self.filters, (list, tuple)) else self.filters
+        if not isinstance(fs, tuple) or not fs or not all(isinstance(f, StructuralFilter) for f in fs):
+            raise ConfigError("filter", self.filters, "one or more structural filters in series")
+        object.__setattr__(self, "filters", fs)
+
+    def __len__(self) -> int:
+        return len(self.filters)
+
+    def __iter__(self):
+        return iter(self.filters)
+
+    def __getitem__(self, i: int) -> StructuralFilter:
+        return self.filters[i]
+
+    @classmethod
+    def from_dict(cls, data: list, key: str = "filter") -> "FilterSeries":
+        """From a list of filter mappings (:meth:`StructuralFilter.from_dict` each; ``key``: the list's name
+        in an error)."""
+        if not isinstance(data, (list, tuple)) or not data:
+            raise ConfigError(key, data, "a non-empty list of filter mappings (keys: "
+                              f"{', '.join(FILTER_KEYS)})")
+        if any(isinstance(d, (list, tuple)) for d in data):
+            raise ConfigError(key, data, "a list of filter mappings (a flat list, no list in it)")
+        return cls(tuple(filter_from_yaml(d, f"{key}[{i}]") for i, d in enumerate(data)))
+
+    def as_dict(self) -> list[dict[str, float]]:
+        """The YAML form: a list of the filters' mappings."""
+        return [f.as_dict() for f in self.filters]
+
+    def continuous(self) -> list[tuple[list[float], list[float], float]]:
+        """Every filter's sections in ``s``, in series order (:meth:`StructuralFilter.continuous`)."""
+        return [sec for f in self.filters for sec in f.continuous()]
+
+    def discrete(self, dt: float) -> list[tuple[np.ndarray, np.ndarray]]:
+        """Every filter's sections in ``z`` at ``dt`` [s], in series order (:meth:`StructuralFilter.discrete`)."""
+        return [sec for f in self.filters for sec in f.discrete(dt)]
+
+    def tf(self, dt: float) -> Any:
+        """The series as a python-control transfer function at ``dt`` [s]: the product of the filters'."""
+        return _sections_tf(self.discrete(dt), dt, "FilterSeries.tf")
+
+
+#: a row's structural filtering: one filter or several in series
+Filter = StructuralFilter | FilterSeries
+
+
+def filter_count(filt: Filter | None) -> int:
+    """How many structural filters ``filt`` holds in series (0 for None)."""
+    return 0 if filt is None else len(filt) if isinstance(filt, FilterSeries) else 1
+
+
+def filter_from_yaml(data: Any, key: str = "filter") -> Filter:
+    """A schedule row's ``filter`` entry: a mapping gives a :class:`StructuralFilter`, a list of mappings a
+    :class:`FilterSeries` (``key``: the entry's name in an error)."""
+    if isinstance(data, (list, tuple)):
+        return FilterSeries.from_dict(list(data), key)
+    if not isinstance(data, dict):
+        raise ConfigError(key, data, f"a filter mapping (keys: {', '.join(FILTER_KEYS)}) or a list of them")
+    unknown = sorted(set(data) - set(FILTER_KEYS))
+    if unknown:
+        raise ConfigError(f"{key}.{unknown[0]}", data[unknown[0]],
+                          f"not a filter key; allowed: {', '.join(FILTER_KEYS)}")
+    try:
+        return StructuralFilter.from_dict(data)
+    except (TypeError, ValueError) as exc:
+        raise ConfigError(key, data, f"a valid structural filter ({exc})") from None
+
+
+def filter_to_yaml(filt: Filter) -> dict[str, float] | list[dict[str, float]]:
+    """The YAML form of ``filt``: a mapping for one filter, a list of mappings for a series."""
+    return filt.as_dict()
+
+
+def _sections_tf(sections: list[tuple[np.ndarray, np.ndarray]], dt: float, feature: str) -> Any:
+    """The product of the discrete ``sections`` as a python-control transfer function at ``dt`` [s]."""
+    require("control", "control", feature)
+    import control
+
+    g = control.tf([1.0], [1.0], dt)
+    for b, a in sections:
+        g = g * control.tf(b, a, dt)
+    return g
 
 
 def _bilinear(c: list[float], k: float) -> np.ndarray:
@@ -115,22 +211,23 @@ def _bilinear(c: list[float], k: float) -> np.ndarray:
 
 
 class FilterChain:
-    """The discrete :class:`StructuralFilter` run sample by sample: ``update(x) -> y``.
+    """The discrete :class:`StructuralFilter` (or :class:`FilterSeries`) run sample by sample: ``update(x) -> y``.
 
     Direct form II transposed per section. :meth:`set_filter` changes the coefficients and keeps the
     states (a filter scheduled over the flight changes slowly); :meth:`reset` puts every section in
     the steady state of a constant input ``x0`` (0 by default), so that a loop switched on does not
     see a filter transient."""
 
-    def __init__(self, filt: StructuralFilter, dt: float) -> None:
+    def __init__(self, filt: Filter, dt: float) -> None:
         if not dt > 0.0:
             raise ValueError(f"dt = {dt!r}: a sampling period > 0 s")
         self.dt = float(dt)
         self.set_filter(filt)
         self.reset()
 
-    def set_filter(self, filt: StructuralFilter, coeffs: list | None = None) -> None:
-        """New coefficients (``coeffs``: ``filt.discrete(dt)`` when already computed), states kept."""
+    def set_filter(self, filt: Filter, coeffs: list | None = None) -> None:
+        """New coefficients (``coeffs``: ``filt.discrete(dt)`` when already computed), states kept (the
+        new filter has the same number of sections)."""
         self.filter = filt
         self.coeffs = filt.discrete(self.dt) if coeffs is None else coeffs
 

@@ -260,7 +260,7 @@ class LQGBatch:
         self.name, self.limit, self.aw = policy.name, policy.limit, policy.aw
         self.axes = [LQGLaw(policy.schedule.rows[p], policy.schedule, policy.limit, n, policy.aw) for p in PLANES]
         self.oc = ObsColumns(np.asarray(policy._i_err, dtype=np.int64), np.full(2, -1, np.int64), int(policy._i_on),
-                             -1, -1)
+                             -1, -1, np.full(2, -1, np.int64))
         self.gimbal = np.zeros((int(n), 2))
 
     def reset(self, rows: Any) -> None:

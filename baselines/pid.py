@@ -33,7 +33,7 @@ control period, and the observation layout; at every step the env's ``info`` giv
 stack's mass, and the observation the controller-on flag (off before the controller starts and during
 staging coasts).
 
-Scheduling (:class:`GainSchedule`): gains interpolated linearly on a monotonic scheduling variable,
+Scheduling (:class:`GainSchedule`, :mod:`.gainschedule`): gains interpolated linearly on a monotonic scheduling variable,
 ``mass`` (the default, as the thesis: ``info["mass"]``, the vehicle's mass at the current time), ``time``
 [s] or ``mach``; beyond the table the end gains are held. ``interpolation: nearest`` takes the nearest
 row instead (switching at the midpoints between breakpoints): each row is then a design for its own
@@ -42,7 +42,16 @@ stretch of the flight, as ``gs-pid-flex``'s are.
 Structural filters (``gs-pid-flex``, :mod:`.flexdesign`): a schedule whose rows carry a ``filter``
 (:class:`.filters.StructuralFilter`, its parameters interpolated like the gains) filters each axis's
 error before the PID, ``u = PID(F(e))``; the filter starts in the steady state of the error whenever
-the controller switches on.
+the controller switches on. A row's ``filter`` may also be a list of filters applied in series,
+``F = F_1 F_2 ...`` (:class:`.filters.FilterSeries`: a second notch for the second bending mode, a slosh
+notch), the same number in every row, each filter's parameters interpolated on their own.
+
+Attitude channel: a schedule whose rows carry ``attitude_gain`` ``k_theta`` [rad/s of rate command per rad
+of attitude error] subtracts the attitude error from each axis's error, ``e = -(rate error) - k_theta
+(attitude error)`` (the observation's ``pitch_attitude_error``, ``yaw_attitude_error`` [rad]), before the
+accelerometer term, the structural filter and the PID: the rate loop then commands a turn back to the
+reference attitude, ``-k_theta`` times its error, and no longer leaves the attitude to drift
+(``tests/test_schedule_channels.py`` checks the sign in flight).
 
 Load relief (:data:`ACCEL_SIGNS`): a schedule whose rows carry ``accel_gain`` ``k_a`` [rad/s of rate
 command per m/s^2 of lateral specific force] adds the IMU's accelerometers to each axis's error,
@@ -53,14 +62,32 @@ proportional to the sensed normal load, and its integral, which otherwise holds 
 where the lateral specific force is zero: the vehicle weathercocks at low frequency and the rate loop
 still damps it at high frequency (the accelerometer load relief of the max-q region:
 docs/flex-design.md, "The slender vehicle").
+
+The schedule's YAML (:mod:`.gainschedule`; docs/flex-design.md, "The schedule file"), a row with two
+filters in series and both channels::
+
+    variable: mass
+    interpolation: nearest
+    rows:
+    - mass_kg: 10164.7
+      kp: 0.42                  # rad of gimbal per rad/s
+      ki: 0.68                  # rad per rad
+      kd: 0.016                 # rad per rad/s^2
+      attitude_gain: 0.5        # rad/s per rad (optional, every row or none)
+      accel_gain: 0.002         # rad/s per m/s^2 (optional, every row or none)
+      filter:                   # one mapping, or a list of them applied in series
+      - {lead_zero_radps: 8.4, lead_pole_radps: 1400.0, lowpass_radps: 126.0, lowpass_damping: 0.41,
+         notch_radps: 59.7, notch_damping: 0.51, notch_depth: 0.022}
+      - {lowpass_radps: 5000.0, notch_radps: 140.0, notch_damping: 0.2, notch_depth: 0.1}
+
+The compiled batch (:mod:`.pidbatch`) flies up to :data:`.pidkernel.FILTERS_MAX` filters per row; a schedule
+with more flies as one copy of the policy per row.
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Hashable
-from dataclasses import dataclass, field
-from functools import cached_property
 from pathlib import Path
 from typing import Any
 
@@ -69,17 +96,13 @@ import numpy as np
 from lvgym.envs.layouts import G0
 from lvgym.envs.presets import SLENDER_V1
 from lvgym.errors import ConfigError
-from lvgym.vehicle.yamlfile import read_yaml
 
 from .batch import RowCopies
-from .filecache import read_once
-from .filters import FILTER_KEYS, FilterChain, StructuralFilter
+from .filters import FilterChain
+from .gainschedule import INTERPOLATIONS, ROW_COLUMNS, SCHEDULES, VARIABLES, GainSchedule  # noqa: F401  (here as before)
 from .pidbatch import PIDBatch
+from .pidkernel import FILTERS_MAX
 
-SCHEDULES = Path(__file__).resolve().parent / "schedules"
-VARIABLES = ("mass", "time", "mach")
-#: how a schedule reads between breakpoints: linearly, or the nearest row (switching at the midpoints)
-INTERPOLATIONS = ("linear", "nearest")
 #: per axis (pitch, yaw): the sign ``s_axis`` of the load-relief term, so that ``+k_a s f`` commands the
 #: body rate that turns the nose into the relative wind. A positive angle of attack (the air from below,
 #: ``+z_b``) gives a normal force and so a specific force along ``-z_b``; a negative pitch rate turns
@@ -87,8 +110,6 @@ INTERPOLATIONS = ("linear", "nearest")
 #: a positive yaw rate turns the nose towards ``+y_b``, so yaw takes ``-accel_y``
 #: (``tests/test_load_relief.py`` checks both in a gust)
 ACCEL_SIGNS = (1.0, -1.0)
-#: a schedule's columns of one number per row (the filters' parameters are the other columns)
-ROW_COLUMNS = ("kp", "ki", "kd", "n", "accel_gain")
 #: the thesis's single gain set (6.3.1), tuned on the rigid SMILE at 28.8 s; N as Table 6.10's 28.8 s row
 THESIS_SINGLE = {"kp": 8.98, "ki": 3.92, "kd": 4.57, "n": 500.0}
 
@@ -144,119 +165,6 @@ class DiscretePID:
         return u
 
 
-@dataclass(frozen=True)
-class GainSchedule:
-    """PID gains at breakpoints of a monotonic scheduling variable, interpolated linearly (ends held)."""
-
-    variable: str
-    points: tuple[float, ...]
-    kp: tuple[float, ...]
-    ki: tuple[float, ...]
-    kd: tuple[float, ...]
-    n: tuple[float, ...]
-    meta: dict = field(default_factory=dict, compare=False)
-    filters: tuple[StructuralFilter, ...] | None = None
-    interpolation: str = "linear"
-    #: load-relief gain per row [rad/s per m/s^2] (None: no accelerometer feedback)
-    accel_gain: tuple[float, ...] | None = None
-
-    def __post_init__(self) -> None:
-        if self.variable not in VARIABLES:
-            raise ValueError(f"variable = {self.variable!r}: one of {VARIABLES}")
-        m = len(self.points)
-        for key in ("kp", "ki", "kd", "n"):
-            if len(getattr(self, key)) != m:
-                raise ValueError(f"{key} has {len(getattr(self, key))} entries for {m} breakpoints")
-        if m < 1:
-            raise ValueError("a schedule needs at least one breakpoint")
-        d = np.diff(np.asarray(self.points, float))
-        if not (np.all(d > 0) or np.all(d < 0)):
-            raise ValueError(f"breakpoints of {self.variable!r} = {list(self.points)}: must be strictly "
-                             "monotonic (a lookup table needs a monotonic scheduling variable, thesis 6.3.1)")
-        for key in ("kp", "ki", "kd"):
-            if any(not (math.isfinite(v) and v >= 0) for v in getattr(self, key)):
-                raise ValueError(f"{key} = {list(getattr(self, key))}: finite gains >= 0")
-        if any(not v > 0 for v in self.n):
-            raise ValueError(f"n = {list(self.n)}: filter coefficients > 0")
-        if self.interpolation not in INTERPOLATIONS:
-            raise ValueError(f"interpolation = {self.interpolation!r}: one of {INTERPOLATIONS}")
-        if self.filters is not None and len(self.filters) != m:
-            raise ValueError(f"filters has {len(self.filters)} entries for {m} breakpoints")
-        if self.accel_gain is not None and (len(self.accel_gain) != m or
-                                            any(not (math.isfinite(v) and v >= 0) for v in self.accel_gain)):
-            raise ConfigError("accel_gain", list(self.accel_gain), f"{m} finite gains >= 0 [rad/s per m/s^2], one per row")
-
-    @cached_property
-    def _table(self) -> tuple[np.ndarray, np.ndarray, dict[str, np.ndarray]]:
-        """Breakpoints, the same sorted ascending, and every column (gains, filter keys) in that order:
-        built once, so a lookup is one ``argmin`` or one ``np.interp`` per column (the same numbers)."""
-        x = np.asarray(self.points, float)
-        order = np.argsort(x)
-        cols = {k: np.asarray(getattr(self, k), float)[order] for k in ROW_COLUMNS if getattr(self, k) is not None}
-        if self.filters is not None:
-            cols.update({k: np.array([getattr(f, k) for f in self.filters], float)[order] for k in FILTER_KEYS})
-        return x, x[order], cols
-
-    def _nearest(self, value: float) -> int:
-        """Index (in :attr:`points` order) of the breakpoint nearest ``value``."""
-        return int(np.argmin(np.abs(self._table[0] - value)))
-
-    def _lookup(self, value: float, keys: tuple[str, ...]) -> list[float]:
-        x, x_sorted, cols = self._table
-        if self.interpolation == "nearest":
-            i = self._nearest(value)
-            return [float(getattr(self, k)[i]) if k in ROW_COLUMNS else float(getattr(self.filters[i], k)) for k in keys]
-        return [float(np.interp(value, x_sorted, cols[k])) for k in keys]
-
-    def filter_at(self, value: float) -> StructuralFilter | None:
-        """The structural filter at ``value`` (each parameter read as the gains are), or None."""
-        if self.filters is None:
-            return None
-        if self.interpolation == "nearest":
-            return self.filters[self._nearest(value)]
-        return StructuralFilter(**dict(zip(FILTER_KEYS, self._lookup(value, FILTER_KEYS))))
-
-    def accel_gain_at(self, value: float) -> float:
-        """The load-relief gain [rad/s per m/s^2] at ``value`` (0 without one)."""
-        return 0.0 if self.accel_gain is None else self._lookup(value, ("accel_gain",))[0]
-
-    def gains(self, value: float) -> tuple[float, float, float, float]:
-        """(kp, ki, kd, n) at ``value`` of the scheduling variable."""
-        return tuple(self._lookup(value, ("kp", "ki", "kd", "n")))
-
-    # ------------------------------------------------------------------ files
-    @classmethod
-    def from_dict(cls, data: dict) -> "GainSchedule":
-        rows = data["rows"]
-        var = data.get("variable", "mass")
-        key = {"mass": "mass_kg", "time": "time_s", "mach": "mach"}[var]
-        get = lambda k, default=None: tuple(float(r.get(k, default)) for r in rows)  # noqa: E731
-        meta = {k: v for k, v in data.items() if k not in ("rows", "variable", "interpolation")}
-        meta["rows"] = rows
-        with_filter = [("filter" in r) for r in rows]
-        if any(with_filter) and not all(with_filter):
-            raise ValueError(f"rows {[i for i, f in enumerate(with_filter) if not f]} have no 'filter': every row or none")
-        filters = tuple(StructuralFilter.from_dict(r["filter"]) for r in rows) if all(with_filter) and rows else None
-        with_accel = [("accel_gain" in r) for r in rows]
-        if any(with_accel) and not all(with_accel):
-            raise ConfigError("accel_gain", [i for i, f in enumerate(with_accel) if not f], "in every row or none")
-        accel = get("accel_gain") if all(with_accel) and rows else None
-        return cls(var, get(key), get("kp"), get("ki"), get("kd"), get("n", math.inf), meta, filters,
-                   data.get("interpolation", "linear"), accel)
-
-    @classmethod
-    def load(cls, path: str | Path) -> "GainSchedule":
-        """A schedule from a YAML file (a path, or the name of one in ``baselines/schedules``)."""
-        p = Path(path)
-        if not p.exists():
-            p = SCHEDULES / (str(path) if str(path).endswith(".yaml") else f"{path}.yaml")
-
-        def read(q: Path) -> "GainSchedule":
-            return cls.from_dict(read_yaml(q)[0])            # libyaml, duplicate keys refused, errors name the file
-
-        return read_once(p, read, "GainSchedule")                  # parsed once per process
-
-
 class PIDPolicy:
     """Pitch and yaw rate PID (identical gains per axis, the vehicle being axisymmetric) as a benchmark
     :class:`~lvgym.benchmark.policy.Policy` of the TVC envs.
@@ -280,7 +188,11 @@ class PIDPolicy:
         self.axes = [DiscretePID(kp, ki, kd, n, self.dt, -self.limit, self.limit) for _ in range(2)]
         #: the accelerometers (pitch: accel_z, yaw: accel_y) where the observation has them
         self._i_acc = [lay.index("accel_z"), lay.index("accel_y")] if "accel_z" in lay.names else None
+        #: the attitude errors (pitch, yaw) where the observation has them
+        self._i_att = ([lay.index("pitch_attitude_error"), lay.index("yaw_attitude_error")]
+                       if "pitch_attitude_error" in lay.names else None)
         self.accel_gain = 0.0                             # load relief [rad/s per m/s^2], see the module docstring
+        self.attitude_gain = 0.0                          # attitude channel [rad/s per rad], see the module docstring
         self.accel_signs = np.asarray(ACCEL_SIGNS)        # s_axis of the load-relief term, per axis
         self.chains: list[FilterChain] | None = None      # structural filters of the error, per axis
         self._filtering = False
@@ -312,9 +224,12 @@ class PIDPolicy:
         """Hook for gain scheduling (nothing for fixed gains)."""
 
     def errors(self, obs: np.ndarray) -> np.ndarray:
-        """The loop's errors [rad/s], pitch and yaw: reference - rate, plus the load-relief rate command
-        ``k_a s_axis f_axis`` when ``accel_gain`` is not zero (module docstring)."""
+        """The loop's errors [rad/s], pitch and yaw: reference - rate, minus ``k_theta`` times the attitude
+        error when ``attitude_gain`` is not zero, plus the load-relief rate command ``k_a s_axis f_axis``
+        when ``accel_gain`` is not zero (module docstring)."""
         e = -obs[self._i_err]
+        if self.attitude_gain != 0.0:
+            e = e - self.attitude_gain * obs[self._i_att]
         if self.accel_gain != 0.0:
             e = e + self.accel_gain * G0 * self.accel_signs * obs[self._i_acc]
         return e
@@ -341,7 +256,7 @@ class PIDPolicy:
         if not (a.dt == b.dt and a.u_min == b.u_min == -self.limit and a.u_max == b.u_max == self.limit):
             return False
         if kind is GainScheduledPIDPolicy:
-            return (self.chains is None) == (self.schedule.filters is None)
+            return (self.chains is None) == (self.schedule.filters is None) and self.schedule.filter_count <= FILTERS_MAX
         return self.chains is None and (a.kp, a.ki, a.kd, a.n) == (b.kp, b.ki, b.kd, b.n)
 
 
@@ -356,6 +271,9 @@ class GainScheduledPIDPolicy(PIDPolicy):
         if self.schedule.accel_gain is not None and self._i_acc is None:
             raise ConfigError("accel_gain", list(self.schedule.accel_gain), "a schedule without load relief: the "
                               "env's observation has no accelerometers (observation 'sensors' or 'flight')")
+        if self.schedule.attitude_gain is not None and self._i_att is None:
+            raise ConfigError("attitude_gain", list(self.schedule.attitude_gain), "a schedule without an attitude "
+                              "channel: the env's observation has no attitude errors")
         if self.schedule.filters is not None:
             f0 = self.schedule.filter_at(self.schedule.points[0])
             self.chains = [FilterChain(f0, self.dt) for _ in self.axes]
@@ -375,6 +293,7 @@ class GainScheduledPIDPolicy(PIDPolicy):
         for pid in self.axes:
             pid.set_gains(*g)
         self.accel_gain = self.schedule.accel_gain_at(self.value)
+        self.attitude_gain = self.schedule.attitude_gain_at(self.value)
         if self.chains is not None:
             filt = self.schedule.filter_at(self.value)
             if filt == self.chains[0].filter:             # unchanged (a nearest-row schedule, mostly)

@@ -4,7 +4,8 @@ Built once from a policy object (a :class:`.pid.PIDPolicy` of fixed gains or a
 :class:`.pid.GainScheduledPIDPolicy`: ``pid``, ``pid-thesis``, ``gs-pid``, ``gs-pid-thesis``,
 ``gs-pid-flex``), it steps every row in one call of the compiled :func:`.pidkernel.pid_act_k`, the per-row
 policy's operations in the per-row policy's order. The structural filters of a nearest-row schedule
-(every flex schedule) are discretised once per schedule row here; those of a linearly interpolated
+(every flex schedule; one filter per row or up to :data:`.pidkernel.FILTERS_MAX` in series) are discretised
+once per schedule row here; those of a linearly interpolated
 schedule change with every value of the scheduling variable and are discretised in Python
 (:meth:`.filters.StructuralFilter.discrete`, the per-row policy's own call) whenever a row's filter changes.
 """
@@ -15,9 +16,10 @@ from typing import Any
 
 import numpy as np
 
-from .filters import StructuralFilter
+from .filters import Filter
 from .pidkernel import (COEFFS, FILTER_ROW, FILTERS_NONE, FILTERS_ROWS, FILTERS_TABLE, GAINS, PID_ROW, SECTIONS,
-                        VAR_FIXED, VAR_MACH, VAR_VALUE, ObsColumns, PIDSetup, PIDState, PIDTable, pid_act_k)
+                        SECTIONS_PER_FILTER, VAR_FIXED, VAR_MACH, VAR_VALUE, ObsColumns, PIDSetup, PIDState, PIDTable,
+                        pid_act_k)
 
 __all__ = ["PIDBatch", "coefficients", "new_state", "obs_columns", "tables"]
 
@@ -28,17 +30,19 @@ _INFO_KEY = {"mass": "mass", "time": "time"}
 def obs_columns(policy: Any) -> ObsColumns:
     """Where ``policy`` (a :class:`.pid.PIDPolicy`) reads its observation entries."""
     acc = np.asarray(policy._i_acc if policy._i_acc is not None else [-1, -1], dtype=np.int64)
-    return ObsColumns(np.asarray(policy._i_err, dtype=np.int64), acc, int(policy._i_on), int(policy._i_mach), -1)
+    att = np.asarray(policy._i_att if policy._i_att is not None else [-1, -1], dtype=np.int64)
+    return ObsColumns(np.asarray(policy._i_err, dtype=np.int64), acc, int(policy._i_on), int(policy._i_mach), -1, att)
 
 
-def coefficients(filt: StructuralFilter, dt: float, out: np.ndarray | None = None) -> np.ndarray:
-    """The discrete sections of ``filt`` at ``dt`` [s] (:meth:`.filters.StructuralFilter.discrete`, the
-    per-row policy's call) packed by :data:`.pidkernel.COEFFS` into ``out`` (a new vector by default); the
-    sums as :meth:`.filters.FilterChain.reset` takes them (``b.sum()``, ``a.sum()``)."""
+def coefficients(filt: Filter, dt: float, out: np.ndarray | None = None) -> np.ndarray:
+    """The discrete sections of ``filt`` (one filter or a series) at ``dt`` [s]
+    (:meth:`.filters.StructuralFilter.discrete`, the per-row policy's call) packed by :data:`.pidkernel.COEFFS`
+    into ``out`` (a new vector by default; the sections beyond the filter's left as they are); the sums as
+    :meth:`.filters.FilterChain.reset` takes them (``b.sum()``, ``a.sum()``)."""
     out = COEFFS.zeros() if out is None else out
     sections = filt.discrete(dt)
-    if len(sections) != SECTIONS:
-        raise ValueError(f"a structural filter of {len(sections)} sections: the kernel runs {SECTIONS}")
+    if len(sections) > SECTIONS:
+        raise ValueError(f"a structural filter of {len(sections)} sections: the kernel runs at most {SECTIONS}")
     b, a = COEFFS.view(out, "b"), COEFFS.view(out, "a")
     bsum, asum = COEFFS.view(out, "bsum"), COEFFS.view(out, "asum")
     for s, (bz, az) in enumerate(sections):
@@ -53,14 +57,17 @@ def tables(policy: Any) -> tuple[PIDTable, PIDSetup]:
     signs = np.asarray(policy.accel_signs, dtype=float)
     no_filters = np.zeros((1, COEFFS.size))
     if schedule is None:                                   # fixed gains: a table of one row, read as nearest
-        gains = GAINS.pack({"kp": pid.kp, "ki": pid.ki, "kd": pid.kd, "n": pid.n, "accel": policy.accel_gain})
+        gains = GAINS.pack({"kp": pid.kp, "ki": pid.ki, "kd": pid.kd, "n": pid.n, "accel": policy.accel_gain,
+                            "attitude": policy.attitude_gain})
         tb = PIDTable(np.zeros(1), np.zeros(1), np.zeros(1, np.int64), gains.reshape(-1, 1), no_filters)
-        return tb, PIDSetup(pid.dt, policy.limit, VAR_FIXED, True, policy.accel_gain != 0.0, FILTERS_NONE, signs)
+        return tb, PIDSetup(pid.dt, policy.limit, VAR_FIXED, True, policy.accel_gain != 0.0, FILTERS_NONE, signs,
+                            policy.attitude_gain != 0.0, 0)
     x, xs, cols = schedule._table
     rank = np.empty(x.size, np.int64)
     rank[np.argsort(x)] = np.arange(x.size)
     gains = np.zeros((GAINS.size, x.size))
-    for name, col in (("kp", "kp"), ("ki", "ki"), ("kd", "kd"), ("n", "n"), ("accel", "accel_gain")):
+    for name, col in (("kp", "kp"), ("ki", "ki"), ("kd", "kd"), ("n", "n"), ("accel", "accel_gain"),
+                      ("attitude", "attitude_gain")):
         gains[GAINS.index(name)] = cols.get(col, 0.0)
     nearest = schedule.interpolation == "nearest"
     if schedule.filters is None:
@@ -71,7 +78,8 @@ def tables(policy: Any) -> tuple[PIDTable, PIDSetup]:
         coeffs, filters = no_filters, FILTERS_ROWS
     variable = VAR_MACH if schedule.variable == "mach" else VAR_VALUE
     tb = PIDTable(x, xs, rank, np.ascontiguousarray(gains), coeffs)
-    return tb, PIDSetup(pid.dt, policy.limit, variable, nearest, schedule.accel_gain is not None, filters, signs)
+    return tb, PIDSetup(pid.dt, policy.limit, variable, nearest, schedule.accel_gain is not None, filters, signs,
+                        schedule.attitude_gain is not None, SECTIONS_PER_FILTER * schedule.filter_count)
 
 
 def new_state(n: int) -> PIDState:
@@ -94,7 +102,7 @@ class PIDBatch:
         self.tb, self.su = tables(policy)
         self.oc = obs_columns(policy)
         self.st = new_state(self.n)
-        self._filters: list[StructuralFilter | None] = [None] * self.n     # FILTERS_ROWS: each row's filter
+        self._filters: list[Filter | None] = [None] * self.n     # FILTERS_ROWS: each row's filter
         self._none = np.zeros(self.n)
         self._key = _INFO_KEY.get(self.schedule.variable) if self.schedule is not None else None
 

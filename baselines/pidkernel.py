@@ -1,5 +1,6 @@
 """The compiled act of the PID family (:mod:`.pid`: fixed gains, a gain schedule, structural filters, load
-relief) for any number of rows: what :class:`.pidbatch.PIDBatch` runs for the rows of a batched env.
+relief, the attitude channel) for any number of rows: what :class:`.pidbatch.PIDBatch` runs for the rows of
+a batched env.
 
 The same floating-point operations in the same order as the per-row policy (:meth:`.pid.PIDPolicy.act`,
 :class:`.pid.DiscretePID`, :class:`.filters.FilterChain`), so that row ``b`` of a batch and a policy of its
@@ -7,7 +8,8 @@ own give the same actions to the bit (``tests/test_policy_batch.py``). The block
 
 * :class:`ObsColumns`: where the observation holds what the laws read (from the env's observation layout);
 * :class:`PIDTable`: the schedule's breakpoints and columns (layout :data:`GAINS`; a fixed-gain policy is
-  a one-row table) and the discrete structural filter of each row (layout :data:`COEFFS`);
+  a one-row table) and the discrete structural filters of each row (layout :data:`COEFFS`: the sections
+  of up to :data:`FILTERS_MAX` filters in series, :attr:`PIDSetup.sections` of them in use);
 * :class:`PIDSetup`: the constants (control period, gimbal limit, how the schedule is read);
 * :class:`PIDState`: each row's state as two packed vectors, the PIDs' (:data:`PID_ROW`) and the
   filters' (:data:`FILTER_ROW`). A kernel takes a row's vectors once and indexes them by their layouts'
@@ -34,8 +36,9 @@ import numpy as np
 from lvgym.envs.layouts import G0
 from lvgym.packing import Field, Packed
 
-__all__ = ["COEFFS", "FILTERS_NONE", "FILTERS_ROWS", "FILTERS_TABLE", "FILTER_ROW", "GAINS", "ObsColumns", "PID_ROW",
-           "PIDSetup", "PIDState", "PIDTable", "SECTIONS", "TAPS", "VAR_FIXED", "VAR_MACH", "VAR_VALUE", "clip_k",
+__all__ = ["COEFFS", "FILTERS_MAX", "FILTERS_NONE", "FILTERS_ROWS", "FILTERS_TABLE", "FILTER_ROW", "GAINS", "ObsColumns",
+           "PID_ROW", "PIDSetup", "PIDState", "PIDTable", "SECTIONS", "SECTIONS_PER_FILTER", "TAPS", "VAR_FIXED",
+           "VAR_MACH", "VAR_VALUE", "clip_k",
            "interp_k", "nearest_k", "pid_act_k", "pid_row_k"]
 
 #: how a row's scheduling variable is read (:attr:`PIDSetup.variable`): fixed gains (no variable), a value
@@ -44,9 +47,11 @@ VAR_FIXED, VAR_VALUE, VAR_MACH = 0, 1, 2
 #: where the structural filter's coefficients come from (:attr:`PIDSetup.filters`): no filters, the
 #: schedule row in use (a nearest-row schedule), each row's own (set from Python, a linear schedule)
 FILTERS_NONE, FILTERS_TABLE, FILTERS_ROWS = 0, 1, 2
-#: sections of a structural filter (lead-lag, low-pass, notch: :meth:`.filters.StructuralFilter.discrete`)
-#: and coefficients per section's numerator and denominator
-SECTIONS, TAPS = 3, 3
+#: sections of a structural filter (lead-lag, low-pass, notch: :meth:`.filters.StructuralFilter.discrete`),
+#: the most filters in series a row holds (a schedule with more flies as per-row copies, :meth:`.pid.PIDPolicy.batch`),
+#: so the most sections, and coefficients per section's numerator and denominator
+SECTIONS_PER_FILTER, FILTERS_MAX, TAPS = 3, 4, 3
+SECTIONS = SECTIONS_PER_FILTER * FILTERS_MAX
 AXES = 2
 
 #: a schedule row's gains (the columns of :attr:`PIDTable.gains`)
@@ -56,9 +61,11 @@ GAINS = Packed("PID gains", [
     Field("kd", 1, "rad per rad/s^2", "derivative gain"),
     Field("n", 1, "rad/s", "derivative filter coefficient (inf: unfiltered)"),
     Field("accel", 1, "rad/s per m/s^2", "load-relief gain (0: none)"),
+    Field("attitude", 1, "rad/s per rad", "attitude gain (0: none)"),
 ])
 
-#: one discrete structural filter: each section's ``b``, ``a`` in ``z`` and their sums
+#: the discrete structural filters of a row in series: each section's ``b``, ``a`` in ``z`` and their sums (the
+#: first :attr:`PIDSetup.sections` sections in use)
 COEFFS = Packed("structural filter coefficients", [
     Field("b", SECTIONS * TAPS, "-", "numerator of each section (b0, b1, b2)", shape=(SECTIONS, TAPS)),
     Field("a", SECTIONS * TAPS, "-", "denominator of each section (1, a1, a2)", shape=(SECTIONS, TAPS)),
@@ -98,13 +105,15 @@ F = FILTER_ROW.at
 class ObsColumns(NamedTuple):
     """Indices into an observation row: ``err`` (2,) the pitch and yaw rate errors, ``acc`` (2,) the
     accelerometers of load relief (``accel_z``, ``accel_y``; -1 where the observation has none), ``on`` the
-    controller-on flag, ``mach`` Mach / 10, ``ref`` the pitch rate reference (-1: none)."""
+    controller-on flag, ``mach`` Mach / 10, ``ref`` the pitch rate reference (-1: none), ``att`` (2,) the
+    pitch and yaw attitude errors (-1 where the observation has none)."""
 
     err: np.ndarray
     acc: np.ndarray
     on: int
     mach: int
     ref: int
+    att: np.ndarray
 
 
 class PIDTable(NamedTuple):
@@ -124,7 +133,8 @@ class PIDSetup(NamedTuple):
     """The constants: ``dt`` [s] the control period, ``limit`` [rad] the gimbal limit (the PID's output
     limits and the action's scale), ``variable`` (:data:`VAR_FIXED` ...), ``nearest`` (the nearest row, else
     linear interpolation), ``accel`` (the schedule has a load-relief column), ``filters``
-    (:data:`FILTERS_NONE` ...), ``signs`` (2,) the load-relief signs per axis."""
+    (:data:`FILTERS_NONE` ...), ``signs`` (2,) the load-relief signs per axis, ``attitude`` (the schedule
+    has an attitude column), ``sections`` the filter sections in use (3 per filter in series)."""
 
     dt: float
     limit: float
@@ -133,6 +143,8 @@ class PIDSetup(NamedTuple):
     accel: bool
     filters: int
     signs: np.ndarray
+    attitude: bool
+    sections: int
 
 
 class PIDState(NamedTuple):
@@ -189,11 +201,11 @@ def clip_k(x, lo, hi):
 
 
 @nb.njit(cache=True, inline="always")
-def _filter_reset(f, ax, x0):
-    """The sections of the filter row ``f``'s axis ``ax`` in the steady state of the input ``x0``
-    (:meth:`.filters.FilterChain.reset`)."""
+def _filter_reset(f, ax, x0, sections):
+    """The first ``sections`` sections of the filter row ``f``'s axis ``ax`` in the steady state of the input
+    ``x0`` (:meth:`.filters.FilterChain.reset`)."""
     x = x0
-    for s in range(SECTIONS):
+    for s in range(sections):
         b, a = F.b + TAPS * s, F.a + TAPS * s
         y = x * f[F.bsum + s] / f[F.asum + s]
         s2 = f[b + 2] * x - f[a + 2] * y
@@ -203,10 +215,11 @@ def _filter_reset(f, ax, x0):
 
 
 @nb.njit(cache=True, inline="always")
-def _filter_update(f, ax, x):
-    """One sample ``x`` through the filter row ``f``'s axis ``ax`` (:meth:`.filters.FilterChain.update`)."""
+def _filter_update(f, ax, x, sections):
+    """One sample ``x`` through the first ``sections`` sections of the filter row ``f``'s axis ``ax``
+    (:meth:`.filters.FilterChain.update`)."""
     y = x
-    for s in range(SECTIONS):
+    for s in range(sections):
         b, a = F.b + TAPS * s, F.a + TAPS * s
         i1, i2 = F.s1 + SECTIONS * ax + s, F.s2 + SECTIONS * ax + s
         s1, s2 = f[i1], f[i2]
@@ -256,6 +269,7 @@ def pid_row_k(tb, su, oc, r, f, obs, value):
         i = nearest_k(tb.x, value)
         k = tb.rank[i]
         kp, ki, kd, n, acc = gains[G.kp, k], gains[G.ki, k], gains[G.kd, k], gains[G.n, k], gains[G.accel, k]
+        att = gains[G.attitude, k]
         if su.filters == FILTERS_TABLE and i != r[P.filt]:      # the filter of another row: its coefficients
             coeffs = tb.coeffs
             for c in range(N_COEFFS):
@@ -265,11 +279,17 @@ def pid_row_k(tb, su, oc, r, f, obs, value):
         xs = tb.xs
         kp, ki, kd = interp_k(value, xs, gains[G.kp]), interp_k(value, xs, gains[G.ki]), interp_k(value, xs, gains[G.kd])
         n, acc = interp_k(value, xs, gains[G.n]), interp_k(value, xs, gains[G.accel])
+        att = interp_k(value, xs, gains[G.attitude])
     if not su.accel:
         acc = 0.0
-    err, acc_at = oc.err, oc.acc
+    if not su.attitude:
+        att = 0.0
+    err, acc_at, att_at = oc.err, oc.acc, oc.att
     e0 = -float(obs[err[0]])
     e1 = -float(obs[err[1]])
+    if att != 0.0:                                     # the attitude channel: - k_theta (attitude error)
+        e0 = e0 - att * float(obs[att_at[0]])
+        e1 = e1 - att * float(obs[att_at[1]])
     if acc != 0.0:
         signs = su.signs
         e0 = e0 + acc * G0 * signs[0] * float(obs[acc_at[0]])
@@ -278,11 +298,11 @@ def pid_row_k(tb, su, oc, r, f, obs, value):
         r[P.filtering] = 0.0
     else:
         if r[P.filtering] == 0.0:                      # switched on: the filters start in steady state
-            _filter_reset(f, 0, e0)
-            _filter_reset(f, 1, e1)
+            _filter_reset(f, 0, e0, su.sections)
+            _filter_reset(f, 1, e1, su.sections)
             r[P.filtering] = 1.0
-        e0 = _filter_update(f, 0, e0)
-        e1 = _filter_update(f, 1, e1)
+        e0 = _filter_update(f, 0, e0, su.sections)
+        e1 = _filter_update(f, 1, e1, su.sections)
     g = (kp, ki, kd, n)
     r[P.gimbal] = _pid_update(su, r, 0, e0, on, g)
     r[P.gimbal + 1] = _pid_update(su, r, 1, e1, on, g)

@@ -6,9 +6,15 @@
 At each row of the schedule (``baselines/schedules/<schedule>.yaml`` or a path) the vehicle is linearised
 at the row's flight time (:func:`.linearize.operating_point` of the protocol's env), the flight
 computer's plant is built (:func:`.flightloop.flight_plant`: servo, vehicle, slope at the IMU, gyro
-filters, hold, delay) and the row's discrete PID closes it, behind the row's structural filter when the
+filters, hold, delay) and the row's discrete PID closes it, behind the row's structural filters when the
 schedule has them (a ``gs-pid-flex`` schedule: lead, low-pass and notch,
-:class:`~lvgym.baselines.filters.StructuralFilter`, as the flex design and the flight apply them). Per row one figure ``loop_<t>s.png``: the
+:class:`~lvgym.baselines.filters.StructuralFilter`, or several such filters in series,
+:class:`~lvgym.baselines.filters.FilterSeries`, as the flex design and the flight apply them), and with the
+row's attitude channel when the schedule has one (``attitude_gain`` k_theta: the error
+``-(rate + k_theta theta)``, the attitude ``theta`` modelled as the trapezoidal integral of the sampled rate,
+``dt/2 (z + 1)/(z - 1)``, which the strapdown attitude of the flight observation is up to the gyro's
+sampling). The accelerometer channel (``accel_gain``) is not in the charts: they show the loop without load
+relief. Per row one figure ``loop_<t>s.png``: the
 open loop's magnitude and phase against frequency up to the Nyquist frequency of the control rate, and its
 Nichols chart, for the rigid and the non-rigid model, with the gain and phase margins of
 :func:`.linearize.margins` written in the legend and the crossovers marked. A row in a coast (no thrust)
@@ -33,27 +39,39 @@ from lvgym.cli.args import arg
 from .flightloop import flight_plant, frequency_response, mode_frequencies
 from .linearize import margins, operating_point, pid_tf
 from .target import vehicle_option
-from ..filters import StructuralFilter
+from ..filters import Filter, filter_count
 from ..pid import GainSchedule
 
 
+def attitude_tf(attitude_gain: float, dt: float) -> control.TransferFunction:
+    """``1 + k_theta dt/2 (z + 1)/(z - 1)``: the rate measurement's path through the error with the attitude
+    channel ``attitude_gain`` k_theta [rad/s per rad] (the attitude as the trapezoidal integral of the
+    sampled rate, at the period ``dt`` [s])."""
+    z = control.tf([1.0, 0.0], [1.0], dt)
+    return 1 + attitude_gain * 0.5 * dt * (z + 1) / (z - 1)
+
+
 def open_loop(op, gains: tuple[float, float, float, float], plane: str = "pitch",
-              filt: StructuralFilter | None = None) -> control.StateSpace:
+              filt: Filter | None = None, attitude_gain: float = 0.0) -> control.StateSpace:
     """The discrete open loop ``C(z) G(z)`` of the flight computer's plant at ``op`` with the PID
     ``gains`` (kp, ki, kd, n) at the env's control period (negative feedback of the gyro rate), behind the
-    structural filter ``filt`` when given."""
+    structural filter or filters in series ``filt`` when given, with the attitude channel ``attitude_gain``
+    [rad/s per rad] (:func:`attitude_tf`) when not 0."""
     g = flight_plant(op, plane)
     c = pid_tf(*gains, dt=g.dt)
     if filt is not None:
         c = c * filt.tf(g.dt)
+    if attitude_gain:
+        c = c * attitude_tf(attitude_gain, g.dt)
     return control.series(g, control.ss(c))
 
 
-def row_loops(vehicle: Any, protocol: str, t: float, gains, policy: Any = None, filt: StructuralFilter | None = None,
-              **options: Any) -> dict[str, Any] | None:
+def row_loops(vehicle: Any, protocol: str, t: float, gains, policy: Any = None, filt: Filter | None = None,
+              attitude_gain: float = 0.0, **options: Any) -> dict[str, Any] | None:
     """Open loops, margins and plant modes at flight time ``t`` [s], or None in a coast; the operating
     points flown with ``policy`` (None: the gimbal centred; :func:`.linearize.operating_point`); ``filt``:
-    the row's structural filter."""
+    the row's structural filter (one, or several in series); ``attitude_gain``: the row's attitude channel
+    [rad/s per rad]."""
     out: dict[str, Any] = {}
     for model in ("rigid", "nonrigid"):
         op = operating_point(vehicle, t, model, protocol=protocol, policy=policy, **options)
@@ -61,7 +79,7 @@ def row_loops(vehicle: Any, protocol: str, t: float, gains, policy: Any = None, 
             return None
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            L = open_loop(op, gains, filt=filt)
+            L = open_loop(op, gains, filt=filt, attitude_gain=attitude_gain)
             out[model] = {"loop": L, "margins": margins(L)}
         if model == "nonrigid":
             out["modes_radps"] = mode_frequencies(op)
@@ -144,13 +162,14 @@ def charts(vehicle: Any, protocol: str, schedule: str, out: Path, log=print, fly
         doc["operating_points"] = {"flown_with": how, **({"env_options": dict(options)} if options else {})}
     for row, value in zip(sched.meta["rows"], sched.points):
         t = float(row["time_s"])
-        filt = sched.filter_at(value)
-        loops = row_loops(vehicle, protocol, t, sched.gains(value), policy, filt, **options)
+        filt, k_theta = sched.filter_at(value), sched.attitude_gain_at(value)
+        loops = row_loops(vehicle, protocol, t, sched.gains(value), policy, filt, k_theta, **options)
         if loops is None:
             log(f"t = {t:g} s: no thrust (coast), skipped")
             continue
         _chart(t, loops, out / f"loop_{t:g}s.png")
-        entry = {"time_s": t, "filtered": filt is not None, **{m: {k: (round(v, 3) if isinstance(v, float) else v)
+        entry = {"time_s": t, "filtered": filt is not None, "filters": filter_count(filt), "attitude_gain": k_theta,
+                 **{m: {k: (round(v, 3) if isinstance(v, float) else v)
                                      for k, v in loops[m]["margins"].items()} for m in ("rigid", "nonrigid")},
                  "modes_radps": {k: [round(f, 2) for f in v] for k, v in loops["modes_radps"].items()}}
         doc["rows"].append(entry)

@@ -32,7 +32,7 @@ import numpy as np
 
 from lvgym.cli.args import arg
 
-from ..filters import StructuralFilter
+from ..filters import Filter, StructuralFilter
 from .flexproblem import (PARAMETERS, START, Requirements, RowProblem, _controller_poly, _from_unit,  # noqa: F401
                           _to_unit, controller, controller_tf, design_row, folded, notch_frequency, open_loop_growth)
 from .flextable import margin_table, row_line
@@ -76,7 +76,7 @@ MISSES = ("rigid gain margin", "rigid phase margin", "flex gain margin", "flex p
           "drift", "sensor noise")
 
 
-def check_loops(plants: dict[str, dict[str, control.StateSpace]], gains, filt: StructuralFilter,
+def check_loops(plants: dict[str, dict[str, control.StateSpace]], gains, filt: Filter,
                 modes: dict[str, list[float]], req: Requirements,
                 noise: tuple[float, float] | None = None) -> dict[str, Any]:
     """Exact margins (:func:`.linearize.margins`) of ``C(z) G(z)`` for every plane and model; for each

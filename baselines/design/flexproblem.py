@@ -27,7 +27,7 @@ import control
 import numpy as np
 from scipy import optimize, signal
 
-from ..filters import StructuralFilter
+from ..filters import Filter, StructuralFilter
 from .flightloop import frequency_response
 from .linearize import pid_tf
 from .noise import noise_rate_on_grid
@@ -121,12 +121,13 @@ def controller(values: dict[str, float], notch_radps: float | None) -> tuple[tup
     return (values["kp"], values["ki"], values["kd"]), filt
 
 
-def controller_tf(gains: tuple[float, float, float], filt: StructuralFilter, dt: float) -> control.TransferFunction:
-    """``C(z)``: the discrete PID (unfiltered derivative) times the structural filter, at ``dt`` [s]."""
+def controller_tf(gains: tuple[float, float, float], filt: Filter, dt: float) -> control.TransferFunction:
+    """``C(z)``: the discrete PID (unfiltered derivative) times the structural filter (one, or several in series:
+    :class:`..filters.FilterSeries`), at ``dt`` [s]."""
     return pid_tf(gains[0], gains[1], gains[2], None, dt) * filt.tf(dt)
 
 
-def _controller_poly(gains, filt: StructuralFilter, dt: float) -> tuple[np.ndarray, np.ndarray]:
+def _controller_poly(gains, filt: Filter, dt: float) -> tuple[np.ndarray, np.ndarray]:
     kp, ki, kd = gains                             # the PID of pid_tf over z (z - 1)
     b = kp * np.array([1.0, -1.0, 0.0]) + ki * dt * np.array([1.0, 0.0, 0.0]) + kd / dt * np.array([1.0, -2.0, 1.0])
     a = np.array([1.0, -1.0, 0.0])
