@@ -226,3 +226,23 @@ def test_stage_aerodynamics_must_be_a_mapping():
     data["stages"][1]["aerodynamics"] = [1, 2]
     with pytest.raises(ConfigError, match="aerodynamics"):
         parse_vehicle(data)
+
+
+def test_a_diverged_row_fails_alone_instead_of_raising():
+    """A row whose state runs away (here its position put 1000 times further from the Earth's centre, where
+    the atmosphere table's density underflows to zero and a gimbal at its stops once spun a slosh pendulum
+    up) is failed as a non-finite one is; the other rows of the batch fly on, as their single envs do."""
+    import lvgym
+    from lvgym.benchmark.suites import condition
+
+    cond = condition("smile-v2", "nonrigid").with_options(mission_time_s=1.0)
+    vec = cond.make_vec_env(2)
+    vec.reset(seed=3)
+    core = vec.unwrapped.core if hasattr(vec.unwrapped, "core") else vec.core
+    core.state.sim.x[0, 0:3] *= 1000.0
+    a = np.zeros((2, 2), np.float32)
+    obs, reward, terminated, truncated, info = vec.step(a)
+    assert terminated[0] and not terminated[1] and core.state.sim.failed[0]
+    single = lvgym.make_env("smile-v2", model="nonrigid", mission_time_s=1.0)
+    single.reset(seed=4)
+    assert np.array_equal(obs[1], single.step(a[1])[0])

@@ -70,8 +70,9 @@ LOADS_SIGNATURE = nb.types.void(nb.types.float64, _vec, _vec, _vec, _vec)
 
 def compile_loads(fn):
     """Compile a Python loads function ``fn(t, x, p, ctx, u)`` (numba-compatible code) for the
-    stepper."""
-    return nb.cfunc(LOADS_SIGNATURE, cache=True)(fn)
+    stepper. A division by zero gives inf or NaN (numpy's error model, as the dynamics kernels), which the
+    simulator's check of the state fails the row on, instead of raising out of the whole batch."""
+    return nb.cfunc(LOADS_SIGNATURE, cache=True, error_model="numpy")(fn)
 
 
 def _zoh(t, x, p, ctx, u):

@@ -182,7 +182,8 @@ def table_state_at(p, o, alt_m, out, oo):
     out[oo + _AIR.density] = rho
     out[oo + _AIR.pressure] = pres
     out[oo + _AIR.temperature] = t
-    out[oo + _AIR.speed_of_sound] = math.sqrt(GAMMA * pres / rho)
+    # far beyond the table (a diverged flight) the density underflows to zero: the ratio from the logarithms
+    out[oo + _AIR.speed_of_sound] = math.sqrt(GAMMA * pres / rho) if rho > 0.0 else math.sqrt(GAMMA * math.exp(lnp - lnrho))
 
 
 @nb.njit(cache=True)

@@ -19,7 +19,8 @@ Per row and per physics step of ``h = duration / ceil(duration / physics_dt)`` s
    advanced over the step with the step's mean inputs (:mod:`.imu`).
 
 After the period the flight conditions are evaluated at the row's new time with the thrust at that
-time. Rows whose state turns non-finite are flagged failed and no longer integrated. The functions
+time. Rows whose state turns non-finite, or diverges beyond :data:`X_DIVERGED` in any entry, are flagged
+failed and no longer integrated. The functions
 release the GIL, so the simulator runs row ranges on several threads.
 
 The compiled functions take a few named blocks: the rows' :class:`~.data.SimData`, the timeline's
@@ -60,6 +61,11 @@ StepSetup = namedtuple("StepSetup", ["rail", "servo", "physics_dt", "n_slosh", "
 AdvanceWork = namedtuple("AdvanceWork", ["rk4", "imu", "params", "modal", "dcm"])
 XS = STATE.per_slosh
 _EPS = 1e-12
+#: a state entry at or beyond this (SI: a position 150 Earth radii from the centre, a speed of 1e9 m/s, a
+#: rate of 1e9 rad/s) is a diverged integration: the row fails as a non-finite one does, before the flight
+#: loads meet numbers they were not written for (a pendulum spun up to 800 rad/s by a gimbal switching
+#: between its stops reached 4e40 in the next physics step, and the step after raised a division by zero)
+X_DIVERGED = 1e9
 
 
 @nb.njit(cache=True, nogil=True, inline="always")
@@ -143,7 +149,7 @@ def advance_range(lo, hi, loads_fn, data, tables, setup, duration):
     _advance_rows(lo, hi, loads_fn, data, tables, setup, duration, work)
 
 
-@nb.njit(cache=True, nogil=True)
+@nb.njit(cache=True, nogil=True, error_model="numpy")
 def _advance_rows(lo, hi, loads_fn, data, tables, setup, duration, work):
     """:func:`advance_range` with its scratch ``work`` (:data:`AdvanceWork`). Every array is used through
     a borrowed view (:mod:`lvgym.borrow`; the caller holds them all for the call): no atomic reference
@@ -222,7 +228,7 @@ def _advance_rows(lo, hi, loads_fn, data, tables, setup, duration, work):
             t[b] = tb
             ok = True
             for i in range(n_x):
-                if not math.isfinite(xb[i]):
+                if not abs(xb[i]) < X_DIVERGED:          # non-finite (NaN fails the test too), or diverged
                     ok = False
                     break
             if not ok:
