@@ -67,6 +67,11 @@ def fixed_policy(env: Any, kind: str = "lqg", name: str | None = None) -> Any:
     return _designed(env, nominal_file(), kind, name or f"fixed-{kind}")
 
 
+# their kind in protocol v2's headline (lvgym.benchmark.headline): classical designs
+auto_policy.kind = "classical"  # type: ignore[attr-defined]
+fixed_policy.kind = "classical"  # type: ignore[attr-defined]
+
+
 def _designed(env: Any, vehicle: Any, kind: str, label: str) -> Any:
     """The ``kind`` policy flying the automatic design of the vehicle file ``vehicle`` on ``env``."""
     from .design.auto import design_vehicle, latest_design

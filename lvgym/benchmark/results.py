@@ -209,8 +209,8 @@ def plot_degradation(degradation: Sequence[Mapping[str, Any]], write_to: IO[byte
 def write_results(out: str | os.PathLike[str], records: Sequence[Mapping[str, Any]],
                   summary: Sequence[Mapping[str, Any]], degradation: Sequence[Mapping[str, Any]],
                   meta: Mapping[str, Any], plots: bool = True, comparison: Sequence[Mapping[str, Any]] = (),
-                  groups: Sequence[Mapping[str, Any]] = (), headline: Sequence[Mapping[str, Any]] = ()
-                  ) -> dict[str, Path]:
+                  groups: Sequence[Mapping[str, Any]] = (), headline: Sequence[Mapping[str, Any]] = (),
+                  family: Sequence[str] = ()) -> dict[str, Path]:
     """Write every result file into ``out`` (created if missing), each atomically; ``results.json``
     last (``headline``: protocol v2's rows, :func:`~.headline.headline`, also as ``headline.csv``). Returns
     the paths by name."""
@@ -228,7 +228,8 @@ def write_results(out: str | os.PathLike[str], records: Sequence[Mapping[str, An
     if headline:
         paths["headline.csv"] = atomic_write_text(folder / "headline.csv", csv_text(flat(headline)))
     paths["table.md"] = atomic_write_text(folder / "table.md",
-                                          markdown_table(summary, degradation, meta, comparison, groups, headline))
+                                          markdown_table(summary, degradation, meta, comparison, groups, headline,
+                                                         family))
     if plots:
         paths["rate_error.png"] = atomic_write(folder / "rate_error.png", lambda f: plot_rate_error(records, f), True)
         if degradation:

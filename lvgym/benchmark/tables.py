@@ -118,7 +118,9 @@ def headline_table(headline: Sequence[Row]) -> list[str]:
     for h in headline:
         room = "-" if not math.isfinite(h["room"]) else (
             f"{100.0 * h['room']:.0f} % [{100.0 * h['room_low']:.0f}, {100.0 * h['room_high']:.0f}] of `{h['causal']}`")
-        out.append(f"| {h['suite']} | {h['model']} | {_headline_cell(h['classical'])} | {_headline_cell(h['learned'])} "
+        cond = h.get("condition", "")
+        where = cond.rsplit("/", 1)[0] if "/" in cond else h["suite"]          # a family suite: the vehicle
+        out.append(f"| {where} | {h['model']} | {_headline_cell(h['classical'])} | {_headline_cell(h['learned'])} "
                    f"| {_headline_cell(h['privileged'])} | {room} |")
     return out
 
@@ -205,13 +207,19 @@ def _section(title: str, lines: list[str]) -> list[str]:
 
 
 def markdown_table(summary: Sequence[Row], degradation: Sequence[Row], meta: Mapping[str, Any] | None = None,
-                   comparison: Sequence[Row] = (), groups: Sequence[Row] = (), headline: Sequence[Row] = ()) -> str:
-    """The comparison as Markdown: protocol v2's headline over every suite (:func:`headline_table`, when
-    ``headline`` has rows), then per suite: the ranked summary (:func:`summary_table`), the rate
+                   comparison: Sequence[Row] = (), groups: Sequence[Row] = (), headline: Sequence[Row] = (),
+                   family: Sequence[str] = ()) -> str:
+    """The comparison as Markdown: a family suite's table over its vehicles (``family``: the lines of
+    :func:`~.family.family_table`, when given), protocol v2's headline over every suite (:func:`headline_table`,
+    when ``headline`` has rows; a family suite's rows named by their vehicle's group), then per suite: the ranked summary (:func:`summary_table`), the rate
     error per phase (:func:`phase_table`), the degradation (:func:`degradation_table`), the paired
     comparison (:func:`comparison_table`) and the agents over training runs (:func:`run_groups_table`)."""
     meta = dict(meta or {})
     out: list[str] = []
+    if family:                                      # a family suite's vehicles gathered (:mod:`.family`)
+        out += ["### The launcher family, over its vehicles", "", "Each vehicle flies the same wind seeds; 95 % "
+                "intervals by resampling the vehicles and the seeds (lvgym.benchmark.family); held: no failed or "
+                "unflyable flight of the vehicle. Per vehicle: the tables below.", "", *family, ""]
     if headline:
         out += ["### Headline (protocol v2)", "", "score_v2 [rad] (lower is better): mean [95 % CI], failed or "
                 "unflyable of the seeds; the room is the best causal policy's score minus the privileged "

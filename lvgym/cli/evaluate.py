@@ -182,16 +182,12 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
         "policies_per_suite": {s: [p.name for p in v] for s, v in per_suite.items()},
         "wall_time_s": round(wall, 3), "created_utc": dt.datetime.now(dt.timezone.utc).isoformat(timespec="seconds"),
     }
-    table = markdown_table(summary, deg, meta, comparison, groups, rows)
-    family = family_rows(records)
-    if family:                                      # a family suite: its vehicles gathered first
-        table = "\n".join(["### The launcher family, over its vehicles", "", "Each vehicle flies the same wind "
-                           "seeds; 95 % intervals by resampling the vehicles and the seeds (lvgym.benchmark.family); "
-                           "held: no failed or unflyable flight of the vehicle. Per vehicle: the tables below.", "",
-                           *family_table(family, family_room(records, {p.name: policy_kind(p) for p in policies})),
-                           "", table])
+    family = family_rows(records)                   # a family suite: its vehicles gathered
+    family_lines = family_table(family, family_room(records, {p.name: policy_kind(p) for p in policies})) \
+        if family else []
+    table = markdown_table(summary, deg, meta, comparison, groups, rows, family_lines)
     paths = write_results(args.out, records, summary, deg, meta, plots=args.plots, comparison=comparison,
-                          groups=groups, headline=rows)
+                          groups=groups, headline=rows, family=family_lines)
     print(table)
     print(f"{len(records)} episodes in {wall:.1f} s ({args.executor}); results in {Path(args.out)}/: "
           f"{', '.join(sorted(paths))}", file=sys.stderr)
