@@ -51,6 +51,12 @@ def test_rl_benchmark_env_example_runs():
     assert ns["obs"].shape == ns["env"].observation_space.shape
 
 
+def test_family_example_runs():
+    (block,) = _python_blocks("family.md")
+    ns = _run("family.md", block)
+    assert ns["obs"].shape == (22,) and ns["env"].unwrapped.observation_layout.names[-1] == "vehicle_slosh_hz"
+
+
 def test_docstring_examples():
     result = doctest.testmod(lvgym.dynamics.model)
     assert result.attempted > 0 and result.failed == 0

@@ -202,8 +202,8 @@ def draw(cells: list[dict], ld: list[float], tw: list[float], out: Path) -> list
                     ha="center", va="center", fontsize=8, color="w")
     ax.legend(handles=[matplotlib.patches.Patch(color=cmap(k), label=h) for k, h in enumerate(HOLDS)],
               loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)
-    ax.set_title("auto-gs-pid (the per-vehicle rigid-body design) in flight; the number: its rows whose linear "
-                 "loop is stable on the non-rigid plant", fontsize=8)
+    ax.set_title("auto-gs-pid, the per-vehicle rigid-body design, in flight (held: no failed flight);\n"
+                 "the number: its rows whose linear loop is stable on the non-rigid plant", fontsize=8)
     fig.savefig(out / "rigid_design.png", dpi=100)
     plt.close(fig)
     return paths + [out / "rigid_design.png"]

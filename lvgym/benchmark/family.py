@@ -104,7 +104,7 @@ def family_table(rows: Sequence[Mapping[str, Any]], rooms: Sequence[Mapping[str,
     """:func:`family_rows` as Markdown lines, ranked per suite and model by the bad share, then score_v2;
     then the room of each suite and model (:func:`family_room`), when given."""
     lines = ["| suite | model | policy | vehicles held | failed [95 % CI] | failed or unflyable [95 % CI] | "
-             "score_v2 [rad] [95 % CI] |", "|---|---|---|---:|---:|---:|---:|"]
+             "score_v2 [rad], mean [95 % CI] |", "|---|---|---|---:|---:|---:|---:|"]
     order = sorted(rows, key=lambda r: (r["suite"], r["model"] != "rigid", r["bad"], r["score_v2"]))
     for r in order:
         pct = "{:.0f} % [{:.0f}, {:.0f}]".format
