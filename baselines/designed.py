@@ -29,11 +29,11 @@ KINDS = ("gs-pid", "gs-pid-flex", "lqg")
 
 def auto_policy(env: Any, kind: str = "gs-pid-flex", name: str | None = None) -> Any:
     """The ``kind`` (one of :data:`KINDS`) policy of the automatic design of ``env``'s vehicle file."""
-    vehicle = getattr(env.unwrapped.task, "vehicle", None)
-    if isinstance(vehicle, str) and not Path(vehicle).suffix and vehicle.startswith("family/"):
-        from lvgym.vehicle.config import VEHICLE_DIR
+    from lvgym.vehicle.config import vehicle_file
 
-        vehicle = VEHICLE_DIR / f"{vehicle}.yaml"   # a shipped family vehicle (the family's suites) by its file
+    vehicle = getattr(env.unwrapped.task, "vehicle", None)
+    if isinstance(vehicle, str) and vehicle.startswith("family/"):
+        vehicle = vehicle_file(vehicle)              # a shipped family vehicle (family/test_20000) by its file
     if not isinstance(vehicle, (str, os.PathLike)) or not Path(os.fspath(vehicle)).suffix:
         raise ConfigError("env vehicle", vehicle, "the path of a vehicle YAML file or a family vehicle "
                           "(family/test_20000; the shipped vehicles fly their shipped designs: gs-pid, "

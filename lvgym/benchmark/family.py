@@ -40,6 +40,19 @@ def crossed_interval(values: np.ndarray | Sequence[np.ndarray], statistic: Calla
     return float(np.quantile(out, a)), float(np.quantile(out, 1.0 - a))
 
 
+#: a family suite's records by (suite, model, policy), then vehicle (the condition's group), then seed
+Cells = dict[tuple[str, str, str], dict[str, dict[int, Mapping[str, Any]]]]
+
+
+def _cells(records: Iterable[Mapping[str, Any]]) -> Cells:
+    """The records of the family suites (:data:`Cells`), in order of appearance; others are left out."""
+    cells: Cells = {}
+    for r in records:
+        if r.get("suite") in SUITES_FAMILY and "score_v2" in r:
+            cells.setdefault((r["suite"], r["model"], r["policy"]), {}).setdefault(r["group"], {})[int(r["seed"])] = r
+    return cells
+
+
 def _matrix(per_vehicle: Mapping[str, Mapping[int, Mapping[str, Any]]], vehicles: Sequence[str], seeds: Sequence[int],
             key: str) -> np.ndarray:
     return np.array([[float(per_vehicle[v][s][key]) for s in seeds] for v in vehicles])
@@ -50,8 +63,8 @@ def family_room(records: Iterable[Mapping[str, Any]], kinds: Mapping[str, str]) 
     :func:`~.headline.policy_kind`; causal: neither ``privileged`` nor ``none``, the zero policy's; the best: the
     fewest failed or unflyable flights, then the lowest mean score_v2), the privileged reference, and the room
     ``1 - score(privileged) / score(best)`` on the vehicles and seeds both flew, with its crossed interval."""
+    cells = _cells(records)
     rows = family_rows(records)
-    recs = [r for r in records if r.get("suite") in SUITES_FAMILY and "score_v2" in r]
     out = []
     for suite, model in dict.fromkeys((r["suite"], r["model"]) for r in rows):
         here = [r for r in rows if (r["suite"], r["model"]) == (suite, model)]
@@ -60,10 +73,7 @@ def family_room(records: Iterable[Mapping[str, Any]], kinds: Mapping[str, str]) 
         if not causal or not ref:
             continue
         best = min(causal, key=lambda r: (r["bad"], r["score_v2"]))
-        per = {p: {} for p in (best["policy"], ref[0]["policy"])}
-        for r in recs:
-            if (r["suite"], r["model"]) == (suite, model) and r["policy"] in per:
-                per[r["policy"]].setdefault(r["group"], {})[int(r["seed"])] = r
+        per = {p: cells[(suite, model, p)] for p in (best["policy"], ref[0]["policy"])}
         vehicles = sorted(set(per[best["policy"]]) & set(per[ref[0]["policy"]]))
         seeds = sorted(set.intersection(*(set(p[v]) for p in per.values() for v in vehicles)))
         b, p = (_matrix(per[name], vehicles, seeds, "score_v2") for name in (best["policy"], ref[0]["policy"]))
@@ -78,12 +88,8 @@ def family_rows(records: Iterable[Mapping[str, Any]]) -> list[dict[str, Any]]:
     appearance: ``suite``, ``model``, ``policy``, ``vehicles``, ``seeds``; ``failed``, ``bad`` (failed or
     unflyable) and ``score_v2``, each as the mean with ``_low`` and ``_high``; ``held`` (vehicles without a
     bad flight). Only the seeds every vehicle flew count (a crossed design)."""
-    cells: dict[tuple[str, str, str], dict[str, dict[int, Mapping[str, Any]]]] = {}
-    for r in records:
-        if r.get("suite") in SUITES_FAMILY and "score_v2" in r:
-            cells.setdefault((r["suite"], r["model"], r["policy"]), {}).setdefault(r["group"], {})[int(r["seed"])] = r
     out = []
-    for (suite, model, policy), per_vehicle in cells.items():
+    for (suite, model, policy), per_vehicle in _cells(records).items():
         seeds = sorted(set.intersection(*(set(v) for v in per_vehicle.values())))
         vehicles = list(per_vehicle)
         grid = [[per_vehicle[v][s] for s in seeds] for v in vehicles]

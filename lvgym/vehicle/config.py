@@ -382,6 +382,19 @@ def clear_vehicle_cache() -> None:
         _LOADED.clear()
 
 
+def vehicle_file(name_or_path: str | Path) -> Path:
+    """The file of a vehicle: a shipped name (``"smile"``, ``"family/test_20000"``: ``lvgym/vehicles/<name>.yaml``)
+    or a path as given (a name without its file is a :class:`ConfigError` listing the shipped vehicles)."""
+    path = Path(name_or_path)
+    if path.suffix:
+        return path
+    path = VEHICLE_DIR / f"{name_or_path}.yaml"
+    if not path.exists():
+        raise ConfigError("vehicle", str(name_or_path), f"one of the shipped vehicles {shipped_vehicles()} or a "
+                          "YAML path")
+    return path
+
+
 def load_vehicle(name_or_path: str | Path) -> Vehicle:
     """Read a vehicle: a shipped name (``"smile"``) or a path to a YAML file.
 
@@ -396,13 +409,8 @@ def load_vehicle(name_or_path: str | Path) -> Vehicle:
     read-only; :func:`clear_vehicle_cache` forgets them."""
     from .yamlfile import read_yaml, with_line
 
-    path = Path(name_or_path)
-    if not path.suffix:
-        path = VEHICLE_DIR / f"{name_or_path}.yaml"
-        if not path.exists():
-            raise ConfigError("vehicle", str(name_or_path), f"one of the shipped vehicles {shipped_vehicles()} or a "
-                              "YAML path")
-    elif not path.is_file():
+    path = vehicle_file(name_or_path)
+    if not path.is_file():
         what = "it is a folder" if path.is_dir() else "there is no such file"
         raise ConfigError("vehicle", str(name_or_path), f"an existing YAML file ({what}) or one of the shipped "
                           f"vehicles {shipped_vehicles()}")

@@ -30,17 +30,15 @@ import math
 
 import numpy as np
 
-from .config import Vehicle, load_vehicle
+from .config import G0, Vehicle, load_vehicle
 from .massmodel import MassModel
+from .propulsion import P_SEA_LEVEL
 from .structure import vehicle_modes
 
 __all__ = ["DESIGN_ENTRIES", "design_parameters", "design_vector"]
 
-#: sea-level pressure [Pa] of the lift-off thrust
-P_SEA_LEVEL = 101_325.0
 #: the window [s] after ignition in which the lift-off thrust is the largest thrust
 THRUST_WINDOW_S = 1.0
-G0 = 9.80665
 #: the entries of :func:`design_vector`, in order, with their units (module docstring)
 DESIGN_ENTRIES = (("mass_t", "t"), ("pitch_inertia", "log10 kg m^2"), ("slenderness", "1/10"),
                   ("thrust_to_weight", "-"), ("control_power", "10/s^2"), ("bending_hz", "10 Hz"),
@@ -88,19 +86,8 @@ def _lift_off_thrust(mm: MassModel, state) -> tuple[float, float]:
 
 def design_vector(vehicle: str | Vehicle) -> np.ndarray:
     """:func:`design_parameters` of a vehicle (a shipped name, a YAML path or a :class:`Vehicle`) scaled
-    as :data:`DESIGN_ENTRIES` (the ``vehicle_info`` observation's block), float32, read-only; the same
-    vehicle object's vector is computed once."""
-    v = vehicle if isinstance(vehicle, Vehicle) else load_vehicle(vehicle)
-    key = id(v)
-    if key not in _VECTORS or _VECTORS[key][0] is not v:
-        if len(_VECTORS) >= 64:
-            _VECTORS.pop(next(iter(_VECTORS)))
-        _VECTORS[key] = (v, _scaled(design_parameters(v)))
-    return _VECTORS[key][1]
-
-
-#: vectors of the vehicles seen, by object identity (the vehicle is kept, so its id is not reused)
-_VECTORS: dict[int, tuple[Vehicle, np.ndarray]] = {}
+    as :data:`DESIGN_ENTRIES` (the ``vehicle_info`` observation's block), float32, read-only."""
+    return _scaled(design_parameters(vehicle if isinstance(vehicle, Vehicle) else load_vehicle(vehicle)))
 
 
 def _scaled(p: dict[str, float]) -> np.ndarray:

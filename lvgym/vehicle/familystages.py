@@ -26,16 +26,18 @@ from __future__ import annotations
 import math
 from typing import Any
 
+from .config import G0
+from .propulsion import P_SEA_LEVEL
+
 __all__ = ["stage_file", "stage_geometry", "stage_masses"]
 
-G0 = 9.80665
 #: the wall's allowed axial stress before the safety factor [Pa] (2219-T87 yields at about 390 MPa; a thin
 #: tube buckles first, so a preliminary sizing takes much less)
 WALL_STRESS_PA = 120e6
 MIN_WALL_M = 0.0015
 STRUCTURE_FACTOR = 1.6
 ENGINE_THRUST_TO_WEIGHT = 60.0
-ISP_S, EXIT_PRESSURE_PA, SEA_LEVEL_PA = 255.0, 70e3, 101325.0
+ISP_S, EXIT_PRESSURE_PA = 255.0, 70e3
 EXIT_AREA_PER_FLOW = 0.07 / 15.6            # [m^2 per kg/s], a small pressure-fed-class engine
 MIXTURE, RHO_LOX, RHO_RP1 = 2.35, 1141.0, 810.0
 #: a composite solid propellant (AP/HTPB/Al) [kg/m^3] and its delivered specific impulse near sea level [s]
@@ -45,7 +47,7 @@ CHAMBER_PA, HOOP_STRESS_PA = 5e6, 300e6
 SOLID_STRUCTURE_FACTOR = 1.25
 #: the tail-off of a solid's thrust table, as a share of the web burn time
 SOLID_TAILOFF = 0.03
-THRUST_PER_FLOW = ISP_S * G0 - (SEA_LEVEL_PA - EXIT_PRESSURE_PA) * EXIT_AREA_PER_FLOW     # [N per kg/s]
+THRUST_PER_FLOW = ISP_S * G0 - (P_SEA_LEVEL - EXIT_PRESSURE_PA) * EXIT_AREA_PER_FLOW     # [N per kg/s]
 
 
 def stage_geometry(D: float, top: float, length: float, nose: float, h: float, fill: float,
