@@ -124,7 +124,7 @@ def test_suites_are_frozen_and_seed_sets_disjoint():
     assert s.seeds("validation", 2) == [VALIDATION_SEED0, VALIDATION_SEED0 + 1]
     assert not set(s.seeds("test", 10_000)) & set(s.seeds("validation", 10_000))
     for suite in SUITES.values():
-        assert suite.version in ("v0", "v1", "v2", "v2-family-draft") and \
+        assert suite.version in ("v0", "v1", "v2", "v2-family") and \
             {c.model for c in suite.conditions} == {"rigid", "nonrigid"}
         assert not suite.reference or suite.version.startswith("v2")      # v0 and v1 name no reference
     assert get_suite("smile-v2").reference == get_suite("smile-v2-faults").reference == "lqg"

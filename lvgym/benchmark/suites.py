@@ -272,14 +272,16 @@ SUITES_V2: dict[str, Suite] = {s.name: s for s in (
 )}
 SUITES.update(SUITES_V2)
 
-#: the launcher family's suites: not frozen yet (results carry ``v2-family-draft``). Each test vehicle
+#: the launcher family's suites, frozen as version ``v2-family`` (fingerprint ``data/v2-family.json``; protocol
+#: v2 was frozen before them, so they are a version of their own; results made before carry
+#: ``v2-family-draft``). Each test vehicle
 #: (``lvgym/vehicles/family``: the first 20 test seeds of :mod:`lvgym.vehicle.generator` whose vehicles
 #: pass the family's checks, written once by ``lvgym.baselines.family.write_family``) is a pair of
 #: conditions, rigid and non-rigid, in smile-v2's conditions for 60 s; a policy flies every vehicle on the
 #: same wind seeds. ``family-v2`` is the ``blind`` track (the flight computer's signals only),
 #: ``family-v2-informed`` the ``informed`` one (the observation ends with the vehicle's design
 #: parameters: the env option ``vehicle_info``). docs/family.md
-PROTOCOL_FAMILY = "v2-family-draft"
+PROTOCOL_FAMILY = "v2-family"
 FAMILY_VEHICLES = tuple(f"family/test_{seed}" for seed in range(20_000, 20_020))
 #: the family's baselines: none, the privileged reference, the nominal member's designs on every vehicle
 #: (fixed), the per-vehicle rigid-body design (the thesis's practice) and flexible designs (the field's)
