@@ -38,6 +38,7 @@ from typing import Any
 import numpy as np
 from stable_baselines3.common.callbacks import BaseCallback
 
+from lvgym.benchmark.flyability import applies
 from lvgym.benchmark.metrics import summarize
 from lvgym.benchmark.policy import Policy
 from lvgym.benchmark.runner import play_episode
@@ -51,6 +52,9 @@ _STEM = re.compile(r"^step_(\d{12})$")
 #: what a validation's ``score`` is: compared lexicographically, lower is better (older runs' checkpoints
 #: without this key ranked on ``[failure rate, rate error]``)
 SELECTION = "failure_rate, score"
+#: the same on a suite that charges flyability (protocol v2 on): the share of failed or unflyable
+#: episodes, then the mean ``score_v2``
+SELECTION_V2 = "failure_rate_v2, score_v2"
 RNG_SUFFIX = "_rng.pkl"
 BUFFER_SUFFIX = "_replay_buffer.pkl"
 
@@ -130,6 +134,8 @@ class ValidationEvaluator:
         s = get_suite(suite) if isinstance(suite, str) else suite
         self.suite = s.with_options(**overrides) if overrides else s
         self.seeds = self.suite.seeds("validation", int(episodes))
+        self.flyability = applies(self.suite.version)
+        self.selection = SELECTION_V2 if self.flyability else SELECTION
         chosen = [c.name for c in self.suite.conditions if c.model == select_on]
         self.selected = chosen or [c.name for c in self.suite.conditions]
         self._envs: dict[Any, Any] = {}
@@ -142,7 +148,7 @@ class ValidationEvaluator:
             self._envs[condition] = condition.make_env()
         return {"suite": self.suite.name, "condition": condition.name, "group": condition.group,
                 "policy": policy.name, "model": condition.model, "seed": int(seed),
-                **play_episode(policy, self._envs[condition], seed)}
+                **play_episode(policy, self._envs[condition], seed, flyability=self.flyability)}
 
     def evaluate(self, policy: Policy) -> dict[str, Any]:
         """Per-condition means and failure rates, and the selection ``score``: ``[failure rate, score]``
@@ -150,11 +156,14 @@ class ValidationEvaluator:
         better). The second entry is the episodes' failure-charged ``score`` of protocol v1
         (:func:`lvgym.benchmark.scoring.flight_metrics`: the rate error plus, for a failed episode, the
         failure penalty for the mission left), so among equal failure rates a policy that fails late is
-        not preferred for its shorter rate-error integral. ``policy``: a Policy, or a callable that builds
+        not preferred for its shorter rate-error integral. On a suite that charges flyability (v2 on) the
+        episodes also carry v2's metrics and the selection ``score`` is ``[failed or unflyable rate, mean
+        score_v2]`` (:data:`SELECTION_V2`). ``policy``: a Policy, or a callable that builds
         one for a condition's env (e.g. a residual policy whose baseline needs the env)."""
         self._built.clear()                          # a factory's policies live for this evaluation only
         records = [self.episode(self._policy(policy, c), c, s) for c in self.suite.conditions for s in self.seeds]
-        rows = summarize(records, ("rate_error_rad", "score", "max_rate_radps", "effort_rad_s", "episode_return"))
+        rows = summarize(records, ("rate_error_rad", "score", "max_rate_radps", "effort_rad_s", "episode_return")
+                         + (("score_v2", "cmd_rate_rms") if self.flyability else ()))
         conds: dict[str, dict[str, float]] = {}
         for r in rows:
             conds[r["condition"]] = {k: float(r[k]) for k in r if isinstance(r[k], (int, float))
@@ -163,10 +172,15 @@ class ValidationEvaluator:
         fail = float(np.mean([c["failure_rate"] for c in sel]))
         err = float(np.mean([c["rate_error_rad_mean"] for c in sel]))
         charged = float(np.mean([c["score_mean"] for c in sel]))
-        return {"suite": self.suite.name, "version": self.suite.version, "seed_set": "validation",
-                "episodes": len(self.seeds), "conditions": conds, "selected_on": list(self.selected),
-                "failure_rate": fail, "rate_error_rad": err, "episode_score": charged, "score": [fail, charged],
-                "selection": SELECTION}
+        out = {"suite": self.suite.name, "version": self.suite.version, "seed_set": "validation",
+               "episodes": len(self.seeds), "conditions": conds, "selected_on": list(self.selected),
+               "failure_rate": fail, "rate_error_rad": err, "episode_score": charged, "score": [fail, charged],
+               "selection": self.selection}
+        if self.flyability:                  # v2: failed or unflyable, then score_v2
+            bad = float(np.mean([c["failure_rate_v2"] for c in sel]))
+            v2 = float(np.mean([c["score_v2_mean"] for c in sel]))
+            out.update({"failure_rate_v2": bad, "score_v2": v2, "score": [bad, v2]})
+        return out
 
     def _policy(self, policy: Any, condition: Any) -> Policy:
         """``policy`` itself, or the one the factory ``policy`` builds for ``condition``'s env (cached)."""
@@ -361,9 +375,9 @@ class CheckpointCallback(BaseCallback):
             result = {**self._validate(step), **self.timing()}
             self.evaluations.append(result)
             self.last_eval = step
-            if self.best is None or self.best.get("selection") != SELECTION or result["score"] < self.best["score"]:
+            if self.best is None or self.best.get("selection") != result["selection"] or result["score"] < self.best["score"]:
                 self.best, new_best = {"num_timesteps": step, "score": result["score"], "stem": stem.name,
-                                       "selection": SELECTION}, True
+                                       "selection": result["selection"]}, True
         state = {**self.meta, "num_timesteps": step, "saved_utc": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
                  **self.timing(), "evaluations": self.evaluations, "best": self.best}
         atomic_write_text(json_path, json_text(state))            # the commit: the checkpoint now exists

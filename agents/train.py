@@ -9,6 +9,7 @@
     lvgym train --max-wall-time 3600                       # stop after an hour with a checkpoint
     lvgym train --algo recurrent-ppo --history 0           # an LSTM policy, residual on lqg
     lvgym train --residual gs-pid-flex --residual-scale 0.2
+    lvgym train --suite smile-v2-faults --residual lqg-front   # a v2 suite's condition, validated on it
 
 (``python train.py`` in a checkout is the same command.) A run lives in ``runs/<name>/``: ``config.yaml``
 (every argument, the resolved hyperparameters and env keywords, lvgym version, git commit),
@@ -48,7 +49,7 @@ from lvgym.parallel import exit_on_sigterm
 
 from .runfolder import create_run, make_logger, provenance
 from .trainsetup import (DEFAULT_EVAL_SUITES, RECIPES, check_options, env_kwargs_of, eval_suite_option, make_venv,
-                         protocol_training, training_seed)
+                         protocol_training, suite_condition, suite_option, training_seed)
 
 __all__ = ["Args", "DEFAULT_EVAL_SUITES", "RECIPES", "RESUME_OVERRIDABLE", "check_options", "create_run",
            "env_kwargs_of", "main", "make_venv", "parse_args", "prepare", "protocol_training", "train",
@@ -79,6 +80,9 @@ class Args:
 
     env_id: str = arg("lvgym/SmileAscent-v1", choices=_choices("env_id"))
     """registered lvgym env id (the options an id's recipe sets, RECIPES, default to it)"""
+    suite: str | None = arg(None, check=suite_option)
+    """train on this benchmark suite's condition of --model (its env id, wind, dispersions and options, e.g.
+    smile-v2-faults' faults; rows reset with training seeds) and validate on the suite (default: --env-id's)"""
     model: str = arg("nonrigid", choices=_choices("model"))
     """flight model: rigid, slosh, flex or nonrigid"""
     wind: str = arg("protocol", choices=_choices("wind"))
@@ -192,7 +196,14 @@ def prepare(args: Args, given: set[str]) -> tuple[Args, dict[str, Any], Path, bo
             config["total_timesteps"] = int(args.total_timesteps)
         build_config(stored.algo, stored.env_id, config["hyperparams"], str(cfg_path))  # still valid?
         return stored, config, run_dir, True
-    recipe = {k: v for k, v in RECIPES.get(args.env_id, {}).items() if k not in given}
+    if args.suite:
+        cond = suite_condition(args.suite, args.model)
+        if "env_id" in given and args.env_id != cond.env_id:
+            raise ConfigError("--env-id", args.env_id, f"{cond.env_id!r} (suite {args.suite!r} flies it) or no --env-id")
+        args = replace(args, env_id=cond.env_id)
+    # a suite's wind is the suite's: the id's recipe gives the rest (residual, history)
+    recipe = {k: v for k, v in RECIPES.get(args.env_id, {}).items()
+              if k not in given and not (args.suite and k == "wind")}
     args = replace(args, **recipe)
     overrides = parse_overrides(args.hp)
     if args.n_envs is not None:
@@ -200,9 +211,9 @@ def prepare(args: Args, given: set[str]) -> tuple[Args, dict[str, Any], Path, bo
     cfg = load_config(args.algo, args.env_id, overrides, args.hyperparams)
     training_seed(args.seed, 0, cfg.n_envs, _prog())
     env_kwargs = env_kwargs_of(args)
-    suite = args.eval_suite or DEFAULT_EVAL_SUITES.get(args.env_id, "none")
-    name = args.name or (f"{args.algo}-{args.env_id.split('/')[-1].split('-')[0].lower()}-{args.model}-s{args.seed}-"
-                         f"{dt.datetime.now().strftime('%Y%m%d-%H%M%S')}")
+    suite = args.eval_suite or args.suite or DEFAULT_EVAL_SUITES.get(args.env_id, "none")
+    where = args.suite or args.env_id.split('/')[-1].split('-')[0].lower()
+    name = args.name or f"{args.algo}-{where}-{args.model}-s{args.seed}-{dt.datetime.now().strftime('%Y%m%d-%H%M%S')}"
     run_dir = Path(args.runs_dir) / name
     if (run_dir / "config.yaml").exists():
         raise SystemExit(f"{_prog()}: {run_dir} exists; continue it with --resume {run_dir} or choose another --name")

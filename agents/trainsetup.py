@@ -15,7 +15,7 @@ import yaml
 from lvgym.errors import ConfigError
 
 __all__ = ["DEFAULT_EVAL_SUITES", "RECIPES", "check_options", "env_kwargs_of", "eval_suite_option", "make_venv",
-           "protocol_training", "training_seed"]
+           "protocol_training", "suite_condition", "suite_option", "training_seed"]
 
 DEFAULT_EVAL_SUITES = {"lvgym/SmileAscent-v0": "smile-windy", "lvgym/SlenderAscent-v0": "slender-ld30",
                        "lvgym/SmileAscent-v1": "smile-v1", "lvgym/SlenderAscent-v1": "slender-v1"}
@@ -28,6 +28,19 @@ DEFAULT_EVAL_SUITES = {"lvgym/SmileAscent-v0": "smile-windy", "lvgym/SlenderAsce
 RECIPES: dict[str, dict[str, Any]] = {
     "lvgym/SmileAscent-v1": {"residual": "lqg", "residual_scale": 0.05, "history": 4, "wind": "turbulence"},
 }
+
+
+def suite_condition(suite: str, model: str) -> Any:
+    """The condition of suite ``suite`` a run on ``--suite`` trains on: its condition of flight model
+    ``model`` (its env id, wind, dispersions and options; the run's rows still reset with training
+    seeds). A family suite is refused: its conditions are the family's test vehicles."""
+    from lvgym.benchmark.suites import SUITES_FAMILY, condition, get_suite
+
+    s = get_suite(suite)
+    if s.name in SUITES_FAMILY:
+        raise ConfigError("--suite", suite, "a suite of one vehicle (a family suite's conditions are its test vehicles, "
+                          "never trained on)")
+    return condition(s.name, model)
 
 
 def protocol_training(env_id: str) -> tuple[str, list[str]]:
@@ -45,16 +58,24 @@ def protocol_training(env_id: str) -> tuple[str, list[str]]:
 
 def env_kwargs_of(args: Any) -> dict[str, Any]:
     """The env keywords of a run (``args``: :class:`lvgym.agents.train.Args`): model, wind, randomisation,
-    observation and the ``--env-kwargs``."""
+    observation and the ``--env-kwargs``. With ``--suite``, ``--wind protocol`` and ``--randomize protocol``
+    mean the suite condition's, whose further options (faults, a mission time, a vehicle) come first and
+    ``--env-kwargs`` after them."""
     r: Any = list(args.randomize)
     wind, protocol_r = protocol_training(args.env_id)
+    suite_options: dict[str, Any] = {}
+    if getattr(args, "suite", None):
+        cond = suite_condition(args.suite, args.model)
+        wind, protocol_r = cond.wind, list(cond.randomize)
+        suite_options = {k: v for k, v in cond.options}
     if r == ["protocol"]:
         r = protocol_r
     elif r in (["all"], ["true"], ["True"]):
         r = True
     elif r in ([], ["none"], ["false"], ["False"]):
         r = False
-    out: dict[str, Any] = {"model": args.model, "wind": wind if args.wind == "protocol" else args.wind, "randomize": r}
+    out: dict[str, Any] = {"model": args.model, "wind": wind if args.wind == "protocol" else args.wind, "randomize": r,
+                           **suite_options}
     out.update({} if args.observation == "env" else {"observation": args.observation})
     out.update({"history": int(args.history)} if args.history else {})   # when on only: old runs unchanged
     for item in args.env_kwargs:
@@ -94,6 +115,15 @@ def eval_suite_option(option: str, value: str) -> str:
 
     if value != "none" and value not in SUITES:
         raise ConfigError(option, value, f"one of {sorted(SUITES)} or 'none'")
+    return value
+
+
+def suite_option(option: str, value: str) -> str:
+    """``--suite``: a suite of the benchmark (:data:`lvgym.benchmark.suites.SUITES`)."""
+    from lvgym.benchmark.suites import SUITES
+
+    if value not in SUITES:
+        raise ConfigError(option, value, f"one of {sorted(SUITES)}")
     return value
 
 
