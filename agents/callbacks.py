@@ -43,7 +43,7 @@ from lvgym.benchmark.metrics import summarize
 from lvgym.benchmark.policy import Policy
 from lvgym.benchmark.runner import play_episode
 from lvgym.benchmark.results import atomic_path, atomic_write_text, json_text, remove_stale_temporaries
-from lvgym.benchmark.suites import Suite, get_suite
+from lvgym.benchmark.suites import Suite, family_validation_suite, get_suite
 
 from .policy import SB3Policy, adapt, copy_policy, policy_files
 from .progress import ProgressBarCallback  # noqa: F401  (its old place)
@@ -127,11 +127,13 @@ class ValidationEvaluator:
     ``overrides``: env keywords for every condition (e.g. ``mission_time_s`` in tests; the suite is then
     marked ``+override``). ``select_on``: the flight model (``rigid``, ``nonrigid``, ...) whose conditions
     make the selection score; None, or a model the suite does not fly: all conditions. A policy trained on
-    one model and selected on every condition has seen the others through model selection."""
+    one model and selected on every condition has seen the others through model selection. A family suite
+    is flown on the family's validation vehicles (:func:`~lvgym.benchmark.suites.family_validation_suite`),
+    never on its test vehicles."""
 
     def __init__(self, suite: str | Suite, episodes: int, overrides: dict[str, Any] | None = None,
                  select_on: str | None = None) -> None:
-        s = get_suite(suite) if isinstance(suite, str) else suite
+        s = family_validation_suite(get_suite(suite) if isinstance(suite, str) else suite)   # never test vehicles
         self.suite = s.with_options(**overrides) if overrides else s
         self.seeds = self.suite.seeds("validation", int(episodes))
         self.flyability = applies(self.suite.version)

@@ -10,6 +10,7 @@
     lvgym train --algo recurrent-ppo --history 0           # an LSTM policy, residual on lqg
     lvgym train --residual gs-pid-flex --residual-scale 0.2
     lvgym train --suite smile-v2-faults --residual lqg-front   # a v2 suite's condition, validated on it
+    lvgym train --suite family-v2-informed --family-vehicles 8 --residual auto-lqg   # the family's train vehicles
 
 (``python train.py`` in a checkout is the same command.) A run lives in ``runs/<name>/``: ``config.yaml``
 (every argument, the resolved hyperparameters and env keywords, lvgym version, git commit),
@@ -48,8 +49,8 @@ from lvgym.errors import ConfigError
 from lvgym.parallel import exit_on_sigterm
 
 from .runfolder import create_run, make_logger, provenance
-from .trainsetup import (DEFAULT_EVAL_SUITES, RECIPES, check_options, env_kwargs_of, eval_suite_option, make_venv,
-                         protocol_training, suite_condition, suite_option, training_seed)
+from .trainsetup import (DEFAULT_EVAL_SUITES, RECIPES, check_options, env_kwargs_of, eval_suite_option, is_family,
+                         make_venv, protocol_training, suite_condition, suite_option, training_seed)
 
 __all__ = ["Args", "DEFAULT_EVAL_SUITES", "RECIPES", "RESUME_OVERRIDABLE", "check_options", "create_run",
            "env_kwargs_of", "main", "make_venv", "parse_args", "prepare", "protocol_training", "train",
@@ -82,7 +83,10 @@ class Args:
     """registered lvgym env id (the options an id's recipe sets, RECIPES, default to it)"""
     suite: str | None = arg(None, check=suite_option)
     """train on this benchmark suite's condition of --model (its env id, wind, dispersions and options, e.g.
-    smile-v2-faults' faults; rows reset with training seeds) and validate on the suite (default: --env-id's)"""
+    smile-v2-faults' faults; rows reset with training seeds) and validate on the suite (default: --env-id's);
+    a family suite trains on the family's train vehicles and validates on its validation vehicles"""
+    family_vehicles: int = arg(8, lo=1, hi=1000)
+    """with a family --suite: the rows fly the family's first N train vehicles (lvgym.agents.familytrain)"""
     model: str = arg("nonrigid", choices=_choices("model"))
     """flight model: rigid, slosh, flex or nonrigid"""
     wind: str = arg("protocol", choices=_choices("wind"))
@@ -210,6 +214,11 @@ def prepare(args: Args, given: set[str]) -> tuple[Args, dict[str, Any], Path, bo
         overrides["n_envs"] = args.n_envs
     cfg = load_config(args.algo, args.env_id, overrides, args.hyperparams)
     training_seed(args.seed, 0, cfg.n_envs, _prog())
+    family = is_family(args.suite)
+    if family:
+        from lvgym.agents.familytrain import row_split
+
+        row_split(cfg.n_envs, args.family_vehicles)                  # a row for every vehicle
     env_kwargs = env_kwargs_of(args)
     suite = args.eval_suite or args.suite or DEFAULT_EVAL_SUITES.get(args.env_id, "none")
     where = args.suite or args.env_id.split('/')[-1].split('-')[0].lower()
@@ -223,6 +232,7 @@ def prepare(args: Args, given: set[str]) -> tuple[Args, dict[str, Any], Path, bo
               **({"residual": res} if (res := residual_options(args.residual, args.residual_scale)) else {}),
               **({"loop_dispersion": loop} if (loop := loop_dispersion_options(args.loop_gain_db,
                                                                                  args.loop_delay_periods)) else {}),
+              **({"family_vehicles": int(args.family_vehicles)} if family else {}),
               "hyperparams_source": cfg.source,
               "created_utc": dt.datetime.now(dt.timezone.utc).isoformat(timespec="seconds"), **provenance()}
     return args, config, run_dir, False
@@ -276,9 +286,15 @@ def _train(args: Args, given: set[str], stop: Any, t0: float) -> Path:
     except ConfigError as exc:
         fail(prog, exc)
     try:                                             # the env's keywords (--model, --wind, --env-kwargs, ...)
+        vehicles = None
+        if config.get("family_vehicles"):            # a family run: its train vehicles' files
+            from lvgym.agents.familytrain import train_vehicle_files
+
+            vehicles = [str(v) for v in train_vehicle_files(config["family_vehicles"])]
+            config["vehicles"] = [Path(v).name for v in vehicles]
         venv = make_venv(config["env_id"], cfg.n_envs, seed, config["env_kwargs"], cfg.normalize, cfg.hyper.gamma,
                          policy_files(stem)[1] if stem is not None else None, config.get("residual"),
-                         config.get("loop_dispersion"))
+                         config.get("loop_dispersion"), vehicles)
     except (ConfigError, ValueError) as exc:
         fail(prog, f"{config['env_id']} option {exc}")
     try:

@@ -15,7 +15,7 @@ import yaml
 from lvgym.errors import ConfigError
 
 __all__ = ["DEFAULT_EVAL_SUITES", "RECIPES", "check_options", "env_kwargs_of", "eval_suite_option", "make_venv",
-           "protocol_training", "suite_condition", "suite_option", "training_seed"]
+           "is_family", "protocol_training", "suite_condition", "suite_option", "training_seed"]
 
 DEFAULT_EVAL_SUITES = {"lvgym/SmileAscent-v0": "smile-windy", "lvgym/SlenderAscent-v0": "slender-ld30",
                        "lvgym/SmileAscent-v1": "smile-v1", "lvgym/SlenderAscent-v1": "slender-v1"}
@@ -33,14 +33,24 @@ RECIPES: dict[str, dict[str, Any]] = {
 def suite_condition(suite: str, model: str) -> Any:
     """The condition of suite ``suite`` a run on ``--suite`` trains on: its condition of flight model
     ``model`` (its env id, wind, dispersions and options; the run's rows still reset with training
-    seeds). A family suite is refused: its conditions are the family's test vehicles."""
+    seeds). For a family suite, whose conditions are its test vehicles, the condition without its
+    ``vehicle``: the run's rows fly the family's train vehicles (:mod:`lvgym.agents.familytrain`)."""
     from lvgym.benchmark.suites import SUITES_FAMILY, condition, get_suite
 
     s = get_suite(suite)
+    cond = condition(s.name, model)
     if s.name in SUITES_FAMILY:
-        raise ConfigError("--suite", suite, "a suite of one vehicle (a family suite's conditions are its test vehicles, "
-                          "never trained on)")
-    return condition(s.name, model)
+        from dataclasses import replace
+
+        cond = replace(cond, options=tuple((k, v) for k, v in cond.options if k != "vehicle"))
+    return cond
+
+
+def is_family(suite: str | None) -> bool:
+    """Whether ``suite`` is one of the launcher family's suites (its runs fly the train vehicles)."""
+    from lvgym.benchmark.suites import SUITES_FAMILY
+
+    return bool(suite) and suite in SUITES_FAMILY
 
 
 def protocol_training(env_id: str) -> tuple[str, list[str]]:
@@ -143,10 +153,13 @@ def training_seed(seed: int, step: int, n_envs: int, prog: str = "train.py") -> 
 
 
 def make_venv(env_id: str, n_envs: int, seed: int, env_kwargs: dict[str, Any], norm: Any, gamma: float,
-              stats: Path | None, residual: dict[str, Any] | None = None, loop: dict[str, Any] | None = None) -> Any:
+              stats: Path | None, residual: dict[str, Any] | None = None, loop: dict[str, Any] | None = None,
+              vehicles: list[str] | None = None) -> Any:
     """Batched SB3 VecEnv (-> :class:`lvgym.agents.loop_dispersion.LoopDispersedVecEnv` with ``loop`` ->
     :class:`lvgym.agents.residual.ResidualVecEnv` with ``residual``) -> EnvClock (the env's wall time,
-    :mod:`lvgym.agents.timing`) -> VecMonitor (episode returns) -> VecNormalize (new, or loaded from ``stats``)."""
+    :mod:`lvgym.agents.timing`) -> VecMonitor (episode returns) -> VecNormalize (new, or loaded from ``stats``).
+    ``vehicles``: vehicle files whose rows share ``n_envs`` (one such stack per vehicle, joined by
+    :class:`lvgym.agents.familytrain.ConcatVecEnv`)."""
     from stable_baselines3.common.vec_env import VecMonitor, VecNormalize
 
     import lvgym  # noqa: F401
@@ -156,8 +169,18 @@ def make_venv(env_id: str, n_envs: int, seed: int, env_kwargs: dict[str, Any], n
     from lvgym.agents.residual import residual_venv
     from lvgym.agents.timing import EnvClock
 
-    base = loop_venv(make_sb3_vec_env(env_id, num_envs=n_envs, seed=seed, **env_kwargs), loop, seed)
-    venv = VecMonitor(EnvClock(residual_venv(base, residual)))
+    def part(kwargs: dict[str, Any], rows: int, first: int) -> Any:
+        return residual_venv(loop_venv(make_sb3_vec_env(env_id, num_envs=rows, seed=first, **kwargs), loop, first),
+                             residual)
+
+    if vehicles:
+        from lvgym.agents.familytrain import concat_venv
+
+        inner = concat_venv(lambda v, rows, first: part({**env_kwargs, "vehicle": v}, rows, first), vehicles, n_envs,
+                            seed)
+    else:
+        inner = part(env_kwargs, n_envs, seed)
+    venv = VecMonitor(EnvClock(inner))
     if stats is not None and stats.is_file():
         return VecNormalize.load(str(stats), venv)
     if norm.norm_obs or norm.norm_reward:

@@ -283,6 +283,9 @@ SUITES.update(SUITES_V2)
 #: parameters: the env option ``vehicle_info``). docs/family.md
 PROTOCOL_FAMILY = "v2-family"
 FAMILY_VEHICLES = tuple(f"family/test_{seed}" for seed in range(20_000, 20_020))
+#: the family's shipped validation vehicles (the first 10 validation seeds that pass its checks): what
+#: training selects and tunes on (:func:`family_validation_suite`), never reported
+FAMILY_VALIDATION_VEHICLES = tuple(f"family/validation_{seed}" for seed in range(10_000, 10_010))
 #: the family's baselines: none, the privileged reference, the nominal member's designs on every vehicle
 #: (fixed), the per-vehicle rigid-body design (the thesis's practice) and flexible designs (the field's)
 FAMILY_POLICIES = ("zero", "privileged", "fixed-gs-pid-flex", "fixed-lqg", "auto-gs-pid", "auto-gs-pid-flex",
@@ -290,12 +293,23 @@ FAMILY_POLICIES = ("zero", "privileged", "fixed-gs-pid-flex", "fixed-lqg", "auto
 FAMILY_MISSION_S = 60.0
 
 
-def _family(suite: str, **options: Any) -> tuple[Condition, ...]:
-    """The conditions of a family suite: a rigid and a non-rigid one per vehicle of :data:`FAMILY_VEHICLES`
-    (grouped per vehicle: ``<suite>/<seed>``)."""
-    return tuple(c for v in FAMILY_VEHICLES for c in _pair(f"{suite}/{v.rsplit('_', 1)[1]}", SMILE_V1,
-                                                           "turbulence_gust", V1_DISPERSIONS, vehicle=v,
-                                                           mission_time_s=FAMILY_MISSION_S, **options))
+def _family(suite: str, vehicles: tuple[str, ...] = FAMILY_VEHICLES, **options: Any) -> tuple[Condition, ...]:
+    """The conditions of a family suite: a rigid and a non-rigid one per vehicle of ``vehicles`` (default
+    :data:`FAMILY_VEHICLES`; grouped per vehicle: ``<suite>/<seed>``)."""
+    return tuple(c for v in vehicles for c in _pair(f"{suite}/{v.rsplit('_', 1)[1]}", SMILE_V1,
+                                                    "turbulence_gust", V1_DISPERSIONS, vehicle=v,
+                                                    mission_time_s=FAMILY_MISSION_S, **options))
+
+
+def family_validation_suite(suite: Suite) -> Suite:
+    """A family suite flown on the family's validation vehicles (:data:`FAMILY_VALIDATION_VEHICLES`) in
+    place of its test vehicles, for training's model selection and tuning (with the validation seeds);
+    any other suite as it is. Named ``<suite>@validation-vehicles``; not a suite of the benchmark."""
+    if suite.name not in SUITES_FAMILY:
+        return suite
+    options = {k: v for k, v in suite.conditions[0].options if k not in ("vehicle", "mission_time_s")}
+    return replace(suite, name=f"{suite.name}@validation-vehicles",
+                   conditions=_family(suite.name, FAMILY_VALIDATION_VEHICLES, **options))
 
 
 SUITES_FAMILY: dict[str, Suite] = {s.name: s for s in (
