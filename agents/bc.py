@@ -2,11 +2,15 @@
 
     lvgym dataset --policies lqg-front --suites smile-v2 --models nonrigid --episodes 50
     lvgym bc --dataset lvgym/smile-v2-nonrigid/lqg-front-v0 --out runs/bc_lqg_front.pt
+    lvgym dataset --policies lqg-front --models nonrigid --episodes 50 --action-noise 0.05   # DART's data
+    lvgym bc --dataset lvgym/smile-v2-nonrigid/lqg-front-noise0p05-v0 --out runs/bc_dart.pt
     python evaluate.py --suites smile-v2 --policies lqg-front bc=lvgym.agents.bc:policy
 
 A multilayer perceptron (torch; two hidden layers of ``--hidden`` units, tanh) maps the last ``--history``
 observations of an episode (the oldest first, zeros before the first) to the action the dataset's policy
-took, by least squares on every step of every episode, with Adam. The classical designs it clones carry
+took (in a dataset recorded with ``--action-noise``, the action it asked for, ``infos["expert_action"]``,
+not the perturbed one the env flew: DART), by least squares on every step of every episode, with Adam.
+The classical designs it clones carry
 state (a Kalman filter, an integrator): the history stands in for it. The trained file holds the weights,
 the history, the observation's normalisation and the dataset it came from. ``policy(env, path=...)`` flies
 it (its default path: ``runs/bc.pt``, or ``LVGYM_BC_PATH``).
@@ -59,7 +63,9 @@ def train(dataset_id: str, out: str | Path, history: int = 8, hidden: int = 128,
     xs, ys = [], []
     for ep in data.iterate_episodes():
         xs.append(features(ep.observations[:-1], history))
-        ys.append(np.asarray(ep.actions, dtype=np.float32))
+        # a noise-injected dataset (lvgym dataset --action-noise) labels each step with the policy's own action
+        labels = ep.infos.get("expert_action") if isinstance(ep.infos, dict) else None
+        ys.append(np.asarray(ep.actions if labels is None else np.asarray(labels)[1:], dtype=np.float32))
     x, y = np.concatenate(xs), np.concatenate(ys)
     mean, std = x.mean(axis=0), x.std(axis=0) + 1e-6
     torch.manual_seed(seed)

@@ -35,15 +35,22 @@ from lvgym.benchmark.suites import SEED_SETS, condition, get_suite
 from lvgym.cli.args import arg, parse
 from lvgym.errors import ConfigError
 
-__all__ = ["collect", "dataset_id"]
+__all__ = ["NOISE_STREAM", "collect", "dataset_id"]
 
 PROG = "lvgym dataset"
 PERMALINK = "https://github.com/lvgym/lvgym"
 
 
-def dataset_id(policy: str, suite: str, model: str) -> str:
-    """The Minari id of ``policy``'s rollouts on ``suite``'s ``model`` condition."""
-    return f"lvgym/{suite}-{model}/{policy}-v0"
+#: the stream of an episode's action-noise generator, ``numpy.random.default_rng([seed, NOISE_STREAM])``
+#: (apart from every draw of the env, which its own seeded generator makes)
+NOISE_STREAM = 7
+
+
+def dataset_id(policy: str, suite: str, model: str, action_noise: float = 0.0) -> str:
+    """The Minari id of ``policy``'s rollouts on ``suite``'s ``model`` condition (``-noise0p05`` after the
+    policy for rollouts with ``action_noise`` 0.05)."""
+    noise = f"-noise{action_noise:g}".replace(".", "p") if action_noise else ""
+    return f"lvgym/{suite}-{model}/{policy}{noise}-v0"
 
 
 def _writable_spec(env: Any) -> Any:
@@ -52,10 +59,14 @@ def _writable_spec(env: Any) -> Any:
 
 
 def collect(policy: str, suite: str = "smile-v2", model: str = "nonrigid", episodes: int = 20,
-            seed_set: str = "validation", **overrides: Any) -> Any:
+            seed_set: str = "validation", action_noise: float = 0.0, **overrides: Any) -> Any:
     """Fly ``episodes`` episodes of ``policy`` (a registered name, or a factory reference) on ``suite``'s
     ``model`` condition (``overrides``: env options, e.g. a shorter ``mission_time_s`` for a test) on the
-    ``seed_set`` seeds and return the Minari dataset written (module docstring)."""
+    ``seed_set`` seeds and return the Minari dataset written (module docstring). ``action_noise`` > 0: the
+    env flies the policy's action plus Gaussian noise of that standard deviation (in the action's units,
+    clipped to the action space; drawn from :data:`NOISE_STREAM`), the dataset's ``actions`` are what the
+    env flew, and ``infos["expert_action"]`` what the policy asked for (zeros at the reset), so a clone
+    learns how the policy corrects the drift of a perturbed flight (DART: Laskey et al., 2017)."""
     import minari
     from minari.data_collector.episode_buffer import EpisodeBuffer
 
@@ -67,6 +78,8 @@ def collect(policy: str, suite: str = "smile-v2", model: str = "nonrigid", episo
     if getattr(factory, "privileged", False):
         raise ConfigError("policies", policy, "a causal policy: the privileged reference acts on what its "
                           "observations do not hold")
+    if not 0.0 <= float(action_noise) <= 1.0:
+        raise ConfigError("action_noise", action_noise, "a standard deviation in [0, 1] (the action's units)")
     suite_obj = get_suite(suite)
     seeds = suite_obj.seeds(seed_set, episodes)
     env = condition(suite, model, **overrides).make_env()
@@ -77,23 +90,32 @@ def collect(policy: str, suite: str = "smile-v2", model: str = "nonrigid", episo
         pol.reset()
         steps: dict[str, list[Any]] = {"observations": [obs], "actions": [], "rewards": [], "terminations": [],
                                        "truncations": []}
+        noise = np.random.default_rng([int(seed), NOISE_STREAM]) if action_noise else None
+        expert: list[np.ndarray] = [np.zeros(env.action_space.shape, env.action_space.dtype)]
         while True:
             action = np.asarray(pol.act(obs, info), dtype=env.action_space.dtype)
+            if noise is not None:
+                expert.append(action)
+                action = np.clip(action + noise.normal(0.0, action_noise, action.shape), env.action_space.low,
+                                 env.action_space.high).astype(env.action_space.dtype)
             obs, reward, terminated, truncated, info = env.step(action)
             for key, value in zip(("observations", "actions", "rewards", "terminations", "truncations"),
                                   (obs, action, float(reward), bool(terminated), bool(truncated))):
                 steps[key].append(value)
             if terminated or truncated:
                 break
-        buffers.append(EpisodeBuffer(id=i, seed=int(seed), **steps))
+        infos = {"expert_action": np.array(expert)} if noise is not None else None
+        buffers.append(EpisodeBuffer(id=i, seed=int(seed), infos=infos, **steps))
     description = (f"{spec.name} flying lvgym's {suite} ({suite_obj.description}; protocol {suite_obj.version}), "
                    f"{model} model, {len(seeds)} episodes on the {seed_set} seeds {seeds[0]}-{seeds[-1]}"
-                   + (f", env options {overrides}" if overrides else ""))
+                   + (f", env options {overrides}" if overrides else "")
+                   + (f", its actions flown with Gaussian noise of standard deviation {action_noise:g} "
+                      "(infos['expert_action']: the policy's own)" if action_noise else ""))
     from lvgym import __version__
 
     env_spec = _writable_spec(env)
     return minari.create_dataset_from_buffers(
-        dataset_id=dataset_id(spec.name, suite, model), buffer=buffers, env=env_spec, eval_env=env_spec,
+        dataset_id=dataset_id(spec.name, suite, model, action_noise), buffer=buffers, env=env_spec, eval_env=env_spec,
         algorithm_name=spec.name, author=f"lvgym {__version__}", author_email="lvgym@users.noreply.github.com",
         code_permalink=PERMALINK, description=description, data_format="arrow")
 
@@ -110,6 +132,9 @@ class Args:
     """the flight models"""
     episodes: int = arg(20, lo=1, hi=10_000)
     """episodes per policy, suite and model (the first validation seeds)"""
+    action_noise: float = arg(0.0, lo=0.0, hi=1.0)
+    """fly the policy's actions with Gaussian noise of this standard deviation and record its own actions
+    in infos['expert_action'] (DART; 0: none)"""
 
 
 def main(argv: Sequence[str] | None = None) -> None:
@@ -117,7 +142,7 @@ def main(argv: Sequence[str] | None = None) -> None:
     for policy in args.policies:
         for suite in args.suites:
             for model in args.models:
-                ds = collect(policy, suite, model, args.episodes)
+                ds = collect(policy, suite, model, args.episodes, action_noise=args.action_noise)
                 print(f"{ds.spec.dataset_id}: {ds.total_episodes} episodes, {ds.total_steps} steps")
 
 

@@ -76,3 +76,25 @@ def test_behaviour_cloning_trains_and_flies_and_knows_its_observation(datasets):
     assert pol.act(obs, info).shape == (2,)
     with pytest.raises(ConfigError, match="bc path"):
         policy(lvgym.make_env("smile-v2", "rigid", history=2), out)          # a stacked observation: 32 entries
+
+
+def test_a_noise_injected_dataset_flies_the_noise_and_labels_with_the_policy(datasets):
+    """DART's data: the env flew the policy's action plus seeded noise; the labels are the policy's own, so a
+    clone trains on them."""
+    pytest.importorskip("torch")
+    from lvgym.agents.bc import train
+    from lvgym.agents.datasets import NOISE_STREAM, collect, dataset_id
+
+    assert dataset_id("lqg", "smile-v2", "rigid", 0.05) == "lvgym/smile-v2-rigid/lqg-noise0p05-v0"
+    with pytest.raises(ConfigError, match="action_noise = 2"):
+        collect("lqg", "smile-v2", "rigid", episodes=1, action_noise=2)
+    collect("lqg", "smile-v2", "rigid", episodes=1, action_noise=0.05, mission_time_s=2.0)
+    ep = next(minari.load_dataset(dataset_id("lqg", "smile-v2", "rigid", 0.05)).iterate_episodes())
+    expert = np.asarray(ep.infos["expert_action"])
+    assert expert.shape == (len(ep.actions) + 1, 2) and not expert[0].any()
+    noise = np.random.default_rng([0, NOISE_STREAM])
+    flown = np.clip(expert[1:3] + noise.normal(0.0, 0.05, (2, 2)), -1.0, 1.0).astype(np.float32)
+    np.testing.assert_array_equal(ep.actions[:2], flown)               # the first two steps, drawn in order
+    assert np.abs(ep.actions - expert[1:]).max() > 0.01
+    content = train(dataset_id("lqg", "smile-v2", "rigid", 0.05), datasets / "dart.pt", history=2, hidden=8, epochs=2)
+    assert content["steps"] == len(ep.actions)
