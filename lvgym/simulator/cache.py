@@ -66,7 +66,7 @@ def _source_digest() -> str:
     root = Path(lvgym.__file__).parent
     files = sorted([*root.glob("vehicle/*.py"), root / "dynamics" / "layout.py", root / "dynamics" / "model.py",
                     root / "environment" / "aeroelastic.py", root / "packing.py", root / "simulator" / "timeline.py",
-                    Path(__file__)])
+                    root / "simulator" / "tabled.py", Path(__file__)])
     h = hashlib.sha256()
     for f in files:
         h.update(f.name.encode())

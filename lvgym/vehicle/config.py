@@ -23,6 +23,7 @@ from lvgym.errors import ConfigError
 
 from .limits import QAlphaLimit, read_qalpha_limit
 from .reader import Reader
+from .timetables import VehicleTables, check_tables, read_tables
 
 #: standard gravity used by the thrust equation [m/s^2]
 G0 = 9.80665
@@ -353,6 +354,8 @@ class Vehicle:
     source: str | None = None
     #: the structural q-alpha limit the file gives (constant or over the flight), or None: the env's
     qalpha_limit: QAlphaLimit | None = None
+    #: tables over flight time that replace the mass properties and modes the parts give (:mod:`.timetables`)
+    tables: VehicleTables | None = None
 
     @property
     def length(self) -> float:
@@ -442,8 +445,8 @@ def load_vehicle(name_or_path: str | Path) -> Vehicle:
 
 def _tables_beside(data: Any, folder: Path) -> None:
     """Resolve, in place, every relative ``table`` path of the file's aerodynamics (the top level's and each
-    stage's, nested models included) against ``folder``, the folder of the YAML file that names it; an
-    absolute path, or a table given inline as a mapping, stays as it is."""
+    stage's, nested models included) and of its ``tables`` against ``folder``, the folder of the YAML file
+    that names it; an absolute path, or a table given inline, stays as it is."""
     def walk(node: Any) -> None:
         if isinstance(node, dict):
             table = node.get("table")
@@ -461,6 +464,19 @@ def _tables_beside(data: Any, folder: Path) -> None:
     for stage in data.get("stages") or []:
         if isinstance(stage, dict):
             walk(stage.get("aerodynamics"))
+    tables = data.get("tables")                     # the CSV paths of :mod:`.timetables`
+    if isinstance(tables, dict):
+        _beside(tables, "mass_properties", folder)
+        for mode in tables.get("modes") if isinstance(tables.get("modes"), list) else []:
+            if isinstance(mode, dict):
+                _beside(mode, "table", folder)
+
+
+def _beside(node: dict, name: str, folder: Path) -> None:
+    """``node[name]`` resolved against ``folder`` when it is a relative path."""
+    value = node.get(name)
+    if isinstance(value, str) and value and not Path(value).is_absolute():
+        node[name] = str(folder / value)
 
 
 def parse_vehicle(data: Any, source: str | None = None) -> Vehicle:
@@ -486,7 +502,8 @@ def parse_vehicle(data: Any, source: str | None = None) -> Vehicle:
                       payload=payload, fairing=fairing, fairing_jettison=jettison,
                       staging=tuple(StagingStep.read(s) for s in r.children("staging")),
                       structure=StructureOptions.read(r.child("structure", None)), aerodynamics=aero,
-                      source=source, qalpha_limit=read_qalpha_limit(r))
+                      source=source, qalpha_limit=read_qalpha_limit(r), tables=read_tables(r))
     r.done()
     check_vehicle(vehicle)
+    check_tables(vehicle)
     return vehicle
