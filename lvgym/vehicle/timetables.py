@@ -30,6 +30,7 @@ and what is allowed.
 from __future__ import annotations
 
 import csv
+import hashlib
 import math
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -45,8 +46,8 @@ if TYPE_CHECKING:
     from .config import Vehicle
 
 __all__ = ["FLOW_ATOL_SHARE", "FLOW_RTOL", "JUMP_SNAP_S", "MASS_COLUMNS", "MODE_COLUMNS", "TimeTable",
-           "VehicleTables", "before_rows", "body_minus_pendulums", "check_tables", "read_tables", "snap_jumps",
-           "stack_at"]
+           "VehicleTables", "before_rows", "body_minus_pendulums", "check_tables", "file_digests", "read_tables",
+           "snap_jumps", "stack_at", "tables_beside"]
 
 #: the columns of ``mass_properties``, the last optional (Izz = Iyy)
 MASS_COLUMNS = ("t", "mass", "cg", "Ixx", "Iyy", "Izz")
@@ -120,6 +121,36 @@ class VehicleTables:
 
 
 # ---------------------------------------------------------------------------- reading
+def tables_beside(data: Any, folder: Path) -> list[str]:
+    """Resolve, in place, the relative CSV paths of the parsed vehicle file ``data``'s ``tables`` against
+    ``folder`` (the YAML file's); the paths of its table files (absolute ones as given)."""
+    tables = data.get("tables") if isinstance(data, dict) else None
+    if not isinstance(tables, dict):
+        return []
+    nodes = [(tables, "mass_properties")]
+    modes = tables.get("modes")
+    nodes += [(m, "table") for m in (modes if isinstance(modes, list) else []) if isinstance(m, dict)]
+    files = []
+    for node, name in nodes:
+        value = node.get(name)
+        if isinstance(value, str) and value:
+            node[name] = value if Path(value).is_absolute() else str(folder / value)
+            files.append(node[name])
+    return files
+
+
+def file_digests(files: list[str]) -> tuple[tuple[str, bytes | None], ...]:
+    """``(path, digest of its bytes or None when unreadable)`` of each file: a vehicle read before is read
+    again when one of its table files changed."""
+    out = []
+    for f in files:
+        try:
+            out.append((f, hashlib.blake2b(Path(f).read_bytes(), digest_size=16).digest()))
+        except OSError:
+            out.append((f, None))
+    return tuple(out)
+
+
 def read_tables(r: Reader) -> VehicleTables | None:
     """The vehicle file's ``tables`` (module docstring), None when absent."""
     sub = r.child("tables", None)
