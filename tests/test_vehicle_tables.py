@@ -200,3 +200,30 @@ def test_the_made_up_vehicle_flies_a_few_seconds_in_the_env(kestrel_tables):
         assert not (terminated or truncated), info.get("termination")
     assert np.all(np.isfinite(obs)) and info["time"] > 1.0
     env.close()
+
+
+def test_an_imu_slope_scales_what_the_sensors_read(tmp_path):
+    """The gimbal slope scales the dynamics' shape, the IMU slope what the gyro reads: at the IMU station the
+    sensor slope is the table's, at another sensor station it keeps the beam's ratio to it."""
+    rows = "[[0, 9.0, 0.02, 0.05, -0.02], [60, 10.0, 0.02, 0.07, -0.03]]"
+    both = _write(tmp_path, f"  modes:\n    - table: {rows}\n      imu_station: -3.0\n", "c.yaml")
+    plain = _write(tmp_path, f"  modes:\n    - table: {MODE1}\n", "a.yaml")
+    tl, tl0 = (build_timeline(MassModel(load_vehicle(p)), "flex", 20.0, sensor_stations=[-3.0, -8.0], cache=False)
+               for p in (both, plain))
+    i = np.flatnonzero(tl.t == 15.0)[0]
+    imu = -0.02 - 0.01 * 15.0 / 60.0
+    np.testing.assert_allclose(tl.dphi_sensor[i, 0, 0], imu, rtol=1e-9)
+    np.testing.assert_allclose(tl.dphi_sensor[i, 1, 0] / imu, tl0.dphi_sensor[i, 1, 0] / tl0.dphi_sensor[i, 0, 0],
+                               rtol=1e-9)
+    lay = tl.dynamics.layout
+    np.testing.assert_allclose(tl.params_at([15.0])[0][lay.params["dphi_gimbal"]][0], 0.05 + 0.02 * 0.25, rtol=1e-12)
+    with pytest.raises(ConfigError, match=r"tables\.modes\[0\]\.imu_station = None: a station \[m\] <= 0 with a "
+                                          r"slope_imu column"):
+        load_vehicle(_write(tmp_path, f"  modes:\n    - table: {rows}\n", "d.yaml"))
+
+
+def test_the_design_information_follows_the_tables(kestrel_tables):
+    from lvgym.vehicle.designinfo import design_parameters
+
+    p = design_parameters(load_vehicle(kestrel_tables))
+    assert p["mass_kg"] == 2250.0 and p["pitch_inertia_kgm2"] == 17000.0 and p["bending_hz"] == 9.0

@@ -412,7 +412,7 @@ def _tabulate(mm: MassModel, model: str, t_end: float, dt: float, n_modes: int |
     md = _mode_rows(modes_rows, K, N, sensors.size, strips, c["stage"], np.inf if tabled else mode_cutoff_hz,
                     mode_basis == "projected", c["t"])
     if tabled:
-        apply_modes(vehicle.tables, md, c["t"], K, mode_cutoff_hz, events, vehicle.source)
+        apply_modes(vehicle.tables, md, c["t"], K, mode_cutoff_hz, events, vehicle.source, modes_rows)
     m_s, L = c["ms"][:, :N], c["L"][:, :N]
     live = (m_s > 0) & (L > 0)
     with np.errstate(divide="ignore", invalid="ignore"):

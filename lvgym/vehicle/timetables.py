@@ -7,7 +7,8 @@ for a vehicle known by its published design data rather than by its parts.
       mass_properties: kestrel_mass.csv      # or inline rows [t s, mass kg, cg station m, Ixx, Iyy(, Izz) kg m^2]
       modes:                                 # one entry per bending mode, the first mode first
         - table: [[0, 11.0, 0.01], [60, 12.5, 0.01], [118, 16.0, 0.02]]   # [t s, frequency Hz, damping ratio]
-        - table: kestrel_mode2.csv           # columns t, hz, zeta (and slope_gimbal)
+        - table: kestrel_mode2.csv           # columns t, hz, zeta (then slope_gimbal, then slope_imu)
+          imu_station: -3.0                  # [m] where slope_imu is (required with that column)
 
 ``mass_properties`` replaces the rigid-equivalent stack's mass, CG station and inertia at every row of the
 timeline (Izz = Iyy when the column is left out; the CG on the axis, the inertia diagonal); with slosh
@@ -16,6 +17,9 @@ so the totals are the table's. Each ``modes`` entry replaces the beam's frequenc
 that mode; the mode shape stays the beam's, scaled as a whole (one factor per mode and row, at the gimbal,
 the slosh hinges, the sensors and the aeroelastic strips alike) to the ``slope_gimbal`` column when it is
 given [1/(m sqrt(kg)), mass-normalised: a slope sigma per unit generalised mass M_k is sigma / sqrt(M_k)].
+A ``slope_imu`` column [1/(m sqrt(kg))] at ``imu_station`` [m] then scales what the sensors read of that
+mode (the shapes at every sensor station, by the ratio at ``imu_station``), so the gimbal-to-gyro gain of the
+mode is the table's ``slope_gimbal * slope_imu`` while the dynamics keep one shape.
 
 Rows are linear between them and held beyond the first and the last. Times are non-decreasing; a time given
 twice is a jump (the row before the event, then the row after it), allowed only within
@@ -51,8 +55,8 @@ __all__ = ["FLOW_ATOL_SHARE", "FLOW_RTOL", "JUMP_SNAP_S", "MASS_COLUMNS", "MODE_
 
 #: the columns of ``mass_properties``, the last optional (Izz = Iyy)
 MASS_COLUMNS = ("t", "mass", "cg", "Ixx", "Iyy", "Izz")
-#: the columns of a ``modes`` entry, the last optional
-MODE_COLUMNS = ("t", "hz", "zeta", "slope_gimbal")
+#: the columns of a ``modes`` entry, the last two optional (``slope_imu`` only after ``slope_gimbal``)
+MODE_COLUMNS = ("t", "hz", "zeta", "slope_gimbal", "slope_imu")
 #: the share of the propellant the engines burn over the table's span by which its mass drop may differ
 FLOW_RTOL = 0.02
 #: and the share of the table's first mass on top (published masses are rounded) [-]
@@ -71,7 +75,8 @@ MAX_SLOPE = 1e3            # [1/(m sqrt(kg))]
 class TimeTable:
     """Rows over flight time: ``t`` (n,) [s] non-decreasing (a time twice: a jump), ``values`` (n, m) in the
     units of ``columns`` (without ``t``); ``key`` its key path in the vehicle file, ``source`` the file its
-    rows came from (the vehicle file or a CSV) and ``lines`` the line of each row there (None: inline)."""
+    rows came from (the vehicle file or a CSV) and ``lines`` the line of each row there (None: inline);
+    ``imu_station`` [m] the station of a mode table's ``slope_imu`` column (None without it)."""
 
     key: str
     columns: tuple[str, ...]
@@ -79,6 +84,7 @@ class TimeTable:
     values: np.ndarray
     source: str | None = None
     lines: tuple[int, ...] | None = None
+    imu_station: float | None = None
 
     @property
     def jumps(self) -> np.ndarray:
@@ -114,7 +120,7 @@ class TimeTable:
 class VehicleTables:
     """The vehicle file's ``tables``: ``mass_properties`` (columns :data:`MASS_COLUMNS`, Izz filled in) or None,
     ``modes`` one table per bending mode from the first (columns :data:`MODE_COLUMNS`, with or without the
-    slope)."""
+    slopes)."""
 
     mass_properties: TimeTable | None = None
     modes: tuple[TimeTable, ...] = ()
@@ -158,13 +164,18 @@ def read_tables(r: Reader) -> VehicleTables | None:
         return None
     mass = None
     if sub.raw("mass_properties", None) is not None:
-        mass = _read_table(sub, "mass_properties", MASS_COLUMNS)
+        mass = _read_table(sub, "mass_properties", MASS_COLUMNS, 5)
         if mass.values.shape[1] == 4:                         # Izz = Iyy
             mass = replace(mass, columns=MASS_COLUMNS, values=np.column_stack([mass.values, mass.values[:, 3]]))
         _check_mass(mass)
     modes = []
     for i, mr in enumerate(sub.children("modes", [])):
-        table = _read_table(mr, "table", MODE_COLUMNS)
+        table = _read_table(mr, "table", MODE_COLUMNS, 3)
+        imu = mr.number("imu_station", None, lo=-MAX_LENGTH, hi=0.0)
+        if (imu is None) != (table.values.shape[1] < 4):
+            raise mr.error("imu_station", imu, "a station [m] <= 0 with a slope_imu column (the fifth), and "
+                           "only with it")
+        table = replace(table, imu_station=imu)
         _check_modes(table, i)
         modes.append(table)
         mr.done()
@@ -172,15 +183,16 @@ def read_tables(r: Reader) -> VehicleTables | None:
     return VehicleTables(mass, tuple(modes))
 
 
-def _read_table(r: Reader, name: str, columns: tuple[str, ...]) -> TimeTable:
-    """Rows of ``columns`` (the last may be left out) inline or from a CSV file (its path relative to the
-    vehicle file's folder, :func:`lvgym.vehicle.config.load_vehicle` resolves it), times checked."""
+def _read_table(r: Reader, name: str, columns: tuple[str, ...], least: int) -> TimeTable:
+    """Rows of the first ``least`` or more of ``columns`` inline or from a CSV file (its path relative to
+    the vehicle file's folder, :func:`lvgym.vehicle.config.load_vehicle` resolves it), times checked."""
     value = r.raw(name)
     key = r.key(name)
-    widths = (len(columns) - 1, len(columns))
-    shape = f"rows [{', '.join(columns[:-1])}(, {columns[-1]})]"
+    widths = range(least, len(columns) + 1)
+    shape = f"rows [{', '.join(columns[:least])}" + "".join(f"(, {c}" for c in columns[least:]) \
+        + ")" * (len(columns) - least) + "]"
     if isinstance(value, str):
-        table = _read_csv(key, value, columns, r.source)
+        table = _read_csv(key, value, columns, least, r.source)
     elif isinstance(value, list) and value:
         rows = []
         for k, row in enumerate(value):
@@ -198,9 +210,10 @@ def _read_table(r: Reader, name: str, columns: tuple[str, ...]) -> TimeTable:
     return table
 
 
-def _read_csv(key: str, path_text: str, columns: tuple[str, ...], vehicle_source: str | None) -> TimeTable:
-    """A table from the CSV file ``path_text``: a header naming ``columns`` (the last may be left out), then
-    one row of finite numbers per line."""
+def _read_csv(key: str, path_text: str, columns: tuple[str, ...], least: int, vehicle_source: str | None
+              ) -> TimeTable:
+    """A table from the CSV file ``path_text``: a header naming the first ``least`` or more of ``columns``,
+    then one row of finite numbers per line."""
     path = Path(path_text)
     try:
         with open(path, newline="", encoding="utf-8") as fh:
@@ -214,9 +227,9 @@ def _read_csv(key: str, path_text: str, columns: tuple[str, ...], vehicle_source
     if not lines:
         raise ConfigError(key, path_text, f"a header line naming the columns {list(columns)}", src)
     header = [h.strip() for h in lines[0][1]]
-    if header not in (list(columns[:-1]), list(columns)):
-        raise ConfigError(f"{key} header", header, f"the columns {list(columns[:-1])}, or with {columns[-1]!r} last",
-                          src, lines[0][0])
+    if header not in [list(columns[:n]) for n in range(least, len(columns) + 1)]:
+        raise ConfigError(f"{key} header", header, f"the columns {list(columns[:least])}, then (optional, in order) "
+                          f"{list(columns[least:])}", src, lines[0][0])
     data = np.empty((len(lines) - 1, len(header)))
     for k, (n, row) in enumerate(lines[1:]):
         try:
@@ -273,9 +286,10 @@ def _check_modes(table: TimeTable, i: int) -> None:
             raise table.error(k, f"mode {i + 1}'s frequency in (0, {MAX_HZ:g}] Hz (second column)")
         if not 0.0 <= v[k, 1] <= 1.0:
             raise table.error(k, "a damping ratio in [0, 1] (third column)")
-        if v.shape[1] == 3 and not (v[k, 2] != 0.0 and abs(v[k, 2]) <= MAX_SLOPE):
-            raise table.error(k, f"a mass-normalised slope at the gimbal, non-zero, at most {MAX_SLOPE:g} in size "
-                              "[1/(m sqrt(kg))] (fourth column)")
+        for j, where in ((2, "the gimbal"), (3, "the IMU")):
+            if v.shape[1] > j and not (v[k, j] != 0.0 and abs(v[k, j]) <= MAX_SLOPE):
+                raise table.error(k, f"a mass-normalised slope at {where}, non-zero, at most {MAX_SLOPE:g} in size "
+                                  f"[1/(m sqrt(kg))] ({'fourth' if j == 2 else 'fifth'} column)")
 
 
 # ---------------------------------------------------------------------------- the whole vehicle
@@ -317,8 +331,11 @@ def check_tables(vehicle: Vehicle) -> None:
                           f"{vehicle.structure.n_modes} mode tables, one per mode from the first", vehicle.source)
     end = max(float(tb.t[-1]) for tb in ([tables.mass_properties] if tables.mass_properties else []) + list(tables.modes))
     events = separations(vehicle, end + JUMP_SNAP_S)
-    for tb in tables.modes:
+    for i, tb in enumerate(tables.modes):
         snap_jumps(tb, events)
+        if tb.imu_station is not None and tb.imu_station < -vehicle.length:
+            raise ConfigError(f"tables.modes[{i}].imu_station", tb.imu_station, f"a station on the vehicle: in "
+                              f"[{-vehicle.length:g}, 0] m", vehicle.source)
     mass = tables.mass_properties
     if mass is None:
         return
