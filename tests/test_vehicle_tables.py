@@ -227,3 +227,13 @@ def test_the_design_information_follows_the_tables(kestrel_tables):
 
     p = design_parameters(load_vehicle(kestrel_tables))
     assert p["mass_kg"] == 2250.0 and p["pitch_inertia_kgm2"] == 17000.0 and p["bending_hz"] == 9.0
+
+
+def test_the_own_launcher_page_shows_the_tested_tables(tmp_path, kestrel_tables):
+    page = (ROOT / "docs" / "own-launcher.md").read_text(encoding="utf-8")
+    block = re.findall(r"## 8\. A vehicle known by its tables.*?```text\n(.*?)```", page, re.DOTALL)[0]
+    path = tmp_path / "from_page.yaml"
+    path.write_text(KESTREL + block, encoding="utf-8")
+    shown, tested = load_vehicle(path).tables, load_vehicle(kestrel_tables).tables
+    np.testing.assert_array_equal(shown.mass_properties.values, tested.mass_properties.values)
+    np.testing.assert_array_equal(shown.modes[0].values, tested.modes[0].values)
