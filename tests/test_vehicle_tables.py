@@ -237,3 +237,28 @@ def test_the_own_launcher_page_shows_the_tested_tables(tmp_path, kestrel_tables)
     shown, tested = load_vehicle(path).tables, load_vehicle(kestrel_tables).tables
     np.testing.assert_array_equal(shown.mass_properties.values, tested.mass_properties.values)
     np.testing.assert_array_equal(shown.modes[0].values, tested.modes[0].values)
+
+
+def test_the_cut_off_goes_by_the_tables_frequency(tmp_path):
+    path = _write(tmp_path, "  modes:\n    - table: [[0, 80.0, 0.02], [60, 80.0, 0.02]]\n")
+    tl = build_timeline(MassModel(load_vehicle(path)), "flex", 5.0, mode_cutoff_hz=50.0, cache=False)
+    p, lay = tl.params_at([2.0])[0], tl.dynamics.layout
+    np.testing.assert_allclose(p[lay.params["omega_modes"]][0], 2 * np.pi * 80.0)
+    assert p[lay.params["phi_gimbal"]][0] == 0.0 and p[lay.params["dphi_gimbal"]][0] == 0.0    # decoupled
+    assert p[lay.params["phi_gimbal"]][1] != 0.0                                              # the beam's 25 Hz
+
+
+def test_a_projected_change_of_basis_carries_the_slope_scale(tmp_path):
+    slope = "[[0, 9.0, 0.02, 0.05], [60, 10.0, 0.02, 0.07]]"
+    tls = [build_timeline(MassModel(load_vehicle(_write(tmp_path, f"  modes:\n    - table: {rows}\n", name))), "flex",
+                          12.0, mode_interval=5.0, mode_basis="projected", cache=False)
+           for rows, name in ((MODE1, "a.yaml"), (slope, "b.yaml"))]
+    plain, scaled = tls
+    assert plain.mode_change_t.tolist() == scaled.mode_change_t.tolist() and plain.mode_change_t.size >= 2
+    dphi = plain.params[:, plain.dynamics.layout.params["dphi_gimbal"]]
+    c = np.ones_like(dphi)
+    c[:, 0] = (0.05 + 0.02 * plain.t / 60.0) / dphi[:, 0]
+    for j, tc in enumerate(plain.mode_change_t):
+        after = int(np.searchsorted(plain.t, tc, side="right")) - 1
+        want = plain.mode_transfer[j] / c[after][:, None] * c[after - 1][None, :]
+        np.testing.assert_allclose(scaled.mode_transfer[j], want, rtol=1e-9, atol=1e-12)
