@@ -7,8 +7,8 @@ rest for the slosh and non-rigid models, so B and the pendulums together are the
 :func:`apply_modes` puts each ``modes`` table's frequency and damping in place of the beam's for its mode
 and, with a ``slope_gimbal`` column, scales the beam's shape of that mode as a whole so that its slope at the
 gimbal is the table's, and with a ``slope_imu`` column scales what the sensors read of it (the shapes at the
-sensor stations) so that its slope at the table's ``imu_station`` is the table's; then decouples the modes above the cut-off by their final frequencies (shapes
-zero). Both move a table's jumps onto the separation they stand for first
+sensor stations) so that its slope at the table's ``imu_station`` is the table's; then decouples the modes
+above the cut-off by their final frequencies (shapes zero). Both move a table's jumps onto the separation they stand for first
 (:func:`~lvgym.vehicle.timetables.snap_jumps`).
 """
 

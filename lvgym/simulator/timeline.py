@@ -18,6 +18,9 @@ deflection field: the timeline stores one transfer matrix per change (:func:`lvg
 rows of modes above the cut-off zeroed, several changes at one time multiplied into one), the simulator
 cuts its steps at the change times and applies the matrix there (:mod:`.piece`).
 
+A vehicle file's ``tables`` (:mod:`lvgym.vehicle.timetables`) replace the stack's mass, CG and inertia and
+the tabled modes' frequencies and damping in the rows (:mod:`.tabled`).
+
 ``model`` picks which parameters the dynamics core flies (thesis section 4.4):
 
 =============  ===============================================================================
@@ -402,7 +405,8 @@ def _tabulate(mm: MassModel, model: str, t_end: float, dt: float, n_modes: int |
                 (("m_b", "mass"), ("r_cg", "cg"), ("J_b", "inertia")):
             cols[key].append(getattr(props, name))
         for key, name in (("gimbal", "gimbal"), ("m", "mass"), ("cg", "cg"), ("J", "inertia"), ("ms", "slosh_mass"),
-                          ("L", "pendulum_length"), ("hinge", "hinge"), ("rest", "slosh_rest"), ("zeta", "slosh_damping")):
+                          ("L", "pendulum_length"), ("hinge", "hinge"), ("rest", "slosh_rest"),
+                          ("zeta", "slosh_damping")):
             cols[key].append(getattr(props, name))
     modes_rows = cols.pop("modes")
     c = {k: np.concatenate(v) for k, v in cols.items()}

@@ -329,7 +329,8 @@ def check_tables(vehicle: Vehicle) -> None:
     if len(tables.modes) > vehicle.structure.n_modes:
         raise ConfigError("tables.modes", len(tables.modes), f"at most structure.n_modes = "
                           f"{vehicle.structure.n_modes} mode tables, one per mode from the first", vehicle.source)
-    end = max(float(tb.t[-1]) for tb in ([tables.mass_properties] if tables.mass_properties else []) + list(tables.modes))
+    every = ([tables.mass_properties] if tables.mass_properties else []) + list(tables.modes)
+    end = max(float(tb.t[-1]) for tb in every)
     events = separations(vehicle, end + JUMP_SNAP_S)
     for i, tb in enumerate(tables.modes):
         snap_jumps(tb, events)
