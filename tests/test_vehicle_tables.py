@@ -262,3 +262,15 @@ def test_a_projected_change_of_basis_carries_the_slope_scale(tmp_path):
         after = int(np.searchsorted(plain.t, tc, side="right")) - 1
         want = plain.mode_transfer[j] / c[after][:, None] * c[after - 1][None, :]
         np.testing.assert_allclose(scaled.mode_transfer[j], want, rtol=1e-9, atol=1e-12)
+
+
+def test_a_copy_under_another_name_shares_the_timeline_cache_key(tmp_path, kestrel_tables):
+    from lvgym.simulator.cache import key
+
+    copy = tmp_path / "another_name.yaml"
+    copy.write_text(kestrel_tables.read_text(encoding="utf-8"), encoding="utf-8")
+    a, b = (key(MassModel(load_vehicle(p)), ("nonrigid", 70.0)) for p in (kestrel_tables, copy))
+    assert a == b
+    other = _write(tmp_path, f"  mass_properties: {MASS.replace('17000', '17001')}\n  modes:\n    - table: {MODE1}\n",
+                   "changed.yaml")
+    assert key(MassModel(load_vehicle(other)), ("nonrigid", 70.0)) != a
