@@ -66,7 +66,7 @@ def _source_digest() -> str:
     root = Path(lvgym.__file__).parent
     files = sorted([*root.glob("vehicle/*.py"), root / "dynamics" / "layout.py", root / "dynamics" / "model.py",
                     root / "environment" / "aeroelastic.py", root / "packing.py", root / "simulator" / "timeline.py",
-                    Path(__file__)])
+                    root / "simulator" / "tabled.py", Path(__file__)])
     h = hashlib.sha256()
     for f in files:
         h.update(f.name.encode())
@@ -78,6 +78,12 @@ def key(mass_model: Any, args: tuple) -> str:
     """The cache key of a timeline of ``mass_model`` built with ``args``."""
     h = hashlib.sha256()
     vehicle = dataclasses.replace(mass_model.vehicle, source=None)        # the content, not the file's name
+    tables = vehicle.tables
+    if tables is not None:                                    # the tables' rows, not the files they came from
+        bare = [None if tb is None else dataclasses.replace(tb, source=None, lines=None)
+                for tb in (tables.mass_properties, *tables.modes)]
+        vehicle = dataclasses.replace(vehicle, tables=dataclasses.replace(tables, mass_properties=bare[0],
+                                                                          modes=tuple(bare[1:])))
     h.update(pickle.dumps((vehicle, mass_model.cg_convention, args, packing.PADDING), protocol=4))
     h.update(_source_digest().encode())
     return h.hexdigest()[:40]

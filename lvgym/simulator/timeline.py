@@ -18,6 +18,9 @@ deflection field: the timeline stores one transfer matrix per change (:func:`lvg
 rows of modes above the cut-off zeroed, several changes at one time multiplied into one), the simulator
 cuts its steps at the change times and applies the matrix there (:mod:`.piece`).
 
+A vehicle file's ``tables`` (:mod:`lvgym.vehicle.timetables`) replace the stack's mass, CG and inertia and
+the tabled modes' frequencies and damping in the rows (:mod:`.tabled`).
+
 ``model`` picks which parameters the dynamics core flies (thesis section 4.4):
 
 =============  ===============================================================================
@@ -44,6 +47,8 @@ from lvgym.vehicle import MassModel
 from lvgym.vehicle.beam import one_blas_thread
 from lvgym.vehicle.massmodel import BURNING, SEPARATED, MassState
 from lvgym.vehicle.structure import ModeSchedule, mode_transfer
+
+from .tabled import apply_mass, apply_modes
 
 MODELS = ("rigid", "slosh", "flex", "nonrigid")
 MODE_BASES = ("held", "projected")
@@ -382,7 +387,7 @@ def _tabulate(mm: MassModel, model: str, t_end: float, dt: float, n_modes: int |
                              probe_stations=probes) if K > 0 else None)
     times, events = _grid(mm, t_end, dt)
     cols: dict[str, list] = {k: [] for k in ("t", "T0", "Ae", "Vs", "burn", "stage", "modes", "m_b", "r_cg", "J_b",
-                                             "gimbal", "m", "cg", "J", "ms", "L", "hinge", "zeta")}
+                                             "gimbal", "m", "cg", "J", "ms", "L", "hinge", "rest", "zeta")}
     for row_t, state in _pieces(mm, times, {t for t, _ in events}):
         props = mm.properties(state)
         T0 = mm.thrust(state, 1.0, 0.0)
@@ -400,13 +405,18 @@ def _tabulate(mm: MassModel, model: str, t_end: float, dt: float, n_modes: int |
                 (("m_b", "mass"), ("r_cg", "cg"), ("J_b", "inertia")):
             cols[key].append(getattr(props, name))
         for key, name in (("gimbal", "gimbal"), ("m", "mass"), ("cg", "cg"), ("J", "inertia"), ("ms", "slosh_mass"),
-                          ("L", "pendulum_length"), ("hinge", "hinge"), ("zeta", "slosh_damping")):
+                          ("L", "pendulum_length"), ("hinge", "hinge"), ("rest", "slosh_rest"),
+                          ("zeta", "slosh_damping")):
             cols[key].append(getattr(props, name))
     modes_rows = cols.pop("modes")
     c = {k: np.concatenate(v) for k, v in cols.items()}
     n = c["t"].size
-    md = _mode_rows(modes_rows, K, N, sensors.size, strips, c["stage"], mode_cutoff_hz, mode_basis == "projected",
-                    c["t"])
+    apply_mass(vehicle.tables, c, events, with_slosh, N, vehicle.source)       # the file's tables (.tabled)
+    tabled = vehicle.tables is not None and bool(vehicle.tables.modes) and K > 0
+    md = _mode_rows(modes_rows, K, N, sensors.size, strips, c["stage"], np.inf if tabled else mode_cutoff_hz,
+                    mode_basis == "projected", c["t"])
+    if tabled:
+        apply_modes(vehicle.tables, md, c["t"], K, mode_cutoff_hz, events, vehicle.source, modes_rows)
     m_s, L = c["ms"][:, :N], c["L"][:, :N]
     live = (m_s > 0) & (L > 0)
     with np.errstate(divide="ignore", invalid="ignore"):

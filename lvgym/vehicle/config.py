@@ -23,6 +23,7 @@ from lvgym.errors import ConfigError
 
 from .limits import QAlphaLimit, read_qalpha_limit
 from .reader import Reader
+from .timetables import VehicleTables, check_tables, file_digests, read_tables, tables_beside
 
 #: standard gravity used by the thrust equation [m/s^2]
 G0 = 9.80665
@@ -353,6 +354,8 @@ class Vehicle:
     source: str | None = None
     #: the structural q-alpha limit the file gives (constant or over the flight), or None: the env's
     qalpha_limit: QAlphaLimit | None = None
+    #: tables over flight time that replace the mass properties and modes the parts give (:mod:`.timetables`)
+    tables: VehicleTables | None = None
 
     @property
     def length(self) -> float:
@@ -370,8 +373,9 @@ def shipped_vehicles() -> list[str]:
     return sorted(p.stem for p in VEHICLE_DIR.glob("*.yaml"))
 
 
-#: vehicles read by :func:`load_vehicle`, by (file, content digest), the latest last
-_LOADED: OrderedDict[tuple[str, bytes], Vehicle] = OrderedDict()
+#: vehicles read by :func:`load_vehicle`, by (file, content digest), the latest last, each with the digests of
+#: the table files it read (:func:`.timetables.file_digests`)
+_LOADED: OrderedDict[tuple[str, bytes], tuple[Vehicle, tuple]] = OrderedDict()
 _LOADED_MAX = 32
 _LOADED_LOCK = threading.Lock()
 
@@ -404,9 +408,9 @@ def load_vehicle(name_or_path: str | Path) -> Vehicle:
     parts that do not fit the vehicle (:mod:`.checks`).
 
     The process keeps the last few vehicles it read, by file and content: loading a file again whose
-    bytes have not changed returns the same (frozen) :class:`Vehicle` object without parsing it, and with
-    it the aerodynamic tables built for that object (:mod:`lvgym.simulator.vehicleaero`). Treat it as
-    read-only; :func:`clear_vehicle_cache` forgets them."""
+    bytes (and those of the CSV files of its ``tables``) have not changed returns the same (frozen)
+    :class:`Vehicle` object without parsing it, and with it the aerodynamic tables built for that object
+    (:mod:`lvgym.simulator.vehicleaero`). Treat it as read-only; :func:`clear_vehicle_cache` forgets them."""
     from .yamlfile import read_yaml, with_line
 
     path = vehicle_file(name_or_path)
@@ -423,18 +427,22 @@ def load_vehicle(name_or_path: str | Path) -> Vehicle:
     if raw is not None:
         key = (str(path.resolve()), hashlib.blake2b(raw, digest_size=16).digest())
         with _LOADED_LOCK:
-            if key in _LOADED:
-                _LOADED.move_to_end(key)
-                return _LOADED[key]
+            hit = _LOADED.get(key)
+        if hit is not None and file_digests([f for f, _ in hit[1]]) == hit[1]:     # its table files unchanged
+            with _LOADED_LOCK:
+                if key in _LOADED:
+                    _LOADED.move_to_end(key)
+            return hit[0]
     data, lines = read_yaml(path, source=path.name, text=text)
     _tables_beside(data, path.resolve().parent)
+    files = tables_beside(data, path.resolve().parent)
     try:
         vehicle = parse_vehicle(data, source=path.name)
     except ConfigError as exc:
         raise with_line(exc, lines) from None
     if key is not None:
         with _LOADED_LOCK:
-            _LOADED[key] = vehicle
+            _LOADED[key] = (vehicle, file_digests(files))
             while len(_LOADED) > _LOADED_MAX:
                 _LOADED.popitem(last=False)
     return vehicle
@@ -486,7 +494,8 @@ def parse_vehicle(data: Any, source: str | None = None) -> Vehicle:
                       payload=payload, fairing=fairing, fairing_jettison=jettison,
                       staging=tuple(StagingStep.read(s) for s in r.children("staging")),
                       structure=StructureOptions.read(r.child("structure", None)), aerodynamics=aero,
-                      source=source, qalpha_limit=read_qalpha_limit(r))
+                      source=source, qalpha_limit=read_qalpha_limit(r), tables=read_tables(r))
     r.done()
     check_vehicle(vehicle)
+    check_tables(vehicle)
     return vehicle

@@ -3,7 +3,9 @@
 
 They are the vehicle file's nominal numbers, computed by lvgym's own mass model and beam at lift-off
 (time 0, every stage attached, the first stage burning at sea level), not the dispersed truth of an
-episode: a flight computer knows its vehicle's design, not the draw of the day.
+episode: a flight computer knows its vehicle's design, not the draw of the day. A vehicle file's ``tables``
+(:mod:`.timetables`) give the lift-off mass, CG and inertia and the first mode's frequency in their place,
+as they do in flight.
 
 ======================  ========  =============================================================================
 entry                   unit      meaning
@@ -34,6 +36,7 @@ from .config import G0, Vehicle, load_vehicle
 from .massmodel import MassModel
 from .propulsion import P_SEA_LEVEL
 from .structure import vehicle_modes
+from .timetables import stack_at
 
 __all__ = ["DESIGN_ENTRIES", "design_parameters", "design_vector"]
 
@@ -52,13 +55,18 @@ def design_parameters(vehicle: Vehicle) -> dict[str, float]:
     mm = MassModel(vehicle)
     state = mm.initial_state()
     props = mm.properties(state)
-    mass = float(props.mass)
-    j_yy = float(props.inertia[1, 1])
+    mass, cg, j_yy = float(props.mass), float(props.cg[0]), float(props.inertia[1, 1])
+    tables = vehicle.tables
+    if tables is not None and tables.mass_properties is not None:
+        m, c, J = stack_at(tables.mass_properties, [0.0])
+        mass, cg, j_yy = float(m[0]), float(c[0, 0]), float(J[0, 1, 1])
     thrust, vectored = _lift_off_thrust(mm, state)
-    arm = float(props.cg[0] - props.gimbal[0])                # CG ahead of the gimbal: > 0 [m]
+    arm = cg - float(props.gimbal[0])                          # CG ahead of the gimbal: > 0 [m]
     diameter = max(s.outer_diameter for s in vehicle.stages)
     bending = 0.0
-    if vehicle.structure.n_modes > 0:
+    if vehicle.structure.n_modes > 0 and tables is not None and tables.modes:
+        bending = float(tables.modes[0].column("hz", [0.0])[0])
+    elif vehicle.structure.n_modes > 0:
         modes = vehicle_modes(vehicle, state, props, n_modes=1)
         bending = float(modes.omega[0]) / (2.0 * math.pi) if modes.omega.size else 0.0
     slosh = np.asarray(props.slosh_mass, float)
