@@ -6,7 +6,7 @@ from compiled loads functions). Models are chosen by name with :func:`make`; imp
 registers them all.
 """
 
-from . import aerodynamics, aeroelastic, atmosphere, barrowman, earth, gravity, wind
+from . import aerodynamics, aeroelastic, atmosphere, barrowman, datasheet, earth, gravity, wind
 from .aerodynamics import AeroState, AxisymmetricAero, Tables6Aero
 from .aeroelastic import StripAeroelastic
 from .barrowman import BarrowmanAero
