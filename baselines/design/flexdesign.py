@@ -296,10 +296,11 @@ def design_schedule(vehicle: Any = "smile", times=None, req: Requirements | None
         if right is not None:
             cases.append(right)
             loops = [(c[0][p], c[1]) for _, c in cases for p in planes]
+            before = e["values"]                         # the row's design on its time and left end
             plain = design_row(RowProblem(loops, req, noise=noise), plain["values"], rng, starts=0, maxiter=maxiter)
             e = plain if relief is None else relief_row(loops, req, plain, relief[0], [e["values"]], noise=noise)
             if load:
-                e = load_row(_load_cases(cases, planes), req, plain, load_objective, load_weight, [e["values"]],
+                e = load_row(_load_cases(cases, planes), req, plain, load_objective, load_weight, [before],
                              noise=noise, maxiter=maxiter)
                 gain = e["values"]["accel_gain"]
         warm = plain["values"]
