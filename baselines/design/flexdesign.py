@@ -206,7 +206,7 @@ def _relieved(case: tuple, gain: float) -> tuple:
 def design_schedule(vehicle: Any = "smile", times=None, req: Requirements | None = None, starts: int = 2,
                     seed: int = 0, log=print, relief: tuple[float, float] | None = None,
                     planes: tuple[str, ...] = ("pitch",), fly: str = "auto", maxiter: int = MAXITER,
-                    load_objective: str | None = None, load_weight: float = 1.0, **options: Any) -> dict[str, Any]:
+                    load_objective: str | None = None, load_weight: float = 10.0, **options: Any) -> dict[str, Any]:
     """Design every row of ``vehicle``'s schedule in time order. Each row flies the stretch between the
     midpoints to its neighbours in the same burn (the policy switches rows at the mass midpoints,
     ``interpolation: nearest``), and is designed to meet the requirements at its own time and at both
@@ -376,7 +376,7 @@ class Args:
     """a load objective the design chooses each row's load relief by (accel_gain and ki): qalpha (the RMS of
     q alpha in 1 m/s of lateral Dryden turbulence) or accel (of the accelerometer's lateral specific force);
     default none (docs/flex-design.md, "The load objective")"""
-    load_weight: float = arg(1.0, lo=0.0, lo_open=True, hi=100.0)
+    load_weight: float = arg(10.0, lo=0.0, lo_open=True, hi=100.0)
     """with --load-objective: the weight of the load measure against the disturbance objective (the design
     minimises log J + WEIGHT log load)"""
     noise_rate: float | None = arg(None, lo=0.0, lo_open=True, hi=100.0, metavar="FRACTION")
@@ -421,7 +421,7 @@ def main(argv: list[str] | None = None) -> int:
              + ("" if planes == ("pitch",) else " --planes " + " ".join(planes))
              + ("" if a.noise_rate is None else f" --noise-rate {a.noise_rate:g}")
              + ("" if a.load_objective is None else f" --load-objective {a.load_objective}"
-                + ("" if a.load_weight == 1.0 else f" --load-weight {a.load_weight:g}"))
+                + ("" if a.load_weight == 10.0 else f" --load-weight {a.load_weight:g}"))
              + ("" if a.fly == "auto" else f" --fly {a.fly}")
              + ("" if a.maxiter == MAXITER else f" --maxiter {a.maxiter}")
              + (" --overwrite" if shipped else f" --out {out}"))

@@ -202,7 +202,7 @@ class LoadProblem(RowProblem):
     cost ``10 sum(penalty^2) + log J + weight log load``."""
 
     def __init__(self, cases: list[tuple[dict[str, control.StateSpace], dict, float, float, str]], req: Requirements,
-                 objective: str = "qalpha", weight: float = 1.0, noise: tuple[float, float] = (0.0, 1.0),
+                 objective: str = "qalpha", weight: float = 10.0, noise: tuple[float, float] = (0.0, 1.0),
                  drift: str = "vehicle", **kw: Any) -> None:
         check_load_options(objective, weight)
         gyro = [({m: _sub(g, 0, 0) for m, g in plants.items()}, modes) for plants, modes, *_ in cases]
@@ -258,7 +258,7 @@ class LoadProblem(RowProblem):
 STARTS = (1e-4, 1e-3, 1e-2)
 
 
-def load_row(cases: list, req: Requirements, plain: dict[str, Any], objective: str, weight: float = 1.0,
+def load_row(cases: list, req: Requirements, plain: dict[str, Any], objective: str, weight: float = 10.0,
              also: list[dict[str, float]] = (), noise: tuple[float, float] = (0.0, 1.0),
              maxiter: int = 3000) -> dict[str, Any]:
     """The load-objective design of a row whose plain design is ``plain`` (:func:`.flexproblem.design_row`'s
