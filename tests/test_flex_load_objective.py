@@ -56,7 +56,7 @@ def test_load_plant_gyro_part_and_wind_angle(smile_row):
 def test_closed_loop_load_against_python_control(smile_row):
     """The load measure of LoadProblem (the closed loop's wind response formed on the grid) against the
     loop closed by python-control on the MIMO plant, u = -C (y_gyro - k_a s y_f), the wind left open."""
-    plants, modes, info = smile_row
+    info = smile_row[2]
     cases = FD._load_cases([(20.0, smile_row)], ("pitch",))
     values = dict(START, kp=0.11, ki=0.55, kd=0.005, lead_zero_radps=3.3, lead_ratio=24.0, accel_gain=0.003)
     for objective, out in (("qalpha", 1), ("accel", 2)):
@@ -95,7 +95,8 @@ def test_default_unchanged(smile_row):
     assert lp["J"] == pytest.approx(plain["J"], rel=1e-6)
     for model in ("rigid", "nonrigid"):
         assert lp[model] == pytest.approx(plain[model], rel=1e-6, abs=1e-9)
-    doc = yaml.safe_load(open(FD.__file__.replace("design/flexdesign.py", "schedules/smile_flex.yaml")))
+    with open(FD.__file__.replace("design/flexdesign.py", "schedules/smile_flex.yaml")) as f:
+        doc = yaml.safe_load(f)
     table = margin_table(doc)
     assert "load" not in table.lower().split("requirements:")[0] and "| load (plain) |" not in table
     assert table.splitlines()[4].endswith("| noise [%] | meets |")
@@ -105,7 +106,7 @@ def test_chosen_relief_lowers_the_load():
     """On SMILE's 28.8 s row (max q) the design with the q-alpha objective (weight 10) lowers the load measure below
     the plain design's and keeps the rate loop's margins (the relieved loop: effective plant)."""
     row = FD.row_plants("smile", 28.8, None, True)
-    plants, modes, info = row
+    plants, modes, _ = row
     req = Requirements()
     cases = [(28.8, row)]
     plain = design_row(RowProblem([(plants["pitch"], modes)], req), None, np.random.default_rng(0), 0, 300)

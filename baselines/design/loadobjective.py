@@ -47,17 +47,17 @@ import numpy as np
 
 from lvgym.environment.turbulence import dryden_psd
 from lvgym.errors import ConfigError
-from lvgym.simulator.flight import flight_conditions_batch
 from lvgym.simulator import CONDITIONS
+from lvgym.simulator.flight import flight_conditions_batch
 
-from .flexproblem import RowProblem, Requirements, _controller_poly, controller, design_row
+from .flexproblem import Requirements, RowProblem, _controller_poly, controller, design_row
 from .flightloop import (control_timing, delay_ss, gyro_filter_ss, hold_and_sample, servo_discrete,
                          vehicle_with_gyro_output)
 from .linearize import INPUTS, PLANES, OperatingPoint, _Coords, plane_states
 from .response import frequency_response
 
-__all__ = ["OBJECTIVES", "ACCEL_GAIN", "SCALE_M", "check_load_options", "load_plant", "effective_plant",
-           "wind_rms", "LoadProblem", "load_row"]
+__all__ = ["ACCEL_GAIN", "OBJECTIVES", "SCALE_M", "LoadProblem", "check_load_options", "effective_plant",
+           "load_plant", "load_row", "wind_rms"]
 
 #: the load objectives: ``qalpha`` (the RMS of q alpha) and ``accel`` (of the accelerometer's lateral specific force)
 OBJECTIVES = ("qalpha", "accel")
@@ -157,7 +157,7 @@ def load_plant(op: OperatingPoint, plane: str = "pitch") -> control.StateSpace:
         vehicle = control.series(vehicle, control.append(gf, one, control.ss(a_acc, b_acc, c_acc, 0.0)))
     dt, delay = control_timing(op)
     h = float(op.task.physics_dt_s) if op.task is not None else dt
-    n = int(round(dt / h))
+    n = round(dt / h)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         g = control.series(control.append(servo_discrete(op, h), control.ss([], [], [], [[1.0]], h)),
@@ -224,7 +224,7 @@ class LoadProblem(RowProblem):
         cases = []
         for (G, band, mats), (resp, cm, *_, s) in zip(self._gyro_cases, self.extra):
             cases.append(({m: resp[m][0][0] - k * s * resp[m][2][0] for m in G}, band,
-                          {m: (A, B, (cm[m][0] - k * s * cm[m][1])[None]) for m, (A, B, _) in mats.items()}))
+                          {m: (A, B, (cm[m][0] - k * s * cm[m][1])[None]) for m, (A, B, _c) in mats.items()}))
         self.cases = cases
         try:
             out = super().evaluate(values)
@@ -235,7 +235,7 @@ class LoadProblem(RowProblem):
         C = np.polyval(b, self.z) / np.polyval(a, self.z)
         resp, _, qbar, airspeed, s = self.extra[0]
         J, load = 0.0, 0.0
-        for m, r in resp.items():
+        for r in resp.values():
             geff_u, geff_w = r[0][0] - k * s * r[2][0], r[0][1] - k * s * r[2][1]
             S = 1.0 / (1.0 + C * geff_u)
             J += float(np.sum(np.abs(r[0][0] * S) ** 2 * self.dw)) / len(resp)
