@@ -131,3 +131,21 @@ def test_bad_options_refused():
         FD.main(["--load-objective", "qalpha", "--load-relief", "0.1", "0.001"])
     with pytest.raises(SystemExit):
         FD.main(["--load-objective", "qalpha", "--load-weight", "0"])
+
+
+def test_margin_table_load_column():
+    """A load-objective document's table gains the column 'load (plain)' on its rows (ends: '-'), and its
+    log line names the objective with the plain design's value."""
+    with open(FD.__file__.replace("design/flexdesign.py", "schedules/smile_flex.yaml")) as f:
+        doc = yaml.safe_load(f)
+    doc["design"]["load_objective"] = "qalpha"
+    for r in doc["rows"]:
+        r["load"] = {"objective": "qalpha", "value": 6374.0, "plain": 6710.0, "J": 243.1, "J_plain": 284.2}
+        r["accel_gain"] = 0.001
+    lines = margin_table(doc).splitlines()
+    assert lines[4].endswith("| meets | load (plain) |") and lines[5].count("|") == lines[4].count("|")
+    row = next(x for x in lines if x.startswith("| 28.8 |"))
+    assert row.endswith("| 6374 (6710) |")
+    end = next(x for x in lines if "(end)" in x)
+    assert end.endswith("| - |")
+    assert "qalpha 6374 Pa deg (plain 6710)" in FD.row_line(doc["rows"][0])
