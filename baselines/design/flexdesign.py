@@ -18,7 +18,9 @@ parameters minimise the energy of the rate's response to a disturbance at the pl
 the row's time), under the constraints of :class:`Requirements` on the plants at the row's time and at
 both ends of its stretch (penalties), by Nelder-Mead from the previous row's design and from seeded
 random starts. Every row is then checked exactly with :func:`.linearize.margins` on the
-python-control loops, in pitch and yaw, on all those plants.
+python-control loops, in pitch and yaw, on all those plants. With ``--load-objective qalpha|accel`` each row's
+load relief (its accelerometer gain and integral) is chosen by the design on the relieved loop
+(:mod:`.loadobjective`).
 """
 
 from __future__ import annotations
