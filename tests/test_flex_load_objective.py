@@ -155,7 +155,8 @@ def test_load_plant_accelerometer_against_the_env():
     """The load plant's gimbal-to-accelerometer part against the v1 env's own accelerometer: SMILE (rigid)
     flown centred to 3 s, then a held gimbal command of 1 % of the limit for 15 control periods; the
     change of the observation's accel_z (times g0) against a flight with the gimbal centred, within 3 %
-    of its largest value (the linear step response), and the gyro's change likewise."""
+    of its largest value (the linear step response), the gyro's change likewise and the angle of attack's
+    (the simulator's flight condition) within 5 %."""
     import gymnasium as gym
 
     from lvgym.baselines.design.linearize import operating_point
@@ -165,7 +166,7 @@ def test_load_plant_accelerometer_against_the_env():
     t0, k, amp = 3.0, 15, 0.01
     env_id, opts = design_env("smile", "v1")
 
-    def fly(a: float) -> tuple[np.ndarray, np.ndarray, float]:
+    def fly(a: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
         env = gym.make(env_id, model="rigid", wind="none", **opts)
         obs, _ = env.reset(seed=0)
         u = env.unwrapped
@@ -175,19 +176,23 @@ def test_load_plant_accelerometer_against_the_env():
             obs, *_ = env.step(zero)
         act = zero.copy()
         act[0] = a
-        acc, gyro = [obs[ia] * G0], [obs[ig]]
+        def alpha() -> float:
+            return float(np.ravel(u.sim.conditions(u.state.sim, "alpha"))[0])
+
+        acc, gyro, al = [obs[ia] * G0], [obs[ig]], [alpha()]
         for _ in range(k):
             obs, *_ = env.step(act)
             acc.append(obs[ia] * G0)
             gyro.append(obs[ig])
-        return np.array(acc), np.array(gyro), float(u.gimbal_limit)
+            al.append(alpha())
+        return np.array(acc), np.array(gyro), np.array(al), float(u.gimbal_limit)
 
-    a1, g1, limit = fly(amp)
-    a0, g0, _ = fly(0.0)
+    a1, g1, al1, limit = fly(amp)
+    a0, g0, al0, _ = fly(0.0)
     g = LO.load_plant(operating_point("smile", t0, "rigid", protocol="v1"), "pitch")
     t = np.arange(k + 1) * g.dt
     cmd = np.r_[np.ones(k), 0.0] * amp * limit
-    for env_change, out in ((a1 - a0, 2), (g1 - g0, 0)):
+    for env_change, out, tol in ((a1 - a0, 2, 0.03), (g1 - g0, 0, 0.03), (al1 - al0, 1, 0.05)):
         _, lin = control.forced_response(LO._sub(g, out, 0), T=t, U=cmd)
         assert np.max(np.abs(env_change)) > 0
-        assert np.max(np.abs(lin - env_change)) < 0.03 * np.max(np.abs(env_change))
+        assert np.max(np.abs(lin - env_change)) < tol * np.max(np.abs(env_change))
