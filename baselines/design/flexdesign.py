@@ -18,7 +18,9 @@ parameters minimise the energy of the rate's response to a disturbance at the pl
 the row's time), under the constraints of :class:`Requirements` on the plants at the row's time and at
 both ends of its stretch (penalties), by Nelder-Mead from the previous row's design and from seeded
 random starts. Every row is then checked exactly with :func:`.linearize.margins` on the
-python-control loops, in pitch and yaw, on all those plants.
+python-control loops, in pitch and yaw, on all those plants. With ``--load-objective qalpha|accel`` each row's
+load relief (its accelerometer gain and integral) is chosen by the design on the relieved loop
+(:mod:`.loadobjective`).
 """
 
 from __future__ import annotations
@@ -31,6 +33,7 @@ import control
 import numpy as np
 
 from lvgym.cli.args import arg
+from lvgym.errors import ConfigError
 
 from ..filters import Filter, StructuralFilter
 from .flexproblem import (PARAMETERS, START, Requirements, RowProblem, _controller_poly, _from_unit,  # noqa: F401
@@ -38,6 +41,7 @@ from .flexproblem import (PARAMETERS, START, Requirements, RowProblem, _controll
 from .flextable import margin_table, row_line
 from .flightloop import flight_plant, frequency_response, mode_frequencies
 from .linearize import margins, operating_point, reused_flights
+from .loadobjective import OBJECTIVES, check_load_options, effective_plant, load_plant, load_row
 from .noise import command_noise_rate, gyro_noise
 from .target import fly_option, stem, vehicle_option
 
@@ -52,23 +56,30 @@ FLEX_TIMES = {"smile": (3.0, 10.0, 15.0, 20.0, 24.4, 28.8, 32.4, 36.0, 42.5, 54.
 MAXITER = 3000
 
 
-def row_plants(vehicle: Any, t: float, policy: Callable | None, **options: Any) -> tuple[dict, dict, dict]:
+def row_plants(vehicle: Any, t: float, policy: Callable | None, load: bool = False,
+               **options: Any) -> tuple[dict, dict, dict]:
     """Pitch and yaw ``flight_plant`` of the rigid and non-rigid v1 vehicle (a shipped name or a vehicle
     file; ``options``: env keywords) at ``t`` [s], flown there with ``policy`` (None: the zero action),
     the non-rigid modes, and the thrust [N], the mass [kg] and the gyro's noise with the servo's rate
-    limit (:func:`.noise.gyro_noise`) there."""
+    limit (:func:`.noise.gyro_noise`) there; ``load``: also ``load`` (the :func:`.loadobjective.load_plant`
+    of each plane and model), ``qbar_pa`` and ``airspeed_mps`` there."""
     plants: dict[str, dict[str, control.StateSpace]] = {"pitch": {}, "yaw": {}}
-    thrust = None
+    loads: dict[str, dict[str, control.StateSpace]] = {"pitch": {}, "yaw": {}}
+    thrust, air = None, {}
     for model in ("rigid", "nonrigid"):
         op = operating_point(vehicle, t, model, protocol="v1", policy=policy, **options)
         thrust = op.condition("thrust")
         for plane in plants:
             plants[plane][model] = flight_plant(op, plane)
+            if load:
+                loads[plane][model] = load_plant(op, plane)
+        if load:
+            air = {"load": loads, "qbar_pa": op.condition("qbar"), "airspeed_mps": op.condition("airspeed")}
         if model == "nonrigid":
             modes = mode_frequencies(op)
             mass = float(op.sim.timeline.interp("mass", [op.t])[0])
             noise = gyro_noise(op)
-    return plants, modes, {"thrust_n": thrust, "mass_kg": mass, "noise": noise}
+    return plants, modes, {"thrust_n": thrust, "mass_kg": mass, "noise": noise, **air}
 
 
 #: the requirements a row can miss, as :func:`check_loops` names them
@@ -180,11 +191,24 @@ def plain_schedule(schedule: Any) -> Any:
         for r in rows]})
 
 
+def _load_cases(cases: list, planes: tuple[str, ...]) -> list:
+    """The :class:`.loadobjective.LoadProblem` cases of a row's ``cases`` ((time, :func:`row_plants`
+    result) pairs, flown with ``load``) in the order of its gyro loops."""
+    return [(c[2]["load"][p], c[1], c[2]["qbar_pa"], c[2]["airspeed_mps"], p) for _, c in cases for p in planes]
+
+
+def _relieved(case: tuple, gain: float) -> tuple:
+    """A :func:`row_plants` result (flown with ``load``) whose plants are the relieved loop's
+    (:func:`.loadobjective.effective_plant` with the load-relief gain ``gain``)."""
+    plants = {p: {m: effective_plant(g, gain, p) for m, g in pl.items()} for p, pl in case[2]["load"].items()}
+    return plants, case[1], case[2]
+
+
 @reused_flights()
 def design_schedule(vehicle: Any = "smile", times=None, req: Requirements | None = None, starts: int = 2,
                     seed: int = 0, log=print, relief: tuple[float, float] | None = None,
                     planes: tuple[str, ...] = ("pitch",), fly: str = "auto", maxiter: int = MAXITER,
-                    **options: Any) -> dict[str, Any]:
+                    load_objective: str | None = None, load_weight: float = 10.0, **options: Any) -> dict[str, Any]:
     """Design every row of ``vehicle``'s schedule in time order. Each row flies the stretch between the
     midpoints to its neighbours in the same burn (the policy switches rows at the mass midpoints,
     ``interpolation: nearest``), and is designed to meet the requirements at its own time and at both
@@ -205,11 +229,20 @@ def design_schedule(vehicle: Any = "smile", times=None, req: Requirements | None
     schedule file; ``privileged``: every operating point with the privileged reference; ``auto``: ``centred``
     for a shipped vehicle (its schedules unchanged), ``pid`` for a file. ``maxiter``: the optimiser's
     iterations per start (fewer: a faster, less converged design). A document not flown centred records how
-    in ``operating_points``. Returns the schedule
-    document."""
+    in ``operating_points``. ``load_objective`` (``qalpha`` or ``accel``; None, the default: none): every row,
+    once designed plainly, is designed again with its load-relief gain and integral chosen by the design
+    (:func:`.loadobjective.load_row`: ``log J + load_weight log load`` under the requirements, the drift as
+    fast as the vehicle's own allowed) and checked on the relieved loop (:func:`.loadobjective.effective_plant`);
+    its ``load`` entry records the load measure and ``J`` of the design and of the plain one, its ``plain``
+    entry the plain design as a ``relief`` row's. Returns the schedule document."""
     from .target import check_fly, check_vehicle, describe, fly_mode, flyer, schedule_flyer
     from .tune import default_times
 
+    check_load_options(load_objective, load_weight)
+    if load_objective is not None and relief is not None:
+        raise ConfigError("load_objective", load_objective, "None with relief (--load-relief gives the relief; "
+                          "--load-objective chooses it)")
+    load = load_objective is not None
     vehicle = check_vehicle(vehicle, "v1")
     fly = fly_mode(check_fly(fly), vehicle)
     fly = "pid" if fly == "rows" else fly
@@ -235,7 +268,7 @@ def design_schedule(vehicle: Any = "smile", times=None, req: Requirements | None
     skipped: list[dict[str, Any]] = []
     warm, left = None, None
     for k, t in enumerate(times):
-        own = row_plants(vehicle, t, schedule_policy(rows) if rows and fly != "privileged" else first, **options)
+        own = row_plants(vehicle, t, schedule_policy(rows) if rows and fly != "privileged" else first, load, **options)
         if own[2]["thrust_n"] <= 0.0:
             log(f"t = {t:g} s: no thrust (coast), skipped")
             skipped.append({"time_s": float(t), "reason": "coast"})
@@ -247,34 +280,47 @@ def design_schedule(vehicle: Any = "smile", times=None, req: Requirements | None
         noise = own[2]["noise"]
         plain = design_row(RowProblem(loops, req, noise=noise), warm, rng, starts, maxiter)
         e = plain if relief is None else relief_row(loops, req, plain, relief[0], noise=noise)
+        if load:
+            e = load_row(_load_cases(cases, planes), req, plain, load_objective, load_weight, noise=noise, maxiter=maxiter)
+        gain = relief[1] if relief is not None else e["values"]["accel_gain"] if load else None
         right = None
         if k + 1 < len(times):
             t_r = 0.5 * (t + times[k + 1])
             gains, filt = controller(e["values"], notch)
             first_rows = rows + [{"time_s": t, "mass_kg": own[2]["mass_kg"], "kp": gains[0], "ki": gains[1], "kd": gains[2],
-                             "filter": filt.as_dict(), **({} if relief is None else {"accel_gain": relief[1]})}]
+                             "filter": filt.as_dict(), **({} if gain is None else {"accel_gain": gain})}]
             try:
-                case = row_plants(vehicle, t_r, first if fly == "privileged" else schedule_policy(first_rows), **options)
+                case = row_plants(vehicle, t_r, first if fly == "privileged" else schedule_policy(first_rows), load,
+                                  **options)
                 right = (t_r, case) if case[2]["thrust_n"] > 0.0 else None
             except RuntimeError as exc:                  # the flight ended before the stretch's end
                 log(f"t = {t_r:g} s: not reached ({exc}); the row is designed without its right end")
         if right is not None:
             cases.append(right)
             loops = [(c[0][p], c[1]) for _, c in cases for p in planes]
+            before = e["values"]                         # the row's design on its time and left end
             plain = design_row(RowProblem(loops, req, noise=noise), plain["values"], rng, starts=0, maxiter=maxiter)
             e = plain if relief is None else relief_row(loops, req, plain, relief[0], [e["values"]], noise=noise)
+            if load:
+                e = load_row(_load_cases(cases, planes), req, plain, load_objective, load_weight, [before],
+                             noise=noise, maxiter=maxiter)
+                gain = e["values"]["accel_gain"]
         warm = plain["values"]
         gains, filt = controller(e["values"], notch)
-        checks = [_checked(c, tc, gains, filt, req) for tc, c in cases]
+        checks = [_checked(_relieved(c, gain) if load else c, tc, gains, filt, req) for tc, c in cases]
         row = {"time_s": float(t), "mass_kg": round(own[2]["mass_kg"], 2), "kp": float(gains[0]),
                "ki": float(gains[1]), "kd": float(gains[2]), "filter": filt.as_dict(),
-               **({} if relief is None else {"accel_gain": float(relief[1])}),
+               **({} if gain is None else {"accel_gain": float(gain)}),
                "meets": all(c["meets"] for c in checks),
                "misses": [m for m in MISSES if any(m in c["misses"] for c in checks)],
                "objective": round(float(e["J"]), 4),
                "stretch_s": [round(min(tc for tc, _ in cases), 3), round(max(tc for tc, _ in cases), 3)],
                "margins": checks[0]["margins"], "modes": checks[0]["modes"], "ends": checks[1:]}
-        if relief is not None:                         # the design the relieved row came from
+        if load:
+            row["load"] = {"objective": load_objective, "value": round(float(e["load"]), 4),
+                           "plain": round(float(e["load_plain"]), 4), "J": round(float(e["J"]), 4),
+                           "J_plain": round(float(e["J_plain"]), 4)}
+        if relief is not None or load:                 # the design the relieved row came from
             pg, pf = controller(plain["values"], notch)
             row["plain"] = {"kp": float(pg[0]), "ki": float(pg[1]), "kd": float(pg[2]), "filter": pf.as_dict(),
                             "feasible": bool(plain["feasible"]),
@@ -288,7 +334,8 @@ def design_schedule(vehicle: Any = "smile", times=None, req: Requirements | None
            "variable": "mass", "interpolation": "nearest", "requirements": asdict(req),
            "design": {"starts": starts, "seed": seed, "planes": list(planes),
                       **({} if maxiter == MAXITER else {"maxiter": maxiter}), **({} if relief is None else
-                                                         {"ki_scale": relief[0], "accel_gain": relief[1]})},
+                                                         {"ki_scale": relief[0], "accel_gain": relief[1]}),
+                      **({} if not load else {"load_objective": load_objective, "load_weight": load_weight})},
            "rows": rows, "skipped": skipped}
     if fly != "centred" or options:                     # the shipped schedules' documents unchanged
         doc["operating_points"] = {"flown_with": how,
@@ -327,6 +374,13 @@ class Args:
     """load relief: scale every row's integral gain by KI_SCALE and add ACCEL_GAIN [rad/s per m/s^2]"""
     planes: list[str] = arg(default_factory=lambda: ["pitch"], choices=("pitch", "yaw"))
     """planes the optimiser holds to the requirements: pitch, or pitch yaw"""
+    load_objective: str | None = arg(None, choices=OBJECTIVES)
+    """a load objective the design chooses each row's load relief by (accel_gain and ki): qalpha (the RMS of
+    q alpha in 1 m/s of lateral Dryden turbulence) or accel (of the accelerometer's lateral specific force);
+    default none (docs/flex-design.md, "The load objective")"""
+    load_weight: float = arg(10.0, lo=0.0, lo_open=True, hi=100.0)
+    """with --load-objective: the weight of the load measure against the disturbance objective (the design
+    minimises log J + WEIGHT log load)"""
     noise_rate: float | None = arg(None, lo=0.0, lo_open=True, hi=100.0, metavar="FRACTION")
     """hold the gimbal rate the gyro's noise commands to this fraction of the servo's rate limit (RMS;
     default: reported, not required; docs/flex-design.md)"""
@@ -341,7 +395,6 @@ def main(argv: list[str] | None = None) -> int:
     from lvgym.benchmark.results import atomic_write_text
     from lvgym.cli import fail
     from lvgym.cli.args import command_name, parse
-    from lvgym.errors import ConfigError
 
     from .tune import SCHEDULES, default_times, output_path
 
@@ -351,11 +404,15 @@ def main(argv: list[str] | None = None) -> int:
     try:                                             # refused before the (slow) design
         out = output_path(name, a.out, a.overwrite, stem=f"{name}_flex")
         times = default_times(a.vehicle, FLEX_TIMES, "--times") if not a.times else a.times
+        if a.load_objective is not None and a.load_relief is not None:
+            raise ConfigError("--load-objective", a.load_objective, "not with --load-relief (which gives the relief "
+                              "--load-objective chooses)")
     except ConfigError as exc:
         fail(command_name(prog), exc)
     planes = tuple(dict.fromkeys(["pitch", *a.planes]))
     doc = design_schedule(a.vehicle, times, Requirements(noise_rate_fraction=a.noise_rate), starts=a.starts,
-                          seed=a.seed, relief=a.load_relief, planes=planes, fly=a.fly, maxiter=a.maxiter)
+                          seed=a.seed, relief=a.load_relief, planes=planes, fly=a.fly, maxiter=a.maxiter,
+                          load_objective=a.load_objective, load_weight=a.load_weight)
     if not doc["rows"]:
         print(f"no flight time of {a.vehicle} could be designed; nothing written", file=sys.stderr)
         return 1
@@ -365,6 +422,8 @@ def main(argv: list[str] | None = None) -> int:
              + ("" if not a.times else " --times " + " ".join(f"{t:g}" for t in a.times))
              + ("" if planes == ("pitch",) else " --planes " + " ".join(planes))
              + ("" if a.noise_rate is None else f" --noise-rate {a.noise_rate:g}")
+             + ("" if a.load_objective is None else f" --load-objective {a.load_objective}"
+                + ("" if a.load_weight == 10.0 else f" --load-weight {a.load_weight:g}"))
              + ("" if a.fly == "auto" else f" --fly {a.fly}")
              + ("" if a.maxiter == MAXITER else f" --maxiter {a.maxiter}")
              + (" --overwrite" if shipped else f" --out {out}"))

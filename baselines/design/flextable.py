@@ -41,13 +41,27 @@ def _meets(row: dict[str, Any]) -> str:
     return "NO" + (f" ({', '.join(row['misses'])})" if row.get("misses") else "")
 
 
+#: the unit of each load objective's measure (:mod:`.loadobjective`)
+LOAD_UNITS = {"qalpha": "Pa deg", "accel": "m/s^2"}
+
+
+def _load(row: dict[str, Any]) -> str:
+    """The row's load measure with the objective and the plain design's (``-`` in an end line)."""
+    ld = row.get("load")
+    return "-" if ld is None else f"{ld['value']:.4g} ({ld['plain']:.4g})"
+
+
 def row_line(row: dict[str, Any]) -> str:
     r, n = _worst(row, "rigid"), _worst(row, "nonrigid")
     s, b1, hi = _mode_summary(row)
+    ld = row.get("load")
+    load = "" if ld is None else (f"  {ld['objective']} {ld['value']:.4g} {LOAD_UNITS[ld['objective']]} (plain "
+                                  f"{ld['plain']:.4g}), J {ld['J']:.4g} (plain {ld['J_plain']:.4g}), "
+                                  f"accel_gain {row.get('accel_gain', 0.0):.3g}")
     return (f"t = {row['time_s']:5.1f} s  m = {row['mass_kg']:8.1f} kg  rigid GM {r['gm']:.1f}/{r['gm_down']:.1f} dB "
             f"PM {r['pm']:.1f} deg  non-rigid GM {n['gm']:.1f}/{n['gm_down']:.1f} dB PM {n['pm']:.1f} deg  "
             f"slosh {s} dB  bending 1 {b1} dB  higher {hi} dB  growth {max(r['growth'], n['growth']):.3f} 1/s  "
-            f"noise {_noise(r, n)} %  meets: {_meets(row)}")
+            f"noise {_noise(r, n)} %  meets: {_meets(row)}" + load)
 
 
 def margin_table(doc: dict[str, Any]) -> str:
@@ -55,6 +69,7 @@ def margin_table(doc: dict[str, Any]) -> str:
     def fmt(x: float) -> str:
         return "none" if not math.isfinite(x) or abs(x) >= 99 else f"{x:.1f}"
 
+    obj = (doc.get("design") or {}).get("load_objective")
     lines = [f"# gs-pid-flex margins: {doc['vehicle']} (protocol {doc['protocol']})", "",
              f"Requirements: {doc['requirements']}. Each row's controller flies from the midpoint to the row "
              "before to the midpoint to the row after (its 'end' lines: the same controller on the plants there). "
@@ -63,10 +78,14 @@ def margin_table(doc: dict[str, Any]) -> str:
              "gain [dB] at the mode ('gain': at least the attenuation below 0 dB; 'phase': inside the loop, held by "
              "the non-rigid margins); noise: the RMS of the gimbal rate the flight gyro's white noise commands "
              "[% of the servo's rate limit], the worse loop (baselines/design/noise.py); 'meets': yes, or NO and the "
-             "requirements missed.", "",
+             "requirements missed." + ("" if obj is None else
+                                       f" Load: the load objective's measure, {obj} [{LOAD_UNITS[obj]} RMS in 1 m/s of "
+                                       "lateral Dryden turbulence], of the row's design (and of its plain design, "
+                                       "without load relief; baselines/design/loadobjective.py)."), "",
              "| t [s] | mass [kg] | kp | ki | kd | rigid GM up/down [dB] | rigid PM [deg] | non-rigid GM up/down [dB] "
-             "| non-rigid PM [deg] | slosh gain [dB] | bending 1 [dB] | higher bending [dB] | noise [%] | meets |",
-             "|---:|---:|---:|---:|---:|---|---:|---|---:|---|---|---:|---:|---|"]
+             "| non-rigid PM [deg] | slosh gain [dB] | bending 1 [dB] | higher bending [dB] | noise [%] | meets |"
+             + ("" if obj is None else " load (plain) |"),
+             "|---:|---:|---:|---:|---:|---|---:|---|---:|---|---|---:|---:|---|" + ("" if obj is None else "---:|")]
     for line in doc["rows"]:
         for kind, row in [("row", line)] + [("end", e) for e in line.get("ends", [])]:
             r, n = _worst(row, "rigid"), _worst(row, "nonrigid")
@@ -75,5 +94,5 @@ def margin_table(doc: dict[str, Any]) -> str:
             gains = (f"{row['kp']:.4f} | {row['ki']:.4f} | {row['kd']:.5f}" if kind == "row" else "same | | ")
             lines.append(f"| {t} | {row['mass_kg']:.0f} | {gains} | {fmt(r['gm'])} / {fmt(r['gm_down'])} | {fmt(r['pm'])} "
                          f"| {fmt(n['gm'])} / {fmt(n['gm_down'])} | {fmt(n['pm'])} | {s} | {b1} | {hi} | {_noise(r, n)} | "
-                         f"{_meets(row)} |")
+                         f"{_meets(row)} |" + ("" if obj is None else f" {_load(row)} |"))
     return "\n".join(lines) + "\n"
