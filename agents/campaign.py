@@ -1,0 +1,339 @@
+"""Training campaigns: configurations x seeds trained on this machine or on a Ray cluster, then every run
+evaluated on the test seeds, then the comparison over the runs (issue 35).
+
+    lvgym campaign agents/campaigns/v2_example.yaml --dry-run     # check the whole file, list the runs
+    lvgym campaign my_campaign.yaml                                # run it here (a process pool)
+    lvgym campaign my_campaign.yaml --executor ray                 # on a local Ray, or the cluster at $RAY_ADDRESS
+    RAY_ADDRESS=head-node:6379 lvgym campaign my_campaign.yaml --executor ray
+
+The campaign file (docs/training.md, "Campaigns"; :mod:`lvgym.agents.campaign_schema`) names the
+configurations (``train.py`` options), the training seeds, the options common to every run and the
+evaluation. The whole file is checked before anything runs, each configuration by ``train.py``'s own
+checks: a bad value is one line naming the file, the key path, the value and what is allowed, and no
+folder is made.
+
+Everything lives in ``<runs_dir>/<name>/``: the run folders ``<configuration>-s<seed>/`` (``train.py``'s),
+``logs/<run>.log`` (each run's output, every attempt), ``evaluation/<run or baseline>.json`` (the episodes
+of the test seeds), ``comparison.md`` and ``comparison.json`` (:mod:`lvgym.agents.campaign_compare`) and
+``campaign.json`` (the file's text and every run's ``train.py`` options).
+
+Each run is one task: a ``train.py`` process started by a worker of the executor (``local``: a process
+pool on this machine; ``ray``: a Ray task of one CPU). What the task does is decided when it starts: a
+run with ``final_model.json`` is finished and skipped, a run folder without it continues with
+``--resume`` (from its newest checkpoint), else the run starts. So the command can simply be run again
+after a kill, and a Ray task whose worker or node died is retried by Ray (its default ``max_retries``,
+3) on another node, where it resumes. On a cluster the runs folder must be on a file system every node
+sees (and lvgym installed on every node). A run that fails or stops at its wall-time budget stops the
+campaign before the evaluation, naming it and its log; run the campaign again to continue.
+
+The evaluation flies, together (the benchmark's batched evaluation, on the same executor), every run's
+policy (its best model by validation, else its final one) and every classical baseline that has no
+evaluation file of the campaign's settings yet; a file already written is not flown again. The
+comparison is then made from the files.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import datetime as dt
+import hashlib
+import json
+import os
+import socket
+import sys
+import time
+from collections.abc import Iterator
+from dataclasses import dataclass, replace
+from pathlib import Path
+from typing import Any
+
+from lvgym.cli import fail
+from lvgym.cli.args import arg, command_name, parse
+from lvgym.errors import ConfigError
+from lvgym.parallel import TaskFailed, default_workers, exit_on_sigterm, run_map
+
+from .campaign_schema import CAMPAIGN_EXECUTORS, Campaign, Run, load_campaign
+
+__all__ = ["Args", "RunTask", "campaign_state", "main", "run_state", "train_run"]
+
+PROG = "lvgym campaign"
+
+
+@dataclass
+class Args:
+    """Command-line arguments (``lvgym campaign --help``)."""
+
+    file: str = arg(positional=True, metavar="FILE")
+    """the campaign's YAML file"""
+    executor: str | None = arg(None, choices=CAMPAIGN_EXECUTORS)
+    """local (a process pool on this machine) or ray (a local Ray, or the cluster at $RAY_ADDRESS); default:
+    the file's executor"""
+    workers: int | None = arg(None, lo=1, hi=100_000, allowed="an integer >= 1")
+    """runs at once on this machine (local; the CPUs of a local Ray); default: the file's, else the CPUs"""
+    dry_run: bool = False
+    """check the file and list the runs and what each would do, run nothing"""
+    progress: bool = True
+    """show the evaluation's progress bar"""
+
+
+@dataclass(frozen=True)
+class RunTask:
+    """What a worker needs to train (or resume, or skip) one run."""
+
+    name: str
+    folder: str
+    argv: tuple[str, ...]
+    log: str
+    cwd: str
+
+
+def run_state(folder: str | Path) -> str:
+    """``finished`` (``final_model.json``), ``resume`` (a run folder without it) or ``new``."""
+    folder = Path(folder)
+    if (folder / "final_model.json").is_file():
+        return "finished"
+    return "resume" if (folder / "config.yaml").is_file() else "new"
+
+
+def _command(task: RunTask) -> list[str]:
+    state = run_state(task.folder)
+    argv = ["--resume", task.folder] if state == "resume" else list(task.argv)
+    return [sys.executable, "-m", "lvgym.agents.train", *argv, "--no-progress"]
+
+
+def _die_with_parent() -> None:
+    """In the train.py child: SIGTERM (it checkpoints and exits) when the worker that started it dies."""
+    import ctypes
+    import signal
+
+    with contextlib.suppress(Exception):
+        ctypes.CDLL(None).prctl(1, signal.SIGTERM)          # PR_SET_PDEATHSIG (Linux)
+
+
+def train_run(task: RunTask) -> dict[str, Any]:
+    """Train, resume or skip one run (decided now, from its folder: a retried task resumes); returns its
+    status: ``skipped``, ``finished``, ``unfinished`` (stopped at its wall-time budget) or ``failed``."""
+    import subprocess
+
+    out = {"run": task.name, "host": socket.gethostname(), "pid": os.getpid()}
+    if run_state(task.folder) == "finished":
+        return {**out, "status": "skipped", "seconds": 0.0}
+    cmd = _command(task)
+    Path(task.log).parent.mkdir(parents=True, exist_ok=True)
+    t0 = time.monotonic()
+    with open(task.log, "ab") as log:
+        log.write(f"== {dt.datetime.now(dt.timezone.utc).isoformat(timespec='seconds')} on {out['host']} (worker "
+                  f"{os.getpid()}): {' '.join(cmd)}\n".encode())
+        log.flush()
+        cwd = task.cwd if os.path.isdir(task.cwd) else str(Path(task.folder).parent)
+        proc = subprocess.run(cmd, stdout=log, stderr=subprocess.STDOUT, cwd=cwd,
+                              preexec_fn=_die_with_parent if sys.platform == "linux" else None)
+    seconds = round(time.monotonic() - t0, 1)
+    if proc.returncode == 0:
+        status = "finished" if run_state(task.folder) == "finished" else "unfinished"
+        return {**out, "status": status, "seconds": seconds, "resumed": cmd[3] == "--resume"}
+    tail = Path(task.log).read_text(encoding="utf-8", errors="replace").strip().splitlines()[-1:]
+    return {**out, "status": "failed", "seconds": seconds, "returncode": proc.returncode, "last_line": " ".join(tail)}
+
+
+# ------------------------------------------------------------------------------------------ the plan
+def campaign_state(campaign: Campaign) -> dict[str, str]:
+    """Each run's state (:func:`run_state`)."""
+    return {r.name: run_state(r.folder) for r in campaign.runs()}
+
+
+def _check_unchanged(campaign: Campaign) -> None:
+    """A run already started with other options than the file now gives is refused (naming its
+    configuration): the run would continue with its own, and the comparison would mix the two."""
+    path = campaign.folder / "campaign.json"
+    if not path.is_file():
+        return
+    before = json.loads(path.read_text(encoding="utf-8")).get("runs", {})
+    for r in campaign.runs():
+        old = before.get(r.name, {}).get("argv")
+        if old is not None and run_state(r.folder) != "new" and list(old) != list(r.argv):
+            raise ConfigError(f"configurations.{r.configuration}", " ".join(r.argv), "the options run "
+                              f"{r.name} was started with ({' '.join(old)}); give the changed configuration a new "
+                              "name, or remove its run folders", campaign.source)
+
+
+def _write_plan(campaign: Campaign) -> None:
+    from lvgym.benchmark.results import atomic_write_text, json_text
+
+    path = campaign.folder / "campaign.json"
+    runs = json.loads(path.read_text(encoding="utf-8")).get("runs", {}) if path.is_file() else {}
+    runs.update({r.name: {"configuration": r.configuration, "seed": r.seed, "argv": list(r.argv)}
+                 for r in campaign.runs()})
+    campaign.folder.mkdir(parents=True, exist_ok=True)
+    atomic_write_text(path, json_text({"name": campaign.name, "source": campaign.source,
+                                       "file": Path(campaign.source).read_text(encoding="utf-8"), "runs": runs,
+                                       "updated_utc": dt.datetime.now(dt.timezone.utc).isoformat(timespec="seconds")}))
+
+
+def _say(text: str) -> None:
+    print(f"{command_name(PROG)}: {text}", file=sys.stderr, flush=True)
+
+
+# ------------------------------------------------------------------------------------------ executors
+@contextlib.contextmanager
+def _ray_session(executor: str, workers: int | None) -> Iterator[None]:
+    """Ray for both stages (started once): the cluster at $RAY_ADDRESS, else a local Ray of ``workers`` CPUs."""
+    if executor != "ray":
+        yield
+        return
+    import ray
+
+    started = not ray.is_initialized()
+    if started and os.environ.get("RAY_ADDRESS"):
+        ray.init(log_to_driver=False, configure_logging=False)
+    elif started:
+        ray.init(address="local", num_cpus=workers or default_workers(), include_dashboard=False,
+                 log_to_driver=False, configure_logging=False)
+    try:
+        yield
+    finally:
+        if started:
+            ray.shutdown()
+
+
+def _train_all(campaign: Campaign, executor: str, workers: int | None) -> list[dict[str, Any]]:
+    runs = [r for r in campaign.runs() if run_state(r.folder) != "finished"]
+    tasks = [RunTask(r.name, r.folder, r.argv, str(campaign.folder / "logs" / f"{r.name}.log"), os.getcwd())
+             for r in runs]
+    if not tasks:
+        return []
+
+    def done(i: int, result: dict[str, Any]) -> None:
+        more = f": {result.get('last_line', '')}" if result["status"] == "failed" else ""
+        _say(f"run {result['run']} {result['status']} in {result['seconds']:.0f} s on {result['host']}{more}")
+
+    n = workers or default_workers()
+    return run_map(train_run, tasks, executor, n, progress=False, on_result=done, desc="runs", unit="run",
+                   describe=lambda t: f"run {t.name}")
+
+
+def _stamp(folder: str) -> str:
+    """What a run's evaluation depends on besides the settings: its final model's record."""
+    return hashlib.sha1((Path(folder) / "final_model.json").read_bytes()).hexdigest()[:16]
+
+
+def _evaluate_all(campaign: Campaign, executor: str, workers: int | None, progress: bool) -> list[dict[str, Any]]:
+    """Every run's and baseline's evaluation records; those not written yet (with these settings) flown now."""
+    from lvgym.benchmark import evaluate, get_suite
+    from lvgym.cli.policies import resolve_policy
+
+    from .campaign_compare import evaluation_settings, read_evaluation, write_evaluation
+
+    ev = campaign.evaluation
+    settings = evaluation_settings(ev)
+    folder = campaign.folder / "evaluation"
+    wanted = [(r.name, f"{r.name}={r.folder}", _stamp(r.folder)) for r in campaign.runs()]
+    wanted += [(b, b, None) for b in ev.baselines]
+    records: dict[str, list[dict[str, Any]]] = {}
+    todo = []
+    for label, ref, stamp in wanted:
+        have = read_evaluation(folder / f"{label}.json", settings, stamp)
+        if have is None:
+            todo.append((label, ref, stamp))
+        else:
+            records[label] = have
+    _say(f"evaluation: {len(records)} of {len(wanted)} already written; flying {len(todo)} "
+         f"({', '.join(x[0] for x in todo) or 'none'})")
+    if todo:
+        suites = [get_suite(s) for s in ev.suites]
+        if ev.mission_time_s is not None:
+            suites = [s.with_options(mission_time_s=ev.mission_time_s) for s in suites]
+        specs = [resolve_policy(ref, command_name(PROG)) for _, ref, _ in todo]
+        t0 = time.perf_counter()
+        flown = evaluate(specs, suites, ev.episodes, ev.seed_set, "ray" if executor == "ray" else "local", workers,
+                         progress)
+        for label, _, stamp in todo:
+            mine = [r for r in flown if r["policy"] == label]
+            write_evaluation(folder / f"{label}.json", label, settings, mine, stamp)
+            records[label] = mine
+        _say(f"evaluation: {len(flown)} episodes in {time.perf_counter() - t0:.1f} s")
+    return [r for label, _, _ in wanted for r in records[label]]
+
+
+def _compare(campaign: Campaign, records: list[dict[str, Any]]) -> tuple[str, list[dict[str, Any]]]:
+    from lvgym.benchmark.results import atomic_write_text, json_text
+
+    from .campaign_compare import comparison_rows, comparison_table, evaluation_settings
+
+    runs: dict[str, list[str]] = {}
+    for r in campaign.runs():
+        runs.setdefault(r.configuration, []).append(r.name)
+    rows = comparison_rows(records, runs, campaign.evaluation.baselines, campaign.evaluation.metric)
+    table = comparison_table(rows, f"Campaign {campaign.name}: {len(runs)} configurations x "
+                                   f"{len(campaign.seeds)} seeds, {campaign.evaluation.seed_set} seeds")
+    atomic_write_text(campaign.folder / "comparison.md", table + "\n")
+    atomic_write_text(campaign.folder / "comparison.json", json_text({
+        "campaign": campaign.name, "settings": evaluation_settings(campaign.evaluation),
+        "metric": campaign.evaluation.metric, "baselines": list(campaign.evaluation.baselines), "runs": runs,
+        "rows": rows, "created_utc": dt.datetime.now(dt.timezone.utc).isoformat(timespec="seconds")}))
+    return table, rows
+
+
+# ------------------------------------------------------------------------------------------ the command
+def _listing(campaign: Campaign, executor: str, workers: int | None) -> list[str]:
+    lines = []
+    for r in campaign.runs():
+        state = run_state(r.folder)
+        what = {"finished": "finished: skipped", "resume": f"resume: train.py --resume {r.folder}",
+                "new": "start: train.py " + " ".join(r.argv)}[state]
+        lines.append(f"  {r.name}: {what}")
+    ev = campaign.evaluation
+    where = (f"ray ({'$RAY_ADDRESS=' + os.environ['RAY_ADDRESS'] if os.environ.get('RAY_ADDRESS') else 'a local Ray'})"
+             if executor == "ray" else "local")
+    head = (f"campaign {campaign.name} in {campaign.folder}: {len(campaign.runs())} runs "
+            f"({len(campaign.configurations)} configurations x {len(campaign.seeds)} seeds) on {where}, "
+            f"{workers or default_workers()} at once")
+    tail = (f"then evaluation: {ev.episodes} {ev.seed_set} seeds of {', '.join(ev.suites)} beside "
+            f"{', '.join(ev.baselines)}; then {campaign.folder / 'comparison.md'}")
+    return [head, *lines, tail]
+
+
+def main(argv: list[str] | None = None) -> dict[str, Any]:
+    """Run (or continue) the campaign of the file; returns the runs' results, the records and the comparison."""
+    args = parse(Args, argv, PROG, __doc__, epilog=True)
+    prog = command_name(PROG)
+    exit_on_sigterm()
+    try:
+        campaign = load_campaign(args.file)
+        _check_unchanged(campaign)
+    except ConfigError as exc:
+        fail(prog, exc)
+    executor = args.executor or campaign.executor
+    workers = args.workers or campaign.workers
+    campaign = replace(campaign, executor=executor, workers=workers)
+    for line in _listing(campaign, executor, workers):
+        print(line, flush=True)
+    if args.dry_run:
+        return {"campaign": campaign, "states": campaign_state(campaign)}
+    _write_plan(campaign)
+    t0 = time.perf_counter()
+    with _ray_session(executor, workers):
+        try:
+            results = _train_all(campaign, executor, workers)
+        except TaskFailed as exc:
+            fail(prog, exc)
+        bad = [r for r in results if r["status"] in ("failed", "unfinished")]
+        if bad:
+            logs = campaign.folder / "logs"
+            fail(prog, "; ".join(f"run {r['run']} {r['status']}" + (f" (exit {r['returncode']})" if "returncode" in r
+                                                                      else " (its wall-time budget is spent)")
+                                 for r in bad) + f"; see {logs}/<run>.log, and run the campaign again to continue")
+        _say(f"training: {len(campaign.runs())} runs finished ({sum(r['status'] == 'finished' for r in results)} "
+             f"now) in {time.perf_counter() - t0:.0f} s")
+        try:
+            records = _evaluate_all(campaign, executor, workers, args.progress)
+        except TaskFailed as exc:
+            fail(prog, exc)
+    table, rows = _compare(campaign, records)
+    print(table)
+    _say(f"comparison in {campaign.folder / 'comparison.md'} and comparison.json ({time.perf_counter() - t0:.0f} s)")
+    return {"campaign": campaign, "results": results, "records": records, "rows": rows, "table": table}
+
+
+if __name__ == "__main__":
+    main()
