@@ -205,7 +205,8 @@ def _train_all(campaign: Campaign, executor: str, workers: int | None) -> list[d
 
     def done(i: int, result: dict[str, Any]) -> None:
         more = f": {result.get('last_line', '')}" if result["status"] == "failed" else ""
-        _say(f"run {result['run']} {result['status']} in {result['seconds']:.0f} s on {result['host']}{more}")
+        again = " (resumed)" if result.get("resumed") else ""
+        _say(f"run {result['run']} {result['status']}{again} in {result['seconds']:.0f} s on {result['host']}{more}")
 
     n = workers or default_workers()
     return run_map(train_run, tasks, executor, n, progress=False, on_result=done, desc="runs", unit="run",
