@@ -201,8 +201,11 @@ def ray_nodes(tmp_path):
 
     def start(args: list[str], name: str) -> subprocess.Popen:
         log = tmp_path / f"ray_{name}.log"
+        # each node its own agent port (the default, 52365, is one per machine: two nodes here, and any other
+        # Ray on this machine, would contend for it)
+        ports = [f"--dashboard-agent-listen-port={_free_port()}"]
         with open(log, "wb") as out:
-            proc = subprocess.Popen([*ray_cmd, "start", *args, *common], cwd=ROOT, env=env, stdout=out,
+            proc = subprocess.Popen([*ray_cmd, "start", *args, *ports, *common], cwd=ROOT, env=env, stdout=out,
                                     stderr=subprocess.STDOUT, start_new_session=True)
         procs.append((proc, log))
         return proc
@@ -218,9 +221,10 @@ def ray_nodes(tmp_path):
         head = start(["--head", f"--port={port}", "--num-cpus=0", "--include-dashboard=false",
                       f"--temp-dir={temp_dir}"], "head")
         wait_started(head, procs[0][1])
-        workers = [start([f"--address=127.0.0.1:{port}", "--num-cpus=1"], f"worker{i}") for i in (1, 2)]
-        for p, log in procs[1:]:
-            wait_started(p, log)
+        workers = []
+        for i in (1, 2):                                            # one after the other: a busy GCS registers both
+            workers.append(start([f"--address=127.0.0.1:{port}", "--num-cpus=1"], f"worker{i}"))
+            wait_started(*procs[-1])
         yield {"address": f"127.0.0.1:{port}", "workers": workers, "env": env}
     finally:
         for proc, _ in reversed(procs):
