@@ -17,14 +17,18 @@ Everything lives in ``<runs_dir>/<name>/``: the run folders ``<configuration>-s<
 of the test seeds), ``comparison.md`` and ``comparison.json`` (:mod:`lvgym.agents.campaign_compare`) and
 ``campaign.json`` (the file's text and every run's ``train.py`` options).
 
-Each run is one task: a ``train.py`` process started by a worker of the executor (``local``: a process
-pool on this machine; ``ray``: a Ray task of one CPU). What the task does is decided when it starts: a
-run with ``final_model.json`` is finished and skipped, a run folder without it continues with
-``--resume`` (from its newest checkpoint), else the run starts. So the command can simply be run again
-after a kill, and a Ray task whose worker or node died is retried by Ray (its default ``max_retries``,
-3) on another node, where it resumes. On a cluster the runs folder must be on a file system every node
-sees (and lvgym installed on every node). A run that fails or stops at its wall-time budget stops the
-campaign before the evaluation, naming it and its log; run the campaign again to continue.
+Each run is one task: a ``train.py`` process started by a worker of the executor (``local``: ``workers``
+threads of this process, each waiting for its ``train.py``; ``ray``: a Ray task of one CPU). What the task
+does is decided when it starts: a run with ``final_model.json`` is finished and skipped, a run folder
+without it continues with ``--resume`` (from its newest checkpoint), else the run starts. So the command
+can simply be run again after a kill, and a Ray task whose worker or node died is retried by Ray (its
+default ``max_retries``, 3) on another node, where it resumes; the run's lock file (``logs/<run>.lock``)
+keeps a retry from starting while a ``train.py`` of the earlier attempt still writes. On a cluster the runs
+folder must be on a file system every node sees (and lvgym installed on every node). A run that fails, or
+stops at its wall-time budget, stops the campaign before the evaluation, naming it and its log; run the
+campaign again to continue. Stopped by SIGTERM or Ctrl-C, the campaign sends each running ``train.py``
+(local) one SIGTERM: it writes a checkpoint and exits; a ``train.py`` whose worker dies gets the same
+(``PR_SET_PDEATHSIG``).
 
 The evaluation flies, together (the benchmark's batched evaluation, on the same executor), every run's
 policy (its best model by validation, else its final one) and every classical baseline that has no
@@ -41,6 +45,7 @@ import json
 import os
 import socket
 import sys
+import threading
 import time
 from collections.abc import Iterator
 from dataclasses import dataclass, replace
@@ -52,7 +57,7 @@ from lvgym.cli.args import arg, command_name, parse
 from lvgym.errors import ConfigError
 from lvgym.parallel import TaskFailed, default_workers, exit_on_sigterm, run_map
 
-from .campaign_schema import CAMPAIGN_EXECUTORS, Campaign, Run, load_campaign
+from .campaign_schema import CAMPAIGN_EXECUTORS, Campaign, load_campaign
 
 __all__ = ["Args", "RunTask", "campaign_state", "main", "run_state", "train_run"]
 
@@ -78,13 +83,15 @@ class Args:
 
 @dataclass(frozen=True)
 class RunTask:
-    """What a worker needs to train (or resume, or skip) one run."""
+    """What a worker needs to train (or resume, or skip) one run; ``own_session``: start its train.py in a
+    session of its own (on this machine: the campaign signals it, not the terminal)."""
 
     name: str
     folder: str
     argv: tuple[str, ...]
     log: str
     cwd: str
+    own_session: bool = False
 
 
 def run_state(folder: str | Path) -> str:
@@ -95,45 +102,105 @@ def run_state(folder: str | Path) -> str:
     return "resume" if (folder / "config.yaml").is_file() else "new"
 
 
+#: the train.py child: SIGTERM (it checkpoints and exits) once the worker thread that started it is gone
+#: (PR_SET_PDEATHSIG, Linux; set in the child itself, not in a preexec_fn, which threads make unsafe)
+_CHILD = """import ctypes, os, runpy, signal, sys
+try:
+    ctypes.CDLL(None).prctl(1, signal.SIGTERM)
+except Exception:
+    pass
+if os.getppid() != int(os.environ.pop("LVGYM_CAMPAIGN_PARENT", os.getppid())):
+    sys.exit(128 + signal.SIGTERM)
+sys.argv[0] = "train.py"
+runpy.run_module("lvgym.agents.train", run_name="__main__", alter_sys=True)
+"""
+
+
 def _command(task: RunTask) -> list[str]:
+    """The run's train.py options now: ``--resume`` for a run folder without final_model.json."""
     state = run_state(task.folder)
     argv = ["--resume", task.folder] if state == "resume" else list(task.argv)
-    return [sys.executable, "-m", "lvgym.agents.train", *argv, "--no-progress"]
+    return [*argv, "--no-progress"]
 
 
-def _die_with_parent() -> None:
-    """In the train.py child: SIGTERM (it checkpoints and exits) when the worker that started it dies."""
-    import ctypes
-    import signal
-
-    with contextlib.suppress(Exception):
-        ctypes.CDLL(None).prctl(1, signal.SIGTERM)          # PR_SET_PDEATHSIG (Linux)
+#: the train.py processes this process started and waits for, and whether the campaign is stopping
+_CHILDREN: set[Any] = set()
+_GUARD = threading.Lock()
+_STOPPING = threading.Event()
 
 
 def train_run(task: RunTask) -> dict[str, Any]:
     """Train, resume or skip one run (decided now, from its folder: a retried task resumes); returns its
-    status: ``skipped``, ``finished``, ``unfinished`` (stopped at its wall-time budget) or ``failed``."""
+    status: ``skipped``, ``finished``, ``unfinished`` (stopped at its wall-time budget or by a signal) or
+    ``failed``. The run's lock file (``logs/<run>.lock``, held by the train.py process too) makes a retried
+    task wait for a train.py of an earlier attempt that is still writing its last checkpoint."""
+    import fcntl
     import subprocess
 
     out = {"run": task.name, "host": socket.gethostname(), "pid": os.getpid()}
     if run_state(task.folder) == "finished":
         return {**out, "status": "skipped", "seconds": 0.0}
-    cmd = _command(task)
     Path(task.log).parent.mkdir(parents=True, exist_ok=True)
     t0 = time.monotonic()
-    with open(task.log, "ab") as log:
-        log.write(f"== {dt.datetime.now(dt.timezone.utc).isoformat(timespec='seconds')} on {out['host']} (worker "
-                  f"{os.getpid()}): {' '.join(cmd)}\n".encode())
-        log.flush()
-        cwd = task.cwd if os.path.isdir(task.cwd) else str(Path(task.folder).parent)
-        proc = subprocess.run(cmd, stdout=log, stderr=subprocess.STDOUT, cwd=cwd,
-                              preexec_fn=_die_with_parent if sys.platform == "linux" else None)
+    with open(str(Path(task.log).with_suffix(".lock")), "a") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        if run_state(task.folder) == "finished":
+            return {**out, "status": "skipped", "seconds": 0.0}
+        cmd = _command(task)
+        with open(task.log, "ab") as log:
+            log.write(f"== {dt.datetime.now(dt.timezone.utc).isoformat(timespec='seconds')} on {out['host']} "
+                      f"(worker {os.getpid()}): {sys.executable} -m lvgym.agents.train {' '.join(cmd)}\n".encode())
+            log.flush()
+            cwd = task.cwd if os.path.isdir(task.cwd) else str(Path(task.folder).parent)
+            with _GUARD:
+                if _STOPPING.is_set():
+                    return {**out, "status": "unfinished", "seconds": 0.0, "returncode": None}
+                proc = subprocess.Popen([sys.executable, "-c", _CHILD, *cmd], stdout=log, stderr=subprocess.STDOUT,
+                                        cwd=cwd, pass_fds=(lock.fileno(),), start_new_session=task.own_session,
+                                        env={**os.environ, "LVGYM_CAMPAIGN_PARENT": str(os.getpid())})
+                _CHILDREN.add(proc)
+            try:
+                proc.wait()
+            finally:
+                with _GUARD:
+                    _CHILDREN.discard(proc)
     seconds = round(time.monotonic() - t0, 1)
+    resumed = cmd[0] == "--resume"
     if proc.returncode == 0:
         status = "finished" if run_state(task.folder) == "finished" else "unfinished"
-        return {**out, "status": status, "seconds": seconds, "resumed": cmd[3] == "--resume"}
+        return {**out, "status": status, "seconds": seconds, "resumed": resumed}
     tail = Path(task.log).read_text(encoding="utf-8", errors="replace").strip().splitlines()[-1:]
-    return {**out, "status": "failed", "seconds": seconds, "returncode": proc.returncode, "last_line": " ".join(tail)}
+    status = "unfinished" if proc.returncode in (128 + 2, 128 + 15) else "failed"    # stopped by a signal
+    return {**out, "status": status, "seconds": seconds, "returncode": proc.returncode, "resumed": resumed,
+            "last_line": " ".join(tail)}
+
+
+def _train_here(tasks: list[RunTask], workers: int, done: Any) -> list[dict[str, Any]]:
+    """The runs on this machine, ``workers`` at once (a thread each waits for its train.py). Stopped (a
+    signal, Ctrl-C): each running train.py gets one SIGTERM, writes a checkpoint and exits."""
+    import signal
+    from concurrent.futures import ThreadPoolExecutor, as_completed
+
+    results = []
+    pool = ThreadPoolExecutor(max_workers=workers, thread_name_prefix="campaign-run")
+    futures = [pool.submit(train_run, t) for t in tasks]
+    try:
+        for f in as_completed(futures):
+            results.append(f.result())
+            done(len(results) - 1, results[-1])
+    except BaseException:
+        with _GUARD:
+            _STOPPING.set()
+            for f in futures:
+                f.cancel()
+            for proc in _CHILDREN:
+                with contextlib.suppress(ProcessLookupError):
+                    proc.send_signal(signal.SIGTERM)
+        _say("stopping: each running train.py writes a checkpoint and exits; run the campaign again to continue")
+        raise
+    finally:
+        pool.shutdown(wait=True)
+    return results
 
 
 # ------------------------------------------------------------------------------------------ the plan
@@ -151,10 +218,31 @@ def _check_unchanged(campaign: Campaign) -> None:
     before = json.loads(path.read_text(encoding="utf-8")).get("runs", {})
     for r in campaign.runs():
         old = before.get(r.name, {}).get("argv")
-        if old is not None and run_state(r.folder) != "new" and list(old) != list(r.argv):
-            raise ConfigError(f"configurations.{r.configuration}", " ".join(r.argv), "the options run "
-                              f"{r.name} was started with ({' '.join(old)}); give the changed configuration a new "
-                              "name, or remove its run folders", campaign.source)
+        if old is None or run_state(r.folder) == "new":
+            continue
+        was, now = _options(old), _options(r.argv)
+        changed = [f for f in dict.fromkeys([*was, *now]) if was.get(f) != now.get(f)]
+        if changed:
+            raise ConfigError(f"configurations.{r.configuration}", _shown(now, changed), f"run {r.name} was started "
+                              f"with {_shown(was, changed)}, and continues with its own options: give the changed configuration a "
+                              "new name (or remove its run folders)", campaign.source)
+
+
+def _options(argv: Any) -> dict[str, tuple[str, ...]]:
+    """train.py options by flag (their order in the file does not matter)."""
+    out: dict[str, tuple[str, ...]] = {}
+    flag = ""
+    for word in argv:
+        if word.startswith("--"):
+            flag = word
+            out[flag] = ()
+        else:
+            out[flag] = (*out.get(flag, ()), word)
+    return out
+
+
+def _shown(options: dict[str, tuple[str, ...]], flags: list[str]) -> str:
+    return " ".join(" ".join([f, *options[f]]) for f in flags if f in options) or "(not given)"
 
 
 def _write_plan(campaign: Campaign) -> None:
@@ -204,11 +292,13 @@ def _train_all(campaign: Campaign, executor: str, workers: int | None) -> list[d
         return []
 
     def done(i: int, result: dict[str, Any]) -> None:
-        more = f": {result.get('last_line', '')}" if result["status"] == "failed" else ""
+        more = f": {result.get('last_line', '')}" if result.get("last_line") else ""
         again = " (resumed)" if result.get("resumed") else ""
         _say(f"run {result['run']} {result['status']}{again} in {result['seconds']:.0f} s on {result['host']}{more}")
 
     n = workers or default_workers()
+    if executor == "local":
+        return _train_here([replace(t, own_session=True) for t in tasks], min(n, len(tasks)), done)
     return run_map(train_run, tasks, executor, n, progress=False, on_result=done, desc="runs", unit="run",
                    describe=lambda t: f"run {t.name}")
 
@@ -321,7 +411,7 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
         bad = [r for r in results if r["status"] in ("failed", "unfinished")]
         if bad:
             logs = campaign.folder / "logs"
-            fail(prog, "; ".join(f"run {r['run']} {r['status']}" + (f" (exit {r['returncode']})" if "returncode" in r
+            fail(prog, "; ".join(f"run {r['run']} {r['status']}" + (f" (exit {r['returncode']})" if r.get("returncode")
                                                                       else " (its wall-time budget is spent)")
                                  for r in bad) + f"; see {logs}/<run>.log, and run the campaign again to continue")
         _say(f"training: {len(campaign.runs())} runs finished ({sum(r['status'] == 'finished' for r in results)} "

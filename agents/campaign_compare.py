@@ -73,6 +73,17 @@ def _values(records: Sequence[Mapping[str, Any]], metric: str) -> dict[tuple[str
     return out
 
 
+def _matrix(values: Mapping[tuple[str, str, str], Mapping[int, tuple[float, bool]]], suite: str,
+            cells: Sequence[str], labels: Sequence[str]) -> tuple[np.ndarray, np.ndarray]:
+    """The ``(policies, episodes)`` matrices of the metric and of the failures of ``labels`` on the seeds they
+    share, the conditions ``cells`` side by side."""
+    cols = [(c, s) for c in cells for s in sorted(set.intersection(*(set(values.get((suite, c, p), {}))
+                                                                     for p in labels)))]
+    v = np.array([[values[(suite, c, p)][s][0] for c, s in cols] for p in labels], dtype=float)
+    f = np.array([[values[(suite, c, p)][s][1] for c, s in cols] for p in labels], dtype=float)
+    return v, f
+
+
 def comparison_rows(records: Sequence[Mapping[str, Any]], runs: Mapping[str, Sequence[str]],
                     baselines: Sequence[str], metric: str = "auto", reps: int = 2000) -> list[dict[str, Any]]:
     """The comparison's rows (module docstring): ``runs`` maps each configuration to its runs' labels."""
@@ -87,21 +98,13 @@ def comparison_rows(records: Sequence[Mapping[str, Any]], runs: Mapping[str, Seq
         conditions = list(dict.fromkeys(c for (_, c, _) in values))
         for cond in [*conditions, "all"]:
             cells = conditions if cond == "all" else [cond]
-
-            def matrix(labels: Sequence[str]) -> tuple[np.ndarray, np.ndarray]:
-                cols = [(c, s) for c in cells for s in sorted(set.intersection(
-                    *(set(values.get((suite, c, p), {})) for p in labels)))]
-                v = np.array([[values[(suite, c, p)][s][0] for c, s in cols] for p in labels], dtype=float)
-                f = np.array([[values[(suite, c, p)][s][1] for c, s in cols] for p in labels], dtype=float)
-                return v, f
-
-            base = {b: matrix([b]) for b in baselines if all((suite, c, b) in values for c in cells)}
+            base = {b: _matrix(values, suite, cells, [b]) for b in baselines if all((suite, c, b) in values for c in cells)}
             best = min(base, key=lambda b: float(np.nanmean(base[b][0]))) if base else None
             for config, labels in runs.items():
                 labels = [p for p in labels if all((suite, c, p) in values for c in cells)]
                 if not labels:
                     continue
-                v, f = matrix(labels)
+                v, f = _matrix(values, suite, cells, labels)
                 point, low, high = iqm({config: v}, reps=reps)[config]
                 row = {"suite": suite, "condition": cond, "configuration": config, "metric": m, "runs": len(labels),
                        "episodes": int(v.shape[1]), "iqm": point, "iqm_ci_low": low, "iqm_ci_high": high,
@@ -109,7 +112,7 @@ def comparison_rows(records: Sequence[Mapping[str, Any]], runs: Mapping[str, Seq
                 row.update({k: math.nan for k in ("baseline_iqm", "baseline_mean", "p_improvement",
                                                   "p_improvement_ci_low", "p_improvement_ci_high")})
                 if best is not None:
-                    both = matrix([best, *labels])[0]               # on the seeds the baseline and runs share
+                    both = _matrix(values, suite, cells, [best, *labels])[0]               # on the seeds the baseline and runs share
                     bv, v2 = both[:1], both[1:]
                     row["baseline_iqm"] = iqm({best: bv}, reps=reps)[best][0]
                     row["baseline_mean"] = float(np.nanmean(bv))

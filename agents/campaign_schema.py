@@ -34,7 +34,7 @@ import yaml
 
 from lvgym.errors import MISSING, ConfigError, check_choice, check_number, did_you_mean
 
-__all__ = ["Campaign", "Evaluation", "Run", "TOP_KEYS", "load_campaign", "train_fields"]
+__all__ = ["TOP_KEYS", "Campaign", "Evaluation", "Run", "load_campaign", "train_fields"]
 
 TOP_KEYS = ("name", "runs_dir", "seeds", "train", "configurations", "evaluation", "executor", "workers")
 EVALUATION_KEYS = ("suites", "episodes", "seed_set", "baselines", "metric", "mission_time_s")
@@ -105,6 +105,7 @@ def train_fields() -> dict[str, dataclasses.Field]:
     """``train.py``'s options by every name a campaign file may give them: the field name, with dashes, and
     the flag without its dashes (``max_wall_time`` for ``max_wall_time_s``)."""
     from lvgym.agents.train import Args
+
     from lvgym.cli.args import _spec
 
     out = {}
@@ -133,6 +134,7 @@ def _text(value: Any) -> str:
 def _option(path: str, f: dataclasses.Field, raw: Any, source: str) -> tuple[Any, list[str]]:
     """``raw`` of train option ``f`` (at ``path``) as train.py's value and its command-line words."""
     from lvgym.agents.train import Args
+
     from lvgym.cli.args import _hints, _kind, _spec, _value
 
     kind, spec, flag = _kind(_hints(Args)[f.name]), _spec(f), _flag(f)
@@ -283,8 +285,8 @@ def _evaluation(data: Any, source: str) -> Evaluation:
                               "policy trained on one vehicle does not fly)", source)
 
     def baseline(path: str, name: str) -> None:
-        from lvgym.cli.policies import resolve_policy
         from lvgym.benchmark.headline import policy_kind
+        from lvgym.cli.policies import resolve_policy
 
         try:
             spec = resolve_policy(name, "campaign")

@@ -25,7 +25,6 @@ from pathlib import Path
 
 import pytest
 import yaml
-
 from lvgym.agents import campaign as camp
 from lvgym.agents.campaign_schema import load_campaign
 
@@ -160,7 +159,8 @@ def test_a_tiny_campaign_runs_resumes_a_killed_run_and_then_skips_everything(tmp
 
     # a changed configuration of a run already started is refused (it would continue with its own options)
     changed = _file(tmp_path, train__total_timesteps=1024)
-    with pytest.raises(SystemExit, match=r"configurations\.a = .*: the options run a-s0 was started with"):
+    with pytest.raises(SystemExit, match=r"configurations\.a = '--total-timesteps 1024': run a-s0 was started with "
+                                         r"--total-timesteps 512, and continues with its own options"):
         camp.main([str(changed), "--dry-run"])
 
 
