@@ -364,5 +364,9 @@ def load_campaign(path: str | os.PathLike[str], check_train: bool = True) -> Cam
         if check_train:
             _check_configuration(cname, merged, tuple(seeds), folder, source, envs_checked)
         out.append((cname, tuple(w for _, _, words in merged.values() for w in words)))
+    clash = sorted({f"{c}-s{s}" for c, _ in out for s in seeds} & set(evaluation.baselines))
+    if clash:
+        raise ConfigError("evaluation.baselines", list(evaluation.baselines), f"names other than the runs' ({clash} "
+                          "is both: a run is labelled <configuration>-s<seed>)", source)
     return Campaign(name, os.path.abspath(runs_dir), tuple(int(s) for s in seeds), tuple(out), evaluation, executor,
                     workers, source)
