@@ -355,8 +355,9 @@ def _compare(campaign: Campaign, records: list[dict[str, Any]]) -> tuple[str, li
     for r in campaign.runs():
         runs.setdefault(r.configuration, []).append(r.name)
     rows = comparison_rows(records, runs, campaign.evaluation.baselines, campaign.evaluation.metric)
-    table = comparison_table(rows, f"Campaign {campaign.name}: {len(runs)} configurations x "
-                                   f"{len(campaign.seeds)} seeds, {campaign.evaluation.seed_set} seeds")
+    n, k = len(runs), len(campaign.seeds)
+    table = comparison_table(rows, f"Campaign {campaign.name}: {n} configuration{'s' * (n != 1)} x {k} "
+                                   f"training seed{'s' * (k != 1)}, on the {campaign.evaluation.seed_set} seeds")
     atomic_write_text(campaign.folder / "comparison.md", table + "\n")
     atomic_write_text(campaign.folder / "comparison.json", json_text({
         "campaign": campaign.name, "settings": evaluation_settings(campaign.evaluation),
