@@ -24,6 +24,11 @@ Every step is restartable: a run with ``final_model.json`` is done and skipped, 
 is continued with ``train.py --resume``, so the command can simply be run again after an interruption.
 Each run's policy (best by validation) is exported as ``<runs-dir>/robustness-policies/<run>.zip`` (so
 that ``evaluate.py`` labels it by run), then ``evaluate.py`` runs on the test seeds.
+
+Campaigns now do this in general (``lvgym campaign FILE``, :mod:`lvgym.agents.campaign`, docs/training.md
+"Campaigns"): any configurations x seeds from one checked YAML file, on this machine or on a Ray cluster,
+then the evaluation on the test seeds and the comparison over the runs; this command is kept as the
+experiment ran.
 """
 
 from __future__ import annotations

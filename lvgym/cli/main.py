@@ -4,6 +4,7 @@
     lvgym evaluate --help              # a command's options
     lvgym evaluate --policies zero lqg --suites smile-v1 --episodes 10
     lvgym train --total-timesteps 2e6 --max-wall-time 3600
+    lvgym campaign agents/campaigns/v2_example.yaml --dry-run
     lvgym design pid --vehicle smile
 
 ``python -m lvgym`` is the same. Each subcommand is the command line of a module (``lvgym evaluate`` is
@@ -30,6 +31,8 @@ COMMANDS: tuple[Command, ...] = (
     Command("evaluate", "lvgym.cli.evaluate:main", "compare policies on the frozen benchmark protocol (evaluate.py)",
             "benchmark", _BENCHMARK),
     Command("train", "lvgym.agents.train:main", "train a policy with stable-baselines3 (train.py)", "train", _TRAIN),
+    Command("campaign", "lvgym.agents.campaign:main", "a training campaign: configurations x seeds (locally or on "
+            "Ray), evaluation on the test seeds, comparison over the runs", "train", _TRAIN),
     Command("margins", "lvgym.cli.margins:main", "time-domain gain and delay margins of policies in the nonlinear "
             "simulation", "benchmark", _BENCHMARK),
     Command("fingerprint", "lvgym.cli.fingerprint:main", "check (or write) a frozen protocol's fingerprint"),
