@@ -296,9 +296,9 @@ class RowProblem:
             e = self.evaluate(self.values(u))
         except (ValueError, np.linalg.LinAlgError):
             return 1e9
-        return self.objective(e)
+        return self.cost_of(e)
 
-    def objective(self, e: dict[str, Any]) -> float:
+    def cost_of(self, e: dict[str, Any]) -> float:
         """The optimiser's cost of an evaluation ``e``: the squared violations (weighted 10) plus log J."""
         return 10.0 * sum(x * x for x in self.violations(e)) + math.log(e["J"])
 

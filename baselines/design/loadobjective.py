@@ -246,9 +246,9 @@ class LoadProblem(RowProblem):
         out["J"], out["load"] = J, load
         return out
 
-    def objective(self, e: dict[str, Any]) -> float:
+    def cost_of(self, e: dict[str, Any]) -> float:
         """The row's cost plus ``weight`` times the log of the load measure."""
-        return super().objective(e) + self.weight * math.log(max(e["load"], 1e-300))
+        return super().cost_of(e) + self.weight * math.log(max(e["load"], 1e-300))
 
 
 #: the load-relief gains [rad/s per m/s^2] the design starts from, besides the plain design's none
