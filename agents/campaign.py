@@ -2,7 +2,7 @@
 evaluated on the test seeds, then the comparison over the runs (issue 35).
 
     lvgym campaign agents/campaigns/v2_example.yaml --dry-run     # check the whole file, list the runs
-    lvgym campaign my_campaign.yaml                                # run it here (a process pool)
+    lvgym campaign my_campaign.yaml                                # run it here (workers train.py processes at once)
     lvgym campaign my_campaign.yaml --executor ray                 # on a local Ray, or the cluster at $RAY_ADDRESS
     RAY_ADDRESS=head-node:6379 lvgym campaign my_campaign.yaml --executor ray
 
@@ -71,7 +71,7 @@ class Args:
     file: str = arg(positional=True, metavar="FILE")
     """the campaign's YAML file"""
     executor: str | None = arg(None, choices=CAMPAIGN_EXECUTORS)
-    """local (a process pool on this machine) or ray (a local Ray, or the cluster at $RAY_ADDRESS); default:
+    """local (train.py processes on this machine, workers at once) or ray (a local Ray, or the cluster at $RAY_ADDRESS); default:
     the file's executor"""
     workers: int | None = arg(None, lo=1, hi=100_000, allowed="an integer >= 1")
     """runs at once on this machine (local; the CPUs of a local Ray); default: the file's, else the CPUs"""

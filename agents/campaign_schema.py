@@ -11,7 +11,7 @@ then the evaluation of every run on the test seeds, then the comparison over the
       res-lqg: {residual: lqg, residual_scale: 0.05, history: 4}
       plain: {residual: none, history: 0, hp: {algo.n_steps: 128}}
     evaluation: {suites: [smile-v2], episodes: 50, seed_set: test, baselines: [gs-pid-flex, lqg]}
-    executor: local                      # local (a process pool on this machine) or ray
+    executor: local                      # local (train.py processes on this machine) or ray
     workers: 2                           # runs at once (local; a local Ray's CPUs)
 
 A train option is named as ``train.py`` names it (``residual_scale`` or ``residual-scale``; ``hp`` and
