@@ -34,6 +34,11 @@ SHORTEN = {
         "policy.net_arch=[8,8] --env-kwargs mission_time_s=2 controller_on_after_s=0.2 --checkpoint-freq 128 "
         "--eval-episodes 1 --eval-mission-time-s 0.5 --no-progress",
     "python evaluate.py --policies runs/my-ppo lqg gs-pid-flex": SHORT_EVAL,
+    "python train.py --suite smile-v2-faults --name my-faults":
+        "--total-timesteps 128 --n-envs 2 --hp algo.n_steps=64 algo.batch_size=64 algo.n_epochs=1 "
+        "policy.net_arch=[8,8] --env-kwargs mission_time_s=2 controller_on_after_s=0.2 --checkpoint-freq 128 "
+        "--eval-episodes 1 --eval-mission-time-s 0.5 --no-progress",
+    "lvgym campaign agents/campaigns/v2_faults_gust.yaml --dry-run": "",
     "python evaluate.py --policies my_policy.py:make gs-pid-flex": SHORT_EVAL,
     "cp lvgym/vehicles/smile_v1.yaml my_rocket.yaml": "",
     "lvgym design pid-flex --vehicle smile": "--times 28.8 --starts 0",
@@ -97,12 +102,23 @@ def test_fly_an_env():
 
 def test_train_then_evaluate(tmp_path):
     """The train-then-evaluate quick start: a tiny run, then evaluate.py on its folder and two baselines."""
-    train, evaluate = _sh(2)
+    train, evaluate = _sh(2)[:2]
     _run(train, tmp_path)
     assert (tmp_path / "runs" / "my-ppo" / "config.yaml").exists()
     proc = _run(evaluate, tmp_path)
     for label in ("my-ppo", "lqg", "gs-pid-flex"):
         assert label in proc.stdout, proc.stdout[-2000:]
+
+
+def test_train_on_a_suite_and_a_campaigns_plan(tmp_path):
+    """The same quick start's v2 lines: a tiny run on smile-v2-faults' condition, and the shipped campaign's
+    dry run (the whole file checked, the runs listed, nothing run)."""
+    suite, campaign = _sh(2)[2:]
+    _run(suite, tmp_path)
+    assert "suite: smile-v2-faults" in (tmp_path / "runs" / "my-faults" / "config.yaml").read_text()
+    (tmp_path / "agents").symlink_to(ROOT / "agents")
+    proc = _run(campaign, tmp_path)
+    assert "6 runs (2 configurations x 3 seeds)" in proc.stdout and not (tmp_path / "runs" / "v2-faults-gust").exists()
 
 
 def test_own_controller_file_acts(tmp_path):
