@@ -13,7 +13,6 @@ rows of vehicle ``k`` after those of vehicle ``k - 1``, its row ``i`` seeded ``s
 
 from __future__ import annotations
 
-import os
 import tempfile
 from collections.abc import Callable, Sequence
 from pathlib import Path
@@ -28,10 +27,10 @@ __all__ = ["ConcatVecEnv", "concat_venv", "family_folder", "row_split", "train_v
 def family_folder() -> Path:
     """Where the train vehicles are written: ``$LVGYM_CACHE_DIR/family`` (default ``~/.cache/lvgym/family``),
     a temporary folder when the cache is off."""
-    root = os.environ.get("LVGYM_CACHE_DIR", "")
-    if root.lower() == "off":
-        return Path(tempfile.mkdtemp(prefix="lvgym-family-"))
-    return (Path(root) if root else Path.home() / ".cache" / "lvgym") / "family"
+    from lvgym.simulator.cache import cache_dir
+
+    timelines = cache_dir()                          # the same root and switch as the timelines' cache
+    return Path(tempfile.mkdtemp(prefix="lvgym-family-")) if timelines is None else timelines.parent / "family"
 
 
 def train_vehicle_files(count: int, folder: str | Path | None = None) -> list[Path]:
