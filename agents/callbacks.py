@@ -446,8 +446,11 @@ def load_replay_buffer(model: Any, stem: Path) -> bool:
 
 def evaluate_saved(path: str | Path, suite: str = "smile-windy", episodes: int = 10,
                    overrides: dict[str, Any] | None = None) -> dict[str, Any]:
-    """Validation of a saved policy (a ``.zip`` or a run folder) as the training run does it."""
-    ev = ValidationEvaluator(suite, episodes, overrides)
+    """Validation of a saved policy (a ``.zip`` or a run folder) as the training run does it (a teacher with
+    its privileged observation options)."""
+    from .policy import privileged_options
+
+    ev = ValidationEvaluator(suite, episodes, {**privileged_options(path), **(overrides or {})} or None)
     try:
         return ev.evaluate(SB3Policy(path))
     finally:

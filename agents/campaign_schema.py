@@ -168,6 +168,8 @@ def _option(path: str, f: dataclasses.Field, raw: Any, source: str) -> tuple[Any
         raise ConfigError(path, raw, exc.allowed, source) from None
     if kind.many:
         words = [repr(x) if isinstance(x, float) else str(x) for x in value]
+        if not words:                           # an empty list or mapping: train.py's default, no flag
+            return value, []
     elif kind.scalar in (int, float):
         words = [repr(value)]
     return value, [flag, *words]

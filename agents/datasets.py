@@ -31,11 +31,12 @@ import numpy as np
 
 import lvgym.cli.policies  # noqa: F401  (registers the built-in policies by name)
 from lvgym.benchmark.registry import resolve_policy
+from lvgym.benchmark.runner import build_policy, policy_options
 from lvgym.benchmark.suites import SEED_SETS, condition, get_suite
 from lvgym.cli.args import arg, parse
 from lvgym.errors import ConfigError
 
-__all__ = ["NOISE_STREAM", "collect", "dataset_id"]
+__all__ = ["NOISE_STREAM", "collect", "dataset_id", "suite_policies"]
 
 PROG = "lvgym dataset"
 PERMALINK = "https://github.com/lvgym/lvgym"
@@ -76,19 +77,24 @@ def collect(policy: str, suite: str = "smile-v2", model: str = "nonrigid", episo
     spec = resolve_policy(policy, PROG)
     factory = spec.resolve()
     if getattr(factory, "privileged", False):
-        raise ConfigError("policies", policy, "a causal policy: the privileged reference acts on what its "
-                          "observations do not hold")
+        raise ConfigError("policies", policy, "a causal policy or a teacher: the privileged reference acts on "
+                          "what its observations do not hold")
+    # a teacher (a saved policy trained on privileged observations, e.g. fault_info) flies with them, and its
+    # rollouts keep only the flight computer's part of the observation: the data of a blind student
+    teacher = policy_options(spec)
     if not 0.0 <= float(action_noise) <= 1.0:
         raise ConfigError("action_noise", action_noise, "a standard deviation in [0, 1] (the action's units)")
     suite_obj = get_suite(suite)
     seeds = suite_obj.seeds(seed_set, episodes)
-    env = condition(suite, model, **overrides).make_env()
-    pol = factory(env, **dict(spec.kwargs))
+    blind = condition(suite, model, **overrides).make_env()
+    env = condition(suite, model, **overrides, **teacher).make_env() if teacher else blind
+    n_obs = int(blind.observation_space.shape[0])
+    pol = build_policy(spec, env)
     buffers = []
     for i, seed in enumerate(seeds):
         obs, info = env.reset(seed=int(seed))
         pol.reset()
-        steps: dict[str, list[Any]] = {"observations": [obs], "actions": [], "rewards": [], "terminations": [],
+        steps: dict[str, list[Any]] = {"observations": [obs[:n_obs]], "actions": [], "rewards": [], "terminations": [],
                                        "truncations": []}
         noise = np.random.default_rng([int(seed), NOISE_STREAM]) if action_noise else None
         expert: list[np.ndarray] = [np.zeros(env.action_space.shape, env.action_space.dtype)]
@@ -100,7 +106,7 @@ def collect(policy: str, suite: str = "smile-v2", model: str = "nonrigid", episo
                                  env.action_space.high).astype(env.action_space.dtype)
             obs, reward, terminated, truncated, info = env.step(action)
             for key, value in zip(("observations", "actions", "rewards", "terminations", "truncations"),
-                                  (obs, action, float(reward), bool(terminated), bool(truncated))):
+                                  (obs[:n_obs], action, float(reward), bool(terminated), bool(truncated))):
                 steps[key].append(value)
             if terminated or truncated:
                 break
@@ -109,11 +115,13 @@ def collect(policy: str, suite: str = "smile-v2", model: str = "nonrigid", episo
     description = (f"{spec.name} flying lvgym's {suite} ({suite_obj.description}; protocol {suite_obj.version}), "
                    f"{model} model, {len(seeds)} episodes on the {seed_set} seeds {seeds[0]}-{seeds[-1]}"
                    + (f", env options {overrides}" if overrides else "")
+                   + (f", a teacher flying with the privileged options {teacher} (the observations recorded are "
+                      "the flight computer's only, without the privileged entries)" if teacher else "")
                    + (f", its actions flown with Gaussian noise of standard deviation {action_noise:g} "
                       "(infos['expert_action']: the policy's own)" if action_noise else ""))
     from lvgym import __version__
 
-    env_spec = _writable_spec(env)
+    env_spec = _writable_spec(blind)
     return minari.create_dataset_from_buffers(
         dataset_id=dataset_id(spec.name, suite, model, action_noise), buffer=buffers, env=env_spec, eval_env=env_spec,
         algorithm_name=spec.name, author=f"lvgym {__version__}", author_email="lvgym@users.noreply.github.com",
@@ -125,7 +133,9 @@ class Args:
     """Command-line arguments (``lvgym dataset --help``)."""
 
     policies: list[str] = arg(default_factory=lambda: ["lqg-front"], metavar="POLICY")
-    """the policies whose rollouts to record (registered names or factory references)"""
+    """the policies whose rollouts to record (registered names, factory references or saved policies; a
+    teacher trained on privileged observations is recorded as its student sees the flight); ``classical``:
+    every classical baseline a suite lists"""
     suites: list[str] = arg(default_factory=lambda: ["smile-v2"], metavar="SUITE")
     """the suites to fly"""
     models: list[str] = arg(default_factory=lambda: ["rigid", "nonrigid"], metavar="MODEL")
@@ -137,10 +147,28 @@ class Args:
     in infos['expert_action'] (DART; 0: none)"""
 
 
+def suite_policies(names: Sequence[str], suite: str) -> list[str]:
+    """``names`` with ``classical`` replaced by ``suite``'s causal classical baselines (its protocol list's
+    policies of kind ``classical``: :func:`lvgym.benchmark.headline.policy_kind`), in the suite's order."""
+    from lvgym.benchmark.headline import policy_kind
+
+    out: list[str] = []
+    for name in names:
+        if name == "classical":
+            listed = get_suite(suite).policies
+            if not listed:
+                raise ConfigError("policies", name, f"a suite that lists its baselines (protocol v2 on); {suite!r} "
+                                  "lists none: name the policies")
+            out += [p for p in listed if policy_kind(resolve_policy(p, PROG)) == "classical"]
+        else:
+            out.append(name)
+    return list(dict.fromkeys(out))
+
+
 def main(argv: Sequence[str] | None = None) -> None:
     args = parse(Args, argv, PROG, __doc__)
-    for policy in args.policies:
-        for suite in args.suites:
+    for suite in args.suites:
+        for policy in suite_policies(args.policies, suite):
             for model in args.models:
                 ds = collect(policy, suite, model, args.episodes, action_noise=args.action_noise)
                 print(f"{ds.spec.dataset_id}: {ds.total_episodes} episodes, {ds.total_steps} steps")

@@ -357,8 +357,21 @@ def load_policy(path: str | Path, name: str | None = None, env: Any = None) -> A
     return adapt(SB3Policy(path, name), env)
 
 
+#: the env options that give a policy privileged observations (a teacher's: lvgym.envs.options)
+PRIVILEGED_OBSERVATIONS = ("fault_info",)
+
+
+def privileged_options(path: str | Path, name: str | None = None, env: Any = None) -> dict[str, Any]:
+    """The privileged observation options the saved policy at ``path`` was trained with (its sidecar's
+    ``env_kwargs``, e.g. ``{"fault_info": True}`` for a teacher): the benchmark flies it with them, and
+    counts it as privileged (:func:`lvgym.benchmark.runner.policy_options`). Empty for a causal policy."""
+    kwargs = read_meta(resolve_model_path(path)).get("env_kwargs") or {}
+    return {k: kwargs[k] for k in PRIVILEGED_OBSERVATIONS if kwargs.get(k)}
+
+
 #: their kind in protocol v2's headline (lvgym.benchmark.headline): trained models
 shipped_policy.kind = load_policy.kind = "learned"  # type: ignore[attr-defined]
+load_policy.condition_options = privileged_options  # type: ignore[attr-defined]
 
 
 def adapt(policy: SB3Policy, env: Any) -> Any:
@@ -420,5 +433,6 @@ if __name__ == "__main__":
     main()
 
 
-__all__ = ["SB3Policy", "adapt", "copy_policy", "load_model", "load_policy", "load_vecnormalize", "policy_files",
+__all__ = ["PRIVILEGED_OBSERVATIONS", "SB3Policy", "adapt", "copy_policy", "load_model", "load_policy", "load_vecnormalize",
+           "policy_files", "privileged_options",
            "read_meta", "resolve_model_path", "save_policy"]

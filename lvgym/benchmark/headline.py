@@ -31,9 +31,12 @@ SOLVED_ROOM = 0.10
 
 def policy_kind(spec: PolicySpec) -> str:
     """The kind of ``spec``'s policy (module docstring): its factory's ``privileged`` or ``kind`` attribute
-    (the zero policy's is ``none``), else ``other``. Imports the factory's module."""
+    (the zero policy's is ``none``), else ``other``; ``privileged`` too for a policy that flies with
+    privileged env options (:func:`~.runner.policy_options`: a teacher). Imports the factory's module."""
+    from .runner import policy_options
+
     factory = spec.resolve()
-    if getattr(factory, "privileged", False):
+    if getattr(factory, "privileged", False) or policy_options(spec):
         return "privileged"
     kind = getattr(factory, "kind", "other")
     if kind not in KINDS:

@@ -238,27 +238,38 @@ def _per_suite(policies: Sequence[PolicySpec] | Mapping[str, Sequence[PolicySpec
     return {s.name: list(policies[s.name]) for s in suites}
 
 
+def policy_options(policy: PolicySpec) -> dict[str, Any]:
+    """The env options ``policy`` flies a condition with: ``privileged_info=True`` for a privileged reference
+    (its factory's ``privileged``), and what its factory's ``condition_options(**kwargs)`` names (a saved
+    teacher's privileged observation, e.g. ``fault_info``); none for a causal policy."""
+    factory = policy.resolve()
+    out: dict[str, Any] = {"privileged_info": True} if getattr(factory, "privileged", False) else {}
+    extra = getattr(factory, "condition_options", None)
+    if callable(extra):
+        out.update(extra(**dict(policy.kwargs)))
+    return out
+
+
 def make_tasks(policies: Sequence[PolicySpec] | Mapping[str, Sequence[PolicySpec]], suites: Sequence[Suite],
                episodes: int, seed_set: str = "test") -> list[Task]:
     """Every episode of every policy on every condition of every suite, in the order of the results:
     suite, condition, policy, episode. ``policies``: one list for every suite, or a mapping of suite name to
     that suite's own list. A policy whose factory has ``privileged = True`` flies each condition with
-    ``privileged_info=True`` (the same flight, with the true state in the info)."""
+    ``privileged_info=True`` (the same flight, with the true state in the info), one that sees privileged
+    observations (a teacher trained with ``fault_info``) with its options (:func:`policy_options`)."""
     per_suite = _per_suite(policies, suites)
-    privileged: dict[str, bool] = {}
+    options: dict[str, dict[str, Any]] = {}
     for suite in suites:
         names = [p.name for p in per_suite[suite.name]]
         if len(set(names)) != len(names):
             raise ValueError(f"policy names {names}: each must be distinct (they label the results)")
-        privileged.update({p.name: bool(getattr(p.resolve(), "privileged", False))
-                           for p in per_suite[suite.name] if p.name not in privileged})
+        options.update({p.name: policy_options(p) for p in per_suite[suite.name] if p.name not in options})
     tasks: list[Task] = []
     for suite in suites:
         seeds = suite.seeds(seed_set, episodes)
         for cond in suite.conditions:
             for pol in per_suite[suite.name]:
-                # a privileged reference (its factory's ``privileged``) reads the true state from the info
-                c = cond.with_options(privileged_info=True) if privileged[pol.name] else cond
+                c = cond.with_options(**options[pol.name]) if options[pol.name] else cond
                 for i, seed in enumerate(seeds):
                     tasks.append(Task(len(tasks), suite.name, suite.version, i, pol, c, seed))
     return tasks
@@ -347,4 +358,4 @@ def evaluate(policies: Sequence[PolicySpec] | Mapping[str, Sequence[PolicySpec]]
 
 __all__ = ["Block", "EXECUTORS", "MAX_BLOCK_ROWS", "PROTOCOL_VERSION", "PolicyError", "PolicySpec", "Task", "ZERO",
            "batch_objects", "block_rows", "build_policy", "default_workers", "episode_objects", "evaluate", "fly_block",
-           "make_blocks", "make_tasks", "play_episode", "run_block", "run_episode", "run_task", "vec_env", "zero_policy"]
+           "make_blocks", "make_tasks", "play_episode", "policy_options", "run_block", "run_episode", "run_task", "vec_env", "zero_policy"]

@@ -35,7 +35,10 @@ import numpy as np
 from lvgym.packing import Field, Packed
 from lvgym.simulator.layouts import ACTUATOR
 
-__all__ = ["FAULT", "FAULT_DRAW", "FAULT_KINDS", "FAULT_NAMES", "FaultKind", "apply_faults", "decode", "fault_names"]
+from .layouts import FAULT_INFO
+
+__all__ = ["FAULT", "FAULT_DRAW", "FAULT_KINDS", "FAULT_NAMES", "FaultKind", "apply_faults", "decode", "fault_info",
+           "fault_names"]
 
 
 @dataclass(frozen=True)
@@ -123,6 +126,32 @@ def fault_names(fault: np.ndarray) -> np.ndarray:
     for b in np.flatnonzero(fault[:, _F.kind] > 0):
         kind = FAULT_KINDS[int(fault[b, _F.kind]) - 1]
         out[b] = kind.name + ((" yaw" if fault[b, _F.axis] else " pitch") if kind.one_axis else "")
+    return out
+
+
+#: the :data:`~.layouts.FAULT_INFO` entries of each one-axis kind, pitch then yaw, and the scale of its size
+_INFO_ENTRIES = {"effectiveness": (("fault_effectiveness_loss_pitch", "fault_effectiveness_loss_yaw"), 1.0),
+                 "bandwidth": (("fault_bandwidth_loss_pitch", "fault_bandwidth_loss_yaw"), 1.0),
+                 "gyro_bias": (("fault_gyro_bias_pitch", "fault_gyro_bias_yaw"), math.degrees(1.0)),
+                 "misalignment": (("fault_misalignment_pitch", "fault_misalignment_yaw"), math.degrees(1.0)),
+                 "stuck": (("fault_stuck_pitch", "fault_stuck_yaw"), 1.0)}
+
+
+def fault_info(fault: np.ndarray) -> np.ndarray:
+    """The privileged observation block of each row's fault (B, :data:`~.layouts.FAULT_INFO` size), float32:
+    zeros until it strikes (``active``), then its size on its kind's entry (deg and deg/s for the angle and
+    the gyro bias; 1 for a stuck actuator)."""
+    out = FAULT_INFO.zeros(fault.shape[0], np.float32)
+    at = FAULT_INFO.at
+    for b in np.flatnonzero((fault[:, _F.kind] > 0) & (fault[:, _F.active] > 0.0)):
+        name = FAULT_NAMES[int(fault[b, _F.kind]) - 1]
+        out[b, at.fault_active] = 1.0
+        if name == "thrust":
+            out[b, at.fault_thrust_loss] = fault[b, _F.size]
+        else:
+            entries, scale = _INFO_ENTRIES[name]
+            size = 1.0 if name == "stuck" else fault[b, _F.size] * scale
+            out[b, getattr(at, entries[int(fault[b, _F.axis])])] = size
     return out
 
 

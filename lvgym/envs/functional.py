@@ -50,9 +50,9 @@ from lvgym.vehicle.slender import SlenderGeometry
 
 from .coast import coast_moment
 from .dispersions import DispersionPlan
-from .faults import FAULT, apply_faults, decode, fault_names
+from .faults import FAULT, apply_faults, decode, fault_info, fault_names
 from .history import HistoryStack, recorded_action
-from .layouts import (ACTIONS, FLIGHT_DRAWS, NAV, OBSERVATIONS, REASONS, REWARD, REWARD_TERMS, SENSOR_NOISE, TASK,
+from .layouts import (ACTIONS, FLIGHT_DRAWS, NAV, OBSERVATIONS, REASONS, REWARD, REWARD_TERMS, SENSOR_NOISE, TASK, VEHICLE_INFO,
                       informed_layout)
 from .limits import qalpha_task_entries, resolve_qalpha_limit
 from .privileged import privileged_info
@@ -156,10 +156,12 @@ class AscentFuncEnv(FuncEnv):
                              physics=PhysicsSpec(s.physics_dt_s, s.slosh_frequency), servo=servo, imu=imu)
         self.n_steps = int(round(s.mission_time_s / s.control_dt_s))
         #: the layout of one sample of the observation mode (the observation itself without ``history``)
-        self.sample_layout = (informed_layout(OBSERVATIONS[s.observation]) if s.vehicle_info
-                              else OBSERVATIONS[s.observation])
+        base = OBSERVATIONS[s.observation]
+        self.sample_layout = informed_layout(base, s.vehicle_info, s.fault_info)
         #: the ``vehicle_info`` block (the vehicle's design parameters) and where it starts, or None
-        self._info = (design_vector(vehicle), OBSERVATIONS[s.observation].size) if s.vehicle_info else None
+        self._info = (design_vector(vehicle), base.size) if s.vehicle_info else None
+        #: where the ``fault_info`` block starts, or None
+        self._fault_at = base.size + (VEHICLE_INFO.size if s.vehicle_info else 0) if s.fault_info else None
         self.history = HistoryStack(self.sample_layout, ACTIONS[s.control], s.history) if s.history else None
         self.observation_layout = self.history.layout if self.history else self.sample_layout
         self.action_space = (spaces.Box(-1.0, 1.0, (2,), np.float32) if s.control == "tvc" else spaces.MultiDiscrete([3]))
@@ -489,14 +491,18 @@ class AscentFuncEnv(FuncEnv):
                 o += sl.stop - sl.start
 
     def _add_info(self, sim: SimData, ts: TaskData, rows: Any) -> None:
-        """The ``vehicle_info`` block of the observation of ``rows`` (an index array or a slice): the
-        vehicle's design parameters, except on a row whose flight failed (its observation stays zero)."""
-        if self._info is None:
+        """The ``vehicle_info`` and ``fault_info`` blocks of the observation of ``rows`` (an index array or a
+        slice): the vehicle's design parameters and the struck fault, except on a row whose flight failed
+        (its observation stays zero)."""
+        if self._info is None and self._fault_at is None:
             return
-        vector, start = self._info
         idx = np.arange(ts.obs.shape[0])[rows]
         idx = idx[~sim.failed[idx]]
-        ts.obs[idx, start:] = vector
+        if self._info is not None:
+            vector, start = self._info
+            ts.obs[idx, start:start + VEHICLE_INFO.size] = vector
+        if self._fault_at is not None:
+            ts.obs[idx, self._fault_at:] = fault_info(ts.fault[idx])
 
     def _add_noise(self, sim: SimData, ts: TaskData, rows: Any, rngs: Sequence[np.random.Generator | None]) -> None:
         """Sensor noise on the observation of ``rows`` (layout SENSOR_NOISE), each row from its own

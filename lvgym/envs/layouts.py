@@ -22,7 +22,7 @@ from lvgym.packing import Field, Packed, rst_table
 
 __all__ = ["ACTIONS", "FLIGHT_DRAWS", "FLIGHT_SOURCE", "G0", "NAV", "OBSERVATIONS", "OBS_FLIGHT", "OBS_SENSORS", "OBS_STATE",
            "REASONS", "REWARD", "REWARD_TERMS", "SENSOR_NOISE",
-           "TASK", "VEHICLE_INFO", "informed_layout", "FD", "NV", "O", "OF", "OS", "RW", "T", "observation_table"]
+           "TASK", "FAULT_INFO", "VEHICLE_INFO", "informed_layout", "FD", "NV", "O", "OF", "OS", "RW", "T", "observation_table"]
 
 G0 = 9.80665
 
@@ -116,11 +116,37 @@ VEHICLE_INFO = Packed("vehicle design parameters", [
 ], interface=True)
 
 
-@functools.lru_cache(maxsize=8)
-def informed_layout(base: Packed) -> Packed:
-    """The observation ``base`` followed by :data:`VEHICLE_INFO` (the option ``vehicle_info``): ``base``'s
-    entries keep their names and indices."""
-    return Packed(f"{base.title}, vehicle design parameters", [*base.fields, *VEHICLE_INFO.fields], interface=True)
+#: ``fault_info=True`` (privileged: a teacher's observation, never a scored causal policy's): the row's in-flight
+#: fault once it has struck (:mod:`.faults`), after the observation mode's entries (and the vehicle block);
+#: every entry is zero before the onset and for a kind the row does not have
+FAULT_INFO = Packed("in-flight fault (privileged)", [
+    Field("fault_active", 1, "-", "1 once the row's fault has struck"),
+    Field("fault_effectiveness_loss_pitch", 1, "-", "lost actuator effectiveness on the pitch axis (0.3-0.7)"),
+    Field("fault_effectiveness_loss_yaw", 1, "-", "the same on the yaw axis"),
+    Field("fault_bandwidth_loss_pitch", 1, "-", "lost share of the pitch servo's natural frequency (0.5-0.8)"),
+    Field("fault_bandwidth_loss_yaw", 1, "-", "the same on the yaw axis"),
+    Field("fault_thrust_loss", 1, "-", "lost share of the thrust (0.1-0.3)"),
+    Field("fault_gyro_bias_pitch", 1, "deg/s", "the pitch gyro's bias step, signed"),
+    Field("fault_gyro_bias_yaw", 1, "deg/s", "the yaw gyro's bias step, signed"),
+    Field("fault_misalignment_pitch", 1, "deg", "the thrust-direction step on the pitch axis, signed"),
+    Field("fault_misalignment_yaw", 1, "deg", "the same on the yaw axis"),
+    Field("fault_stuck_pitch", 1, "-", "1: the pitch actuator is jammed"),
+    Field("fault_stuck_yaw", 1, "-", "1: the yaw actuator is jammed"),
+], interface=True)
+
+
+@functools.lru_cache(maxsize=16)
+def informed_layout(base: Packed, vehicle: bool = True, fault: bool = False) -> Packed:
+    """The observation ``base`` followed by :data:`VEHICLE_INFO` (``vehicle``: the option ``vehicle_info``)
+    and then :data:`FAULT_INFO` (``fault``: the option ``fault_info``): ``base``'s entries keep their names
+    and indices."""
+    blocks = [b for b, on in ((VEHICLE_INFO, vehicle), (FAULT_INFO, fault)) if on]
+    if not blocks:
+        return base
+    title = ", ".join([base.title, *(b.title for b in blocks)])
+    return Packed(title, [*base.fields, *(f for b in blocks for f in b.fields)], interface=True)
+
+
 #: the action as an observation with ``history`` records it (:mod:`.history`), per ``control``: the TVC
 #: command clipped to [-1, 1] (what the flight computer sent, before the controller-off gating and the
 #: ``action_delay_steps`` queue), the RCS pulse as the action minus 1 (so that the zero of a reset is "no pulse")

@@ -256,6 +256,11 @@ class SensorOptions(Options):
     (:data:`~.layouts.VEHICLE_INFO`: mass, pitch inertia, L/D, thrust-to-weight, control power, the first
     bending and slosh frequencies, the slosh mass share; :mod:`lvgym.vehicle.designinfo`): what a flight
     computer can be loaded with, the ``informed`` track of the launcher family's suite"""
+    fault_info: bool = option(False, boolean=True)
+    """privileged: the observation ends with the row's in-flight fault once it has struck
+    (:data:`~.layouts.FAULT_INFO`: its kind's size on its axis, zeros before the onset; after the
+    ``vehicle_info`` block): what a teacher policy may see and no flight computer knows, never a scored
+    causal policy's observation"""
 
 
 @dataclass(frozen=True)
