@@ -112,6 +112,11 @@ class Args:
     """train with the loop gain drawn per episode uniformly in +-this many dB (lvgym.agents.loop_dispersion; 0: off)"""
     loop_delay_periods: int = 0
     """train with an extra loop delay drawn per episode from 0 to this many control periods (0: off)"""
+    load_margin: float = 0.0
+    """train with the q-alpha load charged above --load-margin-threshold of its limit, this many rad/s per
+    unit of ratio (lvgym.agents.loadmargin; 0: off)"""
+    load_margin_threshold: float = 0.8
+    """with --load-margin: the load's ratio to its limit above which it is charged"""
     total_timesteps: int | None = arg(None, lo=1, hi=10**12)
     """env steps of the whole run, e.g. 2e6 (default: n_timesteps of the hyperparameter file)"""
     seed: int = 0
@@ -179,6 +184,7 @@ def prepare(args: Args, given: set[str]) -> tuple[Args, dict[str, Any], Path, bo
     checked, nothing written (:func:`create_run` writes). Raises ConfigError or SystemExit (one line)."""
     from lvgym.agents.config import build_config, load_config, parse_overrides
     from lvgym.agents.loop_dispersion import loop_dispersion_options
+    from lvgym.agents.loadmargin import load_margin_options
     from lvgym.agents.residual import residual_options
 
     check_options(args)
@@ -232,6 +238,8 @@ def prepare(args: Args, given: set[str]) -> tuple[Args, dict[str, Any], Path, bo
               **({"residual": res} if (res := residual_options(args.residual, args.residual_scale)) else {}),
               **({"loop_dispersion": loop} if (loop := loop_dispersion_options(args.loop_gain_db,
                                                                                  args.loop_delay_periods)) else {}),
+              **({"load_margin": lm} if (lm := load_margin_options(args.load_margin,
+                                                                   args.load_margin_threshold)) else {}),
               **({"family_vehicles": int(args.family_vehicles)} if family else {}),
               "hyperparams_source": cfg.source,
               "created_utc": dt.datetime.now(dt.timezone.utc).isoformat(timespec="seconds"), **provenance()}
@@ -294,7 +302,7 @@ def _train(args: Args, given: set[str], stop: Any, t0: float) -> Path:
             config["vehicles"] = [Path(v).name for v in vehicles]
         venv = make_venv(config["env_id"], cfg.n_envs, seed, config["env_kwargs"], cfg.normalize, cfg.hyper.gamma,
                          policy_files(stem)[1] if stem is not None else None, config.get("residual"),
-                         config.get("loop_dispersion"), vehicles)
+                         config.get("loop_dispersion"), vehicles, config.get("load_margin"))
     except (ConfigError, ValueError) as exc:
         fail(prog, f"{config['env_id']} option {exc}")
     try:

@@ -103,6 +103,7 @@ def check_options(args: Any) -> None:
     """The values of ``args`` (:class:`lvgym.agents.train.Args`) checked: the ranges and choices its fields
     declare (as on the command line, for Args built in Python) and what they cannot say (the residual,
     the loop dispersion, the randomisation's names); a ConfigError names the option."""
+    from lvgym.agents.loadmargin import load_margin_options
     from lvgym.agents.loop_dispersion import loop_dispersion_options
     from lvgym.agents.residual import residual_options
     from lvgym.cli.args import check_fields
@@ -111,6 +112,7 @@ def check_options(args: Any) -> None:
     check_fields(args)
     residual_options(args.residual, args.residual_scale)
     loop_dispersion_options(args.loop_gain_db, args.loop_delay_periods)
+    load_margin_options(args.load_margin, args.load_margin_threshold)
     known = set(RANDOMIZE) | {"all", "none", "protocol", "true", "false", "True", "False"}
     for r in args.randomize:
         if r not in known:
@@ -154,9 +156,10 @@ def training_seed(seed: int, step: int, n_envs: int, prog: str = "train.py") -> 
 
 def make_venv(env_id: str, n_envs: int, seed: int, env_kwargs: dict[str, Any], norm: Any, gamma: float,
               stats: Path | None, residual: dict[str, Any] | None = None, loop: dict[str, Any] | None = None,
-              vehicles: list[str] | None = None) -> Any:
+              vehicles: list[str] | None = None, load_margin: dict[str, Any] | None = None) -> Any:
     """Batched SB3 VecEnv (-> :class:`lvgym.agents.loop_dispersion.LoopDispersedVecEnv` with ``loop`` ->
-    :class:`lvgym.agents.residual.ResidualVecEnv` with ``residual``) -> EnvClock (the env's wall time,
+    :class:`lvgym.agents.residual.ResidualVecEnv` with ``residual`` ->
+    :class:`lvgym.agents.loadmargin.LoadMarginVecEnv` with ``load_margin``) -> EnvClock (the env's wall time,
     :mod:`lvgym.agents.timing`) -> VecMonitor (episode returns) -> VecNormalize (new, or loaded from ``stats``).
     ``vehicles``: vehicle files whose rows share ``n_envs`` (one such stack per vehicle, joined by
     :class:`lvgym.agents.familytrain.ConcatVecEnv`)."""
@@ -165,13 +168,15 @@ def make_venv(env_id: str, n_envs: int, seed: int, env_kwargs: dict[str, Any], n
     import lvgym  # noqa: F401
     from lvgym.envs import make_sb3_vec_env
 
+    from lvgym.agents.loadmargin import load_margin_venv
     from lvgym.agents.loop_dispersion import loop_venv
     from lvgym.agents.residual import residual_venv
     from lvgym.agents.timing import EnvClock
 
     def part(kwargs: dict[str, Any], rows: int, first: int) -> Any:
-        return residual_venv(loop_venv(make_sb3_vec_env(env_id, num_envs=rows, seed=first, **kwargs), loop, first),
-                             residual)
+        base = make_sb3_vec_env(env_id, num_envs=rows, seed=first, **kwargs)
+        return load_margin_venv(residual_venv(loop_venv(base, loop, first), residual), load_margin,
+                                base.task.control_dt_s)
 
     if vehicles:
         from lvgym.agents.familytrain import concat_venv

@@ -15,5 +15,5 @@ from .earth import LaunchSite
 from .registry import make, names, register
 
 __all__ = ["AeroState", "AxisymmetricAero", "BarrowmanAero", "Environment", "FlightConditions", "LaunchSite", "StripAeroelastic", "Tables6Aero",
-           "aerodynamics", "aeroelastic", "atmosphere", "barrowman", "earth", "gravity", "make", "names",
+           "aerodynamics", "aeroelastic", "atmosphere", "barrowman", "datasheet", "earth", "gravity", "make", "names",
            "register", "wind"]
