@@ -84,7 +84,8 @@ def test_a_bad_value_is_refused_naming_its_key_before_any_run_starts(tmp_path, o
     assert not (tmp_path / "runs").exists(), "a refused campaign made a folder"
 
 
-@pytest.mark.parametrize("name", ["v2_example", "v2_faults_gust"])
+@pytest.mark.parametrize("name", sorted(p.stem for p in (Path(__file__).resolve().parents[1] / "agents" / "campaigns")
+                                         .glob("*.yaml")))
 def test_the_shipped_campaigns_validate(name):
     c = load_campaign(ROOT / "agents" / "campaigns" / f"{name}.yaml")
     assert len(c.runs()) == len(c.configurations) * len(c.seeds) >= 4 and len(c.seeds) >= 3
