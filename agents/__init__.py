@@ -13,7 +13,7 @@ lvgym envs.
 Training is ``lvgym train`` (``docs/training.md``). Nothing in ``lvgym`` imports this package (the command
 layer names it); importing it does not import stable-baselines3 (the submodules do). Importing it registers
 the shipped learned policies with the benchmark (``ppo``, ``ppo-res-lqg``) and the loader of saved models
-(``evaluate.py --policies runs/my_run`` or ``model.zip``); their factories are named as strings, imported
+(``evaluate.py --policies runs/my_run``, ``model.zip`` or a cloned ``bc.pt``); their factories are named as strings, imported
 only where a policy flies.
 """
 
@@ -27,3 +27,5 @@ register_policy("ppo-res-lqg", "lvgym.agents.policy:shipped_policy", file="ppo_r
 # observations) or a train.py run folder (its best model)
 register_policy_loader("lvgym.agents.policy:load_policy", suffixes=(".zip",), folders=True,
                        description="a stable-baselines3 .zip model or a train.py run folder")
+# a policy cloned by ``lvgym bc`` (its .pt file): evaluate.py --policies runs/student-s0.pt
+register_policy_loader("lvgym.agents.bc:policy", suffixes=(".pt",), description="a cloned policy .pt (lvgym bc)")

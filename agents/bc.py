@@ -124,9 +124,12 @@ class BCPolicy:
         return out.numpy()[0].astype(np.float32)
 
 
-def policy(env: Any, path: str | Path | None = None, name: str = "bc") -> BCPolicy:
-    """The cloned policy of ``path`` (default: ``LVGYM_BC_PATH``, else ``runs/bc.pt``)."""
-    return BCPolicy(env, path or os.environ.get("LVGYM_BC_PATH", "runs/bc.pt"), name)
+def policy(env: Any, path: str | Path | None = None, name: str | None = None) -> BCPolicy:
+    """The cloned policy of ``path`` (default: ``LVGYM_BC_PATH``, else ``runs/bc.pt``), named ``name``
+    (default: ``bc``; the file's stem when ``path`` is given, as ``evaluate.py --policies runs/bc_s0.pt``
+    labels it)."""
+    file = path or os.environ.get("LVGYM_BC_PATH", "runs/bc.pt")
+    return BCPolicy(env, file, name or (Path(file).stem if path else "bc"))
 
 
 policy.kind = "learned"  # type: ignore[attr-defined]

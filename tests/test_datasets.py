@@ -76,6 +76,17 @@ def test_behaviour_cloning_trains_and_flies_and_knows_its_observation(datasets):
     assert pol.act(obs, info).shape == (2,)
     with pytest.raises(ConfigError, match="bc path"):
         policy(lvgym.make_env("smile-v2", "rigid", history=2), out)          # a stacked observation: 32 entries
+    # evaluate.py takes the file itself, labelled by its stem, and flies it as the benchmark flies any policy
+    from lvgym import agents  # noqa: F401  (registers the .pt loader)
+    from lvgym.benchmark import evaluate
+    from lvgym.benchmark.registry import resolve_policy
+    from lvgym.benchmark.suites import get_suite
+
+    spec = resolve_policy(str(out))
+    assert spec.name == "bc" and spec.factory == "lvgym.agents.bc:policy"
+    records = evaluate([spec], [get_suite("smile-v2").with_options(mission_time_s=1.0)], episodes=1,
+                       seed_set="validation", workers=1, progress=False)
+    assert [r["policy"] for r in records] == ["bc", "bc"]
 
 
 def test_a_noise_injected_dataset_flies_the_noise_and_labels_with_the_policy(datasets):
