@@ -155,3 +155,13 @@ def test_an_empty_env_keywords_mapping_adds_no_flag(tmp_path):
     runs = {r.name: r for r in load_campaign(path).runs()}
     assert "--env-kwargs" not in runs["blind-s0"].argv
     assert runs["teacher-s0"].argv[runs["teacher-s0"].argv.index("--env-kwargs") + 1] == "fault_info=true"
+
+
+def test_the_docs_table_of_the_block_names_every_entry():
+    from pathlib import Path
+
+    text = (Path(__file__).resolve().parents[1] / "docs" / "training.md").read_text(encoding="utf-8")
+    for f in FAULT_INFO.fields:
+        pair = f.name.removesuffix("_yaw")
+        shown = f"`{f.name}`" in text or (pair != f.name and f"`{pair}_pitch`, `_yaw`" in text)
+        assert shown, f"docs/training.md: the fault block's table lacks {f.name}"
