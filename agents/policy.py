@@ -361,7 +361,7 @@ def load_policy(path: str | Path, name: str | None = None, env: Any = None) -> A
 PRIVILEGED_OBSERVATIONS = ("fault_info",)
 
 
-def privileged_options(path: str | Path, name: str | None = None, env: Any = None) -> dict[str, Any]:
+def privileged_options(path: str | Path, **_: Any) -> dict[str, Any]:
     """The privileged observation options the saved policy at ``path`` was trained with (its sidecar's
     ``env_kwargs``, e.g. ``{"fault_info": True}`` for a teacher): the benchmark flies it with them, and
     counts it as privileged (:func:`lvgym.benchmark.runner.policy_options`). Empty for a causal policy."""
@@ -433,6 +433,5 @@ if __name__ == "__main__":
     main()
 
 
-__all__ = ["PRIVILEGED_OBSERVATIONS", "SB3Policy", "adapt", "copy_policy", "load_model", "load_policy", "load_vecnormalize",
-           "policy_files", "privileged_options",
-           "read_meta", "resolve_model_path", "save_policy"]
+__all__ = ["PRIVILEGED_OBSERVATIONS", "SB3Policy", "adapt", "copy_policy", "load_model", "load_policy",
+           "load_vecnormalize", "policy_files", "privileged_options", "read_meta", "resolve_model_path", "save_policy"]

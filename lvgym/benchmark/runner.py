@@ -357,5 +357,6 @@ def evaluate(policies: Sequence[PolicySpec] | Mapping[str, Sequence[PolicySpec]]
 
 
 __all__ = ["Block", "EXECUTORS", "MAX_BLOCK_ROWS", "PROTOCOL_VERSION", "PolicyError", "PolicySpec", "Task", "ZERO",
-           "batch_objects", "block_rows", "build_policy", "default_workers", "episode_objects", "evaluate", "fly_block",
-           "make_blocks", "make_tasks", "play_episode", "policy_options", "run_block", "run_episode", "run_task", "vec_env", "zero_policy"]
+           "batch_objects", "block_rows", "build_policy", "default_workers", "episode_objects", "evaluate",
+           "fly_block", "make_blocks", "make_tasks", "play_episode", "policy_options", "run_block", "run_episode",
+           "run_task", "vec_env", "zero_policy"]

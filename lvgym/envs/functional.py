@@ -52,8 +52,8 @@ from .coast import coast_moment
 from .dispersions import DispersionPlan
 from .faults import FAULT, apply_faults, decode, fault_info, fault_names
 from .history import HistoryStack, recorded_action
-from .layouts import (ACTIONS, FLIGHT_DRAWS, NAV, OBSERVATIONS, REASONS, REWARD, REWARD_TERMS, SENSOR_NOISE, TASK, VEHICLE_INFO,
-                      informed_layout)
+from .layouts import (ACTIONS, FLIGHT_DRAWS, NAV, OBSERVATIONS, REASONS, REWARD, REWARD_TERMS, SENSOR_NOISE, TASK,
+                      VEHICLE_INFO, informed_layout)
 from .limits import qalpha_task_entries, resolve_qalpha_limit
 from .privileged import privileged_info
 from .signals import TaskData, qalpha_limit_rows, reset_signals, step_signals_range

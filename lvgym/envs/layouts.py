@@ -22,7 +22,8 @@ from lvgym.packing import Field, Packed, rst_table
 
 __all__ = ["ACTIONS", "FLIGHT_DRAWS", "FLIGHT_SOURCE", "G0", "NAV", "OBSERVATIONS", "OBS_FLIGHT", "OBS_SENSORS", "OBS_STATE",
            "REASONS", "REWARD", "REWARD_TERMS", "SENSOR_NOISE",
-           "TASK", "FAULT_INFO", "VEHICLE_INFO", "informed_layout", "FD", "NV", "O", "OF", "OS", "RW", "T", "observation_table"]
+           "TASK", "FAULT_INFO", "VEHICLE_INFO", "informed_layout", "FD", "NV", "O", "OF", "OS", "RW", "T",
+           "observation_table"]
 
 G0 = 9.80665
 
