@@ -361,12 +361,17 @@ def load_policy(path: str | Path, name: str | None = None, env: Any = None) -> A
 PRIVILEGED_OBSERVATIONS = ("fault_info",)
 
 
+def privileged_env_options(env_kwargs: dict[str, Any] | None) -> dict[str, Any]:
+    """The privileged observation options among a run's env keywords (e.g. ``{"fault_info": True}``)."""
+    kwargs = env_kwargs or {}
+    return {k: kwargs[k] for k in PRIVILEGED_OBSERVATIONS if kwargs.get(k)}
+
+
 def privileged_options(path: str | Path, **_: Any) -> dict[str, Any]:
     """The privileged observation options the saved policy at ``path`` was trained with (its sidecar's
     ``env_kwargs``, e.g. ``{"fault_info": True}`` for a teacher): the benchmark flies it with them, and
     counts it as privileged (:func:`lvgym.benchmark.runner.policy_options`). Empty for a causal policy."""
-    kwargs = read_meta(resolve_model_path(path)).get("env_kwargs") or {}
-    return {k: kwargs[k] for k in PRIVILEGED_OBSERVATIONS if kwargs.get(k)}
+    return privileged_env_options(read_meta(resolve_model_path(path)).get("env_kwargs"))
 
 
 #: their kind in protocol v2's headline (lvgym.benchmark.headline): trained models
@@ -434,4 +439,4 @@ if __name__ == "__main__":
 
 
 __all__ = ["PRIVILEGED_OBSERVATIONS", "SB3Policy", "adapt", "copy_policy", "load_model", "load_policy",
-           "load_vecnormalize", "policy_files", "privileged_options", "read_meta", "resolve_model_path", "save_policy"]
+           "load_vecnormalize", "policy_files", "privileged_env_options", "privileged_options", "read_meta", "resolve_model_path", "save_policy"]

@@ -274,7 +274,7 @@ def _train(args: Args, given: set[str], stop: Any, t0: float) -> Path:
     from lvgym.agents.callbacks import (CheckpointCallback, ValidationEvaluator, clean_incomplete, latest_checkpoint,
                                         load_replay_buffer, load_rng)
     from lvgym.agents.config import ALGOS, algo_class, build_config
-    from lvgym.agents.policy import PRIVILEGED_OBSERVATIONS, policy_files
+    from lvgym.agents.policy import policy_files, privileged_env_options
     from lvgym.agents.progress import ProgressBarCallback, ProgressLineCallback
 
     prog = _prog()
@@ -340,7 +340,7 @@ def _train(args: Args, given: set[str], stop: Any, t0: float) -> Path:
         if suite != "none" and args.eval_freq > 0:
             # a teacher (privileged observations, e.g. fault_info) is validated seeing what it was trained on
             over = {**({"mission_time_s": args.eval_mission_time_s} if args.eval_mission_time_s else {}),
-                    **{k: True for k in PRIVILEGED_OBSERVATIONS if config["env_kwargs"].get(k)}} or None
+                    **privileged_env_options(config["env_kwargs"])} or None
             # runs made before eval_select existed selected on every condition
             select = config.get("eval_select", "all")
             evaluator = ValidationEvaluator(suite, args.eval_episodes, over,

@@ -35,10 +35,9 @@ def policy_kind(spec: PolicySpec) -> str:
     privileged env options (:func:`~.runner.policy_options`: a teacher). Imports the factory's module."""
     from .runner import policy_options
 
-    factory = spec.resolve()
-    if getattr(factory, "privileged", False) or policy_options(spec):
+    if policy_options(spec):                        # a privileged reference's or a teacher's options
         return "privileged"
-    kind = getattr(factory, "kind", "other")
+    kind = getattr(spec.resolve(), "kind", "other")
     if kind not in KINDS:
         raise ValueError(f"policy {spec.name!r}: kind = {kind!r}: one of {KINDS}")
     return kind

@@ -53,7 +53,7 @@ from .dispersions import DispersionPlan
 from .faults import FAULT, apply_faults, decode, fault_info, fault_names
 from .history import HistoryStack, recorded_action
 from .layouts import (ACTIONS, FLIGHT_DRAWS, NAV, OBSERVATIONS, REASONS, REWARD, REWARD_TERMS, SENSOR_NOISE, TASK,
-                      VEHICLE_INFO, informed_layout)
+                      FAULT_INFO, VEHICLE_INFO, informed_layout)
 from .limits import qalpha_task_entries, resolve_qalpha_limit
 from .privileged import privileged_info
 from .signals import TaskData, qalpha_limit_rows, reset_signals, step_signals_range
@@ -159,9 +159,10 @@ class AscentFuncEnv(FuncEnv):
         base = OBSERVATIONS[s.observation]
         self.sample_layout = informed_layout(base, s.vehicle_info, s.fault_info)
         #: the ``vehicle_info`` block (the vehicle's design parameters) and where it starts, or None
-        self._info = (design_vector(vehicle), base.size) if s.vehicle_info else None
+        self._info = ((design_vector(vehicle), self.sample_layout.offset(VEHICLE_INFO.names[0])) if s.vehicle_info
+                      else None)
         #: where the ``fault_info`` block starts, or None
-        self._fault_at = base.size + (VEHICLE_INFO.size if s.vehicle_info else 0) if s.fault_info else None
+        self._fault_at = self.sample_layout.offset(FAULT_INFO.names[0]) if s.fault_info else None
         self.history = HistoryStack(self.sample_layout, ACTIONS[s.control], s.history) if s.history else None
         self.observation_layout = self.history.layout if self.history else self.sample_layout
         self.action_space = (spaces.Box(-1.0, 1.0, (2,), np.float32) if s.control == "tvc" else spaces.MultiDiscrete([3]))
