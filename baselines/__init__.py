@@ -37,6 +37,9 @@ register_policy("aac", flex_aac, name="aac")
 # rate limit (flexdesign --noise-rate 0.2; lvgym.baselines.pid.QUIET_SCHEDULES, docs/flex-design.md), and aac on it
 register_policy("gs-pid-flex-quiet", flex_pid, name="gs-pid-flex-quiet", quiet=True)
 register_policy("aac-quiet", flex_aac, name="aac-quiet", quiet=True)
+# a soft attitude loop without integral, placed on the rigid body's control power over the flight: load relief
+# by design for protocol v2's max-q gust (lvgym.baselines.design.pdrelief, docs/baselines.md)
+register_policy("gs-pd-relief", smile_scheduled_pid, name="gs-pd-relief", schedule="smile_pd_relief")
 # protocol v2's privileged reference: the true state and the aerodynamic moment known (not a flyable design)
 register_policy("privileged", "lvgym.baselines.privileged:privileged", name="privileged")
 # the thesis's gains (6.3.1) and its Table 6.10 schedule, as published

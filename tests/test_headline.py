@@ -75,7 +75,8 @@ def test_headline_without_a_kind_or_a_reference():
 
 def test_the_kinds_of_the_registered_policies():
     assert policy_kind(ZERO) == "none"
-    for name in ("gs-pid", "gs-pid-flex", "gs-pid-flex-quiet", "aac-quiet", "lqg", "lqg-front", "lqg-aw", "mpc"):
+    for name in ("gs-pid", "gs-pid-flex", "gs-pid-flex-quiet", "aac-quiet", "lqg", "lqg-front", "lqg-aw", "mpc",
+                 "gs-pd-relief"):
         assert policy_kind(resolve_policy(name)) == "classical", name
     assert policy_kind(resolve_policy("ppo-res-lqg")) == "learned"
     assert policy_kind(resolve_policy("privileged")) == "privileged"

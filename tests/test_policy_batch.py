@@ -84,7 +84,7 @@ def fly(suite, make, kind, seed=0, model="nonrigid"):
 
 
 @pytest.mark.parametrize("name", ["pid", "pid-thesis", "gs-pid", "gs-pid-thesis", "gs-pid-flex", "aac", "lqg",
-                                  "lqg-front"])
+                                  "lqg-front", "gs-pd-relief"])
 def test_every_baseline_batch_is_its_policy_per_row_on_smile(name):
     kind = {"aac": AACBatch, "lqg": LQGBatch, "lqg-front": LQGBatch}.get(name, PIDBatch)
     fly("smile-v1", registered(name), kind)

@@ -138,7 +138,8 @@ def test_classical_names_every_classical_baseline_a_suite_lists():
     from lvgym.errors import ConfigError
 
     got = suite_policies(["classical", "lqg", "zero"], "smile-v2-faults")
-    assert got[:5] == ["gs-pid-flex", "gs-pid-flex-quiet", "aac-quiet", "lqg", "lqg-front"] and got[5:] == ["zero"]
+    assert got[:6] == ["gs-pid-flex", "gs-pid-flex-quiet", "aac-quiet", "lqg", "lqg-front", "gs-pd-relief"]
+    assert got[6:] == ["zero"]
     assert "privileged" not in got and "ppo-res-lqg" not in got
     with pytest.raises(ConfigError, match="lists none"):
         suite_policies(["classical"], "smile-windy")

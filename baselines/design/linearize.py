@@ -348,6 +348,17 @@ def aero_slopes(op: OperatingPoint, dw: float = 0.1) -> tuple[float, float, floa
     return n_alpha, m_alpha, V, axial
 
 
+def rigid_terms(op: OperatingPoint) -> dict[str, float]:
+    """The rigid body's terms at the operating point: ``mass`` [kg], pitch ``inertia`` about the CG [kg m^2],
+    ``thrust`` [N], its ``vectored_share`` [-] and ``vectored_thrust`` [N], and the gimbal-to-CG ``arm`` [m]."""
+    tl = op.sim.timeline
+    cg = float(tl.interp("cg", [op.t])[0][0]) if np.ndim(tl.cg) == 2 else float(tl.interp("cg", [op.t])[0])
+    thrust, share = float(op.condition("thrust")), float(tl.interp("vectored_share", [op.t])[0])
+    return {"mass": float(tl.interp("mass", [op.t])[0]), "inertia": float(tl.interp("inertia", [op.t])[0][1, 1]),
+            "thrust": thrust, "vectored_share": share, "vectored_thrust": share * thrust,
+            "arm": cg - float(op.p[op.sim.layout.params["r_gimbal"]][0])}
+
+
 def analytic_rigid(op: OperatingPoint) -> control.StateSpace:
     """Textbook rigid pitch-plane model, states ``(w, theta, q)``::
 
@@ -357,16 +368,9 @@ def analytic_rigid(op: OperatingPoint) -> control.StateSpace:
     with mass ``m``, pitch inertia ``J`` about the CG, thrust ``T`` and the share ``s`` of it the gimbal
     turns (the vehicle's ``vectored_share``, 1 for the shipped vehicles), arm ``l`` from the gimbal to the
     CG, axial drag ``D``, normal-force and moment slopes ``N_a``, ``M_a`` from the aerodynamic model."""
-    tl = op.sim.timeline
-    m = float(tl.interp("mass", [op.t])[0])
-    J = float(tl.interp("inertia", [op.t])[0][1, 1])
-    cg = float(tl.interp("cg", [op.t])[0][0]) if np.ndim(tl.cg) == 2 else float(tl.interp("cg", [op.t])[0])
-    lay = op.sim.layout
-    gimbal = float(op.p[lay.params["r_gimbal"]][0])
-    T = op.condition("thrust")
-    s = float(tl.interp("vectored_share", [op.t])[0])
+    terms = rigid_terms(op)
+    m, J, T, s, l = terms["mass"], terms["inertia"], terms["thrust"], terms["vectored_share"], terms["arm"]
     n_a, m_a, V, D = aero_slopes(op)
-    l = cg - gimbal
     A = np.array([[-n_a / (m * V), (-T + D - n_a) / m, 0.0], [0.0, 0.0, 1.0], [m_a / (J * V), m_a / J, 0.0]])
     B = np.array([[s * T / m], [0.0], [s * T * l / J]])
     return control.ss(A, B, [[0.0, 0.0, 1.0]], 0.0)

@@ -61,6 +61,8 @@ COMMANDS: tuple[Command, ...] = (
                 "for the flexible vehicle (gs-pid-flex)", "control", _CONTROL),
         Command("lqg", "lvgym.baselines.design.lqg_design:main", "design the LQG schedule on the non-rigid plant "
                 "(lqg)", "control", _CONTROL),
+        Command("pd-relief", "lvgym.baselines.design.pdrelief:main", "place the soft attitude loop without integral "
+                "on the vehicle's control power (gs-pd-relief)", "control", _CONTROL),
         Command("charts", "lvgym.baselines.design.charts:main", "Bode and Nichols charts of a gain schedule's "
                 "open loops", "control", _CONTROL),
         Command("auto", "lvgym.baselines.design.auto:main", "design gs-pid, gs-pid-flex and lqg for a vehicle file "
