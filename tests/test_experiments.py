@@ -3,7 +3,7 @@
 no other test flies (the control study and the load-relief sweep) run a short case against hand numbers.
 
 The studies' own tests: tests/test_aac.py, test_budget.py, test_cmdnoise.py, test_curves.py,
-test_headroom.py, test_load_relief.py, test_robustness_cli.py, test_runcompare.py,
+test_gust_relief.py, test_headroom.py, test_load_relief.py, test_robustness_cli.py, test_runcompare.py,
 test_slender_aeroelastic.py, test_train_speed.py, test_uncontrolled.py.
 """
 
