@@ -163,7 +163,7 @@ class ValidationEvaluator:
         score_v2]`` (:data:`SELECTION_V2`). ``policy``: a Policy, or a callable that builds
         one for a condition's env (e.g. a residual policy whose baseline needs the env)."""
         self._built.clear()                          # a factory's policies live for this evaluation only
-        records = [self.episode(self._policy(policy, c), c, s) for c in self.suite.conditions for s in self.seeds]
+        records = [r for c in self.suite.conditions for r in self._fly(policy, c)]
         rows = summarize(records, ("rate_error_rad", "score", "max_rate_radps", "effort_rad_s", "episode_return")
                          + (("score_v2", "cmd_rate_rms") if self.flyability else ()))
         conds: dict[str, dict[str, float]] = {}
@@ -183,6 +183,23 @@ class ValidationEvaluator:
             v2 = float(np.mean([c["score_v2_mean"] for c in sel]))
             out.update({"failure_rate_v2": bad, "score_v2": v2, "score": [bad, v2]})
         return out
+
+    def _fly(self, policy: Any, condition: Any) -> list[dict[str, Any]]:
+        """The records of every validation seed on ``condition``, in seed order: flown together as the rows
+        of its batched env when the policy has ``batch(n)`` (:func:`lvgym.benchmark.rows.fly_rows`: each row's
+        record is the single env's :meth:`episode` of its seed, to the bit), else one episode after another."""
+        from lvgym.benchmark.rows import fly_rows
+
+        first, n = self._policy(policy, condition), len(self.seeds)
+        if n == 1 or not callable(getattr(first, "batch", None)):
+            return [self.episode(first, condition, s) for s in self.seeds]
+        key = ("rows", condition, n)
+        if key not in self._envs:
+            self._envs[key] = condition.make_vec_env(n)
+        flown = fly_rows(self._envs[key], self.seeds, [(first.batch(n), np.arange(n))], flyability=self.flyability)
+        return [{"suite": self.suite.name, "condition": condition.name, "group": condition.group,
+                 "policy": first.name, "model": condition.model, "seed": int(seed), **r}
+                for seed, r in zip(self.seeds, flown)]
 
     def _policy(self, policy: Any, condition: Any) -> Policy:
         """``policy`` itself, or the one the factory ``policy`` builds for ``condition``'s env (cached)."""

@@ -276,6 +276,25 @@ def test_validation_ranks_on_failure_rate_then_the_failure_charged_score():
     assert len(built) == len(ev.suite.conditions)
 
 
+def test_validation_flies_a_batched_policys_seeds_as_rows_to_the_bit():
+    """A policy with ``batch(n)`` (or a factory of one) is validated on the rows of each condition's batched
+    env: every record is the one-by-one episode's, to the bit."""
+    from lvgym.agents.callbacks import ValidationEvaluator
+    from lvgym.agents.policy import shipped_policy
+
+    ev = ValidationEvaluator("smile-v2-faults", 3, {"mission_time_s": 8.0})
+    policy = shipped_policy()
+    for given in (policy, lambda env: policy):
+        rows = [r for c in ev.suite.conditions for r in ev._fly(given, c)]
+        one = [ev.episode(policy, c, s) for c in ev.suite.conditions for s in ev.seeds]
+        assert [r["seed"] for r in rows] == [r["seed"] for r in one] == list(ev.seeds) * 2
+        for a, b in zip(rows, one):
+            assert a.keys() == b.keys()
+            for k in a:
+                assert a[k] == b[k] or (isinstance(a[k], float) and np.isnan(a[k]) and np.isnan(b[k])), k
+    assert ev.evaluate(policy)["episodes"] == 3
+
+
 def test_the_fast_action_path_equals_predict():
     """SB3Policy.act skips model.predict's per-call checks for a flat Box observation; the action must be
     exactly predict's."""
