@@ -4,6 +4,9 @@ a log (:class:`ProgressLineCallback`, ``--progress-interval-s``)::
 
     train.py: step 1,228,800 / 5,000,000 (24.6 %), 2,310 steps/s, elapsed 0:08:52, about 0:27:12 left;
     validation at step 1,000,000: score 0.7134, failure rate 0 %
+
+On a protocol v2 suite the validation part reads ``score_v2 ..., failed or unflyable ... %``: what model
+selection ranks on (an unflyable flight is charged like a failed one).
 """
 
 from __future__ import annotations
@@ -110,9 +113,13 @@ class ProgressLineCallback(BaseCallback):
         evaluations = getattr(self.checkpoint, "evaluations", None)
         if evaluations:
             last = evaluations[-1]                   # its "score" is [failure rate, score] (lexicographic)
-            score = last.get("episode_score", last["score"][-1] if isinstance(last["score"], list) else last["score"])
-            text += (f"; validation at step {int(last['num_timesteps']):,}: score {float(score):.4g}, "
-                     f"failure rate {100.0 * float(last.get('failure_rate', 0.0)):.0f} %")
+            text += f"; validation at step {int(last['num_timesteps']):,}: "
+            if "score_v2" in last:                   # protocol v2: what model selection ranks on
+                text += (f"score_v2 {float(last['score_v2']):.4g}, failed or unflyable "
+                         f"{100.0 * float(last['failure_rate_v2']):.0f} %")
+            else:
+                score = last.get("episode_score", last["score"][-1] if isinstance(last["score"], list) else last["score"])
+                text += f"score {float(score):.4g}, failure rate {100.0 * float(last.get('failure_rate', 0.0)):.0f} %"
         return text
 
     def write(self) -> None:

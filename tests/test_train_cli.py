@@ -209,3 +209,19 @@ def test_the_progress_line_gives_steps_speed_time_and_the_validation_score(tmp_p
     assert (run / "final_model.json").is_file()
     quiet = TRAIN.train(_argv(tmp_path, "quiet", steps=128, extra=("--eval-freq", "0", "--progress-interval-s", "0")))
     assert "train.py: step" not in capsys.readouterr().out and (quiet / "final_model.json").is_file()
+
+
+def test_the_progress_line_on_a_v2_suite_gives_what_selection_ranks_on():
+    """On protocol v2 the line gives score_v2 and the failed-or-unflyable share (an unflyable flight is charged
+    like a failed one), not v1's failure rate, which would hide a policy that chatters."""
+    from types import SimpleNamespace
+
+    from lvgym.agents.progress import ProgressLineCallback
+
+    last = {"num_timesteps": 2_048_000, "score": [0.81, 1.739], "episode_score": 0.236, "failure_rate": 0.0,
+            "score_v2": 1.739, "failure_rate_v2": 0.81}
+    cb = ProgressLineCallback(60.0, 3_000_000, SimpleNamespace(evaluations=[last]))
+    cb.model = SimpleNamespace(num_timesteps=2_500_000)
+    assert cb.line().endswith("; validation at step 2,048,000: score_v2 1.739, failed or unflyable 81 %")
+    del last["score_v2"], last["failure_rate_v2"]
+    assert cb.line().endswith("; validation at step 2,048,000: score 0.236, failure rate 0 %")
