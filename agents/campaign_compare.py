@@ -7,7 +7,8 @@ together, by the benchmark's own batched evaluation (:func:`lvgym.benchmark.eval
 
 The comparison (``comparison.md`` and ``comparison.json``), per suite, condition and configuration (and
 per suite over all its conditions, ``all``): the interquartile mean of the metric over the ``(training
-seeds, test seeds)`` matrix with its stratified-bootstrap interval, the mean and the failure rate, and
+seeds, test seeds)`` matrix with its stratified-bootstrap interval, the mean and the failure rate (on a
+protocol v2 suite: failed or unflyable, as ``score_v2`` charges both), and
 the probability of improvement over the best classical baseline of that row (the baseline of the lowest
 mean metric; lower is better), with its interval (:mod:`lvgym.benchmark.stats`, Agarwal et al. 2021).
 """
@@ -65,11 +66,13 @@ def write_evaluation(path: Path, label: str, settings: Mapping[str, Any], record
 
 
 def _values(records: Sequence[Mapping[str, Any]], metric: str) -> dict[tuple[str, str, str], dict[int, tuple[float, bool]]]:
-    """``{(suite, condition, policy): {seed: (metric, failed)}}``."""
+    """``{(suite, condition, policy): {seed: (metric, failed)}}``; with ``score_v2`` (protocol v2) an
+    unflyable flight counts as failed, as the metric charges it."""
     out: dict[tuple[str, str, str], dict[int, tuple[float, bool]]] = {}
     for r in records:
+        failed = bool(r.get("failed", False)) or (metric == "score_v2" and r.get("flyable") is False)
         out.setdefault((r["suite"], r["condition"], r["policy"]), {})[int(r["seed"])] = (
-            float(r[metric]) if r.get(metric) is not None else math.nan, bool(r.get("failed", False)))
+            float(r[metric]) if r.get(metric) is not None else math.nan, failed)
     return out
 
 
@@ -130,7 +133,8 @@ def comparison_table(rows: Sequence[Mapping[str, Any]], title: str) -> str:
     """The comparison as Markdown: one table per suite."""
     lines = [f"# {title}", "",
              "Per configuration: the interquartile mean (IQM) of the metric over training seeds x test seeds with its "
-             "95 % stratified-bootstrap interval, the mean and the failure rate; P(improvement): the probability that "
+             "95 % stratified-bootstrap interval, the mean and the failure rate (`score_v2`: failed or unflyable); "
+             "P(improvement): the probability that "
              "an episode of the configuration scores lower (better) than the best classical baseline's on the same "
              "seed set, with its interval (0.5: neither is better). Lower is better. `all`: every condition of the "
              "suite together.", ""]

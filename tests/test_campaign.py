@@ -313,3 +313,18 @@ def _kill_node(sid: int) -> None:
         if entry.name.isdigit() and _sid(int(entry.name)) == sid:
             with contextlib.suppress(ProcessLookupError, PermissionError):
                 os.killpg(int(entry.name), signal.SIGKILL)
+
+
+def test_on_a_v2_suite_an_unflyable_flight_counts_as_failed_in_the_comparison():
+    """score_v2 charges an unflyable flight like a failed one, so the comparison's failure rate counts both."""
+    from lvgym.agents.campaign_compare import comparison_rows
+
+    def rec(policy, seed, score, failed=False, flyable=True):
+        return {"suite": "smile-v2", "condition": "smile-v2/rigid", "policy": policy, "seed": seed,
+                "score_v2": score, "failed": failed, "flyable": flyable, "score": score}
+
+    records = [rec("a-s0", 0, 1.0, flyable=False), rec("a-s0", 1, 0.5), rec("a-s0", 2, 2.0, failed=True),
+               rec("a-s0", 3, 0.4), rec("lqg", 0, 0.6), rec("lqg", 1, 0.6), rec("lqg", 2, 0.6), rec("lqg", 3, 0.6)]
+    rows = comparison_rows(records, {"a": ["a-s0"]}, ["lqg"], reps=50)
+    row = next(r for r in rows if r["condition"] == "smile-v2/rigid")
+    assert row["metric"] == "score_v2" and row["failure_rate"] == 0.5 and row["baseline"] == "lqg"
