@@ -37,7 +37,7 @@ import numpy as np
 from lvgym.envs.privileged import PREVIEW_PERIODS
 from lvgym.errors import ConfigError
 
-__all__ = ["PrivilegedPolicy", "privileged"]
+__all__ = ["PrivilegedPolicy", "control_lever", "privileged", "relief_hold"]
 
 #: (bandwidth [rad/s], damping) of the attitude loop per flight model, with :data:`RELIEF`: the lowest mean
 #: ``score_v2`` over protocol v2's three SMILE suites on validation seeds 0-19 of a sweep of bandwidths 1, 1.5
@@ -57,6 +57,17 @@ RELIEF = (0.5, 0.9)
 #: the bandwidths of :data:`GAINS`, of previews 0, 5 and 7 on every suite (10 on the SMILE suites did worse
 #: than 5), on both flight models; 0.1 s, about the period of delay plus the servo's lag
 PREVIEW = 5
+
+
+def relief_hold(share: float, onset: float, full: float) -> float:
+    """The share of the attitude loop and of the moment's cancellation kept at ``share`` of the q-alpha limit:
+    1 up to ``onset``, falling linearly to 0 at ``full`` (:data:`RELIEF`)."""
+    return 1.0 - min(1.0, max(0.0, (share - onset) / (full - onset)))
+
+
+def control_lever(info: dict[str, Any]) -> float:
+    """The vectored thrust times its arm about the CG [N m per rad of gimbal] from a privileged step's info."""
+    return float(info["thrust"]) * float(info.get("vectored_share", 1.0)) * float(info["gimbal_arm"])
 
 
 class PrivilegedPolicy:
@@ -108,7 +119,7 @@ class PrivilegedPolicy:
         whose info holds none)."""
         if "m_aero_b" not in info:                          # the reset's info
             return np.zeros(2, dtype=np.float32)
-        lever = float(info["thrust"]) * float(info.get("vectored_share", 1.0)) * float(info["gimbal_arm"])
+        lever = control_lever(info)
         if lever < 1.0:                                     # no thrust: no moment to command
             return np.zeros(2, dtype=np.float32)
         w = np.asarray(info["omega_bi_b"], dtype=float)
@@ -120,9 +131,8 @@ class PrivilegedPolicy:
         e_rate = np.array([w[1] - ref, w[2]])
         # load relief: from ``onset`` to ``full`` of the q-alpha limit the law lets go of the attitude and of the
         # aerodynamic moment (the statically stable vehicle turns into the relative wind); the rate damping stays
-        onset, full = self.relief
         share = float(info.get("qalpha_pa_deg", 0.0)) / float(info.get("qalpha_limit_pa_deg", self.qalpha_limit))
-        hold = 1.0 - min(1.0, max(0.0, (share - onset) / (full - onset)))
+        hold = relief_hold(share, *self.relief)
         alpha = -2.0 * self.z * self.w * e_rate - hold * self.w * self.w * att
         delta = (J[1:] * alpha - hold * m_aero[1:]) / lever
         if self.plant:                                      # the true thrust direction and actuator authority

@@ -10,7 +10,7 @@ from typing import Any
 import numpy as np
 
 from lvgym.baselines.lqg import SCHEDULES as LQG_SCHEDULES
-from lvgym.baselines.privileged import PrivilegedPolicy
+from lvgym.baselines.privileged import PrivilegedPolicy, control_lever, relief_hold
 from lvgym.benchmark.registry import resolve_policy
 from lvgym.benchmark.runner import build_policy
 
@@ -43,7 +43,7 @@ class SoftLaw(PrivilegedPolicy):
         if "m_aero_b" not in info:                          # the reset's info
             self.integral[:] = 0.0
             return np.zeros(2, dtype=np.float32)
-        lever = float(info["thrust"]) * float(info.get("vectored_share", 1.0)) * float(info["gimbal_arm"])
+        lever = control_lever(info)
         if lever < 1.0:
             return np.zeros(2, dtype=np.float32)
         if self.signals == "true":
@@ -70,9 +70,8 @@ def soft_law(env: Any, w: float = 2.0, z: float = 1.0, signals: str = "obs", mom
 soft_law.privileged = True  # type: ignore[attr-defined]
 
 
-def hold(share: float, onset: float, full: float) -> float:
-    """The reference's relief factor: 1 up to ``onset`` of the q-alpha limit, falling linearly to 0 at ``full``."""
-    return 1.0 - min(1.0, max(0.0, (share - onset) / (full - onset)))
+#: the reference's relief factor (1 up to ``onset`` of the q-alpha limit, 0 from ``full``)
+hold = relief_hold
 
 
 class FadedPolicy:

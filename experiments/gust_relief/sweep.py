@@ -70,7 +70,7 @@ def specs(names: Sequence[str]) -> list[PolicySpec]:
             import lvgym.baselines  # noqa: F401  (registers the classical designs)
             from lvgym.benchmark.registry import resolve_policy
 
-            out.append(PolicySpec(name, resolve_policy(name).factory, resolve_policy(name).kwargs))
+            out.append(resolve_policy(name))
         elif isinstance(v[1], tuple):
             out.append(PolicySpec(name, v[0], v[1]))
         else:
