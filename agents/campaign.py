@@ -309,7 +309,9 @@ def _stamp(folder: str) -> str:
 
 
 def _evaluate_all(campaign: Campaign, executor: str, workers: int | None, progress: bool) -> list[dict[str, Any]]:
-    """Every run's and baseline's evaluation records; those not written yet (with these settings) flown now."""
+    """Every run's and baseline's evaluation records; those not written yet (with these settings) flown now,
+    in one evaluation: a run on the suites its configuration flies (:meth:`Campaign.suites_of`: the family's
+    informed runs on the informed suite, the others on the rest), a baseline on every suite."""
     from lvgym.benchmark import evaluate, get_suite
     from lvgym.cli.policies import resolve_policy
 
@@ -318,32 +320,34 @@ def _evaluate_all(campaign: Campaign, executor: str, workers: int | None, progre
     ev = campaign.evaluation
     settings = evaluation_settings(ev)
     folder = campaign.folder / "evaluation"
-    wanted = [(r.name, f"{r.name}={r.folder}", _stamp(r.folder)) for r in campaign.runs()]
-    wanted += [(b, b, None) for b in ev.baselines]
+    wanted = [(r.name, f"{r.name}={r.folder}", _stamp(r.folder), campaign.suites_of(r.configuration))
+              for r in campaign.runs()]
+    wanted += [(b, b, None, ev.suites) for b in ev.baselines]
     records: dict[str, list[dict[str, Any]]] = {}
     todo = []
-    for label, ref, stamp in wanted:
+    for label, ref, stamp, flies in wanted:
         have = read_evaluation(folder / f"{label}.json", settings, stamp)
         if have is None:
-            todo.append((label, ref, stamp))
+            todo.append((label, ref, stamp, flies))
         else:
             records[label] = have
     _say(f"evaluation: {len(records)} of {len(wanted)} already written; flying {len(todo)} "
          f"({', '.join(x[0] for x in todo) or 'none'})")
     if todo:
-        suites = [get_suite(s) for s in ev.suites]
+        suites = [get_suite(s) for s in ev.suites if any(s in flies for *_, flies in todo)]
         if ev.mission_time_s is not None:
             suites = [s.with_options(mission_time_s=ev.mission_time_s) for s in suites]
-        specs = [resolve_policy(ref, command_name(PROG)) for _, ref, _ in todo]
+        specs = {label: resolve_policy(ref, command_name(PROG)) for label, ref, _, _ in todo}
+        per_suite = {s.name: [specs[label] for label, *_, flies in todo if s.name in flies] for s in suites}
         t0 = time.perf_counter()
-        flown = evaluate(specs, suites, ev.episodes, ev.seed_set, "ray" if executor == "ray" else "local", workers,
-                         progress)
-        for label, _, stamp in todo:
+        flown = evaluate(per_suite, suites, ev.episodes, ev.seed_set, "ray" if executor == "ray" else "local",
+                         workers, progress)
+        for label, _, stamp, _ in todo:
             mine = [r for r in flown if r["policy"] == label]
             write_evaluation(folder / f"{label}.json", label, settings, mine, stamp)
             records[label] = mine
         _say(f"evaluation: {len(flown)} episodes in {time.perf_counter() - t0:.1f} s")
-    return [r for label, _, _ in wanted for r in records[label]]
+    return [r for label, *_ in wanted for r in records[label]]
 
 
 def _compare(campaign: Campaign, records: list[dict[str, Any]]) -> tuple[str, list[dict[str, Any]]]:
@@ -382,7 +386,9 @@ def _listing(campaign: Campaign, executor: str, workers: int | None) -> list[str
             f"{workers or default_workers()} at once")
     tail = (f"then evaluation: {ev.episodes} {ev.seed_set} seeds of {', '.join(ev.suites)} beside "
             f"{', '.join(ev.baselines)}; then {campaign.folder / 'comparison.md'}")
-    return [head, *lines, tail]
+    some = [f"  {c} flies {', '.join(campaign.suites_of(c))}" for c, _ in campaign.configurations
+            if campaign.suites_of(c) != ev.suites]
+    return [head, *lines, tail, *some]
 
 
 def main(argv: list[str] | None = None) -> dict[str, Any]:

@@ -6,7 +6,8 @@ protocol). A file whose settings are the campaign's is not flown again; the miss
 together, by the benchmark's own batched evaluation (:func:`lvgym.benchmark.evaluate`).
 
 The comparison (``comparison.md`` and ``comparison.json``), per suite, condition and configuration (and
-per suite over all its conditions, ``all``): the interquartile mean of the metric over the ``(training
+per suite over all its conditions, ``all``; a family suite per flight model over its vehicles, then ``all``:
+:func:`condition_groups`): the interquartile mean of the metric over the ``(training
 seeds, test seeds)`` matrix with its stratified-bootstrap interval, the mean and the failure rate (on a
 protocol v2 suite: failed or unflyable, as ``score_v2`` charges both), and
 the probability of improvement over the best classical baseline of that row (the baseline of the lowest
@@ -23,7 +24,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["comparison_rows", "comparison_table", "evaluation_settings", "metric_of", "read_evaluation",
+__all__ = ["comparison_rows", "condition_groups", "comparison_table", "evaluation_settings", "metric_of", "read_evaluation",
            "write_evaluation"]
 
 
@@ -87,6 +88,20 @@ def _matrix(values: Mapping[tuple[str, str, str], Mapping[int, tuple[float, bool
     return v, f
 
 
+def condition_groups(suite: str, conditions: Sequence[str]) -> list[tuple[str, list[str]]]:
+    """The comparison's cells of a suite: each condition, then ``all``. A family suite's conditions are its
+    vehicles in each flight model (``family-v2/20000/rigid``): its cells are the models over every vehicle
+    (``rigid, 20 vehicles``), then ``all``."""
+    from lvgym.benchmark.suites import SUITES_FAMILY
+
+    if suite not in SUITES_FAMILY:
+        return [*((c, [c]) for c in conditions), ("all", list(conditions))]
+    by_model: dict[str, list[str]] = {}
+    for c in conditions:
+        by_model.setdefault(c.rsplit("/", 1)[-1], []).append(c)
+    return [*((f"{m}, {len(cells)} vehicles", cells) for m, cells in by_model.items()), ("all", list(conditions))]
+
+
 def comparison_rows(records: Sequence[Mapping[str, Any]], runs: Mapping[str, Sequence[str]],
                     baselines: Sequence[str], metric: str = "auto", reps: int = 2000) -> list[dict[str, Any]]:
     """The comparison's rows (module docstring): ``runs`` maps each configuration to its runs' labels."""
@@ -99,8 +114,7 @@ def comparison_rows(records: Sequence[Mapping[str, Any]], runs: Mapping[str, Seq
         m = metric_of(metric, SUITES[suite].version)
         values = _values([r for r in records if r["suite"] == suite], m)
         conditions = list(dict.fromkeys(c for (_, c, _) in values))
-        for cond in [*conditions, "all"]:
-            cells = conditions if cond == "all" else [cond]
+        for cond, cells in condition_groups(suite, conditions):
             base = {b: _matrix(values, suite, cells, [b]) for b in baselines if all((suite, c, b) in values for c in cells)}
             best = min(base, key=lambda b: float(np.nanmean(base[b][0]))) if base else None
             for config, labels in runs.items():

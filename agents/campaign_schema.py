@@ -34,7 +34,8 @@ import yaml
 
 from lvgym.errors import MISSING, ConfigError, check_choice, check_number, did_you_mean
 
-__all__ = ["TOP_KEYS", "Campaign", "Evaluation", "Run", "load_campaign", "train_fields"]
+__all__ = ["TOP_KEYS", "Campaign", "Evaluation", "Run", "load_campaign", "observes_vehicle", "suites_flown",
+           "train_fields"]
 
 TOP_KEYS = ("name", "runs_dir", "seeds", "train", "configurations", "evaluation", "executor", "workers")
 EVALUATION_KEYS = ("suites", "episodes", "seed_set", "baselines", "metric", "mission_time_s")
@@ -84,6 +85,13 @@ class Campaign:
     executor: str = "local"
     workers: int | None = None
     source: str = ""
+    #: configuration -> the evaluation suites its runs fly (:func:`suites_flown`); a configuration left out
+    #: flies them all
+    flies: tuple[tuple[str, tuple[str, ...]], ...] = ()
+
+    def suites_of(self, configuration: str) -> tuple[str, ...]:
+        """The evaluation suites the runs of ``configuration`` fly."""
+        return dict(self.flies).get(configuration, self.evaluation.suites)
 
     @property
     def folder(self) -> Path:
@@ -246,6 +254,32 @@ def _check_configuration(name: str, options: dict[str, tuple[str, Any, list[str]
         raise ConfigError(path, given, f"{config['env_id']} option {exc}", source) from None
 
 
+def observes_vehicle(options: Any) -> bool:
+    """Whether an env of these keywords (a suite condition's options, or a run's env keywords) ends its
+    observation with the vehicle's design parameters (the env option ``vehicle_info``)."""
+    return bool(dict(options).get("vehicle_info", False))
+
+
+def suites_flown(name: str, options: dict[str, tuple[str, Any, list[str]]], suites: tuple[str, ...],
+                 source: str) -> tuple[str, ...]:
+    """The evaluation ``suites`` configuration ``name`` (its merged train options) can fly: those whose
+    observation is the one it trains on. A run trained with the vehicle's design parameters in view (the
+    family's informed track, ``vehicle_info``) flies the suites that give them (``family-v2-informed``);
+    any other run the suites that do not (``family-v2``, the blind track, and the one-vehicle suites).
+    None of them: a ConfigError naming the configuration."""
+    from lvgym.agents.train import Args, env_kwargs_of
+    from lvgym.benchmark.suites import get_suite
+
+    values = {k: v for k, (_, v, _) in options.items()}
+    mine = observes_vehicle(env_kwargs_of(Args(**values, name=name)))
+    out = tuple(s for s in suites if observes_vehicle(get_suite(s).conditions[0].options) == mine)
+    if not out:
+        track = "with the vehicle's design parameters (vehicle_info)" if mine else "without the vehicle's design parameters"
+        raise ConfigError(f"configurations.{name}", values.get("suite", "(no suite)"), f"a configuration whose "
+                          f"observation one of evaluation.suites {list(suites)} gives: it trains {track}", source)
+    return out
+
+
 # ------------------------------------------------------------------------------------ the file
 def _keys(path: str, data: Any, allowed: tuple[str, ...], source: str, required: tuple[str, ...] = ()) -> dict:
     if not isinstance(data, dict):
@@ -282,9 +316,6 @@ def _evaluation(data: Any, source: str) -> Evaluation:
         if name not in SUITES:
             raise ConfigError(path, name, f"a suite of the protocol{did_you_mean(name, SUITES)}; one of "
                               f"{sorted(SUITES)}", source)
-        if name.startswith("family"):
-            raise ConfigError(path, name, "a suite of one vehicle (a family suite flies its test vehicles, which a "
-                              "policy trained on one vehicle does not fly)", source)
 
     def baseline(path: str, name: str) -> None:
         from lvgym.benchmark.headline import policy_kind
@@ -356,7 +387,7 @@ def load_campaign(path: str | os.PathLike[str], check_train: bool = True) -> Cam
         raise ConfigError(exc.key, exc.value, exc.allowed, source) from None
     evaluation = _evaluation(d.get("evaluation"), source)
     folder = os.path.abspath(os.path.join(runs_dir, name))
-    out, envs_checked = [], set()
+    out, flies, envs_checked = [], [], set()
     for cname, options in configs.items():
         if not isinstance(cname, str) or not NAME.match(cname):
             raise ConfigError(f"configurations.{cname}", options, "a name: letters, digits and . _ + - (not "
@@ -366,9 +397,10 @@ def load_campaign(path: str | os.PathLike[str], check_train: bool = True) -> Cam
         if check_train:
             _check_configuration(cname, merged, tuple(seeds), folder, source, envs_checked)
         out.append((cname, tuple(w for _, _, words in merged.values() for w in words)))
+        flies.append((cname, suites_flown(cname, merged, evaluation.suites, source)))
     clash = sorted({f"{c}-s{s}" for c, _ in out for s in seeds} & set(evaluation.baselines))
     if clash:
         raise ConfigError("evaluation.baselines", list(evaluation.baselines), f"names other than the runs' ({clash} "
                           "is both: a run is labelled <configuration>-s<seed>)", source)
     return Campaign(name, os.path.abspath(runs_dir), tuple(int(s) for s in seeds), tuple(out), evaluation, executor,
-                    workers, source)
+                    workers, source, tuple(flies))

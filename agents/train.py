@@ -117,6 +117,9 @@ class Args:
     unit of ratio (lvgym.agents.loadmargin; 0: off)"""
     load_margin_threshold: float = 0.8
     """with --load-margin: the load's ratio to its limit above which it is charged"""
+    command_rate_charge: float = arg(0.0, lo=0.0, hi=100.0)
+    """train with the gimbal command's rate charged as protocol v2's flyability rule measures it, this many
+    rad/s per unit of (rate / rate limit)^2 (lvgym.agents.commandrate; 0: off)"""
     total_timesteps: int | None = arg(None, lo=1, hi=10**12)
     """env steps of the whole run, e.g. 2e6 (default: n_timesteps of the hyperparameter file)"""
     seed: int = 0
@@ -184,6 +187,7 @@ def prepare(args: Args, given: set[str]) -> tuple[Args, dict[str, Any], Path, bo
     checked, nothing written (:func:`create_run` writes). Raises ConfigError or SystemExit (one line)."""
     from lvgym.agents.config import build_config, load_config, parse_overrides
     from lvgym.agents.loop_dispersion import loop_dispersion_options
+    from lvgym.agents.commandrate import command_rate_options
     from lvgym.agents.loadmargin import load_margin_options
     from lvgym.agents.residual import residual_options
 
@@ -240,6 +244,7 @@ def prepare(args: Args, given: set[str]) -> tuple[Args, dict[str, Any], Path, bo
                                                                                  args.loop_delay_periods)) else {}),
               **({"load_margin": lm} if (lm := load_margin_options(args.load_margin,
                                                                    args.load_margin_threshold)) else {}),
+              **({"command_rate": cr} if (cr := command_rate_options(args.command_rate_charge)) else {}),
               **({"family_vehicles": int(args.family_vehicles)} if family else {}),
               "hyperparams_source": cfg.source,
               "created_utc": dt.datetime.now(dt.timezone.utc).isoformat(timespec="seconds"), **provenance()}
@@ -302,7 +307,8 @@ def _train(args: Args, given: set[str], stop: Any, t0: float) -> Path:
             config["vehicles"] = [Path(v).name for v in vehicles]
         venv = make_venv(config["env_id"], cfg.n_envs, seed, config["env_kwargs"], cfg.normalize, cfg.hyper.gamma,
                          policy_files(stem)[1] if stem is not None else None, config.get("residual"),
-                         config.get("loop_dispersion"), vehicles, config.get("load_margin"))
+                         config.get("loop_dispersion"), vehicles,
+                         {k: config[k] for k in ("load_margin", "command_rate") if config.get(k)})
     except (ConfigError, ValueError) as exc:
         fail(prog, f"{config['env_id']} option {exc}")
     try:

@@ -103,6 +103,7 @@ def check_options(args: Any) -> None:
     """The values of ``args`` (:class:`lvgym.agents.train.Args`) checked: the ranges and choices its fields
     declare (as on the command line, for Args built in Python) and what they cannot say (the residual,
     the loop dispersion, the randomisation's names); a ConfigError names the option."""
+    from lvgym.agents.commandrate import command_rate_options
     from lvgym.agents.loadmargin import load_margin_options
     from lvgym.agents.loop_dispersion import loop_dispersion_options
     from lvgym.agents.residual import residual_options
@@ -113,6 +114,7 @@ def check_options(args: Any) -> None:
     residual_options(args.residual, args.residual_scale)
     loop_dispersion_options(args.loop_gain_db, args.loop_delay_periods)
     load_margin_options(args.load_margin, args.load_margin_threshold)
+    command_rate_options(args.command_rate_charge)
     known = set(RANDOMIZE) | {"all", "none", "protocol", "true", "false", "True", "False"}
     for r in args.randomize:
         if r not in known:
@@ -156,11 +158,13 @@ def training_seed(seed: int, step: int, n_envs: int, prog: str = "train.py") -> 
 
 def make_venv(env_id: str, n_envs: int, seed: int, env_kwargs: dict[str, Any], norm: Any, gamma: float,
               stats: Path | None, residual: dict[str, Any] | None = None, loop: dict[str, Any] | None = None,
-              vehicles: list[str] | None = None, load_margin: dict[str, Any] | None = None) -> Any:
+              vehicles: list[str] | None = None, charges: dict[str, Any] | None = None) -> Any:
     """Batched SB3 VecEnv (-> :class:`lvgym.agents.loop_dispersion.LoopDispersedVecEnv` with ``loop`` ->
+    :class:`lvgym.agents.commandrate.CommandRateVecEnv` with ``charges["command_rate"]`` ->
     :class:`lvgym.agents.residual.ResidualVecEnv` with ``residual`` ->
-    :class:`lvgym.agents.loadmargin.LoadMarginVecEnv` with ``load_margin``) -> EnvClock (the env's wall time,
-    :mod:`lvgym.agents.timing`) -> VecMonitor (episode returns) -> VecNormalize (new, or loaded from ``stats``).
+    :class:`lvgym.agents.loadmargin.LoadMarginVecEnv` with ``charges["load_margin"]``) -> EnvClock (the env's
+    wall time, :mod:`lvgym.agents.timing`) -> VecMonitor (episode returns) -> VecNormalize (new, or loaded
+    from ``stats``). ``charges``: the run config's records of the training charges (absent: off).
     ``vehicles``: vehicle files whose rows share ``n_envs`` (one such stack per vehicle, joined by
     :class:`lvgym.agents.familytrain.ConcatVecEnv`)."""
     from stable_baselines3.common.vec_env import VecMonitor, VecNormalize
@@ -168,14 +172,18 @@ def make_venv(env_id: str, n_envs: int, seed: int, env_kwargs: dict[str, Any], n
     import lvgym  # noqa: F401
     from lvgym.envs import make_sb3_vec_env
 
+    from lvgym.agents.commandrate import command_rate_venv
     from lvgym.agents.loadmargin import load_margin_venv
     from lvgym.agents.loop_dispersion import loop_venv
     from lvgym.agents.residual import residual_venv
     from lvgym.agents.timing import EnvClock
 
+    charges = dict(charges or {})
+
     def part(kwargs: dict[str, Any], rows: int, first: int) -> Any:
         base = make_sb3_vec_env(env_id, num_envs=rows, seed=first, **kwargs)
-        return load_margin_venv(residual_venv(loop_venv(base, loop, first), residual), load_margin,
+        commanded = command_rate_venv(loop_venv(base, loop, first), charges.get("command_rate"))
+        return load_margin_venv(residual_venv(commanded, residual), charges.get("load_margin"),
                                 base.task.control_dt_s)
 
     if vehicles:

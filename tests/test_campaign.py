@@ -27,6 +27,7 @@ import pytest
 import yaml
 from lvgym.agents import campaign as camp
 from lvgym.agents.campaign_schema import load_campaign
+from lvgym.errors import ConfigError
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -328,3 +329,81 @@ def test_on_a_v2_suite_an_unflyable_flight_counts_as_failed_in_the_comparison():
     rows = comparison_rows(records, {"a": ["a-s0"]}, ["lqg"], reps=50)
     row = next(r for r in rows if r["condition"] == "smile-v2/rigid")
     assert row["metric"] == "score_v2" and row["failure_rate"] == 0.5 and row["baseline"] == "lqg"
+
+
+# ------------------------------------------------------------------------------------------ the family's tracks
+def _family_file(tmp: Path, suites: list[str], configurations: dict) -> Path:
+    return _file(tmp, "fam", configurations=configurations,
+                 evaluation={"suites": suites, "episodes": 1, "baselines": ["auto-lqg"], "mission_time_s": 2.0})
+
+
+def test_a_family_campaign_flies_each_track_on_the_suite_that_gives_its_observation(tmp_path):
+    """The blind track's runs (and a run trained on one vehicle) fly family-v2, the informed track's runs
+    family-v2-informed: the observation the run was trained on."""
+    path = _family_file(tmp_path, ["family-v2", "family-v2-informed", "smile-v2"],
+                        {"blind": {"suite": "family-v2"}, "informed": {"suite": "family-v2-informed"},
+                         "smile": {"suite": "smile-v2"}, "told": {"env_kwargs": {"vehicle_info": True}}})
+    c = load_campaign(path, check_train=False)
+    assert c.suites_of("blind") == ("family-v2", "smile-v2")
+    assert c.suites_of("smile") == ("family-v2", "smile-v2")
+    assert c.suites_of("informed") == ("family-v2-informed",)
+    assert c.suites_of("told") == ("family-v2-informed",)
+    lines = camp._listing(c, "local", 2)
+    assert "  informed flies family-v2-informed" in lines and "  blind flies family-v2, smile-v2" in lines
+
+
+def test_a_configuration_whose_observation_no_evaluation_suite_gives_is_refused(tmp_path):
+    path = _family_file(tmp_path, ["family-v2-informed"], {"blind": {"suite": "family-v2"}})
+    with pytest.raises(ConfigError, match=r"configurations\.blind = 'family-v2': a configuration whose observation "
+                                          r"one of evaluation\.suites \['family-v2-informed'\] gives: it trains "
+                                          r"without the vehicle's design parameters"):
+        load_campaign(path, check_train=False)
+
+
+def test_the_evaluation_flies_each_run_on_its_own_suites_and_the_baselines_on_all(tmp_path, monkeypatch):
+    import lvgym.benchmark as bench
+
+    path = _family_file(tmp_path, ["family-v2", "family-v2-informed"],
+                        {"blind": {"suite": "family-v2"}, "informed": {"suite": "family-v2-informed"}})
+    c = load_campaign(path, check_train=False)
+    for r in c.runs():
+        Path(r.folder).mkdir(parents=True)
+        (Path(r.folder) / "final_model.json").write_text("{}")
+    monkeypatch.setattr("lvgym.cli.policies.resolve_policy", lambda ref, prog: ref.split("=")[0])
+    calls = []
+
+    def fake(per_suite, suites, episodes, seed_set, executor, workers, progress):
+        calls.append({s.name: list(v) for s, v in zip(suites, per_suite.values())})
+        assert [s.name for s in suites] == list(per_suite) and all(s.version.endswith("+override") for s in suites)
+        return [{"policy": p, "suite": s} for s, ps in per_suite.items() for p in ps]
+
+    monkeypatch.setattr(bench, "evaluate", fake)
+    records = camp._evaluate_all(c, "local", 2, False)
+    assert calls == [{"family-v2": ["blind-s0", "blind-s1", "auto-lqg"],
+                      "family-v2-informed": ["informed-s0", "informed-s1", "auto-lqg"]}]
+    assert {(r["policy"], r["suite"]) for r in records} == {
+        ("blind-s0", "family-v2"), ("blind-s1", "family-v2"), ("informed-s0", "family-v2-informed"),
+        ("informed-s1", "family-v2-informed"), ("auto-lqg", "family-v2"), ("auto-lqg", "family-v2-informed")}
+    assert camp._evaluate_all(c, "local", 2, False) == records and len(calls) == 1     # written: not flown again
+
+
+def test_a_family_suite_is_compared_per_flight_model_over_its_vehicles():
+    """Two vehicles, two seeds, one run and one baseline: the rows are each model over both vehicles, then
+    all; the mean and the failure share by hand."""
+    from lvgym.agents.campaign_compare import comparison_rows
+
+    def rec(policy, vehicle, model, seed, score, failed=False):
+        return {"suite": "family-v2", "condition": f"family-v2/{vehicle}/{model}", "policy": policy, "seed": seed,
+                "score_v2": score, "failed": failed, "flyable": True, "score": score}
+
+    records = [rec(p, v, m, s, x + (0.5 if m == "nonrigid" else 0.0) + 0.1 * s, failed=(p == "auto-lqg" and v == 20001
+                                                                                       and m == "nonrigid" and s == 1))
+               for p, x in (("a-s0", 1.0), ("auto-lqg", 2.0)) for v in (20000, 20001)
+               for m in ("rigid", "nonrigid") for s in (0, 1)]
+    rows = comparison_rows(records, {"a": ["a-s0"]}, ["auto-lqg"], reps=50)
+    assert [r["condition"] for r in rows] == ["rigid, 2 vehicles", "nonrigid, 2 vehicles", "all"]
+    by = {r["condition"]: r for r in rows}
+    assert by["rigid, 2 vehicles"]["mean"] == pytest.approx(1.05) and by["rigid, 2 vehicles"]["episodes"] == 4
+    assert by["nonrigid, 2 vehicles"]["baseline_mean"] == pytest.approx(2.55)
+    assert by["all"]["mean"] == pytest.approx(1.30) and by["all"]["episodes"] == 8
+    assert by["all"]["failure_rate"] == 0.0 and by["nonrigid, 2 vehicles"]["p_improvement"] == 1.0
