@@ -9,7 +9,8 @@ activations, a diagonal Gaussian whose deterministic action is its mean) :class:
 actor's layers on each row as ``addmv``, the matrix-vector product the one-observation forward runs,
 checked against the policy's own ``_predict`` on probe observations when built (a torch whose products
 differ falls back). Other models run the policy's ``_predict`` (or ``model.predict``) per row; recurrent
-ones keep each row's LSTM state.
+ones keep each row's LSTM state (a recurrent actor-critic as a tensor, its ``_predict`` called directly:
+:meth:`SB3Batch._recurrent_rows`).
 """
 
 from __future__ import annotations
@@ -101,6 +102,9 @@ class SB3Batch:
         self._starts = np.ones(self.n, dtype=bool)
         fast = policy._fast_path()
         self._mlp = MlpRows.build(fast[0]) if fast is not None else None
+        pol = getattr(self.model, "policy", None)
+        self._lstm_rows = bool(policy.recurrent and hasattr(pol, "lstm_hidden_state_shape")
+                               and not pol.squash_output and len(self.expected) == 1)
 
     def reset(self, rows: Any) -> None:
         """The rows ``rows`` start an episode (their history and LSTM state restart)."""
@@ -160,6 +164,8 @@ class SB3Batch:
         p = self.policy
         if self.normalizer is not None and getattr(self.normalizer, "norm_obs", True):
             obs = np.asarray(self.normalizer.normalize_obs(obs), dtype=np.float32)
+        if p.recurrent and self._lstm_rows:
+            return self._recurrent_rows(rows, obs)
         if p.recurrent:                                   # each row's LSTM state, as the policy keeps its own
             out = []
             for j, b in enumerate(rows.tolist()):
@@ -181,3 +187,25 @@ class SB3Batch:
             out = [policy._predict(torch.as_tensor(obs[j:j + 1]), deterministic=p.deterministic).cpu().numpy()
                    for j in range(rows.size)]
         return np.clip(np.concatenate(out).reshape(rows.size, *low.shape), low, high)
+
+    def _recurrent_rows(self, rows: np.ndarray, obs: np.ndarray) -> np.ndarray:
+        """A recurrent actor-critic's actions row by row, as ``model.predict`` gives them for one row (the same
+        ``_predict`` on the same float32 tensors, zero state at a row's first step, the clip to the action
+        space), without its per-call conversions: each row's LSTM state stays a tensor."""
+        import torch
+
+        policy, space = self.model.policy, self.model.action_space
+        policy.set_training_mode(False)
+        out = np.empty((rows.size, *space.shape), np.float32)
+        with torch.no_grad():
+            for j, b in enumerate(rows.tolist()):
+                state = self._lstm[b]
+                if state is None:
+                    zero = torch.zeros(policy.lstm_hidden_state_shape, dtype=torch.float32)
+                    state = (zero, zero)
+                start = torch.tensor([float(self._starts[b])], dtype=torch.float32)
+                action, self._lstm[b] = policy._predict(torch.as_tensor(obs[j:j + 1]), lstm_states=state,
+                                                        episode_starts=start, deterministic=self.policy.deterministic)
+                self._starts[b] = False
+                out[j] = action.cpu().numpy().reshape(space.shape)
+        return np.clip(out, space.low, space.high)

@@ -157,6 +157,20 @@ def test_recurrent_ppo_trains_saves_and_flies_through_the_adapter(tmp_path):
             if t in starts:
                 single.reset()
             assert np.allclose(single.act(seq[t, row], {}), out[t][row], atol=1e-6)
+    # the benchmark's rows (SB3Batch, its LSTM fast path): each row's actions are the single policy's to the bit
+    rows = SB3Policy(run).batch(2)
+    assert rows._lstm_rows
+    got = []
+    for t in range(4):
+        if t == 1:
+            rows.reset([1])
+        got.append(rows.act(np.arange(2), seq[t], {}))
+    for row, starts in ((0, (0,)), (1, (0, 1))):
+        single = SB3Policy(run)
+        for t in range(4):
+            if t in starts:
+                single.reset()
+            assert np.array_equal(single.act(seq[t, row], {}), got[t][row])
 
 
 def test_recurrent_ppo_hyperparameters_are_validated():
