@@ -293,7 +293,7 @@ def _design(path: str, folder: Path, budget: Budget, grid: dict, options: dict[s
 class Args:
     """Command-line arguments (``lvgym design auto --help``)."""
 
-    vehicle: str = arg(..., check=vehicle_option, metavar="PATH")
+    vehicle: str = arg(check=vehicle_option, metavar="PATH")
     """the vehicle YAML file (docs/vehicles.md)"""
     out: str | None = None
     """a folder to copy the design into (default: the cache's entry only, printed)"""
