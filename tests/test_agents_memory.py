@@ -171,6 +171,11 @@ def test_recurrent_ppo_trains_saves_and_flies_through_the_adapter(tmp_path):
             if t in starts:
                 single.reset()
             assert np.array_equal(single.act(seq[t, row], {}), got[t][row])
+    # the speed study's replay of both paths (it checks their actions are equal to the bit)
+    from experiments.policy_batch_speed import recurrent_act
+
+    best = recurrent_act.main([str(run), "--rows", "3", "--steps", "2", "--repeats", "1"])
+    assert set(best) == {"model.predict", "LSTM rows"} and all(t > 0 for t in best.values())
 
 
 def test_recurrent_ppo_hyperparameters_are_validated():
