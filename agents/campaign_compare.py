@@ -24,8 +24,8 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["comparison_rows", "condition_groups", "comparison_table", "evaluation_settings", "metric_of", "read_evaluation",
-           "write_evaluation"]
+__all__ = ["comparison_rows", "comparison_table", "condition_groups", "evaluation_settings", "metric_of",
+           "read_evaluation", "write_evaluation"]
 
 
 def metric_of(metric: str, version: str) -> str:

@@ -274,7 +274,8 @@ def suites_flown(name: str, options: dict[str, tuple[str, Any, list[str]]], suit
     mine = observes_vehicle(env_kwargs_of(Args(**values, name=name)))
     out = tuple(s for s in suites if observes_vehicle(get_suite(s).conditions[0].options) == mine)
     if not out:
-        track = "with the vehicle's design parameters (vehicle_info)" if mine else "without the vehicle's design parameters"
+        track = ("with the vehicle's design parameters (vehicle_info)" if mine
+                 else "without the vehicle's design parameters")
         raise ConfigError(f"configurations.{name}", values.get("suite", "(no suite)"), f"a configuration whose "
                           f"observation one of evaluation.suites {list(suites)} gives: it trains {track}", source)
     return out

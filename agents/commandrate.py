@@ -62,7 +62,8 @@ class CommandRateVecEnv(VecEnvWrapper):
         if not facts.gimbal_limit_rad > 0.0:
             raise ConfigError("command_rate_charge", charge.weight, "0 on an env without a gimbal (an RCS task)")
         self.charge = charge
-        self.dt, self.limit_rad, self.rate_limit_radps = facts.dt_s, facts.gimbal_limit_rad, facts.gimbal_rate_limit_radps
+        self.dt, self.limit_rad = facts.dt_s, facts.gimbal_limit_rad
+        self.rate_limit_radps = facts.gimbal_rate_limit_radps
         self._last = np.zeros((self.num_envs, 2))          # the command of each row's previous step [rad]
         self._on = np.zeros(self.num_envs, dtype=bool)      # its controller acted at that step
         self._command = self._last
