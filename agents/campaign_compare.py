@@ -96,9 +96,10 @@ def condition_groups(suite: str, conditions: Sequence[str]) -> list[tuple[str, l
 
     if suite not in SUITES_FAMILY:
         return [*((c, [c]) for c in conditions), ("all", list(conditions))]
+    model = {c.name: c.model for c in SUITES_FAMILY[suite].conditions}
     by_model: dict[str, list[str]] = {}
     for c in conditions:
-        by_model.setdefault(c.rsplit("/", 1)[-1], []).append(c)
+        by_model.setdefault(model[c], []).append(c)
     return [*((f"{m}, {len(cells)} vehicles", cells) for m, cells in by_model.items()), ("all", list(conditions))]
 
 

@@ -27,6 +27,7 @@ from typing import Any
 import numpy as np
 from stable_baselines3.common.vec_env import VecEnvWrapper
 
+from lvgym.benchmark.scoring import FlightLog, gimbal_command
 from lvgym.errors import ConfigError, check_number
 
 __all__ = ["CommandRate", "CommandRateVecEnv", "command_rate_options", "command_rate_venv"]
@@ -55,8 +56,6 @@ class CommandRateVecEnv(VecEnvWrapper):
     env's (:meth:`lvgym.benchmark.scoring.FlightLog.for_env`)."""
 
     def __init__(self, venv: Any, charge: CommandRate) -> None:
-        from lvgym.benchmark.scoring import FlightLog
-
         super().__init__(venv)
         facts = FlightLog.for_env(venv)
         if not facts.gimbal_limit_rad > 0.0:
@@ -75,8 +74,7 @@ class CommandRateVecEnv(VecEnvWrapper):
         return obs
 
     def step_async(self, actions: np.ndarray) -> None:
-        self._command = np.clip(np.asarray(actions, dtype=float).reshape(self.num_envs, -1)[:, :2], -1.0, 1.0) \
-            * self.limit_rad
+        self._command = gimbal_command(np.reshape(actions, (self.num_envs, -1))[:, :2], self.limit_rad)
         self.venv.step_async(actions)
 
     def step_wait(self) -> Any:
