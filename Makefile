@@ -27,12 +27,13 @@ bench: $(STAMP)
 	$(PY) -m lvgym.bench
 	$(PY) -m lvgym.bench_envs
 
-# rollouts of every classical baseline on every v2 suite, as Minari datasets (validation seeds; into
-# MINARI_DATASETS_PATH, default ~/.minari/datasets): the data offline RL starts from (docs/training.md)
+# rollouts of every classical baseline and shipped learned policy on every v2 suite, as Minari datasets
+# (validation seeds; into MINARI_DATASETS_PATH, default ~/.minari/datasets): the data offline RL starts from
+# (docs/training.md)
 DATASET_SUITES ?= smile-v2 smile-v2-maxq-gust smile-v2-faults stratos-tvc-v2 slender-v2
 DATASET_EPISODES ?= 50
 datasets: $(STAMP)
-	$(VENV)/bin/lvgym dataset --policies classical --suites $(DATASET_SUITES) --episodes $(DATASET_EPISODES)
+	$(VENV)/bin/lvgym dataset --policies classical learned --suites $(DATASET_SUITES) --episodes $(DATASET_EPISODES)
 
 clean:
 	rm -rf $(VENV) .pytest_cache

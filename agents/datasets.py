@@ -135,7 +135,7 @@ class Args:
     policies: list[str] = arg(default_factory=lambda: ["lqg-front"], metavar="POLICY")
     """the policies whose rollouts to record (registered names, factory references or saved policies; a
     teacher trained on privileged observations is recorded as its student sees the flight); ``classical``:
-    every classical baseline a suite lists"""
+    every classical baseline a suite lists, ``learned``: every shipped learned policy it lists"""
     suites: list[str] = arg(default_factory=lambda: ["smile-v2"], metavar="SUITE")
     """the suites to fly"""
     models: list[str] = arg(default_factory=lambda: ["rigid", "nonrigid"], metavar="MODEL")
@@ -147,19 +147,24 @@ class Args:
     in infos['expert_action'] (DART; 0: none)"""
 
 
+#: the keywords of ``--policies`` that stand for a suite's listed policies of one kind
+KIND_KEYWORDS = ("classical", "learned")
+
+
 def suite_policies(names: Sequence[str], suite: str) -> list[str]:
-    """``names`` with ``classical`` replaced by ``suite``'s causal classical baselines (its protocol list's
-    policies of kind ``classical``: :func:`lvgym.benchmark.headline.policy_kind`), in the suite's order."""
+    """``names`` with ``classical`` replaced by ``suite``'s causal classical baselines and ``learned`` by its
+    shipped learned policies (its protocol list's policies of that kind:
+    :func:`lvgym.benchmark.headline.policy_kind`), in the suite's order; duplicates dropped."""
     from lvgym.benchmark.headline import policy_kind
 
     out: list[str] = []
     for name in names:
-        if name == "classical":
+        if name in KIND_KEYWORDS:
             listed = get_suite(suite).policies
             if not listed:
-                raise ConfigError("policies", name, f"a suite that lists its baselines (protocol v2 on); {suite!r} "
+                raise ConfigError("policies", name, f"a suite that lists its policies (protocol v2 on); {suite!r} "
                                   "lists none: name the policies")
-            out += [p for p in listed if policy_kind(resolve_policy(p, PROG)) == "classical"]
+            out += [p for p in listed if policy_kind(resolve_policy(p, PROG)) == name]
         else:
             out.append(name)
     return list(dict.fromkeys(out))
@@ -168,7 +173,10 @@ def suite_policies(names: Sequence[str], suite: str) -> list[str]:
 def main(argv: Sequence[str] | None = None) -> None:
     args = parse(Args, argv, PROG, __doc__)
     for suite in args.suites:
-        for policy in suite_policies(args.policies, suite):
+        policies = suite_policies(args.policies, suite)
+        if not policies:
+            print(f"{suite}: lists no policy of {args.policies}; nothing to record")
+        for policy in policies:
             for model in args.models:
                 ds = collect(policy, suite, model, args.episodes, action_noise=args.action_noise)
                 print(f"{ds.spec.dataset_id}: {ds.total_episodes} episodes, {ds.total_steps} steps")

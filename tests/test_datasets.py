@@ -109,3 +109,27 @@ def test_a_noise_injected_dataset_flies_the_noise_and_labels_with_the_policy(dat
     assert np.abs(ep.actions - expert[1:]).max() > 0.01
     content = train(dataset_id("lqg", "smile-v2", "rigid", 0.05), datasets / "dart.pt", history=2, hidden=8, epochs=2)
     assert content["steps"] == len(ep.actions)
+
+
+def test_the_shipped_learned_policy_is_recorded_as_it_flies(datasets):
+    from lvgym.agents.datasets import collect, dataset_id
+    from lvgym.benchmark.registry import resolve_policy
+    from lvgym.benchmark.runner import build_policy
+
+    pytest.importorskip("stable_baselines3")
+    collect("ppo-res-lqg", "smile-v2-faults", "nonrigid", episodes=1, mission_time_s=3.0)
+    data = minari.load_dataset(dataset_id("ppo-res-lqg", "smile-v2-faults", "nonrigid"))
+    assert data.storage.metadata["algorithm_name"] == "ppo-res-lqg"
+    env = lvgym.make_env("smile-v2-faults", "nonrigid", mission_time_s=3.0)
+    pol = build_policy(resolve_policy("ppo-res-lqg"), env)
+    (ep,) = data.iterate_episodes()
+    obs, info = env.reset(seed=0)
+    pol.reset()
+    actions = []
+    for recorded in ep.observations[1:]:
+        action = pol.act(obs, info)
+        obs, _, terminated, truncated, info = env.step(action)
+        actions.append(action)
+        np.testing.assert_array_equal(obs, recorded)
+    np.testing.assert_array_equal(ep.actions, np.array(actions))
+    assert np.abs(ep.actions).max() > 0                       # the policy acted in the flight recorded

@@ -145,6 +145,14 @@ def test_classical_names_every_classical_baseline_a_suite_lists():
         suite_policies(["classical"], "smile-windy")
 
 
+def test_learned_names_the_shipped_learned_policies_a_suite_lists():
+    from lvgym.agents.datasets import suite_policies
+
+    assert suite_policies(["learned"], "smile-v2-faults") == ["ppo-res-lqg"]
+    assert suite_policies(["classical", "learned"], "smile-v2")[-1] == "ppo-res-lqg"
+    assert suite_policies(["learned"], "stratos-tvc-v2") == []          # no learned policy is made for it
+
+
 def test_an_empty_env_keywords_mapping_adds_no_flag(tmp_path):
     from lvgym.agents.campaign_schema import load_campaign
 
