@@ -124,11 +124,12 @@ def test_the_shipped_learned_policy_is_recorded_as_it_flies(datasets):
     pol = build_policy(resolve_policy("ppo-res-lqg"), env)
     (ep,) = data.iterate_episodes()
     obs, info = env.reset(seed=0)
+    np.testing.assert_array_equal(obs, ep.observations[0])
     pol.reset()
     actions = []
     for recorded in ep.observations[1:]:
         action = pol.act(obs, info)
-        obs, _, terminated, truncated, info = env.step(action)
+        obs, _, _, _, info = env.step(action)
         actions.append(action)
         np.testing.assert_array_equal(obs, recorded)
     np.testing.assert_array_equal(ep.actions, np.array(actions))
