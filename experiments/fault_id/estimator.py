@@ -1,0 +1,119 @@
+"""The learned thrust-direction estimator and the policy that flies it: ``lqg`` with its command corrected by
+the misalignment a network reads from the last half second of flight signals.
+
+The fault suite's room for ``lqg`` is knowing the thrust's direction (README.md, :mod:`.privileges`): ``lqg``
+given the true misalignment, ``delta = delta_lqg - misalignment``, fails 2 of 100 validation flights where
+``lqg`` fails 7. :class:`Estimator` learns that misalignment from what a flight computer has: a window of
+:data:`WINDOW` control steps of the env's observation (14 entries) and of the two actions it sent
+(:data:`FEATURES`). :class:`FaultIdPolicy` flies ``lqg`` (its own Kalman filter sees its own command, as if
+the thrust went where the gimbal points) and subtracts the estimate, in units of the gimbal limit.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import torch
+from torch import nn
+
+#: the control steps the estimator reads (0.5 s at SMILE's 0.02 s)
+WINDOW = 25
+#: one step's features: the env's observation (lvgym.envs.core.OBS_NAMES) then the action sent (pitch, yaw)
+ACTIONS = ("action_pitch", "action_yaw")
+N_OBS = 14
+FEATURES = N_OBS + len(ACTIONS)
+#: where :mod:`.train` writes a training seed's estimator
+RESULTS = Path("results") / "fault_id"
+
+
+class Estimator(nn.Module):
+    """``(B, WINDOW, FEATURES)`` features -> ``(B, 2)`` misalignment (pitch, yaw) over the gimbal limit; the
+    features standardised by the training set's per-feature ``mean`` and ``std``."""
+
+    def __init__(self, mean: np.ndarray, std: np.ndarray, hidden: int = 256) -> None:
+        super().__init__()
+        self.register_buffer("mean", torch.as_tensor(mean, dtype=torch.float32))
+        self.register_buffer("std", torch.as_tensor(std, dtype=torch.float32))
+        self.net = nn.Sequential(nn.Linear(WINDOW * FEATURES, hidden), nn.Tanh(), nn.Linear(hidden, hidden), nn.Tanh(),
+                                 nn.Linear(hidden, 2))
+
+    def forward(self, window: torch.Tensor) -> torch.Tensor:
+        return self.net(((window - self.mean) / self.std).flatten(1))
+
+
+class Window:
+    """The last :data:`WINDOW` steps' features of ``n`` rows (zeros before the first), oldest first."""
+
+    def __init__(self, n: int) -> None:
+        self.x = np.zeros((n, WINDOW, FEATURES), dtype=np.float32)
+        self.last_action = np.zeros((n, len(ACTIONS)), dtype=np.float32)
+
+    def push(self, rows: np.ndarray, observations: np.ndarray) -> np.ndarray:
+        """Add the step's observations of ``rows`` (with the actions they sent last) and return their windows."""
+        self.x[rows, :-1] = self.x[rows, 1:]
+        self.x[rows, -1, :N_OBS] = observations
+        self.x[rows, -1, N_OBS:] = self.last_action[rows]
+        return self.x[rows]
+
+    def sent(self, rows: np.ndarray, actions: np.ndarray) -> None:
+        self.last_action[rows] = actions
+
+
+def corrected(base: np.ndarray, estimate: np.ndarray) -> np.ndarray:
+    """The action sent: the base law's action less the estimated misalignment (both over the gimbal limit),
+    within the action space."""
+    return np.clip(np.asarray(base, dtype=np.float64) - estimate, -1.0, 1.0).astype(np.float32)
+
+
+class FaultIdPolicy:
+    """``lqg`` with the estimator's correction (module docstring); one env row (the benchmark's policy)."""
+
+    def __init__(self, env: Any, estimator: Estimator, name: str = "lqg-thrust-id") -> None:
+        import lvgym.baselines  # noqa: F401  (registers lqg)
+        from lvgym.benchmark.registry import resolve_policy
+        from lvgym.benchmark.runner import build_policy
+
+        self.base = build_policy(resolve_policy("lqg"), env)
+        self.estimator = estimator.eval()
+        self.name = name
+        self.window = Window(1)
+
+    def reset(self) -> None:
+        self.base.reset()
+        self.window = Window(1)
+
+    def act(self, observation: np.ndarray, info: dict[str, Any]) -> np.ndarray:
+        rows = np.zeros(1, dtype=np.int64)
+        base = np.asarray(self.base.act(observation, info), dtype=np.float64)
+        w = self.window.push(rows, np.asarray(observation, dtype=np.float32)[None])
+        with torch.no_grad():
+            estimate = self.estimator(torch.as_tensor(w)).numpy()[0].astype(np.float64)
+        a = corrected(base, estimate)
+        self.window.sent(rows, a[None])
+        return a
+
+
+def load(path: str | Path) -> Estimator:
+    """An estimator saved by :mod:`.train`."""
+    state = torch.load(path, map_location="cpu", weights_only=True)
+    est = Estimator(state["mean"].numpy(), state["std"].numpy())
+    est.load_state_dict(state)
+    return est
+
+
+def _seeded(k: int):
+    def factory(env: Any) -> FaultIdPolicy:
+        return FaultIdPolicy(env, load(RESULTS / f"estimator-s{k}.pt"), name=f"lqg-thrust-id-s{k}")
+    factory.__name__ = f"s{k}"
+    return factory
+
+
+#: the three training seeds' policies (``evaluate.py --policies experiments/fault_id/estimator.py:s0``)
+s0, s1, s2 = (_seeded(k) for k in range(3))
+
+
+def from_file(env: Any, path: str, name: str = "lqg-thrust-id") -> FaultIdPolicy:
+    """The policy flying the estimator saved at ``path``."""
+    return FaultIdPolicy(env, load(path), name=name)

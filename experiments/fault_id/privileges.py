@@ -1,0 +1,158 @@
+"""Which privilege flies the fault suite: the privileged reference with one privilege taken away at a time, and
+``lqg`` given what the reference knows of the fault.
+
+    python -m experiments.fault_id.privileges --seeds 100
+
+Flies every variant of :data:`VARIANTS` on ``smile-v2-faults``, rigid and non-rigid, validation seeds ``0 ..
+seeds - 1``, and prints the mean ``score_v2`` with the failed or unflyable flights and their reasons. The
+reference (:mod:`lvgym.baselines.privileged`) knows the true state, the plant (the true thrust misalignment and
+each actuator's effectiveness), the wind 0.1 s ahead, and it relieves the load; the ``lqg-*`` variants add to
+``lqg``'s command what the reference knows of the plant: ``delta = delta_lqg - misalignment`` (``mis``),
+``delta_lqg / effectiveness`` (``eff``), the misalignment known late (``mis-late-*``), or only the first
+step's (the dispersion's, never the fault's: ``mis-static``). A study: it flies no test seed.
+"""
+
+from __future__ import annotations
+
+from collections import Counter, defaultdict
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from lvgym.cli.args import arg, parse
+
+#: a relief that never acts (from five times the q-alpha limit)
+NO_RELIEF = (5.0, 6.0)
+
+
+def reference(env: Any, preview: bool = True, relief: bool = True, plant: bool = True, name: str = "privileged") -> Any:
+    """The privileged reference with its wind preview, its load relief or its knowledge of the plant taken away."""
+    from lvgym.baselines.privileged import privileged
+
+    return privileged(env, name=name, preview_periods=None if preview else 0, relief=None if relief else NO_RELIEF,
+                      plant=plant)
+
+
+reference.privileged = True  # type: ignore[attr-defined]
+
+
+class PlantKnown:
+    """``lqg``'s action corrected by the true plant from the step's privileged info: less the misalignment
+    (``mis``; known ``late_steps`` control steps late, or only its first value with ``static``), divided by
+    the actuator's effectiveness (``eff``)."""
+
+    def __init__(self, env: Any, mis: bool, eff: bool, late_steps: int, static: bool, name: str) -> None:
+        import lvgym.baselines  # noqa: F401  (registers lqg)
+        from lvgym.benchmark.registry import resolve_policy
+        from lvgym.benchmark.runner import build_policy
+
+        self.base = build_policy(resolve_policy("lqg"), env)
+        self.limit = float(env.unwrapped.func.gimbal_limit)
+        self.mis, self.eff, self.late, self.static, self.name = mis, eff, int(late_steps), static, name
+        self.seen: list[np.ndarray] = []
+
+    def reset(self) -> None:
+        self.base.reset()
+        self.seen = []
+
+    def act(self, observation: np.ndarray, info: dict[str, Any]) -> np.ndarray:
+        a = np.asarray(self.base.act(observation, info), dtype=np.float64)
+        if "misalignment" not in info:                       # the reset's info
+            return a.astype(np.float32)
+        self.seen.append(np.asarray(info["misalignment"], dtype=np.float64))
+        if self.mis:
+            known = self.seen[0] if self.static else self.seen[max(0, len(self.seen) - 1 - self.late)]
+            a = a - known / self.limit
+        if self.eff:
+            a = a / np.maximum(np.asarray(info["actuator_effectiveness"], dtype=np.float64), 0.1)
+        return np.clip(a, -1.0, 1.0).astype(np.float32)
+
+
+def plant_known(env: Any, mis: bool = True, eff: bool = False, late_steps: int = 0, static: bool = False,
+                name: str = "lqg-mis") -> PlantKnown:
+    """:class:`PlantKnown` (it reads the privileged info, so the runner flies it with ``privileged_info``)."""
+    return PlantKnown(env, mis, eff, late_steps, static, name)
+
+
+plant_known.privileged = True  # type: ignore[attr-defined]
+
+_REF = "experiments.fault_id.privileges:reference"
+_LQG = "experiments.fault_id.privileges:plant_known"
+#: the variants by name: (factory, its keywords); ``lqg`` is the registered design
+VARIANTS: dict[str, tuple[str, dict[str, Any]] | None] = {
+    "privileged": (_REF, {}),
+    "no-preview": (_REF, {"preview": False}),
+    "no-relief": (_REF, {"relief": False}),
+    "no-plant": (_REF, {"plant": False}),
+    "no-plant-no-relief": (_REF, {"plant": False, "relief": False}),
+    "true-state-only": (_REF, {"plant": False, "relief": False, "preview": False}),
+    "lqg": None,
+    "lqg-mis-eff": (_LQG, {"eff": True}),
+    "lqg-mis": (_LQG, {}),
+    "lqg-eff": (_LQG, {"mis": False, "eff": True}),
+    "lqg-mis-late-0.25s": (_LQG, {"late_steps": 12}),
+    "lqg-mis-late-0.5s": (_LQG, {"late_steps": 25}),
+    "lqg-mis-late-1s": (_LQG, {"late_steps": 50}),
+    "lqg-mis-late-2s": (_LQG, {"late_steps": 100}),
+    "lqg-mis-static": (_LQG, {"static": True}),
+}
+
+
+def specs(names: Sequence[str]) -> list[Any]:
+    """The policies of the variants ``names``."""
+    import lvgym.baselines  # noqa: F401
+    from lvgym.benchmark.registry import resolve_policy
+    from lvgym.benchmark.runner import PolicySpec
+    from lvgym.errors import ConfigError
+
+    out = []
+    for name in names:
+        if name not in VARIANTS:
+            raise ConfigError("variants", name, f"one of {list(VARIANTS)}")
+        v = VARIANTS[name]
+        out.append(resolve_policy(name) if v is None else
+                   PolicySpec(name, v[0], tuple(sorted({**v[1], "name": name}.items()))))
+    return out
+
+
+@dataclass
+class Args:
+    """Command-line arguments (``python -m experiments.fault_id.privileges --help``)."""
+
+    seeds: int = arg(100, lo=1, hi=10_000)
+    """validation seeds per variant and flight model"""
+    variants: list[str] = arg(default_factory=lambda: list(VARIANTS), metavar="NAME")
+    """the variants to fly (default: all)"""
+
+
+def main(argv: Sequence[str] | None = None) -> None:
+    from lvgym.benchmark import evaluate, get_suite
+
+    args = parse(Args, argv, "python -m experiments.fault_id.privileges", __doc__)
+    try:
+        policies = specs(args.variants)
+    except ValueError as exc:
+        raise SystemExit(f"python -m experiments.fault_id.privileges: {exc}") from None
+    records = evaluate(policies, [get_suite("smile-v2-faults")], args.seeds, "validation", progress=False)
+    cells: dict[tuple[str, str], list[dict]] = defaultdict(list)
+    for r in records:
+        cells[(r["policy"], r["model"])].append(r)
+    print(f"\nsmile-v2-faults, validation seeds 0-{args.seeds - 1}: mean score_v2 [rad] (failed or unflyable: "
+          "q-alpha / attitude / other or unflyable)\n")
+    print("| variant | rigid | non-rigid |\n|---|---|---|")
+    for p in policies:
+        row = []
+        for model in ("rigid", "nonrigid"):
+            rs = cells[(p.name, model)]
+            why = Counter(("q-alpha" if "q-alpha" in str(r["failure_reason"]) else "attitude"
+                           if "attitude" in str(r["failure_reason"]) else "other") if r["failed"] else "unflyable"
+                          for r in rs if r["failed"] or not r["flyable"])
+            row.append(f"{np.mean([r['score_v2'] for r in rs]):.3f} ({sum(why.values())}: "
+                       f"{why['q-alpha']} / {why['attitude']} / {why['other'] + why['unflyable']})")
+        print(f"| {p.name} | " + " | ".join(row) + " |")
+
+
+if __name__ == "__main__":
+    main()
