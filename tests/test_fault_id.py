@@ -29,6 +29,8 @@ def test_the_window_keeps_the_last_steps_oldest_first():
 def test_the_correction_by_hand():
     np.testing.assert_allclose(corrected(np.array([0.5, -0.2]), np.array([0.1, -0.3])), [0.4, 0.1], rtol=1e-6)
     assert corrected(np.array([0.95]), np.array([-0.2]))[0] == 1.0
+    # the dead band shrinks the estimate towards zero: 0.1 - 0.04 and nothing of -0.03
+    np.testing.assert_allclose(corrected(np.array([0.5, -0.2]), np.array([0.1, -0.03]), 0.04), [0.44, -0.2], rtol=1e-6)
 
 
 class _Base:
@@ -60,7 +62,8 @@ def test_the_variants_are_named():
 
 
 def test_the_student_in_a_batch_flies_as_the_benchmark_flies_it():
-    """Two rows of :func:`fly` with an estimator (untrained, seeded) against the single env flying
+    """Two rows of :func:`fly` with an estimator (fitted for one epoch, seeded) and a dead band against the
+    single env flying
     :class:`FaultIdPolicy`: the same flights (the estimator's batched and single forward may differ in the
     last bits, so the scores are compared to 1e-6)."""
     torch.manual_seed(0)
@@ -68,9 +71,9 @@ def test_the_student_in_a_batch_flies_as_the_benchmark_flies_it():
     x, y, _ = fly("rigid", [0, 1], None, np.random.default_rng(0), **short)
     assert x.shape[1:] == (WINDOW, FEATURES) and y.shape == (len(x), 2)
     est = fit(x, y, seed=0, epochs=1)
-    _, _, batch = fly("rigid", [5, 6], est, **short)
+    _, _, batch = fly("rigid", [5, 6], est, deadband=0.04, **short)
     env = condition("rigid", **short).make_env()
     for seed, rec in zip([5, 6], batch):
-        single = play_episode(FaultIdPolicy(env, est), env, seed, flyability=True)
+        single = play_episode(FaultIdPolicy(env, est, deadband=0.04), env, seed, flyability=True)
         assert single["score_v2"] == pytest.approx(rec["score_v2"], rel=1e-6)
         assert single["max_qalpha_pa_deg"] == pytest.approx(rec["max_qalpha_pa_deg"], rel=1e-6)

@@ -26,6 +26,9 @@ N_OBS = 14
 FEATURES = N_OBS + len(ACTIONS)
 #: where :mod:`.train` writes a training seed's estimator
 RESULTS = Path("results") / "fault_id"
+#: the dead band of the correction the seeded policies fly [over the gimbal limit]: the best of 0, 0.04 and
+#: 0.08 for each of the three training seeds on validation seeds 0-99 (``python -m experiments.fault_id.deadband``)
+DEADBAND = 0.04
 
 
 class Estimator(nn.Module):
@@ -61,16 +64,18 @@ class Window:
         self.last_action[rows] = actions
 
 
-def corrected(base: np.ndarray, estimate: np.ndarray) -> np.ndarray:
+def corrected(base: np.ndarray, estimate: np.ndarray, deadband: float = 0.0) -> np.ndarray:
     """The action sent: the base law's action less the estimated misalignment (both over the gimbal limit),
-    within the action space."""
-    return np.clip(np.asarray(base, dtype=np.float64) - estimate, -1.0, 1.0).astype(np.float32)
+    shrunk towards zero by ``deadband`` (a soft threshold: estimates smaller than it give no correction, larger
+    ones lose it), within the action space."""
+    e = np.sign(estimate) * np.maximum(np.abs(estimate) - deadband, 0.0)
+    return np.clip(np.asarray(base, dtype=np.float64) - e, -1.0, 1.0).astype(np.float32)
 
 
 class FaultIdPolicy:
     """``lqg`` with the estimator's correction (module docstring); one env row (the benchmark's policy)."""
 
-    def __init__(self, env: Any, estimator: Estimator, name: str = "lqg-thrust-id") -> None:
+    def __init__(self, env: Any, estimator: Estimator, name: str = "lqg-thrust-id", deadband: float = 0.0) -> None:
         import lvgym.baselines  # noqa: F401  (registers lqg)
         from lvgym.benchmark.registry import resolve_policy
         from lvgym.benchmark.runner import build_policy
@@ -78,6 +83,7 @@ class FaultIdPolicy:
         self.base = build_policy(resolve_policy("lqg"), env)
         self.estimator = estimator.eval()
         self.name = name
+        self.deadband = float(deadband)
         self.window = Window(1)
 
     def reset(self) -> None:
@@ -90,7 +96,7 @@ class FaultIdPolicy:
         w = self.window.push(rows, np.asarray(observation, dtype=np.float32)[None])
         with torch.no_grad():
             estimate = self.estimator(torch.as_tensor(w)).numpy()[0].astype(np.float64)
-        a = corrected(base, estimate)
+        a = corrected(base, estimate, self.deadband)
         self.window.sent(rows, a[None])
         return a
 
@@ -105,15 +111,16 @@ def load(path: str | Path) -> Estimator:
 
 def _seeded(k: int):
     def factory(env: Any) -> FaultIdPolicy:
-        return FaultIdPolicy(env, load(RESULTS / f"estimator-s{k}.pt"), name=f"lqg-thrust-id-s{k}")
+        return FaultIdPolicy(env, load(RESULTS / f"estimator-s{k}.pt"), name=f"lqg-thrust-id-s{k}", deadband=DEADBAND)
     factory.__name__ = f"s{k}"
     return factory
 
 
-#: the three training seeds' policies (``evaluate.py --policies experiments/fault_id/estimator.py:s0``)
+#: the three training seeds' policies at :data:`DEADBAND`
+#: (``evaluate.py --policies experiments/fault_id/estimator.py:s0``)
 s0, s1, s2 = (_seeded(k) for k in range(3))
 
 
-def from_file(env: Any, path: str, name: str = "lqg-thrust-id") -> FaultIdPolicy:
+def from_file(env: Any, path: str, name: str = "lqg-thrust-id", deadband: float = DEADBAND) -> FaultIdPolicy:
     """The policy flying the estimator saved at ``path``."""
-    return FaultIdPolicy(env, load(path), name=name)
+    return FaultIdPolicy(env, load(path), name=name, deadband=deadband)

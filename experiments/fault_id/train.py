@@ -45,11 +45,13 @@ def condition(model: str, **options: Any):
 
 
 def fly(model: str, seeds: Sequence[int], estimator: Estimator | None = None,
-        rng: np.random.Generator | None = None, **options: Any) -> tuple[np.ndarray, np.ndarray, list[dict]]:
+        rng: np.random.Generator | None = None, deadband: float = 0.0,
+        **options: Any) -> tuple[np.ndarray, np.ndarray, list[dict]]:
     """Fly the rows seeded ``seeds`` of the batched env of ``model``: ``lqg`` corrected by the true
     misalignment known late by a delay drawn from ``rng`` (``estimator`` None: the teacher) or by the
-    ``estimator`` (the student). Returns the windows ``(steps, WINDOW, FEATURES)``, their labels ``(steps, 2)``
-    and the flights' records (protocol v2's fields); ``options``: env keywords (tests shorten the mission)."""
+    ``estimator`` (the student, its estimate shrunk by ``deadband``: :func:`.estimator.corrected`). Returns
+    the windows ``(steps, WINDOW, FEATURES)``, their labels ``(steps, 2)`` and the flights' records
+    (protocol v2's fields); ``options``: env keywords (tests shorten the mission)."""
     from lvgym.benchmark.batch import as_batch
     from lvgym.benchmark.rows import RowsLog
     from lvgym.benchmark.runner import build_policy
@@ -85,7 +87,7 @@ def fly(model: str, seeds: Sequence[int], estimator: Estimator | None = None,
         else:
             with torch.no_grad():
                 estimate = estimator(torch.as_tensor(w)).numpy().astype(np.float64)
-        a = corrected(base, estimate)
+        a = corrected(base, estimate, 0.0 if estimator is None else deadband)
         window.sent(live, a)
         actions = np.zeros((n, 2), dtype=np.float32)
         actions[live] = a
@@ -121,13 +123,14 @@ def fit(x: np.ndarray, y: np.ndarray, seed: int, epochs: int) -> Estimator:
     return est
 
 
-def validate(est: Estimator, episodes: int) -> dict[str, tuple[float, int]]:
+def validate(est: Estimator, episodes: int, deadband: float = 0.0) -> dict[str, tuple[float, int]]:
     """Mean ``score_v2`` and failed or unflyable flights of the student on validation seeds ``0 ..
     episodes - 1`` per flight model (:func:`fly`: the rows of one batched env; the benchmark flies the same
     law one row at a time through :class:`.estimator.FaultIdPolicy`)."""
     out = {}
     for model in ("rigid", "nonrigid"):
-        rs = [r for k in range(0, episodes, 100) for r in fly(model, range(k, min(episodes, k + 100)), est)[2]]
+        rs = [r for k in range(0, episodes, 100)
+              for r in fly(model, range(k, min(episodes, k + 100)), est, deadband=deadband)[2]]
         bad = sum(bool(r["failed"] or not r["flyable"]) for r in rs)
         out[model] = (float(np.mean([r["score_v2"] for r in rs])), bad)
     return out
