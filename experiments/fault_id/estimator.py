@@ -6,7 +6,8 @@ given the true misalignment, ``delta = delta_lqg - misalignment``, fails 2 of 10
 ``lqg`` fails 7. :class:`Estimator` learns that misalignment from what a flight computer has: a window of
 :data:`WINDOW` control steps of the env's observation (14 entries) and of the two actions it sent
 (:data:`FEATURES`). :class:`FaultIdPolicy` flies ``lqg`` (its own Kalman filter sees its own command, as if
-the thrust went where the gimbal points) and subtracts the estimate, in units of the gimbal limit.
+the thrust went where the gimbal points) and subtracts the estimate, in units of the gimbal limit, once past a
+dead band (:data:`DEADBAND`, :func:`corrected`).
 """
 
 from __future__ import annotations
@@ -20,7 +21,8 @@ from torch import nn
 
 #: the control steps the estimator reads (0.5 s at SMILE's 0.02 s)
 WINDOW = 25
-#: one step's features: the env's observation (lvgym.envs.core.OBS_NAMES) then the action sent (pitch, yaw)
+#: one step's features: the env's observation (its ``observation_layout``: the 14 entries of SMILE's v1 env,
+#: ``roll_rate`` .. ``pitch_rate_reference``) then the action sent (pitch, yaw)
 ACTIONS = ("action_pitch", "action_yaw")
 N_OBS = 14
 FEATURES = N_OBS + len(ACTIONS)
@@ -80,6 +82,11 @@ class FaultIdPolicy:
         from lvgym.benchmark.registry import resolve_policy
         from lvgym.benchmark.runner import build_policy
 
+        from lvgym.errors import ConfigError
+
+        if tuple(env.observation_space.shape) != (N_OBS,):
+            raise ConfigError("env observation", list(env.observation_space.shape),
+                              f"({N_OBS},): the estimator reads SMILE's v1 observation")
         self.base = build_policy(resolve_policy("lqg"), env)
         self.estimator = estimator.eval()
         self.name = name
