@@ -52,7 +52,9 @@ def fly(model: str, seeds: Sequence[int], estimator: Estimator | None = None,
     ``estimator`` (the student, its estimate shrunk by ``deadband``: :func:`.estimator.corrected`). Returns
     the windows ``(steps, WINDOW, FEATURES)``, their labels ``(steps, 2)`` and the flights' records
     (protocol v2's fields); ``options``: env keywords (tests shorten the mission)."""
+    import lvgym.baselines  # noqa: F401  (registers lqg)
     from lvgym.benchmark.batch import as_batch
+    from lvgym.benchmark.registry import resolve_policy
     from lvgym.benchmark.rows import RowsLog
     from lvgym.benchmark.runner import build_policy
 
@@ -60,9 +62,6 @@ def fly(model: str, seeds: Sequence[int], estimator: Estimator | None = None,
     n = len(seeds)
     env, env1 = c.make_vec_env(n), c.make_env()
     limit = float(env1.unwrapped.func.gimbal_limit)
-    import lvgym.baselines  # noqa: F401  (registers lqg)
-    from lvgym.benchmark.registry import resolve_policy
-
     spec = resolve_policy("lqg")
     lqg = as_batch(build_policy(spec, env1), n, lambda: build_policy(spec, env1))
     delay = None if estimator is not None else [DELAYS[i] for i in rng.integers(0, len(DELAYS), n)]
