@@ -79,9 +79,9 @@ class FaultIdPolicy:
 
     def __init__(self, env: Any, estimator: Estimator, name: str = "lqg-thrust-id", deadband: float = 0.0) -> None:
         import lvgym.baselines  # noqa: F401  (registers lqg)
+
         from lvgym.benchmark.registry import resolve_policy
         from lvgym.benchmark.runner import build_policy
-
         from lvgym.errors import ConfigError
 
         if tuple(env.observation_space.shape) != (N_OBS,):

@@ -45,6 +45,7 @@ class PlantKnown:
 
     def __init__(self, env: Any, mis: bool, eff: bool, late_steps: int, static: bool, name: str) -> None:
         import lvgym.baselines  # noqa: F401  (registers lqg)
+
         from lvgym.benchmark.registry import resolve_policy
         from lvgym.benchmark.runner import build_policy
 
@@ -103,6 +104,7 @@ VARIANTS: dict[str, tuple[str, dict[str, Any]] | None] = {
 def specs(names: Sequence[str]) -> list[Any]:
     """The policies of the variants ``names``."""
     import lvgym.baselines  # noqa: F401
+
     from lvgym.benchmark.registry import resolve_policy
     from lvgym.benchmark.runner import PolicySpec
     from lvgym.errors import ConfigError

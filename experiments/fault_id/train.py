@@ -53,6 +53,7 @@ def fly(model: str, seeds: Sequence[int], estimator: Estimator | None = None,
     the windows ``(steps, WINDOW, FEATURES)``, their labels ``(steps, 2)`` and the flights' records
     (protocol v2's fields); ``options``: env keywords (tests shorten the mission)."""
     import lvgym.baselines  # noqa: F401  (registers lqg)
+
     from lvgym.benchmark.batch import as_batch
     from lvgym.benchmark.registry import resolve_policy
     from lvgym.benchmark.rows import RowsLog
