@@ -74,20 +74,26 @@ def corrected(base: np.ndarray, estimate: np.ndarray, deadband: float = 0.0) -> 
     return np.clip(np.asarray(base, dtype=np.float64) - e, -1.0, 1.0).astype(np.float32)
 
 
+def base_lqg(env: Any) -> Any:
+    """``lqg`` built for ``env`` as the benchmark builds a registered policy (the law the study corrects)."""
+    import lvgym.baselines  # noqa: F401  (registers lqg)
+
+    from lvgym.benchmark.registry import resolve_policy
+    from lvgym.benchmark.runner import build_policy
+
+    return build_policy(resolve_policy("lqg"), env)
+
+
 class FaultIdPolicy:
     """``lqg`` with the estimator's correction (module docstring); one env row (the benchmark's policy)."""
 
     def __init__(self, env: Any, estimator: Estimator, name: str = "lqg-thrust-id", deadband: float = 0.0) -> None:
-        import lvgym.baselines  # noqa: F401  (registers lqg)
-
-        from lvgym.benchmark.registry import resolve_policy
-        from lvgym.benchmark.runner import build_policy
         from lvgym.errors import ConfigError
 
         if tuple(env.observation_space.shape) != (N_OBS,):
             raise ConfigError("env observation", list(env.observation_space.shape),
                               f"({N_OBS},): the estimator reads SMILE's v1 observation")
-        self.base = build_policy(resolve_policy("lqg"), env)
+        self.base = base_lqg(env)
         self.estimator = estimator.eval()
         self.name = name
         self.deadband = float(deadband)

@@ -44,12 +44,9 @@ class PlantKnown:
     the actuator's effectiveness (``eff``)."""
 
     def __init__(self, env: Any, mis: bool, eff: bool, late_steps: int, static: bool, name: str) -> None:
-        import lvgym.baselines  # noqa: F401  (registers lqg)
+        from .estimator import base_lqg
 
-        from lvgym.benchmark.registry import resolve_policy
-        from lvgym.benchmark.runner import build_policy
-
-        self.base = build_policy(resolve_policy("lqg"), env)
+        self.base = base_lqg(env)
         self.limit = float(env.unwrapped.func.gimbal_limit)
         self.mis, self.eff, self.late, self.static, self.name = mis, eff, int(late_steps), static, name
         self.seen: list[np.ndarray] = []

@@ -29,7 +29,7 @@ import torch
 
 from lvgym.cli.args import arg, parse
 
-from .estimator import RESULTS, Estimator, Window, corrected
+from .estimator import RESULTS, Estimator, Window, base_lqg, corrected
 
 #: the teacher's delays [control steps] of its knowledge of the misalignment (0-2 s at 0.02 s; the last: never)
 DELAYS = (0, 12, 25, 50, 100, None)
@@ -52,19 +52,14 @@ def fly(model: str, seeds: Sequence[int], estimator: Estimator | None = None,
     ``estimator`` (the student, its estimate shrunk by ``deadband``: :func:`.estimator.corrected`). Returns
     the windows ``(steps, WINDOW, FEATURES)``, their labels ``(steps, 2)`` and the flights' records
     (protocol v2's fields); ``options``: env keywords (tests shorten the mission)."""
-    import lvgym.baselines  # noqa: F401  (registers lqg)
-
     from lvgym.benchmark.batch import as_batch
-    from lvgym.benchmark.registry import resolve_policy
     from lvgym.benchmark.rows import RowsLog
-    from lvgym.benchmark.runner import build_policy
 
     c = condition(model, privileged_info=True, **options)
     n = len(seeds)
     env, env1 = c.make_vec_env(n), c.make_env()
     limit = float(env1.unwrapped.func.gimbal_limit)
-    spec = resolve_policy("lqg")
-    lqg = as_batch(build_policy(spec, env1), n, lambda: build_policy(spec, env1))
+    lqg = as_batch(base_lqg(env1), n, lambda: base_lqg(env1))
     delay = None if estimator is not None else [DELAYS[i] for i in rng.integers(0, len(DELAYS), n)]
     obs, info = env.reset(seed=[int(s) for s in seeds])
     lqg.reset(np.arange(n))
