@@ -412,6 +412,23 @@ def test_paired_comparison_and_agents_over_runs():
     assert g["iqm_ci_low"] <= g["iqm"] <= g["iqm_ci_high"]
 
 
+def test_v2_records_are_compared_by_score_v2():
+    """evaluate.py compares a v2 suite by the protocol's score_v2 (it charges an unflyable flight), v1 by score."""
+    from lvgym.benchmark import compare, protocol_metric, run_groups
+    # "quiet" scores better by v1's score, "chatters" by score_v2 (v1's score does not charge the chatter)
+    recs = [dict(_v1_rec("quiet", s, 1.0 + 0.1 * s), score_v2=2.0 + 0.1 * s, flyable=True) for s in range(5)]
+    recs += [dict(_v1_rec("chatters", s, 1.5 + 0.1 * s), score_v2=1.0 + 0.05 * s * s, flyable=True) for s in range(5)]
+    assert protocol_metric(recs) == "score_v2" and protocol_metric([_v1_rec("a", 0, 1.0)]) == "score"
+    rows = compare(recs, summarize(recs), protocol_metric(recs), reference="quiet", reps=200)
+    other = next(r for r in rows if r["policy"] == "chatters")
+    assert other["metric"] == "score_v2" and other["diff"] == pytest.approx(-0.9) and other["wins"] == 5
+    runs = [dict(r, policy=f"agent-s{k}") for k, part in enumerate((recs[:5], recs[5:])) for r in part]
+    (g,) = run_groups(runs, protocol_metric(runs), reps=200)
+    assert g["mean"] == pytest.approx(np.mean([r["score_v2"] for r in recs]))
+    table = markdown_table(summarize(recs), [], comparison=rows, groups=[g])
+    assert "IQM score_v2 [rad]" in table and "mean score_v2 [rad]" in table
+
+
 def test_score_degradation_counts_failures_with_a_paired_test():
     recs = [_v1_rec("p", s, 1.0 + 0.1 * s) for s in range(4)]
     recs += [_v1_rec("p", s, 2.0 + 0.1 * s, failed=(s < 2), cond="s/nonrigid", model="nonrigid") for s in range(4)]

@@ -40,10 +40,16 @@ import numpy as np
 from .metrics import per_seed, rank
 from .stats import REPS, iqm, paired, probability_of_improvement
 
-__all__ = ["RUN_LABEL", "compare", "run_groups"]
+__all__ = ["RUN_LABEL", "compare", "protocol_metric", "run_groups"]
 
 #: a policy label that names one training run of an agent: ``<agent>-s<training seed>``
 RUN_LABEL = re.compile(r"^(?P<agent>.+)-s(?P<seed>\d+)$")
+
+
+def protocol_metric(records: Sequence[dict[str, Any]]) -> str:
+    """The score a suite's ``records`` are compared by: ``score_v2`` when every record carries it (protocol v2,
+    which charges an unflyable flight as a failure), else ``score`` (protocols v0 and v1)."""
+    return "score_v2" if records and all("score_v2" in r for r in records) else "score"
 
 
 def compare(records: Sequence[dict[str, Any]], summary: Sequence[dict[str, Any]], metric: str = "score",

@@ -176,7 +176,8 @@ def comparison_table(comparison: Sequence[Row]) -> list[str]:
     """Lines of one suite's paired comparison with the reference policy of each condition."""
     if not comparison:
         return []
-    out = ["| condition | policy | rank | IQM score [rad] | against | diff [rad] [95 % CI] | wins/ties/losses "
+    metric = comparison[0].get("metric", "score")
+    out = [f"| condition | policy | rank | IQM {metric} [rad] | against | diff [rad] [95 % CI] | wins/ties/losses "
            "| p (Wilcoxon) | p (t) | P(better) [95 % CI] |", "|---|---|---:|---:|---|---:|---:|---:|---:|---:|"]
     for c in comparison:
         iqm = _interval(c["iqm"], c["iqm_ci_low"], c["iqm_ci_high"])
@@ -194,7 +195,8 @@ def run_groups_table(groups: Sequence[Row]) -> list[str]:
     """Lines of one suite's table of agents over their training runs."""
     if not groups:
         return []
-    out = ["| condition | agent | runs | episodes | mean score [rad] | IQM score [rad] [95 % CI] |",
+    metric = groups[0].get("metric", "score")
+    out = [f"| condition | agent | runs | episodes | mean {metric} [rad] | IQM {metric} [rad] [95 % CI] |",
            "|---|---|---:|---:|---:|---:|"]
     for g in groups:
         out.append(f"| {_short(g['condition'])} | {g['agent']} | {g['runs']} | {g['episodes']} | {g['mean']:.4f} "
@@ -248,10 +250,11 @@ def markdown_table(summary: Sequence[Row], degradation: Sequence[Row], meta: Map
                         "failure", degradation_table(deg) if deg else [])
         comp = _of_suite(comparison, suite)
         if comp:
-            out += _section(f"Paired comparison of the score ({suite}) with the reference policy of each "
+            out += _section(f"Paired comparison of the {comp[0]['metric']} ({suite}) with the reference policy of each "
                             "condition on the same seeds: diff = policy - reference (negative: better); P(better): "
                             "the probability that an episode of the policy scores lower", comparison_table(comp))
-        out += _section(f"Agents over their training runs ({suite}): IQM of the score over "
-                        "(runs, episodes)", run_groups_table(_of_suite(groups, suite)))
+        grp = _of_suite(groups, suite)
+        out += _section(f"Agents over their training runs ({suite}): IQM of the "
+                        f"{grp[0]['metric'] if grp else 'score'} over (runs, episodes)", run_groups_table(grp))
         out.append("")
     return "\n".join(out)

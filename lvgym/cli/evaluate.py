@@ -53,8 +53,8 @@ from pathlib import Path
 from typing import Any
 
 from lvgym.benchmark import (DEFAULT_SUITE, EXECUTORS, PROTOCOL_VERSION, SEED_SETS, SUITES, PolicySpec, compare,
-                             degradation, evaluate, get_suite, markdown_table, normalise, run_groups, summarize,
-                             write_results)
+                             degradation, evaluate, get_suite, markdown_table, normalise, protocol_metric,
+                             run_groups, summarize, write_results)
 from lvgym.benchmark.family import family_room, family_rows, family_table
 from lvgym.benchmark.headline import headline, policy_kind
 from lvgym.cli.policies import POLICIES, resolve_policy  # (registers the built-in policies)
@@ -169,8 +169,13 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
     summary = summarize(records)
     normalise(summary, records, {s.name: s.reference for s in suites if s.reference})
     deg = degradation(summary, "score", records=records) + degradation(summary, "rate_error_rad", records=records)
-    comparison = compare(records, summary, "score", args.reference)
-    groups = run_groups(records, "score")
+    comparison: list[dict[str, Any]] = []
+    groups: list[dict[str, Any]] = []
+    for name in dict.fromkeys(r["suite"] for r in records):     # each suite by its protocol's score
+        of_suite = [r for r in records if r["suite"] == name]
+        metric = protocol_metric(of_suite)
+        comparison += compare(of_suite, [r for r in summary if r["suite"] == name], metric, args.reference)
+        groups += run_groups(of_suite, metric)
     rows = headline(summary, records, {p.name: policy_kind(p) for p in policies})
     meta = {
         "protocol": PROTOCOL_VERSION, "seed_set": args.seed_set, "episodes": args.episodes, "args": asdict(args),
