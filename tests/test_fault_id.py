@@ -44,7 +44,7 @@ class _Base:
 def test_lqg_given_the_plant_by_hand():
     p = PlantKnown.__new__(PlantKnown)
     p.base, p.limit, p.seen, p.name = _Base(), 0.1, [], "x"
-    p.mis, p.eff, p.late, p.static = True, True, 1, False
+    p.mis, p.eff, p.late, p.static, p.aero = True, True, 1, False, False
     assert np.allclose(p.act(np.zeros(14), {}), [0.2, -0.1])        # the reset's info: the law alone
     info = {"misalignment": np.array([0.01, 0.0]), "actuator_effectiveness": np.array([0.5, 1.0])}
     np.testing.assert_allclose(p.act(np.zeros(14), info), [(0.2 - 0.1) / 0.5, -0.1], rtol=1e-6)
@@ -77,3 +77,58 @@ def test_the_student_in_a_batch_flies_as_the_benchmark_flies_it():
         single = play_episode(FaultIdPolicy(env, est, deadband=0.04), env, seed, flyability=True)
         assert single["score_v2"] == pytest.approx(rec["score_v2"], rel=1e-6)
         assert single["max_qalpha_pa_deg"] == pytest.approx(rec["max_qalpha_pa_deg"], rel=1e-6)
+
+
+def test_the_inversion_terms_and_command_by_hand():
+    from experiments.fault_id.inversion import A_MAX, command, law_terms
+    limit = 0.1
+    info = {"m_aero_b": np.array([[0.0, 2.0e4, -1.0e4], [0.0, 5.0, 5.0]]), "thrust": np.array([1.0e5, 0.0]),
+            "vectored_share": np.array([1.0, 1.0]), "gimbal_arm": np.array([2.0, 2.0]),
+            "actuator_effectiveness": np.array([[0.5, 1.0], [1.0, 1.0]]),
+            "misalignment": np.array([[0.01, -0.02], [0.0, 0.0]]), "J_b_diag": np.array([[1.0, 4.0e4, 3.0e6]] * 2),
+            "qalpha_pa_deg": np.array([1.0e5, 0.0]), "qalpha_limit_pa_deg": np.array([2.5e5, 2.5e5])}
+    t = law_terms(info, 2, limit)
+    lever = 2.0e5                                                    # T l [N m per rad]
+    np.testing.assert_allclose(t[0, :4], [0.1 / 0.5 / limit, -0.05 / limit, 0.01 / 0.5 / limit, -0.02 / limit])
+    np.testing.assert_allclose(t[0, 4:], [4.0e4 / lever / 0.5 / limit, A_MAX, 0.4])   # yaw's a at its ceiling
+    assert np.all(t[1] == 0.0) and np.all(law_terms({}, 2, limit) == 0.0)      # no thrust; the reset's info
+    obs = np.array([[0.1, -0.2, 0.01, 0.0]])                         # rate errors, attitude errors
+    w, z = 1.5, 1.0
+    alpha = np.array([-2 * z * w * 0.1 - w * w * 0.01, -2 * z * w * -0.2])
+    terms = np.array([[0.3, -0.1, 0.05, 0.0, 2.0, 1.0, 0.4]])      # below the relief's onset (0.5)
+    np.testing.assert_allclose(command(obs, terms, [0, 1, 2, 3], w, z)[0],
+                               [2.0 * alpha[0] - 0.3 - 0.05, 1.0 * alpha[1] + 0.1], rtol=1e-6)
+    terms[0, 6] = 0.7                                                # half-way: h = 0.5
+    half = np.array([-2 * z * w * 0.1 - 0.5 * w * w * 0.01, alpha[1]])
+    np.testing.assert_allclose(command(obs, terms, [0, 1, 2, 3], w, z)[0],
+                               [2.0 * half[0] - 0.15 - 0.05, 1.0 * half[1] + 0.05], rtol=1e-6)
+
+
+def test_the_inversion_teacher_is_the_reference_on_the_observation(monkeypatch):
+    """The inversion scheme's teacher (the law on the true terms, batched; here without its exploration) flies
+    as the privileged reference given the observation's errors, without its preview, one env row at a time."""
+    import experiments.fault_id.train as train
+    from experiments.fault_id.privileges import reference
+    monkeypatch.setattr(train, "NOISE", (0.0,))
+    short = {"mission_time_s": 4.0}
+    _, y, batch = fly("nonrigid", [3, 4], None, np.random.default_rng(0), scheme="inversion", **short)
+    assert y.shape[1] == 7 and np.any(y[:, 4] > 0.0)
+    env = condition("nonrigid", privileged_info=True, **short).make_env()
+    for seed, rec in zip([3, 4], batch):
+        law = reference(env, preview=False, observed=True)
+        single = play_episode(law, env, seed, flyability=True)
+        assert single["score_v2"] == pytest.approx(rec["score_v2"], rel=1e-9)
+
+
+def test_the_inversion_student_in_a_batch_flies_as_the_benchmark_flies_it():
+    from experiments.fault_id.inversion import InversionPolicy
+    torch.manual_seed(0)
+    short = {"mission_time_s": 3.0}
+    x, y, _ = fly("rigid", [0, 1], None, np.random.default_rng(0), scheme="inversion", **short)
+    est = fit(x, y, seed=0, epochs=1, scaled=True)
+    assert est.label_std.shape == (7,)
+    _, _, batch = fly("rigid", [5, 6], est, scheme="inversion", **short)
+    env = condition("rigid", **short).make_env()
+    for seed, rec in zip([5, 6], batch):
+        single = play_episode(InversionPolicy(env, est), env, seed, flyability=True)
+        assert single["score_v2"] == pytest.approx(rec["score_v2"], rel=1e-6)

@@ -34,18 +34,25 @@ DEADBAND = 0.04
 
 
 class Estimator(nn.Module):
-    """``(B, WINDOW, FEATURES)`` features -> ``(B, 2)`` misalignment (pitch, yaw) over the gimbal limit; the
-    features standardised by the training set's per-feature ``mean`` and ``std``."""
+    """``(B, WINDOW, FEATURES)`` features -> ``(B, outputs)`` labels: the misalignment (pitch, yaw) over the
+    gimbal limit (this module's policy), or the law's terms of :mod:`.inversion`; the features standardised by
+    the training set's per-feature ``mean`` and ``std``, the labels by ``label_mean`` and ``label_std`` (none:
+    as they are)."""
 
-    def __init__(self, mean: np.ndarray, std: np.ndarray, hidden: int = 256) -> None:
+    def __init__(self, mean: np.ndarray, std: np.ndarray, hidden: int = 256, outputs: int = 2,
+                 label_mean: np.ndarray | None = None, label_std: np.ndarray | None = None) -> None:
         super().__init__()
         self.register_buffer("mean", torch.as_tensor(mean, dtype=torch.float32))
         self.register_buffer("std", torch.as_tensor(std, dtype=torch.float32))
+        self.register_buffer("label_mean", torch.as_tensor(np.zeros(outputs) if label_mean is None else label_mean,
+                                                           dtype=torch.float32))
+        self.register_buffer("label_std", torch.as_tensor(np.ones(outputs) if label_std is None else label_std,
+                                                          dtype=torch.float32))
         self.net = nn.Sequential(nn.Linear(WINDOW * FEATURES, hidden), nn.Tanh(), nn.Linear(hidden, hidden), nn.Tanh(),
-                                 nn.Linear(hidden, 2))
+                                 nn.Linear(hidden, outputs))
 
     def forward(self, window: torch.Tensor) -> torch.Tensor:
-        return self.net(((window - self.mean) / self.std).flatten(1))
+        return self.net(((window - self.mean) / self.std).flatten(1)) * self.label_std + self.label_mean
 
 
 class Window:
@@ -117,7 +124,10 @@ class FaultIdPolicy:
 def load(path: str | Path) -> Estimator:
     """An estimator saved by :mod:`.train`."""
     state = torch.load(path, map_location="cpu", weights_only=True)
-    est = Estimator(state["mean"].numpy(), state["std"].numpy())
+    outputs = int(state["net.4.bias"].shape[0])
+    state.setdefault("label_mean", torch.zeros(outputs))          # saved before the labels were scaled
+    state.setdefault("label_std", torch.ones(outputs))
+    est = Estimator(state["mean"].numpy(), state["std"].numpy(), outputs=outputs)
     est.load_state_dict(state)
     return est
 

@@ -27,12 +27,46 @@ from lvgym.cli.args import arg, parse
 NO_RELIEF = (5.0, 6.0)
 
 
-def reference(env: Any, preview: bool = True, relief: bool = True, plant: bool = True, name: str = "privileged") -> Any:
-    """The privileged reference with its wind preview, its load relief or its knowledge of the plant taken away."""
+def reference(env: Any, preview: bool = True, relief: bool = True, plant: bool = True, observed: bool = False,
+              eff: bool = True, aero_late_steps: int = 0, name: str = "privileged") -> Any:
+    """The privileged reference with its wind preview, its load relief or its knowledge of the plant taken away;
+    ``observed``: on the flight computer's rate and attitude errors (the observation's) instead of the true ones;
+    ``eff`` False: without the actuators' effectiveness (the misalignment kept); ``aero_late_steps``: the
+    aerodynamic moment as it acted that many control steps ago (without preview)."""
     from lvgym.baselines.privileged import privileged
 
-    return privileged(env, name=name, preview_periods=None if preview else 0, relief=None if relief else NO_RELIEF,
-                      plant=plant)
+    law = privileged(env, name=name, preview_periods=None if preview else 0, relief=None if relief else NO_RELIEF,
+                     plant=plant)
+    return Withheld(law, env, observed, eff, aero_late_steps) if observed or not eff or aero_late_steps else law
+
+
+class Withheld:
+    """A privileged law given less than the step's privileged info: the observation's rate and attitude errors
+    in place of the true ones (``observed``), no effectiveness (``eff`` False), the aerodynamic moment of
+    ``late`` steps ago."""
+
+    def __init__(self, law: Any, env: Any, observed: bool, eff: bool, late: int) -> None:
+        names = list(env.unwrapped.func.observation_layout.names)
+        self.law, self.name, self.observed, self.eff, self.late = law, law.name, observed, eff, int(late)
+        self.i = [names.index(n) for n in ("pitch_rate_error", "yaw_rate_error", "pitch_attitude_error",
+                                            "yaw_attitude_error", "pitch_rate_reference")]
+        self.m_aero: list[np.ndarray] = []
+
+    def reset(self) -> None:
+        self.law.reset()
+        self.m_aero = []
+
+    def act(self, observation: np.ndarray, info: dict[str, Any]) -> np.ndarray:
+        if "omega_bi_b" in info:
+            info = dict(info)
+            if self.observed:
+                q, r, th, ps, ref = (float(observation[i]) for i in self.i)
+                info.update(omega_bi_b=np.array([0.0, q + ref, r]), attitude_error=np.array([th, ps]))
+            if not self.eff:
+                info["actuator_effectiveness"] = np.ones(2)
+            self.m_aero.append(np.asarray(info["m_aero_b"], dtype=np.float64))
+            info["m_aero_b"] = self.m_aero[max(0, len(self.m_aero) - 1 - self.late)]
+        return self.law.act(observation, info)
 
 
 reference.privileged = True  # type: ignore[attr-defined]
@@ -43,12 +77,14 @@ class PlantKnown:
     (``mis``; known ``late_steps`` control steps late, or only its first value with ``static``), divided by
     the actuator's effectiveness (``eff``)."""
 
-    def __init__(self, env: Any, mis: bool, eff: bool, late_steps: int, static: bool, name: str) -> None:
+    def __init__(self, env: Any, mis: bool, eff: bool, late_steps: int, static: bool, name: str,
+                 aero: bool = False) -> None:
         from .estimator import base_lqg
 
         self.base = base_lqg(env)
         self.limit = float(env.unwrapped.func.gimbal_limit)
         self.mis, self.eff, self.late, self.static, self.name = mis, eff, int(late_steps), static, name
+        self.aero = aero
         self.seen: list[np.ndarray] = []
 
     def reset(self) -> None:
@@ -63,15 +99,19 @@ class PlantKnown:
         if self.mis:
             known = self.seen[0] if self.static else self.seen[max(0, len(self.seen) - 1 - self.late)]
             a = a - known / self.limit
+        if self.aero:
+            from lvgym.baselines.privileged import control_lever
+
+            a = a - np.asarray(info["m_aero_b"], dtype=np.float64)[1:] / max(control_lever(info), 1.0) / self.limit
         if self.eff:
             a = a / np.maximum(np.asarray(info["actuator_effectiveness"], dtype=np.float64), 0.1)
         return np.clip(a, -1.0, 1.0).astype(np.float32)
 
 
 def plant_known(env: Any, mis: bool = True, eff: bool = False, late_steps: int = 0, static: bool = False,
-                name: str = "lqg-mis") -> PlantKnown:
+                name: str = "lqg-mis", aero: bool = False) -> PlantKnown:
     """:class:`PlantKnown` (it reads the privileged info, so the runner flies it with ``privileged_info``)."""
-    return PlantKnown(env, mis, eff, late_steps, static, name)
+    return PlantKnown(env, mis, eff, late_steps, static, name, aero)
 
 
 plant_known.privileged = True  # type: ignore[attr-defined]
@@ -86,7 +126,17 @@ VARIANTS: dict[str, tuple[str, dict[str, Any]] | None] = {
     "no-plant": (_REF, {"plant": False}),
     "no-plant-no-relief": (_REF, {"plant": False, "relief": False}),
     "true-state-only": (_REF, {"plant": False, "relief": False, "preview": False}),
+    "no-preview-observed": (_REF, {"preview": False, "observed": True}),
+    "observed": (_REF, {"observed": True}),
+    "no-preview-observed-no-relief": (_REF, {"preview": False, "observed": True, "relief": False}),
+    "no-preview-observed-no-eff": (_REF, {"preview": False, "observed": True, "eff": False}),
+    "no-preview-observed-no-plant": (_REF, {"preview": False, "observed": True, "plant": False}),
+    "no-preview-observed-aero-late-2": (_REF, {"preview": False, "observed": True, "aero_late_steps": 2}),
+    "no-preview-observed-aero-late-5": (_REF, {"preview": False, "observed": True, "aero_late_steps": 5}),
+    "no-preview-observed-aero-late-10": (_REF, {"preview": False, "observed": True, "aero_late_steps": 10}),
     "lqg": None,
+    "lqg-mis-aero": (_LQG, {"aero": True}),
+    "lqg-mis-eff-aero": (_LQG, {"eff": True, "aero": True}),
     "lqg-mis-eff": (_LQG, {"eff": True}),
     "lqg-mis": (_LQG, {}),
     "lqg-eff": (_LQG, {"mis": False, "eff": True}),

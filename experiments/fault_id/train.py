@@ -30,6 +30,7 @@ import torch
 from lvgym.cli.args import arg, parse
 
 from .estimator import RESULTS, Estimator, Window, base_lqg, corrected
+from .inversion import TERMS, command, error_index, gains, law_terms
 
 #: the teacher's delays [control steps] of its knowledge of the misalignment (0-2 s at 0.02 s; the last: never)
 DELAYS = (0, 12, 25, 50, 100, None)
@@ -44,45 +45,103 @@ def condition(model: str, **options: Any):
     return {c.model: c for c in get_suite(SUITE).conditions}[model].with_options(**options)
 
 
+class ThrustScheme:
+    """``lqg`` corrected by the misalignment: the teacher's (true, known late by a delay drawn per flight from
+    :data:`DELAYS` with ``rng``) or the student's estimate shrunk by ``deadband``
+    (:func:`.estimator.corrected`); labels: the true misalignment over the gimbal limit."""
+
+    prefix, outputs, scaled = "estimator", 2, False
+
+    def __init__(self, env1: Any, n: int, rng: np.random.Generator | None, deadband: float) -> None:
+        from lvgym.benchmark.batch import as_batch
+
+        self.limit, self.n, self.deadband = float(env1.unwrapped.func.gimbal_limit), n, deadband
+        self.lqg = as_batch(base_lqg(env1), n, lambda: base_lqg(env1))
+        self.lqg.reset(np.arange(n))
+        self.delay = None if rng is None else [DELAYS[i] for i in rng.integers(0, len(DELAYS), n)]
+        self.truth: list[np.ndarray] = []                 # every row's label at every step
+
+    def labels(self, info: dict[str, Any]) -> np.ndarray:
+        m = info.get("misalignment")
+        self.truth.append(np.zeros((self.n, 2)) if m is None else np.asarray(m, dtype=np.float64).reshape(self.n, 2)
+                          / self.limit)
+        return self.truth[-1]
+
+    def act(self, live: np.ndarray, obs: np.ndarray, info: dict[str, Any], estimate: np.ndarray | None) -> np.ndarray:
+        base = np.asarray(self.lqg.act(live, obs, info), dtype=np.float64)
+        if estimate is None:                             # the teacher: the truth, late
+            step = len(self.truth) - 1
+            estimate = np.array([self.truth[step - d][r] if d is not None and step >= d else np.zeros(2)
+                                 for r, d in zip(live, (self.delay[r] for r in live))])
+        return corrected(base, estimate, 0.0 if self.delay is not None else self.deadband)
+
+
+class InversionScheme:
+    """The law of :mod:`.inversion` on the true terms (the teacher) or the student's estimate; labels: the true
+    terms (:func:`.inversion.law_terms`)."""
+
+    prefix, outputs, scaled = "inversion", len(TERMS), True
+
+    def __init__(self, env1: Any, n: int, rng: np.random.Generator | None, deadband: float) -> None:
+        self.limit, self.n = float(env1.unwrapped.func.gimbal_limit), n
+        self.index, (self.w, self.z) = error_index(env1), gains(env1)
+        self.truth = np.zeros((n, len(TERMS)))
+        self.rng = rng                                   # the teacher's: its exploration
+        self.sigma = None if rng is None else np.asarray(NOISE)[rng.integers(0, len(NOISE), n)][:, None]
+        self.noise = np.zeros((n, 2))
+
+    def labels(self, info: dict[str, Any]) -> np.ndarray:
+        self.truth = law_terms(info, self.n, self.limit)
+        return self.truth
+
+    def act(self, live: np.ndarray, obs: np.ndarray, info: dict[str, Any], estimate: np.ndarray | None) -> np.ndarray:
+        if estimate is not None:
+            return command(obs, estimate, self.index, self.w, self.z)
+        # the teacher's action with a slowly varying exploration: without it the action sent last holds the
+        # label (it is ``a alpha - f``), and a student reads ``f`` back from its own action
+        self.noise[live] = (NOISE_PHI * self.noise[live] + np.sqrt(1.0 - NOISE_PHI ** 2) * self.sigma[live]
+                            * self.rng.standard_normal((len(live), 2)))
+        return np.clip(command(obs, self.truth[live], self.index, self.w, self.z) + self.noise[live],
+                       -1.0, 1.0).astype(np.float32)
+
+
+#: the inversion teacher's exploration: its standard deviations [gimbal limits], one drawn per flight, and the
+#: step-to-step correlation of the noise (a time constant of 0.2 s at 0.02 s)
+NOISE = (0.0, 0.05, 0.1)
+NOISE_PHI = float(np.exp(-0.1))
+#: the students by name (``--scheme``)
+SCHEMES = {"thrust": ThrustScheme, "inversion": InversionScheme}
+
+
 def fly(model: str, seeds: Sequence[int], estimator: Estimator | None = None,
-        rng: np.random.Generator | None = None, deadband: float = 0.0,
+        rng: np.random.Generator | None = None, deadband: float = 0.0, scheme: str = "thrust",
         **options: Any) -> tuple[np.ndarray, np.ndarray, list[dict]]:
-    """Fly the rows seeded ``seeds`` of the batched env of ``model``: ``lqg`` corrected by the true
-    misalignment known late by a delay drawn from ``rng`` (``estimator`` None: the teacher) or by the
-    ``estimator`` (the student, its estimate shrunk by ``deadband``: :func:`.estimator.corrected`). Returns
-    the windows ``(steps, WINDOW, FEATURES)``, their labels ``(steps, 2)`` and the flights' records
-    (protocol v2's fields); ``options``: env keywords (tests shorten the mission)."""
-    from lvgym.benchmark.batch import as_batch
+    """Fly the rows seeded ``seeds`` of the batched env of ``model`` with ``scheme``'s law (:data:`SCHEMES`) on
+    the truth (``estimator`` None: the teacher; ``rng`` draws its delays) or on the ``estimator``'s output (the
+    student; ``deadband``: the thrust scheme's). Returns the windows ``(steps, WINDOW, FEATURES)``, their
+    labels ``(steps, outputs)`` and the flights' records (protocol v2's fields); ``options``: env keywords
+    (tests shorten the mission)."""
     from lvgym.benchmark.rows import RowsLog
 
     c = condition(model, privileged_info=True, **options)
     n = len(seeds)
     env, env1 = c.make_vec_env(n), c.make_env()
-    limit = float(env1.unwrapped.func.gimbal_limit)
-    lqg = as_batch(base_lqg(env1), n, lambda: base_lqg(env1))
-    delay = None if estimator is not None else [DELAYS[i] for i in rng.integers(0, len(DELAYS), n)]
     obs, info = env.reset(seed=[int(s) for s in seeds])
-    lqg.reset(np.arange(n))
+    law = SCHEMES[scheme](env1, n, rng if estimator is None else None, deadband)
     window, log = Window(n), RowsLog(env)
-    truth: list[np.ndarray] = []                      # the true misalignment of every row at every step [rad]
     xs, ys = [], []
-    done, step = np.zeros(n, dtype=bool), 0
+    done = np.zeros(n, dtype=bool)
     while not done.all():
         live = np.flatnonzero(~done)
-        base = np.asarray(lqg.act(live, obs[live], info), dtype=np.float64)
-        truth.append(np.asarray(info["misalignment"], dtype=np.float64).reshape(n, 2) if "misalignment" in info
-                     else np.zeros((n, 2)))
+        truth = law.labels(info)
         w = window.push(live, obs[live])
         xs.append(w.copy())
-        ys.append((truth[-1][live] / limit).astype(np.float32))
-        if estimator is None:
-            known = [truth[step - d][r] if d is not None and step >= d else np.zeros(2) for r, d in
-                     zip(live, (delay[r] for r in live))]
-            estimate = np.array(known) / limit
-        else:
+        ys.append(truth[live].astype(np.float32))
+        estimate = None
+        if estimator is not None:
             with torch.no_grad():
                 estimate = estimator(torch.as_tensor(w)).numpy().astype(np.float64)
-        a = corrected(base, estimate, 0.0 if estimator is None else deadband)
+        a = law.act(live, obs[live], info, estimate)
         window.sent(live, a)
         actions = np.zeros((n, 2), dtype=np.float32)
         actions[live] = a
@@ -91,16 +150,17 @@ def fly(model: str, seeds: Sequence[int], estimator: Estimator | None = None,
         ended = live[(np.asarray(term) | np.asarray(trunc))[live]]
         log.end(ended, info)
         done[ended] = True
-        step += 1
     env.close()
     return np.concatenate(xs), np.concatenate(ys), log.records(True)
 
 
-def fit(x: np.ndarray, y: np.ndarray, seed: int, epochs: int) -> Estimator:
-    """The estimator fitted to windows ``x`` and labels ``y`` (torch seeded with ``seed``)."""
+def fit(x: np.ndarray, y: np.ndarray, seed: int, epochs: int, scaled: bool = False) -> Estimator:
+    """The estimator fitted to windows ``x`` and labels ``y`` (torch seeded with ``seed``; ``scaled``: the
+    labels standardised, each weighing the same in the error)."""
     torch.manual_seed(seed)
     flat = x.reshape(-1, x.shape[-1])
-    est = Estimator(flat.mean(0), flat.std(0) + 1e-6)
+    est = Estimator(flat.mean(0), flat.std(0) + 1e-6, outputs=y.shape[1],
+                    label_mean=y.mean(0) if scaled else None, label_std=y.std(0) + 1e-6 if scaled else None)
     opt = torch.optim.Adam(est.parameters(), 1e-3)
     xt, yt = torch.as_tensor(x), torch.as_tensor(y)
     g = torch.Generator().manual_seed(seed)
@@ -108,24 +168,25 @@ def fit(x: np.ndarray, y: np.ndarray, seed: int, epochs: int) -> Estimator:
         perm, total = torch.randperm(len(xt), generator=g), 0.0
         for i in range(0, len(xt), 1024):
             b = perm[i:i + 1024]
-            loss = ((est(xt[b]) - yt[b]) ** 2).mean()
+            loss = (((est(xt[b]) - yt[b]) / est.label_std) ** 2).mean()
             opt.zero_grad()
             loss.backward()
             opt.step()
             total += float(loss.detach()) * len(b)
-        print(f"  epoch {epoch}: mean squared error {total / len(xt):.3e} (labels' variance {float(yt.var()):.3e})",
+        print(f"  epoch {epoch}: mean squared error {total / len(xt):.3e} (labels' variance "
+              f"{float((yt / est.label_std).var(0).mean()):.3e})",
               flush=True)
     return est
 
 
-def validate(est: Estimator, episodes: int, deadband: float = 0.0) -> dict[str, tuple[float, int]]:
+def validate(est: Estimator, episodes: int, deadband: float = 0.0, scheme: str = "thrust") -> dict[str, tuple[float, int]]:
     """Mean ``score_v2`` and failed or unflyable flights of the student on validation seeds ``0 ..
     episodes - 1`` per flight model (:func:`fly`: the rows of one batched env; the benchmark flies the same
     law one row at a time through :class:`.estimator.FaultIdPolicy`)."""
     out = {}
     for model in ("rigid", "nonrigid"):
         rs = [r for k in range(0, episodes, 100)
-              for r in fly(model, range(k, min(episodes, k + 100)), est, deadband=deadband)[2]]
+              for r in fly(model, range(k, min(episodes, k + 100)), est, deadband=deadband, scheme=scheme)[2]]
         bad = sum(bool(r["failed"] or not r["flyable"]) for r in rs)
         out[model] = (float(np.mean([r["score_v2"] for r in rs])), bad)
     return out
@@ -145,6 +206,9 @@ class Args:
     """epochs per fit"""
     validation: int = arg(100, lo=0, hi=1000)
     """validation seeds flown after each fit (0: none)"""
+    scheme: str = arg("thrust", choices=tuple(SCHEMES))
+    """the student: the thrust's direction for ``lqg`` (results/fault_id/estimator-s<seed>.pt), or the
+    inversion law's terms (inversion-s<seed>.pt)"""
 
 
 def main(argv: Sequence[str] | None = None) -> None:
@@ -153,6 +217,7 @@ def main(argv: Sequence[str] | None = None) -> None:
     RESULTS.mkdir(parents=True, exist_ok=True)
     rng, t0 = np.random.default_rng(a.seed), time.time()
     first = 100_000 + 10_000 * a.seed
+    prefix = SCHEMES[a.scheme].prefix
     xs, ys = [], []
     est: Estimator | None = None                      # the teacher flies round 0, the student the others
     for rnd in range(a.rounds + 1):
@@ -161,19 +226,19 @@ def main(argv: Sequence[str] | None = None) -> None:
         for model in ("rigid", "nonrigid"):
             for k in range(0, count, 100):
                 seeds = list(range(start + k, start + min(count, k + 100)))
-                x, y, _ = fly(model, seeds, est, rng)
+                x, y, _ = fly(model, seeds, est, rng, scheme=a.scheme)
                 xs.append(x)
                 ys.append(y)
         print(f"seed {a.seed} round {rnd}: {sum(len(x) for x in xs)} steps of data at {time.time() - t0:.0f} s",
               flush=True)
-        est = fit(np.concatenate(xs), np.concatenate(ys), a.seed, a.epochs)
-        torch.save(est.state_dict(), RESULTS / f"estimator-s{a.seed}-r{rnd}.pt")
+        est = fit(np.concatenate(xs), np.concatenate(ys), a.seed, a.epochs, SCHEMES[a.scheme].scaled)
+        torch.save(est.state_dict(), RESULTS / f"{prefix}-s{a.seed}-r{rnd}.pt")
         if a.validation:
-            v = validate(est, a.validation)
+            v = validate(est, a.validation, scheme=a.scheme)
             print(f"seed {a.seed} round {rnd} validation 0-{a.validation - 1}: " + ", ".join(
                 f"{m} {s:.3f} ({b})" for m, (s, b) in v.items()) + f" at {time.time() - t0:.0f} s", flush=True)
-    torch.save(est.state_dict(), RESULTS / f"estimator-s{a.seed}.pt")
-    print(f"wrote {RESULTS / f'estimator-s{a.seed}.pt'} in {time.time() - t0:.0f} s")
+    torch.save(est.state_dict(), RESULTS / f"{prefix}-s{a.seed}.pt")
+    print(f"wrote {RESULTS / f'{prefix}-s{a.seed}.pt'} in {time.time() - t0:.0f} s")
 
 
 if __name__ == "__main__":
