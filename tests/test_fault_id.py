@@ -107,7 +107,7 @@ def test_the_inversion_terms_and_command_by_hand():
 def test_the_inversion_teacher_is_the_reference_on_the_observation(monkeypatch):
     """The inversion scheme's teacher (the law on the true terms, batched; here without its exploration) flies
     as the privileged reference given the observation's errors, without its preview, one env row at a time."""
-    import experiments.fault_id.train as train
+    from experiments.fault_id import train
     from experiments.fault_id.privileges import reference
     monkeypatch.setattr(train, "NOISE", (0.0,))
     short = {"mission_time_s": 4.0}
