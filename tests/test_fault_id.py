@@ -132,3 +132,19 @@ def test_the_inversion_student_in_a_batch_flies_as_the_benchmark_flies_it():
     for seed, rec in zip([5, 6], batch):
         single = play_episode(InversionPolicy(env, est), env, seed, flyability=True)
         assert single["score_v2"] == pytest.approx(rec["score_v2"], rel=1e-6)
+
+
+def test_an_ensemble_is_the_mean_of_its_members_and_saves_whole(tmp_path):
+    from experiments.fault_id.estimator import Ensemble, Estimator, load, save
+    torch.manual_seed(0)
+    members = [Estimator(np.zeros(FEATURES), np.ones(FEATURES), hidden=8, outputs=3, label_mean=np.arange(3.0),
+                         label_std=np.full(3, 2.0)) for _ in range(3)]
+    x = torch.randn(4, WINDOW, FEATURES)
+    ens = Ensemble(members)
+    with torch.no_grad():
+        want = sum(m(x) for m in members) / 3
+        assert torch.allclose(ens(x), want, atol=1e-6)
+        save(ens, tmp_path / "e.pt")
+        assert torch.allclose(load(tmp_path / "e.pt")(x), want, atol=1e-6)
+        save(members[0], tmp_path / "one.pt")                     # one estimator: its own state
+        assert torch.allclose(load(tmp_path / "one.pt")(x), members[0](x))

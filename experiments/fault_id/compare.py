@@ -6,6 +6,8 @@ failed or unflyable, probability of improvement over the best classical design (
         lqg-thrust-id-s1=experiments/fault_id/estimator.py:s1 lqg-thrust-id-s2=experiments/fault_id/estimator.py:s2
     python -m experiments.fault_id.compare --folder results/fault_id/test
 
+(and the same with ``inversion-id-s0=experiments/fault_id/inversion.py:s0`` ...: every student flown is compared)
+
 (The same comparison a training campaign prints: :func:`agents.campaign_compare.comparison_rows`.)
 """
 
@@ -19,7 +21,9 @@ from pathlib import Path
 from lvgym.cli.args import arg, parse
 
 BASELINES = ("lqg", "lqg-front", "aac-quiet")
-CONFIGURATION = "lqg-thrust-id"
+#: the students' labels, ``<configuration>-s<training seed>``: the thrust-direction estimator on ``lqg``
+#: (:mod:`.estimator`) and the reference's law on the learned disturbance observer (:mod:`.inversion`)
+CONFIGURATIONS = ("lqg-thrust-id", "inversion-id")
 
 
 @dataclass
@@ -38,12 +42,12 @@ def main(argv: Sequence[str] | None = None) -> None:
     if not path.is_file():
         raise SystemExit(f"python -m experiments.fault_id.compare: {path}: no such file (evaluate.py's --out)")
     records = json.loads(path.read_text())["episodes"]
-    labels = sorted({r["policy"] for r in records if r["policy"].startswith(CONFIGURATION + "-s")})
-    if not labels:
-        raise SystemExit(f"{a.folder}: no policy labelled {CONFIGURATION}-s<seed>")
-    rows = comparison_rows(records, {CONFIGURATION: labels}, [b for b in BASELINES
-                                                              if any(r["policy"] == b for r in records)])
-    print(comparison_table(rows, f"{CONFIGURATION} on the test seeds"))
+    runs = {c: sorted({r["policy"] for r in records if r["policy"].startswith(c + "-s")}) for c in CONFIGURATIONS}
+    runs = {c: labels for c, labels in runs.items() if labels}
+    if not runs:
+        raise SystemExit(f"{a.folder}: no policy labelled <configuration>-s<seed> of {list(CONFIGURATIONS)}")
+    rows = comparison_rows(records, runs, [b for b in BASELINES if any(r["policy"] == b for r in records)])
+    print(comparison_table(rows, f"{', '.join(runs)} on the test seeds"))
 
 
 if __name__ == "__main__":

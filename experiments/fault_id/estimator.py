@@ -94,7 +94,8 @@ def base_lqg(env: Any) -> Any:
 class FaultIdPolicy:
     """``lqg`` with the estimator's correction (module docstring); one env row (the benchmark's policy)."""
 
-    def __init__(self, env: Any, estimator: Estimator, name: str = "lqg-thrust-id", deadband: float = 0.0) -> None:
+    def __init__(self, env: Any, estimator: Estimator | Ensemble, name: str = "lqg-thrust-id",
+                 deadband: float = 0.0) -> None:
         from lvgym.errors import ConfigError
 
         if tuple(env.observation_space.shape) != (N_OBS,):
@@ -121,15 +122,38 @@ class FaultIdPolicy:
         return a
 
 
-def load(path: str | Path) -> Estimator:
-    """An estimator saved by :mod:`.train`."""
-    state = torch.load(path, map_location="cpu", weights_only=True)
+class Ensemble(nn.Module):
+    """The mean of several estimators' outputs (the fits of a training seed's last DAgger rounds: each round's
+    fit errs differently, and their mean errs less in closed loop, README.md)."""
+
+    def __init__(self, members: list[Estimator]) -> None:
+        super().__init__()
+        self.members = nn.ModuleList(members)
+
+    def forward(self, window: torch.Tensor) -> torch.Tensor:
+        return torch.stack([m(window) for m in self.members]).mean(0)
+
+
+def save(estimator: Estimator | Ensemble, path: str | Path) -> None:
+    """Write ``estimator`` (an :class:`Ensemble`: its members' states in one file) for :func:`load`."""
+    members = estimator.members if isinstance(estimator, Ensemble) else None
+    torch.save({"members": [m.state_dict() for m in members]} if members is not None else estimator.state_dict(),
+               path)
+
+
+def _one(state: dict[str, torch.Tensor]) -> Estimator:
     outputs = int(state["net.4.bias"].shape[0])
     state.setdefault("label_mean", torch.zeros(outputs))          # saved before the labels were scaled
     state.setdefault("label_std", torch.ones(outputs))
     est = Estimator(state["mean"].numpy(), state["std"].numpy(), outputs=outputs)
     est.load_state_dict(state)
     return est
+
+
+def load(path: str | Path) -> Estimator | Ensemble:
+    """An estimator, or an ensemble of them, saved by :mod:`.train` (:func:`save`)."""
+    state = torch.load(path, map_location="cpu", weights_only=True)
+    return Ensemble([_one(m) for m in state["members"]]) if "members" in state else _one(state)
 
 
 def _seeded(k: int):

@@ -28,7 +28,7 @@ from typing import Any
 
 import numpy as np
 
-from .estimator import N_OBS, RESULTS, Estimator, Window, load
+from .estimator import N_OBS, RESULTS, Ensemble, Estimator, Window, load
 
 #: the law's terms, in the order of :func:`law_terms`
 TERMS = ("f_aero_pitch", "f_aero_yaw", "f_mis_pitch", "f_mis_yaw", "a_pitch", "a_yaw", "qalpha_share")
@@ -92,7 +92,7 @@ class InversionPolicy:
     """The law of the module docstring on the estimator's ``f`` and ``a``; one env row (the benchmark's policy;
     it needs no privileged information)."""
 
-    def __init__(self, env: Any, estimator: Estimator, name: str = "inversion-id") -> None:
+    def __init__(self, env: Any, estimator: Estimator | Ensemble, name: str = "inversion-id") -> None:
         from lvgym.errors import ConfigError
 
         if tuple(env.observation_space.shape) != (N_OBS,):

@@ -1,20 +1,33 @@
-"""Train the thrust-direction estimator (:mod:`.estimator`) of one training seed: a teacher-student scheme.
+"""Train a student of one training seed (a teacher-student scheme): the thrust-direction estimator
+(:mod:`.estimator`, ``--scheme thrust``) or the disturbance observer of the reference's law
+(:mod:`.inversion`, ``--scheme inversion``).
 
     python -m experiments.fault_id.train --seed 0            # results/fault_id/estimator-s0.pt
+    python -m experiments.fault_id.train --scheme inversion --seed 0 --flights 100 --rounds 4 --validation 50
+                                                             # results/fault_id/inversion-s0.pt
 
-1. **Teacher's flights.** ``lqg`` flies ``smile-v2-faults`` (both flight models, ``--flights`` each, training
-   seeds ``100000 + 10000 seed ...``: neither validation nor test seeds) with the true misalignment (the env's
-   privileged info) subtracted from its command, known late by a delay drawn per flight from
-   :data:`DELAYS` (never known, for one flight in six), so the flights cover the states before and after
-   the correction. Every step is recorded as the student sees it (:class:`.estimator.Window`) with the true
-   misalignment over the gimbal limit as its label.
-2. **Regression.** :class:`.estimator.Estimator` fitted by mean squared error (Adam, ``--epochs``).
+1. **Teacher's flights** on ``smile-v2-faults`` (both flight models, ``--flights`` each, training seeds
+   ``100000 + 10000 seed ...``: neither validation nor test seeds), every step recorded as the student sees
+   it (:class:`.estimator.Window`) with its label (:class:`ThrustScheme`, :class:`InversionScheme`):
+
+   - ``thrust``: ``lqg`` with the true misalignment (the env's privileged info) subtracted from its
+     command, known late by a delay drawn per flight from :data:`DELAYS` (never known, for one flight in
+     six), so the flights cover the states before and after the correction; label: the true misalignment
+     over the gimbal limit.
+   - ``inversion``: the reference's law on the true terms (:func:`.inversion.law_terms`), its action with an
+     exploration noise of a standard deviation drawn per flight from :data:`NOISE` (else the action sent
+     last holds the label, and the student reads it back from its own action); label: the true terms.
+2. **Regression.** :class:`.estimator.Estimator` fitted by mean squared error (Adam, ``--epochs``; the
+   inversion's labels standardised).
 3. **DAgger rounds** (``--rounds``): the student flies half as many flights again, labelled the same way,
-   added to the data, and the estimator is fitted again.
+   added to the data, and the estimator is fitted again. The thrust scheme's policy is the last fit; the
+   inversion's the mean of the last three fits (:class:`.estimator.Ensemble`).
 
 After each fit the student flies validation seeds ``0 .. --validation - 1`` of both flight models and the
 mean ``score_v2`` and its failed or unflyable flights are printed (``lqg``: 0.994 (6) rigid, 1.109 (7)
-non-rigid on seeds 0-99; ``lqg`` with the true misalignment 0.778 (2), 0.900 (2): README.md).
+non-rigid on seeds 0-99; ``lqg`` with the true misalignment 0.778 (2), 0.900 (2): README.md). One seed of the
+inversion scheme with the command above holds about 2.0 M steps and 8-10 GB of memory at its last fit: three
+at once on 24 GB run out of memory.
 """
 
 from __future__ import annotations
@@ -29,7 +42,7 @@ import torch
 
 from lvgym.cli.args import arg, parse
 
-from .estimator import RESULTS, Estimator, Window, base_lqg, corrected
+from .estimator import RESULTS, Ensemble, Estimator, Window, base_lqg, corrected, save
 from .inversion import TERMS, command, error_index, gains, law_terms
 
 #: the teacher's delays [control steps] of its knowledge of the misalignment (0-2 s at 0.02 s; the last: never)
@@ -50,7 +63,7 @@ class ThrustScheme:
     :data:`DELAYS` with ``rng``) or the student's estimate shrunk by ``deadband``
     (:func:`.estimator.corrected`); labels: the true misalignment over the gimbal limit."""
 
-    prefix, outputs, scaled = "estimator", 2, False
+    prefix, outputs, scaled, ensemble = "estimator", 2, False, 1
 
     def __init__(self, env1: Any, n: int, rng: np.random.Generator | None, deadband: float) -> None:
         from lvgym.benchmark.batch import as_batch
@@ -80,7 +93,7 @@ class InversionScheme:
     """The law of :mod:`.inversion` on the true terms (the teacher) or the student's estimate; labels: the true
     terms (:func:`.inversion.law_terms`)."""
 
-    prefix, outputs, scaled = "inversion", len(TERMS), True
+    prefix, outputs, scaled, ensemble = "inversion", len(TERMS), True, 3
 
     def __init__(self, env1: Any, n: int, rng: np.random.Generator | None, deadband: float) -> None:
         self.limit, self.n = float(env1.unwrapped.func.gimbal_limit), n
@@ -113,7 +126,7 @@ NOISE_PHI = float(np.exp(-0.1))
 SCHEMES = {"thrust": ThrustScheme, "inversion": InversionScheme}
 
 
-def fly(model: str, seeds: Sequence[int], estimator: Estimator | None = None,
+def fly(model: str, seeds: Sequence[int], estimator: Estimator | Ensemble | None = None,
         rng: np.random.Generator | None = None, deadband: float = 0.0, scheme: str = "thrust",
         **options: Any) -> tuple[np.ndarray, np.ndarray, list[dict]]:
     """Fly the rows seeded ``seeds`` of the batched env of ``model`` with ``scheme``'s law (:data:`SCHEMES`) on
@@ -179,7 +192,8 @@ def fit(x: np.ndarray, y: np.ndarray, seed: int, epochs: int, scaled: bool = Fal
     return est
 
 
-def validate(est: Estimator, episodes: int, deadband: float = 0.0, scheme: str = "thrust") -> dict[str, tuple[float, int]]:
+def validate(est: Estimator | Ensemble, episodes: int, deadband: float = 0.0,
+             scheme: str = "thrust") -> dict[str, tuple[float, int]]:
     """Mean ``score_v2`` and failed or unflyable flights of the student on validation seeds ``0 ..
     episodes - 1`` per flight model (:func:`fly`: the rows of one batched env; the benchmark flies the same
     law one row at a time through :class:`.estimator.FaultIdPolicy`)."""
@@ -220,6 +234,7 @@ def main(argv: Sequence[str] | None = None) -> None:
     prefix = SCHEMES[a.scheme].prefix
     xs, ys = [], []
     est: Estimator | None = None                      # the teacher flies round 0, the student the others
+    fits: list[Estimator] = []
     for rnd in range(a.rounds + 1):
         count = a.flights if rnd == 0 else max(1, a.flights // 2)
         start = first + (0 if rnd == 0 else 5_000 * rnd)
@@ -232,12 +247,19 @@ def main(argv: Sequence[str] | None = None) -> None:
         print(f"seed {a.seed} round {rnd}: {sum(len(x) for x in xs)} steps of data at {time.time() - t0:.0f} s",
               flush=True)
         est = fit(np.concatenate(xs), np.concatenate(ys), a.seed, a.epochs, SCHEMES[a.scheme].scaled)
-        torch.save(est.state_dict(), RESULTS / f"{prefix}-s{a.seed}-r{rnd}.pt")
+        fits.append(est)
+        save(est, RESULTS / f"{prefix}-s{a.seed}-r{rnd}.pt")
         if a.validation:
             v = validate(est, a.validation, scheme=a.scheme)
             print(f"seed {a.seed} round {rnd} validation 0-{a.validation - 1}: " + ", ".join(
                 f"{m} {s:.3f} ({b})" for m, (s, b) in v.items()) + f" at {time.time() - t0:.0f} s", flush=True)
-    torch.save(est.state_dict(), RESULTS / f"{prefix}-s{a.seed}.pt")
+    last = SCHEMES[a.scheme].ensemble                 # the policy: the mean of the last rounds' fits
+    final = Ensemble(fits[-last:]) if last > 1 else est
+    save(final, RESULTS / f"{prefix}-s{a.seed}.pt")
+    if a.validation and last > 1:
+        v = validate(final, a.validation, scheme=a.scheme)
+        print(f"seed {a.seed} the last {last} rounds' mean, validation 0-{a.validation - 1}: " + ", ".join(
+            f"{m} {s:.3f} ({b})" for m, (s, b) in v.items()), flush=True)
     print(f"wrote {RESULTS / f'{prefix}-s{a.seed}.pt'} in {time.time() - t0:.0f} s")
 
 
