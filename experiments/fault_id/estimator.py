@@ -145,7 +145,8 @@ def _one(state: dict[str, torch.Tensor]) -> Estimator:
     outputs = int(state["net.4.bias"].shape[0])
     state.setdefault("label_mean", torch.zeros(outputs))          # saved before the labels were scaled
     state.setdefault("label_std", torch.ones(outputs))
-    est = Estimator(state["mean"].numpy(), state["std"].numpy(), outputs=outputs)
+    est = Estimator(state["mean"].numpy(), state["std"].numpy(), hidden=int(state["net.0.bias"].shape[0]),
+                    outputs=outputs)
     est.load_state_dict(state)
     return est
 
