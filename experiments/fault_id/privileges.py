@@ -9,7 +9,10 @@ reference (:mod:`lvgym.baselines.privileged`) knows the true state, the plant (t
 each actuator's effectiveness), the wind 0.1 s ahead, and it relieves the load; the ``lqg-*`` variants add to
 ``lqg``'s command what the reference knows of the plant: ``delta = delta_lqg - misalignment`` (``mis``),
 ``delta_lqg / effectiveness`` (``eff``), the misalignment known late (``mis-late-*``), or only the first
-step's (the dispersion's, never the fault's: ``mis-static``). A study: it flies no test seed.
+step's (the dispersion's, never the fault's: ``mis-static``), or the present aerodynamic moment cancelled
+(``aero``). The ``*-observed*`` variants fly the reference on the observation's rate and attitude errors
+(:class:`Withheld`), with the aerodynamic moment known late or without the effectiveness: what the reference's
+law needs that a flight computer could estimate (:mod:`.inversion`). A study: it flies no test seed.
 """
 
 from __future__ import annotations
