@@ -20,7 +20,7 @@ from pathlib import Path
 
 from lvgym.cli.args import arg, parse
 
-BASELINES = ("lqg", "lqg-front", "aac-quiet")
+BASELINES = ("lqg", "lqg-front", "aac-quiet", "gs-pd-relief")
 #: the students' labels, ``<configuration>-s<training seed>``: the thrust-direction estimator on ``lqg``
 #: (:mod:`.estimator`) and the reference's law on the learned disturbance observer (:mod:`.inversion`)
 CONFIGURATIONS = ("lqg-thrust-id", "inversion-id")
