@@ -1,8 +1,9 @@
 """The policy interface shared by every controller the benchmark compares (PID baselines, learned agents).
 
 A policy sees what a Gymnasium env returns and nothing else: the observation (SMILE's 14 entries by
-default, named in order by the env's ``unwrapped.observation_layout``, :data:`lvgym.envs.layouts.OBSERVATIONS`)
-and the ``info`` dict of the last step (an empty dict right after a reset). It returns an action of the env's action space.
+default, named in order by the env's ``unwrapped.observation_layout``,
+:data:`lvgym.envs.layouts.OBSERVATIONS`) and the ``info`` dict of the last step (an empty dict right after
+a reset). It returns an action of the env's action space.
 
 >>> policy = ZeroPolicy()
 >>> policy.reset()

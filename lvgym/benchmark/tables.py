@@ -250,8 +250,8 @@ def markdown_table(summary: Sequence[Row], degradation: Sequence[Row], meta: Map
                         "failure", degradation_table(deg) if deg else [])
         comp = _of_suite(comparison, suite)
         if comp:
-            out += _section(f"Paired comparison of the {comp[0]['metric']} ({suite}) with the reference policy of each "
-                            "condition on the same seeds: diff = policy - reference (negative: better); P(better): "
+            out += _section(f"Paired comparison of the {comp[0]['metric']} ({suite}) with the reference policy of "
+                            "each condition on the same seeds: diff = policy - reference (negative: better); P(better): "
                             "the probability that an episode of the policy scores lower", comparison_table(comp))
         grp = _of_suite(groups, suite)
         out += _section(f"Agents over their training runs ({suite}): IQM of the "
