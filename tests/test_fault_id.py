@@ -148,3 +148,21 @@ def test_an_ensemble_is_the_mean_of_its_members_and_saves_whole(tmp_path):
         assert torch.allclose(load(tmp_path / "e.pt")(x), want, atol=1e-6)
         save(members[0], tmp_path / "one.pt")                     # one estimator: its own state
         assert torch.allclose(load(tmp_path / "one.pt")(x), members[0](x))
+
+
+def test_a_loop_gain_labels_the_terms_as_the_action_must_carry_them(monkeypatch):
+    """With a gain g after the action, the inversion teacher commands the law over g (the flight sees the
+    undispersed law's gimbal angles) and its labels are the terms over g; the q-alpha share stays."""
+    from experiments.fault_id import train
+    monkeypatch.setattr(train, "NOISE", (0.0,))
+    short = {"mission_time_s": 3.0}
+    gain = np.array([2.0, 0.5])
+    _, y1, r1 = fly("rigid", [7, 8], None, np.random.default_rng(0), scheme="inversion", **short)
+    _, y2, r2 = fly("rigid", [7, 8], None, np.random.default_rng(0), scheme="inversion", loop_gain=gain, **short)
+    assert y1.shape == y2.shape
+    rows = np.resize([0, 1], len(y1))                 # the steps interleave the two rows while both fly
+    np.testing.assert_allclose(y2[:, :6] * gain[rows][:, None], y1[:, :6], rtol=1e-4, atol=1e-6)
+    np.testing.assert_allclose(y2[:, 6], y1[:, 6], rtol=1e-4, atol=1e-9)
+    assert [r["score_v2"] for r in r2] == pytest.approx([r["score_v2"] for r in r1], rel=1e-6)
+    with pytest.raises(ValueError, match="inversion"):
+        fly("rigid", [7], None, np.random.default_rng(0), loop_gain=np.ones(1), **short)

@@ -65,7 +65,8 @@ class ThrustScheme:
 
     prefix, outputs, scaled, ensemble = "estimator", 2, False, 1
 
-    def __init__(self, env1: Any, n: int, rng: np.random.Generator | None, deadband: float) -> None:
+    def __init__(self, env1: Any, n: int, rng: np.random.Generator | None, deadband: float,
+                 loop_gain: np.ndarray | None = None) -> None:
         from lvgym.benchmark.batch import as_batch
 
         self.limit, self.n, self.deadband = float(env1.unwrapped.func.gimbal_limit), n, deadband
@@ -95,9 +96,13 @@ class InversionScheme:
 
     prefix, outputs, scaled, ensemble = "inversion", len(TERMS), True, 3
 
-    def __init__(self, env1: Any, n: int, rng: np.random.Generator | None, deadband: float) -> None:
+    def __init__(self, env1: Any, n: int, rng: np.random.Generator | None, deadband: float,
+                 loop_gain: np.ndarray | None = None) -> None:
         self.limit, self.n = float(env1.unwrapped.func.gimbal_limit), n
         self.index, (self.w, self.z) = error_index(env1), gains(env1)
+        # a loop gain after the action (the margins' perturbation) scales the control power the action sees:
+        # the terms in gimbal angles are labelled as the action must carry them, the truth over the gain
+        self.per_gain = np.ones((n, 1)) if loop_gain is None else 1.0 / np.asarray(loop_gain, dtype=float)[:, None]
         self.truth = np.zeros((n, len(TERMS)))
         self.rng = rng                                   # the teacher's: its exploration
         self.sigma = None if rng is None else np.asarray(NOISE)[rng.integers(0, len(NOISE), n)][:, None]
@@ -105,6 +110,7 @@ class InversionScheme:
 
     def labels(self, info: dict[str, Any]) -> np.ndarray:
         self.truth = law_terms(info, self.n, self.limit)
+        self.truth[:, :6] *= self.per_gain
         return self.truth
 
     def act(self, live: np.ndarray, obs: np.ndarray, info: dict[str, Any], estimate: np.ndarray | None) -> np.ndarray:
@@ -128,19 +134,23 @@ SCHEMES = {"thrust": ThrustScheme, "inversion": InversionScheme}
 
 def fly(model: str, seeds: Sequence[int], estimator: Estimator | Ensemble | None = None,
         rng: np.random.Generator | None = None, deadband: float = 0.0, scheme: str = "thrust",
-        **options: Any) -> tuple[np.ndarray, np.ndarray, list[dict]]:
+        loop_gain: np.ndarray | None = None, **options: Any) -> tuple[np.ndarray, np.ndarray, list[dict]]:
     """Fly the rows seeded ``seeds`` of the batched env of ``model`` with ``scheme``'s law (:data:`SCHEMES`) on
     the truth (``estimator`` None: the teacher; ``rng`` draws its delays) or on the ``estimator``'s output (the
     student; ``deadband``: the thrust scheme's). Returns the windows ``(steps, WINDOW, FEATURES)``, their
-    labels ``(steps, outputs)`` and the flights' records (protocol v2's fields); ``options``: env keywords
-    (tests shorten the mission)."""
+    labels ``(steps, outputs)`` and the flights' records (protocol v2's fields); ``loop_gain``: per row, a gain
+    on the action after the flight computer sent it (the margins' perturbation, a training device; the
+    inversion scheme only); ``options``: env keywords (tests shorten the mission)."""
     from lvgym.benchmark.rows import RowsLog
 
     c = condition(model, privileged_info=True, **options)
     n = len(seeds)
     env, env1 = c.make_vec_env(n), c.make_env()
     obs, info = env.reset(seed=[int(s) for s in seeds])
-    law = SCHEMES[scheme](env1, n, rng if estimator is None else None, deadband)
+    if loop_gain is not None and scheme != "inversion":
+        raise ValueError("loop_gain: the inversion scheme's training device only")
+    law = SCHEMES[scheme](env1, n, rng if estimator is None else None, deadband, loop_gain)
+    gain = np.ones((n, 1)) if loop_gain is None else np.asarray(loop_gain, dtype=float)[:, None]
     window, log = Window(n), RowsLog(env)
     xs, ys = [], []
     done = np.zeros(n, dtype=bool)
@@ -157,7 +167,7 @@ def fly(model: str, seeds: Sequence[int], estimator: Estimator | Ensemble | None
         a = law.act(live, obs[live], info, estimate)
         window.sent(live, a)
         actions = np.zeros((n, 2), dtype=np.float32)
-        actions[live] = a
+        actions[live] = np.clip(a * gain[live], -1.0, 1.0)
         obs, reward, term, trunc, info = env.step(actions)
         log.add(live, obs, reward, info, actions)
         ended = live[(np.asarray(term) | np.asarray(trunc))[live]]
@@ -220,6 +230,9 @@ class Args:
     """epochs per fit"""
     validation: int = arg(100, lo=0, hi=1000)
     """validation seeds flown after each fit (0: none)"""
+    loop_gain_db: float = arg(0.0, lo=0.0, hi=12.0)
+    """the inversion scheme's loop dispersion: a gain on every flight's action drawn uniformly in dB within
+    +- this (0: none)"""
     scheme: str = arg("thrust", choices=tuple(SCHEMES))
     """the student: the thrust's direction for ``lqg`` (results/fault_id/estimator-s<seed>.pt), or the
     inversion law's terms (inversion-s<seed>.pt)"""
@@ -231,7 +244,7 @@ def main(argv: Sequence[str] | None = None) -> None:
     RESULTS.mkdir(parents=True, exist_ok=True)
     rng, t0 = np.random.default_rng(a.seed), time.time()
     first = 100_000 + 10_000 * a.seed
-    prefix = SCHEMES[a.scheme].prefix
+    prefix = SCHEMES[a.scheme].prefix + (f"-gain{a.loop_gain_db:g}" if a.loop_gain_db else "")
     xs, ys = [], []
     est: Estimator | None = None                      # the teacher flies round 0, the student the others
     fits: list[Estimator] = []
@@ -241,7 +254,9 @@ def main(argv: Sequence[str] | None = None) -> None:
         for model in ("rigid", "nonrigid"):
             for k in range(0, count, 100):
                 seeds = list(range(start + k, start + min(count, k + 100)))
-                x, y, _ = fly(model, seeds, est, rng, scheme=a.scheme)
+                gain = (10.0 ** (rng.uniform(-a.loop_gain_db, a.loop_gain_db, len(seeds)) / 20.0)
+                        if a.loop_gain_db else None)
+                x, y, _ = fly(model, seeds, est, rng, scheme=a.scheme, loop_gain=gain)
                 xs.append(x)
                 ys.append(y)
         print(f"seed {a.seed} round {rnd}: {sum(len(x) for x in xs)} steps of data at {time.time() - t0:.0f} s",
