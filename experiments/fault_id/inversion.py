@@ -118,12 +118,14 @@ class InversionPolicy:
         return a[0]
 
 
-def _seeded(k: int):
+def _seeded(k: int, prefix: str = "inversion", label: str = "inversion-id"):
     def factory(env: Any) -> InversionPolicy:
-        return InversionPolicy(env, load(RESULTS / f"inversion-s{k}.pt"), name=f"inversion-id-s{k}")
+        return InversionPolicy(env, load(RESULTS / f"{prefix}-s{k}.pt"), name=f"{label}-s{k}")
     factory.__name__ = f"s{k}"
     return factory
 
 
-#: the three training seeds' policies (``evaluate.py --policies experiments/fault_id/inversion.py:s0``)
+#: the three training seeds' policies (``evaluate.py --policies experiments.fault_id.inversion:s0``)
 s0, s1, s2 = (_seeded(k) for k in range(3))
+#: seed 0 trained under the loop dispersion (``train.py --loop-gain-db 6``: inversion-gain6-s0.pt)
+gain6_s0 = _seeded(0, "inversion-gain6", "inversion-id-gain6")
