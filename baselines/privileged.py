@@ -59,10 +59,10 @@ RELIEF = (0.5, 0.9)
 PREVIEW = 5
 
 
-def relief_hold(share: float, onset: float, full: float) -> float:
-    """The share of the attitude loop and of the moment's cancellation kept at ``share`` of the q-alpha limit:
-    1 up to ``onset``, falling linearly to 0 at ``full`` (:data:`RELIEF`)."""
-    return 1.0 - min(1.0, max(0.0, (share - onset) / (full - onset)))
+def relief_hold(share: float | np.ndarray, onset: float, full: float) -> float | np.ndarray:
+    """The share of the attitude loop and of the moment's cancellation kept at ``share`` of the q-alpha limit
+    (a number or an array of them): 1 up to ``onset``, falling linearly to 0 at ``full`` (:data:`RELIEF`)."""
+    return 1.0 - np.clip((share - onset) / (full - onset), 0.0, 1.0)
 
 
 def control_lever(info: dict[str, Any]) -> float:

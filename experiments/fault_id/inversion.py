@@ -66,11 +66,11 @@ def law_terms(info: dict[str, Any], n: int, limit: float) -> np.ndarray:
 def command(observations: np.ndarray, terms: np.ndarray, index: list[int], w: float, z: float) -> np.ndarray:
     """The law's action (module docstring) within [-1, 1] for ``(n, 14)`` observations (``index``: the
     positions of :data:`ERRORS`) and ``(n, 7)`` terms (:func:`law_terms`, true or estimated)."""
-    from lvgym.baselines.privileged import RELIEF
+    from lvgym.baselines.privileged import RELIEF, relief_hold
 
     o = np.asarray(observations, dtype=np.float64)
     e_rate, e_att = o[:, index[:2]], o[:, index[2:]]
-    hold = (1.0 - np.clip((terms[:, 6:7] - RELIEF[0]) / (RELIEF[1] - RELIEF[0]), 0.0, 1.0))
+    hold = relief_hold(terms[:, 6:7], *RELIEF)
     alpha = -2.0 * z * w * e_rate - hold * w * w * e_att
     return np.clip(terms[:, 4:6] * alpha - hold * terms[:, 0:2] - terms[:, 2:4], -1.0, 1.0).astype(np.float32)
 
