@@ -8,11 +8,13 @@ lvgym envs.
 - :mod:`lvgym.agents.progress`: the progress bar and the progress line;
 - :mod:`lvgym.agents.policy`: :class:`~lvgym.agents.policy.SB3Policy`, a trained model behind the benchmark Policy interface;
 - :mod:`lvgym.agents.residual`: residual policies on a classical baseline (training wrapper and adapter);
+- :mod:`lvgym.agents.inversion`: ``inversion-id``, the privileged reference's law on a learned disturbance
+  observer (:mod:`lvgym.agents.observer`, NumPy at flight time; fitted with :mod:`lvgym.agents.observer_fit`);
 - :mod:`experiments.rigid_vs_nonrigid_training.robustness`: the rigid-trained vs nonrigid-trained experiment.
 
 Training is ``lvgym train`` (``docs/training.md``). Nothing in ``lvgym`` imports this package (the command
 layer names it); importing it does not import stable-baselines3 (the submodules do). Importing it registers
-the shipped learned policies with the benchmark (``ppo``, ``ppo-res-lqg``) and the loaders of saved models
+the shipped learned policies with the benchmark (``ppo``, ``ppo-res-lqg``, ``inversion-id``) and the loaders of saved models
 (``evaluate.py --policies runs/my_run``, ``model.zip`` or a cloned ``bc.pt``); their factories are named as
 strings, imported only where a policy flies.
 """
@@ -23,6 +25,9 @@ from lvgym.benchmark.registry import register_policy, register_policy_loader
 # observation), and protocol v1's: PPO residual on lqg, flight sensors, a 4-sample history
 register_policy("ppo", "lvgym.agents.policy:shipped_policy")
 register_policy("ppo-res-lqg", "lvgym.agents.policy:shipped_policy", file="ppo_res_lqg_smile_v1", name="ppo-res-lqg")
+# protocol v2's, for smile-v2-faults: the privileged reference's law on a learned disturbance observer (a
+# teacher-student scheme; it flies in NumPy)
+register_policy("inversion-id", "lvgym.agents.inversion:shipped_inversion")
 # a saved stable-baselines3 model (an optional <stem>_vecnormalize.pkl next to it normalises the
 # observations) or a train.py run folder (its best model)
 register_policy_loader("lvgym.agents.policy:load_policy", suffixes=(".zip",), folders=True,

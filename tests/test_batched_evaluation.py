@@ -3,6 +3,7 @@ episode of its seed, to the bit (lvgym.benchmark.runner.run_block against run_ta
 
 - every policy of evaluate.py's defaults, on both models of every v1 suite (short missions);
 - rows that end early (failures) are masked out while the others fly on (the max-q gust suite, whole);
+- the shipped v2 learned policy (``inversion-id``) on the fault suite;
 - a user's policy with only a per-row ``act`` (no ``batch``) flies through the per-row adapter;
 - the fingerprint's batched records are the single-env episodes.
 """
@@ -78,6 +79,15 @@ def test_every_default_policy_flies_the_single_env_episodes_as_rows(suite, model
     records = check_block(tasks(suite, model, specs, [0, 1], mission_time_s=SHORT_S))
     assert len(records) == 2 * len(specs)
     assert all(r["duration_s"] > 0 for r in records)
+
+
+@pytest.mark.parametrize("model", ["rigid", "nonrigid"])
+def test_the_shipped_v2_learned_policy_flies_the_single_env_episodes_as_rows(model):
+    """``inversion-id`` (its own ``batch``: a window per row, the law on the rows at once) on the fault suite,
+    long enough for the observer's window to fill and the controller to act."""
+    records = check_block(tasks("smile-v2-faults", model, [resolve_policy("inversion-id")], [0, 1, 2],
+                                mission_time_s=6.0))
+    assert len({r["score_v2"] for r in records}) == 3
 
 
 def test_rows_that_end_early_are_masked_out_while_the_others_fly_on():

@@ -111,17 +111,17 @@ def test_a_noise_injected_dataset_flies_the_noise_and_labels_with_the_policy(dat
     assert content["steps"] == len(ep.actions)
 
 
-def test_the_shipped_learned_policy_is_recorded_as_it_flies(datasets):
+@pytest.mark.parametrize("policy", ["ppo-res-lqg", "inversion-id"])
+def test_the_shipped_learned_policies_are_recorded_as_they_fly(datasets, policy):
     from lvgym.agents.datasets import collect, dataset_id
     from lvgym.benchmark.registry import resolve_policy
     from lvgym.benchmark.runner import build_policy
 
-    pytest.importorskip("stable_baselines3")
-    collect("ppo-res-lqg", "smile-v2-faults", "nonrigid", episodes=1, mission_time_s=3.0)
-    data = minari.load_dataset(dataset_id("ppo-res-lqg", "smile-v2-faults", "nonrigid"))
-    assert data.storage.metadata["algorithm_name"] == "ppo-res-lqg"
+    collect(policy, "smile-v2-faults", "nonrigid", episodes=1, mission_time_s=3.0)
+    data = minari.load_dataset(dataset_id(policy, "smile-v2-faults", "nonrigid"))
+    assert data.storage.metadata["algorithm_name"] == policy
     env = lvgym.make_env("smile-v2-faults", "nonrigid", mission_time_s=3.0)
-    pol = build_policy(resolve_policy("ppo-res-lqg"), env)
+    pol = build_policy(resolve_policy(policy), env)
     (ep,) = data.iterate_episodes()
     obs, info = env.reset(seed=0)
     np.testing.assert_array_equal(obs, ep.observations[0])

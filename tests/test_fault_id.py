@@ -1,5 +1,6 @@
-"""The fault-identification study (experiments.fault_id): the estimator's window and correction by hand, the
-plant-knowing variants by hand, and the student flown in a batch against the benchmark's single env."""
+"""The fault-identification study (experiments.fault_id): the estimator's correction by hand, the
+plant-knowing variants by hand, the teachers and the students flown in a batch against the benchmark's single
+env (the shipped observer and law: tests/test_inversion_policy.py)."""
 
 from __future__ import annotations
 
@@ -7,23 +8,11 @@ import numpy as np
 import pytest
 import torch
 
-from experiments.fault_id.estimator import FEATURES, N_OBS, WINDOW, FaultIdPolicy, Window, corrected
+from experiments.fault_id.estimator import FEATURES, WINDOW, FaultIdPolicy, corrected
 from experiments.fault_id.privileges import VARIANTS, PlantKnown, specs
 from experiments.fault_id.train import condition, fit, fly
 from lvgym.benchmark.runner import play_episode
 from lvgym.errors import ConfigError
-
-
-def test_the_window_keeps_the_last_steps_oldest_first():
-    w = Window(2)
-    rows = np.array([1])
-    for k in range(WINDOW + 2):
-        w.push(rows, np.full((1, N_OBS), k, np.float32))
-        w.sent(rows, np.array([[10.0 + k, -k]], np.float32))
-    x = w.x[1]
-    assert x[-1, 0] == WINDOW + 1 and x[0, 0] == 2                 # the last WINDOW steps' observations
-    assert x[-1, N_OBS] == 10.0 + WINDOW and x[-1, N_OBS + 1] == -WINDOW   # with the action sent before them
-    assert np.all(w.x[0] == 0.0) and x.shape == (WINDOW, FEATURES)  # row 0 untouched
 
 
 def test_the_correction_by_hand():
@@ -79,31 +68,6 @@ def test_the_student_in_a_batch_flies_as_the_benchmark_flies_it():
         assert single["max_qalpha_pa_deg"] == pytest.approx(rec["max_qalpha_pa_deg"], rel=1e-6)
 
 
-def test_the_inversion_terms_and_command_by_hand():
-    from experiments.fault_id.inversion import A_MAX, command, law_terms
-    limit = 0.1
-    info = {"m_aero_b": np.array([[0.0, 2.0e4, -1.0e4], [0.0, 5.0, 5.0]]), "thrust": np.array([1.0e5, 0.0]),
-            "vectored_share": np.array([1.0, 1.0]), "gimbal_arm": np.array([2.0, 2.0]),
-            "actuator_effectiveness": np.array([[0.5, 1.0], [1.0, 1.0]]),
-            "misalignment": np.array([[0.01, -0.02], [0.0, 0.0]]), "J_b_diag": np.array([[1.0, 4.0e4, 3.0e6]] * 2),
-            "qalpha_pa_deg": np.array([1.0e5, 0.0]), "qalpha_limit_pa_deg": np.array([2.5e5, 2.5e5])}
-    t = law_terms(info, 2, limit)
-    lever = 2.0e5                                                    # T l [N m per rad]
-    np.testing.assert_allclose(t[0, :4], [0.1 / 0.5 / limit, -0.05 / limit, 0.01 / 0.5 / limit, -0.02 / limit])
-    np.testing.assert_allclose(t[0, 4:], [4.0e4 / lever / 0.5 / limit, A_MAX, 0.4])   # yaw's a at its ceiling
-    assert np.all(t[1] == 0.0) and np.all(law_terms({}, 2, limit) == 0.0)      # no thrust; the reset's info
-    obs = np.array([[0.1, -0.2, 0.01, 0.0]])                         # rate errors, attitude errors
-    w, z = 1.5, 1.0
-    alpha = np.array([-2 * z * w * 0.1 - w * w * 0.01, -2 * z * w * -0.2])
-    terms = np.array([[0.3, -0.1, 0.05, 0.0, 2.0, 1.0, 0.4]])      # below the relief's onset (0.5)
-    np.testing.assert_allclose(command(obs, terms, [0, 1, 2, 3], w, z)[0],
-                               [2.0 * alpha[0] - 0.3 - 0.05, 1.0 * alpha[1] + 0.1], rtol=1e-6)
-    terms[0, 6] = 0.7                                                # half-way: h = 0.5
-    half = np.array([-2 * z * w * 0.1 - 0.5 * w * w * 0.01, alpha[1]])
-    np.testing.assert_allclose(command(obs, terms, [0, 1, 2, 3], w, z)[0],
-                               [2.0 * half[0] - 0.15 - 0.05, 1.0 * half[1] + 0.05], rtol=1e-6)
-
-
 def test_the_inversion_teacher_is_the_reference_on_the_observation(monkeypatch):
     """The inversion scheme's teacher (the law on the true terms, batched; here without its exploration) flies
     as the privileged reference given the observation's errors, without its preview, one env row at a time."""
@@ -122,6 +86,7 @@ def test_the_inversion_teacher_is_the_reference_on_the_observation(monkeypatch):
 
 def test_the_inversion_student_in_a_batch_flies_as_the_benchmark_flies_it():
     from experiments.fault_id.inversion import InversionPolicy
+    from lvgym.agents.observer_fit import to_observer
     torch.manual_seed(0)
     short = {"mission_time_s": 3.0}
     x, y, _ = fly("rigid", [0, 1], None, np.random.default_rng(0), scheme="inversion", **short)
@@ -130,24 +95,8 @@ def test_the_inversion_student_in_a_batch_flies_as_the_benchmark_flies_it():
     _, _, batch = fly("rigid", [5, 6], est, scheme="inversion", **short)
     env = condition("rigid", **short).make_env()
     for seed, rec in zip([5, 6], batch):
-        single = play_episode(InversionPolicy(env, est), env, seed, flyability=True)
+        single = play_episode(InversionPolicy(env, to_observer(est)), env, seed, flyability=True)
         assert single["score_v2"] == pytest.approx(rec["score_v2"], rel=1e-6)
-
-
-def test_an_ensemble_is_the_mean_of_its_members_and_saves_whole(tmp_path):
-    from experiments.fault_id.estimator import Ensemble, Estimator, load, save
-    torch.manual_seed(0)
-    members = [Estimator(np.zeros(FEATURES), np.ones(FEATURES), hidden=8, outputs=3, label_mean=np.arange(3.0),
-                         label_std=np.full(3, 2.0)) for _ in range(3)]
-    x = torch.randn(4, WINDOW, FEATURES)
-    ens = Ensemble(members)
-    with torch.no_grad():
-        want = sum(m(x) for m in members) / 3
-        assert torch.allclose(ens(x), want, atol=1e-6)
-        save(ens, tmp_path / "e.pt")
-        assert torch.allclose(load(tmp_path / "e.pt")(x), want, atol=1e-6)
-        save(members[0], tmp_path / "one.pt")                     # one estimator: its own state
-        assert torch.allclose(load(tmp_path / "one.pt")(x), members[0](x))
 
 
 def test_a_loop_gain_labels_the_terms_as_the_action_must_carry_them(monkeypatch):

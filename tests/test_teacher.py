@@ -140,7 +140,7 @@ def test_classical_names_every_classical_baseline_a_suite_lists():
     got = suite_policies(["classical", "lqg", "zero"], "smile-v2-faults")
     assert got[:6] == ["gs-pid-flex", "gs-pid-flex-quiet", "aac-quiet", "lqg", "lqg-front", "gs-pd-relief"]
     assert got[6:] == ["zero"]
-    assert "privileged" not in got and "ppo-res-lqg" not in got
+    assert "privileged" not in got and "ppo-res-lqg" not in got and "inversion-id" not in got
     with pytest.raises(ConfigError, match="lists none"):
         suite_policies(["classical"], "smile-windy")
 
@@ -148,8 +148,8 @@ def test_classical_names_every_classical_baseline_a_suite_lists():
 def test_learned_names_the_shipped_learned_policies_a_suite_lists():
     from lvgym.agents.datasets import suite_policies
 
-    assert suite_policies(["learned"], "smile-v2-faults") == ["ppo-res-lqg"]
-    assert suite_policies(["classical", "learned"], "smile-v2")[-1] == "ppo-res-lqg"
+    assert suite_policies(["learned"], "smile-v2-faults") == ["ppo-res-lqg", "inversion-id"]
+    assert suite_policies(["classical", "learned"], "smile-v2")[-2:] == ["ppo-res-lqg", "inversion-id"]
     assert suite_policies(["learned"], "stratos-tvc-v2") == []          # no learned policy is made for it
 
 

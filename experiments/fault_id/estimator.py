@@ -3,11 +3,13 @@ the misalignment a network reads from the last half second of flight signals.
 
 The fault suite's room for ``lqg`` is knowing the thrust's direction (README.md, :mod:`.privileges`): ``lqg``
 given the true misalignment, ``delta = delta_lqg - misalignment``, fails 2 of 100 validation flights where
-``lqg`` fails 7. :class:`Estimator` learns that misalignment from what a flight computer has: a window of
-:data:`WINDOW` control steps of the env's observation (14 entries) and of the two actions it sent
-(:data:`FEATURES`). :class:`FaultIdPolicy` flies ``lqg`` (its own Kalman filter sees its own command, as if
-the thrust went where the gimbal points) and subtracts the estimate, in units of the gimbal limit, once past a
-dead band (:data:`DEADBAND`, :func:`corrected`).
+``lqg`` fails 7. An :class:`~lvgym.agents.observer_fit.Estimator` learns that misalignment from what a flight
+computer has: a window of :data:`~lvgym.agents.observer.WINDOW` control steps of the env's observation (14
+entries) and of the two actions it sent (the shipped observer's features, :mod:`lvgym.agents.observer`;
+the network of :mod:`lvgym.agents.observer_fit`).
+:class:`FaultIdPolicy` flies ``lqg`` (its own Kalman filter sees its own command, as if the thrust went where
+the gimbal points) and subtracts the estimate, in units of the gimbal limit, once past a dead band
+(:data:`DEADBAND`, :func:`corrected`).
 """
 
 from __future__ import annotations
@@ -16,61 +18,18 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import torch
-from torch import nn
 
-#: the control steps the estimator reads (0.5 s at SMILE's 0.02 s)
-WINDOW = 25
-#: one step's features: the env's observation (its ``observation_layout``: the 14 entries of SMILE's v1 env,
-#: ``roll_rate`` .. ``pitch_rate_reference``) then the action sent (pitch, yaw)
-ACTIONS = ("action_pitch", "action_yaw")
-N_OBS = 14
-FEATURES = N_OBS + len(ACTIONS)
+from lvgym.agents.observer import FEATURES, N_OBS, WINDOW, Window
+from lvgym.agents.observer_fit import Ensemble, Estimator, load, save
+
+__all__ = ["DEADBAND", "FEATURES", "N_OBS", "RESULTS", "WINDOW", "Ensemble", "Estimator", "FaultIdPolicy", "Window",
+           "base_lqg", "corrected", "from_file", "load", "save"]
+
 #: where :mod:`.train` writes a training seed's estimator
 RESULTS = Path("results") / "fault_id"
 #: the dead band of the correction the seeded policies fly [over the gimbal limit]: the best of 0, 0.04 and
 #: 0.08 for each of the three training seeds on validation seeds 0-99 (``python -m experiments.fault_id.deadband``)
 DEADBAND = 0.04
-
-
-class Estimator(nn.Module):
-    """``(B, WINDOW, FEATURES)`` features -> ``(B, outputs)`` labels: the misalignment (pitch, yaw) over the
-    gimbal limit (this module's policy), or the law's terms of :mod:`.inversion`; the features standardised by
-    the training set's per-feature ``mean`` and ``std``, the labels by ``label_mean`` and ``label_std`` (none:
-    as they are)."""
-
-    def __init__(self, mean: np.ndarray, std: np.ndarray, hidden: int = 256, outputs: int = 2,
-                 label_mean: np.ndarray | None = None, label_std: np.ndarray | None = None) -> None:
-        super().__init__()
-        self.register_buffer("mean", torch.as_tensor(mean, dtype=torch.float32))
-        self.register_buffer("std", torch.as_tensor(std, dtype=torch.float32))
-        self.register_buffer("label_mean", torch.as_tensor(np.zeros(outputs) if label_mean is None else label_mean,
-                                                           dtype=torch.float32))
-        self.register_buffer("label_std", torch.as_tensor(np.ones(outputs) if label_std is None else label_std,
-                                                          dtype=torch.float32))
-        self.net = nn.Sequential(nn.Linear(WINDOW * FEATURES, hidden), nn.Tanh(), nn.Linear(hidden, hidden), nn.Tanh(),
-                                 nn.Linear(hidden, outputs))
-
-    def forward(self, window: torch.Tensor) -> torch.Tensor:
-        return self.net(((window - self.mean) / self.std).flatten(1)) * self.label_std + self.label_mean
-
-
-class Window:
-    """The last :data:`WINDOW` steps' features of ``n`` rows (zeros before the first), oldest first."""
-
-    def __init__(self, n: int) -> None:
-        self.x = np.zeros((n, WINDOW, FEATURES), dtype=np.float32)
-        self.last_action = np.zeros((n, len(ACTIONS)), dtype=np.float32)
-
-    def push(self, rows: np.ndarray, observations: np.ndarray) -> np.ndarray:
-        """Add the step's observations of ``rows`` (with the actions they sent last) and return their windows."""
-        self.x[rows, :-1] = self.x[rows, 1:]
-        self.x[rows, -1, :N_OBS] = observations
-        self.x[rows, -1, N_OBS:] = self.last_action[rows]
-        return self.x[rows]
-
-    def sent(self, rows: np.ndarray, actions: np.ndarray) -> None:
-        self.last_action[rows] = actions
 
 
 def corrected(base: np.ndarray, estimate: np.ndarray, deadband: float = 0.0) -> np.ndarray:
@@ -115,46 +74,13 @@ class FaultIdPolicy:
         rows = np.zeros(1, dtype=np.int64)
         base = np.asarray(self.base.act(observation, info), dtype=np.float64)
         w = self.window.push(rows, np.asarray(observation, dtype=np.float32)[None])
+        import torch
+
         with torch.no_grad():
             estimate = self.estimator(torch.as_tensor(w)).numpy()[0].astype(np.float64)
         a = corrected(base, estimate, self.deadband)
         self.window.sent(rows, a[None])
         return a
-
-
-class Ensemble(nn.Module):
-    """The mean of several estimators' outputs (the fits of a training seed's last DAgger rounds: each round's
-    fit errs differently, and their mean errs less in closed loop, README.md)."""
-
-    def __init__(self, members: list[Estimator]) -> None:
-        super().__init__()
-        self.members = nn.ModuleList(members)
-
-    def forward(self, window: torch.Tensor) -> torch.Tensor:
-        return torch.stack([m(window) for m in self.members]).mean(0)
-
-
-def save(estimator: Estimator | Ensemble, path: str | Path) -> None:
-    """Write ``estimator`` (an :class:`Ensemble`: its members' states in one file) for :func:`load`."""
-    members = estimator.members if isinstance(estimator, Ensemble) else None
-    torch.save({"members": [m.state_dict() for m in members]} if members is not None else estimator.state_dict(),
-               path)
-
-
-def _one(state: dict[str, torch.Tensor]) -> Estimator:
-    outputs = int(state["net.4.bias"].shape[0])
-    state.setdefault("label_mean", torch.zeros(outputs))          # saved before the labels were scaled
-    state.setdefault("label_std", torch.ones(outputs))
-    est = Estimator(state["mean"].numpy(), state["std"].numpy(), hidden=int(state["net.0.bias"].shape[0]),
-                    outputs=outputs)
-    est.load_state_dict(state)
-    return est
-
-
-def load(path: str | Path) -> Estimator | Ensemble:
-    """An estimator, or an ensemble of them, saved by :mod:`.train` (:func:`save`)."""
-    state = torch.load(path, map_location="cpu", weights_only=True)
-    return Ensemble([_one(m) for m in state["members"]]) if "members" in state else _one(state)
 
 
 def _seeded(k: int):

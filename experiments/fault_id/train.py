@@ -8,20 +8,21 @@
 
 1. **Teacher's flights** on ``smile-v2-faults`` (both flight models, ``--flights`` each, training seeds
    ``100000 + 10000 seed ...``: neither validation nor test seeds), every step recorded as the student sees
-   it (:class:`.estimator.Window`) with its label (:class:`ThrustScheme`, :class:`InversionScheme`):
+   it (:class:`lvgym.agents.observer.Window`) with its label (:class:`ThrustScheme`, :class:`InversionScheme`):
 
    - ``thrust``: ``lqg`` with the true misalignment (the env's privileged info) subtracted from its
      command, known late by a delay drawn per flight from :data:`DELAYS` (never known, for one flight in
      six), so the flights cover the states before and after the correction; label: the true misalignment
      over the gimbal limit.
-   - ``inversion``: the reference's law on the true terms (:func:`.inversion.law_terms`), its action with an
-     exploration noise of a standard deviation drawn per flight from :data:`NOISE` (else the action sent
-     last holds the label, and the student reads it back from its own action); label: the true terms.
-2. **Regression.** :class:`.estimator.Estimator` fitted by mean squared error (Adam, ``--epochs``; the
+   - ``inversion``: the reference's law on the true terms (:func:`lvgym.agents.inversion.law_terms`), its
+     action with an exploration noise of a standard deviation drawn per flight from :data:`NOISE` (else the
+     action sent last holds the label, and the student reads it back from its own action); label: the true
+     terms.
+2. **Regression.** :class:`lvgym.agents.observer_fit.Estimator` fitted by mean squared error (Adam, ``--epochs``; the
    inversion's labels standardised).
 3. **DAgger rounds** (``--rounds``): the student flies half as many flights again, labelled the same way,
    added to the data, and the estimator is fitted again. The thrust scheme's policy is the last fit; the
-   inversion's the mean of the last three fits (:class:`.estimator.Ensemble`).
+   inversion's the mean of the last three fits (:class:`lvgym.agents.observer_fit.Ensemble`).
 
 After each fit the student flies validation seeds ``0 .. --validation - 1`` of both flight models and the
 mean ``score_v2`` and its failed or unflyable flights are printed (``lqg``: 0.994 (6) rigid, 1.109 (7)
@@ -40,10 +41,12 @@ from typing import Any
 import numpy as np
 import torch
 
+from lvgym.agents.inversion import TERMS, command, error_index, gains, law_terms
+from lvgym.agents.observer import Window
+from lvgym.agents.observer_fit import Ensemble, Estimator, save
 from lvgym.cli.args import arg, parse
 
-from .estimator import RESULTS, Ensemble, Estimator, Window, base_lqg, corrected, save
-from .inversion import TERMS, command, error_index, gains, law_terms
+from .estimator import RESULTS, base_lqg, corrected
 
 #: the teacher's delays [control steps] of its knowledge of the misalignment (0-2 s at 0.02 s; the last: never)
 DELAYS = (0, 12, 25, 50, 100, None)
@@ -91,8 +94,8 @@ class ThrustScheme:
 
 
 class InversionScheme:
-    """The law of :mod:`.inversion` on the true terms (the teacher) or the student's estimate; labels: the true
-    terms (:func:`.inversion.law_terms`)."""
+    """The law of :mod:`lvgym.agents.inversion` on the true terms (the teacher) or the student's estimate;
+    labels: the true terms (:func:`lvgym.agents.inversion.law_terms`)."""
 
     prefix, outputs, scaled, ensemble = "inversion", len(TERMS), True, 3
 
@@ -206,7 +209,8 @@ def validate(est: Estimator | Ensemble, episodes: int, deadband: float = 0.0,
              scheme: str = "thrust") -> dict[str, tuple[float, int]]:
     """Mean ``score_v2`` and failed or unflyable flights of the student on validation seeds ``0 ..
     episodes - 1`` per flight model (:func:`fly`: the rows of one batched env; the benchmark flies the same
-    law one row at a time through :class:`.estimator.FaultIdPolicy`)."""
+    law one row at a time through :class:`.estimator.FaultIdPolicy` or
+    :class:`lvgym.agents.inversion.InversionPolicy`)."""
     out = {}
     for model in ("rigid", "nonrigid"):
         rs = [r for k in range(0, episodes, 100)

@@ -242,10 +242,10 @@ PROTOCOL_V2 = "v2"
 V2_FAULT_KINDS = ("effectiveness", "bandwidth", "thrust", "gyro_bias", "misalignment")
 #: the policies v2 reports on SMILE: no control, the flex design that breaks the flyability rule and its quiet
 #: redesigns, the LQG family, the soft loop without integral made for the max-q gust (added 2026-12-05 with
-#: issue 35's finding; the suites, seeds and fingerprints unchanged), the shipped learned policy and the
-#: privileged reference
+#: issue 35's finding; the suites, seeds and fingerprints unchanged), the shipped learned policies (v1's
+#: residual PPO; ``inversion-id``, trained on the faults, added 2026-12-06 likewise) and the privileged reference
 V2_SMILE_POLICIES = ("zero", "gs-pid-flex", "gs-pid-flex-quiet", "aac-quiet", "lqg", "lqg-front", "gs-pd-relief",
-                     "ppo-res-lqg", "privileged")
+                     "ppo-res-lqg", "inversion-id", "privileged")
 #: ... on Stratos III (no LQG or learned policy is made for it)
 V2_STRATOS_POLICIES = ("zero", "gs-pid-flex", "gs-pid-flex-quiet", "aac-quiet", "privileged")
 #: ... on the slender vehicle (its one design, the load-relief gs-pid-flex, has no quiet version that flies)

@@ -1,0 +1,205 @@
+"""``inversion-id``: the privileged reference's law flown on what a learned observer estimates of the plant
+and of the aerodynamic moment from a flight computer's signals (a learned disturbance observer; issue 35's
+shipped policy for ``smile-v2-faults``, docs/training-results.md).
+
+The privileged reference (:mod:`lvgym.baselines.privileged`) inverts the rigid body: per axis it commands the
+gimbal angle whose thrust moment gives a second-order attitude loop's angular acceleration and cancels the
+aerodynamic moment, less the thrust misalignment, over the actuator's effectiveness, with load relief. Flown
+on the observation's rate and attitude errors, without its wind preview, it needs per axis (pitch, yaw)
+three numbers of the plant and one of the flight (:data:`TERMS`, :func:`law_terms`):
+
+- ``f_aero = M_aero / (T l eff)`` and ``f_mis = misalignment / eff``, the gimbal angles that cancel the
+  aerodynamic moment and the misalignment (over the gimbal limit);
+- ``a = J / (T l eff)``, the gimbal angle per rad/s^2 of angular acceleration (the inverse of the control
+  power, over the gimbal limit; 0 without thrust, where the law commands nothing);
+- ``share``, the q-alpha over its limit (one for both axes);
+
+and commands ``delta = a alpha - h f_aero - f_mis`` with ``alpha = -2 zeta w e_rate - h w^2 e_att``
+(:func:`command`; ``w``, ``zeta``: the reference's :data:`~lvgym.baselines.privileged.GAINS` of the flight
+model; ``h``: the reference's relief, :func:`~lvgym.baselines.privileged.relief_hold`). The env knows the terms
+(its ``privileged_info``); a flight computer does not. :class:`InversionPolicy` flies the law with them
+estimated by a :class:`~lvgym.agents.observer.Estimator` (an :class:`~lvgym.agents.observer.Ensemble`) from the
+last :data:`~lvgym.agents.observer.WINDOW` steps of observations and actions sent. It is causal: it reads
+the observation only.
+
+The shipped observer (:data:`SHIPPED`, ``agents/trained``) was trained on SMILE's fault suite, both flight
+models, with the reference's law on the true terms as the teacher and DAgger rounds
+(``python -m experiments.fault_id.train --scheme inversion``); the policy refuses an env it was not trained
+for (:func:`check_env`).
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from lvgym.errors import ConfigError
+
+from .observer import N_OBS, Observer, Window
+
+__all__ = ["SHIPPED", "TERMS", "InversionBatch", "InversionPolicy", "command", "law_terms", "shipped_inversion"]
+
+#: the law's terms, in the order of :func:`law_terms`
+TERMS = ("f_aero_pitch", "f_aero_yaw", "f_mis_pitch", "f_mis_yaw", "a_pitch", "a_yaw", "qalpha_share")
+#: the labels' ceiling of ``a`` [gimbal limits per rad/s^2]: the thrust's tail-off would send it to infinity
+A_MAX = 5.0
+#: the observation's entries the law reads (SMILE's flight observation)
+ERRORS = ("pitch_rate_error", "yaw_rate_error", "pitch_attitude_error", "yaw_attitude_error")
+#: the lever [N m per rad of gimbal] under which the law commands nothing (the privileged reference's)
+NO_THRUST = 1.0
+#: the shipped observer (``<stem>.npz``) and its record (``<stem>.json``: how it was trained, the env)
+SHIPPED = "inversion_id_smile_v2_faults"
+TRAINED = Path(__file__).resolve().parent / "trained"
+
+
+def law_terms(info: dict[str, Any], n: int, limit: float) -> np.ndarray:
+    """``(n, 7)``: :data:`TERMS` of the module docstring (``f_aero``, ``f_mis`` over the gimbal limit ``limit``
+    [rad], ``a`` [gimbal limits per rad/s^2], ``share`` [-]) from a privileged step's info of ``n`` rows (zeros
+    without thrust, or before the first step). The observer's labels."""
+    out = np.zeros((n, len(TERMS)))
+    if "m_aero_b" not in info:                               # the reset's info
+        return out
+    lever = (np.asarray(info["thrust"], dtype=float) * np.asarray(info.get("vectored_share", 1.0), dtype=float)
+             * np.asarray(info["gimbal_arm"], dtype=float)).reshape(n)
+    on = lever >= NO_THRUST
+    eff = np.maximum(np.asarray(info["actuator_effectiveness"], dtype=float).reshape(n, 2), 0.1)
+    m_aero = np.asarray(info["m_aero_b"], dtype=float).reshape(n, 3)[:, 1:]
+    mis = np.asarray(info["misalignment"], dtype=float).reshape(n, 2)
+    J = np.asarray(info["J_b_diag"], dtype=float).reshape(n, 3)[:, 1:]
+    safe = np.where(on, lever, 1.0)[:, None]
+    out[on, 0:2] = (m_aero / safe / eff / limit)[on]
+    out[on, 2:4] = (mis / eff / limit)[on]
+    out[on, 4:6] = np.minimum(J / (safe * eff) / limit, A_MAX)[on]
+    out[:, 6] = (np.asarray(info["qalpha_pa_deg"], dtype=float) / np.asarray(info["qalpha_limit_pa_deg"], dtype=float)
+                 ).reshape(n)
+    return out
+
+
+def command(observations: np.ndarray, terms: np.ndarray, index: list[int], w: float, z: float) -> np.ndarray:
+    """The law's action (module docstring) within [-1, 1] for ``(n, 14)`` observations (``index``: the
+    positions of :data:`ERRORS`) and ``(n, 7)`` terms (:func:`law_terms`, true or estimated); ``w`` [rad/s]
+    and ``z`` [-]: the attitude loop's bandwidth and damping."""
+    from lvgym.baselines.privileged import RELIEF, relief_hold
+
+    o = np.asarray(observations, dtype=np.float64)
+    e_rate, e_att = o[:, index[:2]], o[:, index[2:]]
+    hold = relief_hold(terms[:, 6:7], *RELIEF)
+    alpha = -2.0 * z * w * e_rate - hold * w * w * e_att
+    return np.clip(terms[:, 4:6] * alpha - hold * terms[:, 0:2] - terms[:, 2:4], -1.0, 1.0).astype(np.float32)
+
+
+def gains(env: Any) -> tuple[float, float]:
+    """The reference's (bandwidth [rad/s], damping) for ``env``'s flight model."""
+    from lvgym.baselines.privileged import GAINS
+
+    return GAINS["rigid" if env.unwrapped.func.spec.model == "rigid" else "nonrigid"]
+
+
+def error_index(env: Any) -> list[int]:
+    """Where :data:`ERRORS` sit in ``env``'s observation."""
+    names = list(env.unwrapped.func.observation_layout.names)
+    missing = [n for n in ERRORS if n not in names]
+    if missing:
+        raise ConfigError("env observation", names, f"an observation with {list(ERRORS)} (the law's errors)")
+    return [names.index(n) for n in ERRORS]
+
+
+def env_record(env: Any) -> dict[str, Any]:
+    """What of ``env`` the observer's features depend on: the vehicle, the observation, its history, the
+    control and the control period [s]."""
+    spec = env.unwrapped.func.spec
+    return {"vehicle": spec.vehicle, "observation": spec.sensors.observation, "history": spec.sensors.history,
+            "control": spec.actuator.control, "control_dt_s": spec.timing.control_dt_s}
+
+
+def check_env(env: Any, trained: dict[str, Any]) -> None:
+    """Refuse ``env`` when it differs from the env the observer was trained on (``trained``: its
+    :func:`env_record`) in anything its features depend on, naming the key."""
+    for key, value in env_record(env).items():
+        if key in trained and trained[key] != value:
+            raise ConfigError(f"inversion-id env {key}", value, f"{trained[key]!r}: the observer was trained on it")
+    if tuple(env.observation_space.shape) != (N_OBS,):
+        raise ConfigError("env observation", list(env.observation_space.shape),
+                          f"({N_OBS},): the observer reads SMILE's flight observation")
+
+
+class InversionPolicy:
+    """The law of the module docstring on the observer's estimated terms; one env row (the benchmark's
+    policy; no privileged information). ``observer``: a window ``(WINDOW, FEATURES)`` -> the terms ``(7,)``
+    (an :class:`~lvgym.agents.observer.Observer`); ``trained``: the :func:`env_record` it was trained on (it
+    refuses another env: :func:`check_env`)."""
+
+    def __init__(self, env: Any, observer: Callable[[np.ndarray], np.ndarray], name: str = "inversion-id",
+                 trained: dict[str, Any] | None = None) -> None:
+        check_env(env, trained or {})
+        self.observer = observer
+        self.name = name
+        self.index, (self.w, self.z) = error_index(env), gains(env)
+        self.window = Window(1)
+
+    def reset(self) -> None:
+        """Forget the flight: the window starts from zeros."""
+        self.window = Window(1)
+
+    def act(self, observation: np.ndarray, info: dict[str, Any]) -> np.ndarray:
+        """The gimbal action (pitch, yaw) in [-1, 1] from the observation (``info`` is not read)."""
+        return InversionBatch.step(self, np.zeros(1, dtype=np.int64), np.asarray(observation)[None])[0]
+
+    def batch(self, n: int) -> InversionBatch:
+        """The same policy for ``n`` rows of a batched env (each row's actions are its single env's, to the bit)."""
+        return InversionBatch(self, n)
+
+
+class InversionBatch:
+    """:class:`InversionPolicy` for the rows of a batched env (the interface of :mod:`lvgym.benchmark.batch`):
+    one window per row, the observer on each row's window, the law on the rows at once (elementwise: a row's
+    action does not depend on the others)."""
+
+    def __init__(self, policy: InversionPolicy, n: int) -> None:
+        self.name, self.observer = policy.name, policy.observer
+        self.index, self.w, self.z = policy.index, policy.w, policy.z
+        self.window = Window(int(n))
+
+    def reset(self, rows: Any) -> None:
+        self.window.reset(np.asarray(rows, dtype=np.int64).reshape(-1))
+
+    def act(self, rows: Any, observations: np.ndarray, info: dict[str, Any]) -> np.ndarray:
+        return self.step(self, np.asarray(rows, dtype=np.int64).reshape(-1), np.asarray(observations))
+
+    @staticmethod
+    def step(law: InversionPolicy | InversionBatch, rows: np.ndarray, observations: np.ndarray) -> np.ndarray:
+        """The actions of ``rows`` for their ``(len(rows), 14)`` observations, their windows moved on by one."""
+        o = np.asarray(observations, dtype=np.float32)
+        windows = law.window.push(rows, o)
+        terms = np.stack([law.observer(w) for w in windows])
+        a = command(o, terms, law.index, law.w, law.z)
+        law.window.sent(rows, a)
+        return a
+
+
+def from_file(env: Any, path: str | Path, name: str = "inversion-id", trained: dict[str, Any] | None = None
+              ) -> InversionPolicy:
+    """The policy on the observer saved at ``path``: an :class:`~lvgym.agents.observer.Observer`'s ``.npz``, or
+    a training run's torch ``.pt`` (:func:`lvgym.agents.observer_fit.load`; needs torch)."""
+    if Path(path).suffix == ".pt":
+        from .observer_fit import load, to_observer
+
+        return InversionPolicy(env, to_observer(load(path)), name=name, trained=trained)
+    return InversionPolicy(env, Observer.load(path), name=name, trained=trained)
+
+
+def shipped_inversion(env: Any, name: str = "inversion-id", file: str = SHIPPED) -> InversionPolicy:
+    """The shipped policy: ``agents/trained/<file>.npz`` flown on ``env`` (refused unless it is the env of
+    ``<file>.json``'s ``env``)."""
+    weights, record = TRAINED / f"{file}.npz", TRAINED / f"{file}.json"
+    if not weights.is_file() or not record.is_file():
+        raise FileNotFoundError(f"the shipped policy {str(weights)!r} or its record is missing "
+                                "(docs/training-results.md)")
+    return from_file(env, weights, name=name, trained=json.loads(record.read_text())["env"])
+
+
+shipped_inversion.kind = from_file.kind = "learned"  # type: ignore[attr-defined]

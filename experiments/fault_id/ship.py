@@ -1,0 +1,96 @@
+"""Choose the shipped ``inversion-id`` among the training seeds on the validation seeds, and write it with its
+record into ``agents/trained`` (:data:`lvgym.agents.inversion.SHIPPED`).
+
+    python -m experiments.fault_id.ship --prefix inversion-gain6 --seeds 0 1 2 --validation 100
+
+Each seed's observer (``results/fault_id/<prefix>-s<k>.pt``, written by :mod:`.train`) is converted to the
+flight computer's NumPy form (``<prefix>-s<k>.npz``, :func:`lvgym.agents.observer_fit.to_observer`) and flown
+by the benchmark (:func:`lvgym.benchmark.evaluate`, as the shipped policy flies) on validation seeds
+``0 .. --validation - 1`` of ``smile-v2-faults``, both flight models; the shipped one is the seed with the
+fewest failed or unflyable non-rigid flights, then the lowest non-rigid mean ``score_v2``. The test seeds are
+not flown. The record (``<stem>.json``) holds the training command, the validation of every candidate, the
+choice, the env the observer was trained on (:func:`lvgym.agents.inversion.env_record`, which the policy
+checks) and the observer file's SHA-256.
+"""
+
+from __future__ import annotations
+
+import datetime
+import hashlib
+import json
+import shutil
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from lvgym.agents.inversion import SHIPPED, TRAINED, env_record
+from lvgym.agents.observer_fit import load, to_observer
+from lvgym.benchmark import PolicySpec, evaluate, get_suite
+from lvgym.cli.args import arg, parse
+
+from .estimator import RESULTS
+from .train import SUITE, condition
+
+
+@dataclass
+class Args:
+    """Command-line arguments (``python -m experiments.fault_id.ship --help``)."""
+
+    prefix: str = arg("inversion-gain6")
+    """the training runs' file prefix in results/fault_id (``inversion``: no loop dispersion)"""
+    seeds: list[int] = arg(default_factory=lambda: [0, 1, 2], metavar="SEED")
+    """the training seeds to choose from"""
+    validation: int = arg(100, lo=10, hi=1000)
+    """validation seeds flown per flight model"""
+    loop_gain_db: float = arg(6.0, lo=0.0, hi=12.0)
+    """the loop dispersion the runs were trained under (recorded)"""
+
+
+def validation(path: str, episodes: int) -> dict[str, dict[str, float]]:
+    """Per flight model, the mean ``score_v2`` and the failed or unflyable flights of the observer at ``path``
+    (``.npz``) on ``smile-v2-faults``'s first ``episodes`` validation seeds, flown by the benchmark."""
+    spec = PolicySpec("inversion-id", "lvgym.agents.inversion:from_file", (("path", path),))
+    records = evaluate([spec], [get_suite(SUITE)], episodes, seed_set="validation", progress=False)
+    out = {}
+    for model in ("rigid", "nonrigid"):
+        rs = [r for r in records if r["condition"].endswith(model)]
+        out[model] = {"score_v2_mean": float(np.mean([r["score_v2"] for r in rs])),
+                      "failed_or_unflyable": sum(bool(r["failed"] or not r["flyable"]) for r in rs)}
+    return out
+
+
+def main(argv: Sequence[str] | None = None) -> None:
+    a = parse(Args, argv, "python -m experiments.fault_id.ship", __doc__)
+    candidates = {}
+    for k in a.seeds:
+        npz = RESULTS / f"{a.prefix}-s{k}.npz"
+        to_observer(load(RESULTS / f"{a.prefix}-s{k}.pt")).save(npz)
+        candidates[k] = validation(str(npz.resolve()), a.validation)
+        print(f"seed {k}: " + ", ".join(f"{m} {v['score_v2_mean']:.3f} ({v['failed_or_unflyable']})"
+                                         for m, v in candidates[k].items()), flush=True)
+    best = min(candidates, key=lambda k: (candidates[k]["nonrigid"]["failed_or_unflyable"],
+                                          candidates[k]["nonrigid"]["score_v2_mean"]))
+    source = RESULTS / f"{a.prefix}-s{best}.npz"
+    target = TRAINED / f"{SHIPPED}.npz"
+    shutil.copyfile(source, target)
+    record = {
+        "policy": "inversion-id",
+        "suite": SUITE,
+        "env": env_record(condition("nonrigid").make_env()),
+        "training": {"command": f"python -m experiments.fault_id.train --scheme inversion --seed {best} --flights 100 "
+                                f"--rounds 4 --validation 50" + (f" --loop-gain-db {a.loop_gain_db:g}"
+                                                                 if a.loop_gain_db else ""),
+                     "seeds": list(a.seeds), "file": f"{a.prefix}-s{best}.pt"},
+        "validation": {"seeds": f"0-{a.validation - 1}", "candidates": {str(k): v for k, v in candidates.items()},
+                       "selection": "fewest failed or unflyable non-rigid flights, then the lowest non-rigid mean "
+                                    "score_v2", "chosen": best},
+        "sha256": hashlib.sha256(target.read_bytes()).hexdigest(),
+        "date": datetime.date.today().isoformat(),
+    }
+    (TRAINED / f"{SHIPPED}.json").write_text(json.dumps(record, indent=1, sort_keys=True) + "\n")
+    print(f"shipped seed {best} as {target} (record {SHIPPED}.json)")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,158 @@
+"""The shipped disturbance-observer policy ``inversion-id`` (lvgym.agents.inversion, lvgym.agents.observer):
+the observer's window, the law's terms and command by hand, the NumPy observer against the torch network it
+was fitted as, the shipped file against its record, the envs it refuses, its batch against its single env to
+the bit, and that it flies without torch."""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+import torch
+
+import lvgym
+import lvgym.cli.policies  # noqa: F401  (registers the built-in policies)
+from lvgym.agents.inversion import (A_MAX, SHIPPED, TERMS, TRAINED, InversionPolicy, command, env_record, from_file,
+                                    law_terms)
+from lvgym.agents.observer import FEATURES, N_OBS, WINDOW, Observer, Window
+from lvgym.agents.observer_fit import Ensemble, Estimator, load, save, to_observer
+from lvgym.benchmark.headline import policy_kind
+from lvgym.benchmark.registry import resolve_policy
+from lvgym.benchmark.runner import build_policy, play_episode
+from lvgym.errors import ConfigError
+
+
+def _ensemble(outputs: int = len(TERMS), hidden: int = 8, k: int = 3) -> Ensemble:
+    torch.manual_seed(0)
+    rng = np.random.default_rng(1)
+    return Ensemble([Estimator(rng.normal(0.0, 0.1, FEATURES), rng.uniform(0.5, 2.0, FEATURES), hidden=hidden,
+                               outputs=outputs, label_mean=rng.normal(0.0, 0.1, outputs),
+                               label_std=rng.uniform(0.05, 0.5, outputs)) for _ in range(k)])
+
+
+def test_the_window_keeps_the_last_steps_oldest_first():
+    w = Window(2)
+    rows = np.array([1])
+    for k in range(WINDOW + 2):
+        w.push(rows, np.full((1, N_OBS), k, np.float32))
+        w.sent(rows, np.array([[10.0 + k, -k]], np.float32))
+    x = w.x[1]
+    assert x[-1, 0] == WINDOW + 1 and x[0, 0] == 2                 # the last WINDOW steps' observations
+    assert x[-1, N_OBS] == 10.0 + WINDOW and x[-1, N_OBS + 1] == -WINDOW   # with the action sent before them
+    assert np.all(w.x[0] == 0.0) and x.shape == (WINDOW, FEATURES)  # row 0 untouched
+    w.reset(rows)
+    assert not w.x.any() and not w.last_action.any()
+
+
+def test_the_terms_and_the_command_by_hand():
+    limit = 0.1
+    info = {"m_aero_b": np.array([[0.0, 2.0e4, -1.0e4], [0.0, 5.0, 5.0]]), "thrust": np.array([1.0e5, 0.0]),
+            "vectored_share": np.array([1.0, 1.0]), "gimbal_arm": np.array([2.0, 2.0]),
+            "actuator_effectiveness": np.array([[0.5, 1.0], [1.0, 1.0]]),
+            "misalignment": np.array([[0.01, -0.02], [0.0, 0.0]]), "J_b_diag": np.array([[1.0, 4.0e4, 3.0e6]] * 2),
+            "qalpha_pa_deg": np.array([1.0e5, 0.0]), "qalpha_limit_pa_deg": np.array([2.5e5, 2.5e5])}
+    t = law_terms(info, 2, limit)
+    lever = 2.0e5                                                    # T l [N m per rad]
+    np.testing.assert_allclose(t[0, :4], [0.1 / 0.5 / limit, -0.05 / limit, 0.01 / 0.5 / limit, -0.02 / limit])
+    np.testing.assert_allclose(t[0, 4:], [4.0e4 / lever / 0.5 / limit, A_MAX, 0.4])   # yaw's a at its ceiling
+    assert np.all(t[1] == 0.0) and np.all(law_terms({}, 2, limit) == 0.0)      # no thrust; the reset's info
+    obs = np.array([[0.1, -0.2, 0.01, 0.0]])                         # rate errors, attitude errors
+    w, z = 1.5, 1.0
+    alpha = np.array([-2 * z * w * 0.1 - w * w * 0.01, -2 * z * w * -0.2])
+    terms = np.array([[0.3, -0.1, 0.05, 0.0, 2.0, 1.0, 0.4]])      # below the relief's onset (0.5)
+    np.testing.assert_allclose(command(obs, terms, [0, 1, 2, 3], w, z)[0],
+                               [2.0 * alpha[0] - 0.3 - 0.05, 1.0 * alpha[1] + 0.1], rtol=1e-6)
+    terms[0, 6] = 0.7                                                # half-way: h = 0.5
+    half = np.array([-2 * z * w * 0.1 - 0.5 * w * w * 0.01, alpha[1]])
+    np.testing.assert_allclose(command(obs, terms, [0, 1, 2, 3], w, z)[0],
+                               [2.0 * half[0] - 0.15 - 0.05, 1.0 * half[1] + 0.05], rtol=1e-6)
+
+
+def test_an_ensemble_is_the_mean_of_its_members_and_saves_whole(tmp_path):
+    ens = _ensemble(outputs=3)
+    members = list(ens.members)
+    x = torch.randn(4, WINDOW, FEATURES)
+    with torch.no_grad():
+        want = sum(m(x) for m in members) / 3
+        assert torch.allclose(ens(x), want, atol=1e-6)
+        save(ens, tmp_path / "e.pt")
+        assert torch.allclose(load(tmp_path / "e.pt")(x), want, atol=1e-6)
+        save(members[0], tmp_path / "one.pt")                     # one estimator: its own state
+        assert torch.allclose(load(tmp_path / "one.pt")(x), members[0](x))
+
+
+def test_the_numpy_observer_is_the_fitted_network(tmp_path):
+    """The flight computer's fused NumPy forward against torch's, over windows of the features' scale; its
+    file round trip to the bit."""
+    ens = _ensemble(hidden=32)
+    x = np.random.default_rng(2).normal(0.0, 1.0, (16, WINDOW, FEATURES)).astype(np.float32)
+    with torch.no_grad():
+        want = ens(torch.as_tensor(x)).numpy()
+    obs = to_observer(ens)
+    got = np.stack([obs(w) for w in x])
+    assert got.shape == (16, len(TERMS)) and got.dtype == np.float64
+    np.testing.assert_allclose(got, want, rtol=1e-5, atol=1e-6)
+    obs.save(tmp_path / "o.npz")
+    again = Observer.load(tmp_path / "o.npz")
+    assert all(np.array_equal(again(w), obs(w)) for w in x)
+    with pytest.raises(FileNotFoundError, match="no observer file"):
+        Observer.load(tmp_path / "missing.npz")
+    with pytest.raises(ValueError, match="features"):
+        Observer([{k: (v[:, :10] if k == "w0" else v) for k, v in obs.members[0].items()}])
+
+
+def test_the_shipped_observer_is_its_record():
+    """The weights are the file the record's SHA-256 names; the record names the env it was trained on, the
+    training command, the validation of every candidate seed and the one chosen."""
+    record = json.loads((TRAINED / f"{SHIPPED}.json").read_text())
+    data = (TRAINED / f"{SHIPPED}.npz").read_bytes()
+    assert hashlib.sha256(data).hexdigest() == record["sha256"]
+    env = lvgym.make_env("smile-v2-faults", "nonrigid")
+    assert record["env"] == env_record(env) and record["suite"] == "smile-v2-faults"
+    assert "--scheme inversion" in record["training"]["command"]
+    chosen = record["validation"]["chosen"]
+    assert str(chosen) in record["validation"]["candidates"] and len(record["validation"]["candidates"]) >= 3
+    assert Observer.load(TRAINED / f"{SHIPPED}.npz").outputs == len(TERMS)
+
+
+def test_the_shipped_policy_is_registered_learned_and_causal():
+    spec = resolve_policy("inversion-id")
+    assert policy_kind(spec) == "learned"
+    assert "inversion-id" in lvgym.benchmark.get_suite("smile-v2-faults").policies
+    pol = build_policy(spec, lvgym.make_env("smile-v2-faults", "rigid"))
+    assert isinstance(pol, InversionPolicy) and pol.name == "inversion-id"
+
+
+@pytest.mark.parametrize(("suite", "key"), [("stratos-tvc-v2", "vehicle"), ("smile-v1", "history")])
+def test_it_refuses_an_env_it_was_not_trained_on(suite, key):
+    spec = resolve_policy("inversion-id")
+    env = lvgym.make_env(suite, "nonrigid", **({"history": 4} if key == "history" else {}))
+    with pytest.raises(ConfigError) as err:
+        build_policy(spec, env)
+    assert key in str(err.value)
+
+
+def test_a_study_file_flies_on_its_torch_weights(tmp_path):
+    """``from_file`` takes a training run's ``.pt`` as its ``.npz``: the same estimates to float32 rounding."""
+    ens = _ensemble(hidden=16)
+    save(ens, tmp_path / "run.pt")
+    to_observer(ens).save(tmp_path / "run.npz")
+    env = lvgym.make_env("smile-v2-faults", "nonrigid", mission_time_s=3.0)
+    a = play_episode(from_file(env, tmp_path / "run.pt"), env, 3, flyability=True)
+    b = play_episode(from_file(env, tmp_path / "run.npz"), env, 3, flyability=True)
+    assert a["score_v2"] == pytest.approx(b["score_v2"], rel=1e-6)
+
+
+def test_the_shipped_policy_flies_without_torch():
+    code = ("import sys, lvgym, lvgym.cli.policies\n"
+            "from lvgym.benchmark.registry import resolve_policy\n"
+            "from lvgym.benchmark.runner import build_policy, play_episode\n"
+            "env = lvgym.make_env('smile-v2-faults', 'nonrigid', mission_time_s=2.5)\n"
+            "r = play_episode(build_policy(resolve_policy('inversion-id'), env), env, 0)\n"
+            "print('torch' in sys.modules, r['duration_s'])\n")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.split()
+    assert out[0] == "False" and float(out[1]) == pytest.approx(2.5, abs=0.03)
