@@ -6,9 +6,9 @@ failed or unflyable, probability of improvement over the best classical design (
         lqg-thrust-id-s1=experiments/fault_id/estimator.py:s1 lqg-thrust-id-s2=experiments/fault_id/estimator.py:s2
     python -m experiments.fault_id.compare --folder results/fault_id/test
 
-(and the same with ``inversion-id-s0=experiments/fault_id/inversion.py:s0`` ...: every student flown is compared)
+(and the same with ``inversion-id-s0=experiments.fault_id.inversion:s0`` ...: every student flown is compared)
 
-(The same comparison a training campaign prints: :func:`agents.campaign_compare.comparison_rows`.)
+(The same comparison a training campaign prints: :func:`lvgym.agents.campaign_compare.comparison_rows`.)
 """
 
 from __future__ import annotations
@@ -22,8 +22,9 @@ from lvgym.cli.args import arg, parse
 
 BASELINES = ("lqg", "lqg-front", "aac-quiet", "gs-pd-relief")
 #: the students' labels, ``<configuration>-s<training seed>``: the thrust-direction estimator on ``lqg``
-#: (:mod:`.estimator`) and the reference's law on the learned disturbance observer (:mod:`.inversion`)
-CONFIGURATIONS = ("lqg-thrust-id", "inversion-id")
+#: (:mod:`.estimator`) and the reference's law on the learned disturbance observer (:mod:`.inversion`), trained
+#: without and with the loop dispersion (``--loop-gain-db 6``)
+CONFIGURATIONS = ("lqg-thrust-id", "inversion-id", "inversion-id-gain6")
 
 
 @dataclass
@@ -35,7 +36,7 @@ class Args:
 
 
 def main(argv: Sequence[str] | None = None) -> None:
-    from agents.campaign_compare import comparison_rows, comparison_table
+    from lvgym.agents.campaign_compare import comparison_rows, comparison_table
 
     a = parse(Args, argv, "python -m experiments.fault_id.compare", __doc__)
     path = Path(a.folder) / "results.json"
