@@ -14,9 +14,9 @@ lvgym envs.
 
 Training is ``lvgym train`` (``docs/training.md``). Nothing in ``lvgym`` imports this package (the command
 layer names it); importing it does not import stable-baselines3 (the submodules do). Importing it registers
-the shipped learned policies with the benchmark (``ppo``, ``ppo-res-lqg``, ``inversion-id``) and the loaders of saved models
-(``evaluate.py --policies runs/my_run``, ``model.zip`` or a cloned ``bc.pt``); their factories are named as
-strings, imported only where a policy flies.
+the shipped learned policies with the benchmark (``ppo``, ``ppo-res-lqg``, ``inversion-id``) and the loaders
+of saved models (``evaluate.py --policies runs/my_run``, ``model.zip`` or a cloned ``bc.pt``); their
+factories are named as strings, imported only where a policy flies.
 """
 
 from lvgym.benchmark.registry import register_policy, register_policy_loader

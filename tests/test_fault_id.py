@@ -115,3 +115,15 @@ def test_a_loop_gain_labels_the_terms_as_the_action_must_carry_them(monkeypatch)
     assert [r["score_v2"] for r in r2] == pytest.approx([r["score_v2"] for r in r1], rel=1e-6)
     with pytest.raises(ValueError, match="inversion"):
         fly("rigid", [7], None, np.random.default_rng(0), loop_gain=np.ones(1), **short)
+
+
+def test_the_inversion_teacher_flies_a_family_vehicle_and_the_thrust_scheme_refuses_the_family():
+    from experiments.fault_id.train import main
+    from lvgym.benchmark.suites import FAMILY_VALIDATION_VEHICLES
+    v = FAMILY_VALIDATION_VEHICLES[0]
+    _, y, recs = fly("nonrigid", [0, 1], None, np.random.default_rng(0), scheme="inversion", suite="family-v2",
+                     vehicle=v, mission_time_s=3.0)
+    assert y.shape[1] == 7 and np.any(y[:, 4] > 0.0) and len(recs) == 2
+    assert condition("nonrigid", "family-v2", vehicle=v).make_env().unwrapped.func.spec.vehicle != "smile_v1"
+    with pytest.raises(ConfigError, match="--suite"):
+        main(["--suite", "family-v2", "--scheme", "thrust"])

@@ -53,12 +53,13 @@ DELAYS = (0, 12, 25, 50, 100, None)
 SUITE = "smile-v2-faults"
 
 
-def condition(model: str, **options: Any):
-    """The fault suite's condition of ``model`` with env ``options`` (``privileged_info=True``: the info the
-    teacher and the labels need, the same flight with the true state in the info)."""
+def condition(model: str, suite: str = SUITE, **options: Any):
+    """``suite``'s condition of ``model`` with env ``options`` (``privileged_info=True``: the info the teacher
+    and the labels need, the same flight with the true state in the info; a family suite's: its last
+    vehicle's unless ``options`` name the ``vehicle``)."""
     from lvgym.benchmark.suites import get_suite
 
-    return {c.model: c for c in get_suite(SUITE).conditions}[model].with_options(**options)
+    return {c.model: c for c in get_suite(suite).conditions}[model].with_options(**options)
 
 
 class ThrustScheme:
@@ -137,16 +138,18 @@ SCHEMES = {"thrust": ThrustScheme, "inversion": InversionScheme}
 
 def fly(model: str, seeds: Sequence[int], estimator: Estimator | Ensemble | None = None,
         rng: np.random.Generator | None = None, deadband: float = 0.0, scheme: str = "thrust",
-        loop_gain: np.ndarray | None = None, **options: Any) -> tuple[np.ndarray, np.ndarray, list[dict]]:
+        loop_gain: np.ndarray | None = None, suite: str = SUITE, **options: Any
+        ) -> tuple[np.ndarray, np.ndarray, list[dict]]:
     """Fly the rows seeded ``seeds`` of the batched env of ``model`` with ``scheme``'s law (:data:`SCHEMES`) on
     the truth (``estimator`` None: the teacher; ``rng`` draws its delays) or on the ``estimator``'s output (the
     student; ``deadband``: the thrust scheme's). Returns the windows ``(steps, WINDOW, FEATURES)``, their
     labels ``(steps, outputs)`` and the flights' records (protocol v2's fields); ``loop_gain``: per row, a gain
     on the action after the flight computer sent it (the margins' perturbation, a training device; the
-    inversion scheme only); ``options``: env keywords (tests shorten the mission)."""
+    inversion scheme only); ``suite``: whose condition (a family's with ``vehicle=`` in ``options``);
+    ``options``: env keywords (tests shorten the mission)."""
     from lvgym.benchmark.rows import RowsLog
 
-    c = condition(model, privileged_info=True, **options)
+    c = condition(model, suite, privileged_info=True, **options)
     n = len(seeds)
     env, env1 = c.make_vec_env(n), c.make_env()
     obs, info = env.reset(seed=[int(s) for s in seeds])
@@ -206,15 +209,24 @@ def fit(x: np.ndarray, y: np.ndarray, seed: int, epochs: int, scaled: bool = Fal
 
 
 def validate(est: Estimator | Ensemble, episodes: int, deadband: float = 0.0,
-             scheme: str = "thrust") -> dict[str, tuple[float, int]]:
+             scheme: str = "thrust", suite: str = SUITE) -> dict[str, tuple[float, int]]:
     """Mean ``score_v2`` and failed or unflyable flights of the student on validation seeds ``0 ..
     episodes - 1`` per flight model (:func:`fly`: the rows of one batched env; the benchmark flies the same
     law one row at a time through :class:`.estimator.FaultIdPolicy` or
-    :class:`lvgym.agents.inversion.InversionPolicy`)."""
+    :class:`lvgym.agents.inversion.InversionPolicy`); on the family, ``episodes`` spread over its validation
+    vehicles (:data:`lvgym.benchmark.suites.FAMILY_VALIDATION_VEHICLES`, seeds ``0 .. episodes / 10 - 1``
+    each)."""
+    from lvgym.benchmark.suites import FAMILY_VALIDATION_VEHICLES
+
     out = {}
     for model in ("rigid", "nonrigid"):
-        rs = [r for k in range(0, episodes, 100)
-              for r in fly(model, range(k, min(episodes, k + 100)), est, deadband=deadband, scheme=scheme)[2]]
+        if suite == SUITE:
+            rs = [r for k in range(0, episodes, 100)
+                  for r in fly(model, range(k, min(episodes, k + 100)), est, deadband=deadband, scheme=scheme)[2]]
+        else:
+            each = max(1, episodes // len(FAMILY_VALIDATION_VEHICLES))
+            rs = [r for v in FAMILY_VALIDATION_VEHICLES
+                  for r in fly(model, range(each), est, scheme=scheme, suite=suite, vehicle=v)[2]]
         bad = sum(bool(r["failed"] or not r["flyable"]) for r in rs)
         out[model] = (float(np.mean([r["score_v2"] for r in rs])), bad)
     return out
@@ -240,6 +252,11 @@ class Args:
     scheme: str = arg("thrust", choices=tuple(SCHEMES))
     """the student: the thrust's direction for ``lqg`` (results/fault_id/estimator-s<seed>.pt), or the
     inversion law's terms (inversion-s<seed>.pt)"""
+    suite: str = arg(SUITE, choices=(SUITE, "family-v2"))
+    """where the flights are: the fault suite, or the launcher family's train vehicles (validation on its
+    validation vehicles; the inversion scheme only; files ``inversion-family-...``)"""
+    family_vehicles: int = arg(16, lo=1, hi=200)
+    """the family's train vehicles the flights are spread over (``--suite family-v2``)"""
 
 
 def main(argv: Sequence[str] | None = None) -> None:
@@ -248,7 +265,18 @@ def main(argv: Sequence[str] | None = None) -> None:
     RESULTS.mkdir(parents=True, exist_ok=True)
     rng, t0 = np.random.default_rng(a.seed), time.time()
     first = 100_000 + 10_000 * a.seed
-    prefix = SCHEMES[a.scheme].prefix + (f"-gain{a.loop_gain_db:g}" if a.loop_gain_db else "")
+    family = a.suite != SUITE
+    if family and a.scheme != "inversion":
+        from lvgym.errors import ConfigError
+
+        raise ConfigError("--suite", a.suite, f"{SUITE} for the thrust scheme (the family: --scheme inversion)")
+    vehicles = [None]
+    if family:
+        from lvgym.agents.familytrain import train_vehicle_files
+
+        vehicles = [str(f) for f in train_vehicle_files(a.family_vehicles)]
+    prefix = (SCHEMES[a.scheme].prefix + ("-family" if family else "")
+              + (f"-gain{a.loop_gain_db:g}" if a.loop_gain_db else ""))
     xs, ys = [], []
     est: Estimator | None = None                      # the teacher flies round 0, the student the others
     fits: list[Estimator] = []
@@ -257,26 +285,31 @@ def main(argv: Sequence[str] | None = None) -> None:
         start = first + (0 if rnd == 0 else 5_000 * rnd)
         for model in ("rigid", "nonrigid"):
             for k in range(0, count, 100):
-                seeds = list(range(start + k, start + min(count, k + 100)))
-                gain = (10.0 ** (rng.uniform(-a.loop_gain_db, a.loop_gain_db, len(seeds)) / 20.0)
-                        if a.loop_gain_db else None)
-                x, y, _ = fly(model, seeds, est, rng, scheme=a.scheme, loop_gain=gain)
-                xs.append(x)
-                ys.append(y)
+                chunk = list(range(start + k, start + min(count, k + 100)))
+                for j, vehicle in enumerate(vehicles):          # the family: the chunk's seeds dealt out
+                    seeds = chunk[j::len(vehicles)]
+                    if not seeds:
+                        continue
+                    gain = (10.0 ** (rng.uniform(-a.loop_gain_db, a.loop_gain_db, len(seeds)) / 20.0)
+                            if a.loop_gain_db else None)
+                    where = {"suite": a.suite, "vehicle": vehicle} if family else {}
+                    x, y, _ = fly(model, seeds, est, rng, scheme=a.scheme, loop_gain=gain, **where)
+                    xs.append(x)
+                    ys.append(y)
         print(f"seed {a.seed} round {rnd}: {sum(len(x) for x in xs)} steps of data at {time.time() - t0:.0f} s",
               flush=True)
         est = fit(np.concatenate(xs), np.concatenate(ys), a.seed, a.epochs, SCHEMES[a.scheme].scaled)
         fits.append(est)
         save(est, RESULTS / f"{prefix}-s{a.seed}-r{rnd}.pt")
         if a.validation:
-            v = validate(est, a.validation, scheme=a.scheme)
+            v = validate(est, a.validation, scheme=a.scheme, suite=a.suite)
             print(f"seed {a.seed} round {rnd} validation 0-{a.validation - 1}: " + ", ".join(
                 f"{m} {s:.3f} ({b})" for m, (s, b) in v.items()) + f" at {time.time() - t0:.0f} s", flush=True)
     last = SCHEMES[a.scheme].ensemble                 # the policy: the mean of the last rounds' fits
     final = Ensemble(fits[-last:]) if last > 1 else est
     save(final, RESULTS / f"{prefix}-s{a.seed}.pt")
     if a.validation and last > 1:
-        v = validate(final, a.validation, scheme=a.scheme)
+        v = validate(final, a.validation, scheme=a.scheme, suite=a.suite)
         print(f"seed {a.seed} the last {last} rounds' mean, validation 0-{a.validation - 1}: " + ", ".join(
             f"{m} {s:.3f} ({b})" for m, (s, b) in v.items()), flush=True)
     print(f"wrote {RESULTS / f'{prefix}-s{a.seed}.pt'} in {time.time() - t0:.0f} s")
