@@ -127,3 +127,13 @@ def test_the_inversion_teacher_flies_a_family_vehicle_and_the_thrust_scheme_refu
     assert condition("nonrigid", "family-v2", vehicle=v).make_env().unwrapped.func.spec.vehicle != "smile_v1"
     with pytest.raises(ConfigError, match="--suite"):
         main(["--suite", "family-v2", "--scheme", "thrust"])
+
+
+def test_the_ship_scores_each_flight_model_apart():
+    """``nonrigid`` ends in ``rigid``: the split is on the condition's last part (it once mixed them)."""
+    from experiments.fault_id.ship import per_model
+    recs = [{"condition": "smile-v2-faults/rigid", "score_v2": 1.0, "failed": False, "flyable": True},
+            {"condition": "smile-v2-faults/nonrigid", "score_v2": 3.0, "failed": True, "flyable": True},
+            {"condition": "smile-v2-faults/nonrigid", "score_v2": 2.0, "failed": False, "flyable": False}]
+    assert per_model(recs) == {"rigid": {"score_v2_mean": 1.0, "failed_or_unflyable": 0},
+                               "nonrigid": {"score_v2_mean": 2.5, "failed_or_unflyable": 2}}

@@ -47,17 +47,22 @@ class Args:
     """the loop dispersion the runs were trained under (recorded)"""
 
 
-def validation(path: str, episodes: int) -> dict[str, dict[str, float]]:
-    """Per flight model, the mean ``score_v2`` and the failed or unflyable flights of the observer at ``path``
-    (``.npz``) on ``smile-v2-faults``'s first ``episodes`` validation seeds, flown by the benchmark."""
-    spec = PolicySpec("inversion-id", "lvgym.agents.inversion:from_file", (("path", path),))
-    records = evaluate([spec], [get_suite(SUITE)], episodes, seed_set="validation", progress=False)
+def per_model(records: list[dict]) -> dict[str, dict[str, float]]:
+    """Per flight model (the last part of a record's ``condition``), the mean ``score_v2`` and the failed or
+    unflyable flights of ``records``."""
     out = {}
     for model in ("rigid", "nonrigid"):
-        rs = [r for r in records if r["condition"].endswith(model)]
+        rs = [r for r in records if r["condition"].rsplit("/", 1)[-1] == model]
         out[model] = {"score_v2_mean": float(np.mean([r["score_v2"] for r in rs])),
                       "failed_or_unflyable": sum(bool(r["failed"] or not r["flyable"]) for r in rs)}
     return out
+
+
+def validation(path: str, episodes: int) -> dict[str, dict[str, float]]:
+    """:func:`per_model` of the observer at ``path`` (``.npz``) on ``smile-v2-faults``'s first ``episodes``
+    validation seeds, flown by the benchmark."""
+    spec = PolicySpec("inversion-id", "lvgym.agents.inversion:from_file", (("path", path),))
+    return per_model(evaluate([spec], [get_suite(SUITE)], episodes, seed_set="validation", progress=False))
 
 
 def main(argv: Sequence[str] | None = None) -> None:
