@@ -137,3 +137,14 @@ def test_the_ship_scores_each_flight_model_apart():
             {"condition": "smile-v2-faults/nonrigid", "score_v2": 2.0, "failed": False, "flyable": False}]
     assert per_model(recs) == {"rigid": {"score_v2_mean": 1.0, "failed_or_unflyable": 0},
                                "nonrigid": {"score_v2_mean": 2.5, "failed_or_unflyable": 2}}
+
+
+def test_the_feasibility_study_lists_each_lost_flight_once_with_who_lost_it():
+    from experiments.fault_id.feasible import failed
+    recs = [{"suite": "smile-v2-faults", "condition": "smile-v2-faults/nonrigid", "seed": 7, "policy": p,
+             "failed": f, "flyable": fl} for p, f, fl in (("a", True, True), ("b", False, False), ("c", False, True))]
+    recs.append({"suite": "smile-v2-faults", "condition": "smile-v2-faults/rigid", "seed": 3, "policy": "a",
+                 "failed": True, "flyable": True})
+    recs.append({"suite": "smile-v2", "condition": "smile-v2/rigid", "seed": 1, "policy": "a", "failed": True,
+                 "flyable": True})
+    assert failed(recs) == {("nonrigid", 7): ["a", "b"], ("rigid", 3): ["a"]}
