@@ -41,7 +41,8 @@ from lvgym.errors import ConfigError
 
 from .observer import N_OBS, Observer, Window
 
-__all__ = ["SHIPPED", "TERMS", "InversionBatch", "InversionPolicy", "command", "law_terms", "shipped_inversion"]
+__all__ = ["A_MAX", "ERRORS", "SHIPPED", "TERMS", "InversionBatch", "InversionPolicy", "check_env", "command",
+           "env_record", "error_index", "from_file", "gains", "law_terms", "shipped_inversion"]
 
 #: the law's terms, in the order of :func:`law_terms`
 TERMS = ("f_aero_pitch", "f_aero_yaw", "f_mis_pitch", "f_mis_yaw", "a_pitch", "a_yaw", "qalpha_share")
@@ -104,7 +105,8 @@ def error_index(env: Any) -> list[int]:
     names = list(env.unwrapped.func.observation_layout.names)
     missing = [n for n in ERRORS if n not in names]
     if missing:
-        raise ConfigError("env observation", names, f"an observation with {list(ERRORS)} (the law's errors)")
+        raise ConfigError("env observation", f"without {missing}", f"an observation with {list(ERRORS)} (the law's "
+                          "errors)")
     return [names.index(n) for n in ERRORS]
 
 

@@ -148,3 +148,12 @@ def test_the_feasibility_study_lists_each_lost_flight_once_with_who_lost_it():
     recs.append({"suite": "smile-v2", "condition": "smile-v2/rigid", "seed": 1, "policy": "a", "failed": True,
                  "flyable": True})
     assert failed(recs) == {("nonrigid", 7): ["a", "b"], ("rigid", 3): ["a"]}
+
+
+def test_the_law_room_study_flies_validation_seeds_and_the_familys_validation_vehicles():
+    from experiments.fault_id.law_room import CLASSICAL, places
+    from lvgym.benchmark.suites import FAMILY_VALIDATION_VEHICLES, get_suite
+    fam = places("family-v2", 2)
+    assert len(fam) == 2 * len(FAMILY_VALIDATION_VEHICLES) and fam[1] == ({"vehicle": FAMILY_VALIDATION_VEHICLES[0]}, 1)
+    assert places("stratos-tvc-v2", 3) == [({}, k) for k in get_suite("stratos-tvc-v2").seeds("validation", 3)]
+    assert all(get_suite(s).version.startswith("v2") or s == "family-v2" for s in CLASSICAL)
