@@ -18,6 +18,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import torch
 
 from lvgym.agents.observer import FEATURES, N_OBS, WINDOW, Window
 from lvgym.agents.observer_fit import Ensemble, Estimator, load, save
@@ -74,8 +75,6 @@ class FaultIdPolicy:
         rows = np.zeros(1, dtype=np.int64)
         base = np.asarray(self.base.act(observation, info), dtype=np.float64)
         w = self.window.push(rows, np.asarray(observation, dtype=np.float32)[None])
-        import torch
-
         with torch.no_grad():
             estimate = self.estimator(torch.as_tensor(w)).numpy()[0].astype(np.float64)
         a = corrected(base, estimate, self.deadband)

@@ -5,6 +5,8 @@
     python -m experiments.fault_id.train --seed 0            # results/fault_id/estimator-s0.pt
     python -m experiments.fault_id.train --scheme inversion --seed 0 --flights 100 --rounds 4 --validation 50
                                                              # results/fault_id/inversion-s0.pt
+    python -m experiments.fault_id.train --scheme inversion --suite family-v2 --family-vehicles 16
+                                                             # the family's train vehicles: inversion-family-s0.pt
 
 1. **Teacher's flights** on ``smile-v2-faults`` (both flight models, ``--flights`` each, training seeds
    ``100000 + 10000 seed ...``: neither validation nor test seeds), every step recorded as the student sees
