@@ -157,3 +157,27 @@ def test_the_law_room_study_flies_validation_seeds_and_the_familys_validation_ve
     assert len(fam) == 2 * len(FAMILY_VALIDATION_VEHICLES) and fam[1] == ({"vehicle": FAMILY_VALIDATION_VEHICLES[0]}, 1)
     assert places("stratos-tvc-v2", 3) == [({}, k) for k in get_suite("stratos-tvc-v2").seeds("validation", 3)]
     assert all(get_suite(s).version.startswith("v2") or s == "family-v2" for s in CLASSICAL)
+
+
+def test_the_moment_extrapolated_along_its_slope_by_hand():
+    from experiments.fault_id.privileges import SLOPE_STEPS, Withheld
+
+    class Seen:
+        name = "seen"
+
+        def reset(self):
+            self.m = []
+
+        def act(self, observation, info):
+            self.m.append(np.asarray(info["m_aero_b"]))
+            return np.zeros(2, np.float32)
+
+    law = Seen()
+    law.reset()
+    w = Withheld.__new__(Withheld)
+    w.law, w.name, w.observed, w.eff, w.late, w.ahead, w.m_aero = law, "x", False, True, 0, 5, []
+    for k in range(8):                                  # a moment growing by 2 N m per step
+        w.act(np.zeros(14), {"omega_bi_b": np.zeros(3), "m_aero_b": np.array([0.0, 2.0 * k, 0.0])})
+    assert SLOPE_STEPS == 5
+    np.testing.assert_allclose(law.m[-1], [0.0, 14.0 + 5 * 2.0, 0.0])   # 5 steps ahead along the slope
+    np.testing.assert_allclose(law.m[0], [0.0, 0.0, 0.0])               # the first step: no slope yet

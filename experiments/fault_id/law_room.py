@@ -27,7 +27,8 @@ from .train import condition
 
 #: the reference's variants (keywords of :func:`.privileges.reference`)
 VARIANTS = {"privileged": {}, "no preview": {"preview": False}, "observed": {"observed": True},
-            "observed, no preview": {"preview": False, "observed": True}}
+            "observed, no preview": {"preview": False, "observed": True},
+            "observed, the moment extrapolated 5 steps": {"preview": False, "observed": True, "aero_ahead_steps": 5}}
 #: the suites it takes, with the classical design each is compared with (the suite's reference design;
 #: the slender vehicle's only design)
 CLASSICAL = {"smile-v2": "lqg", "smile-v2-faults": "lqg", "smile-v2-maxq-gust": "gs-pd-relief",

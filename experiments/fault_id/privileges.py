@@ -30,27 +30,35 @@ from lvgym.cli.args import arg, parse
 NO_RELIEF = (5.0, 6.0)
 
 
+#: the span [control steps] of the slope an extrapolated aerodynamic moment is drawn along
+SLOPE_STEPS = 5
+
+
 def reference(env: Any, preview: bool = True, relief: bool = True, plant: bool = True, observed: bool = False,
-              eff: bool = True, aero_late_steps: int = 0, name: str = "privileged") -> Any:
+              eff: bool = True, aero_late_steps: int = 0, aero_ahead_steps: int = 0, name: str = "privileged") -> Any:
     """The privileged reference with its wind preview, its load relief or its knowledge of the plant taken away;
     ``observed``: on the flight computer's rate and attitude errors (the observation's) instead of the true ones;
     ``eff`` False: without the actuators' effectiveness (the misalignment kept); ``aero_late_steps``: the
-    aerodynamic moment as it acted that many control steps ago (without preview)."""
+    aerodynamic moment as it acted that many control steps ago (without preview); ``aero_ahead_steps``: the
+    moment as it acts extrapolated that many steps ahead along its slope over the last :data:`SLOPE_STEPS`
+    (what a causal predictor of the moment ahead could do without learning; without preview)."""
     from lvgym.baselines.privileged import privileged
 
     law = privileged(env, name=name, preview_periods=None if preview else 0, relief=None if relief else NO_RELIEF,
                      plant=plant)
-    return Withheld(law, env, observed, eff, aero_late_steps) if observed or not eff or aero_late_steps else law
+    withheld = observed or not eff or aero_late_steps or aero_ahead_steps
+    return Withheld(law, env, observed, eff, aero_late_steps, aero_ahead_steps) if withheld else law
 
 
 class Withheld:
     """A privileged law given less than the step's privileged info: the observation's rate and attitude errors
     in place of the true ones (``observed``), no effectiveness (``eff`` False), the aerodynamic moment of
-    ``late`` steps ago."""
+    ``late`` steps ago, or the present one extrapolated ``ahead`` steps."""
 
-    def __init__(self, law: Any, env: Any, observed: bool, eff: bool, late: int) -> None:
+    def __init__(self, law: Any, env: Any, observed: bool, eff: bool, late: int, ahead: int = 0) -> None:
         names = list(env.unwrapped.func.observation_layout.names)
         self.law, self.name, self.observed, self.eff, self.late = law, law.name, observed, eff, int(late)
+        self.ahead = int(ahead)
         self.i = [names.index(n) for n in ("pitch_rate_error", "yaw_rate_error", "pitch_attitude_error",
                                             "yaw_attitude_error", "pitch_rate_reference")]
         self.m_aero: list[np.ndarray] = []
@@ -69,6 +77,9 @@ class Withheld:
                 info["actuator_effectiveness"] = np.ones(2)
             self.m_aero.append(np.asarray(info["m_aero_b"], dtype=np.float64))
             info["m_aero_b"] = self.m_aero[max(0, len(self.m_aero) - 1 - self.late)]
+            if self.ahead:                                  # along the slope of the last SLOPE_STEPS
+                back = self.m_aero[max(0, len(self.m_aero) - 1 - SLOPE_STEPS)]
+                info["m_aero_b"] = self.m_aero[-1] + self.ahead * (self.m_aero[-1] - back) / SLOPE_STEPS
         return self.law.act(observation, info)
 
 
@@ -137,6 +148,7 @@ VARIANTS: dict[str, tuple[str, dict[str, Any]] | None] = {
     "no-preview-observed-aero-late-2": (_REF, {"preview": False, "observed": True, "aero_late_steps": 2}),
     "no-preview-observed-aero-late-5": (_REF, {"preview": False, "observed": True, "aero_late_steps": 5}),
     "no-preview-observed-aero-late-10": (_REF, {"preview": False, "observed": True, "aero_late_steps": 10}),
+    "no-preview-observed-aero-extrapolated-5": (_REF, {"preview": False, "observed": True, "aero_ahead_steps": 5}),
     "lqg": None,
     "lqg-mis-aero": (_LQG, {"aero": True}),
     "lqg-mis-eff-aero": (_LQG, {"eff": True, "aero": True}),
