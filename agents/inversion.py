@@ -57,10 +57,12 @@ SHIPPED = "inversion_id_smile_v2_faults"
 TRAINED = Path(__file__).resolve().parent / "trained"
 
 
-def law_terms(info: dict[str, Any], n: int, limit: float) -> np.ndarray:
+def law_terms(info: dict[str, Any], n: int, limit: float, ahead: int = 0) -> np.ndarray:
     """``(n, 7)``: :data:`TERMS` of the module docstring (``f_aero``, ``f_mis`` over the gimbal limit ``limit``
     [rad], ``a`` [gimbal limits per rad/s^2], ``share`` [-]) from a privileged step's info of ``n`` rows (zeros
-    without thrust, or before the first step). The observer's labels."""
+    without thrust, or before the first step). The observer's labels; ``ahead`` > 0: ``f_aero`` of the
+    aerodynamic moment that many control periods ahead (the info's ``m_aero_ahead_b``: the reference's
+    preview, a label a causal observer can only predict)."""
     out = np.zeros((n, len(TERMS)))
     if "m_aero_b" not in info:                               # the reset's info
         return out
@@ -68,7 +70,8 @@ def law_terms(info: dict[str, Any], n: int, limit: float) -> np.ndarray:
              * np.asarray(info["gimbal_arm"], dtype=float)).reshape(n)
     on = lever >= NO_THRUST
     eff = np.maximum(np.asarray(info["actuator_effectiveness"], dtype=float).reshape(n, 2), 0.1)
-    m_aero = np.asarray(info["m_aero_b"], dtype=float).reshape(n, 3)[:, 1:]
+    m_aero = (np.asarray(info["m_aero_ahead_b"], dtype=float).reshape(n, -1, 3)[:, ahead - 1, 1:] if ahead
+              else np.asarray(info["m_aero_b"], dtype=float).reshape(n, 3)[:, 1:])
     mis = np.asarray(info["misalignment"], dtype=float).reshape(n, 2)
     J = np.asarray(info["J_b_diag"], dtype=float).reshape(n, 3)[:, 1:]
     safe = np.where(on, lever, 1.0)[:, None]

@@ -72,7 +72,7 @@ class ThrustScheme:
     prefix, outputs, scaled, ensemble = "estimator", 2, False, 1
 
     def __init__(self, env1: Any, n: int, rng: np.random.Generator | None, deadband: float,
-                 loop_gain: np.ndarray | None = None) -> None:
+                 loop_gain: np.ndarray | None = None, ahead: int = 0) -> None:
         from lvgym.benchmark.batch import as_batch
 
         self.limit, self.n, self.deadband = float(env1.unwrapped.func.gimbal_limit), n, deadband
@@ -103,8 +103,8 @@ class InversionScheme:
     prefix, outputs, scaled, ensemble = "inversion", len(TERMS), True, 3
 
     def __init__(self, env1: Any, n: int, rng: np.random.Generator | None, deadband: float,
-                 loop_gain: np.ndarray | None = None) -> None:
-        self.limit, self.n = float(env1.unwrapped.func.gimbal_limit), n
+                 loop_gain: np.ndarray | None = None, ahead: int = 0) -> None:
+        self.limit, self.n, self.ahead = float(env1.unwrapped.func.gimbal_limit), n, int(ahead)
         self.index, (self.w, self.z) = error_index(env1), gains(env1)
         # a loop gain after the action (the margins' perturbation) scales the control power the action sees:
         # the terms in gimbal angles are labelled as the action must carry them, the truth over the gain
@@ -115,7 +115,7 @@ class InversionScheme:
         self.noise = np.zeros((n, 2))
 
     def labels(self, info: dict[str, Any]) -> np.ndarray:
-        self.truth = law_terms(info, self.n, self.limit)
+        self.truth = law_terms(info, self.n, self.limit, self.ahead)
         self.truth[:, :6] *= self.per_gain
         return self.truth
 
@@ -140,7 +140,7 @@ SCHEMES = {"thrust": ThrustScheme, "inversion": InversionScheme}
 
 def fly(model: str, seeds: Sequence[int], estimator: Estimator | Ensemble | None = None,
         rng: np.random.Generator | None = None, deadband: float = 0.0, scheme: str = "thrust",
-        loop_gain: np.ndarray | None = None, suite: str = SUITE, **options: Any
+        loop_gain: np.ndarray | None = None, suite: str = SUITE, ahead: int = 0, **options: Any
         ) -> tuple[np.ndarray, np.ndarray, list[dict]]:
     """Fly the rows seeded ``seeds`` of the batched env of ``model`` with ``scheme``'s law (:data:`SCHEMES`) on
     the truth (``estimator`` None: the teacher; ``rng`` draws its delays) or on the ``estimator``'s output (the
@@ -148,6 +148,7 @@ def fly(model: str, seeds: Sequence[int], estimator: Estimator | Ensemble | None
     labels ``(steps, outputs)`` and the flights' records (protocol v2's fields); ``loop_gain``: per row, a gain
     on the action after the flight computer sent it (the margins' perturbation, a training device; the
     inversion scheme only); ``suite``: whose condition (a family's with ``vehicle=`` in ``options``);
+    ``ahead``: the inversion's moment label that many control periods ahead (its teacher flies on it);
     ``options``: env keywords (tests shorten the mission)."""
     from lvgym.benchmark.rows import RowsLog
 
@@ -157,7 +158,7 @@ def fly(model: str, seeds: Sequence[int], estimator: Estimator | Ensemble | None
     obs, info = env.reset(seed=[int(s) for s in seeds])
     if loop_gain is not None and scheme != "inversion":
         raise ValueError("loop_gain: the inversion scheme's training device only")
-    law = SCHEMES[scheme](env1, n, rng if estimator is None else None, deadband, loop_gain)
+    law = SCHEMES[scheme](env1, n, rng if estimator is None else None, deadband, loop_gain, ahead)
     gain = np.ones((n, 1)) if loop_gain is None else np.asarray(loop_gain, dtype=float)[:, None]
     window, log = Window(n), RowsLog(env)
     xs, ys = [], []
@@ -222,9 +223,10 @@ def validate(est: Estimator | Ensemble, episodes: int, deadband: float = 0.0,
 
     out = {}
     for model in ("rigid", "nonrigid"):
-        if suite == SUITE:
+        if suite != "family-v2":
             rs = [r for k in range(0, episodes, 100)
-                  for r in fly(model, range(k, min(episodes, k + 100)), est, deadband=deadband, scheme=scheme)[2]]
+                  for r in fly(model, range(k, min(episodes, k + 100)), est, deadband=deadband, scheme=scheme,
+                               suite=suite)[2]]
         else:
             each = max(1, episodes // len(FAMILY_VALIDATION_VEHICLES))
             rs = [r for v in FAMILY_VALIDATION_VEHICLES
@@ -254,9 +256,13 @@ class Args:
     scheme: str = arg("thrust", choices=tuple(SCHEMES))
     """the student: the thrust's direction for ``lqg`` (results/fault_id/estimator-s<seed>.pt), or the
     inversion law's terms (inversion-s<seed>.pt)"""
-    suite: str = arg(SUITE, choices=(SUITE, "family-v2"))
-    """where the flights are: the fault suite, or the launcher family's train vehicles (validation on its
-    validation vehicles; the inversion scheme only; files ``inversion-family-...``)"""
+    suite: str = arg(SUITE, choices=(SUITE, "smile-v2", "stratos-tvc-v2", "family-v2"))
+    """where the flights are: the fault suite, another v2 suite, or the launcher family's train vehicles
+    (validation on its validation vehicles); other than the fault suite: the inversion scheme only, files
+    ``inversion-<suite>-...`` (``inversion-family-...``)"""
+    ahead: int = arg(0, lo=0, hi=10)
+    """the inversion's moment label that many control periods ahead (the preview the teacher flies on; 0:
+    the moment as it acts); files ``...-ahead<k>``"""
     family_vehicles: int = arg(16, lo=1, hi=200)
     """the family's train vehicles the flights are spread over (``--suite family-v2``)"""
 
@@ -267,17 +273,19 @@ def main(argv: Sequence[str] | None = None) -> None:
     RESULTS.mkdir(parents=True, exist_ok=True)
     rng, t0 = np.random.default_rng(a.seed), time.time()
     first = 100_000 + 10_000 * a.seed
-    family = a.suite != SUITE
-    if family and a.scheme != "inversion":
+    family = a.suite == "family-v2"
+    if a.scheme != "inversion" and (a.suite != SUITE or a.ahead):
         from lvgym.errors import ConfigError
 
-        raise ConfigError("--suite", a.suite, f"{SUITE} for the thrust scheme (the family: --scheme inversion)")
+        raise ConfigError("--suite" if a.suite != SUITE else "--ahead", a.suite if a.suite != SUITE else a.ahead,
+                          f"{SUITE} and 0 for the thrust scheme (the others: --scheme inversion)")
     vehicles = [None]
     if family:
         from lvgym.agents.familytrain import train_vehicle_files
 
         vehicles = [str(f) for f in train_vehicle_files(a.family_vehicles)]
-    prefix = (SCHEMES[a.scheme].prefix + ("-family" if family else "")
+    where = "" if a.suite == SUITE else "-family" if family else f"-{a.suite}"
+    prefix = (SCHEMES[a.scheme].prefix + where + (f"-ahead{a.ahead}" if a.ahead else "")
               + (f"-gain{a.loop_gain_db:g}" if a.loop_gain_db else ""))
     xs, ys = [], []
     est: Estimator | None = None                      # the teacher flies round 0, the student the others
@@ -294,8 +302,8 @@ def main(argv: Sequence[str] | None = None) -> None:
                         continue
                     gain = (10.0 ** (rng.uniform(-a.loop_gain_db, a.loop_gain_db, len(seeds)) / 20.0)
                             if a.loop_gain_db else None)
-                    where = {"suite": a.suite, "vehicle": vehicle} if family else {}
-                    x, y, _ = fly(model, seeds, est, rng, scheme=a.scheme, loop_gain=gain, **where)
+                    place = {"suite": a.suite, **({"vehicle": vehicle} if family else {})}
+                    x, y, _ = fly(model, seeds, est, rng, scheme=a.scheme, loop_gain=gain, ahead=a.ahead, **place)
                     xs.append(x)
                     ys.append(y)
         print(f"seed {a.seed} round {rnd}: {sum(len(x) for x in xs)} steps of data at {time.time() - t0:.0f} s",
