@@ -60,6 +60,11 @@ def test_the_terms_and_the_command_by_hand():
     np.testing.assert_allclose(t[0, :4], [0.1 / 0.5 / limit, -0.05 / limit, 0.01 / 0.5 / limit, -0.02 / limit])
     np.testing.assert_allclose(t[0, 4:], [4.0e4 / lever / 0.5 / limit, A_MAX, 0.4])   # yaw's a at its ceiling
     assert np.all(t[1] == 0.0) and np.all(law_terms({}, 2, limit) == 0.0)      # no thrust; the reset's info
+    ahead = np.zeros((2, 10, 3))
+    ahead[0, 4] = [0.0, -4.0e4, 1.0e4]                              # the moment 5 periods ahead
+    t5 = law_terms(dict(info, m_aero_ahead_b=ahead), 2, limit, ahead=5)
+    np.testing.assert_allclose(t5[0, :2], [-0.2 / 0.5 / limit, 0.05 / limit])
+    np.testing.assert_allclose(t5[:, 2:], t[:, 2:])                 # the other terms as they are
     obs = np.array([[0.1, -0.2, 0.01, 0.0]])                         # rate errors, attitude errors
     w, z = 1.5, 1.0
     alpha = np.array([-2 * z * w * 0.1 - w * w * 0.01, -2 * z * w * -0.2])
