@@ -21,7 +21,7 @@ from pathlib import Path
 from lvgym.cli.args import arg, parse
 
 from .privileges import reference
-from .train import SUITE, condition
+from .train import SUITE, condition, lost
 
 #: the laws each failed flight is flown again with
 LAWS = ("privileged", "teacher", "lqg")
@@ -40,7 +40,7 @@ def failed(records: list[dict]) -> dict[tuple[str, int], list[str]]:
     that lost it, in order of model and seed."""
     out: dict[tuple[str, int], list[str]] = {}
     for r in records:
-        if r["suite"] == SUITE and (r["failed"] or not r["flyable"]):
+        if r["suite"] == SUITE and lost(r):
             out.setdefault((r["condition"].rsplit("/", 1)[-1], int(r["seed"])), []).append(r["policy"])
     return dict(sorted(out.items()))
 
@@ -61,7 +61,7 @@ def main(argv: Sequence[str] | None = None) -> None:
         env = envs[model]
         laws = (reference(env), reference(env, preview=False, observed=True), build_policy(resolve_policy("lqg"), env))
         flown = [play_episode(law, env, seed, flyability=True) for law in laws]
-        cells = ["fails" if (r["failed"] or not r["flyable"]) else "flies" for r in flown]
+        cells = ["fails" if lost(r) else "flies" for r in flown]
         print(f"| {model} | {seed} | {flown[0]['fault']} | {', '.join(policies)} | " + " | ".join(cells) + " |",
               flush=True)
 

@@ -18,12 +18,10 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
-import numpy as np
-
 from lvgym.cli.args import arg, parse
 
 from .privileges import reference
-from .train import condition
+from .train import condition, scored
 
 #: the reference's variants (keywords of :func:`.privileges.reference`)
 VARIANTS = {"privileged": {}, "no preview": {"preview": False}, "observed": {"observed": True},
@@ -83,8 +81,7 @@ def main(argv: Sequence[str] | None = None) -> None:
     for model in a.models:
         for variant in (*VARIANTS, None):
             rs = flights(a.suite, model, a.seeds, variant)
-            bad = sum(bool(r["failed"] or not r["flyable"]) for r in rs)
-            mean = float(np.mean([r["score_v2"] for r in rs]))
+            mean, bad = scored(rs)
             print(f"| {variant or CLASSICAL[a.suite]} | {model} | {mean:.3f} | {bad} of {len(rs)} |", flush=True)
 
 

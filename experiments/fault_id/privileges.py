@@ -34,6 +34,13 @@ NO_RELIEF = (5.0, 6.0)
 SLOPE_STEPS = 5
 
 
+def extrapolate(history: Sequence[np.ndarray], ahead: int, span: int = SLOPE_STEPS) -> np.ndarray:
+    """The last of ``history`` carried ``ahead`` steps along its slope over the last ``span`` steps (over
+    fewer at the start of a flight: none at its first step)."""
+    back = history[max(0, len(history) - 1 - span)]
+    return history[-1] + ahead * (history[-1] - back) / span
+
+
 def reference(env: Any, preview: bool = True, relief: bool = True, plant: bool = True, observed: bool = False,
               eff: bool = True, aero_late_steps: int = 0, aero_ahead_steps: int = 0, name: str = "privileged") -> Any:
     """The privileged reference with its wind preview, its load relief or its knowledge of the plant taken away;
@@ -78,8 +85,7 @@ class Withheld:
             self.m_aero.append(np.asarray(info["m_aero_b"], dtype=np.float64))
             info["m_aero_b"] = self.m_aero[max(0, len(self.m_aero) - 1 - self.late)]
             if self.ahead:                                  # along the slope of the last SLOPE_STEPS
-                back = self.m_aero[max(0, len(self.m_aero) - 1 - SLOPE_STEPS)]
-                info["m_aero_b"] = self.m_aero[-1] + self.ahead * (self.m_aero[-1] - back) / SLOPE_STEPS
+                info["m_aero_b"] = extrapolate(self.m_aero, self.ahead)
         return self.law.act(observation, info)
 
 

@@ -22,15 +22,13 @@ import shutil
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-import numpy as np
-
 from lvgym.agents.inversion import SHIPPED, TRAINED, env_record
 from lvgym.agents.observer_fit import load, to_observer
 from lvgym.benchmark import PolicySpec, evaluate, get_suite
 from lvgym.cli.args import arg, parse
 
 from .estimator import RESULTS
-from .train import SUITE, condition
+from .train import SUITE, condition, scored
 
 
 @dataclass
@@ -52,9 +50,8 @@ def per_model(records: list[dict]) -> dict[str, dict[str, float]]:
     unflyable flights of ``records``."""
     out = {}
     for model in ("rigid", "nonrigid"):
-        rs = [r for r in records if r["condition"].rsplit("/", 1)[-1] == model]
-        out[model] = {"score_v2_mean": float(np.mean([r["score_v2"] for r in rs])),
-                      "failed_or_unflyable": sum(bool(r["failed"] or not r["flyable"]) for r in rs)}
+        mean, bad = scored([r for r in records if r["condition"].rsplit("/", 1)[-1] == model])
+        out[model] = {"score_v2_mean": mean, "failed_or_unflyable": bad}
     return out
 
 

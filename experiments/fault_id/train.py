@@ -211,6 +211,16 @@ def fit(x: np.ndarray, y: np.ndarray, seed: int, epochs: int, scaled: bool = Fal
     return est
 
 
+def lost(record: dict[str, Any]) -> bool:
+    """Whether a flight's record is failed or unflyable (protocol v2's charge)."""
+    return bool(record["failed"] or not record["flyable"])
+
+
+def scored(records: Sequence[dict[str, Any]]) -> tuple[float, int]:
+    """The mean ``score_v2`` of ``records`` and how many of them are lost (:func:`lost`)."""
+    return float(np.mean([r["score_v2"] for r in records])), sum(lost(r) for r in records)
+
+
 def validate(est: Estimator | Ensemble, episodes: int, deadband: float = 0.0,
              scheme: str = "thrust", suite: str = SUITE) -> dict[str, tuple[float, int]]:
     """Mean ``score_v2`` and failed or unflyable flights of the student on validation seeds ``0 ..
@@ -231,8 +241,7 @@ def validate(est: Estimator | Ensemble, episodes: int, deadband: float = 0.0,
             each = max(1, episodes // len(FAMILY_VALIDATION_VEHICLES))
             rs = [r for v in FAMILY_VALIDATION_VEHICLES
                   for r in fly(model, range(each), est, scheme=scheme, suite=suite, vehicle=v)[2]]
-        bad = sum(bool(r["failed"] or not r["flyable"]) for r in rs)
-        out[model] = (float(np.mean([r["score_v2"] for r in rs])), bad)
+        out[model] = scored(rs)
     return out
 
 

@@ -33,5 +33,5 @@ __all__ = ["CVAR_LEVEL", "Condition", "DEFAULT_SUITE", "EXECUTORS", "PROTOCOL_VE
            "SEED_SETS", "SUITES", "SUMMARY_METRICS", "Suite", "TEST_SEED0", "Trajectory", "TrajectoryBuilder",
            "V1_METRICS", "VALIDATION_SEED0", "ZERO", "ZeroPolicy", "atomic_write", "atomic_write_text", "build_policy",
            "compare", "condition", "cvar", "degradation", "episode_metrics", "evaluate", "get_suite", "make_tasks",
-           "protocol_metric", "markdown_table", "normalise", "play_episode", "rank", "register_policy", "register_policy_loader", "run_episode",
-           "run_groups", "summarize", "write_results", "PolicyError"]
+           "protocol_metric", "markdown_table", "normalise", "play_episode", "rank", "register_policy",
+           "register_policy_loader", "run_episode", "run_groups", "summarize", "write_results", "PolicyError"]
