@@ -263,6 +263,7 @@ def test_cli_end_to_end(tmp_path, tiny_sb3):
     assert len(rows) == 2 * 2 * 2 and {r["policy"] for r in rows} == {"zero", "tiny"}
     data = json.loads((out / "results.json").read_text())
     assert data["meta"]["suites"]["smile-windy"]["version"] == "v0+override"
+    assert data["meta"]["protocol"] == "v0+override"           # the suites' own versions, not a constant
     assert (out / "table.md").read_text() in proc.stdout
 
 

@@ -204,3 +204,31 @@ def test_the_extrapolated_student_adds_its_estimates_slope():
                    *gains(env))[0]
     np.testing.assert_allclose(a, want, rtol=1e-6)
     assert type(as_batch(p, 2, lambda: p)).__name__ == "RowPolicies"
+
+
+def test_the_extrapolated_label_is_the_true_moment_carried_along_its_slope(monkeypatch):
+    """``--extrapolated 5``: the moment terms labelled (and flown by the teacher) are the present ones carried 5
+    steps along their last 5; the other terms, and the reset's zeros, stay."""
+    from experiments.fault_id import train
+
+    def ramp(info, n, limit, ahead=0):               # f_aero of row r at step k: (r + 1) k / 100
+        out = np.zeros((n, 7))
+        if "m_aero_b" in info:
+            out[:, 0] = (np.arange(n) + 1) * info["k"] / 100.0
+            out[:, 4] = 1.0
+        return out
+
+    monkeypatch.setattr(train, "law_terms", ramp)
+    env = condition("rigid", mission_time_s=3.0).make_env()
+    scheme = train.InversionScheme(env, 2, None, 0.0, extrapolated=5)
+    assert not scheme.labels({}).any()                # the reset
+    for k in range(1, 9):
+        y = scheme.labels({"m_aero_b": None, "k": k})
+    np.testing.assert_allclose(y[:, 0], [(8 + 5) / 100.0, 2 * (8 + 5) / 100.0])
+    np.testing.assert_allclose(y[:, 4], 1.0)
+    first = train.InversionScheme(env, 2, None, 0.0, extrapolated=5)
+    np.testing.assert_allclose(first.labels({"m_aero_b": None, "k": 3})[:, 0], [0.03, 0.06])   # no slope yet
+    with pytest.raises(ConfigError, match="--extrapolated"):
+        train.main(["--extrapolated", "5"])           # the thrust scheme
+    with pytest.raises(ConfigError, match="--extrapolated"):
+        train.main(["--scheme", "inversion", "--ahead", "5", "--extrapolated", "5"])

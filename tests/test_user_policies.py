@@ -96,6 +96,7 @@ def test_a_users_file_and_module_fly_on_two_spawned_workers(user_folder):
     out = EVALUATE.main(["--policies", "zero", "my_policy.py:make", "user_controllers:make", *ARGS, "--workers", "2",
                          "--out", str(user_folder / "out")])
     assert [p["name"] for p in out["meta"]["policies"]] == ["zero", "my_policy", "user_controllers"]
+    assert out["meta"]["protocol"] == "v1+override"           # smile-v1, its mission shortened
     assert out["meta"]["policies"][1]["factory"] == f"{user_folder / 'my_policy.py'}:make"
     mine, via_module, zero = _scores(out, "my_policy"), _scores(out, "user_controllers"), _scores(out, "zero")
     assert len(mine) == 4 and mine == via_module                    # the same factory, by file and by module

@@ -49,6 +49,7 @@ from lvgym.agents.observer_fit import Ensemble, Estimator, save
 from lvgym.cli.args import arg, parse
 
 from .estimator import RESULTS, base_lqg, corrected
+from .privileges import extrapolate
 
 #: the teacher's delays [control steps] of its knowledge of the misalignment (0-2 s at 0.02 s; the last: never)
 DELAYS = (0, 12, 25, 50, 100, None)
@@ -72,7 +73,7 @@ class ThrustScheme:
     prefix, outputs, scaled, ensemble = "estimator", 2, False, 1
 
     def __init__(self, env1: Any, n: int, rng: np.random.Generator | None, deadband: float,
-                 loop_gain: np.ndarray | None = None, ahead: int = 0) -> None:
+                 loop_gain: np.ndarray | None = None, ahead: int = 0, extrapolated: int = 0) -> None:
         from lvgym.benchmark.batch import as_batch
 
         self.limit, self.n, self.deadband = float(env1.unwrapped.func.gimbal_limit), n, deadband
@@ -98,13 +99,17 @@ class ThrustScheme:
 
 class InversionScheme:
     """The law of :mod:`lvgym.agents.inversion` on the true terms (the teacher) or the student's estimate;
-    labels: the true terms (:func:`lvgym.agents.inversion.law_terms`)."""
+    labels: the true terms (:func:`lvgym.agents.inversion.law_terms`), the moment's ``ahead`` control periods
+    ahead (the preview), or the moment as it acts carried ``extrapolated`` periods along its slope over the
+    last :data:`.privileges.SLOPE_STEPS` (:func:`.privileges.extrapolate`: a causal label, the estimate's
+    slope learned from the window instead of differenced from the student's own estimates)."""
 
     prefix, outputs, scaled, ensemble = "inversion", len(TERMS), True, 3
 
     def __init__(self, env1: Any, n: int, rng: np.random.Generator | None, deadband: float,
-                 loop_gain: np.ndarray | None = None, ahead: int = 0) -> None:
+                 loop_gain: np.ndarray | None = None, ahead: int = 0, extrapolated: int = 0) -> None:
         self.limit, self.n, self.ahead = float(env1.unwrapped.func.gimbal_limit), n, int(ahead)
+        self.extrapolated, self.aero = int(extrapolated), []   # the true f_aero of every step (its slope)
         self.index, (self.w, self.z) = error_index(env1), gains(env1)
         # a loop gain after the action (the margins' perturbation) scales the control power the action sees:
         # the terms in gimbal angles are labelled as the action must carry them, the truth over the gain
@@ -116,6 +121,9 @@ class InversionScheme:
 
     def labels(self, info: dict[str, Any]) -> np.ndarray:
         self.truth = law_terms(info, self.n, self.limit, self.ahead)
+        if self.extrapolated and "m_aero_b" in info:         # not the reset's info
+            self.aero.append(self.truth[:, 0:2].copy())
+            self.truth[:, 0:2] = extrapolate(self.aero, self.extrapolated)
         self.truth[:, :6] *= self.per_gain
         return self.truth
 
@@ -140,7 +148,8 @@ SCHEMES = {"thrust": ThrustScheme, "inversion": InversionScheme}
 
 def fly(model: str, seeds: Sequence[int], estimator: Estimator | Ensemble | None = None,
         rng: np.random.Generator | None = None, deadband: float = 0.0, scheme: str = "thrust",
-        loop_gain: np.ndarray | None = None, suite: str = SUITE, ahead: int = 0, **options: Any
+        loop_gain: np.ndarray | None = None, suite: str = SUITE, ahead: int = 0, extrapolated: int = 0,
+        **options: Any
         ) -> tuple[np.ndarray, np.ndarray, list[dict]]:
     """Fly the rows seeded ``seeds`` of the batched env of ``model`` with ``scheme``'s law (:data:`SCHEMES`) on
     the truth (``estimator`` None: the teacher; ``rng`` draws its delays) or on the ``estimator``'s output (the
@@ -149,6 +158,7 @@ def fly(model: str, seeds: Sequence[int], estimator: Estimator | Ensemble | None
     on the action after the flight computer sent it (the margins' perturbation, a training device; the
     inversion scheme only); ``suite``: whose condition (a family's with ``vehicle=`` in ``options``);
     ``ahead``: the inversion's moment label that many control periods ahead (its teacher flies on it);
+    ``extrapolated``: ... the moment as it acts carried that many periods along its slope (the same);
     ``options``: env keywords (tests shorten the mission)."""
     from lvgym.benchmark.rows import RowsLog
 
@@ -158,7 +168,7 @@ def fly(model: str, seeds: Sequence[int], estimator: Estimator | Ensemble | None
     obs, info = env.reset(seed=[int(s) for s in seeds])
     if loop_gain is not None and scheme != "inversion":
         raise ValueError("loop_gain: the inversion scheme's training device only")
-    law = SCHEMES[scheme](env1, n, rng if estimator is None else None, deadband, loop_gain, ahead)
+    law = SCHEMES[scheme](env1, n, rng if estimator is None else None, deadband, loop_gain, ahead, extrapolated)
     gain = np.ones((n, 1)) if loop_gain is None else np.asarray(loop_gain, dtype=float)[:, None]
     window, log = Window(n), RowsLog(env)
     xs, ys = [], []
@@ -272,6 +282,9 @@ class Args:
     ahead: int = arg(0, lo=0, hi=10)
     """the inversion's moment label that many control periods ahead (the preview the teacher flies on; 0:
     the moment as it acts); files ``...-ahead<k>``"""
+    extrapolated: int = arg(0, lo=0, hi=10)
+    """the inversion's moment label: the moment as it acts carried that many control periods along its slope
+    over the last 5 (causal; the teacher flies on it; 0: none); files ``...-extrapolated<k>``"""
     family_vehicles: int = arg(16, lo=1, hi=200)
     """the family's train vehicles the flights are spread over (``--suite family-v2``)"""
 
@@ -283,11 +296,14 @@ def main(argv: Sequence[str] | None = None) -> None:
     rng, t0 = np.random.default_rng(a.seed), time.time()
     first = 100_000 + 10_000 * a.seed
     family = a.suite == "family-v2"
-    if a.scheme != "inversion" and (a.suite != SUITE or a.ahead):
-        from lvgym.errors import ConfigError
+    from lvgym.errors import ConfigError
 
-        raise ConfigError("--suite" if a.suite != SUITE else "--ahead", a.suite if a.suite != SUITE else a.ahead,
-                          f"{SUITE} and 0 for the thrust scheme (the others: --scheme inversion)")
+    if a.scheme != "inversion" and (a.suite != SUITE or a.ahead or a.extrapolated):
+        key, value = next((k, v) for k, v in (("--suite", a.suite if a.suite != SUITE else None),
+                                              ("--ahead", a.ahead), ("--extrapolated", a.extrapolated)) if v)
+        raise ConfigError(key, value, f"{SUITE} and 0 for the thrust scheme (the others: --scheme inversion)")
+    if a.ahead and a.extrapolated:
+        raise ConfigError("--extrapolated", a.extrapolated, "0 with --ahead (one label of the moment)")
     vehicles = [None]
     if family:
         from lvgym.agents.familytrain import train_vehicle_files
@@ -295,6 +311,7 @@ def main(argv: Sequence[str] | None = None) -> None:
         vehicles = [str(f) for f in train_vehicle_files(a.family_vehicles)]
     where = "" if a.suite == SUITE else "-family" if family else f"-{a.suite}"
     prefix = (SCHEMES[a.scheme].prefix + where + (f"-ahead{a.ahead}" if a.ahead else "")
+              + (f"-extrapolated{a.extrapolated}" if a.extrapolated else "")
               + (f"-gain{a.loop_gain_db:g}" if a.loop_gain_db else ""))
     xs, ys = [], []
     est: Estimator | None = None                      # the teacher flies round 0, the student the others
@@ -312,7 +329,8 @@ def main(argv: Sequence[str] | None = None) -> None:
                     gain = (10.0 ** (rng.uniform(-a.loop_gain_db, a.loop_gain_db, len(seeds)) / 20.0)
                             if a.loop_gain_db else None)
                     place = {"suite": a.suite, **({"vehicle": vehicle} if family else {})}
-                    x, y, _ = fly(model, seeds, est, rng, scheme=a.scheme, loop_gain=gain, ahead=a.ahead, **place)
+                    x, y, _ = fly(model, seeds, est, rng, scheme=a.scheme, loop_gain=gain, ahead=a.ahead,
+                                    extrapolated=a.extrapolated, **place)
                     xs.append(x)
                     ys.append(y)
         print(f"seed {a.seed} round {rnd}: {sum(len(x) for x in xs)} steps of data at {time.time() - t0:.0f} s",

@@ -52,7 +52,7 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any
 
-from lvgym.benchmark import (DEFAULT_SUITE, EXECUTORS, PROTOCOL_VERSION, SEED_SETS, SUITES, PolicySpec, compare,
+from lvgym.benchmark import (DEFAULT_SUITE, EXECUTORS, SEED_SETS, SUITES, PolicySpec, compare,
                              degradation, evaluate, get_suite, markdown_table, normalise, protocol_metric,
                              run_groups, summarize, write_results)
 from lvgym.benchmark.family import family_room, family_rows, family_table
@@ -178,7 +178,7 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
         groups += run_groups(of_suite, metric)
     rows = headline(summary, records, {p.name: policy_kind(p) for p in policies})
     meta = {
-        "protocol": PROTOCOL_VERSION, "seed_set": args.seed_set, "episodes": args.episodes, "args": asdict(args),
+        "protocol": ", ".join(sorted({s.version for s in suites})), "seed_set": args.seed_set, "episodes": args.episodes, "args": asdict(args),
         "suites": {s.name: {"version": s.version, "description": s.description, "overrides": dict(s.overrides),
                             "first_seed": s.seeds(args.seed_set, args.episodes)[0],
                             "last_seed": s.seeds(args.seed_set, args.episodes)[-1],
