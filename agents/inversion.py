@@ -41,8 +41,8 @@ from lvgym.errors import ConfigError
 
 from .observer import N_OBS, Observer, Window
 
-__all__ = ["A_MAX", "ERRORS", "SHIPPED", "TERMS", "InversionBatch", "InversionPolicy", "check_env", "command",
-           "env_record", "error_index", "from_file", "gains", "law_terms", "shipped_inversion"]
+__all__ = ["A_MAX", "ERRORS", "SHIPPED", "SPAN", "TERMS", "InversionBatch", "InversionPolicy", "Lead", "carry",
+           "check_env", "command", "env_record", "error_index", "from_file", "gains", "law_terms", "shipped_inversion"]
 
 #: the law's terms, in the order of :func:`law_terms`
 TERMS = ("f_aero_pitch", "f_aero_yaw", "f_mis_pitch", "f_mis_yaw", "a_pitch", "a_yaw", "qalpha_share")
@@ -132,23 +132,64 @@ def check_env(env: Any, trained: dict[str, Any]) -> None:
                           f"({N_OBS},): the observer reads SMILE's flight observation")
 
 
+#: the span [control steps] of the slope a lead carries the aerodynamic moment along (:class:`Lead`)
+SPAN = 5
+
+
+def carry(now: np.ndarray, back: np.ndarray, ahead: int, span: int = SPAN) -> np.ndarray:
+    """``now`` carried ``ahead`` steps along the slope from ``back``, ``span`` steps before it."""
+    return now + ahead * (now - back) / span
+
+
+class Lead:
+    """The aerodynamic-moment terms (``f_aero``, pitch and yaw) of ``n`` rows carried ``ahead`` control steps
+    along their slope over the last ``span`` steps (:func:`carry`; over fewer at the start of a flight, none
+    at its first step): a causal prediction of the moment the gimbal will meet, about a delay and a servo lag
+    later (the privileged reference reads it 5 steps ahead in the wind). ``ahead`` 0: the terms as they are."""
+
+    def __init__(self, n: int, ahead: int = 0, span: int = SPAN) -> None:
+        if ahead < 0 or span < 1:
+            raise ConfigError("lead", (ahead, span), "ahead >= 0 and span >= 1 control steps")
+        self.ahead, self.span = int(ahead), int(span)
+        self.past = np.zeros((int(n), self.span + 1, 2))          # oldest first
+        self.count = np.zeros(int(n), dtype=np.int64)
+
+    def push(self, rows: np.ndarray, f_aero: np.ndarray) -> np.ndarray:
+        """Add the step's ``f_aero`` ``(len(rows), 2)`` of ``rows`` and return them carried ahead."""
+        f = np.asarray(f_aero, dtype=np.float64)
+        if not self.ahead:
+            return f
+        self.past[rows, :-1] = self.past[rows, 1:]
+        self.past[rows, -1] = f
+        self.count[rows] += 1
+        back = self.past[rows, np.maximum(0, self.span + 1 - self.count[rows])]
+        return carry(f, back, self.ahead, self.span)
+
+    def reset(self, rows: np.ndarray) -> None:
+        """Forget the flights of ``rows``."""
+        self.past[rows] = 0.0
+        self.count[rows] = 0
+
+
 class InversionPolicy:
     """The law of the module docstring on the observer's estimated terms; one env row (the benchmark's
     policy; no privileged information). ``observer``: a window ``(WINDOW, FEATURES)`` -> the terms ``(7,)``
     (an :class:`~lvgym.agents.observer.Observer`); ``trained``: the :func:`env_record` it was trained on (it
-    refuses another env: :func:`check_env`)."""
+    refuses another env: :func:`check_env`); ``lead``, ``span``: the control steps the estimated aerodynamic
+    moment is carried ahead along its slope over ``span`` steps (:class:`Lead`; 0: the moment as estimated)."""
 
     def __init__(self, env: Any, observer: Callable[[np.ndarray], np.ndarray], name: str = "inversion-id",
-                 trained: dict[str, Any] | None = None) -> None:
+                 trained: dict[str, Any] | None = None, lead: int = 0, span: int = SPAN) -> None:
         check_env(env, trained or {})
         self.observer = observer
         self.name = name
         self.index, (self.w, self.z) = error_index(env), gains(env)
-        self.window = Window(1)
+        self.lead, self.span = int(lead), int(span)
+        self.reset()
 
     def reset(self) -> None:
-        """Forget the flight: the window starts from zeros."""
-        self.window = Window(1)
+        """Forget the flight: the window starts from zeros, the lead from no slope."""
+        self.window, self.ahead = Window(1), Lead(1, self.lead, self.span)
 
     def act(self, observation: np.ndarray, info: dict[str, Any]) -> np.ndarray:
         """The gimbal action (pitch, yaw) in [-1, 1] from the observation (``info`` is not read)."""
@@ -167,10 +208,12 @@ class InversionBatch:
     def __init__(self, policy: InversionPolicy, n: int) -> None:
         self.name, self.observer = policy.name, policy.observer
         self.index, self.w, self.z = policy.index, policy.w, policy.z
-        self.window = Window(int(n))
+        self.window, self.ahead = Window(int(n)), Lead(int(n), policy.lead, policy.span)
 
     def reset(self, rows: Any) -> None:
-        self.window.reset(np.asarray(rows, dtype=np.int64).reshape(-1))
+        rows = np.asarray(rows, dtype=np.int64).reshape(-1)
+        self.window.reset(rows)
+        self.ahead.reset(rows)
 
     def act(self, rows: Any, observations: np.ndarray, info: dict[str, Any]) -> np.ndarray:
         return self.step(self, np.asarray(rows, dtype=np.int64).reshape(-1), np.asarray(observations))
@@ -181,20 +224,24 @@ class InversionBatch:
         o = np.asarray(observations, dtype=np.float32)
         windows = law.window.push(rows, o)
         terms = np.stack([law.observer(w) for w in windows])
+        terms[:, 0:2] = law.ahead.push(rows, terms[:, 0:2])
         a = command(o, terms, law.index, law.w, law.z)
         law.window.sent(rows, a)
         return a
 
 
-def from_file(env: Any, path: str | Path, name: str = "inversion-id", trained: dict[str, Any] | None = None
-              ) -> InversionPolicy:
+def from_file(env: Any, path: str | Path, name: str = "inversion-id", trained: dict[str, Any] | None = None,
+              lead: int = 0, span: int = SPAN) -> InversionPolicy:
     """The policy on the observer saved at ``path``: an :class:`~lvgym.agents.observer.Observer`'s ``.npz``, or
-    a training run's torch ``.pt`` (:func:`lvgym.agents.observer_fit.load`; needs torch)."""
+    a training run's torch ``.pt`` (:func:`lvgym.agents.observer_fit.load`; needs torch); ``lead``, ``span``:
+    the :class:`Lead` of its aerodynamic moment [control steps]."""
     if Path(path).suffix == ".pt":
         from .observer_fit import load, to_observer
 
-        return InversionPolicy(env, to_observer(load(path)), name=name, trained=trained)
-    return InversionPolicy(env, Observer.load(path), name=name, trained=trained)
+        observer: Callable[[np.ndarray], np.ndarray] = to_observer(load(path))
+    else:
+        observer = Observer.load(path)
+    return InversionPolicy(env, observer, name=name, trained=trained, lead=lead, span=span)
 
 
 def shipped_inversion(env: Any, name: str = "inversion-id", file: str = SHIPPED) -> InversionPolicy:

@@ -183,29 +183,6 @@ def test_the_moment_extrapolated_along_its_slope_by_hand():
     np.testing.assert_allclose(law.m[0], [0.0, 0.0, 0.0])               # the first step: no slope yet
 
 
-def test_the_extrapolated_student_adds_its_estimates_slope():
-    """A ramp of estimated aerodynamic-moment terms, extrapolated 5 steps along the last 5: the command is the
-    law's on the ramp's value 5 steps on; the policy flies row by row (no batch)."""
-    from experiments.fault_id.inversion import Extrapolated, command, error_index, gains
-    from lvgym.benchmark.batch import as_batch
-
-    env = condition("rigid", mission_time_s=3.0).make_env()
-    calls = []
-
-    def ramp(window):
-        calls.append(1)
-        return np.array([0.01 * len(calls), 0.0, 0.0, 0.0, 1.0, 1.0, 0.0])
-
-    p = Extrapolated(env, ramp, name="x")
-    obs = np.zeros(14, np.float32)
-    for _ in range(8):
-        a = p.act(obs, {})
-    want = command(obs[None], np.array([[0.08 + 5 * 0.01, 0.0, 0.0, 0.0, 1.0, 1.0, 0.0]]), error_index(env),
-                   *gains(env))[0]
-    np.testing.assert_allclose(a, want, rtol=1e-6)
-    assert type(as_batch(p, 2, lambda: p)).__name__ == "RowPolicies"
-
-
 def test_the_extrapolated_label_is_the_true_moment_carried_along_its_slope(monkeypatch):
     """``--extrapolated 5``: the moment terms labelled (and flown by the teacher) are the present ones carried 5
     steps along their last 5; the other terms, and the reset's zeros, stay."""

@@ -16,7 +16,7 @@ import torch
 
 import lvgym
 import lvgym.cli.policies  # noqa: F401  (registers the built-in policies)
-from lvgym.agents.inversion import (A_MAX, SHIPPED, TERMS, TRAINED, InversionPolicy, command, env_record, from_file,
+from lvgym.agents.inversion import (A_MAX, SHIPPED, TERMS, TRAINED, InversionPolicy, Lead, command, env_record, from_file,
                                     law_terms)
 from lvgym.agents.observer import FEATURES, N_OBS, WINDOW, Observer, Window
 from lvgym.agents.observer_fit import Ensemble, Estimator, load, save, to_observer
@@ -161,3 +161,54 @@ def test_the_shipped_policy_flies_without_torch():
             "print('torch' in sys.modules, r['duration_s'])\n")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.split()
     assert out[0] == "False" and float(out[1]) == pytest.approx(2.5, abs=0.03)
+
+
+def test_a_lead_carries_the_moment_along_its_slope_by_hand():
+    """Two rows of ramps (0.01 and 0.02 per step): 3 steps ahead along the last 5 is the ramp 3 steps on, from
+    the sixth step; before, along the slope from the first step (over 5); none at the first step; a row's
+    reset starts it again without touching the other; lead 0 is the terms as they are."""
+    lead, rows = Lead(2, 3), np.arange(2)
+    slopes = np.array([[0.01, 0.0], [0.02, -0.01]])
+    first = lead.push(rows, slopes * 1)
+    np.testing.assert_allclose(first, slopes)                               # no slope yet
+    second = lead.push(rows, slopes * 2)
+    np.testing.assert_allclose(second, slopes * (2 + 3 * 1 / 5))            # one step's rise over 5
+    for k in range(3, 9):
+        out = lead.push(rows, slopes * k)
+    np.testing.assert_allclose(out, slopes * (8 + 3))
+    lead.reset(np.array([0]))
+    out = lead.push(np.array([0, 1]), slopes * np.array([[1.0], [9.0]]))
+    np.testing.assert_allclose(out, [slopes[0], slopes[1] * (9 + 3)])
+    still = Lead(1, 0)
+    np.testing.assert_array_equal(still.push(np.zeros(1, dtype=np.int64), [[0.3, -0.2]]), [[0.3, -0.2]])
+    with pytest.raises(ConfigError, match="lead"):
+        Lead(1, -1)
+
+
+def test_a_policy_with_a_lead_commands_the_law_on_the_moment_ahead_and_its_batch_is_its_rows():
+    """A ramp of estimated moments: the action is the law's on the ramp 3 steps on; the batch of two rows
+    gives each row its single policy's actions, to the bit."""
+    env = lvgym.make_env("smile-v2-faults", "rigid", mission_time_s=3.0)
+    calls = []
+
+    def ramp(window):
+        calls.append(1)
+        return np.array([0.01 * len(calls), 0.0, 0.0, 0.0, 1.0, 1.0, 0.0])
+
+    p = InversionPolicy(env, ramp, name="x", lead=3)
+    obs = np.zeros(14, np.float32)
+    for _ in range(8):
+        a = p.act(obs, {})
+    want = command(obs[None], np.array([[0.08 + 3 * 0.01, 0.0, 0.0, 0.0, 1.0, 1.0, 0.0]]), p.index, p.w, p.z)[0]
+    np.testing.assert_allclose(a, want, rtol=1e-6)
+    observer = to_observer(_ensemble(hidden=16))
+    single = [InversionPolicy(env, observer, lead=3) for _ in range(2)]
+    batch = InversionPolicy(env, observer, lead=3).batch(2)
+    batch.reset([0, 1])
+    rng = np.random.default_rng(0)
+    for step in range(30):
+        o = rng.normal(0.0, 0.05, (2, 14)).astype(np.float32)
+        rows = np.array([0, 1]) if step != 12 else np.array([1])            # row 0 sits out a step
+        got = batch.act(rows, o[rows], {})
+        for j, r in enumerate(rows):
+            np.testing.assert_array_equal(got[j], single[r].act(o[r], {}))

@@ -37,8 +37,9 @@ SLOPE_STEPS = 5
 def extrapolate(history: Sequence[np.ndarray], ahead: int, span: int = SLOPE_STEPS) -> np.ndarray:
     """The last of ``history`` carried ``ahead`` steps along its slope over the last ``span`` steps (over
     fewer at the start of a flight: none at its first step)."""
-    back = history[max(0, len(history) - 1 - span)]
-    return history[-1] + ahead * (history[-1] - back) / span
+    from lvgym.agents.inversion import carry
+
+    return carry(history[-1], history[max(0, len(history) - 1 - span)], ahead, span)
 
 
 def reference(env: Any, preview: bool = True, relief: bool = True, plant: bool = True, observed: bool = False,

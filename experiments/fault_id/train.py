@@ -43,7 +43,7 @@ from typing import Any
 import numpy as np
 import torch
 
-from lvgym.agents.inversion import TERMS, command, error_index, gains, law_terms
+from lvgym.agents.inversion import TERMS, Lead, command, error_index, gains, law_terms
 from lvgym.agents.observer import Window
 from lvgym.agents.observer_fit import Ensemble, Estimator, save
 from lvgym.cli.args import arg, parse
@@ -73,7 +73,7 @@ class ThrustScheme:
     prefix, outputs, scaled, ensemble = "estimator", 2, False, 1
 
     def __init__(self, env1: Any, n: int, rng: np.random.Generator | None, deadband: float,
-                 loop_gain: np.ndarray | None = None, ahead: int = 0, extrapolated: int = 0) -> None:
+                 loop_gain: np.ndarray | None = None, ahead: int = 0, extrapolated: int = 0, lead: int = 0) -> None:
         from lvgym.benchmark.batch import as_batch
 
         self.limit, self.n, self.deadband = float(env1.unwrapped.func.gimbal_limit), n, deadband
@@ -102,14 +102,17 @@ class InversionScheme:
     labels: the true terms (:func:`lvgym.agents.inversion.law_terms`), the moment's ``ahead`` control periods
     ahead (the preview), or the moment as it acts carried ``extrapolated`` periods along its slope over the
     last :data:`.privileges.SLOPE_STEPS` (:func:`.privileges.extrapolate`: a causal label, the estimate's
-    slope learned from the window instead of differenced from the student's own estimates)."""
+    slope learned from the window instead of differenced from the student's own estimates); ``lead``: the law
+    flies the moment terms carried that many periods along their slope (:class:`lvgym.agents.inversion.Lead`:
+    the teacher's of the truth, the student's of its estimates), the labels stay."""
 
     prefix, outputs, scaled, ensemble = "inversion", len(TERMS), True, 3
 
     def __init__(self, env1: Any, n: int, rng: np.random.Generator | None, deadband: float,
-                 loop_gain: np.ndarray | None = None, ahead: int = 0, extrapolated: int = 0) -> None:
+                 loop_gain: np.ndarray | None = None, ahead: int = 0, extrapolated: int = 0, lead: int = 0) -> None:
         self.limit, self.n, self.ahead = float(env1.unwrapped.func.gimbal_limit), n, int(ahead)
         self.extrapolated, self.aero = int(extrapolated), []   # the true f_aero of every step (its slope)
+        self.lead = Lead(n, lead)                              # the law's, on the truth or the estimate
         self.index, (self.w, self.z) = error_index(env1), gains(env1)
         # a loop gain after the action (the margins' perturbation) scales the control power the action sees:
         # the terms in gimbal angles are labelled as the action must carry them, the truth over the gain
@@ -128,13 +131,15 @@ class InversionScheme:
         return self.truth
 
     def act(self, live: np.ndarray, obs: np.ndarray, info: dict[str, Any], estimate: np.ndarray | None) -> np.ndarray:
+        terms = (self.truth[live] if estimate is None else estimate).copy()
+        terms[:, 0:2] = self.lead.push(live, terms[:, 0:2])
         if estimate is not None:
-            return command(obs, estimate, self.index, self.w, self.z)
+            return command(obs, terms, self.index, self.w, self.z)
         # the teacher's action with a slowly varying exploration: without it the action sent last holds the
         # label (it is ``a alpha - f``), and a student reads ``f`` back from its own action
         self.noise[live] = (NOISE_PHI * self.noise[live] + np.sqrt(1.0 - NOISE_PHI ** 2) * self.sigma[live]
                             * self.rng.standard_normal((len(live), 2)))
-        return np.clip(command(obs, self.truth[live], self.index, self.w, self.z) + self.noise[live],
+        return np.clip(command(obs, terms, self.index, self.w, self.z) + self.noise[live],
                        -1.0, 1.0).astype(np.float32)
 
 
@@ -149,7 +154,7 @@ SCHEMES = {"thrust": ThrustScheme, "inversion": InversionScheme}
 def fly(model: str, seeds: Sequence[int], estimator: Estimator | Ensemble | None = None,
         rng: np.random.Generator | None = None, deadband: float = 0.0, scheme: str = "thrust",
         loop_gain: np.ndarray | None = None, suite: str = SUITE, ahead: int = 0, extrapolated: int = 0,
-        **options: Any
+        lead: int = 0, **options: Any
         ) -> tuple[np.ndarray, np.ndarray, list[dict]]:
     """Fly the rows seeded ``seeds`` of the batched env of ``model`` with ``scheme``'s law (:data:`SCHEMES`) on
     the truth (``estimator`` None: the teacher; ``rng`` draws its delays) or on the ``estimator``'s output (the
@@ -159,6 +164,7 @@ def fly(model: str, seeds: Sequence[int], estimator: Estimator | Ensemble | None
     inversion scheme only); ``suite``: whose condition (a family's with ``vehicle=`` in ``options``);
     ``ahead``: the inversion's moment label that many control periods ahead (its teacher flies on it);
     ``extrapolated``: ... the moment as it acts carried that many periods along its slope (the same);
+    ``lead``: the inversion's law flies its moment carried that many periods along its slope (the labels stay);
     ``options``: env keywords (tests shorten the mission)."""
     from lvgym.benchmark.rows import RowsLog
 
@@ -168,7 +174,8 @@ def fly(model: str, seeds: Sequence[int], estimator: Estimator | Ensemble | None
     obs, info = env.reset(seed=[int(s) for s in seeds])
     if loop_gain is not None and scheme != "inversion":
         raise ValueError("loop_gain: the inversion scheme's training device only")
-    law = SCHEMES[scheme](env1, n, rng if estimator is None else None, deadband, loop_gain, ahead, extrapolated)
+    law = SCHEMES[scheme](env1, n, rng if estimator is None else None, deadband, loop_gain, ahead, extrapolated,
+                          lead)
     gain = np.ones((n, 1)) if loop_gain is None else np.asarray(loop_gain, dtype=float)[:, None]
     window, log = Window(n), RowsLog(env)
     xs, ys = [], []
@@ -232,7 +239,7 @@ def scored(records: Sequence[dict[str, Any]]) -> tuple[float, int]:
 
 
 def validate(est: Estimator | Ensemble, episodes: int, deadband: float = 0.0,
-             scheme: str = "thrust", suite: str = SUITE) -> dict[str, tuple[float, int]]:
+             scheme: str = "thrust", suite: str = SUITE, lead: int = 0) -> dict[str, tuple[float, int]]:
     """Mean ``score_v2`` and failed or unflyable flights of the student on validation seeds ``0 ..
     episodes - 1`` per flight model (:func:`fly`: the rows of one batched env; the benchmark flies the same
     law one row at a time through :class:`.estimator.FaultIdPolicy` or
@@ -246,11 +253,11 @@ def validate(est: Estimator | Ensemble, episodes: int, deadband: float = 0.0,
         if suite != "family-v2":
             rs = [r for k in range(0, episodes, 100)
                   for r in fly(model, range(k, min(episodes, k + 100)), est, deadband=deadband, scheme=scheme,
-                               suite=suite)[2]]
+                               suite=suite, lead=lead)[2]]
         else:
             each = max(1, episodes // len(FAMILY_VALIDATION_VEHICLES))
             rs = [r for v in FAMILY_VALIDATION_VEHICLES
-                  for r in fly(model, range(each), est, scheme=scheme, suite=suite, vehicle=v)[2]]
+                  for r in fly(model, range(each), est, scheme=scheme, suite=suite, lead=lead, vehicle=v)[2]]
         out[model] = scored(rs)
     return out
 
@@ -285,6 +292,10 @@ class Args:
     extrapolated: int = arg(0, lo=0, hi=10)
     """the inversion's moment label: the moment as it acts carried that many control periods along its slope
     over the last 5 (causal; the teacher flies on it; 0: none); files ``...-extrapolated<k>``"""
+    lead: int = arg(0, lo=0, hi=10)
+    """the inversion's law flies the moment terms carried that many control periods along their slope over the
+    last 5 (the teacher's true ones, the student's estimates; the labels stay the present terms; the policy
+    flies it with ``lead``); files ``...-lead<k>``"""
     family_vehicles: int = arg(16, lo=1, hi=200)
     """the family's train vehicles the flights are spread over (``--suite family-v2``)"""
 
@@ -298,9 +309,10 @@ def main(argv: Sequence[str] | None = None) -> None:
     family = a.suite == "family-v2"
     from lvgym.errors import ConfigError
 
-    if a.scheme != "inversion" and (a.suite != SUITE or a.ahead or a.extrapolated):
+    if a.scheme != "inversion" and (a.suite != SUITE or a.ahead or a.extrapolated or a.lead):
         key, value = next((k, v) for k, v in (("--suite", a.suite if a.suite != SUITE else None),
-                                              ("--ahead", a.ahead), ("--extrapolated", a.extrapolated)) if v)
+                                              ("--ahead", a.ahead), ("--extrapolated", a.extrapolated),
+                                              ("--lead", a.lead)) if v)
         raise ConfigError(key, value, f"{SUITE} and 0 for the thrust scheme (the others: --scheme inversion)")
     if a.ahead and a.extrapolated:
         raise ConfigError("--extrapolated", a.extrapolated, "0 with --ahead (one label of the moment)")
@@ -311,7 +323,7 @@ def main(argv: Sequence[str] | None = None) -> None:
         vehicles = [str(f) for f in train_vehicle_files(a.family_vehicles)]
     where = "" if a.suite == SUITE else "-family" if family else f"-{a.suite}"
     prefix = (SCHEMES[a.scheme].prefix + where + (f"-ahead{a.ahead}" if a.ahead else "")
-              + (f"-extrapolated{a.extrapolated}" if a.extrapolated else "")
+              + (f"-extrapolated{a.extrapolated}" if a.extrapolated else "") + (f"-lead{a.lead}" if a.lead else "")
               + (f"-gain{a.loop_gain_db:g}" if a.loop_gain_db else ""))
     xs, ys = [], []
     est: Estimator | None = None                      # the teacher flies round 0, the student the others
@@ -330,7 +342,7 @@ def main(argv: Sequence[str] | None = None) -> None:
                             if a.loop_gain_db else None)
                     place = {"suite": a.suite, **({"vehicle": vehicle} if family else {})}
                     x, y, _ = fly(model, seeds, est, rng, scheme=a.scheme, loop_gain=gain, ahead=a.ahead,
-                                    extrapolated=a.extrapolated, **place)
+                                    extrapolated=a.extrapolated, lead=a.lead, **place)
                     xs.append(x)
                     ys.append(y)
         print(f"seed {a.seed} round {rnd}: {sum(len(x) for x in xs)} steps of data at {time.time() - t0:.0f} s",
@@ -339,14 +351,14 @@ def main(argv: Sequence[str] | None = None) -> None:
         fits.append(est)
         save(est, RESULTS / f"{prefix}-s{a.seed}-r{rnd}.pt")
         if a.validation:
-            v = validate(est, a.validation, scheme=a.scheme, suite=a.suite)
+            v = validate(est, a.validation, scheme=a.scheme, suite=a.suite, lead=a.lead)
             print(f"seed {a.seed} round {rnd} validation 0-{a.validation - 1}: " + ", ".join(
                 f"{m} {s:.3f} ({b})" for m, (s, b) in v.items()) + f" at {time.time() - t0:.0f} s", flush=True)
     last = SCHEMES[a.scheme].ensemble                 # the policy: the mean of the last rounds' fits
     final = Ensemble(fits[-last:]) if last > 1 else est
     save(final, RESULTS / f"{prefix}-s{a.seed}.pt")
     if a.validation and last > 1:
-        v = validate(final, a.validation, scheme=a.scheme, suite=a.suite)
+        v = validate(final, a.validation, scheme=a.scheme, suite=a.suite, lead=a.lead)
         print(f"seed {a.seed} the last {last} rounds' mean, validation 0-{a.validation - 1}: " + ", ".join(
             f"{m} {s:.3f} ({b})" for m, (s, b) in v.items()), flush=True)
     print(f"wrote {RESULTS / f'{prefix}-s{a.seed}.pt'} in {time.time() - t0:.0f} s")
