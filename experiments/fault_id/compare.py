@@ -20,11 +20,12 @@ from pathlib import Path
 
 from lvgym.cli.args import arg, parse
 
-BASELINES = ("lqg", "lqg-front", "aac-quiet", "gs-pd-relief")
+BASELINES = ("lqg", "lqg-front", "aac-quiet", "gs-pd-relief", "gs-pid-flex-quiet")
 #: the students' labels, ``<configuration>-s<training seed>``: the thrust-direction estimator on ``lqg``
 #: (:mod:`.estimator`) and the reference's law on the learned disturbance observer (:mod:`.inversion`), trained
-#: without and with the loop dispersion (``--loop-gain-db 6``)
-CONFIGURATIONS = ("lqg-thrust-id", "inversion-id", "inversion-id-gain6")
+#: without and with the loop dispersion (``--loop-gain-db 6``), and on Stratos III with the law's lead of 3 steps
+#: (``inversion-stratos-lead3-s0=experiments.fault_id.inversion:stratos_lead3_s0`` ...)
+CONFIGURATIONS = ("lqg-thrust-id", "inversion-id", "inversion-id-gain6", "inversion-stratos-lead3")
 
 
 @dataclass

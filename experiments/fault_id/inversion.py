@@ -17,7 +17,8 @@ from lvgym.agents.inversion import (A_MAX, ERRORS, NO_THRUST, TERMS, InversionPo
 from .estimator import RESULTS
 
 __all__ = ["A_MAX", "ERRORS", "NO_THRUST", "TERMS", "InversionPolicy", "command", "error_index", "gain6_s0",
-           "gain6_s1", "gain6_s2", "gains", "law_terms", "s0", "s1", "s2"]
+           "gain6_s1", "gain6_s2", "gains", "law_terms", "s0", "s1", "s2", "stratos_extrapolated15_s0",
+           "stratos_extrapolated_s0", "stratos_lead3_s0", "stratos_lead3_s1", "stratos_lead3_s2", "stratos_s0"]
 
 
 def _seeded(k: int, prefix: str = "inversion", label: str = "inversion-id", attribute: str = ""):
@@ -48,3 +49,8 @@ stratos_extrapolated_s0 = _lead("inversion-stratos-tvc-v2", 0, "inversion-strato
 #: ... its slope over the last 15 steps (a smoother slope of a noisy estimate)
 stratos_extrapolated15_s0 = _lead("inversion-stratos-tvc-v2", 0, "inversion-stratos-extrapolated15",
                                   "stratos_extrapolated15_", span=15)
+#: the Stratos III students trained with the law's lead of 3 steps (``train.py --suite stratos-tvc-v2 --lead 3
+#: --flights 200 --epochs 16 --tag f200e16``), flown with it
+stratos_lead3_s0, stratos_lead3_s1, stratos_lead3_s2 = (
+    _lead("inversion-stratos-tvc-v2-lead3-f200e16", k, "inversion-stratos-lead3", "stratos_lead3_", lead=3)
+    for k in range(3))

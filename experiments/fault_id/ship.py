@@ -1,16 +1,18 @@
-"""Choose the shipped ``inversion-id`` among the training seeds on the validation seeds, and write it with its
-record into ``agents/trained`` (:data:`lvgym.agents.inversion.SHIPPED`).
+"""Choose a shipped disturbance-observer policy among the training seeds on the validation seeds, and write it
+with its record into ``agents/trained`` (``inversion-id``: :data:`lvgym.agents.inversion.SHIPPED`).
 
     python -m experiments.fault_id.ship --prefix inversion-gain6 --seeds 0 1 2 --validation 100
+    python -m experiments.fault_id.ship --suite stratos-tvc-v2 --prefix inversion-stratos-tvc-v2-lead3 --lead 3 \
+        --loop-gain-db 0 --stem inversion_id_stratos_tvc_v2 --name inversion-id-stratos
 
 Each seed's observer (``results/fault_id/<prefix>-s<k>.pt``, written by :mod:`.train`) is converted to the
 flight computer's NumPy form (``<prefix>-s<k>.npz``, :func:`lvgym.agents.observer_fit.to_observer`) and flown
-by the benchmark (:func:`lvgym.benchmark.evaluate`, as the shipped policy flies) on validation seeds
-``0 .. --validation - 1`` of ``smile-v2-faults``, both flight models; the shipped one is the seed with the
+by the benchmark (:func:`lvgym.benchmark.evaluate`, as the shipped policy flies, with its ``--lead``) on
+validation seeds ``0 .. --validation - 1`` of ``--suite``, both flight models; the shipped one is the seed with the
 fewest failed or unflyable non-rigid flights, then the lowest non-rigid mean ``score_v2``. The test seeds are
 not flown. The record (``<stem>.json``) holds the training command, the validation of every candidate, the
 choice, the env the observer was trained on (:func:`lvgym.agents.inversion.env_record`, which the policy
-checks) and the observer file's SHA-256.
+checks), the law's lead (which the policy flies) and the observer file's SHA-256.
 """
 
 from __future__ import annotations
@@ -43,6 +45,20 @@ class Args:
     """validation seeds flown per flight model"""
     loop_gain_db: float = arg(6.0, lo=0.0, hi=12.0)
     """the loop dispersion the runs were trained under (recorded)"""
+    suite: str = arg(SUITE, choices=(SUITE, "smile-v2", "stratos-tvc-v2"))
+    """the suite the runs were trained on and are validated on"""
+    lead: int = arg(0, lo=0, hi=10)
+    """the law's lead [control steps] the runs were trained with (``train.py --lead``), flown and recorded"""
+    flights: int = arg(100, lo=10, hi=2000)
+    """the runs' ``--flights`` (recorded)"""
+    epochs: int = arg(8, lo=1, hi=100)
+    """the runs' ``--epochs`` (recorded)"""
+    tag: str = arg("")
+    """the runs' ``--tag`` (recorded)"""
+    stem: str = arg(SHIPPED)
+    """the shipped files' name in agents/trained (``<stem>.npz``, ``<stem>.json``)"""
+    name: str = arg("inversion-id")
+    """the registered policy's name (recorded)"""
 
 
 def per_model(records: list[dict]) -> dict[str, dict[str, float]]:
@@ -55,11 +71,11 @@ def per_model(records: list[dict]) -> dict[str, dict[str, float]]:
     return out
 
 
-def validation(path: str, episodes: int) -> dict[str, dict[str, float]]:
-    """:func:`per_model` of the observer at ``path`` (``.npz``) on ``smile-v2-faults``'s first ``episodes``
-    validation seeds, flown by the benchmark."""
-    spec = PolicySpec("inversion-id", "lvgym.agents.inversion:from_file", (("path", path),))
-    return per_model(evaluate([spec], [get_suite(SUITE)], episodes, seed_set="validation", progress=False))
+def validation(path: str, episodes: int, suite: str = SUITE, lead: int = 0) -> dict[str, dict[str, float]]:
+    """:func:`per_model` of the observer at ``path`` (``.npz``, flown with ``lead``) on ``suite``'s first
+    ``episodes`` validation seeds, flown by the benchmark."""
+    spec = PolicySpec("inversion-id", "lvgym.agents.inversion:from_file", (("lead", lead), ("path", path)))
+    return per_model(evaluate([spec], [get_suite(suite)], episodes, seed_set="validation", progress=False))
 
 
 def main(argv: Sequence[str] | None = None) -> None:
@@ -68,21 +84,24 @@ def main(argv: Sequence[str] | None = None) -> None:
     for k in a.seeds:
         npz = RESULTS / f"{a.prefix}-s{k}.npz"
         to_observer(load(RESULTS / f"{a.prefix}-s{k}.pt")).save(npz)
-        candidates[k] = validation(str(npz.resolve()), a.validation)
+        candidates[k] = validation(str(npz.resolve()), a.validation, a.suite, a.lead)
         print(f"seed {k}: " + ", ".join(f"{m} {v['score_v2_mean']:.3f} ({v['failed_or_unflyable']})"
                                          for m, v in candidates[k].items()), flush=True)
     best = min(candidates, key=lambda k: (candidates[k]["nonrigid"]["failed_or_unflyable"],
                                           candidates[k]["nonrigid"]["score_v2_mean"]))
     source = RESULTS / f"{a.prefix}-s{best}.npz"
-    target = TRAINED / f"{SHIPPED}.npz"
+    target = TRAINED / f"{a.stem}.npz"
     shutil.copyfile(source, target)
+    options = ((f" --suite {a.suite}" if a.suite != SUITE else "") + (f" --lead {a.lead}" if a.lead else "")
+               + (f" --epochs {a.epochs}" if a.epochs != 8 else "") + (f" --tag {a.tag}" if a.tag else "")
+               + (f" --loop-gain-db {a.loop_gain_db:g}" if a.loop_gain_db else ""))
     record = {
-        "policy": "inversion-id",
-        "suite": SUITE,
-        "env": env_record(condition("nonrigid").make_env()),
-        "training": {"command": f"python -m experiments.fault_id.train --scheme inversion --seed {best} --flights 100 "
-                                f"--rounds 4 --validation 50" + (f" --loop-gain-db {a.loop_gain_db:g}"
-                                                                 if a.loop_gain_db else ""),
+        "policy": a.name,
+        "suite": a.suite,
+        "env": env_record(condition("nonrigid", a.suite).make_env()),
+        "lead": a.lead,
+        "training": {"command": f"python -m experiments.fault_id.train --scheme inversion --seed {best} "
+                                f"--flights {a.flights} --rounds 4 --validation 50{options}",
                      "seeds": list(a.seeds), "file": f"{a.prefix}-s{best}.pt"},
         "validation": {"seeds": f"0-{a.validation - 1}", "candidates": {str(k): v for k, v in candidates.items()},
                        "selection": "fewest failed or unflyable non-rigid flights, then the lowest non-rigid mean "
@@ -90,8 +109,8 @@ def main(argv: Sequence[str] | None = None) -> None:
         "sha256": hashlib.sha256(target.read_bytes()).hexdigest(),
         "date": datetime.date.today().isoformat(),
     }
-    (TRAINED / f"{SHIPPED}.json").write_text(json.dumps(record, indent=1, sort_keys=True) + "\n")
-    print(f"shipped seed {best} as {target} (record {SHIPPED}.json)")
+    (TRAINED / f"{a.stem}.json").write_text(json.dumps(record, indent=1, sort_keys=True) + "\n")
+    print(f"shipped seed {best} as {target} (record {a.stem}.json)")
 
 
 if __name__ == "__main__":

@@ -296,6 +296,8 @@ class Args:
     """the inversion's law flies the moment terms carried that many control periods along their slope over the
     last 5 (the teacher's true ones, the student's estimates; the labels stay the present terms; the policy
     flies it with ``lead``); files ``...-lead<k>``"""
+    tag: str = arg("")
+    """a label ending the files' prefix (a run of other ``--flights`` or ``--epochs`` beside the first)"""
     family_vehicles: int = arg(16, lo=1, hi=200)
     """the family's train vehicles the flights are spread over (``--suite family-v2``)"""
 
@@ -324,6 +326,7 @@ def main(argv: Sequence[str] | None = None) -> None:
     where = "" if a.suite == SUITE else "-family" if family else f"-{a.suite}"
     prefix = (SCHEMES[a.scheme].prefix + where + (f"-ahead{a.ahead}" if a.ahead else "")
               + (f"-extrapolated{a.extrapolated}" if a.extrapolated else "") + (f"-lead{a.lead}" if a.lead else "")
+              + (f"-{a.tag}" if a.tag else "")
               + (f"-gain{a.loop_gain_db:g}" if a.loop_gain_db else ""))
     xs, ys = [], []
     est: Estimator | None = None                      # the teacher flies round 0, the student the others
