@@ -28,6 +28,9 @@ register_policy("ppo-res-lqg", "lvgym.agents.policy:shipped_policy", file="ppo_r
 # protocol v2's, for smile-v2-faults: the privileged reference's law on a learned disturbance observer (a
 # teacher-student scheme; it flies in NumPy)
 register_policy("inversion-id", "lvgym.agents.inversion:shipped_inversion")
+# ... for stratos-tvc-v2: the same law on an observer trained on Stratos III, its moment carried 3 steps ahead
+register_policy("inversion-id-stratos", "lvgym.agents.inversion:shipped_inversion", file="inversion_id_stratos_tvc_v2",
+                name="inversion-id-stratos")
 # a saved stable-baselines3 model (an optional <stem>_vecnormalize.pkl next to it normalises the
 # observations) or a train.py run folder (its best model)
 register_policy_loader("lvgym.agents.policy:load_policy", suffixes=(".zip",), folders=True,

@@ -3,7 +3,7 @@ episode of its seed, to the bit (lvgym.benchmark.runner.run_block against run_ta
 
 - every policy of evaluate.py's defaults, on both models of every v1 suite (short missions);
 - rows that end early (failures) are masked out while the others fly on (the max-q gust suite, whole);
-- the shipped v2 learned policy (``inversion-id``) on the fault suite;
+- the shipped v2 learned policies (``inversion-id`` on the fault suite, ``inversion-id-stratos`` on Stratos III);
 - a user's policy with only a per-row ``act`` (no ``batch``) flies through the per-row adapter;
 - the fingerprint's batched records are the single-env episodes.
 """
@@ -81,12 +81,14 @@ def test_every_default_policy_flies_the_single_env_episodes_as_rows(suite, model
     assert all(r["duration_s"] > 0 for r in records)
 
 
+@pytest.mark.parametrize(("policy", "suite"), [("inversion-id", "smile-v2-faults"),
+                                               ("inversion-id-stratos", "stratos-tvc-v2")])
 @pytest.mark.parametrize("model", ["rigid", "nonrigid"])
-def test_the_shipped_v2_learned_policy_flies_the_single_env_episodes_as_rows(model):
+def test_the_shipped_v2_learned_policies_fly_the_single_env_episodes_as_rows(model, policy, suite):
     """``inversion-id`` (its own ``batch``: a window per row, the law on the rows at once) on the fault suite,
-    long enough for the observer's window to fill and the controller to act."""
-    records = check_block(tasks("smile-v2-faults", model, [resolve_policy("inversion-id")], [0, 1, 2],
-                                mission_time_s=6.0))
+    and ``inversion-id-stratos`` (the same, with a lead per row) on Stratos III, long enough for the observer's
+    window to fill and the controller to act."""
+    records = check_block(tasks(suite, model, [resolve_policy(policy)], [0, 1, 2], mission_time_s=6.0))
     assert len({r["score_v2"] for r in records}) == 3
 
 

@@ -110,31 +110,38 @@ def test_the_numpy_observer_is_the_fitted_network(tmp_path):
         Observer([{k: (v[:, :10] if k == "w0" else v) for k, v in obs.members[0].items()}])
 
 
-def test_the_shipped_observer_is_its_record():
+@pytest.mark.parametrize(("stem", "suite", "lead"), [(SHIPPED, "smile-v2-faults", 0),
+                                                     ("inversion_id_stratos_tvc_v2", "stratos-tvc-v2", 3)])
+def test_the_shipped_observers_are_their_records(stem, suite, lead):
     """The weights are the file the record's SHA-256 names; the record names the env it was trained on, the
-    training command, the validation of every candidate seed and the one chosen."""
-    record = json.loads((TRAINED / f"{SHIPPED}.json").read_text())
-    data = (TRAINED / f"{SHIPPED}.npz").read_bytes()
+    training command, the validation of every candidate seed, the one chosen and the law's lead."""
+    record = json.loads((TRAINED / f"{stem}.json").read_text())
+    data = (TRAINED / f"{stem}.npz").read_bytes()
     assert hashlib.sha256(data).hexdigest() == record["sha256"]
-    env = lvgym.make_env("smile-v2-faults", "nonrigid")
-    assert record["env"] == env_record(env) and record["suite"] == "smile-v2-faults"
-    assert "--scheme inversion" in record["training"]["command"]
+    env = lvgym.make_env(suite, "nonrigid")
+    assert record["env"] == env_record(env) and record["suite"] == suite
+    assert "--scheme inversion" in record["training"]["command"] and record.get("lead", 0) == lead
+    assert (f"--lead {lead}" in record["training"]["command"]) == bool(lead)
     chosen = record["validation"]["chosen"]
     assert str(chosen) in record["validation"]["candidates"] and len(record["validation"]["candidates"]) >= 3
-    assert Observer.load(TRAINED / f"{SHIPPED}.npz").outputs == len(TERMS)
+    assert Observer.load(TRAINED / f"{stem}.npz").outputs == len(TERMS)
 
 
-def test_the_shipped_policy_is_registered_learned_and_causal():
-    spec = resolve_policy("inversion-id")
+@pytest.mark.parametrize(("name", "suite", "lead"), [("inversion-id", "smile-v2-faults", 0),
+                                                     ("inversion-id-stratos", "stratos-tvc-v2", 3)])
+def test_the_shipped_policies_are_registered_learned_and_causal(name, suite, lead):
+    spec = resolve_policy(name)
     assert policy_kind(spec) == "learned"
-    assert "inversion-id" in lvgym.benchmark.get_suite("smile-v2-faults").policies
-    pol = build_policy(spec, lvgym.make_env("smile-v2-faults", "rigid"))
-    assert isinstance(pol, InversionPolicy) and pol.name == "inversion-id"
+    assert name in lvgym.benchmark.get_suite(suite).policies
+    pol = build_policy(spec, lvgym.make_env(suite, "rigid"))
+    assert isinstance(pol, InversionPolicy) and pol.name == name and pol.lead == lead
 
 
-@pytest.mark.parametrize(("suite", "key"), [("stratos-tvc-v2", "vehicle"), ("smile-v1", "history")])
-def test_it_refuses_an_env_it_was_not_trained_on(suite, key):
-    spec = resolve_policy("inversion-id")
+@pytest.mark.parametrize(("name", "suite", "key"), [("inversion-id", "stratos-tvc-v2", "vehicle"),
+                                                    ("inversion-id", "smile-v1", "history"),
+                                                    ("inversion-id-stratos", "smile-v2", "vehicle")])
+def test_it_refuses_an_env_it_was_not_trained_on(name, suite, key):
+    spec = resolve_policy(name)
     env = lvgym.make_env(suite, "nonrigid", **({"history": 4} if key == "history" else {}))
     with pytest.raises(ConfigError) as err:
         build_policy(spec, env)

@@ -150,7 +150,8 @@ def test_learned_names_the_shipped_learned_policies_a_suite_lists():
 
     assert suite_policies(["learned"], "smile-v2-faults") == ["ppo-res-lqg", "inversion-id"]
     assert suite_policies(["classical", "learned"], "smile-v2")[-2:] == ["ppo-res-lqg", "inversion-id"]
-    assert suite_policies(["learned"], "stratos-tvc-v2") == []          # no learned policy is made for it
+    assert suite_policies(["learned"], "stratos-tvc-v2") == ["inversion-id-stratos"]   # its own observer
+    assert suite_policies(["learned"], "slender-v2") == []              # no learned policy is made for it
 
 
 def test_an_empty_env_keywords_mapping_adds_no_flag(tmp_path):

@@ -14,6 +14,7 @@ failed or unflyable, probability of improvement over the best classical design (
 from __future__ import annotations
 
 import json
+import re
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -25,7 +26,8 @@ BASELINES = ("lqg", "lqg-front", "aac-quiet", "gs-pd-relief", "gs-pid-flex-quiet
 #: (:mod:`.estimator`) and the reference's law on the learned disturbance observer (:mod:`.inversion`), trained
 #: without and with the loop dispersion (``--loop-gain-db 6``), and on Stratos III with the law's lead of 3 steps
 #: (``inversion-stratos-lead3-s0=experiments.fault_id.inversion:stratos_lead3_s0`` ...)
-CONFIGURATIONS = ("lqg-thrust-id", "inversion-id", "inversion-id-gain6", "inversion-stratos-lead3")
+CONFIGURATIONS = ("lqg-thrust-id", "inversion-id", "inversion-id-gain6", "inversion-stratos-lead3",
+                  "inversion-stratos-lead3-gain6")
 
 
 @dataclass
@@ -44,7 +46,8 @@ def main(argv: Sequence[str] | None = None) -> None:
     if not path.is_file():
         raise SystemExit(f"python -m experiments.fault_id.compare: {path}: no such file (evaluate.py's --out)")
     records = json.loads(path.read_text())["episodes"]
-    runs = {c: sorted({r["policy"] for r in records if r["policy"].startswith(c + "-s")}) for c in CONFIGURATIONS}
+    runs = {c: sorted({r["policy"] for r in records if re.fullmatch(re.escape(c) + r"-s\d+", r["policy"])})
+            for c in CONFIGURATIONS}
     runs = {c: labels for c, labels in runs.items() if labels}
     if not runs:
         raise SystemExit(f"{a.folder}: no policy labelled <configuration>-s<seed> of {list(CONFIGURATIONS)}")

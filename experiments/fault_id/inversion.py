@@ -18,7 +18,8 @@ from .estimator import RESULTS
 
 __all__ = ["A_MAX", "ERRORS", "NO_THRUST", "TERMS", "InversionPolicy", "command", "error_index", "gain6_s0",
            "gain6_s1", "gain6_s2", "gains", "law_terms", "s0", "s1", "s2", "stratos_extrapolated15_s0",
-           "stratos_extrapolated_s0", "stratos_lead3_s0", "stratos_lead3_s1", "stratos_lead3_s2", "stratos_s0"]
+           "stratos_extrapolated_s0", "stratos_lead3_gain6_s0", "stratos_lead3_gain6_s1", "stratos_lead3_gain6_s2", "stratos_lead3_s0",
+           "stratos_lead3_s1", "stratos_lead3_s2", "stratos_s0"]
 
 
 def _seeded(k: int, prefix: str = "inversion", label: str = "inversion-id", attribute: str = ""):
@@ -54,3 +55,7 @@ stratos_extrapolated15_s0 = _lead("inversion-stratos-tvc-v2", 0, "inversion-stra
 stratos_lead3_s0, stratos_lead3_s1, stratos_lead3_s2 = (
     _lead("inversion-stratos-tvc-v2-lead3-f200e16", k, "inversion-stratos-lead3", "stratos_lead3_", lead=3)
     for k in range(3))
+#: ... and under the loop dispersion (``--loop-gain-db 6``)
+stratos_lead3_gain6_s0, stratos_lead3_gain6_s1, stratos_lead3_gain6_s2 = (
+    _lead("inversion-stratos-tvc-v2-lead3-f200e16-gain6", k, "inversion-stratos-lead3-gain6", "stratos_lead3_gain6_",
+          lead=3) for k in range(3))

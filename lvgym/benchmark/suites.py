@@ -246,8 +246,9 @@ V2_FAULT_KINDS = ("effectiveness", "bandwidth", "thrust", "gyro_bias", "misalign
 #: residual PPO; ``inversion-id``, trained on the faults, added 2026-12-06 likewise) and the privileged reference
 V2_SMILE_POLICIES = ("zero", "gs-pid-flex", "gs-pid-flex-quiet", "aac-quiet", "lqg", "lqg-front", "gs-pd-relief",
                      "ppo-res-lqg", "inversion-id", "privileged")
-#: ... on Stratos III (no LQG or learned policy is made for it)
-V2_STRATOS_POLICIES = ("zero", "gs-pid-flex", "gs-pid-flex-quiet", "aac-quiet", "privileged")
+#: ... on Stratos III (no LQG is made for it; its learned policy ``inversion-id-stratos`` added 2026-12-06, the
+#: suite, seeds and fingerprint unchanged)
+V2_STRATOS_POLICIES = ("zero", "gs-pid-flex", "gs-pid-flex-quiet", "aac-quiet", "inversion-id-stratos", "privileged")
 #: ... on the slender vehicle (its one design, the load-relief gs-pid-flex, has no quiet version that flies)
 V2_SLENDER_POLICIES = ("zero", "gs-pid-flex", "privileged")
 SUITES_V2: dict[str, Suite] = {s.name: s for s in (
