@@ -111,16 +111,17 @@ def test_a_noise_injected_dataset_flies_the_noise_and_labels_with_the_policy(dat
     assert content["steps"] == len(ep.actions)
 
 
-@pytest.mark.parametrize("policy", ["ppo-res-lqg", "inversion-id"])
-def test_the_shipped_learned_policies_are_recorded_as_they_fly(datasets, policy):
+@pytest.mark.parametrize(("policy", "suite"), [("ppo-res-lqg", "smile-v2-faults"), ("inversion-id", "smile-v2-faults"),
+                                               ("inversion-id-stratos", "stratos-tvc-v2")])
+def test_the_shipped_learned_policies_are_recorded_as_they_fly(datasets, policy, suite):
     from lvgym.agents.datasets import collect, dataset_id
     from lvgym.benchmark.registry import resolve_policy
     from lvgym.benchmark.runner import build_policy
 
-    collect(policy, "smile-v2-faults", "nonrigid", episodes=1, mission_time_s=3.0)
-    data = minari.load_dataset(dataset_id(policy, "smile-v2-faults", "nonrigid"))
+    collect(policy, suite, "nonrigid", episodes=1, mission_time_s=3.0)
+    data = minari.load_dataset(dataset_id(policy, suite, "nonrigid"))
     assert data.storage.metadata["algorithm_name"] == policy
-    env = lvgym.make_env("smile-v2-faults", "nonrigid", mission_time_s=3.0)
+    env = lvgym.make_env(suite, "nonrigid", mission_time_s=3.0)
     pol = build_policy(resolve_policy(policy), env)
     (ep,) = data.iterate_episodes()
     obs, info = env.reset(seed=0)
