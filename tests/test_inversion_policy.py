@@ -16,8 +16,8 @@ import torch
 
 import lvgym
 import lvgym.cli.policies  # noqa: F401  (registers the built-in policies)
-from lvgym.agents.inversion import (A_MAX, SHIPPED, TERMS, TRAINED, InversionPolicy, Lead, command, env_record, from_file,
-                                    law_terms)
+from lvgym.agents.inversion import (A_MAX, SHIPPED, TERMS, TRAINED, InversionPolicy, Lead, command, env_record,
+                                    from_file, law_terms)
 from lvgym.agents.observer import FEATURES, N_OBS, WINDOW, Observer, Window
 from lvgym.agents.observer_fit import Ensemble, Estimator, load, save, to_observer
 from lvgym.benchmark.headline import policy_kind

@@ -18,8 +18,8 @@ from .estimator import RESULTS
 
 __all__ = ["A_MAX", "ERRORS", "NO_THRUST", "TERMS", "InversionPolicy", "command", "error_index", "gain6_s0",
            "gain6_s1", "gain6_s2", "gains", "law_terms", "s0", "s1", "s2", "stratos_extrapolated15_s0",
-           "stratos_extrapolated_s0", "stratos_lead3_gain6_s0", "stratos_lead3_gain6_s1", "stratos_lead3_gain6_s2", "stratos_lead3_s0",
-           "stratos_lead3_s1", "stratos_lead3_s2", "stratos_s0"]
+           "stratos_extrapolated_s0", "stratos_lead3_gain6_s0", "stratos_lead3_gain6_s1", "stratos_lead3_gain6_s2",
+           "stratos_lead3_s0", "stratos_lead3_s1", "stratos_lead3_s2", "stratos_s0"]
 
 
 def _seeded(k: int, prefix: str = "inversion", label: str = "inversion-id", attribute: str = ""):
@@ -46,7 +46,8 @@ def _lead(prefix: str, k: int, label: str, attribute: str, lead: int = 5, span: 
 #: was trained, and with its moment carried 5 steps ahead along its last 5 (:class:`lvgym.agents.inversion.Lead`;
 #: ``evaluate.py --seed-set validation`` only)
 stratos_s0 = _seeded(0, "inversion-stratos-tvc-v2", "inversion-stratos", "stratos_")
-stratos_extrapolated_s0 = _lead("inversion-stratos-tvc-v2", 0, "inversion-stratos-extrapolated", "stratos_extrapolated_")
+stratos_extrapolated_s0 = _lead("inversion-stratos-tvc-v2", 0, "inversion-stratos-extrapolated",
+                                "stratos_extrapolated_")
 #: ... its slope over the last 15 steps (a smoother slope of a noisy estimate)
 stratos_extrapolated15_s0 = _lead("inversion-stratos-tvc-v2", 0, "inversion-stratos-extrapolated15",
                                   "stratos_extrapolated15_", span=15)

@@ -2,14 +2,15 @@
 with its record into ``agents/trained`` (``inversion-id``: :data:`lvgym.agents.inversion.SHIPPED`).
 
     python -m experiments.fault_id.ship --prefix inversion-gain6 --seeds 0 1 2 --validation 100
-    python -m experiments.fault_id.ship --suite stratos-tvc-v2 --prefix inversion-stratos-tvc-v2-lead3 --lead 3 \
-        --loop-gain-db 0 --stem inversion_id_stratos_tvc_v2 --name inversion-id-stratos
+    python -m experiments.fault_id.ship --suite stratos-tvc-v2 --prefix inversion-stratos-tvc-v2-lead3-f200e16-gain6 \
+        --lead 3 --loop-gain-db 6 --flights 200 --epochs 16 --tag f200e16 --stem inversion_id_stratos_tvc_v2 \
+        --name inversion-id-stratos                          # inversion-id-stratos
 
 Each seed's observer (``results/fault_id/<prefix>-s<k>.pt``, written by :mod:`.train`) is converted to the
 flight computer's NumPy form (``<prefix>-s<k>.npz``, :func:`lvgym.agents.observer_fit.to_observer`) and flown
 by the benchmark (:func:`lvgym.benchmark.evaluate`, as the shipped policy flies, with its ``--lead``) on
-validation seeds ``0 .. --validation - 1`` of ``--suite``, both flight models; the shipped one is the seed with the
-fewest failed or unflyable non-rigid flights, then the lowest non-rigid mean ``score_v2``. The test seeds are
+validation seeds ``0 .. --validation - 1`` of ``--suite``, both flight models; the shipped one is the seed with
+the fewest failed or unflyable non-rigid flights, then the lowest non-rigid mean ``score_v2``. The test seeds are
 not flown. The record (``<stem>.json``) holds the training command, the validation of every candidate, the
 choice, the env the observer was trained on (:func:`lvgym.agents.inversion.env_record`, which the policy
 checks), the law's lead (which the policy flies) and the observer file's SHA-256.

@@ -178,7 +178,8 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
         groups += run_groups(of_suite, metric)
     rows = headline(summary, records, {p.name: policy_kind(p) for p in policies})
     meta = {
-        "protocol": ", ".join(sorted({s.version for s in suites})), "seed_set": args.seed_set, "episodes": args.episodes, "args": asdict(args),
+        "protocol": ", ".join(sorted({s.version for s in suites})), "seed_set": args.seed_set,
+        "episodes": args.episodes, "args": asdict(args),
         "suites": {s.name: {"version": s.version, "description": s.description, "overrides": dict(s.overrides),
                             "first_seed": s.seeds(args.seed_set, args.episodes)[0],
                             "last_seed": s.seeds(args.seed_set, args.episodes)[-1],
