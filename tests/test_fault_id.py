@@ -209,3 +209,12 @@ def test_the_extrapolated_label_is_the_true_moment_carried_along_its_slope(monke
         train.main(["--extrapolated", "5"])           # the thrust scheme
     with pytest.raises(ConfigError, match="--extrapolated"):
         train.main(["--scheme", "inversion", "--ahead", "5", "--extrapolated", "5"])
+
+
+def test_the_studys_students_are_learned_in_the_headline():
+    """A student flown as ``module:factory`` enters the headline's learned column, not the causal "other"."""
+    from lvgym.benchmark.headline import policy_kind
+    from lvgym.benchmark.runner import PolicySpec
+    for factory in ("experiments.fault_id.inversion:gain6_s0", "experiments.fault_id.inversion:stratos_lead3_s1",
+                    "experiments.fault_id.estimator:s2"):
+        assert policy_kind(PolicySpec("x", factory)) == "learned"

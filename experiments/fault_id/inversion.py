@@ -26,6 +26,7 @@ def _seeded(k: int, prefix: str = "inversion", label: str = "inversion-id", attr
     def factory(env: Any) -> InversionPolicy:
         return from_file(env, RESULTS / f"{prefix}-s{k}.pt", name=f"{label}-s{k}")
     factory.__name__ = f"{attribute}s{k}"
+    factory.kind = "learned"                          # the headline's column (lvgym.benchmark.headline)
     return factory
 
 
@@ -39,6 +40,7 @@ def _lead(prefix: str, k: int, label: str, attribute: str, lead: int = 5, span: 
     def factory(env: Any) -> InversionPolicy:
         return from_file(env, RESULTS / f"{prefix}-s{k}.pt", name=f"{label}-s{k}", lead=lead, span=span)
     factory.__name__ = f"{attribute}s{k}"
+    factory.kind = "learned"
     return factory
 
 
