@@ -11,8 +11,8 @@ from __future__ import annotations
 
 from typing import Any
 
-from lvgym.agents.inversion import (A_MAX, ERRORS, NO_THRUST, TERMS, InversionPolicy, command, error_index, from_file,
-                                    gains, law_terms)
+from lvgym.agents.inversion import (A_MAX, ERRORS, NO_THRUST, SPAN, TERMS, InversionPolicy, command, error_index,
+                                    from_file, gains, law_terms)
 
 from .estimator import RESULTS
 
@@ -22,9 +22,12 @@ __all__ = ["A_MAX", "ERRORS", "NO_THRUST", "TERMS", "InversionPolicy", "command"
            "stratos_lead3_s0", "stratos_lead3_s1", "stratos_lead3_s2", "stratos_s0"]
 
 
-def _seeded(k: int, prefix: str = "inversion", label: str = "inversion-id", attribute: str = ""):
+def _seeded(k: int, prefix: str = "inversion", label: str = "inversion-id", attribute: str = "", lead: int = 0,
+            span: int = SPAN):
+    """The factory of training seed ``k``'s student (``results/fault_id/<prefix>-s<k>.pt``), flown with
+    ``lead`` and ``span`` (:class:`lvgym.agents.inversion.Lead`)."""
     def factory(env: Any) -> InversionPolicy:
-        return from_file(env, RESULTS / f"{prefix}-s{k}.pt", name=f"{label}-s{k}")
+        return from_file(env, RESULTS / f"{prefix}-s{k}.pt", name=f"{label}-s{k}", lead=lead, span=span)
     factory.__name__ = f"{attribute}s{k}"
     factory.kind = "learned"                          # the headline's column (lvgym.benchmark.headline)
     return factory
@@ -36,29 +39,21 @@ s0, s1, s2 = (_seeded(k) for k in range(3))
 gain6_s0, gain6_s1, gain6_s2 = (_seeded(k, "inversion-gain6", "inversion-id-gain6", "gain6_") for k in range(3))
 
 
-def _lead(prefix: str, k: int, label: str, attribute: str, lead: int = 5, span: int = 5):
-    def factory(env: Any) -> InversionPolicy:
-        return from_file(env, RESULTS / f"{prefix}-s{k}.pt", name=f"{label}-s{k}", lead=lead, span=span)
-    factory.__name__ = f"{attribute}s{k}"
-    factory.kind = "learned"
-    return factory
-
-
 #: the Stratos III student of the present moment (``train.py --scheme inversion --suite stratos-tvc-v2``) as it
 #: was trained, and with its moment carried 5 steps ahead along its last 5 (:class:`lvgym.agents.inversion.Lead`;
 #: ``evaluate.py --seed-set validation`` only)
 stratos_s0 = _seeded(0, "inversion-stratos-tvc-v2", "inversion-stratos", "stratos_")
-stratos_extrapolated_s0 = _lead("inversion-stratos-tvc-v2", 0, "inversion-stratos-extrapolated",
-                                "stratos_extrapolated_")
+stratos_extrapolated_s0 = _seeded(0, "inversion-stratos-tvc-v2", "inversion-stratos-extrapolated",
+                                  "stratos_extrapolated_", lead=5)
 #: ... its slope over the last 15 steps (a smoother slope of a noisy estimate)
-stratos_extrapolated15_s0 = _lead("inversion-stratos-tvc-v2", 0, "inversion-stratos-extrapolated15",
-                                  "stratos_extrapolated15_", span=15)
+stratos_extrapolated15_s0 = _seeded(0, "inversion-stratos-tvc-v2", "inversion-stratos-extrapolated15",
+                                    "stratos_extrapolated15_", lead=5, span=15)
 #: the Stratos III students trained with the law's lead of 3 steps (``train.py --suite stratos-tvc-v2 --lead 3
 #: --flights 200 --epochs 16 --tag f200e16``), flown with it
 stratos_lead3_s0, stratos_lead3_s1, stratos_lead3_s2 = (
-    _lead("inversion-stratos-tvc-v2-lead3-f200e16", k, "inversion-stratos-lead3", "stratos_lead3_", lead=3)
+    _seeded(k, "inversion-stratos-tvc-v2-lead3-f200e16", "inversion-stratos-lead3", "stratos_lead3_", lead=3)
     for k in range(3))
 #: ... and under the loop dispersion (``--loop-gain-db 6``)
 stratos_lead3_gain6_s0, stratos_lead3_gain6_s1, stratos_lead3_gain6_s2 = (
-    _lead("inversion-stratos-tvc-v2-lead3-f200e16-gain6", k, "inversion-stratos-lead3-gain6", "stratos_lead3_gain6_",
-          lead=3) for k in range(3))
+    _seeded(k, "inversion-stratos-tvc-v2-lead3-f200e16-gain6", "inversion-stratos-lead3-gain6",
+            "stratos_lead3_gain6_", lead=3) for k in range(3))

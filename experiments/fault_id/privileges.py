@@ -24,21 +24,21 @@ from typing import Any
 
 import numpy as np
 
+from lvgym.agents.inversion import SPAN, carry
 from lvgym.cli.args import arg, parse
 
 #: a relief that never acts (from five times the q-alpha limit)
 NO_RELIEF = (5.0, 6.0)
 
 
-#: the span [control steps] of the slope an extrapolated aerodynamic moment is drawn along
-SLOPE_STEPS = 5
+#: the span [control steps] of the slope an extrapolated aerodynamic moment is drawn along (the shipped law's
+#: :data:`lvgym.agents.inversion.SPAN`)
+SLOPE_STEPS = SPAN
 
 
 def extrapolate(history: Sequence[np.ndarray], ahead: int, span: int = SLOPE_STEPS) -> np.ndarray:
     """The last of ``history`` carried ``ahead`` steps along its slope over the last ``span`` steps (over
     fewer at the start of a flight: none at its first step)."""
-    from lvgym.agents.inversion import carry
-
     return carry(history[-1], history[max(0, len(history) - 1 - span)], ahead, span)
 
 

@@ -49,7 +49,6 @@ from lvgym.agents.observer_fit import Ensemble, Estimator, save
 from lvgym.cli.args import arg, parse
 
 from .estimator import RESULTS, base_lqg, corrected
-from .privileges import extrapolate
 
 #: the teacher's delays [control steps] of its knowledge of the misalignment (0-2 s at 0.02 s; the last: never)
 DELAYS = (0, 12, 25, 50, 100, None)
@@ -101,7 +100,7 @@ class InversionScheme:
     """The law of :mod:`lvgym.agents.inversion` on the true terms (the teacher) or the student's estimate;
     labels: the true terms (:func:`lvgym.agents.inversion.law_terms`), the moment's ``ahead`` control periods
     ahead (the preview), or the moment as it acts carried ``extrapolated`` periods along its slope over the
-    last :data:`.privileges.SLOPE_STEPS` (:func:`.privileges.extrapolate`: a causal label, the estimate's
+    last :data:`lvgym.agents.inversion.SPAN` (:class:`lvgym.agents.inversion.Lead`: a causal label, the estimate's
     slope learned from the window instead of differenced from the student's own estimates); ``lead``: the law
     flies the moment terms carried that many periods along their slope (:class:`lvgym.agents.inversion.Lead`:
     the teacher's of the truth, the student's of its estimates), the labels stay."""
@@ -111,7 +110,7 @@ class InversionScheme:
     def __init__(self, env1: Any, n: int, rng: np.random.Generator | None, deadband: float,
                  loop_gain: np.ndarray | None = None, ahead: int = 0, extrapolated: int = 0, lead: int = 0) -> None:
         self.limit, self.n, self.ahead = float(env1.unwrapped.func.gimbal_limit), n, int(ahead)
-        self.extrapolated, self.aero = int(extrapolated), []   # the true f_aero of every step (its slope)
+        self.label_lead = Lead(n, extrapolated)               # the label's, on the true moment
         self.lead = Lead(n, lead)                              # the law's, on the truth or the estimate
         self.index, (self.w, self.z) = error_index(env1), gains(env1)
         # a loop gain after the action (the margins' perturbation) scales the control power the action sees:
@@ -124,9 +123,8 @@ class InversionScheme:
 
     def labels(self, info: dict[str, Any]) -> np.ndarray:
         self.truth = law_terms(info, self.n, self.limit, self.ahead)
-        if self.extrapolated and "m_aero_b" in info:         # not the reset's info
-            self.aero.append(self.truth[:, 0:2].copy())
-            self.truth[:, 0:2] = extrapolate(self.aero, self.extrapolated)
+        if "m_aero_b" in info:                               # not the reset's info
+            self.truth[:, 0:2] = self.label_lead.push(np.arange(self.n), self.truth[:, 0:2])
         self.truth[:, :6] *= self.per_gain
         return self.truth
 
