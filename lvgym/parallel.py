@@ -10,7 +10,9 @@ An exception raised in a task reaches the caller as itself, with its own message
 the worker checks that it survives pickling and, if it does not, sends a :class:`WorkerError` carrying
 its type, message and traceback instead (a pool would otherwise break with ``BrokenProcessPool`` and
 lose the message); Ray's ``RayTaskError`` wrapper is removed. With ``describe``, the error is a
-:class:`TaskFailed` naming the task, raised from the original.
+:class:`TaskFailed` naming the task, raised from the original. A pool whose worker died (killed, out of
+memory, or a calling script without an ``if __name__ == "__main__":`` guard, which every spawned worker
+re-imports) raises a ``BrokenProcessPool`` that says so.
 """
 
 from __future__ import annotations
@@ -20,6 +22,7 @@ import os
 import sys
 from collections.abc import Callable, Sequence
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+from concurrent.futures.process import BrokenProcessPool
 from typing import Any, TypeVar
 
 __all__ = ["EXECUTORS", "TaskFailed", "WorkerError", "check_workers", "default_workers", "exit_on_sigterm",
@@ -28,6 +31,12 @@ __all__ = ["EXECUTORS", "TaskFailed", "WorkerError", "check_workers", "default_w
 EXECUTORS = ("local", "serial", "ray")
 T = TypeVar("T")
 R = TypeVar("R")
+
+BROKEN_POOL_HELP = (
+    "lvgym: a worker of the local process pool died. Workers are spawned and import the calling script again: a "
+    "script that runs lvgym at import time needs its top level under `if __name__ == \"__main__\":` "
+    "(Python printed its own explanation above if so). Other causes: the worker was killed or ran out of "
+    "memory (fewer `workers`), or a native crash. executor='serial' runs in this process.")
 
 
 def exit_on_sigterm() -> None:
@@ -134,6 +143,8 @@ def _local(fn: Callable[[T], R], tasks: Sequence[T], done: Callable[[int, R], No
                 for f in finished:
                     try:
                         r = f.result()
+                    except BrokenProcessPool as exc:
+                        raise _TaskError(futures[f]) from BrokenProcessPool(f"{exc} ({BROKEN_POOL_HELP})")
                     except Exception as exc:
                         raise _TaskError(futures[f]) from exc
                     done(futures[f], r)

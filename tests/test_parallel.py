@@ -76,3 +76,34 @@ def test_bad_worker_counts_are_refused_before_any_worker_starts(workers):
 
     with pytest.raises(ConfigError, match=r"^workers = .*: an integer in \[1, 100000\]$"):
         run_map(_square_or_fail, [1], "local", workers=workers, progress=False)
+
+
+def _die(x):
+    import os
+
+    os._exit(3)
+
+
+def test_a_dead_worker_breaks_the_pool_with_its_likely_causes():
+    from concurrent.futures.process import BrokenProcessPool
+
+    with pytest.raises(BrokenProcessPool, match=r"terminated abruptly.*lvgym: a worker .* died.*__name__ == "
+                                                r"\"__main__\".*ran out of memory"):
+        run_map(_die, [1, 2], "local", workers=2, progress=False)
+
+
+def test_a_script_without_a_main_guard_is_told_what_to_do(tmp_path):
+    import os
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    script = tmp_path / "unguarded.py"
+    script.write_text("from lvgym.parallel import run_map\nprint(run_map(abs, [-1, -2], workers=2, progress=False))\n")
+    root = Path(__file__).resolve().parents[1]
+    run = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, timeout=120, cwd=root,
+                         env={**os.environ, "PYTHONPATH": str(root)})
+    assert run.returncode != 0
+    last = run.stderr.strip().splitlines()[-1]
+    assert last.startswith("concurrent.futures.process.BrokenProcessPool:")
+    assert 'needs its top level under `if __name__ == "__main__":`' in last
