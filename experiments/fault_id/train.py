@@ -201,6 +201,42 @@ def fly(model: str, seeds: Sequence[int], estimator: Estimator | Ensemble | None
     return np.concatenate(xs), np.concatenate(ys), log.records(True)
 
 
+class Data:
+    """The windows and labels of every round, in one array each that grows in place: the fits see a contiguous
+    view, the same numbers as the rounds' arrays concatenated, without a second copy (a round's data of the
+    longer missions is gigabytes, and two runs share the machine)."""
+
+    def __init__(self) -> None:
+        self.x: np.ndarray | None = None
+        self.y: np.ndarray | None = None
+        self.n = 0
+
+    def __len__(self) -> int:
+        return self.n
+
+    def reserve(self, capacity: int) -> None:
+        """Room for ``capacity`` steps (a copy now rather than one per round)."""
+        if self.x is not None and capacity > len(self.x):
+            x = np.empty((capacity, *self.x.shape[1:]), dtype=self.x.dtype)
+            y = np.empty((capacity, *self.y.shape[1:]), dtype=self.y.dtype)
+            x[:self.n], y[:self.n] = self.x[:self.n], self.y[:self.n]
+            self.x, self.y = x, y
+
+    def add(self, x: np.ndarray, y: np.ndarray) -> None:
+        """Append a flight batch's windows ``x`` and labels ``y``."""
+        if self.x is None:
+            self.x = np.empty((0, *x.shape[1:]), dtype=x.dtype)
+            self.y = np.empty((0, *y.shape[1:]), dtype=y.dtype)
+        if self.n + len(x) > len(self.x):
+            self.reserve(max(self.n + len(x), 2 * len(self.x)))
+        self.x[self.n:self.n + len(x)], self.y[self.n:self.n + len(y)] = x, y
+        self.n += len(x)
+
+    def view(self) -> tuple[np.ndarray, np.ndarray]:
+        """The windows and labels so far (views, not copies)."""
+        return self.x[:self.n], self.y[:self.n]
+
+
 def fit(x: np.ndarray, y: np.ndarray, seed: int, epochs: int, scaled: bool = False) -> Estimator:
     """The estimator fitted to windows ``x`` and labels ``y`` (torch seeded with ``seed``; ``scaled``: the
     labels standardised, each weighing the same in the error)."""
@@ -326,7 +362,7 @@ def main(argv: Sequence[str] | None = None) -> None:
               + (f"-extrapolated{a.extrapolated}" if a.extrapolated else "") + (f"-lead{a.lead}" if a.lead else "")
               + (f"-{a.tag}" if a.tag else "")
               + (f"-gain{a.loop_gain_db:g}" if a.loop_gain_db else ""))
-    xs, ys = [], []
+    data = Data()
     est: Estimator | None = None                      # the teacher flies round 0, the student the others
     fits: list[Estimator] = []
     for rnd in range(a.rounds + 1):
@@ -344,11 +380,11 @@ def main(argv: Sequence[str] | None = None) -> None:
                     place = {"suite": a.suite, **({"vehicle": vehicle} if family else {})}
                     x, y, _ = fly(model, seeds, est, rng, scheme=a.scheme, loop_gain=gain, ahead=a.ahead,
                                     extrapolated=a.extrapolated, lead=a.lead, **place)
-                    xs.append(x)
-                    ys.append(y)
-        print(f"seed {a.seed} round {rnd}: {sum(len(x) for x in xs)} steps of data at {time.time() - t0:.0f} s",
-              flush=True)
-        est = fit(np.concatenate(xs), np.concatenate(ys), a.seed, a.epochs, SCHEMES[a.scheme].scaled)
+                    data.add(x, y)
+            if rnd == 0:                              # room for the rounds to come, each about half of round 0
+                data.reserve(len(data) + a.rounds * (len(data) // 2 + len(data) // 8))
+        print(f"seed {a.seed} round {rnd}: {len(data)} steps of data at {time.time() - t0:.0f} s", flush=True)
+        est = fit(*data.view(), a.seed, a.epochs, SCHEMES[a.scheme].scaled)
         fits.append(est)
         save(est, RESULTS / f"{prefix}-s{a.seed}-r{rnd}.pt")
         if a.validation:
