@@ -228,7 +228,7 @@ class Data:
             self.x = np.empty((0, *x.shape[1:]), dtype=x.dtype)
             self.y = np.empty((0, *y.shape[1:]), dtype=y.dtype)
         if self.n + len(x) > len(self.x):
-            self.reserve(max(self.n + len(x), 2 * len(self.x)))
+            self.reserve(max(self.n + len(x), len(self.x) + len(self.x) // 4))
         self.x[self.n:self.n + len(x)], self.y[self.n:self.n + len(y)] = x, y
         self.n += len(x)
 
@@ -381,8 +381,8 @@ def main(argv: Sequence[str] | None = None) -> None:
                     x, y, _ = fly(model, seeds, est, rng, scheme=a.scheme, loop_gain=gain, ahead=a.ahead,
                                     extrapolated=a.extrapolated, lead=a.lead, **place)
                     data.add(x, y)
-            if rnd == 0:                              # room for the rounds to come, each about half of round 0
-                data.reserve(len(data) + a.rounds * (len(data) // 2 + len(data) // 8))
+            if rnd == 0:                              # room for the rounds to come (each flies half the flights
+                data.reserve(len(data) * (4 + 3 * a.rounds) // 4)       # of round 0, their steps up to 3/4)
         print(f"seed {a.seed} round {rnd}: {len(data)} steps of data at {time.time() - t0:.0f} s", flush=True)
         est = fit(*data.view(), a.seed, a.epochs, SCHEMES[a.scheme].scaled)
         fits.append(est)
