@@ -216,5 +216,27 @@ def test_the_studys_students_are_learned_in_the_headline():
     from lvgym.benchmark.headline import policy_kind
     from lvgym.benchmark.runner import PolicySpec
     for factory in ("experiments.fault_id.inversion:gain6_s0", "experiments.fault_id.inversion:stratos_lead3_s1",
-                    "experiments.fault_id.estimator:s2"):
+                    "experiments.fault_id.inversion:smile_lead5_gain6_s2", "experiments.fault_id.estimator:s2"):
         assert policy_kind(PolicySpec("x", factory)) == "learned"
+
+
+def test_the_rounds_data_grows_in_place_as_their_concatenation():
+    """Batches of windows appended (past the room reserved, then grown by a quarter) read as the batches
+    concatenated, as views of one array."""
+    from experiments.fault_id.train import Data
+
+    rng = np.random.default_rng(0)
+    xs = [rng.normal(size=(n, 3, 2)).astype(np.float32) for n in (5, 7, 2, 9)]
+    ys = [rng.normal(size=(len(x), 4)).astype(np.float32) for x in xs]
+    data = Data()
+    data.add(xs[0], ys[0])
+    assert len(data) == 5 and len(data.x) == 5                   # no room beyond the first batch
+    data.reserve(14)
+    data.add(xs[1], ys[1])
+    assert len(data) == 12 and len(data.x) == 14
+    data.add(xs[2], ys[2])
+    data.add(xs[3], ys[3])                                       # 14 + 9 > 14: max(23, 14 + 3)
+    assert len(data) == 23 and len(data.x) == 23
+    x, y = data.view()
+    assert np.array_equal(x, np.concatenate(xs)) and np.array_equal(y, np.concatenate(ys))
+    assert x.base is data.x and x.dtype == np.float32 and y.shape == (23, 4)

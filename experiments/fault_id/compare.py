@@ -25,9 +25,10 @@ BASELINES = ("lqg", "lqg-front", "aac-quiet", "gs-pd-relief", "gs-pid-flex-quiet
 #: the students' labels, ``<configuration>-s<training seed>``: the thrust-direction estimator on ``lqg``
 #: (:mod:`.estimator`) and the reference's law on the learned disturbance observer (:mod:`.inversion`), trained
 #: without and with the loop dispersion (``--loop-gain-db 6``), and on Stratos III with the law's lead of 3 steps
-#: (``inversion-stratos-lead3-s0=experiments.fault_id.inversion:stratos_lead3_s0`` ...)
+#: (``inversion-stratos-lead3-s0=experiments.fault_id.inversion:stratos_lead3_s0`` ...), and on smile-v2 with a lead
+#: of 5 steps under the dispersion (``inversion-smile-lead5-gain6-s0=...:smile_lead5_gain6_s0`` ...)
 CONFIGURATIONS = ("lqg-thrust-id", "inversion-id", "inversion-id-gain6", "inversion-stratos-lead3",
-                  "inversion-stratos-lead3-gain6")
+                  "inversion-stratos-lead3-gain6", "inversion-smile-lead5-gain6")
 
 
 @dataclass

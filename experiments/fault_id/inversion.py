@@ -19,7 +19,8 @@ from .estimator import RESULTS
 __all__ = ["A_MAX", "ERRORS", "NO_THRUST", "TERMS", "InversionPolicy", "command", "error_index", "gain6_s0",
            "gain6_s1", "gain6_s2", "gains", "law_terms", "s0", "s1", "s2", "stratos_extrapolated15_s0",
            "stratos_extrapolated_s0", "stratos_lead3_gain6_s0", "stratos_lead3_gain6_s1", "stratos_lead3_gain6_s2",
-           "stratos_lead3_s0", "stratos_lead3_s1", "stratos_lead3_s2", "stratos_s0"]
+           "smile_lead5_gain6_s0", "smile_lead5_gain6_s1", "smile_lead5_gain6_s2", "stratos_lead3_s0",
+           "stratos_lead3_s1", "stratos_lead3_s2", "stratos_s0"]
 
 
 def _seeded(k: int, prefix: str = "inversion", label: str = "inversion-id", attribute: str = "", lead: int = 0,
@@ -57,3 +58,8 @@ stratos_lead3_s0, stratos_lead3_s1, stratos_lead3_s2 = (
 stratos_lead3_gain6_s0, stratos_lead3_gain6_s1, stratos_lead3_gain6_s2 = (
     _seeded(k, "inversion-stratos-tvc-v2-lead3-f200e16-gain6", "inversion-stratos-lead3-gain6",
             "stratos_lead3_gain6_", lead=3) for k in range(3))
+#: the smile-v2 students trained with the law's lead of 5 steps under the loop dispersion (``train.py --suite
+#: smile-v2 --lead 5 --flights 200 --epochs 16 --tag f200e16 --loop-gain-db 6``), flown with it
+smile_lead5_gain6_s0, smile_lead5_gain6_s1, smile_lead5_gain6_s2 = (
+    _seeded(k, "inversion-smile-v2-lead5-f200e16-gain6", "inversion-smile-lead5-gain6", "smile_lead5_gain6_",
+            lead=5) for k in range(3))
