@@ -45,7 +45,7 @@ import torch
 
 from lvgym.agents.inversion import TERMS, Lead, command, error_index, gains, law_terms
 from lvgym.agents.observer import Window
-from lvgym.agents.observer_fit import Ensemble, Estimator, save
+from lvgym.agents.observer_fit import Ensemble, Estimator, load, save
 from lvgym.cli.args import arg, parse
 
 from .estimator import RESULTS, base_lqg, corrected
@@ -334,6 +334,9 @@ class Args:
     """a label ending the files' prefix (a run of other ``--flights`` or ``--epochs`` beside the first)"""
     family_vehicles: int = arg(16, lo=1, hi=200)
     """the family's train vehicles the flights are spread over (``--suite family-v2``)"""
+    resume: bool = False
+    """take each round's fit from its file when a run of the same options left it (the rounds' data are flown
+    again, the same flights; a fit is skipped, not its flights)"""
 
 
 def main(argv: Sequence[str] | None = None) -> None:
@@ -384,9 +387,15 @@ def main(argv: Sequence[str] | None = None) -> None:
             if rnd == 0:                              # room for the rounds to come (each flies half the flights
                 data.reserve(len(data) * (4 + 3 * a.rounds) // 4)       # of round 0, their steps up to 3/4)
         print(f"seed {a.seed} round {rnd}: {len(data)} steps of data at {time.time() - t0:.0f} s", flush=True)
+        done = RESULTS / f"{prefix}-s{a.seed}-r{rnd}.pt"
+        if a.resume and done.is_file():               # this round's fit, from a run that stopped after it
+            est = load(done)
+            fits.append(est)
+            print(f"seed {a.seed} round {rnd}: loaded {done}", flush=True)
+            continue
         est = fit(*data.view(), a.seed, a.epochs, SCHEMES[a.scheme].scaled)
         fits.append(est)
-        save(est, RESULTS / f"{prefix}-s{a.seed}-r{rnd}.pt")
+        save(est, done)
         if a.validation:
             v = validate(est, a.validation, scheme=a.scheme, suite=a.suite, lead=a.lead)
             print(f"seed {a.seed} round {rnd} validation 0-{a.validation - 1}: " + ", ".join(
