@@ -14,9 +14,10 @@ lvgym envs.
 
 Training is ``lvgym train`` (``docs/training.md``). Nothing in ``lvgym`` imports this package (the command
 layer names it); importing it does not import stable-baselines3 (the submodules do). Importing it registers
-the shipped learned policies with the benchmark (``ppo``, ``ppo-res-lqg``, ``inversion-id``) and the loaders
-of saved models (``evaluate.py --policies runs/my_run``, ``model.zip`` or a cloned ``bc.pt``); their
-factories are named as strings, imported only where a policy flies.
+the shipped learned policies with the benchmark (``ppo``, ``ppo-res-lqg``, ``inversion-id``,
+``inversion-id-stratos``, ``inversion-id-smile``) and the loaders of saved models (``evaluate.py --policies
+runs/my_run``, ``model.zip`` or a cloned ``bc.pt``); their factories are named as strings, imported only where
+a policy flies.
 """
 
 from lvgym.benchmark.registry import register_policy, register_policy_loader
@@ -31,6 +32,9 @@ register_policy("inversion-id", "lvgym.agents.inversion:shipped_inversion")
 # ... for stratos-tvc-v2: the same law on an observer trained on Stratos III, its moment carried 3 steps ahead
 register_policy("inversion-id-stratos", "lvgym.agents.inversion:shipped_inversion", file="inversion_id_stratos_tvc_v2",
                 name="inversion-id-stratos")
+# ... for smile-v2 (no faults): an observer trained on its flights, the moment carried 5 steps ahead
+register_policy("inversion-id-smile", "lvgym.agents.inversion:shipped_inversion", file="inversion_id_smile_v2",
+                name="inversion-id-smile")
 # a saved stable-baselines3 model (an optional <stem>_vecnormalize.pkl next to it normalises the
 # observations) or a train.py run folder (its best model)
 register_policy_loader("lvgym.agents.policy:load_policy", suffixes=(".zip",), folders=True,

@@ -82,7 +82,8 @@ def test_every_default_policy_flies_the_single_env_episodes_as_rows(suite, model
 
 
 @pytest.mark.parametrize(("policy", "suite"), [("inversion-id", "smile-v2-faults"),
-                                               ("inversion-id-stratos", "stratos-tvc-v2")])
+                                               ("inversion-id-stratos", "stratos-tvc-v2"),
+                                               ("inversion-id-smile", "smile-v2")])
 @pytest.mark.parametrize("model", ["rigid", "nonrigid"])
 def test_the_shipped_v2_learned_policies_fly_the_single_env_episodes_as_rows(model, policy, suite):
     """``inversion-id`` (its own ``batch``: a window per row, the law on the rows at once) on the fault suite,

@@ -112,7 +112,7 @@ def test_a_noise_injected_dataset_flies_the_noise_and_labels_with_the_policy(dat
 
 
 @pytest.mark.parametrize(("policy", "suite"), [("ppo-res-lqg", "smile-v2-faults"), ("inversion-id", "smile-v2-faults"),
-                                               ("inversion-id-stratos", "stratos-tvc-v2")])
+                                               ("inversion-id-stratos", "stratos-tvc-v2"), ("inversion-id-smile", "smile-v2")])
 def test_the_shipped_learned_policies_are_recorded_as_they_fly(datasets, policy, suite):
     from lvgym.agents.datasets import collect, dataset_id
     from lvgym.benchmark.registry import resolve_policy

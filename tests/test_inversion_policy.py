@@ -111,7 +111,8 @@ def test_the_numpy_observer_is_the_fitted_network(tmp_path):
 
 
 @pytest.mark.parametrize(("stem", "suite", "lead"), [(SHIPPED, "smile-v2-faults", 0),
-                                                     ("inversion_id_stratos_tvc_v2", "stratos-tvc-v2", 3)])
+                                                     ("inversion_id_stratos_tvc_v2", "stratos-tvc-v2", 3),
+                                                     ("inversion_id_smile_v2", "smile-v2", 5)])
 def test_the_shipped_observers_are_their_records(stem, suite, lead):
     """The weights are the file the record's SHA-256 names; the record names the env it was trained on, the
     training command, the validation of every candidate seed, the one chosen and the law's lead."""
@@ -128,7 +129,8 @@ def test_the_shipped_observers_are_their_records(stem, suite, lead):
 
 
 @pytest.mark.parametrize(("name", "suite", "lead"), [("inversion-id", "smile-v2-faults", 0),
-                                                     ("inversion-id-stratos", "stratos-tvc-v2", 3)])
+                                                     ("inversion-id-stratos", "stratos-tvc-v2", 3),
+                                                     ("inversion-id-smile", "smile-v2", 5)])
 def test_the_shipped_policies_are_registered_learned_and_causal(name, suite, lead):
     spec = resolve_policy(name)
     assert policy_kind(spec) == "learned"
@@ -139,7 +141,8 @@ def test_the_shipped_policies_are_registered_learned_and_causal(name, suite, lea
 
 @pytest.mark.parametrize(("name", "suite", "key"), [("inversion-id", "stratos-tvc-v2", "vehicle"),
                                                     ("inversion-id", "smile-v1", "history"),
-                                                    ("inversion-id-stratos", "smile-v2", "vehicle")])
+                                                    ("inversion-id-stratos", "smile-v2", "vehicle"),
+                                                    ("inversion-id-smile", "stratos-tvc-v2", "vehicle")])
 def test_it_refuses_an_env_it_was_not_trained_on(name, suite, key):
     spec = resolve_policy(name)
     env = lvgym.make_env(suite, "nonrigid", **({"history": 4} if key == "history" else {}))

@@ -148,8 +148,9 @@ def test_classical_names_every_classical_baseline_a_suite_lists():
 def test_learned_names_the_shipped_learned_policies_a_suite_lists():
     from lvgym.agents.datasets import suite_policies
 
-    assert suite_policies(["learned"], "smile-v2-faults") == ["ppo-res-lqg", "inversion-id"]
-    assert suite_policies(["classical", "learned"], "smile-v2")[-2:] == ["ppo-res-lqg", "inversion-id"]
+    assert suite_policies(["learned"], "smile-v2-faults") == ["ppo-res-lqg", "inversion-id", "inversion-id-smile"]
+    assert suite_policies(["classical", "learned"], "smile-v2")[-3:] == ["ppo-res-lqg", "inversion-id",
+                                                                         "inversion-id-smile"]
     assert suite_policies(["learned"], "stratos-tvc-v2") == ["inversion-id-stratos"]   # its own observer
     assert suite_policies(["learned"], "slender-v2") == []              # no learned policy is made for it
 

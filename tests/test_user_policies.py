@@ -183,6 +183,6 @@ def test_the_built_in_names_are_the_registered_ones():
         "fixed-gs-pid-flex", "lvgym.baselines.designed:fixed_policy", (("kind", "gs-pid-flex"), ("name", "fixed-gs-pid-flex")))
     assert sorted(registry.POLICIES) == ["aac", "aac-quiet", "auto-gs-pid", "auto-gs-pid-flex", "auto-lqg",
                                          "fixed-gs-pid-flex", "fixed-lqg", "gs-pd-relief", "gs-pid", "gs-pid-flex",
-                                         "gs-pid-flex-quiet", "gs-pid-thesis", "inversion-id", "inversion-id-stratos",
-                                         "lqg", "lqg-aw", "lqg-front", "mpc", "pid", "pid-thesis", "ppo", "ppo-res-lqg",
-                                         "privileged", "zero"]
+                                         "gs-pid-flex-quiet", "gs-pid-thesis", "inversion-id", "inversion-id-smile",
+                                         "inversion-id-stratos", "lqg", "lqg-aw", "lqg-front", "mpc", "pid", "pid-thesis",
+                                         "ppo", "ppo-res-lqg", "privileged", "zero"]

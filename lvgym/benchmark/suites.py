@@ -243,9 +243,10 @@ V2_FAULT_KINDS = ("effectiveness", "bandwidth", "thrust", "gyro_bias", "misalign
 #: the policies v2 reports on SMILE: no control, the flex design that breaks the flyability rule and its quiet
 #: redesigns, the LQG family, the soft loop without integral made for the max-q gust (added 2026-12-05 with
 #: issue 35's finding; the suites, seeds and fingerprints unchanged), the shipped learned policies (v1's
-#: residual PPO; ``inversion-id``, trained on the faults, added 2026-12-06 likewise) and the privileged reference
+#: residual PPO; ``inversion-id``, trained on the faults, and ``inversion-id-smile``, on smile-v2, added 2026-12-06
+#: likewise) and the privileged reference
 V2_SMILE_POLICIES = ("zero", "gs-pid-flex", "gs-pid-flex-quiet", "aac-quiet", "lqg", "lqg-front", "gs-pd-relief",
-                     "ppo-res-lqg", "inversion-id", "privileged")
+                     "ppo-res-lqg", "inversion-id", "inversion-id-smile", "privileged")
 #: ... on Stratos III (no LQG is made for it; its learned policy ``inversion-id-stratos`` added 2026-12-06, the
 #: suite, seeds and fingerprint unchanged)
 V2_STRATOS_POLICIES = ("zero", "gs-pid-flex", "gs-pid-flex-quiet", "aac-quiet", "inversion-id-stratos", "privileged")
