@@ -240,3 +240,30 @@ def test_the_rounds_data_grows_in_place_as_their_concatenation():
     x, y = data.view()
     assert np.array_equal(x, np.concatenate(xs)) and np.array_equal(y, np.concatenate(ys))
     assert x.base is data.x and x.dtype == np.float32 and y.shape == (23, 4)
+
+
+def test_a_resumed_run_takes_the_finished_rounds_fits_and_ends_as_the_whole_run(monkeypatch, tmp_path, capsys):
+    """``--resume``: the rounds' flights are flown again (the same data), each round whose fit was left on disk
+    is read, not fitted, and the final ensemble is the uninterrupted run's to the bit."""
+    from experiments.fault_id import train
+    from lvgym.agents.observer_fit import load
+
+    real = train.fly
+    monkeypatch.setattr(train, "fly", lambda *a, **k: real(*a, mission_time_s=2.0, **k))
+    monkeypatch.setattr(train, "RESULTS", tmp_path)
+    argv = ["--scheme", "inversion", "--suite", "smile-v2", "--flights", "10", "--rounds", "2", "--epochs", "1",
+            "--validation", "0"]
+    train.main(argv)
+    final = tmp_path / "inversion-smile-v2-s0.pt"
+    whole = load(final)
+    first = (tmp_path / "inversion-smile-v2-s0-r0.pt").stat().st_mtime_ns
+    final.unlink()
+    (tmp_path / "inversion-smile-v2-s0-r2.pt").unlink()              # stopped during round 2's fit
+    capsys.readouterr()
+    train.main([*argv, "--resume"])
+    out = capsys.readouterr().out
+    assert "round 0: loaded" in out and "round 1: loaded" in out and "round 2: loaded" not in out
+    assert (tmp_path / "inversion-smile-v2-s0-r0.pt").stat().st_mtime_ns == first
+    again = load(final)
+    assert all(torch.equal(a, b) for m, n in zip(whole.members, again.members)
+               for a, b in zip(m.state_dict().values(), n.state_dict().values()))
