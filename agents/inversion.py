@@ -24,9 +24,10 @@ the observation only.
 
 The shipped observer (:data:`SHIPPED`, ``agents/trained``) was trained on SMILE's fault suite, both flight
 models, with the reference's law on the true terms as the teacher and DAgger rounds
-(``python -m experiments.fault_id.train --scheme inversion``); ``inversion-id-stratos``'s on Stratos III, the
-law flying its estimated moment carried 3 steps ahead (:class:`Lead`, the record's ``lead``). A policy
-refuses an env its observer was not trained for (:func:`check_env`).
+(``python -m experiments.fault_id.train --scheme inversion``); ``inversion-id-stratos``'s on Stratos III and
+``inversion-id-smile``'s on ``smile-v2``, the law flying its estimated moment carried 3 and 5 steps ahead
+(:class:`Lead`, the record's ``lead``). A policy refuses an env its observer was not trained for
+(:func:`check_env`).
 """
 
 from __future__ import annotations

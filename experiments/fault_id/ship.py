@@ -5,6 +5,9 @@ with its record into ``agents/trained`` (``inversion-id``: :data:`lvgym.agents.i
     python -m experiments.fault_id.ship --suite stratos-tvc-v2 --prefix inversion-stratos-tvc-v2-lead3-f200e16-gain6 \
         --lead 3 --loop-gain-db 6 --flights 200 --epochs 16 --tag f200e16 --stem inversion_id_stratos_tvc_v2 \
         --name inversion-id-stratos                          # inversion-id-stratos
+    python -m experiments.fault_id.ship --suite smile-v2 --prefix inversion-smile-v2-lead5-f200e16-gain6 --lead 5 \
+        --loop-gain-db 6 --flights 200 --epochs 16 --tag f200e16 --stem inversion_id_smile_v2 \
+        --name inversion-id-smile                            # inversion-id-smile
 
 Each seed's observer (``results/fault_id/<prefix>-s<k>.pt``, written by :mod:`.train`) is converted to the
 flight computer's NumPy form (``<prefix>-s<k>.npz``, :func:`lvgym.agents.observer_fit.to_observer`) and flown
