@@ -33,7 +33,7 @@ models, with the reference's law on the true terms as the teacher and DAgger rou
 from __future__ import annotations
 
 import json
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -98,11 +98,24 @@ def command(observations: np.ndarray, terms: np.ndarray, index: list[int], w: fl
     return np.clip(terms[:, 4:6] * alpha - hold * terms[:, 0:2] - terms[:, 2:4], -1.0, 1.0).astype(np.float32)
 
 
-def gains(env: Any) -> tuple[float, float]:
-    """The reference's (bandwidth [rad/s], damping) for ``env``'s flight model."""
+def gains(env: Any, law: dict[str, Any] | Sequence[tuple[str, Any]] | None = None) -> tuple[float, float]:
+    """The law's (bandwidth [rad/s], damping) for ``env``'s flight model: ``law``'s ``{model: [bandwidth,
+    damping]}`` where it names the model (a student's record: its law's own gains), else the reference's
+    :data:`~lvgym.baselines.privileged.GAINS`."""
     from lvgym.baselines.privileged import GAINS
 
-    return GAINS["rigid" if env.unwrapped.func.spec.model == "rigid" else "nonrigid"]
+    model = "rigid" if env.unwrapped.func.spec.model == "rigid" else "nonrigid"
+    law = dict(law or {})                             # or its (model, gains) pairs: a policy spec's hashable form
+    unknown = sorted(set(law) - set(GAINS))
+    if unknown:
+        raise ConfigError("law", unknown, f"flight models of {sorted(GAINS)}")
+    own = law.get(model)
+    if own is None:
+        return GAINS[model]
+    w, z = (float(v) for v in own)
+    if not (0.0 < w <= 100.0 and 0.0 < z <= 10.0):
+        raise ConfigError(f"law {model}", list(own), "[bandwidth, damping] in (0, 100] rad/s and (0, 10]")
+    return w, z
 
 
 def error_index(env: Any) -> list[int]:
@@ -178,14 +191,16 @@ class InversionPolicy:
     policy; no privileged information). ``observer``: a window ``(WINDOW, FEATURES)`` -> the terms ``(7,)``
     (an :class:`~lvgym.agents.observer.Observer`); ``trained``: the :func:`env_record` it was trained on (it
     refuses another env: :func:`check_env`); ``lead``, ``span``: the control steps the estimated aerodynamic
-    moment is carried ahead along its slope over ``span`` steps (:class:`Lead`; 0: the moment as estimated)."""
+    moment is carried ahead along its slope over ``span`` steps (:class:`Lead`; 0: the moment as estimated);
+    ``law``: the law's gains per flight model where they are not the reference's (:func:`gains`)."""
 
     def __init__(self, env: Any, observer: Callable[[np.ndarray], np.ndarray], name: str = "inversion-id",
-                 trained: dict[str, Any] | None = None, lead: int = 0, span: int = SPAN) -> None:
+                 trained: dict[str, Any] | None = None, lead: int = 0, span: int = SPAN,
+                 law: dict[str, Any] | None = None) -> None:
         check_env(env, trained or {})
         self.observer = observer
         self.name = name
-        self.index, (self.w, self.z) = error_index(env), gains(env)
+        self.index, (self.w, self.z) = error_index(env), gains(env, law)
         self.lead, self.span = int(lead), int(span)
         self.reset()
 
@@ -233,28 +248,31 @@ class InversionBatch:
 
 
 def from_file(env: Any, path: str | Path, name: str = "inversion-id", trained: dict[str, Any] | None = None,
-              lead: int = 0, span: int = SPAN) -> InversionPolicy:
+              lead: int = 0, span: int = SPAN, law: dict[str, Any] | None = None) -> InversionPolicy:
     """The policy on the observer saved at ``path``: an :class:`~lvgym.agents.observer.Observer`'s ``.npz``, or
     a training run's torch ``.pt`` (:func:`lvgym.agents.observer_fit.load`; needs torch); ``lead``, ``span``:
-    the :class:`Lead` of its aerodynamic moment [control steps]."""
+    the :class:`Lead` of its aerodynamic moment [control steps]; ``law``: its gains per flight model
+    (:func:`gains`; None: the reference's)."""
     if Path(path).suffix == ".pt":
         from .observer_fit import load, to_observer
 
         observer: Callable[[np.ndarray], np.ndarray] = to_observer(load(path))
     else:
         observer = Observer.load(path)
-    return InversionPolicy(env, observer, name=name, trained=trained, lead=lead, span=span)
+    return InversionPolicy(env, observer, name=name, trained=trained, lead=lead, span=span, law=law)
 
 
 def shipped_inversion(env: Any, name: str = "inversion-id", file: str = SHIPPED) -> InversionPolicy:
     """A shipped policy: ``agents/trained/<file>.npz`` flown on ``env`` (refused unless it is the env of
-    ``<file>.json``'s ``env``) with the record's ``lead`` (:class:`Lead`; none when it names none)."""
+    ``<file>.json``'s ``env``) with the record's ``lead`` (:class:`Lead`; none when it names none) and ``law``
+    (its gains per flight model, :func:`gains`; the reference's when it names none)."""
     weights, record = TRAINED / f"{file}.npz", TRAINED / f"{file}.json"
     if not weights.is_file() or not record.is_file():
         raise FileNotFoundError(f"the shipped policy {str(weights)!r} or its record is missing "
                                 "(docs/training-results.md)")
     meta = json.loads(record.read_text())
-    return from_file(env, weights, name=name, trained=meta["env"], lead=int(meta.get("lead", 0)))
+    return from_file(env, weights, name=name, trained=meta["env"], lead=int(meta.get("lead", 0)),
+                     law=meta.get("law"))
 
 
 shipped_inversion.kind = from_file.kind = "learned"  # type: ignore[attr-defined]

@@ -68,18 +68,21 @@ def test_the_student_in_a_batch_flies_as_the_benchmark_flies_it():
         assert single["max_qalpha_pa_deg"] == pytest.approx(rec["max_qalpha_pa_deg"], rel=1e-6)
 
 
-def test_the_inversion_teacher_is_the_reference_on_the_observation(monkeypatch):
+@pytest.mark.parametrize("bandwidth", [0.0, 1.25])
+def test_the_inversion_teacher_is_the_reference_on_the_observation(monkeypatch, bandwidth):
     """The inversion scheme's teacher (the law on the true terms, batched; here without its exploration) flies
-    as the privileged reference given the observation's errors, without its preview, one env row at a time."""
+    as the privileged reference given the observation's errors, without its preview, one env row at a time;
+    with ``--bandwidth``'s gains, as the reference of that bandwidth."""
     from experiments.fault_id import train
     from experiments.fault_id.privileges import reference
     monkeypatch.setattr(train, "NOISE", (0.0,))
     short = {"mission_time_s": 4.0}
-    _, y, batch = fly("nonrigid", [3, 4], None, np.random.default_rng(0), scheme="inversion", **short)
+    _, y, batch = fly("nonrigid", [3, 4], None, np.random.default_rng(0), scheme="inversion",
+                      law=train.own_law(bandwidth), **short)
     assert y.shape[1] == 7 and np.any(y[:, 4] > 0.0)
     env = condition("nonrigid", privileged_info=True, **short).make_env()
     for seed, rec in zip([3, 4], batch):
-        law = reference(env, preview=False, observed=True)
+        law = reference(env, preview=False, observed=True, bandwidth_radps=bandwidth or None)
         single = play_episode(law, env, seed, flyability=True)
         assert single["score_v2"] == pytest.approx(rec["score_v2"], rel=1e-9)
 
@@ -216,8 +219,28 @@ def test_the_studys_students_are_learned_in_the_headline():
     from lvgym.benchmark.headline import policy_kind
     from lvgym.benchmark.runner import PolicySpec
     for factory in ("experiments.fault_id.inversion:gain6_s0", "experiments.fault_id.inversion:stratos_lead3_s1",
-                    "experiments.fault_id.inversion:smile_lead5_gain6_s2", "experiments.fault_id.estimator:s2"):
+                    "experiments.fault_id.inversion:smile_lead5_gain6_s2",
+                    "experiments.fault_id.inversion:smile_lead5_w125_gain6_s0", "experiments.fault_id.estimator:s2"):
         assert policy_kind(PolicySpec("x", factory)) == "learned"
+
+
+def test_a_configuration_of_the_study_is_a_row_of_factories_and_a_label_to_compare(monkeypatch, tmp_path):
+    """Each row of ``STUDENTS`` gives a factory per training seed, which flies that run's file with the row's
+    lead and non-rigid bandwidth under ``<label>-s<k>``; ``compare`` groups by the rows' labels."""
+    from experiments.fault_id import inversion
+    from experiments.fault_id.compare import configurations
+    from lvgym.agents.observer_fit import Ensemble, Estimator, save
+    from lvgym.baselines.privileged import GAINS
+    rng = np.random.default_rng(0)
+    save(Ensemble([Estimator(rng.normal(0.0, 0.1, FEATURES), np.ones(FEATURES), hidden=8, outputs=7)]),
+         tmp_path / "inversion-smile-v2-lead5-w1.25-f200e16-gain6-s1.pt")
+    monkeypatch.setattr(inversion, "RESULTS", tmp_path)
+    env = condition("nonrigid", "smile-v2", mission_time_s=2.0).make_env()
+    pol = inversion.smile_lead5_w125_gain6_s1(env)
+    assert (pol.name, pol.lead, pol.w, pol.z) == ("inversion-smile-lead5-w125-gain6-s1", 5, 1.25, GAINS["nonrigid"][1])
+    assert len(inversion.FACTORIES) == 3 * len(inversion.STUDENTS)
+    assert inversion.STUDENTS["smile_lead5_w125_gain6_"].label in configurations()
+    assert configurations()[0] == "lqg-thrust-id" and len(set(configurations())) == len(configurations())
 
 
 def test_the_rounds_data_grows_in_place_as_their_concatenation():
@@ -267,3 +290,17 @@ def test_a_resumed_run_takes_the_finished_rounds_fits_and_ends_as_the_whole_run(
     again = load(final)
     assert all(torch.equal(a, b) for m, n in zip(whole.members, again.members)
                for a, b in zip(m.state_dict().values(), n.state_dict().values()))
+
+
+def test_the_bandwidth_names_the_runs_files_and_the_thrust_scheme_refuses_it(monkeypatch, tmp_path):
+    from experiments.fault_id import train
+
+    real = train.fly
+    monkeypatch.setattr(train, "fly", lambda *a, **k: real(*a, mission_time_s=2.0, **k))
+    monkeypatch.setattr(train, "RESULTS", tmp_path)
+    train.main(["--scheme", "inversion", "--suite", "smile-v2", "--flights", "10", "--rounds", "0", "--epochs", "1",
+                "--validation", "0", "--lead", "5", "--bandwidth", "1.25"])
+    assert (tmp_path / "inversion-smile-v2-lead5-w1.25-s0.pt").is_file()
+    assert train.own_law(1.25) == {"nonrigid": [1.25, 1.0]} and train.own_law(0.0) is None
+    with pytest.raises(ConfigError, match="--bandwidth"):
+        train.main(["--bandwidth", "1.25"])

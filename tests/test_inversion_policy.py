@@ -222,3 +222,32 @@ def test_a_policy_with_a_lead_commands_the_law_on_the_moment_ahead_and_its_batch
         got = batch.act(rows, o[rows], {})
         for j, r in enumerate(rows):
             np.testing.assert_array_equal(got[j], single[r].act(o[r], {}))
+
+
+def test_the_laws_own_gains_per_flight_model_by_hand_and_refused_by_name():
+    """A record's ``law`` sets the bandwidth and damping of the flight model it names (as a dict or as a policy
+    spec's pairs), the other keeps the reference's; the command is the law's with them (by hand: a rate error of
+    0.1 rad/s with ``a`` = 0.5 commands -0.5 * 2 * z * w * 0.1); an unknown model or a bad value is refused by
+    name, and a shipped record's ``law`` is what its policy flies."""
+    from lvgym.agents.inversion import gains
+    from lvgym.baselines.privileged import GAINS
+
+    rigid, nonrigid = (lvgym.make_env("smile-v2", m, mission_time_s=2.0) for m in ("rigid", "nonrigid"))
+    law = {"nonrigid": [1.25, 0.9]}
+    assert gains(nonrigid, law) == (1.25, 0.9) and gains(rigid, law) == GAINS["rigid"]
+    assert gains(nonrigid, (("nonrigid", (1.25, 0.9)),)) == (1.25, 0.9) and gains(nonrigid) == GAINS["nonrigid"]
+    p = InversionPolicy(nonrigid, lambda w: np.array([0.0, 0.0, 0.0, 0.0, 0.5, 0.5, 0.0]), law=law)
+    obs = np.zeros(14, np.float32)
+    obs[p.index[0]] = 0.1
+    np.testing.assert_allclose(p.act(obs, {}), [-0.5 * 2 * 0.9 * 1.25 * 0.1, 0.0], rtol=1e-6)
+    with pytest.raises(ConfigError, match="law") as err:
+        gains(nonrigid, {"non-rigid": [1.25, 1.0]})
+    assert "non-rigid" in str(err.value) and "nonrigid" in str(err.value)
+    with pytest.raises(ConfigError, match="law nonrigid"):
+        gains(nonrigid, {"nonrigid": [0.0, 1.0]})
+    for stem, name in ((SHIPPED, "inversion-id"), ("inversion_id_stratos_tvc_v2", "inversion-id-stratos"),
+                       ("inversion_id_smile_v2", "inversion-id-smile")):
+        record = json.loads((TRAINED / f"{stem}.json").read_text())
+        assert ("law" in record) == ("--bandwidth" in record["training"]["command"])
+        pol = build_policy(resolve_policy(name), lvgym.make_env(record["suite"], "nonrigid", mission_time_s=2.0))
+        assert (pol.w, pol.z) == gains(nonrigid, record.get("law"))

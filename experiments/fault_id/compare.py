@@ -22,13 +22,16 @@ from pathlib import Path
 from lvgym.cli.args import arg, parse
 
 BASELINES = ("lqg", "lqg-front", "aac-quiet", "gs-pd-relief", "gs-pid-flex-quiet")
-#: the students' labels, ``<configuration>-s<training seed>``: the thrust-direction estimator on ``lqg``
-#: (:mod:`.estimator`) and the reference's law on the learned disturbance observer (:mod:`.inversion`), trained
-#: without and with the loop dispersion (``--loop-gain-db 6``), and on Stratos III with the law's lead of 3 steps
-#: (``inversion-stratos-lead3-s0=experiments.fault_id.inversion:stratos_lead3_s0`` ...), and on smile-v2 with a lead
-#: of 5 steps under the dispersion (``inversion-smile-lead5-gain6-s0=...:smile_lead5_gain6_s0`` ...)
-CONFIGURATIONS = ("lqg-thrust-id", "inversion-id", "inversion-id-gain6", "inversion-stratos-lead3",
-                  "inversion-stratos-lead3-gain6", "inversion-smile-lead5-gain6")
+
+
+def configurations() -> tuple[str, ...]:
+    """The students' labels, ``<configuration>-s<training seed>``: the thrust-direction estimator on ``lqg``
+    (:mod:`.estimator`) and every configuration of the reference's law on the learned disturbance observer
+    (:data:`.inversion.STUDENTS`; flown as ``inversion-smile-lead5-gain6-s0=experiments.fault_id.inversion:
+    smile_lead5_gain6_s0`` ...)."""
+    from .inversion import STUDENTS
+
+    return ("lqg-thrust-id", *dict.fromkeys(s.label for s in STUDENTS.values()))
 
 
 @dataclass
@@ -47,11 +50,12 @@ def main(argv: Sequence[str] | None = None) -> None:
     if not path.is_file():
         raise SystemExit(f"python -m experiments.fault_id.compare: {path}: no such file (evaluate.py's --out)")
     records = json.loads(path.read_text())["episodes"]
+    known = configurations()
     runs = {c: sorted({r["policy"] for r in records if re.fullmatch(re.escape(c) + r"-s\d+", r["policy"])})
-            for c in CONFIGURATIONS}
+            for c in known}
     runs = {c: labels for c, labels in runs.items() if labels}
     if not runs:
-        raise SystemExit(f"{a.folder}: no policy labelled <configuration>-s<seed> of {list(CONFIGURATIONS)}")
+        raise SystemExit(f"{a.folder}: no policy labelled <configuration>-s<seed> of {list(known)}")
     rows = comparison_rows(records, runs, [b for b in BASELINES if any(r["policy"] == b for r in records)])
     print(comparison_table(rows, f"{', '.join(runs)} on the test seeds"))
 

@@ -43,17 +43,19 @@ def extrapolate(history: Sequence[np.ndarray], ahead: int, span: int = SLOPE_STE
 
 
 def reference(env: Any, preview: bool = True, relief: bool = True, plant: bool = True, observed: bool = False,
-              eff: bool = True, aero_late_steps: int = 0, aero_ahead_steps: int = 0, name: str = "privileged") -> Any:
+              eff: bool = True, aero_late_steps: int = 0, aero_ahead_steps: int = 0, name: str = "privileged",
+              bandwidth_radps: float | None = None) -> Any:
     """The privileged reference with its wind preview, its load relief or its knowledge of the plant taken away;
     ``observed``: on the flight computer's rate and attitude errors (the observation's) instead of the true ones;
     ``eff`` False: without the actuators' effectiveness (the misalignment kept); ``aero_late_steps``: the
     aerodynamic moment as it acted that many control steps ago (without preview); ``aero_ahead_steps``: the
     moment as it acts extrapolated that many steps ahead along its slope over the last :data:`SLOPE_STEPS`
-    (what a causal predictor of the moment ahead could do without learning; without preview)."""
+    (what a causal predictor of the moment ahead could do without learning; without preview);
+    ``bandwidth_radps``: the attitude loop's (None: the reference's)."""
     from lvgym.baselines.privileged import privileged
 
-    law = privileged(env, name=name, preview_periods=None if preview else 0, relief=None if relief else NO_RELIEF,
-                     plant=plant)
+    law = privileged(env, bandwidth_radps, name=name, preview_periods=None if preview else 0,
+                     relief=None if relief else NO_RELIEF, plant=plant)
     withheld = observed or not eff or aero_late_steps or aero_ahead_steps
     return Withheld(law, env, observed, eff, aero_late_steps, aero_ahead_steps) if withheld else law
 

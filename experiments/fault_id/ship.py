@@ -8,6 +8,9 @@ with its record into ``agents/trained`` (``inversion-id``: :data:`lvgym.agents.i
     python -m experiments.fault_id.ship --suite smile-v2 --prefix inversion-smile-v2-lead5-f200e16-gain6 --lead 5 \
         --loop-gain-db 6 --flights 200 --epochs 16 --tag f200e16 --stem inversion_id_smile_v2 \
         --name inversion-id-smile                            # inversion-id-smile
+    python -m experiments.fault_id.ship --suite smile-v2 --prefix inversion-smile-v2-lead5-w1.25-f200e16-gain6 \
+        --lead 5 --bandwidth 1.25 --loop-gain-db 6 --flights 200 --epochs 16 --tag f200e16 \
+        --stem inversion_id_smile_v2 --name inversion-id-smile   # inversion-id-smile, the law's bandwidth 1.25 rad/s
 
 Each seed's observer (``results/fault_id/<prefix>-s<k>.pt``, written by :mod:`.train`) is converted to the
 flight computer's NumPy form (``<prefix>-s<k>.npz``, :func:`lvgym.agents.observer_fit.to_observer`) and flown
@@ -16,7 +19,7 @@ validation seeds ``0 .. --validation - 1`` of ``--suite``, both flight models; t
 the fewest failed or unflyable non-rigid flights, then the lowest non-rigid mean ``score_v2``. The test seeds are
 not flown. The record (``<stem>.json``) holds the training command, the validation of every candidate, the
 choice, the env the observer was trained on (:func:`lvgym.agents.inversion.env_record`, which the policy
-checks), the law's lead (which the policy flies) and the observer file's SHA-256.
+checks), the law's lead and gains (which the policy flies) and the observer file's SHA-256.
 """
 
 from __future__ import annotations
@@ -34,7 +37,7 @@ from lvgym.benchmark import PolicySpec, evaluate, get_suite
 from lvgym.cli.args import arg, parse
 
 from .estimator import RESULTS
-from .train import SUITE, condition, scored
+from .train import SUITE, condition, own_law, scored
 
 
 @dataclass
@@ -53,6 +56,9 @@ class Args:
     """the suite the runs were trained on and are validated on"""
     lead: int = arg(0, lo=0, hi=10)
     """the law's lead [control steps] the runs were trained with (``train.py --lead``), flown and recorded"""
+    bandwidth: float = arg(0.0, lo=0.0, hi=10.0)
+    """the non-rigid law's bandwidth [rad/s] the runs were trained with (``train.py --bandwidth``; 0: the
+    reference's), flown and recorded"""
     flights: int = arg(100, lo=10, hi=2000)
     """the runs' ``--flights`` (recorded)"""
     epochs: int = arg(8, lo=1, hi=100)
@@ -75,20 +81,24 @@ def per_model(records: list[dict]) -> dict[str, dict[str, float]]:
     return out
 
 
-def validation(path: str, episodes: int, suite: str = SUITE, lead: int = 0) -> dict[str, dict[str, float]]:
-    """:func:`per_model` of the observer at ``path`` (``.npz``, flown with ``lead``) on ``suite``'s first
-    ``episodes`` validation seeds, flown by the benchmark."""
-    spec = PolicySpec("inversion-id", "lvgym.agents.inversion:from_file", (("lead", lead), ("path", path)))
+def validation(path: str, episodes: int, suite: str = SUITE, lead: int = 0,
+               law: dict[str, list[float]] | None = None) -> dict[str, dict[str, float]]:
+    """:func:`per_model` of the observer at ``path`` (``.npz``, flown with ``lead`` and the gains ``law``,
+    :func:`lvgym.agents.inversion.gains`) on ``suite``'s first ``episodes`` validation seeds, flown by the
+    benchmark."""
+    pairs = tuple((model, tuple(v)) for model, v in sorted((law or {}).items()))   # a spec's options hash
+    spec = PolicySpec("inversion-id", "lvgym.agents.inversion:from_file",
+                      (("lead", lead), ("path", path)) + ((("law", pairs),) if pairs else ()))
     return per_model(evaluate([spec], [get_suite(suite)], episodes, seed_set="validation", progress=False))
 
 
 def main(argv: Sequence[str] | None = None) -> None:
     a = parse(Args, argv, "python -m experiments.fault_id.ship", __doc__)
-    candidates = {}
+    candidates, law = {}, own_law(a.bandwidth)
     for k in a.seeds:
         npz = RESULTS / f"{a.prefix}-s{k}.npz"
         to_observer(load(RESULTS / f"{a.prefix}-s{k}.pt")).save(npz)
-        candidates[k] = validation(str(npz.resolve()), a.validation, a.suite, a.lead)
+        candidates[k] = validation(str(npz.resolve()), a.validation, a.suite, a.lead, law)
         print(f"seed {k}: " + ", ".join(f"{m} {v['score_v2_mean']:.3f} ({v['failed_or_unflyable']})"
                                          for m, v in candidates[k].items()), flush=True)
     best = min(candidates, key=lambda k: (candidates[k]["nonrigid"]["failed_or_unflyable"],
@@ -97,6 +107,7 @@ def main(argv: Sequence[str] | None = None) -> None:
     target = TRAINED / f"{a.stem}.npz"
     shutil.copyfile(source, target)
     options = ((f" --suite {a.suite}" if a.suite != SUITE else "") + (f" --lead {a.lead}" if a.lead else "")
+               + (f" --bandwidth {a.bandwidth:g}" if a.bandwidth else "")
                + (f" --epochs {a.epochs}" if a.epochs != 8 else "") + (f" --tag {a.tag}" if a.tag else "")
                + (f" --loop-gain-db {a.loop_gain_db:g}" if a.loop_gain_db else ""))
     record = {
@@ -104,6 +115,7 @@ def main(argv: Sequence[str] | None = None) -> None:
         "suite": a.suite,
         "env": env_record(condition("nonrigid", a.suite).make_env()),
         "lead": a.lead,
+        **({"law": law} if law else {}),
         "training": {"command": f"python -m experiments.fault_id.train --scheme inversion --seed {best} "
                                 f"--flights {a.flights} --rounds 4 --validation 50{options}",
                      "seeds": list(a.seeds), "file": f"{a.prefix}-s{best}.pt"},

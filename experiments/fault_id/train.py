@@ -72,7 +72,8 @@ class ThrustScheme:
     prefix, outputs, scaled, ensemble = "estimator", 2, False, 1
 
     def __init__(self, env1: Any, n: int, rng: np.random.Generator | None, deadband: float,
-                 loop_gain: np.ndarray | None = None, ahead: int = 0, extrapolated: int = 0, lead: int = 0) -> None:
+                 loop_gain: np.ndarray | None = None, ahead: int = 0, extrapolated: int = 0, lead: int = 0,
+                 law: dict[str, Any] | None = None) -> None:
         from lvgym.benchmark.batch import as_batch
 
         self.limit, self.n, self.deadband = float(env1.unwrapped.func.gimbal_limit), n, deadband
@@ -103,16 +104,18 @@ class InversionScheme:
     last :data:`lvgym.agents.inversion.SPAN` (:class:`lvgym.agents.inversion.Lead`: a causal label, the estimate's
     slope learned from the window instead of differenced from the student's own estimates); ``lead``: the law
     flies the moment terms carried that many periods along their slope (:class:`lvgym.agents.inversion.Lead`:
-    the teacher's of the truth, the student's of its estimates), the labels stay."""
+    the teacher's of the truth, the student's of its estimates), the labels stay; ``law``: the law's gains per
+    flight model where they are not the reference's (:func:`lvgym.agents.inversion.gains`)."""
 
     prefix, outputs, scaled, ensemble = "inversion", len(TERMS), True, 3
 
     def __init__(self, env1: Any, n: int, rng: np.random.Generator | None, deadband: float,
-                 loop_gain: np.ndarray | None = None, ahead: int = 0, extrapolated: int = 0, lead: int = 0) -> None:
+                 loop_gain: np.ndarray | None = None, ahead: int = 0, extrapolated: int = 0, lead: int = 0,
+                 law: dict[str, Any] | None = None) -> None:
         self.limit, self.n, self.ahead = float(env1.unwrapped.func.gimbal_limit), n, int(ahead)
         self.label_lead = Lead(n, extrapolated)               # the label's, on the true moment
         self.lead = Lead(n, lead)                              # the law's, on the truth or the estimate
-        self.index, (self.w, self.z) = error_index(env1), gains(env1)
+        self.index, (self.w, self.z) = error_index(env1), gains(env1, law)
         # a loop gain after the action (the margins' perturbation) scales the control power the action sees:
         # the terms in gimbal angles are labelled as the action must carry them, the truth over the gain
         self.per_gain = np.ones((n, 1)) if loop_gain is None else 1.0 / np.asarray(loop_gain, dtype=float)[:, None]
@@ -152,7 +155,7 @@ SCHEMES = {"thrust": ThrustScheme, "inversion": InversionScheme}
 def fly(model: str, seeds: Sequence[int], estimator: Estimator | Ensemble | None = None,
         rng: np.random.Generator | None = None, deadband: float = 0.0, scheme: str = "thrust",
         loop_gain: np.ndarray | None = None, suite: str = SUITE, ahead: int = 0, extrapolated: int = 0,
-        lead: int = 0, **options: Any
+        lead: int = 0, law: dict[str, Any] | None = None, **options: Any
         ) -> tuple[np.ndarray, np.ndarray, list[dict]]:
     """Fly the rows seeded ``seeds`` of the batched env of ``model`` with ``scheme``'s law (:data:`SCHEMES`) on
     the truth (``estimator`` None: the teacher; ``rng`` draws its delays) or on the ``estimator``'s output (the
@@ -163,6 +166,7 @@ def fly(model: str, seeds: Sequence[int], estimator: Estimator | Ensemble | None
     ``ahead``: the inversion's moment label that many control periods ahead (its teacher flies on it);
     ``extrapolated``: ... the moment as it acts carried that many periods along its slope (the same);
     ``lead``: the inversion's law flies its moment carried that many periods along its slope (the labels stay);
+    ``law``: its gains per flight model (:func:`lvgym.agents.inversion.gains`; None: the reference's);
     ``options``: env keywords (tests shorten the mission)."""
     from lvgym.benchmark.rows import RowsLog
 
@@ -172,15 +176,15 @@ def fly(model: str, seeds: Sequence[int], estimator: Estimator | Ensemble | None
     obs, info = env.reset(seed=[int(s) for s in seeds])
     if loop_gain is not None and scheme != "inversion":
         raise ValueError("loop_gain: the inversion scheme's training device only")
-    law = SCHEMES[scheme](env1, n, rng if estimator is None else None, deadband, loop_gain, ahead, extrapolated,
-                          lead)
+    pilot = SCHEMES[scheme](env1, n, rng if estimator is None else None, deadband, loop_gain, ahead, extrapolated,
+                            lead, law)
     gain = np.ones((n, 1)) if loop_gain is None else np.asarray(loop_gain, dtype=float)[:, None]
     window, log = Window(n), RowsLog(env)
     xs, ys = [], []
     done = np.zeros(n, dtype=bool)
     while not done.all():
         live = np.flatnonzero(~done)
-        truth = law.labels(info)
+        truth = pilot.labels(info)
         w = window.push(live, obs[live])
         xs.append(w.copy())
         ys.append(truth[live].astype(np.float32))
@@ -188,7 +192,7 @@ def fly(model: str, seeds: Sequence[int], estimator: Estimator | Ensemble | None
         if estimator is not None:
             with torch.no_grad():
                 estimate = estimator(torch.as_tensor(w)).numpy().astype(np.float64)
-        a = law.act(live, obs[live], info, estimate)
+        a = pilot.act(live, obs[live], info, estimate)
         window.sent(live, a)
         actions = np.zeros((n, 2), dtype=np.float32)
         actions[live] = np.clip(a * gain[live], -1.0, 1.0)
@@ -237,6 +241,14 @@ class Data:
         return self.x[:self.n], self.y[:self.n]
 
 
+def own_law(bandwidth: float) -> dict[str, list[float]] | None:
+    """The inversion law's gains per flight model (:func:`lvgym.agents.inversion.gains`) of ``--bandwidth``: the
+    non-rigid vehicle's bandwidth [rad/s] with the reference's damping; None (the reference's gains) for 0."""
+    from lvgym.baselines.privileged import GAINS
+
+    return {"nonrigid": [float(bandwidth), GAINS["nonrigid"][1]]} if bandwidth else None
+
+
 def fit(x: np.ndarray, y: np.ndarray, seed: int, epochs: int, scaled: bool = False) -> Estimator:
     """The estimator fitted to windows ``x`` and labels ``y`` (torch seeded with ``seed``; ``scaled``: the
     labels standardised, each weighing the same in the error)."""
@@ -272,14 +284,14 @@ def scored(records: Sequence[dict[str, Any]]) -> tuple[float, int]:
     return float(np.mean([r["score_v2"] for r in records])), sum(lost(r) for r in records)
 
 
-def validate(est: Estimator | Ensemble, episodes: int, deadband: float = 0.0,
-             scheme: str = "thrust", suite: str = SUITE, lead: int = 0) -> dict[str, tuple[float, int]]:
+def validate(est: Estimator | Ensemble, episodes: int, deadband: float = 0.0, scheme: str = "thrust",
+             suite: str = SUITE, lead: int = 0, law: dict[str, Any] | None = None) -> dict[str, tuple[float, int]]:
     """Mean ``score_v2`` and failed or unflyable flights of the student on validation seeds ``0 ..
     episodes - 1`` per flight model (:func:`fly`: the rows of one batched env; the benchmark flies the same
     law one row at a time through :class:`.estimator.FaultIdPolicy` or
     :class:`lvgym.agents.inversion.InversionPolicy`); on the family, ``episodes`` spread over its validation
     vehicles (:data:`lvgym.benchmark.suites.FAMILY_VALIDATION_VEHICLES`, seeds ``0 .. episodes / 10 - 1``
-    each)."""
+    each); ``lead``, ``law``: :func:`fly`'s."""
     from lvgym.benchmark.suites import FAMILY_VALIDATION_VEHICLES
 
     out = {}
@@ -287,11 +299,12 @@ def validate(est: Estimator | Ensemble, episodes: int, deadband: float = 0.0,
         if suite != "family-v2":
             rs = [r for k in range(0, episodes, 100)
                   for r in fly(model, range(k, min(episodes, k + 100)), est, deadband=deadband, scheme=scheme,
-                               suite=suite, lead=lead)[2]]
+                               suite=suite, lead=lead, law=law)[2]]
         else:
             each = max(1, episodes // len(FAMILY_VALIDATION_VEHICLES))
             rs = [r for v in FAMILY_VALIDATION_VEHICLES
-                  for r in fly(model, range(each), est, scheme=scheme, suite=suite, lead=lead, vehicle=v)[2]]
+                  for r in fly(model, range(each), est, scheme=scheme, suite=suite, lead=lead, law=law,
+                               vehicle=v)[2]]
         out[model] = scored(rs)
     return out
 
@@ -330,6 +343,9 @@ class Args:
     """the inversion's law flies the moment terms carried that many control periods along their slope over the
     last 5 (the teacher's true ones, the student's estimates; the labels stay the present terms; the policy
     flies it with ``lead``); files ``...-lead<k>``"""
+    bandwidth: float = arg(0.0, lo=0.0, hi=10.0)
+    """the inversion's law's bandwidth [rad/s] on the non-rigid vehicle, its damping the reference's (0: the
+    reference's gains, :data:`lvgym.baselines.privileged.GAINS`); files ``...-w<bandwidth>``"""
     tag: str = arg("")
     """a label ending the files' prefix (a run of other ``--flights`` or ``--epochs`` beside the first)"""
     family_vehicles: int = arg(16, lo=1, hi=200)
@@ -348,10 +364,10 @@ def main(argv: Sequence[str] | None = None) -> None:
     family = a.suite == "family-v2"
     from lvgym.errors import ConfigError
 
-    if a.scheme != "inversion" and (a.suite != SUITE or a.ahead or a.extrapolated or a.lead):
+    if a.scheme != "inversion" and (a.suite != SUITE or a.ahead or a.extrapolated or a.lead or a.bandwidth):
         key, value = next((k, v) for k, v in (("--suite", a.suite if a.suite != SUITE else None),
                                               ("--ahead", a.ahead), ("--extrapolated", a.extrapolated),
-                                              ("--lead", a.lead)) if v)
+                                              ("--lead", a.lead), ("--bandwidth", a.bandwidth)) if v)
         raise ConfigError(key, value, f"{SUITE} and 0 for the thrust scheme (the others: --scheme inversion)")
     if a.ahead and a.extrapolated:
         raise ConfigError("--extrapolated", a.extrapolated, "0 with --ahead (one label of the moment)")
@@ -363,8 +379,9 @@ def main(argv: Sequence[str] | None = None) -> None:
     where = "" if a.suite == SUITE else "-family" if family else f"-{a.suite}"
     prefix = (SCHEMES[a.scheme].prefix + where + (f"-ahead{a.ahead}" if a.ahead else "")
               + (f"-extrapolated{a.extrapolated}" if a.extrapolated else "") + (f"-lead{a.lead}" if a.lead else "")
-              + (f"-{a.tag}" if a.tag else "")
+              + (f"-w{a.bandwidth:g}" if a.bandwidth else "") + (f"-{a.tag}" if a.tag else "")
               + (f"-gain{a.loop_gain_db:g}" if a.loop_gain_db else ""))
+    law = own_law(a.bandwidth)
     data = Data()
     est: Estimator | None = None                      # the teacher flies round 0, the student the others
     fits: list[Estimator] = []
@@ -382,7 +399,7 @@ def main(argv: Sequence[str] | None = None) -> None:
                             if a.loop_gain_db else None)
                     place = {"suite": a.suite, **({"vehicle": vehicle} if family else {})}
                     x, y, _ = fly(model, seeds, est, rng, scheme=a.scheme, loop_gain=gain, ahead=a.ahead,
-                                    extrapolated=a.extrapolated, lead=a.lead, **place)
+                                    extrapolated=a.extrapolated, lead=a.lead, law=law, **place)
                     data.add(x, y)
             if rnd == 0:                              # room for the rounds to come (each flies half the flights
                 data.reserve(len(data) * (4 + 3 * a.rounds) // 4)       # of round 0, their steps up to 3/4)
@@ -397,14 +414,14 @@ def main(argv: Sequence[str] | None = None) -> None:
         fits.append(est)
         save(est, done)
         if a.validation:
-            v = validate(est, a.validation, scheme=a.scheme, suite=a.suite, lead=a.lead)
+            v = validate(est, a.validation, scheme=a.scheme, suite=a.suite, lead=a.lead, law=law)
             print(f"seed {a.seed} round {rnd} validation 0-{a.validation - 1}: " + ", ".join(
                 f"{m} {s:.3f} ({b})" for m, (s, b) in v.items()) + f" at {time.time() - t0:.0f} s", flush=True)
     last = SCHEMES[a.scheme].ensemble                 # the policy: the mean of the last rounds' fits
     final = Ensemble(fits[-last:]) if last > 1 else est
     save(final, RESULTS / f"{prefix}-s{a.seed}.pt")
     if a.validation and last > 1:
-        v = validate(final, a.validation, scheme=a.scheme, suite=a.suite, lead=a.lead)
+        v = validate(final, a.validation, scheme=a.scheme, suite=a.suite, lead=a.lead, law=law)
         print(f"seed {a.seed} the last {last} rounds' mean, validation 0-{a.validation - 1}: " + ", ".join(
             f"{m} {s:.3f} ({b})" for m, (s, b) in v.items()), flush=True)
     print(f"wrote {RESULTS / f'{prefix}-s{a.seed}.pt'} in {time.time() - t0:.0f} s")
