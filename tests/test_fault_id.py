@@ -304,3 +304,11 @@ def test_the_bandwidth_names_the_runs_files_and_the_thrust_scheme_refuses_it(mon
     assert train.own_law(1.25) == {"nonrigid": [1.25, 1.0]} and train.own_law(0.0) is None
     with pytest.raises(ConfigError, match="--bandwidth"):
         train.main(["--bandwidth", "1.25"])
+
+
+@pytest.mark.parametrize(("n", "rows"), [(1, 4), (37, 5), (1000, 64), (20_001, 1 << 16)])
+def test_the_fits_standard_deviation_is_numpys_to_the_bit(n, rows):
+    """``row_std`` (chunks of ``rows`` rows, no temporary of the whole data) is ``std(0)`` bit for bit."""
+    from experiments.fault_id.train import row_std
+    flat = np.random.default_rng(n).normal(3.0, 2.0, (n, 16)).astype(np.float32)
+    assert np.array_equal(row_std(flat, flat.mean(0), rows), flat.std(0))

@@ -249,12 +249,25 @@ def own_law(bandwidth: float) -> dict[str, list[float]] | None:
     return {"nonrigid": [float(bandwidth), GAINS["nonrigid"][1]]} if bandwidth else None
 
 
+def row_std(flat: np.ndarray, mean: np.ndarray, rows: int = 1 << 16) -> np.ndarray:
+    """``flat.std(0)`` (``flat`` ``(n, k)``, ``mean`` its ``flat.mean(0)``) to the bit, without NumPy's temporary
+    of the whole array (gigabytes for a training run's windows): the squared deviations of ``rows`` rows at a
+    time, summed row after row as NumPy's reduction over the first axis sums them."""
+    total = None
+    for i in range(0, len(flat), rows):
+        d = flat[i:i + rows] - mean
+        np.multiply(d, d, out=d)
+        total = np.add.reduce(d if total is None else np.concatenate([total[None], d]), axis=0)
+    return np.sqrt(np.true_divide(total, len(flat)))
+
+
 def fit(x: np.ndarray, y: np.ndarray, seed: int, epochs: int, scaled: bool = False) -> Estimator:
     """The estimator fitted to windows ``x`` and labels ``y`` (torch seeded with ``seed``; ``scaled``: the
     labels standardised, each weighing the same in the error)."""
     torch.manual_seed(seed)
     flat = x.reshape(-1, x.shape[-1])
-    est = Estimator(flat.mean(0), flat.std(0) + 1e-6, outputs=y.shape[1],
+    mean = flat.mean(0)
+    est = Estimator(mean, row_std(flat, mean) + 1e-6, outputs=y.shape[1],
                     label_mean=y.mean(0) if scaled else None, label_std=y.std(0) + 1e-6 if scaled else None)
     opt = torch.optim.Adam(est.parameters(), 1e-3)
     xt, yt = torch.as_tensor(x), torch.as_tensor(y)
