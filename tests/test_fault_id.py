@@ -312,3 +312,24 @@ def test_the_fits_standard_deviation_is_numpys_to_the_bit(n, rows):
     from experiments.fault_id.train import row_std
     flat = np.random.default_rng(n).normal(3.0, 2.0, (n, 16)).astype(np.float32)
     assert np.array_equal(row_std(flat, flat.mean(0), rows), flat.std(0))
+
+
+def test_the_law_gains_study_flies_the_causal_teacher_and_refuses_a_bad_variant():
+    """Its variant of the reference's gains, lead 5 over 5, is the law_room's extrapolated teacher flight for
+    flight; a bandwidth of 1.25 flies another law; a malformed variant is refused by name."""
+    from experiments.fault_id.law_gains import flights, variant
+    from experiments.fault_id.privileges import reference
+    from lvgym.benchmark.suites import get_suite
+    short = {"mission_time_s": 3.0}
+    env = condition("nonrigid", "smile-v2", privileged_info=True, **short).make_env()
+    teacher = reference(env, preview=False, observed=True, aero_ahead_steps=5)
+    mine = flights("smile-v2", "nonrigid", 2, "1,1,0.5,0.9,5,5", **short)
+    seeds = [int(k) for k in get_suite("smile-v2").seeds("validation", 2)]
+    assert [r["score_v2"] for r in mine] == [play_episode(teacher, env, k, flyability=True)["score_v2"] for k in seeds]
+    assert [r["score_v2"] for r in flights("smile-v2", "nonrigid", 2, "1.25,1,0.5,0.9,5,5", **short)] != \
+        [r["score_v2"] for r in mine]
+    assert variant("1.25,0.9,0.6,1,6,4") == (1.25, 0.9, (0.6, 1.0), 6, 4)
+    for bad in ("1,1,0.5,0.9,5", "1,1,0.5,0.9,5,0", "a,1,0.5,0.9,5,5", "1,1,0.5,0.9,5.5,5"):
+        with pytest.raises(ConfigError, match="--variants"):
+            variant(bad)
+

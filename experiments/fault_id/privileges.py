@@ -63,12 +63,13 @@ def reference(env: Any, preview: bool = True, relief: bool = True, plant: bool =
 class Withheld:
     """A privileged law given less than the step's privileged info: the observation's rate and attitude errors
     in place of the true ones (``observed``), no effectiveness (``eff`` False), the aerodynamic moment of
-    ``late`` steps ago, or the present one extrapolated ``ahead`` steps."""
+    ``late`` steps ago, or the present one extrapolated ``ahead`` steps along its slope over ``span``."""
 
-    def __init__(self, law: Any, env: Any, observed: bool, eff: bool, late: int, ahead: int = 0) -> None:
+    def __init__(self, law: Any, env: Any, observed: bool, eff: bool, late: int, ahead: int = 0,
+                 span: int = SLOPE_STEPS) -> None:
         names = list(env.unwrapped.func.observation_layout.names)
         self.law, self.name, self.observed, self.eff, self.late = law, law.name, observed, eff, int(late)
-        self.ahead = int(ahead)
+        self.ahead, self.span = int(ahead), int(span)
         self.i = [names.index(n) for n in ("pitch_rate_error", "yaw_rate_error", "pitch_attitude_error",
                                             "yaw_attitude_error", "pitch_rate_reference")]
         self.m_aero: list[np.ndarray] = []
@@ -87,8 +88,8 @@ class Withheld:
                 info["actuator_effectiveness"] = np.ones(2)
             self.m_aero.append(np.asarray(info["m_aero_b"], dtype=np.float64))
             info["m_aero_b"] = self.m_aero[max(0, len(self.m_aero) - 1 - self.late)]
-            if self.ahead:                                  # along the slope of the last SLOPE_STEPS
-                info["m_aero_b"] = extrapolate(self.m_aero, self.ahead)
+            if self.ahead:                                  # along the slope of the last span steps
+                info["m_aero_b"] = extrapolate(self.m_aero, self.ahead, self.span)
         return self.law.act(observation, info)
 
 
