@@ -179,6 +179,7 @@ def test_the_moment_extrapolated_along_its_slope_by_hand():
     law.reset()
     w = Withheld.__new__(Withheld)
     w.law, w.name, w.observed, w.eff, w.late, w.ahead, w.m_aero = law, "x", False, True, 0, 5, []
+    w.span = SLOPE_STEPS
     for k in range(8):                                  # a moment growing by 2 N m per step
         w.act(np.zeros(14), {"omega_bi_b": np.zeros(3), "m_aero_b": np.array([0.0, 2.0 * k, 0.0])})
     assert SLOPE_STEPS == 5
