@@ -26,13 +26,15 @@ The shipped observer (:data:`SHIPPED`, ``agents/trained``) was trained on SMILE'
 models, with the reference's law on the true terms as the teacher and DAgger rounds
 (``python -m experiments.fault_id.train --scheme inversion``); ``inversion-id-stratos``'s on Stratos III and
 ``inversion-id-smile``'s on ``smile-v2``, the law flying its estimated moment carried 3 and 5 steps ahead
-(:class:`Lead`, the record's ``lead``). A policy refuses an env its observer was not trained for
+(:class:`Lead`, the record's ``lead``), ``inversion-id-smile``'s law at a non-rigid bandwidth of 1.25 rad/s
+(:func:`gains`, the record's ``law``). A policy refuses an env its observer was not trained for
 (:func:`check_env`).
 """
 
 from __future__ import annotations
 
 import json
+import math
 from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
@@ -112,7 +114,10 @@ def gains(env: Any, law: dict[str, Any] | Sequence[tuple[str, Any]] | None = Non
     own = law.get(model)
     if own is None:
         return GAINS[model]
-    w, z = (float(v) for v in own)
+    try:
+        w, z = (float(v) for v in own)
+    except (TypeError, ValueError):
+        w = z = math.nan
     if not (0.0 < w <= 100.0 and 0.0 < z <= 10.0):
         raise ConfigError(f"law {model}", list(own), "[bandwidth, damping] in (0, 100] rad/s and (0, 10]")
     return w, z

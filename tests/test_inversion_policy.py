@@ -243,8 +243,9 @@ def test_the_laws_own_gains_per_flight_model_by_hand_and_refused_by_name():
     with pytest.raises(ConfigError, match="law") as err:
         gains(nonrigid, {"non-rigid": [1.25, 1.0]})
     assert "non-rigid" in str(err.value) and "nonrigid" in str(err.value)
-    with pytest.raises(ConfigError, match="law nonrigid"):
-        gains(nonrigid, {"nonrigid": [0.0, 1.0]})
+    for bad in ([0.0, 1.0], [1.25], "fast"):
+        with pytest.raises(ConfigError, match="law nonrigid"):
+            gains(nonrigid, {"nonrigid": bad})
     for stem, name in ((SHIPPED, "inversion-id"), ("inversion_id_stratos_tvc_v2", "inversion-id-stratos"),
                        ("inversion_id_smile_v2", "inversion-id-smile")):
         record = json.loads((TRAINED / f"{stem}.json").read_text())
