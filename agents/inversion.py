@@ -54,6 +54,9 @@ TERMS = ("f_aero_pitch", "f_aero_yaw", "f_mis_pitch", "f_mis_yaw", "a_pitch", "a
 A_MAX = 5.0
 #: the observation's entries the law reads (SMILE's flight observation)
 ERRORS = ("pitch_rate_error", "yaw_rate_error", "pitch_attitude_error", "yaw_attitude_error")
+#: a law's own gains: ``{flight model: [bandwidth, damping]}`` or, as a policy spec's options must be hashable,
+#: its ``(model, (bandwidth, damping))`` pairs (:func:`gains`)
+Law = dict[str, Any] | Sequence[tuple[str, Any]]
 #: the lever [N m per rad of gimbal] under which the law commands nothing (the privileged reference's)
 NO_THRUST = 1.0
 #: the shipped observer (``<stem>.npz``) and its record (``<stem>.json``: how it was trained, the env)
@@ -100,7 +103,7 @@ def command(observations: np.ndarray, terms: np.ndarray, index: list[int], w: fl
     return np.clip(terms[:, 4:6] * alpha - hold * terms[:, 0:2] - terms[:, 2:4], -1.0, 1.0).astype(np.float32)
 
 
-def gains(env: Any, law: dict[str, Any] | Sequence[tuple[str, Any]] | None = None) -> tuple[float, float]:
+def gains(env: Any, law: Law | None = None) -> tuple[float, float]:
     """The law's (bandwidth [rad/s], damping) for ``env``'s flight model: ``law``'s ``{model: [bandwidth,
     damping]}`` where it names the model (a student's record: its law's own gains), else the reference's
     :data:`~lvgym.baselines.privileged.GAINS`."""
@@ -201,7 +204,7 @@ class InversionPolicy:
 
     def __init__(self, env: Any, observer: Callable[[np.ndarray], np.ndarray], name: str = "inversion-id",
                  trained: dict[str, Any] | None = None, lead: int = 0, span: int = SPAN,
-                 law: dict[str, Any] | None = None) -> None:
+                 law: Law | None = None) -> None:
         check_env(env, trained or {})
         self.observer = observer
         self.name = name
@@ -253,7 +256,7 @@ class InversionBatch:
 
 
 def from_file(env: Any, path: str | Path, name: str = "inversion-id", trained: dict[str, Any] | None = None,
-              lead: int = 0, span: int = SPAN, law: dict[str, Any] | None = None) -> InversionPolicy:
+              lead: int = 0, span: int = SPAN, law: Law | None = None) -> InversionPolicy:
     """The policy on the observer saved at ``path``: an :class:`~lvgym.agents.observer.Observer`'s ``.npz``, or
     a training run's torch ``.pt`` (:func:`lvgym.agents.observer_fit.load`; needs torch); ``lead``, ``span``:
     the :class:`Lead` of its aerodynamic moment [control steps]; ``law``: its gains per flight model
