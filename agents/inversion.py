@@ -165,32 +165,46 @@ def carry(now: np.ndarray, back: np.ndarray, ahead: int, span: int = SPAN) -> np
 
 
 class Lead:
-    """The aerodynamic-moment terms (``f_aero``, pitch and yaw) of ``n`` rows carried ``ahead`` control steps
-    along their slope over the last ``span`` steps (:func:`carry`; over fewer at the start of a flight, none
+    """The aerodynamic-moment terms (``f_aero``, pitch and yaw) of ``n`` rows averaged over the last ``average``
+    control steps (over fewer at the start of a flight; 1: as they are), then carried ``ahead`` steps along
+    the average's slope over the last ``span`` steps (:func:`carry`; over fewer at the start of a flight, none
     at its first step): a causal prediction of the moment the gimbal will meet, about a delay and a servo lag
-    later (the privileged reference reads it 5 steps ahead in the wind). ``ahead`` 0: the terms as they are."""
+    later (the privileged reference reads it 5 steps ahead in the wind). ``ahead`` 0 and ``average`` 1: the
+    terms as they are. The average removes an oscillation of its period exactly and delays the moment by
+    ``(average - 1) / 2`` steps, which the lead takes back: a learned observer can close a loop with its own
+    action through the window it reads (the fault suite's observer on a gyro bias step: a limit cycle of 6
+    steps, about 8 Hz; docs/training-results.md)."""
 
-    def __init__(self, n: int, ahead: int = 0, span: int = SPAN) -> None:
-        if ahead < 0 or span < 1:
-            raise ConfigError("lead", (ahead, span), "ahead >= 0 and span >= 1 control steps")
-        self.ahead, self.span = int(ahead), int(span)
-        self.past = np.zeros((int(n), self.span + 1, 2))          # oldest first
+    def __init__(self, n: int, ahead: int = 0, span: int = SPAN, average: int = 1) -> None:
+        if ahead < 0 or span < 1 or average < 1:
+            raise ConfigError("lead", {"ahead": ahead, "span": span, "average": average},
+                              "ahead >= 0, span >= 1 and average >= 1 control steps")
+        self.ahead, self.span, self.average = int(ahead), int(span), int(average)
+        self.past = np.zeros((int(n), self.span + 1, 2))          # the averages, oldest first
         self.count = np.zeros(int(n), dtype=np.int64)
+        self.raw = np.zeros((int(n), self.average, 2))            # the terms as they came, oldest first
 
     def push(self, rows: np.ndarray, f_aero: np.ndarray) -> np.ndarray:
-        """Add the step's ``f_aero`` ``(len(rows), 2)`` of ``rows`` and return them carried ahead."""
+        """Add the step's ``f_aero`` ``(len(rows), 2)`` of ``rows`` and return them averaged and carried ahead."""
         f = np.asarray(f_aero, dtype=np.float64)
+        if not self.ahead and self.average == 1:
+            return f
+        self.count[rows] += 1
+        if self.average > 1:
+            self.raw[rows, :-1] = self.raw[rows, 1:]
+            self.raw[rows, -1] = f
+            f = self.raw[rows].sum(axis=1) / np.minimum(self.count[rows], self.average)[:, None]
         if not self.ahead:
             return f
         self.past[rows, :-1] = self.past[rows, 1:]
         self.past[rows, -1] = f
-        self.count[rows] += 1
         back = self.past[rows, np.maximum(0, self.span + 1 - self.count[rows])]
         return carry(f, back, self.ahead, self.span)
 
     def reset(self, rows: np.ndarray) -> None:
         """Forget the flights of ``rows``."""
         self.past[rows] = 0.0
+        self.raw[rows] = 0.0
         self.count[rows] = 0
 
 
@@ -199,22 +213,23 @@ class InversionPolicy:
     policy; no privileged information). ``observer``: a window ``(WINDOW, FEATURES)`` -> the terms ``(7,)``
     (an :class:`~lvgym.agents.observer.Observer`); ``trained``: the :func:`env_record` it was trained on (it
     refuses another env: :func:`check_env`); ``lead``, ``span``: the control steps the estimated aerodynamic
-    moment is carried ahead along its slope over ``span`` steps (:class:`Lead`; 0: the moment as estimated);
-    ``law``: the law's gains per flight model where they are not the reference's (:func:`gains`)."""
+    moment is carried ahead along its slope over ``span`` steps (:class:`Lead`; 0: the moment as estimated),
+    after its average over ``average`` steps (1: none); ``law``: the law's gains per flight model where they
+    are not the reference's (:func:`gains`)."""
 
     def __init__(self, env: Any, observer: Callable[[np.ndarray], np.ndarray], name: str = "inversion-id",
                  trained: dict[str, Any] | None = None, lead: int = 0, span: int = SPAN,
-                 law: Law | None = None) -> None:
+                 law: Law | None = None, average: int = 1) -> None:
         check_env(env, trained or {})
         self.observer = observer
         self.name = name
         self.index, (self.w, self.z) = error_index(env), gains(env, law)
-        self.lead, self.span = int(lead), int(span)
+        self.lead, self.span, self.average = int(lead), int(span), int(average)
         self.reset()
 
     def reset(self) -> None:
         """Forget the flight: the window starts from zeros, the lead from no slope."""
-        self.window, self.ahead = Window(1), Lead(1, self.lead, self.span)
+        self.window, self.ahead = Window(1), Lead(1, self.lead, self.span, self.average)
 
     def act(self, observation: np.ndarray, info: dict[str, Any]) -> np.ndarray:
         """The gimbal action (pitch, yaw) in [-1, 1] from the observation (``info`` is not read)."""
@@ -233,7 +248,7 @@ class InversionBatch:
     def __init__(self, policy: InversionPolicy, n: int) -> None:
         self.name, self.observer = policy.name, policy.observer
         self.index, self.w, self.z = policy.index, policy.w, policy.z
-        self.window, self.ahead = Window(int(n)), Lead(int(n), policy.lead, policy.span)
+        self.window, self.ahead = Window(int(n)), Lead(int(n), policy.lead, policy.span, policy.average)
 
     def reset(self, rows: Any) -> None:
         rows = np.asarray(rows, dtype=np.int64).reshape(-1)
@@ -256,18 +271,19 @@ class InversionBatch:
 
 
 def from_file(env: Any, path: str | Path, name: str = "inversion-id", trained: dict[str, Any] | None = None,
-              lead: int = 0, span: int = SPAN, law: Law | None = None) -> InversionPolicy:
+              lead: int = 0, span: int = SPAN, law: Law | None = None, average: int = 1) -> InversionPolicy:
     """The policy on the observer saved at ``path``: an :class:`~lvgym.agents.observer.Observer`'s ``.npz``, or
-    a training run's torch ``.pt`` (:func:`lvgym.agents.observer_fit.load`; needs torch); ``lead``, ``span``:
-    the :class:`Lead` of its aerodynamic moment [control steps]; ``law``: its gains per flight model
-    (:func:`gains`; None: the reference's)."""
+    a training run's torch ``.pt`` (:func:`lvgym.agents.observer_fit.load`; needs torch); ``lead``, ``span``,
+    ``average``: the :class:`Lead` of its aerodynamic moment [control steps]; ``law``: its gains per flight
+    model (:func:`gains`; None: the reference's)."""
     if Path(path).suffix == ".pt":
         from .observer_fit import load, to_observer
 
         observer: Callable[[np.ndarray], np.ndarray] = to_observer(load(path))
     else:
         observer = Observer.load(path)
-    return InversionPolicy(env, observer, name=name, trained=trained, lead=lead, span=span, law=law)
+    return InversionPolicy(env, observer, name=name, trained=trained, lead=lead, span=span, law=law,
+                           average=average)
 
 
 def shipped_inversion(env: Any, name: str = "inversion-id", file: str = SHIPPED) -> InversionPolicy:

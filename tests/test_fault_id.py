@@ -10,7 +10,7 @@ import torch
 
 from experiments.fault_id.estimator import FEATURES, WINDOW, FaultIdPolicy, corrected
 from experiments.fault_id.privileges import VARIANTS, PlantKnown, specs
-from experiments.fault_id.train import condition, fit, fly
+from experiments.fault_id.train import condition, fit, fly, lost
 from lvgym.benchmark.runner import play_episode
 from lvgym.errors import ConfigError
 
@@ -227,7 +227,7 @@ def test_the_studys_students_are_learned_in_the_headline():
 
 def test_a_configuration_of_the_study_is_a_row_of_factories_and_a_label_to_compare(monkeypatch, tmp_path):
     """Each row of ``STUDENTS`` gives a factory per training seed, which flies that run's file with the row's
-    lead and non-rigid bandwidth under ``<label>-s<k>``; ``compare`` groups by the rows' labels."""
+    lead, average and non-rigid bandwidth under ``<label>-s<k>``; ``compare`` groups by the rows' labels."""
     from experiments.fault_id import inversion
     from experiments.fault_id.compare import configurations
     from lvgym.agents.observer_fit import Ensemble, Estimator, save
@@ -241,6 +241,10 @@ def test_a_configuration_of_the_study_is_a_row_of_factories_and_a_label_to_compa
     assert (pol.name, pol.lead, pol.w, pol.z) == ("inversion-smile-lead5-w125-gain6-s1", 5, 1.25, GAINS["nonrigid"][1])
     assert len(inversion.FACTORIES) == 3 * len(inversion.STUDENTS)
     assert inversion.STUDENTS["smile_lead5_w125_gain6_"].label in configurations()
+    save(Ensemble([Estimator(rng.normal(0.0, 0.1, FEATURES), np.ones(FEATURES), hidden=8, outputs=7)]),
+         tmp_path / "inversion-gain6-s2.pt")
+    faults = inversion.gain6_avg6_lead3_s2(condition("nonrigid", mission_time_s=2.0).make_env())
+    assert (faults.name, faults.lead, faults.average) == ("inversion-id-gain6-avg6-lead3-s2", 3, 6)
     assert configurations()[0] == "lqg-thrust-id" and len(set(configurations())) == len(configurations())
 
 
@@ -334,3 +338,16 @@ def test_the_law_gains_study_flies_the_causal_teacher_and_refuses_a_bad_variant(
         with pytest.raises(ConfigError, match="--variants"):
             variant(bad)
 
+
+
+def test_one_kind_of_fault_flies_validation_seeds_with_that_kind_only(capsys):
+    """Every flight draws the one kind asked (``thrust``: no axis); the printed count is the lost flights';
+    a range that ends before it starts is refused by name."""
+    from experiments.fault_id.one_kind import main
+    out = main(["--kind", "thrust", "--first", "3", "--last", "5", "--policies", "zero", "--model", "rigid"])
+    records = out["zero"]
+    assert len(records) == 2 and all(r["fault"] == "thrust" for r in records)
+    printed = capsys.readouterr().out
+    assert f"failed or unflyable {sum(lost(r) for r in records)}" in printed and "seeds 3-4" in printed
+    with pytest.raises(ConfigError, match="--last"):
+        main(["--first", "5", "--last", "5"])

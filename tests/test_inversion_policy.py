@@ -195,9 +195,30 @@ def test_a_lead_carries_the_moment_along_its_slope_by_hand():
         Lead(1, -1)
 
 
-def test_a_policy_with_a_lead_commands_the_law_on_the_moment_ahead_and_its_batch_is_its_rows():
-    """A ramp of estimated moments: the action is the law's on the ramp 3 steps on; the batch of two rows
-    gives each row its single policy's actions, to the bit."""
+def test_an_average_before_the_lead_by_hand():
+    """Averaged over 4 steps: the mean of the steps so far until the fourth, then of the last 4; an oscillation
+    of period 4 is removed whole; with a lead of 2 over 5 the average of a ramp (1.5 steps behind it) is
+    carried 2 steps along its own slope; a reset starts the average again; an average under 1 is refused."""
+    avg, row = Lead(1, 0, average=4), np.zeros(1, dtype=np.int64)
+    out = [avg.push(row, [[float(k), -float(k)]])[0, 0] for k in range(1, 7)]
+    np.testing.assert_allclose(out, [1.0, 1.5, 2.0, 2.5, 3.5, 4.5])
+    wave = [avg.push(row, [[v, 0.0]])[0, 0] for v in [1.0, 0.0, -1.0, 0.0] * 3]
+    np.testing.assert_allclose(wave[4:], 0.0, atol=1e-12)
+    both = Lead(1, 2, average=4)
+    for k in range(1, 11):
+        got = both.push(row, [[0.1 * k, 0.0]])[0, 0]
+    np.testing.assert_allclose(got, 0.1 * (10 - 1.5) + 2 * 0.1)
+    both.reset(row)
+    np.testing.assert_allclose(both.push(row, [[0.7, 0.3]]), [[0.7, 0.3]])
+    with pytest.raises(ConfigError, match="average"):
+        Lead(1, 0, average=0)
+
+
+@pytest.mark.parametrize("average", [1, 6])
+def test_a_policy_with_a_lead_commands_the_law_on_the_moment_ahead_and_its_batch_is_its_rows(average):
+    """A ramp of estimated moments: the action is the law's on the ramp 3 steps on (on its average over 6
+    steps, 2.5 steps behind it, carried along its slope); the batch of two rows gives each row its single
+    policy's actions, to the bit."""
     env = lvgym.make_env("smile-v2-faults", "rigid", mission_time_s=3.0)
     calls = []
 
@@ -205,15 +226,16 @@ def test_a_policy_with_a_lead_commands_the_law_on_the_moment_ahead_and_its_batch
         calls.append(1)
         return np.array([0.01 * len(calls), 0.0, 0.0, 0.0, 1.0, 1.0, 0.0])
 
-    p = InversionPolicy(env, ramp, name="x", lead=3)
+    p = InversionPolicy(env, ramp, name="x", lead=3, average=average)
     obs = np.zeros(14, np.float32)
-    for _ in range(8):
+    for _ in range(12):
         a = p.act(obs, {})
-    want = command(obs[None], np.array([[0.08 + 3 * 0.01, 0.0, 0.0, 0.0, 1.0, 1.0, 0.0]]), p.index, p.w, p.z)[0]
+    moment = 0.12 - 0.01 * (average - 1) / 2 + 3 * 0.01
+    want = command(obs[None], np.array([[moment, 0.0, 0.0, 0.0, 1.0, 1.0, 0.0]]), p.index, p.w, p.z)[0]
     np.testing.assert_allclose(a, want, rtol=1e-6)
     observer = to_observer(_ensemble(hidden=16))
-    single = [InversionPolicy(env, observer, lead=3) for _ in range(2)]
-    batch = InversionPolicy(env, observer, lead=3).batch(2)
+    single = [InversionPolicy(env, observer, lead=3, average=average) for _ in range(2)]
+    batch = InversionPolicy(env, observer, lead=3, average=average).batch(2)
     batch.reset([0, 1])
     rng = np.random.default_rng(0)
     for step in range(30):

@@ -17,8 +17,8 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
-from lvgym.agents.inversion import (A_MAX, ERRORS, NO_THRUST, SPAN, TERMS, InversionPolicy, command, error_index,
-                                    from_file, gains, law_terms)
+from lvgym.agents.inversion import (A_MAX, ERRORS, NO_THRUST, SHIPPED, SPAN, TERMS, TRAINED, InversionPolicy, command,
+                                    error_index, from_file, gains, law_terms)
 
 from .estimator import RESULTS
 from .train import own_law
@@ -30,7 +30,7 @@ SEEDS = (0, 1, 2)
 @dataclass(frozen=True)
 class Student:
     """A configuration of the study: the training runs' file prefix (``results/fault_id/<prefix>-s<k>.pt``), the
-    label its policies fly under, and how the law flies the observer: ``lead``, ``span``
+    label its policies fly under, and how the law flies the observer: ``lead``, ``span``, ``average``
     (:class:`lvgym.agents.inversion.Lead`) and ``bandwidth`` (the non-rigid law's, ``train.py --bandwidth``;
     0: the reference's)."""
 
@@ -39,6 +39,7 @@ class Student:
     lead: int = 0
     span: int = SPAN
     bandwidth: float = 0.0
+    average: int = 1
 
 
 #: the configurations by attribute prefix
@@ -46,6 +47,9 @@ STUDENTS = {
     # the fault suite's students, without and with the loop dispersion (train.py --loop-gain-db 6)
     "": Student("inversion", "inversion-id"),
     "gain6_": Student("inversion-gain6", "inversion-id-gain6"),
+    # ... the same runs flown with their moment averaged over 6 steps (the observer's 8 Hz limit cycle on a gyro
+    # bias step) and carried 3 steps ahead: chosen on validation seeds after training, not trained with
+    "gain6_avg6_lead3_": Student("inversion-gain6", "inversion-id-gain6-avg6-lead3", lead=3, average=6),
     # Stratos III's student of the present moment as trained, and with its moment carried 5 steps ahead along
     # its last 5 or 15 steps (evaluate.py --seed-set validation only)
     "stratos_": Student("inversion-stratos-tvc-v2", "inversion-stratos"),
@@ -71,14 +75,21 @@ def seeded(attribute: str, k: int) -> Callable[[Any], InversionPolicy]:
 
     def factory(env: Any) -> InversionPolicy:
         return from_file(env, RESULTS / f"{student.prefix}-s{k}.pt", name=f"{student.label}-s{k}", lead=student.lead,
-                         span=student.span, law=own_law(student.bandwidth))
+                         span=student.span, law=own_law(student.bandwidth), average=student.average)
     factory.__name__ = f"{attribute}s{k}"
     factory.kind = "learned"                          # the headline's column (lvgym.benchmark.headline)
     return factory
 
 
+def shipped_avg6_lead3(env: Any) -> InversionPolicy:
+    """The shipped ``inversion-id``'s observer (``agents/trained``) flown with its moment averaged over 6 steps
+    and carried 3 ahead (validation seeds only: tried on 2026-12-07, not shipped)."""
+    return from_file(env, TRAINED / f"{SHIPPED}.npz", name="inversion-id-avg6-lead3", lead=3, average=6)
+
+
+shipped_avg6_lead3.kind = "learned"  # type: ignore[attr-defined]
 FACTORIES = {f"{attribute}s{k}": seeded(attribute, k) for attribute in STUDENTS for k in SEEDS}
 globals().update(FACTORIES)                           # evaluate.py --policies experiments.fault_id.inversion:s0
 
 __all__ = ["A_MAX", "ERRORS", "FACTORIES", "NO_THRUST", "STUDENTS", "TERMS", "InversionPolicy", "Student", "command",
-           "error_index", "gains", "law_terms", "seeded", *FACTORIES]
+           "error_index", "gains", "law_terms", "seeded", "shipped_avg6_lead3", *FACTORIES]
