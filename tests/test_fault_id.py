@@ -339,7 +339,6 @@ def test_the_law_gains_study_flies_the_causal_teacher_and_refuses_a_bad_variant(
             variant(bad)
 
 
-
 def test_one_kind_of_fault_flies_validation_seeds_with_that_kind_only(capsys):
     """Every flight draws the one kind asked (``thrust``: no axis); the printed count is the lost flights';
     a range that ends before it starts is refused by name."""
