@@ -57,10 +57,10 @@ def test_the_student_in_a_batch_flies_as_the_benchmark_flies_it():
     last bits, so the scores are compared to 1e-6)."""
     torch.manual_seed(0)
     short = {"mission_time_s": 3.0}
-    x, y, _ = fly("rigid", [0, 1], None, np.random.default_rng(0), **short)
+    x, y, _, _ = fly("rigid", [0, 1], None, np.random.default_rng(0), **short)
     assert x.shape[1:] == (WINDOW, FEATURES) and y.shape == (len(x), 2)
     est = fit(x, y, seed=0, epochs=1)
-    _, _, batch = fly("rigid", [5, 6], est, deadband=0.04, **short)
+    _, _, batch, _ = fly("rigid", [5, 6], est, deadband=0.04, **short)
     env = condition("rigid", **short).make_env()
     for seed, rec in zip([5, 6], batch):
         single = play_episode(FaultIdPolicy(env, est, deadband=0.04), env, seed, flyability=True)
@@ -77,7 +77,7 @@ def test_the_inversion_teacher_is_the_reference_on_the_observation(monkeypatch, 
     from experiments.fault_id.privileges import reference
     monkeypatch.setattr(train, "NOISE", (0.0,))
     short = {"mission_time_s": 4.0}
-    _, y, batch = fly("nonrigid", [3, 4], None, np.random.default_rng(0), scheme="inversion",
+    _, y, batch, _ = fly("nonrigid", [3, 4], None, np.random.default_rng(0), scheme="inversion",
                       law=train.own_law(bandwidth), **short)
     assert y.shape[1] == 7 and np.any(y[:, 4] > 0.0)
     env = condition("nonrigid", privileged_info=True, **short).make_env()
@@ -92,10 +92,10 @@ def test_the_inversion_student_in_a_batch_flies_as_the_benchmark_flies_it():
     from lvgym.agents.observer_fit import to_observer
     torch.manual_seed(0)
     short = {"mission_time_s": 3.0}
-    x, y, _ = fly("rigid", [0, 1], None, np.random.default_rng(0), scheme="inversion", **short)
+    x, y, _, _ = fly("rigid", [0, 1], None, np.random.default_rng(0), scheme="inversion", **short)
     est = fit(x, y, seed=0, epochs=1, scaled=True)
     assert est.label_std.shape == (7,)
-    _, _, batch = fly("rigid", [5, 6], est, scheme="inversion", **short)
+    _, _, batch, _ = fly("rigid", [5, 6], est, scheme="inversion", **short)
     env = condition("rigid", **short).make_env()
     for seed, rec in zip([5, 6], batch):
         single = play_episode(InversionPolicy(env, to_observer(est)), env, seed, flyability=True)
@@ -109,8 +109,8 @@ def test_a_loop_gain_labels_the_terms_as_the_action_must_carry_them(monkeypatch)
     monkeypatch.setattr(train, "NOISE", (0.0,))
     short = {"mission_time_s": 3.0}
     gain = np.array([2.0, 0.5])
-    _, y1, r1 = fly("rigid", [7, 8], None, np.random.default_rng(0), scheme="inversion", **short)
-    _, y2, r2 = fly("rigid", [7, 8], None, np.random.default_rng(0), scheme="inversion", loop_gain=gain, **short)
+    _, y1, r1, _ = fly("rigid", [7, 8], None, np.random.default_rng(0), scheme="inversion", **short)
+    _, y2, r2, _ = fly("rigid", [7, 8], None, np.random.default_rng(0), scheme="inversion", loop_gain=gain, **short)
     assert y1.shape == y2.shape
     rows = np.resize([0, 1], len(y1))                 # the steps interleave the two rows while both fly
     np.testing.assert_allclose(y2[:, :6] * gain[rows][:, None], y1[:, :6], rtol=1e-4, atol=1e-6)
@@ -124,7 +124,7 @@ def test_the_inversion_teacher_flies_a_family_vehicle_and_the_thrust_scheme_refu
     from experiments.fault_id.train import main
     from lvgym.benchmark.suites import FAMILY_VALIDATION_VEHICLES
     v = FAMILY_VALIDATION_VEHICLES[0]
-    _, y, recs = fly("nonrigid", [0, 1], None, np.random.default_rng(0), scheme="inversion", suite="family-v2",
+    _, y, recs, _ = fly("nonrigid", [0, 1], None, np.random.default_rng(0), scheme="inversion", suite="family-v2",
                      vehicle=v, mission_time_s=3.0)
     assert y.shape[1] == 7 and np.any(y[:, 4] > 0.0) and len(recs) == 2
     assert condition("nonrigid", "family-v2", vehicle=v).make_env().unwrapped.func.spec.vehicle != "smile_v1"
@@ -350,3 +350,78 @@ def test_one_kind_of_fault_flies_validation_seeds_with_that_kind_only(capsys):
     assert f"failed or unflyable {sum(lost(r) for r in records)}" in printed and "seeds 3-4" in printed
     with pytest.raises(ConfigError, match="--last"):
         main(["--first", "5", "--last", "5"])
+
+
+def test_the_steps_since_ignition_count_from_the_controllers_return_after_a_coast():
+    """``Ignition`` by hand: -1 until ``controller_on`` comes back after it fell once the controller had acted
+    (row 0: on at step 2, the coast at 4-5, ignition at 6), then 0, 1, ...; a row that never coasts (row 1)
+    stays -1, whichever rows a step pushes."""
+    from experiments.fault_id.train import Ignition
+
+    on = np.array([[0, 0, 1, 1, 0, 0, 1, 1, 0], [0, 1, 1, 1, 1, 1, 1, 1, 1]], dtype=float)
+    lit, got = Ignition(2, on=3), []
+    for k in range(on.shape[1]):
+        rows = np.array([0]) if k == 7 else np.array([0, 1])      # row 1 sits a step out: nothing moves it
+        obs = np.zeros((len(rows), 5))
+        obs[:, 3] = on[rows, k]
+        got.append(dict(zip(rows.tolist(), lit.push(rows, obs).tolist())))
+    assert [g[0] for g in got] == [-1, -1, -1, -1, -1, -1, 0, 1, 2]
+    assert [g.get(1) for g in got] == [-1] * 7 + [None, -1]
+
+
+def test_the_rounds_weights_grow_with_their_data_and_weigh_the_fits_mean_error(capsys):
+    """The weights appended beside the windows (1 where none are given; None, the plain mean, when all are
+    1), and a fit's first epoch in one batch reports the weighted mean of the initial network's errors:
+    sum(w mean_j e_j^2) / sum(w), the network drawn from the same seed."""
+    from experiments.fault_id.train import Data
+    from lvgym.agents.observer_fit import Estimator
+
+    rng = np.random.default_rng(1)
+    x = rng.normal(size=(40, WINDOW, FEATURES)).astype(np.float32)
+    y = rng.normal(size=(40, 3)).astype(np.float32)
+    data = Data()
+    data.add(x[:10], y[:10])
+    assert data.weights() is None
+    data.add(x[10:], y[10:], np.where(np.arange(30) < 5, 10.0, 1.0))
+    w = data.weights()
+    assert w.dtype == np.float32 and np.array_equal(w, np.r_[np.ones(10), np.full(5, 10.0), np.ones(25)])
+    capsys.readouterr()
+    fit(*data.view(), seed=3, epochs=1, scaled=True, weight=w)
+    reported = float(capsys.readouterr().out.split("mean squared error ")[1].split()[0])
+    torch.manual_seed(3)
+    flat = x.reshape(-1, FEATURES)
+    from experiments.fault_id.train import row_std
+    first = Estimator(flat.mean(0), row_std(flat, flat.mean(0)) + 1e-6, outputs=3, label_mean=y.mean(0),
+                      label_std=y.std(0) + 1e-6)
+    with torch.no_grad():
+        e = (((first(torch.as_tensor(x)) - torch.as_tensor(y)) / first.label_std) ** 2).mean(1).numpy()
+    assert reported == pytest.approx(float((e * w).sum() / w.sum()), rel=1e-3)
+    assert reported != pytest.approx(float(e.mean()), rel=1e-2)
+
+
+def test_the_ignition_weight_names_the_runs_files_and_weighs_the_windows_after_ignition(monkeypatch, tmp_path):
+    """``--ignition-weight 10 --ignition-s 1``: the windows fewer than 1 s after the next stage's ignition
+    (the flights' times since it, here every other step 0.5 s after, the rest before) weigh 10 in the fit;
+    the files end ``-ign10``."""
+    from experiments.fault_id import train
+
+    real, seen = train.fly, []
+
+    def fly_short(*a, **k):
+        x, y, r, _ = real(*a, mission_time_s=2.0, **k)
+        return x, y, r, np.where(np.arange(len(x)) % 2 == 1, 0.5, -1.0)
+
+    def fit_seen(x, y, seed, epochs, scaled=False, weight=None):
+        seen.append(weight.copy())
+        return real_fit(x, y, seed, epochs, scaled, weight)
+
+    real_fit = train.fit
+    monkeypatch.setattr(train, "fly", fly_short)
+    monkeypatch.setattr(train, "fit", fit_seen)
+    monkeypatch.setattr(train, "RESULTS", tmp_path)
+    train.main(["--scheme", "inversion", "--suite", "smile-v2", "--flights", "10", "--rounds", "0", "--epochs", "1",
+                "--validation", "0", "--ignition-weight", "10", "--ignition-s", "1"])
+    assert (tmp_path / "inversion-smile-v2-ign10-s0.pt").is_file()
+    (w,) = seen
+    per_batch = np.where(np.arange(len(w) // 2) % 2 == 1, 10.0, 1.0)       # two batches (rigid, non-rigid)
+    assert np.array_equal(w, np.r_[per_batch, per_batch])

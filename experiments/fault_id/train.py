@@ -21,7 +21,8 @@
      action sent last holds the label, and the student reads it back from its own action); label: the true
      terms.
 2. **Regression.** :class:`lvgym.agents.observer_fit.Estimator` fitted by mean squared error (Adam, ``--epochs``; the
-   inversion's labels standardised).
+   inversion's labels standardised; ``--ignition-weight``: the windows of the first ``--ignition-s`` after the
+   next stage's ignition weigh more, :class:`Ignition`).
 3. **DAgger rounds** (``--rounds``): the student flies half as many flights again, labelled the same way,
    added to the data, and the estimator is fitted again. The thrust scheme's policy is the last fit; the
    inversion's the mean of the last three fits (:class:`lvgym.agents.observer_fit.Ensemble`).
@@ -157,11 +158,12 @@ def fly(model: str, seeds: Sequence[int], estimator: Estimator | Ensemble | None
         rng: np.random.Generator | None = None, deadband: float = 0.0, scheme: str = "thrust",
         loop_gain: np.ndarray | None = None, suite: str = SUITE, ahead: int = 0, extrapolated: int = 0,
         lead: int = 0, law: dict[str, Any] | None = None, **options: Any
-        ) -> tuple[np.ndarray, np.ndarray, list[dict]]:
+        ) -> tuple[np.ndarray, np.ndarray, list[dict], np.ndarray]:
     """Fly the rows seeded ``seeds`` of the batched env of ``model`` with ``scheme``'s law (:data:`SCHEMES`) on
     the truth (``estimator`` None: the teacher; ``rng`` draws its delays) or on the ``estimator``'s output (the
     student; ``deadband``: the thrust scheme's). Returns the windows ``(steps, WINDOW, FEATURES)``, their
-    labels ``(steps, outputs)`` and the flights' records (protocol v2's fields); ``loop_gain``: per row, a gain
+    labels ``(steps, outputs)``, the flights' records (protocol v2's fields) and each window's time [s] since
+    the next stage's ignition (:class:`Ignition`; -1 before it); ``loop_gain``: per row, a gain
     on the action after the flight computer sent it (the margins' perturbation, a training device; the
     inversion scheme only); ``suite``: whose condition (a family's with ``vehicle=`` in ``options``);
     ``ahead``: the inversion's moment label that many control periods ahead (its teacher flies on it);
@@ -181,7 +183,8 @@ def fly(model: str, seeds: Sequence[int], estimator: Estimator | Ensemble | None
                             lead, law)
     gain = np.ones((n, 1)) if loop_gain is None else np.asarray(loop_gain, dtype=float)[:, None]
     window, log = Window(n), RowsLog(env)
-    xs, ys = [], []
+    lit = Ignition(n, list(env1.unwrapped.func.observation_layout.names).index("controller_on"))
+    xs, ys, since = [], [], []
     done = np.zeros(n, dtype=bool)
     while not done.all():
         live = np.flatnonzero(~done)
@@ -189,6 +192,7 @@ def fly(model: str, seeds: Sequence[int], estimator: Estimator | Ensemble | None
         w = window.push(live, obs[live])
         xs.append(w.copy())
         ys.append(truth[live].astype(np.float32))
+        since.append(lit.push(live, obs[live]))
         estimate = None
         if estimator is not None:
             with torch.no_grad():
@@ -203,17 +207,41 @@ def fly(model: str, seeds: Sequence[int], estimator: Estimator | Ensemble | None
         log.end(ended, info)
         done[ended] = True
     env.close()
-    return np.concatenate(xs), np.concatenate(ys), log.records(True)
+    steps = np.concatenate(since)
+    dt = float(env1.unwrapped.func.spec.timing.control_dt_s)
+    return np.concatenate(xs), np.concatenate(ys), log.records(True), np.where(steps >= 0, steps * dt, -1.0)
+
+
+class Ignition:
+    """Per row of a flight's batch, the control steps since the next stage's ignition: the observation's
+    ``controller_on`` (at index ``on``) back to 1 after it fell to 0 once the controller had acted (the
+    staging coast); -1 before (a flight without a coast: throughout)."""
+
+    def __init__(self, n: int, on: int) -> None:
+        self.on = on
+        self.acted = np.zeros(n, dtype=bool)          # the controller has acted
+        self.coast = np.zeros(n, dtype=bool)          # ... and stopped since
+        self.since = np.full(n, -1, dtype=np.int64)
+
+    def push(self, rows: np.ndarray, observations: np.ndarray) -> np.ndarray:
+        """The step's observations of ``rows`` in; their steps since ignition (0: the first step it acts again)."""
+        now = np.asarray(observations)[:, self.on] > 0.5
+        lit = self.since[rows] >= 0
+        self.since[rows] = np.where(lit, self.since[rows] + 1, np.where(self.coast[rows] & now, 0, -1))
+        self.coast[rows] |= self.acted[rows] & ~now
+        self.acted[rows] |= now
+        return self.since[rows].copy()
 
 
 class Data:
-    """The windows and labels of every round, in one array each that grows in place: the fits see a contiguous
-    view, the same numbers as the rounds' arrays concatenated, without a second copy (a round's data of the
-    longer missions is gigabytes, and two runs share the machine)."""
+    """The windows, labels and weights of every round, in one array each that grows in place: the fits see a
+    contiguous view, the same numbers as the rounds' arrays concatenated, without a second copy (a round's
+    data of the longer missions is gigabytes, and two runs share the machine)."""
 
     def __init__(self) -> None:
         self.x: np.ndarray | None = None
         self.y: np.ndarray | None = None
+        self.w: np.ndarray | None = None
         self.n = 0
 
     def __len__(self) -> int:
@@ -224,22 +252,30 @@ class Data:
         if self.x is not None and capacity > len(self.x):
             x = np.empty((capacity, *self.x.shape[1:]), dtype=self.x.dtype)
             y = np.empty((capacity, *self.y.shape[1:]), dtype=self.y.dtype)
-            x[:self.n], y[:self.n] = self.x[:self.n], self.y[:self.n]
-            self.x, self.y = x, y
+            w = np.empty(capacity, dtype=np.float32)
+            x[:self.n], y[:self.n], w[:self.n] = self.x[:self.n], self.y[:self.n], self.w[:self.n]
+            self.x, self.y, self.w = x, y, w
 
-    def add(self, x: np.ndarray, y: np.ndarray) -> None:
-        """Append a flight batch's windows ``x`` and labels ``y``."""
+    def add(self, x: np.ndarray, y: np.ndarray, w: np.ndarray | None = None) -> None:
+        """Append a flight batch's windows ``x``, labels ``y`` and their weights in the fit ``w`` (None: 1)."""
         if self.x is None:
             self.x = np.empty((0, *x.shape[1:]), dtype=x.dtype)
             self.y = np.empty((0, *y.shape[1:]), dtype=y.dtype)
+            self.w = np.empty(0, dtype=np.float32)
         if self.n + len(x) > len(self.x):
             self.reserve(max(self.n + len(x), len(self.x) + len(self.x) // 4))
         self.x[self.n:self.n + len(x)], self.y[self.n:self.n + len(y)] = x, y
+        self.w[self.n:self.n + len(x)] = 1.0 if w is None else w
         self.n += len(x)
 
     def view(self) -> tuple[np.ndarray, np.ndarray]:
         """The windows and labels so far (views, not copies)."""
         return self.x[:self.n], self.y[:self.n]
+
+    def weights(self) -> np.ndarray | None:
+        """The windows' weights so far (a view), or None when every weight is 1 (the fit's plain mean)."""
+        w = self.w[:self.n]
+        return None if np.all(w == 1.0) else w
 
 
 def own_law(bandwidth: float) -> dict[str, list[float]] | None:
@@ -262,9 +298,11 @@ def row_std(flat: np.ndarray, mean: np.ndarray, rows: int = 1 << 16) -> np.ndarr
     return np.sqrt(np.true_divide(total, len(flat)))
 
 
-def fit(x: np.ndarray, y: np.ndarray, seed: int, epochs: int, scaled: bool = False) -> Estimator:
+def fit(x: np.ndarray, y: np.ndarray, seed: int, epochs: int, scaled: bool = False,
+        weight: np.ndarray | None = None) -> Estimator:
     """The estimator fitted to windows ``x`` and labels ``y`` (torch seeded with ``seed``; ``scaled``: the
-    labels standardised, each weighing the same in the error)."""
+    labels standardised, each weighing the same in the error; ``weight``: each window's weight in a batch's
+    mean error, None: all the same)."""
     torch.manual_seed(seed)
     flat = x.reshape(-1, x.shape[-1])
     mean = flat.mean(0)
@@ -272,12 +310,14 @@ def fit(x: np.ndarray, y: np.ndarray, seed: int, epochs: int, scaled: bool = Fal
                     label_mean=y.mean(0) if scaled else None, label_std=y.std(0) + 1e-6 if scaled else None)
     opt = torch.optim.Adam(est.parameters(), 1e-3)
     xt, yt = torch.as_tensor(x), torch.as_tensor(y)
+    wt = None if weight is None else torch.as_tensor(np.asarray(weight, dtype=np.float32))
     g = torch.Generator().manual_seed(seed)
     for epoch in range(epochs):
         perm, total = torch.randperm(len(xt), generator=g), 0.0
         for i in range(0, len(xt), 1024):
             b = perm[i:i + 1024]
-            loss = (((est(xt[b]) - yt[b]) / est.label_std) ** 2).mean()
+            error = ((est(xt[b]) - yt[b]) / est.label_std) ** 2
+            loss = error.mean() if wt is None else (error.mean(1) * wt[b]).sum() / wt[b].sum()
             opt.zero_grad()
             loss.backward()
             opt.step()
@@ -360,6 +400,12 @@ class Args:
     bandwidth: float = arg(0.0, lo=0.0, hi=10.0)
     """the inversion's law's bandwidth [rad/s] on the non-rigid vehicle, its damping the reference's (0: the
     reference's gains, :data:`lvgym.baselines.privileged.GAINS`); files ``...-w<bandwidth>``"""
+    ignition_weight: float = arg(1.0, lo=1.0, hi=100.0)
+    """the weight in the fits of the windows of the first ``--ignition-s`` after the next stage's ignition
+    (:class:`Ignition`: the law's terms change at once after a coast of ten seconds; 1: all weigh the same);
+    files ``...-ign<weight>``"""
+    ignition_s: float = arg(2.0, lo=0.02, hi=20.0)
+    """how long after the next stage's ignition ``--ignition-weight`` holds [s]"""
     tag: str = arg("")
     """a label ending the files' prefix (a run of other ``--flights`` or ``--epochs`` beside the first)"""
     family_vehicles: int = arg(16, lo=1, hi=200)
@@ -394,6 +440,7 @@ def main(argv: Sequence[str] | None = None) -> None:
     prefix = (SCHEMES[a.scheme].prefix + where + (f"-ahead{a.ahead}" if a.ahead else "")
               + (f"-extrapolated{a.extrapolated}" if a.extrapolated else "") + (f"-lead{a.lead}" if a.lead else "")
               + (f"-w{a.bandwidth:g}" if a.bandwidth else "") + (f"-{a.tag}" if a.tag else "")
+              + (f"-ign{a.ignition_weight:g}" if a.ignition_weight != 1.0 else "")
               + (f"-gain{a.loop_gain_db:g}" if a.loop_gain_db else ""))
     law = own_law(a.bandwidth)
     data = Data()
@@ -412,9 +459,9 @@ def main(argv: Sequence[str] | None = None) -> None:
                     gain = (10.0 ** (rng.uniform(-a.loop_gain_db, a.loop_gain_db, len(seeds)) / 20.0)
                             if a.loop_gain_db else None)
                     place = {"suite": a.suite, **({"vehicle": vehicle} if family else {})}
-                    x, y, _ = fly(model, seeds, est, rng, scheme=a.scheme, loop_gain=gain, ahead=a.ahead,
-                                    extrapolated=a.extrapolated, lead=a.lead, law=law, **place)
-                    data.add(x, y)
+                    x, y, _, since = fly(model, seeds, est, rng, scheme=a.scheme, loop_gain=gain,
+                                         ahead=a.ahead, extrapolated=a.extrapolated, lead=a.lead, law=law, **place)
+                    data.add(x, y, np.where((since >= 0) & (since < a.ignition_s), a.ignition_weight, 1.0))
             if rnd == 0:                              # room for the rounds to come (each flies half the flights
                 data.reserve(len(data) * (4 + 3 * a.rounds) // 4)       # of round 0, their steps up to 3/4)
         print(f"seed {a.seed} round {rnd}: {len(data)} steps of data at {time.time() - t0:.0f} s", flush=True)
@@ -424,7 +471,7 @@ def main(argv: Sequence[str] | None = None) -> None:
             fits.append(est)
             print(f"seed {a.seed} round {rnd}: loaded {done}", flush=True)
             continue
-        est = fit(*data.view(), a.seed, a.epochs, SCHEMES[a.scheme].scaled)
+        est = fit(*data.view(), a.seed, a.epochs, SCHEMES[a.scheme].scaled, data.weights())
         fits.append(est)
         save(est, done)
         if a.validation:
