@@ -245,6 +245,10 @@ def test_a_configuration_of_the_study_is_a_row_of_factories_and_a_label_to_compa
          tmp_path / "inversion-gain6-s2.pt")
     faults = inversion.gain6_avg6_lead3_s2(condition("nonrigid", mission_time_s=2.0).make_env())
     assert (faults.name, faults.lead, faults.average) == ("inversion-id-gain6-avg6-lead3-s2", 3, 6)
+    save(Ensemble([Estimator(rng.normal(0.0, 0.1, FEATURES), np.ones(FEATURES), hidden=8, outputs=7)]),
+         tmp_path / "inversion-ign10-gain6-s0.pt")
+    staged = inversion.gain6_ign10_s0(condition("nonrigid", mission_time_s=2.0).make_env())
+    assert (staged.name, staged.lead, staged.average) == ("inversion-id-gain6-ign10-s0", 0, 1)
     assert configurations()[0] == "lqg-thrust-id" and len(set(configurations())) == len(configurations())
 
 

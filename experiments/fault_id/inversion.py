@@ -50,6 +50,9 @@ STUDENTS = {
     # ... the same runs flown with their moment averaged over 6 steps (the observer's 8 Hz limit cycle on a gyro
     # bias step) and carried 3 steps ahead: chosen on validation seeds after training, not trained with
     "gain6_avg6_lead3_": Student("inversion-gain6", "inversion-id-gain6-avg6-lead3", lead=3, average=6),
+    # ... trained with the windows of the first 2 s after the next stage's ignition weighing 10 in the fits
+    # (--ignition-weight 10: the staging coast's failures)
+    "gain6_ign10_": Student("inversion-ign10-gain6", "inversion-id-gain6-ign10"),
     # Stratos III's student of the present moment as trained, and with its moment carried 5 steps ahead along
     # its last 5 or 15 steps (evaluate.py --seed-set validation only)
     "stratos_": Student("inversion-stratos-tvc-v2", "inversion-stratos"),
