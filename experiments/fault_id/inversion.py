@@ -53,6 +53,8 @@ STUDENTS = {
     # ... trained with the windows of the first 2 s after the next stage's ignition weighing 10 in the fits
     # (--ignition-weight 10: the staging coast's failures)
     "gain6_ign10_": Student("inversion-ign10-gain6", "inversion-id-gain6-ign10"),
+    "gain6_ign10_avg6_lead3_": Student("inversion-ign10-gain6", "inversion-id-gain6-ign10-avg6-lead3", lead=3,
+                                       average=6),
     # Stratos III's student of the present moment as trained, and with its moment carried 5 steps ahead along
     # its last 5 or 15 steps (evaluate.py --seed-set validation only)
     "stratos_": Student("inversion-stratos-tvc-v2", "inversion-stratos"),
