@@ -255,7 +255,7 @@ def test_a_configuration_of_the_study_is_a_row_of_factories_and_a_label_to_compa
 def test_the_rounds_data_grows_in_place_as_their_concatenation():
     """Batches of windows appended (past the room reserved, then grown by a quarter) read as the batches
     concatenated, as views of one array."""
-    from experiments.fault_id.train import Data
+    from experiments.fault_id.fitting import Data
 
     rng = np.random.default_rng(0)
     xs = [rng.normal(size=(n, 3, 2)).astype(np.float32) for n in (5, 7, 2, 9)]
@@ -318,7 +318,7 @@ def test_the_bandwidth_names_the_runs_files_and_the_thrust_scheme_refuses_it(mon
 @pytest.mark.parametrize(("n", "rows"), [(1, 4), (37, 5), (1000, 64), (20_001, 1 << 16)])
 def test_the_fits_standard_deviation_is_numpys_to_the_bit(n, rows):
     """``row_std`` (chunks of ``rows`` rows, no temporary of the whole data) is ``std(0)`` bit for bit."""
-    from experiments.fault_id.train import row_std
+    from experiments.fault_id.fitting import row_std
     flat = np.random.default_rng(n).normal(3.0, 2.0, (n, 16)).astype(np.float32)
     assert np.array_equal(row_std(flat, flat.mean(0), rows), flat.std(0))
 
@@ -377,7 +377,7 @@ def test_the_rounds_weights_grow_with_their_data_and_weigh_the_fits_mean_error(c
     """The weights appended beside the windows (1 where none are given; None, the plain mean, when all are
     1), and a fit's first epoch in one batch reports the weighted mean of the initial network's errors:
     sum(w mean_j e_j^2) / sum(w), the network drawn from the same seed."""
-    from experiments.fault_id.train import Data
+    from experiments.fault_id.fitting import Data
     from lvgym.agents.observer_fit import Estimator
 
     rng = np.random.default_rng(1)
@@ -394,7 +394,7 @@ def test_the_rounds_weights_grow_with_their_data_and_weigh_the_fits_mean_error(c
     reported = float(capsys.readouterr().out.split("mean squared error ")[1].split()[0])
     torch.manual_seed(3)
     flat = x.reshape(-1, FEATURES)
-    from experiments.fault_id.train import row_std
+    from experiments.fault_id.fitting import row_std
     first = Estimator(flat.mean(0), row_std(flat, flat.mean(0)) + 1e-6, outputs=3, label_mean=y.mean(0),
                       label_std=y.std(0) + 1e-6)
     with torch.no_grad():
@@ -429,3 +429,33 @@ def test_the_ignition_weight_names_the_runs_files_and_weighs_the_windows_after_i
     (w,) = seen
     per_batch = np.where(np.arange(len(w) // 2) % 2 == 1, 10.0, 1.0)       # two batches (rigid, non-rigid)
     assert np.array_equal(w, np.r_[per_batch, per_batch])
+
+
+def test_the_teachers_upset_cancels_a_drawn_share_of_the_moment_for_a_drawn_while_after_ignition(monkeypatch):
+    """``upset=1``: every teacher flight draws a share of the aerodynamic moment in ``UPSET_GAIN`` and a
+    duration in ``UPSET_S``; within it after ignition its action is the law on the moment times that share,
+    before ignition (-1) and after it the law on the truth (without exploration noise); a student is never
+    upset, and the thrust scheme refuses it."""
+    from experiments.fault_id import train
+    from lvgym.agents.inversion import command, error_index, gains
+
+    monkeypatch.setattr(train, "NOISE", (0.0,))
+    env1 = condition("nonrigid", privileged_info=True, mission_time_s=2.0).make_env()
+    pilot = train.InversionScheme(env1, 3, np.random.default_rng(4), 0.0, upset=1.0)
+    assert np.all((pilot.upset_gain >= 0.3) & (pilot.upset_gain <= 0.8))
+    assert np.all((pilot.upset_s >= 0.5) & (pilot.upset_s <= 2.0))
+    truth = np.random.default_rng(5).uniform(0.1, 0.5, (3, 7))
+    pilot.truth = truth.copy()
+    obs = np.random.default_rng(6).normal(0.0, 0.01, (3, 14))
+    since = np.array([0.2, -1.0, pilot.upset_s[2] + 0.02])
+    got = pilot.act(np.arange(3), obs, {}, None, since)
+    upset = truth.copy()
+    upset[0, 0:2] *= pilot.upset_gain[0]
+    w, z = gains(env1)
+    want = np.clip(command(obs, np.r_[upset[:1], truth[1:]], error_index(env1), w, z), -1.0, 1.0)
+    np.testing.assert_allclose(got, want, rtol=1e-6)
+    assert np.all(train.InversionScheme(env1, 3, None, 0.0, upset=1.0).upset_gain == 1.0)
+    with pytest.raises(ValueError, match="upset"):
+        fly("rigid", [7], None, np.random.default_rng(0), upset=0.5, mission_time_s=1.0)
+    with pytest.raises(ConfigError, match="--upset"):
+        train.main(["--upset", "0.5"])

@@ -31,8 +31,8 @@ After each fit the student flies validation seeds ``0 .. --validation - 1`` of b
 mean ``score_v2`` and its failed or unflyable flights are printed (``lqg``: 0.994 (6) rigid, 1.109 (7)
 non-rigid on seeds 0-99; ``lqg`` with the true misalignment 0.778 (2), 0.900 (2): README.md). A run's memory
 is its data (float32 windows, 1.6 kB per step; the fit's standard deviation is taken in chunks of rows,
-:func:`row_std`): SMILE's ``--flights 200 --rounds 4`` reach 3.9 M steps, 6.3 GB, and about 7 GB per process
-at round 3; three such runs at once outgrow 24 GB in round 4.
+:func:`.fitting.row_std`): SMILE's ``--flights 200 --rounds 4`` reach 3.9 M steps, 6.3 GB, and about 7 GB per
+process at round 3; three such runs at once outgrow 24 GB in round 4.
 """
 
 from __future__ import annotations
@@ -51,6 +51,7 @@ from lvgym.agents.observer_fit import Ensemble, Estimator, load, save
 from lvgym.cli.args import arg, parse
 
 from .estimator import RESULTS, base_lqg, corrected
+from .fitting import Data, fit
 
 #: the teacher's delays [control steps] of its knowledge of the misalignment (0-2 s at 0.02 s; the last: never)
 DELAYS = (0, 12, 25, 50, 100, None)
@@ -75,7 +76,7 @@ class ThrustScheme:
 
     def __init__(self, env1: Any, n: int, rng: np.random.Generator | None, deadband: float,
                  loop_gain: np.ndarray | None = None, ahead: int = 0, extrapolated: int = 0, lead: int = 0,
-                 law: dict[str, Any] | None = None) -> None:
+                 law: dict[str, Any] | None = None, upset: float = 0.0) -> None:
         from lvgym.benchmark.batch import as_batch
 
         self.limit, self.n, self.deadband = float(env1.unwrapped.func.gimbal_limit), n, deadband
@@ -90,7 +91,8 @@ class ThrustScheme:
                           / self.limit)
         return self.truth[-1]
 
-    def act(self, live: np.ndarray, obs: np.ndarray, info: dict[str, Any], estimate: np.ndarray | None) -> np.ndarray:
+    def act(self, live: np.ndarray, obs: np.ndarray, info: dict[str, Any], estimate: np.ndarray | None,
+            since: np.ndarray) -> np.ndarray:
         base = np.asarray(self.lqg.act(live, obs, info), dtype=np.float64)
         if estimate is None:                             # the teacher: the truth, late
             step = len(self.truth) - 1
@@ -107,13 +109,16 @@ class InversionScheme:
     slope learned from the window instead of differenced from the student's own estimates); ``lead``: the law
     flies the moment terms carried that many periods along their slope (:class:`lvgym.agents.inversion.Lead`:
     the teacher's of the truth, the student's of its estimates), the labels stay; ``law``: the law's gains per
-    flight model where they are not the reference's (:func:`lvgym.agents.inversion.gains`)."""
+    flight model where they are not the reference's (:func:`lvgym.agents.inversion.gains`); ``upset``: the
+    share of the teacher's flights that, after the next stage's ignition, cancel only a part of the
+    aerodynamic moment (a gain drawn from :data:`UPSET_GAIN`) for a while (drawn from :data:`UPSET_S`), then
+    fly it out on the truth: flights through the large moments a late estimate meets there, labelled."""
 
     prefix, outputs, scaled, ensemble = "inversion", len(TERMS), True, 3
 
     def __init__(self, env1: Any, n: int, rng: np.random.Generator | None, deadband: float,
                  loop_gain: np.ndarray | None = None, ahead: int = 0, extrapolated: int = 0, lead: int = 0,
-                 law: dict[str, Any] | None = None) -> None:
+                 law: dict[str, Any] | None = None, upset: float = 0.0) -> None:
         self.limit, self.n, self.ahead = float(env1.unwrapped.func.gimbal_limit), n, int(ahead)
         self.label_lead = Lead(n, extrapolated)               # the label's, on the true moment
         self.lead = Lead(n, lead)                              # the law's, on the truth or the estimate
@@ -125,6 +130,11 @@ class InversionScheme:
         self.rng = rng                                   # the teacher's: its exploration
         self.sigma = None if rng is None else np.asarray(NOISE)[rng.integers(0, len(NOISE), n)][:, None]
         self.noise = np.zeros((n, 2))
+        self.upset_gain, self.upset_s = np.ones(n), np.zeros(n)      # none: the whole moment, never
+        if upset and rng is not None:
+            hit = rng.random(n) < upset
+            self.upset_gain[hit] = rng.uniform(*UPSET_GAIN, n)[hit]
+            self.upset_s[hit] = rng.uniform(*UPSET_S, n)[hit]
 
     def labels(self, info: dict[str, Any]) -> np.ndarray:
         self.truth = law_terms(info, self.n, self.limit, self.ahead)
@@ -133,11 +143,15 @@ class InversionScheme:
         self.truth[:, :6] *= self.per_gain
         return self.truth
 
-    def act(self, live: np.ndarray, obs: np.ndarray, info: dict[str, Any], estimate: np.ndarray | None) -> np.ndarray:
+    def act(self, live: np.ndarray, obs: np.ndarray, info: dict[str, Any], estimate: np.ndarray | None,
+            since: np.ndarray) -> np.ndarray:
+        """The rows ``live``'s actions; ``since``: their time since the next stage's ignition [s] (-1 before)."""
         terms = (self.truth[live] if estimate is None else estimate).copy()
         terms[:, 0:2] = self.lead.push(live, terms[:, 0:2])
         if estimate is not None:
             return command(obs, terms, self.index, self.w, self.z)
+        upset = (since >= 0.0) & (since < self.upset_s[live])
+        terms[upset, 0:2] *= self.upset_gain[live][upset][:, None]
         # the teacher's action with a slowly varying exploration: without it the action sent last holds the
         # label (it is ``a alpha - f``), and a student reads ``f`` back from its own action
         self.noise[live] = (NOISE_PHI * self.noise[live] + np.sqrt(1.0 - NOISE_PHI ** 2) * self.sigma[live]
@@ -150,6 +164,10 @@ class InversionScheme:
 #: step-to-step correlation of the noise (a time constant of 0.2 s at 0.02 s)
 NOISE = (0.0, 0.05, 0.1)
 NOISE_PHI = float(np.exp(-0.1))
+#: the inversion teacher's upsets after the next stage's ignition (``upset``): the share of the aerodynamic
+#: moment it cancels and for how long [s], each drawn uniformly per flight
+UPSET_GAIN = (0.3, 0.8)
+UPSET_S = (0.5, 2.0)
 #: the students by name (``--scheme``)
 SCHEMES = {"thrust": ThrustScheme, "inversion": InversionScheme}
 
@@ -157,7 +175,7 @@ SCHEMES = {"thrust": ThrustScheme, "inversion": InversionScheme}
 def fly(model: str, seeds: Sequence[int], estimator: Estimator | Ensemble | None = None,
         rng: np.random.Generator | None = None, deadband: float = 0.0, scheme: str = "thrust",
         loop_gain: np.ndarray | None = None, suite: str = SUITE, ahead: int = 0, extrapolated: int = 0,
-        lead: int = 0, law: dict[str, Any] | None = None, **options: Any
+        lead: int = 0, law: dict[str, Any] | None = None, upset: float = 0.0, **options: Any
         ) -> tuple[np.ndarray, np.ndarray, list[dict], np.ndarray]:
     """Fly the rows seeded ``seeds`` of the batched env of ``model`` with ``scheme``'s law (:data:`SCHEMES`) on
     the truth (``estimator`` None: the teacher; ``rng`` draws its delays) or on the ``estimator``'s output (the
@@ -170,6 +188,7 @@ def fly(model: str, seeds: Sequence[int], estimator: Estimator | Ensemble | None
     ``extrapolated``: ... the moment as it acts carried that many periods along its slope (the same);
     ``lead``: the inversion's law flies its moment carried that many periods along its slope (the labels stay);
     ``law``: its gains per flight model (:func:`lvgym.agents.inversion.gains`; None: the reference's);
+    ``upset``: the share of the inversion teacher's flights upset after ignition (:class:`InversionScheme`);
     ``options``: env keywords (tests shorten the mission)."""
     from lvgym.benchmark.rows import RowsLog
 
@@ -179,8 +198,11 @@ def fly(model: str, seeds: Sequence[int], estimator: Estimator | Ensemble | None
     obs, info = env.reset(seed=[int(s) for s in seeds])
     if loop_gain is not None and scheme != "inversion":
         raise ValueError("loop_gain: the inversion scheme's training device only")
+    if upset and scheme != "inversion":
+        raise ValueError("upset: the inversion scheme's training device only")
     pilot = SCHEMES[scheme](env1, n, rng if estimator is None else None, deadband, loop_gain, ahead, extrapolated,
-                            lead, law)
+                            lead, law, upset)
+    dt = float(env1.unwrapped.func.spec.timing.control_dt_s)
     gain = np.ones((n, 1)) if loop_gain is None else np.asarray(loop_gain, dtype=float)[:, None]
     window, log = Window(n), RowsLog(env)
     lit = Ignition(n, list(env1.unwrapped.func.observation_layout.names).index("controller_on"))
@@ -192,12 +214,13 @@ def fly(model: str, seeds: Sequence[int], estimator: Estimator | Ensemble | None
         w = window.push(live, obs[live])
         xs.append(w.copy())
         ys.append(truth[live].astype(np.float32))
-        since.append(lit.push(live, obs[live]))
+        steps = lit.push(live, obs[live])
+        since.append(np.where(steps >= 0, steps * dt, -1.0))
         estimate = None
         if estimator is not None:
             with torch.no_grad():
                 estimate = estimator(torch.as_tensor(w)).numpy().astype(np.float64)
-        a = pilot.act(live, obs[live], info, estimate)
+        a = pilot.act(live, obs[live], info, estimate, since[-1])
         window.sent(live, a)
         actions = np.zeros((n, 2), dtype=np.float32)
         actions[live] = np.clip(a * gain[live], -1.0, 1.0)
@@ -207,9 +230,7 @@ def fly(model: str, seeds: Sequence[int], estimator: Estimator | Ensemble | None
         log.end(ended, info)
         done[ended] = True
     env.close()
-    steps = np.concatenate(since)
-    dt = float(env1.unwrapped.func.spec.timing.control_dt_s)
-    return np.concatenate(xs), np.concatenate(ys), log.records(True), np.where(steps >= 0, steps * dt, -1.0)
+    return np.concatenate(xs), np.concatenate(ys), log.records(True), np.concatenate(since)
 
 
 class Ignition:
@@ -233,99 +254,12 @@ class Ignition:
         return self.since[rows].copy()
 
 
-class Data:
-    """The windows, labels and weights of every round, in one array each that grows in place: the fits see a
-    contiguous view, the same numbers as the rounds' arrays concatenated, without a second copy (a round's
-    data of the longer missions is gigabytes, and two runs share the machine)."""
-
-    def __init__(self) -> None:
-        self.x: np.ndarray | None = None
-        self.y: np.ndarray | None = None
-        self.w: np.ndarray | None = None
-        self.n = 0
-
-    def __len__(self) -> int:
-        return self.n
-
-    def reserve(self, capacity: int) -> None:
-        """Room for ``capacity`` steps (a copy now rather than one per round)."""
-        if self.x is not None and capacity > len(self.x):
-            x = np.empty((capacity, *self.x.shape[1:]), dtype=self.x.dtype)
-            y = np.empty((capacity, *self.y.shape[1:]), dtype=self.y.dtype)
-            w = np.empty(capacity, dtype=np.float32)
-            x[:self.n], y[:self.n], w[:self.n] = self.x[:self.n], self.y[:self.n], self.w[:self.n]
-            self.x, self.y, self.w = x, y, w
-
-    def add(self, x: np.ndarray, y: np.ndarray, w: np.ndarray | None = None) -> None:
-        """Append a flight batch's windows ``x``, labels ``y`` and their weights in the fit ``w`` (None: 1)."""
-        if self.x is None:
-            self.x = np.empty((0, *x.shape[1:]), dtype=x.dtype)
-            self.y = np.empty((0, *y.shape[1:]), dtype=y.dtype)
-            self.w = np.empty(0, dtype=np.float32)
-        if self.n + len(x) > len(self.x):
-            self.reserve(max(self.n + len(x), len(self.x) + len(self.x) // 4))
-        self.x[self.n:self.n + len(x)], self.y[self.n:self.n + len(y)] = x, y
-        self.w[self.n:self.n + len(x)] = 1.0 if w is None else w
-        self.n += len(x)
-
-    def view(self) -> tuple[np.ndarray, np.ndarray]:
-        """The windows and labels so far (views, not copies)."""
-        return self.x[:self.n], self.y[:self.n]
-
-    def weights(self) -> np.ndarray | None:
-        """The windows' weights so far (a view), or None when every weight is 1 (the fit's plain mean)."""
-        w = self.w[:self.n]
-        return None if np.all(w == 1.0) else w
-
-
 def own_law(bandwidth: float) -> dict[str, list[float]] | None:
     """The inversion law's gains per flight model (:func:`lvgym.agents.inversion.gains`) of ``--bandwidth``: the
     non-rigid vehicle's bandwidth [rad/s] with the reference's damping; None (the reference's gains) for 0."""
     from lvgym.baselines.privileged import GAINS
 
     return {"nonrigid": [float(bandwidth), GAINS["nonrigid"][1]]} if bandwidth else None
-
-
-def row_std(flat: np.ndarray, mean: np.ndarray, rows: int = 1 << 16) -> np.ndarray:
-    """``flat.std(0)`` (``flat`` ``(n, k)``, ``mean`` its ``flat.mean(0)``) to the bit, without NumPy's temporary
-    of the whole array (gigabytes for a training run's windows): the squared deviations of ``rows`` rows at a
-    time, summed row after row as NumPy's reduction over the first axis sums them."""
-    total = None
-    for i in range(0, len(flat), rows):
-        d = flat[i:i + rows] - mean
-        np.multiply(d, d, out=d)
-        total = np.add.reduce(d if total is None else np.concatenate([total[None], d]), axis=0)
-    return np.sqrt(np.true_divide(total, len(flat)))
-
-
-def fit(x: np.ndarray, y: np.ndarray, seed: int, epochs: int, scaled: bool = False,
-        weight: np.ndarray | None = None) -> Estimator:
-    """The estimator fitted to windows ``x`` and labels ``y`` (torch seeded with ``seed``; ``scaled``: the
-    labels standardised, each weighing the same in the error; ``weight``: each window's weight in a batch's
-    mean error, None: all the same)."""
-    torch.manual_seed(seed)
-    flat = x.reshape(-1, x.shape[-1])
-    mean = flat.mean(0)
-    est = Estimator(mean, row_std(flat, mean) + 1e-6, outputs=y.shape[1],
-                    label_mean=y.mean(0) if scaled else None, label_std=y.std(0) + 1e-6 if scaled else None)
-    opt = torch.optim.Adam(est.parameters(), 1e-3)
-    xt, yt = torch.as_tensor(x), torch.as_tensor(y)
-    wt = None if weight is None else torch.as_tensor(np.asarray(weight, dtype=np.float32))
-    g = torch.Generator().manual_seed(seed)
-    for epoch in range(epochs):
-        perm, total = torch.randperm(len(xt), generator=g), 0.0
-        for i in range(0, len(xt), 1024):
-            b = perm[i:i + 1024]
-            error = ((est(xt[b]) - yt[b]) / est.label_std) ** 2
-            loss = error.mean() if wt is None else (error.mean(1) * wt[b]).sum() / wt[b].sum()
-            opt.zero_grad()
-            loss.backward()
-            opt.step()
-            total += float(loss.detach()) * len(b)
-        print(f"  epoch {epoch}: mean squared error {total / len(xt):.3e} (labels' variance "
-              f"{float((yt / est.label_std).var(0).mean()):.3e})",
-              flush=True)
-    return est
 
 
 def lost(record: dict[str, Any]) -> bool:
@@ -406,6 +340,10 @@ class Args:
     files ``...-ign<weight>``"""
     ignition_s: float = arg(2.0, lo=0.02, hi=20.0)
     """how long after the next stage's ignition ``--ignition-weight`` holds [s]"""
+    upset: float = arg(0.0, lo=0.0, hi=1.0)
+    """the share of the inversion teacher's flights that cancel only part of the aerodynamic moment for a
+    while after the next stage's ignition, then fly it out (:class:`InversionScheme`; 0: none); files
+    ``...-upset<share>``"""
     tag: str = arg("")
     """a label ending the files' prefix (a run of other ``--flights`` or ``--epochs`` beside the first)"""
     family_vehicles: int = arg(16, lo=1, hi=200)
@@ -424,10 +362,12 @@ def main(argv: Sequence[str] | None = None) -> None:
     family = a.suite == "family-v2"
     from lvgym.errors import ConfigError
 
-    if a.scheme != "inversion" and (a.suite != SUITE or a.ahead or a.extrapolated or a.lead or a.bandwidth):
+    if a.scheme != "inversion" and (a.suite != SUITE or a.ahead or a.extrapolated or a.lead or a.bandwidth
+                                    or a.upset):
         key, value = next((k, v) for k, v in (("--suite", a.suite if a.suite != SUITE else None),
                                               ("--ahead", a.ahead), ("--extrapolated", a.extrapolated),
-                                              ("--lead", a.lead), ("--bandwidth", a.bandwidth)) if v)
+                                              ("--lead", a.lead), ("--bandwidth", a.bandwidth),
+                                              ("--upset", a.upset)) if v)
         raise ConfigError(key, value, f"{SUITE} and 0 for the thrust scheme (the others: --scheme inversion)")
     if a.ahead and a.extrapolated:
         raise ConfigError("--extrapolated", a.extrapolated, "0 with --ahead (one label of the moment)")
@@ -441,6 +381,7 @@ def main(argv: Sequence[str] | None = None) -> None:
               + (f"-extrapolated{a.extrapolated}" if a.extrapolated else "") + (f"-lead{a.lead}" if a.lead else "")
               + (f"-w{a.bandwidth:g}" if a.bandwidth else "") + (f"-{a.tag}" if a.tag else "")
               + (f"-ign{a.ignition_weight:g}" if a.ignition_weight != 1.0 else "")
+              + (f"-upset{a.upset:g}" if a.upset else "")
               + (f"-gain{a.loop_gain_db:g}" if a.loop_gain_db else ""))
     law = own_law(a.bandwidth)
     data = Data()
@@ -460,7 +401,8 @@ def main(argv: Sequence[str] | None = None) -> None:
                             if a.loop_gain_db else None)
                     place = {"suite": a.suite, **({"vehicle": vehicle} if family else {})}
                     x, y, _, since = fly(model, seeds, est, rng, scheme=a.scheme, loop_gain=gain,
-                                         ahead=a.ahead, extrapolated=a.extrapolated, lead=a.lead, law=law, **place)
+                                         ahead=a.ahead, extrapolated=a.extrapolated, lead=a.lead, law=law,
+                                         upset=a.upset, **place)
                     data.add(x, y, np.where((since >= 0) & (since < a.ignition_s), a.ignition_weight, 1.0))
             if rnd == 0:                              # room for the rounds to come (each flies half the flights
                 data.reserve(len(data) * (4 + 3 * a.rounds) // 4)       # of round 0, their steps up to 3/4)
