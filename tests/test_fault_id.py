@@ -249,6 +249,10 @@ def test_a_configuration_of_the_study_is_a_row_of_factories_and_a_label_to_compa
          tmp_path / "inversion-ign10-gain6-s0.pt")
     staged = inversion.gain6_ign10_s0(condition("nonrigid", mission_time_s=2.0).make_env())
     assert (staged.name, staged.lead, staged.average) == ("inversion-id-gain6-ign10-s0", 0, 1)
+    save(Ensemble([Estimator(rng.normal(0.0, 0.1, FEATURES), np.ones(FEATURES), hidden=8, outputs=7)]),
+         tmp_path / "inversion-upset0.5-gain6-s1.pt")
+    upset = inversion.gain6_upset_avg6_lead3_s1(condition("nonrigid", mission_time_s=2.0).make_env())
+    assert (upset.name, upset.lead, upset.average) == ("inversion-id-gain6-upset-avg6-lead3-s1", 3, 6)
     assert configurations()[0] == "lqg-thrust-id" and len(set(configurations())) == len(configurations())
 
 

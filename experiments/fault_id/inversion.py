@@ -55,6 +55,11 @@ STUDENTS = {
     "gain6_ign10_": Student("inversion-ign10-gain6", "inversion-id-gain6-ign10"),
     "gain6_ign10_avg6_lead3_": Student("inversion-ign10-gain6", "inversion-id-gain6-ign10-avg6-lead3", lead=3,
                                        average=6),
+    # ... trained with half the teacher's flights upset after the next stage's ignition (--upset 0.5: 30-80 %
+    # of the aerodynamic moment cancelled for 0.5-2 s, then flown out), and flown with the average and the lead
+    "gain6_upset_": Student("inversion-upset0.5-gain6", "inversion-id-gain6-upset"),
+    "gain6_upset_avg6_lead3_": Student("inversion-upset0.5-gain6", "inversion-id-gain6-upset-avg6-lead3", lead=3,
+                                       average=6),
     # Stratos III's student of the present moment as trained, and with its moment carried 5 steps ahead along
     # its last 5 or 15 steps (evaluate.py --seed-set validation only)
     "stratos_": Student("inversion-stratos-tvc-v2", "inversion-stratos"),
