@@ -44,9 +44,11 @@ import numpy as np
 from lvgym.errors import ConfigError
 
 from .observer import N_OBS, Observer, Window
+from .staging import GIMBAL, RATES, Ignition, Measured, signal_index
 
-__all__ = ["A_MAX", "ERRORS", "SHIPPED", "SPAN", "TERMS", "InversionBatch", "InversionPolicy", "Lead", "carry",
-           "check_env", "command", "env_record", "error_index", "from_file", "gains", "law_terms", "shipped_inversion"]
+__all__ = ["A_MAX", "ERRORS", "SHIPPED", "SPAN", "TERMS", "InversionBatch", "InversionPolicy", "Lead", "Staging",
+           "carry", "check_env", "command", "env_record", "error_index", "from_file", "gains", "law_terms",
+           "shipped_inversion"]
 
 #: the law's terms, in the order of :func:`law_terms`
 TERMS = ("f_aero_pitch", "f_aero_yaw", "f_mis_pitch", "f_mis_yaw", "a_pitch", "a_yaw", "qalpha_share")
@@ -208,6 +210,26 @@ class Lead:
         self.count[rows] = 0
 
 
+class Staging:
+    """How a policy flies the next stage's ignition: for ``seconds`` after it (0: never; ``steps``: in control
+    periods of ``env``) the aerodynamic moment is the moment measured from the rigid body
+    (:class:`~lvgym.agents.staging.Measured`, on the observer's control power) less the observer's
+    misalignment, in place of the observer's estimate, while the observer's window still holds the coast."""
+
+    def __init__(self, env: Any, seconds: float = 0.0) -> None:
+        if not 0.0 <= seconds <= 60.0:
+            raise ConfigError("ignition", seconds, "0 (never) to 60 s after the next stage's ignition")
+        self.dt = float(env.unwrapped.func.spec.timing.control_dt_s)
+        self.steps = round(seconds / self.dt)
+        if self.steps:
+            self.on = signal_index(env, ("controller_on",))[0]
+            self.rates, self.gimbal = signal_index(env, RATES), signal_index(env, GIMBAL)
+
+    def rows(self, n: int) -> tuple[Ignition, Measured] | None:
+        """The ignition's clock and the measured moment of ``n`` rows (None: never)."""
+        return (Ignition(n, self.on), Measured(n, self.rates, self.gimbal, self.dt)) if self.steps else None
+
+
 class InversionPolicy:
     """The law of the module docstring on the observer's estimated terms; one env row (the benchmark's
     policy; no privileged information). ``observer``: a window ``(WINDOW, FEATURES)`` -> the terms ``(7,)``
@@ -215,21 +237,25 @@ class InversionPolicy:
     refuses another env: :func:`check_env`); ``lead``, ``span``: the control steps the estimated aerodynamic
     moment is carried ahead along its slope over ``span`` steps (:class:`Lead`; 0: the moment as estimated),
     after its average over ``average`` steps (1: none); ``law``: the law's gains per flight model where they
-    are not the reference's (:func:`gains`)."""
+    are not the reference's (:func:`gains`); ``ignition``: for that long [s] after the next stage's ignition
+    the law cancels the moment measured from the rigid body (:class:`Staging`) in place of the estimated
+    aerodynamic moment (0: never)."""
 
     def __init__(self, env: Any, observer: Callable[[np.ndarray], np.ndarray], name: str = "inversion-id",
                  trained: dict[str, Any] | None = None, lead: int = 0, span: int = SPAN,
-                 law: Law | None = None, average: int = 1) -> None:
+                 law: Law | None = None, average: int = 1, ignition: float = 0.0) -> None:
         check_env(env, trained or {})
         self.observer = observer
         self.name = name
         self.index, (self.w, self.z) = error_index(env), gains(env, law)
         self.lead, self.span, self.average = int(lead), int(span), int(average)
+        self.staging = Staging(env, ignition)
         self.reset()
 
     def reset(self) -> None:
-        """Forget the flight: the window starts from zeros, the lead from no slope."""
+        """Forget the flight: the window starts from zeros, the lead from no slope, the ignition's clock."""
         self.window, self.ahead = Window(1), Lead(1, self.lead, self.span, self.average)
+        self.fresh = self.staging.rows(1)
 
     def act(self, observation: np.ndarray, info: dict[str, Any]) -> np.ndarray:
         """The gimbal action (pitch, yaw) in [-1, 1] from the observation (``info`` is not read)."""
@@ -249,11 +275,15 @@ class InversionBatch:
         self.name, self.observer = policy.name, policy.observer
         self.index, self.w, self.z = policy.index, policy.w, policy.z
         self.window, self.ahead = Window(int(n)), Lead(int(n), policy.lead, policy.span, policy.average)
+        self.staging, self.fresh = policy.staging, policy.staging.rows(int(n))
 
     def reset(self, rows: Any) -> None:
         rows = np.asarray(rows, dtype=np.int64).reshape(-1)
         self.window.reset(rows)
         self.ahead.reset(rows)
+        if self.fresh is not None:
+            for part in self.fresh:
+                part.reset(rows)
 
     def act(self, rows: Any, observations: np.ndarray, info: dict[str, Any]) -> np.ndarray:
         return self.step(self, np.asarray(rows, dtype=np.int64).reshape(-1), np.asarray(observations))
@@ -265,17 +295,26 @@ class InversionBatch:
         windows = law.window.push(rows, o)
         terms = np.stack([law.observer(w) for w in windows])
         terms[:, 0:2] = law.ahead.push(rows, terms[:, 0:2])
+        if law.fresh is not None:                      # the next stage's first seconds: the measured moment
+            lit, measured = law.fresh
+            since = lit.push(rows, o)
+            measured.push(rows, o)
+            now = (since >= 0) & (since < law.staging.steps)
+            if now.any():
+                terms[now, 0:2] = measured.moment(rows[now], terms[now, 4:6]) - terms[now, 2:4]
         a = command(o, terms, law.index, law.w, law.z)
         law.window.sent(rows, a)
         return a
 
 
 def from_file(env: Any, path: str | Path, name: str = "inversion-id", trained: dict[str, Any] | None = None,
-              lead: int = 0, span: int = SPAN, law: Law | None = None, average: int = 1) -> InversionPolicy:
+              lead: int = 0, span: int = SPAN, law: Law | None = None, average: int = 1,
+              ignition: float = 0.0) -> InversionPolicy:
     """The policy on the observer saved at ``path``: an :class:`~lvgym.agents.observer.Observer`'s ``.npz``, or
     a training run's torch ``.pt`` (:func:`lvgym.agents.observer_fit.load`; needs torch); ``lead``, ``span``,
     ``average``: the :class:`Lead` of its aerodynamic moment [control steps]; ``law``: its gains per flight
-    model (:func:`gains`; None: the reference's)."""
+    model (:func:`gains`; None: the reference's); ``ignition``: the seconds after the next stage's ignition
+    it flies the measured moment (:class:`Staging`)."""
     if Path(path).suffix == ".pt":
         from .observer_fit import load, to_observer
 
@@ -283,7 +322,7 @@ def from_file(env: Any, path: str | Path, name: str = "inversion-id", trained: d
     else:
         observer = Observer.load(path)
     return InversionPolicy(env, observer, name=name, trained=trained, lead=lead, span=span, law=law,
-                           average=average)
+                           average=average, ignition=ignition)
 
 
 def shipped_inversion(env: Any, name: str = "inversion-id", file: str = SHIPPED) -> InversionPolicy:

@@ -360,23 +360,6 @@ def test_one_kind_of_fault_flies_validation_seeds_with_that_kind_only(capsys):
         main(["--first", "5", "--last", "5"])
 
 
-def test_the_steps_since_ignition_count_from_the_controllers_return_after_a_coast():
-    """``Ignition`` by hand: -1 until ``controller_on`` comes back after it fell once the controller had acted
-    (row 0: on at step 2, the coast at 4-5, ignition at 6), then 0, 1, ...; a row that never coasts (row 1)
-    stays -1, whichever rows a step pushes."""
-    from experiments.fault_id.train import Ignition
-
-    on = np.array([[0, 0, 1, 1, 0, 0, 1, 1, 0], [0, 1, 1, 1, 1, 1, 1, 1, 1]], dtype=float)
-    lit, got = Ignition(2, on=3), []
-    for k in range(on.shape[1]):
-        rows = np.array([0]) if k == 7 else np.array([0, 1])      # row 1 sits a step out: nothing moves it
-        obs = np.zeros((len(rows), 5))
-        obs[:, 3] = on[rows, k]
-        got.append(dict(zip(rows.tolist(), lit.push(rows, obs).tolist())))
-    assert [g[0] for g in got] == [-1, -1, -1, -1, -1, -1, 0, 1, 2]
-    assert [g.get(1) for g in got] == [-1] * 7 + [None, -1]
-
-
 def test_the_rounds_weights_grow_with_their_data_and_weigh_the_fits_mean_error(capsys):
     """The weights appended beside the windows (1 where none are given; None, the plain mean, when all are
     1), and a fit's first epoch in one batch reports the weighted mean of the initial network's errors:

@@ -31,8 +31,9 @@ SEEDS = (0, 1, 2)
 class Student:
     """A configuration of the study: the training runs' file prefix (``results/fault_id/<prefix>-s<k>.pt``), the
     label its policies fly under, and how the law flies the observer: ``lead``, ``span``, ``average``
-    (:class:`lvgym.agents.inversion.Lead`) and ``bandwidth`` (the non-rigid law's, ``train.py --bandwidth``;
-    0: the reference's)."""
+    (:class:`lvgym.agents.inversion.Lead`), ``bandwidth`` (the non-rigid law's, ``train.py --bandwidth``;
+    0: the reference's) and ``ignition`` (the seconds after the next stage's ignition it cancels the moment
+    measured from the rigid body, :class:`lvgym.agents.inversion.Staging`; 0: never)."""
 
     prefix: str
     label: str
@@ -40,6 +41,7 @@ class Student:
     span: int = SPAN
     bandwidth: float = 0.0
     average: int = 1
+    ignition: float = 0.0
 
 
 #: the configurations by attribute prefix
@@ -58,6 +60,11 @@ STUDENTS = {
     # ... trained with half the teacher's flights upset after the next stage's ignition (--upset 0.5: 30-80 %
     # of the aerodynamic moment cancelled for 0.5-2 s, then flown out), and flown with the average and the lead
     "gain6_upset_": Student("inversion-upset0.5-gain6", "inversion-id-gain6-upset"),
+    # the shipped command's runs and the upset ones flown with the moment measured from the rigid body for the
+    # first 4 s after the next stage's ignition (chosen on validation seeds after training, not trained with)
+    "gain6_ignition4_": Student("inversion-gain6", "inversion-id-gain6-ignition4", ignition=4.0),
+    "gain6_upset_ignition4_": Student("inversion-upset0.5-gain6", "inversion-id-gain6-upset-ignition4",
+                                      ignition=4.0),
     "gain6_upset_avg6_lead3_": Student("inversion-upset0.5-gain6", "inversion-id-gain6-upset-avg6-lead3", lead=3,
                                        average=6),
     # Stratos III's student of the present moment as trained, and with its moment carried 5 steps ahead along
@@ -85,7 +92,8 @@ def seeded(attribute: str, k: int) -> Callable[[Any], InversionPolicy]:
 
     def factory(env: Any) -> InversionPolicy:
         return from_file(env, RESULTS / f"{student.prefix}-s{k}.pt", name=f"{student.label}-s{k}", lead=student.lead,
-                         span=student.span, law=own_law(student.bandwidth), average=student.average)
+                         span=student.span, law=own_law(student.bandwidth), average=student.average,
+                         ignition=student.ignition)
     factory.__name__ = f"{attribute}s{k}"
     factory.kind = "learned"                          # the headline's column (lvgym.benchmark.headline)
     return factory
@@ -97,9 +105,15 @@ def shipped_avg6_lead3(env: Any) -> InversionPolicy:
     return from_file(env, TRAINED / f"{SHIPPED}.npz", name="inversion-id-avg6-lead3", lead=3, average=6)
 
 
-shipped_avg6_lead3.kind = "learned"  # type: ignore[attr-defined]
+def shipped_ignition4(env: Any) -> InversionPolicy:
+    """The shipped ``inversion-id``'s observer (``agents/trained``) flown with the moment measured from the rigid
+    body for the first 4 s after the next stage's ignition (validation seeds: 2026-12-07)."""
+    return from_file(env, TRAINED / f"{SHIPPED}.npz", name="inversion-id-ignition4", ignition=4.0)
+
+
+shipped_avg6_lead3.kind = shipped_ignition4.kind = "learned"  # type: ignore[attr-defined]
 FACTORIES = {f"{attribute}s{k}": seeded(attribute, k) for attribute in STUDENTS for k in SEEDS}
 globals().update(FACTORIES)                           # evaluate.py --policies experiments.fault_id.inversion:s0
 
 __all__ = ["A_MAX", "ERRORS", "FACTORIES", "NO_THRUST", "STUDENTS", "TERMS", "InversionPolicy", "Student", "command",
-           "error_index", "gains", "law_terms", "seeded", "shipped_avg6_lead3", *FACTORIES]
+           "error_index", "gains", "law_terms", "seeded", "shipped_avg6_lead3", "shipped_ignition4", *FACTORIES]

@@ -22,7 +22,7 @@
      terms.
 2. **Regression.** :class:`lvgym.agents.observer_fit.Estimator` fitted by mean squared error (Adam, ``--epochs``; the
    inversion's labels standardised; ``--ignition-weight``: the windows of the first ``--ignition-s`` after the
-   next stage's ignition weigh more, :class:`Ignition`).
+   next stage's ignition weigh more, :class:`lvgym.agents.staging.Ignition`).
 3. **DAgger rounds** (``--rounds``): the student flies half as many flights again, labelled the same way,
    added to the data, and the estimator is fitted again. The thrust scheme's policy is the last fit; the
    inversion's the mean of the last three fits (:class:`lvgym.agents.observer_fit.Ensemble`).
@@ -47,6 +47,7 @@ import torch
 
 from lvgym.agents.inversion import TERMS, Lead, command, error_index, gains, law_terms
 from lvgym.agents.observer import Window
+from lvgym.agents.staging import Ignition, signal_index
 from lvgym.agents.observer_fit import Ensemble, Estimator, load, save
 from lvgym.cli.args import arg, parse
 
@@ -181,8 +182,8 @@ def fly(model: str, seeds: Sequence[int], estimator: Estimator | Ensemble | None
     the truth (``estimator`` None: the teacher; ``rng`` draws its delays) or on the ``estimator``'s output (the
     student; ``deadband``: the thrust scheme's). Returns the windows ``(steps, WINDOW, FEATURES)``, their
     labels ``(steps, outputs)``, the flights' records (protocol v2's fields) and each window's time [s] since
-    the next stage's ignition (:class:`Ignition`; -1 before it); ``loop_gain``: per row, a gain
-    on the action after the flight computer sent it (the margins' perturbation, a training device; the
+    the next stage's ignition (:class:`lvgym.agents.staging.Ignition`; -1 before it); ``loop_gain``: per row,
+    a gain on the action after the flight computer sent it (the margins' perturbation, a training device; the
     inversion scheme only); ``suite``: whose condition (a family's with ``vehicle=`` in ``options``);
     ``ahead``: the inversion's moment label that many control periods ahead (its teacher flies on it);
     ``extrapolated``: ... the moment as it acts carried that many periods along its slope (the same);
@@ -205,7 +206,7 @@ def fly(model: str, seeds: Sequence[int], estimator: Estimator | Ensemble | None
     dt = float(env1.unwrapped.func.spec.timing.control_dt_s)
     gain = np.ones((n, 1)) if loop_gain is None else np.asarray(loop_gain, dtype=float)[:, None]
     window, log = Window(n), RowsLog(env)
-    lit = Ignition(n, list(env1.unwrapped.func.observation_layout.names).index("controller_on"))
+    lit = Ignition(n, signal_index(env1, ("controller_on",))[0])
     xs, ys, since = [], [], []
     done = np.zeros(n, dtype=bool)
     while not done.all():
@@ -231,27 +232,6 @@ def fly(model: str, seeds: Sequence[int], estimator: Estimator | Ensemble | None
         done[ended] = True
     env.close()
     return np.concatenate(xs), np.concatenate(ys), log.records(True), np.concatenate(since)
-
-
-class Ignition:
-    """Per row of a flight's batch, the control steps since the next stage's ignition: the observation's
-    ``controller_on`` (at index ``on``) back to 1 after it fell to 0 once the controller had acted (the
-    staging coast); -1 before (a flight without a coast: throughout)."""
-
-    def __init__(self, n: int, on: int) -> None:
-        self.on = on
-        self.acted = np.zeros(n, dtype=bool)          # the controller has acted
-        self.coast = np.zeros(n, dtype=bool)          # ... and stopped since
-        self.since = np.full(n, -1, dtype=np.int64)
-
-    def push(self, rows: np.ndarray, observations: np.ndarray) -> np.ndarray:
-        """The step's observations of ``rows`` in; their steps since ignition (0: the first step it acts again)."""
-        now = np.asarray(observations)[:, self.on] > 0.5
-        lit = self.since[rows] >= 0
-        self.since[rows] = np.where(lit, self.since[rows] + 1, np.where(self.coast[rows] & now, 0, -1))
-        self.coast[rows] |= self.acted[rows] & ~now
-        self.acted[rows] |= now
-        return self.since[rows].copy()
 
 
 def own_law(bandwidth: float) -> dict[str, list[float]] | None:
@@ -336,7 +316,8 @@ class Args:
     reference's gains, :data:`lvgym.baselines.privileged.GAINS`); files ``...-w<bandwidth>``"""
     ignition_weight: float = arg(1.0, lo=1.0, hi=100.0)
     """the weight in the fits of the windows of the first ``--ignition-s`` after the next stage's ignition
-    (:class:`Ignition`: the law's terms change at once after a coast of ten seconds; 1: all weigh the same);
+    (:class:`lvgym.agents.staging.Ignition`: the law's terms change at once after a coast of ten seconds; 1:
+    all weigh the same);
     files ``...-ign<weight>``"""
     ignition_s: float = arg(2.0, lo=0.02, hi=20.0)
     """how long after the next stage's ignition ``--ignition-weight`` holds [s]"""
