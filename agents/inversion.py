@@ -327,15 +327,17 @@ def from_file(env: Any, path: str | Path, name: str = "inversion-id", trained: d
 
 def shipped_inversion(env: Any, name: str = "inversion-id", file: str = SHIPPED) -> InversionPolicy:
     """A shipped policy: ``agents/trained/<file>.npz`` flown on ``env`` (refused unless it is the env of
-    ``<file>.json``'s ``env``) with the record's ``lead`` (:class:`Lead`; none when it names none) and ``law``
-    (its gains per flight model, :func:`gains`; the reference's when it names none)."""
+    ``<file>.json``'s ``env``) with the record's ``lead`` (:class:`Lead`; none when it names none), ``law``
+    (its gains per flight model, :func:`gains`; the reference's when it names none) and ``ignition`` (the
+    seconds it flies the measured moment after the next stage's ignition, :class:`Staging`; none when it names
+    none)."""
     weights, record = TRAINED / f"{file}.npz", TRAINED / f"{file}.json"
     if not weights.is_file() or not record.is_file():
         raise FileNotFoundError(f"the shipped policy {str(weights)!r} or its record is missing "
                                 "(docs/training-results.md)")
     meta = json.loads(record.read_text())
     return from_file(env, weights, name=name, trained=meta["env"], lead=int(meta.get("lead", 0)),
-                     law=meta.get("law"))
+                     law=meta.get("law"), ignition=float(meta.get("ignition", 0.0)))
 
 
 shipped_inversion.kind = from_file.kind = "learned"  # type: ignore[attr-defined]
