@@ -65,6 +65,8 @@ STUDENTS = {
     "gain6_ignition4_": Student("inversion-gain6", "inversion-id-gain6-ignition4", ignition=4.0),
     "gain6_upset_ignition4_": Student("inversion-upset0.5-gain6", "inversion-id-gain6-upset-ignition4",
                                       ignition=4.0),
+    "gain6_avg6_lead3_ignition4_": Student("inversion-gain6", "inversion-id-gain6-avg6-lead3-ignition4", lead=3,
+                                           average=6, ignition=4.0),
     "gain6_upset_avg6_lead3_": Student("inversion-upset0.5-gain6", "inversion-id-gain6-upset-avg6-lead3", lead=3,
                                        average=6),
     # Stratos III's student of the present moment as trained, and with its moment carried 5 steps ahead along
@@ -111,9 +113,18 @@ def shipped_ignition4(env: Any) -> InversionPolicy:
     return from_file(env, TRAINED / f"{SHIPPED}.npz", name="inversion-id-ignition4", ignition=4.0)
 
 
-shipped_avg6_lead3.kind = shipped_ignition4.kind = "learned"  # type: ignore[attr-defined]
+def shipped_avg6_lead3_ignition4(env: Any) -> InversionPolicy:
+    """The shipped ``inversion-id``'s observer with its moment averaged over 6 steps and carried 3 ahead, and the
+    measured moment for the first 4 s after the next stage's ignition (validation seeds: 2026-12-07)."""
+    return from_file(env, TRAINED / f"{SHIPPED}.npz", name="inversion-id-avg6-lead3-ignition4", lead=3, average=6,
+                     ignition=4.0)
+
+
+for _factory in (shipped_avg6_lead3, shipped_ignition4, shipped_avg6_lead3_ignition4):
+    _factory.kind = "learned"  # type: ignore[attr-defined]
 FACTORIES = {f"{attribute}s{k}": seeded(attribute, k) for attribute in STUDENTS for k in SEEDS}
 globals().update(FACTORIES)                           # evaluate.py --policies experiments.fault_id.inversion:s0
 
 __all__ = ["A_MAX", "ERRORS", "FACTORIES", "NO_THRUST", "STUDENTS", "TERMS", "InversionPolicy", "Student", "command",
-           "error_index", "gains", "law_terms", "seeded", "shipped_avg6_lead3", "shipped_ignition4", *FACTORIES]
+           "error_index", "gains", "law_terms", "seeded", "shipped_avg6_lead3", "shipped_avg6_lead3_ignition4",
+           "shipped_ignition4", *FACTORIES]
