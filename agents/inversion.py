@@ -28,7 +28,9 @@ models, with the reference's law on the true terms as the teacher and DAgger rou
 ``inversion-id-smile``'s on ``smile-v2``, the law flying its estimated moment carried 3 and 5 steps ahead
 (:class:`Lead`, the record's ``lead``), ``inversion-id-smile``'s law at a non-rigid bandwidth of 1.25 rad/s
 (:func:`gains`, the record's ``law``). A policy refuses an env its observer was not trained for
-(:func:`check_env`).
+(:func:`check_env`). ``ignition``: for its first seconds after the next stage's ignition the law can cancel
+the moment measured from the rigid body (:class:`Staging`, :mod:`lvgym.agents.staging`; the record's
+``ignition``; no shipped record names one).
 """
 
 from __future__ import annotations

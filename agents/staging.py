@@ -14,7 +14,10 @@ coast is large beside the new stage's control moment, and an estimate 40 % short
   ``f_aero + f_mis = a omega_dot - delta`` with ``omega_dot`` the gyro rates' slope over the last
   :data:`SPAN` control steps and ``delta`` the observed gimbal position averaged over the same steps (a
   disturbance observer; its ``a`` is the learned observer's estimate). Over the coast its steps hold the
-  aerodynamic moment alone, which the new stage meets at once.
+  aerodynamic moment alone, which the new stage meets at once. The law on it is an incremental dynamic
+  inversion, ``delta = delta_mean + a (alpha - omega_dot)`` (INDI; Sieberling, Chu and Mulder, J. Guid.
+  Control Dyn. 33(6), 2010): its increment loop needs the estimated ``a`` well under twice the true one (an
+  observer 30-100 % high closes a 2 Hz loop through the servo's lag: docs/training-results.md).
 """
 
 from __future__ import annotations
