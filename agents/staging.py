@@ -2,7 +2,7 @@
 rigid body while a learned observer's window still holds the staging coast (:mod:`lvgym.agents.inversion`).
 
 SMILE's first stage burns out at about 43 s; the gimbal is held at zero through a coast of about ten seconds
-(the observation's ``controller_on`` is 0) and the next stage ignites at about 53.5 s. Its first seconds are
+(the observation's ``controller_on`` is 0) and the next stage ignites at about 54 s. Its first seconds are
 where the fault suite's learned observer lost its flights (docs/training-results.md, "The next stage's
 ignition"): its window has seen no thrust, the aerodynamic moment of an unstable vehicle at the end of the
 coast is large beside the new stage's control moment, and an estimate 40 % short lets the attitude diverge.
