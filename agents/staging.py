@@ -16,8 +16,9 @@ coast is large beside the new stage's control moment, and an estimate 40 % short
   disturbance observer; its ``a`` is the learned observer's estimate). Over the coast its steps hold the
   aerodynamic moment alone, which the new stage meets at once. The law on it is an incremental dynamic
   inversion, ``delta = delta_mean + a (alpha - omega_dot)`` (INDI; Sieberling, Chu and Mulder, J. Guid.
-  Control Dyn. 33(6), 2010): its increment loop needs the estimated ``a`` well under twice the true one (an
-  observer 30-100 % high closes a 2 Hz loop through the servo's lag: docs/training-results.md).
+  Control Dyn. 33(6), 2010): its increment loop needs the estimated ``a`` under twice the true one, and less
+  behind the servo's lag (on one validation flight it starts a 2 Hz oscillation whose cause is not found yet:
+  docs/training-results.md).
 """
 
 from __future__ import annotations
