@@ -446,3 +446,22 @@ def test_the_teachers_upset_cancels_a_drawn_share_of_the_moment_for_a_drawn_whil
         fly("rigid", [7], None, np.random.default_rng(0), upset=0.5, mission_time_s=1.0)
     with pytest.raises(ConfigError, match="--upset"):
         train.main(["--upset", "0.5"])
+
+
+def test_the_ship_flies_a_candidate_with_its_ignition_seconds(monkeypatch):
+    """``ship.py --ignition``: a candidate's validation flies the policy spec with the seconds of the measured
+    moment after ignition among its options (none when 0), so the record's ``ignition`` is what was chosen on."""
+    from experiments.fault_id import ship
+
+    seen = []
+
+    def evaluate(specs, suites, episodes, **kw):
+        seen.append(dict(specs[0].kwargs))
+        return [{"condition": f"smile-v2-faults/{m}", "score_v2": 1.0, "failed": False, "flyable": True}
+                for m in ("rigid", "nonrigid")]
+
+    monkeypatch.setattr(ship, "evaluate", evaluate)
+    ship.validation("x.npz", 10, ignition=4.0)
+    ship.validation("x.npz", 10)
+    assert seen[0]["ignition"] == 4.0 and "ignition" not in seen[1]
+    assert seen[0]["path"] == "x.npz" and seen[0]["lead"] == 0
