@@ -132,12 +132,7 @@ def gains(env: Any, law: Law | None = None) -> tuple[float, float]:
 
 def error_index(env: Any) -> list[int]:
     """Where :data:`ERRORS` sit in ``env``'s observation."""
-    names = list(env.unwrapped.func.observation_layout.names)
-    missing = [n for n in ERRORS if n not in names]
-    if missing:
-        raise ConfigError("env observation", f"without {missing}", f"an observation with {list(ERRORS)} (the law's "
-                          "errors)")
-    return [names.index(n) for n in ERRORS]
+    return signal_index(env, ERRORS, "the law's errors")
 
 
 def env_record(env: Any) -> dict[str, Any]:

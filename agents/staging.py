@@ -38,13 +38,15 @@ GIMBAL = ("gimbal_pitch", "gimbal_yaw")
 SPAN = 3
 
 
-def signal_index(env: Any, names: tuple[str, ...]) -> list[int]:
-    """Where ``names`` sit in ``env``'s observation (refused by name where one is missing)."""
-    have = list(env.unwrapped.func.observation_layout.names)
-    missing = [n for n in names if n not in have]
+def signal_index(env: Any, names: tuple[str, ...], what: str = "") -> list[int]:
+    """Where ``names`` sit in ``env``'s observation (its layout's offsets; refused by name where one is
+    missing, ``what`` saying what needs them)."""
+    layout = env.unwrapped.func.observation_layout
+    missing = [n for n in names if n not in layout]
     if missing:
-        raise ConfigError("env observation", f"without {missing}", f"an observation with {list(names)}")
-    return [have.index(n) for n in names]
+        raise ConfigError("env observation", f"without {missing}",
+                          f"an observation with {list(names)}" + (f" ({what})" if what else ""))
+    return [layout.index(n) for n in names]
 
 
 class Ignition:
