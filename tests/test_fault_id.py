@@ -179,12 +179,42 @@ def test_the_moment_extrapolated_along_its_slope_by_hand():
     law.reset()
     w = Withheld.__new__(Withheld)
     w.law, w.name, w.observed, w.eff, w.late, w.ahead, w.m_aero = law, "x", False, True, 0, 5, []
-    w.span = SLOPE_STEPS
+    w.span, w.plant_late, w.plant = SLOPE_STEPS, 0, []
     for k in range(8):                                  # a moment growing by 2 N m per step
         w.act(np.zeros(14), {"omega_bi_b": np.zeros(3), "m_aero_b": np.array([0.0, 2.0 * k, 0.0])})
     assert SLOPE_STEPS == 5
     np.testing.assert_allclose(law.m[-1], [0.0, 14.0 + 5 * 2.0, 0.0])   # 5 steps ahead along the slope
     np.testing.assert_allclose(law.m[0], [0.0, 0.0, 0.0])               # the first step: no slope yet
+
+
+def test_the_plant_known_late_by_hand():
+    """``plant_late``: the moment, misalignment and effectiveness the law sees are those of that many steps before
+    (the first step's before there were so many); the thrust, the state and the q-alpha are the step's own."""
+    from experiments.fault_id.privileges import PLANT, Withheld
+
+    class Seen:
+        name = "seen"
+
+        def reset(self):
+            self.info = []
+
+        def act(self, observation, info):
+            self.info.append(dict(info))
+            return np.zeros(2, np.float32)
+
+    law = Seen()
+    w = Withheld.__new__(Withheld)
+    w.law, w.name, w.observed, w.eff, w.late, w.ahead, w.span, w.plant_late = law, "x", False, True, 0, 0, 5, 3
+    w.reset()
+    for k in range(6):
+        w.act(np.zeros(14), {"omega_bi_b": np.full(3, float(k)), "qalpha_pa_deg": 10.0 * k, "m_aero_b": np.full(3, k),
+                             "misalignment": np.full(2, -k), "actuator_effectiveness": np.full(2, 1.0 - k / 10),
+                             "thrust": 100.0 * k, "vectored_share": 1.0})
+    assert set(PLANT) == {"m_aero_b", "misalignment", "actuator_effectiveness"}
+    seen = [(i["thrust"], i["misalignment"][0], i["m_aero_b"][1], i["actuator_effectiveness"][0], i["qalpha_pa_deg"],
+             i["omega_bi_b"][0]) for i in law.info]
+    assert seen[0] == (0.0, 0, 0, 1.0, 0.0, 0.0) and seen[3] == (300.0, 0, 0, 1.0, 30.0, 3.0)   # 3 late, from 0
+    assert seen[5] == (500.0, -2, 2, 0.8, 50.0, 5.0)
 
 
 def test_the_extrapolated_label_is_the_true_moment_carried_along_its_slope(monkeypatch):

@@ -7,7 +7,9 @@ errors without the wind ahead (the disturbance-observer student's teacher) and b
     python -m experiments.fault_id.feasible --folder results/fault_id/val300-gain6
 
 A flight the reference fails too is beyond what the law can fly on this actuator; one its teacher flies is
-the student's own (its estimate's) failure. Refuses a run on the test seeds: what fails there is reported,
+the student's own (its estimate's) failure. ``--late 5 10``: the teacher again, knowing what the fault changed
+(the plant's entries of the info, :data:`.privileges.PLANT`) that many control steps late: how soon a causal
+law must know it. Refuses a run on the test seeds: what fails there is reported,
 never studied flight by flight.
 """
 
@@ -33,6 +35,10 @@ class Args:
 
     folder: str = arg("results/fault_id/val300-gain6")
     """evaluate.py's --out folder of a validation run on smile-v2-faults (its results.json)"""
+    late: list[int] = arg(default_factory=list, metavar="STEPS", lo=1, hi=500)
+    """the teacher flown again with the plant known that many control steps late (one column each)"""
+    seeds: list[int] = arg(default_factory=list, metavar="SEED", lo=0, hi=9_999)
+    """only these validation seeds of the run's lost flights (default: all)"""
 
 
 def failed(records: list[dict]) -> dict[tuple[str, int], list[str]]:
@@ -56,10 +62,14 @@ def main(argv: Sequence[str] | None = None) -> None:
     if run["meta"]["seed_set"] != "validation":
         raise SystemExit(f"{a.folder}: a run on the test seeds; this study takes validation runs only")
     envs = {m: condition(m, privileged_info=True).make_env() for m in ("rigid", "nonrigid")}
-    print("| model | seed | fault | lost by | " + " | ".join(LAWS) + " |\n|---|---|---|---|" + "---|" * len(LAWS))
+    names = list(LAWS) + [f"teacher, plant {k} steps late" for k in a.late]
+    print("| model | seed | fault | lost by | " + " | ".join(names) + " |\n|---|---|---|---|" + "---|" * len(names))
     for (model, seed), policies in failed(records).items():
+        if a.seeds and seed not in a.seeds:
+            continue
         env = envs[model]
-        laws = (reference(env), reference(env, preview=False, observed=True), build_policy(resolve_policy("lqg"), env))
+        laws = (reference(env), reference(env, preview=False, observed=True), build_policy(resolve_policy("lqg"), env),
+                *(reference(env, preview=False, observed=True, plant_late_steps=k) for k in a.late))
         flown = [play_episode(law, env, seed, flyability=True) for law in laws]
         cells = ["fails" if lost(r) else "flies" for r in flown]
         print(f"| {model} | {seed} | {flown[0]['fault']} | {', '.join(policies)} | " + " | ".join(cells) + " |",

@@ -44,32 +44,44 @@ def extrapolate(history: Sequence[np.ndarray], ahead: int, span: int = SLOPE_STE
 
 def reference(env: Any, preview: bool = True, relief: bool = True, plant: bool = True, observed: bool = False,
               eff: bool = True, aero_late_steps: int = 0, aero_ahead_steps: int = 0, name: str = "privileged",
-              bandwidth_radps: float | None = None) -> Any:
+              bandwidth_radps: float | None = None, plant_late_steps: int = 0) -> Any:
     """The privileged reference with its wind preview, its load relief or its knowledge of the plant taken away;
     ``observed``: on the flight computer's rate and attitude errors (the observation's) instead of the true ones;
     ``eff`` False: without the actuators' effectiveness (the misalignment kept); ``aero_late_steps``: the
     aerodynamic moment as it acted that many control steps ago (without preview); ``aero_ahead_steps``: the
     moment as it acts extrapolated that many steps ahead along its slope over the last :data:`SLOPE_STEPS`
     (what a causal predictor of the moment ahead could do without learning; without preview);
-    ``bandwidth_radps``: the attitude loop's (None: the reference's)."""
+    ``bandwidth_radps``: the attitude loop's (None: the reference's); ``plant_late_steps``: every entry of
+    :data:`PLANT` (the aerodynamic moment, the misalignment, the effectiveness) as it was that many control
+    steps ago (how soon a causal law must know what a fault changed; without preview)."""
     from lvgym.baselines.privileged import privileged
 
     law = privileged(env, bandwidth_radps, name=name, preview_periods=None if preview else 0,
                      relief=None if relief else NO_RELIEF, plant=plant)
-    withheld = observed or not eff or aero_late_steps or aero_ahead_steps
-    return Withheld(law, env, observed, eff, aero_late_steps, aero_ahead_steps) if withheld else law
+    withheld = observed or not eff or aero_late_steps or aero_ahead_steps or plant_late_steps
+    return (Withheld(law, env, observed, eff, aero_late_steps, aero_ahead_steps, plant_late=plant_late_steps)
+            if withheld else law)
+
+
+#: the privileged info of the moments a fault changes, which ``plant_late_steps`` delays; the thrust stays the
+#: step's own (the accelerometers measure it within a step, and the sequencer knows the ignition), and so do
+#: the vehicle's geometry and inertia, the state and the q-alpha
+PLANT = ("m_aero_b", "misalignment", "actuator_effectiveness")
 
 
 class Withheld:
     """A privileged law given less than the step's privileged info: the observation's rate and attitude errors
     in place of the true ones (``observed``), no effectiveness (``eff`` False), the aerodynamic moment of
-    ``late`` steps ago, or the present one extrapolated ``ahead`` steps along its slope over ``span``."""
+    ``late`` steps ago, or the present one extrapolated ``ahead`` steps along its slope over ``span``, and
+    every entry of :data:`PLANT` as it was ``plant_late`` steps ago (the first step's before there were so
+    many)."""
 
     def __init__(self, law: Any, env: Any, observed: bool, eff: bool, late: int, ahead: int = 0,
-                 span: int = SLOPE_STEPS) -> None:
+                 span: int = SLOPE_STEPS, plant_late: int = 0) -> None:
         names = list(env.unwrapped.func.observation_layout.names)
         self.law, self.name, self.observed, self.eff, self.late = law, law.name, observed, eff, int(late)
-        self.ahead, self.span = int(ahead), int(span)
+        self.ahead, self.span, self.plant_late = int(ahead), int(span), int(plant_late)
+        self.plant: list[dict[str, Any]] = []
         self.i = [names.index(n) for n in ("pitch_rate_error", "yaw_rate_error", "pitch_attitude_error",
                                             "yaw_attitude_error", "pitch_rate_reference")]
         self.m_aero: list[np.ndarray] = []
@@ -77,6 +89,7 @@ class Withheld:
     def reset(self) -> None:
         self.law.reset()
         self.m_aero = []
+        self.plant = []
 
     def act(self, observation: np.ndarray, info: dict[str, Any]) -> np.ndarray:
         if "omega_bi_b" in info:
@@ -90,6 +103,9 @@ class Withheld:
             info["m_aero_b"] = self.m_aero[max(0, len(self.m_aero) - 1 - self.late)]
             if self.ahead:                                  # along the slope of the last span steps
                 info["m_aero_b"] = extrapolate(self.m_aero, self.ahead, self.span)
+            if self.plant_late:
+                self.plant.append({k: info[k] for k in PLANT if k in info})
+                info.update(self.plant[max(0, len(self.plant) - 1 - self.plant_late)])
         return self.law.act(observation, info)
 
 
