@@ -30,7 +30,9 @@ models, with the reference's law on the true terms as the teacher and DAgger rou
 (:func:`gains`, the record's ``law``). A policy refuses an env its observer was not trained for
 (:func:`check_env`). ``ignition``: for its first seconds after the next stage's ignition the law can cancel
 the moment measured from the rigid body (:class:`Staging`, :mod:`lvgym.agents.staging`; the record's
-``ignition``; no shipped record names one).
+``ignition``). ``inversion-id`` flies its moment averaged over 6 steps and carried 3 ahead, and the measured
+moment for 4 s after the ignition: options chosen after training on validation seeds 0-1,999 (the record's
+``flight``, docs/training-results.md).
 """
 
 from __future__ import annotations
@@ -324,17 +326,18 @@ def from_file(env: Any, path: str | Path, name: str = "inversion-id", trained: d
 
 def shipped_inversion(env: Any, name: str = "inversion-id", file: str = SHIPPED) -> InversionPolicy:
     """A shipped policy: ``agents/trained/<file>.npz`` flown on ``env`` (refused unless it is the env of
-    ``<file>.json``'s ``env``) with the record's ``lead`` (:class:`Lead`; none when it names none), ``law``
-    (its gains per flight model, :func:`gains`; the reference's when it names none) and ``ignition`` (the
-    seconds it flies the measured moment after the next stage's ignition, :class:`Staging`; none when it names
-    none)."""
+    ``<file>.json``'s ``env``) with the record's ``lead`` and ``average`` (:class:`Lead`; none when it names
+    none), ``law`` (its gains per flight model, :func:`gains`; the reference's when it names none) and
+    ``ignition`` (the seconds it flies the measured moment after the next stage's ignition, :class:`Staging`;
+    none when it names none)."""
     weights, record = TRAINED / f"{file}.npz", TRAINED / f"{file}.json"
     if not weights.is_file() or not record.is_file():
         raise FileNotFoundError(f"the shipped policy {str(weights)!r} or its record is missing "
                                 "(docs/training-results.md)")
     meta = json.loads(record.read_text())
     return from_file(env, weights, name=name, trained=meta["env"], lead=int(meta.get("lead", 0)),
-                     law=meta.get("law"), ignition=float(meta.get("ignition", 0.0)))
+                     law=meta.get("law"), average=int(meta.get("average", 1)),
+                     ignition=float(meta.get("ignition", 0.0)))
 
 
 shipped_inversion.kind = from_file.kind = "learned"  # type: ignore[attr-defined]

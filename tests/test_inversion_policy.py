@@ -110,33 +110,44 @@ def test_the_numpy_observer_is_the_fitted_network(tmp_path):
         Observer([{k: (v[:, :10] if k == "w0" else v) for k, v in obs.members[0].items()}])
 
 
-@pytest.mark.parametrize(("stem", "suite", "lead"), [(SHIPPED, "smile-v2-faults", 0),
+@pytest.mark.parametrize(("stem", "suite", "lead"), [(SHIPPED, "smile-v2-faults", 3),
                                                      ("inversion_id_stratos_tvc_v2", "stratos-tvc-v2", 3),
                                                      ("inversion_id_smile_v2", "smile-v2", 5)])
 def test_the_shipped_observers_are_their_records(stem, suite, lead):
     """The weights are the file the record's SHA-256 names; the record names the env it was trained on, the
-    training command, the validation of every candidate seed, the one chosen and the law's lead."""
+    training command, the validation of every candidate seed, the one chosen and the law's lead: trained with
+    (``--lead``), or chosen after training with the other flight options (its ``flight``: the options, the
+    commands that flew them on validation seeds, and what each scored)."""
     record = json.loads((TRAINED / f"{stem}.json").read_text())
     data = (TRAINED / f"{stem}.npz").read_bytes()
     assert hashlib.sha256(data).hexdigest() == record["sha256"]
     env = lvgym.make_env(suite, "nonrigid")
     assert record["env"] == env_record(env) and record["suite"] == suite
     assert "--scheme inversion" in record["training"]["command"] and record.get("lead", 0) == lead
-    assert (f"--lead {lead}" in record["training"]["command"]) == bool(lead)
+    flight = record.get("flight", {}).get("options", {})
+    trained = f"--lead {lead}" in record["training"]["command"]
+    assert trained == (bool(lead) and "lead" not in flight) and (trained or flight.get("lead", 0) == lead)
+    if flight:                                          # chosen after training: flown, and on validation seeds
+        assert all(record[key] == value for key, value in flight.items())
+        assert all("--seed-set validation" in c for c in record["flight"]["commands"])
+        assert "as trained" in record["flight"]["validation"]
     chosen = record["validation"]["chosen"]
     assert str(chosen) in record["validation"]["candidates"] and len(record["validation"]["candidates"]) >= 3
     assert Observer.load(TRAINED / f"{stem}.npz").outputs == len(TERMS)
 
 
-@pytest.mark.parametrize(("name", "suite", "lead"), [("inversion-id", "smile-v2-faults", 0),
-                                                     ("inversion-id-stratos", "stratos-tvc-v2", 3),
-                                                     ("inversion-id-smile", "smile-v2", 5)])
-def test_the_shipped_policies_are_registered_learned_and_causal(name, suite, lead):
+@pytest.mark.parametrize(("name", "suite", "lead", "average", "ignition_steps"),
+                         [("inversion-id", "smile-v2-faults", 3, 6, 200), ("inversion-id-stratos", "stratos-tvc-v2", 3, 1, 0),
+                          ("inversion-id-smile", "smile-v2", 5, 1, 0)])
+def test_the_shipped_policies_are_registered_learned_and_causal(name, suite, lead, average, ignition_steps):
+    """Each flies its record's options: ``inversion-id`` its moment averaged over 6 steps and carried 3 ahead,
+    and the measured moment for 4 s (200 control steps) after the next stage's ignition."""
     spec = resolve_policy(name)
     assert policy_kind(spec) == "learned"
     assert name in lvgym.benchmark.get_suite(suite).policies
     pol = build_policy(spec, lvgym.make_env(suite, "rigid"))
     assert isinstance(pol, InversionPolicy) and pol.name == name and pol.lead == lead
+    assert pol.average == average and pol.staging.steps == ignition_steps
 
 
 @pytest.mark.parametrize(("name", "suite", "key"), [("inversion-id", "stratos-tvc-v2", "vehicle"),
