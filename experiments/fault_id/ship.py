@@ -19,7 +19,7 @@ validation seeds ``0 .. --validation - 1`` of ``--suite``, both flight models; t
 the fewest failed or unflyable non-rigid flights, then the lowest non-rigid mean ``score_v2``. The test seeds are
 not flown. The record (``<stem>.json``) holds the training command, the validation of every candidate, the
 choice, the env the observer was trained on (:func:`lvgym.agents.inversion.env_record`, which the policy
-checks), the law's lead, gains and ``--ignition`` (which the policy flies) and the observer file's SHA-256.
+checks), the law's lead, gains, ``--average`` and ``--ignition`` (which the policy flies) and the observer file's SHA-256.
 """
 
 from __future__ import annotations
@@ -62,6 +62,9 @@ class Args:
     ignition: float = arg(0.0, lo=0.0, hi=60.0)
     """the seconds after the next stage's ignition the law cancels the moment measured from the rigid body
     (:class:`lvgym.agents.inversion.Staging`; 0: never), flown and recorded"""
+    average: int = arg(1, lo=1, hi=50)
+    """the control steps the estimated moment is averaged over before its lead
+    (:class:`lvgym.agents.inversion.Lead`; 1: none), flown and recorded"""
     flights: int = arg(100, lo=10, hi=2000)
     """the runs' ``--flights`` (recorded)"""
     epochs: int = arg(8, lo=1, hi=100)
@@ -85,14 +88,17 @@ def per_model(records: list[dict]) -> dict[str, dict[str, float]]:
 
 
 def validation(path: str, episodes: int, suite: str = SUITE, lead: int = 0,
-               law: dict[str, list[float]] | None = None, ignition: float = 0.0) -> dict[str, dict[str, float]]:
-    """:func:`per_model` of the observer at ``path`` (``.npz``, flown with ``lead``, the gains ``law``,
-    :func:`lvgym.agents.inversion.gains`, and the measured moment for ``ignition`` seconds after the next
-    stage's ignition) on ``suite``'s first ``episodes`` validation seeds, flown by the benchmark."""
+               law: dict[str, list[float]] | None = None, ignition: float = 0.0,
+               average: int = 1) -> dict[str, dict[str, float]]:
+    """:func:`per_model` of the observer at ``path`` (``.npz``, flown with ``lead`` after an ``average`` over
+    that many steps, the gains ``law``, :func:`lvgym.agents.inversion.gains`, and the measured moment for
+    ``ignition`` seconds after the next stage's ignition) on ``suite``'s first ``episodes`` validation seeds,
+    flown by the benchmark."""
     pairs = tuple((model, tuple(v)) for model, v in sorted((law or {}).items()))   # a spec's options hash
     spec = PolicySpec("inversion-id", "lvgym.agents.inversion:from_file",
                       (("lead", lead), ("path", path)) + ((("law", pairs),) if pairs else ())
-                      + ((("ignition", ignition),) if ignition else ()))
+                      + ((("ignition", ignition),) if ignition else ())
+                      + ((("average", average),) if average > 1 else ()))
     return per_model(evaluate([spec], [get_suite(suite)], episodes, seed_set="validation", progress=False))
 
 
@@ -102,7 +108,7 @@ def main(argv: Sequence[str] | None = None) -> None:
     for k in a.seeds:
         npz = RESULTS / f"{a.prefix}-s{k}.npz"
         to_observer(load(RESULTS / f"{a.prefix}-s{k}.pt")).save(npz)
-        candidates[k] = validation(str(npz.resolve()), a.validation, a.suite, a.lead, law, a.ignition)
+        candidates[k] = validation(str(npz.resolve()), a.validation, a.suite, a.lead, law, a.ignition, a.average)
         print(f"seed {k}: " + ", ".join(f"{m} {v['score_v2_mean']:.3f} ({v['failed_or_unflyable']})"
                                          for m, v in candidates[k].items()), flush=True)
     best = min(candidates, key=lambda k: (candidates[k]["nonrigid"]["failed_or_unflyable"],
@@ -121,6 +127,7 @@ def main(argv: Sequence[str] | None = None) -> None:
         "lead": a.lead,
         **({"law": law} if law else {}),
         **({"ignition": a.ignition} if a.ignition else {}),
+        **({"average": a.average} if a.average > 1 else {}),
         "training": {"command": f"python -m experiments.fault_id.train --scheme inversion --seed {best} "
                                 f"--flights {a.flights} --rounds 4 --validation 50{options}",
                      "seeds": list(a.seeds), "file": f"{a.prefix}-s{best}.pt"},
