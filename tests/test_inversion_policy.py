@@ -137,7 +137,8 @@ def test_the_shipped_observers_are_their_records(stem, suite, lead):
 
 
 @pytest.mark.parametrize(("name", "suite", "lead", "average", "ignition_steps"),
-                         [("inversion-id", "smile-v2-faults", 3, 6, 200), ("inversion-id-stratos", "stratos-tvc-v2", 3, 1, 0),
+                         [("inversion-id", "smile-v2-faults", 3, 6, 200),
+                          ("inversion-id-stratos", "stratos-tvc-v2", 3, 1, 0),
                           ("inversion-id-smile", "smile-v2", 5, 1, 0)])
 def test_the_shipped_policies_are_registered_learned_and_causal(name, suite, lead, average, ignition_steps):
     """Each flies its record's options: ``inversion-id`` its moment averaged over 6 steps and carried 3 ahead,

@@ -19,7 +19,8 @@ validation seeds ``0 .. --validation - 1`` of ``--suite``, both flight models; t
 the fewest failed or unflyable non-rigid flights, then the lowest non-rigid mean ``score_v2``. The test seeds are
 not flown. The record (``<stem>.json``) holds the training command, the validation of every candidate, the
 choice, the env the observer was trained on (:func:`lvgym.agents.inversion.env_record`, which the policy
-checks), the law's lead, gains, ``--average`` and ``--ignition`` (which the policy flies) and the observer file's SHA-256.
+checks), the law's lead, gains, ``--average`` and ``--ignition`` (which the policy flies) and the observer
+file's SHA-256.
 """
 
 from __future__ import annotations
