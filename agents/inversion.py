@@ -213,13 +213,20 @@ class Staging:
     """How a policy flies the next stage's ignition: for ``seconds`` after it (0: never; ``steps``: in control
     periods of ``env``) the aerodynamic moment is the moment measured from the rigid body
     (:class:`~lvgym.agents.staging.Measured`, on the observer's control power) less the observer's
-    misalignment, in place of the observer's estimate, while the observer's window still holds the coast."""
+    misalignment, in place of the observer's estimate, while the observer's window still holds the coast;
+    ``share`` < 1: that share of the measured moment and the rest of the estimate. The measured moment closes
+    an incremental loop on the gimbal whose gain is the observer's error in the control power (and a gain
+    between the command and the servo, as the margin test's); half of it keeps that loop's gain margin
+    (docs/training-results.md)."""
 
-    def __init__(self, env: Any, seconds: float = 0.0) -> None:
+    def __init__(self, env: Any, seconds: float = 0.0, share: float = 1.0) -> None:
         if not 0.0 <= seconds <= 60.0:
             raise ConfigError("ignition", seconds, "0 (never) to 60 s after the next stage's ignition")
+        if not 0.0 < share <= 1.0:
+            raise ConfigError("ignition share", share, "more than 0 and at most 1 (the measured moment's share)")
         self.dt = float(env.unwrapped.func.spec.timing.control_dt_s)
         self.steps = round(seconds / self.dt)
+        self.share = float(share)
         if self.steps:
             self.on = signal_index(env, ("controller_on",))[0]
             self.rates, self.gimbal = signal_index(env, RATES), signal_index(env, GIMBAL)
@@ -238,17 +245,19 @@ class InversionPolicy:
     after its average over ``average`` steps (1: none); ``law``: the law's gains per flight model where they
     are not the reference's (:func:`gains`); ``ignition``: for that long [s] after the next stage's ignition
     the law cancels the moment measured from the rigid body (:class:`Staging`) in place of the estimated
-    aerodynamic moment (0: never)."""
+    aerodynamic moment (0: never), ``ignition_share`` of it and the rest of the estimate (1: the measured
+    alone)."""
 
     def __init__(self, env: Any, observer: Callable[[np.ndarray], np.ndarray], name: str = "inversion-id",
                  trained: dict[str, Any] | None = None, lead: int = 0, span: int = SPAN,
-                 law: Law | None = None, average: int = 1, ignition: float = 0.0) -> None:
+                 law: Law | None = None, average: int = 1, ignition: float = 0.0,
+                 ignition_share: float = 1.0) -> None:
         check_env(env, trained or {})
         self.observer = observer
         self.name = name
         self.index, (self.w, self.z) = error_index(env), gains(env, law)
         self.lead, self.span, self.average = int(lead), int(span), int(average)
-        self.staging = Staging(env, ignition)
+        self.staging = Staging(env, ignition, ignition_share)
         self.reset()
 
     def reset(self) -> None:
@@ -300,7 +309,9 @@ class InversionBatch:
             measured.push(rows, o)
             now = (since >= 0) & (since < law.staging.steps)
             if now.any():
-                terms[now, 0:2] = measured.moment(rows[now], terms[now, 4:6]) - terms[now, 2:4]
+                w = law.staging.share
+                terms[now, 0:2] = (w * (measured.moment(rows[now], terms[now, 4:6]) - terms[now, 2:4])
+                                   + (1.0 - w) * terms[now, 0:2])
         a = command(o, terms, law.index, law.w, law.z)
         law.window.sent(rows, a)
         return a
@@ -308,12 +319,12 @@ class InversionBatch:
 
 def from_file(env: Any, path: str | Path, name: str = "inversion-id", trained: dict[str, Any] | None = None,
               lead: int = 0, span: int = SPAN, law: Law | None = None, average: int = 1,
-              ignition: float = 0.0) -> InversionPolicy:
+              ignition: float = 0.0, ignition_share: float = 1.0) -> InversionPolicy:
     """The policy on the observer saved at ``path``: an :class:`~lvgym.agents.observer.Observer`'s ``.npz``, or
     a training run's torch ``.pt`` (:func:`lvgym.agents.observer_fit.load`; needs torch); ``lead``, ``span``,
     ``average``: the :class:`Lead` of its aerodynamic moment [control steps]; ``law``: its gains per flight
     model (:func:`gains`; None: the reference's); ``ignition``: the seconds after the next stage's ignition
-    it flies the measured moment (:class:`Staging`)."""
+    it flies the measured moment, ``ignition_share`` of it (:class:`Staging`)."""
     if Path(path).suffix == ".pt":
         from .observer_fit import load, to_observer
 
@@ -321,15 +332,15 @@ def from_file(env: Any, path: str | Path, name: str = "inversion-id", trained: d
     else:
         observer = Observer.load(path)
     return InversionPolicy(env, observer, name=name, trained=trained, lead=lead, span=span, law=law,
-                           average=average, ignition=ignition)
+                           average=average, ignition=ignition, ignition_share=ignition_share)
 
 
 def shipped_inversion(env: Any, name: str = "inversion-id", file: str = SHIPPED) -> InversionPolicy:
     """A shipped policy: ``agents/trained/<file>.npz`` flown on ``env`` (refused unless it is the env of
     ``<file>.json``'s ``env``) with the record's ``lead`` and ``average`` (:class:`Lead`; none when it names
     none), ``law`` (its gains per flight model, :func:`gains`; the reference's when it names none) and
-    ``ignition`` (the seconds it flies the measured moment after the next stage's ignition, :class:`Staging`;
-    none when it names none)."""
+    ``ignition`` and ``ignition_share`` (the seconds it flies the measured moment after the next stage's
+    ignition and its share, :class:`Staging`; none and 1 when it names none)."""
     weights, record = TRAINED / f"{file}.npz", TRAINED / f"{file}.json"
     if not weights.is_file() or not record.is_file():
         raise FileNotFoundError(f"the shipped policy {str(weights)!r} or its record is missing "
@@ -337,7 +348,8 @@ def shipped_inversion(env: Any, name: str = "inversion-id", file: str = SHIPPED)
     meta = json.loads(record.read_text())
     return from_file(env, weights, name=name, trained=meta["env"], lead=int(meta.get("lead", 0)),
                      law=meta.get("law"), average=int(meta.get("average", 1)),
-                     ignition=float(meta.get("ignition", 0.0)))
+                     ignition=float(meta.get("ignition", 0.0)),
+                     ignition_share=float(meta.get("ignition_share", 1.0)))
 
 
 shipped_inversion.kind = from_file.kind = "learned"  # type: ignore[attr-defined]

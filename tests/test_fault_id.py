@@ -481,7 +481,8 @@ def test_the_teachers_upset_cancels_a_drawn_share_of_the_moment_for_a_drawn_whil
 def test_the_ship_flies_a_candidate_with_its_ignition_seconds(monkeypatch):
     """``ship.py --ignition``: a candidate's validation flies the policy spec with the seconds of the measured
     moment after ignition among its options (none when 0), so the record's ``ignition`` is what was chosen on;
-    ``--average`` the same for the moment's average (none when 1)."""
+    ``--average`` the same for the moment's average (none when 1), ``--ignition-share`` for the measured
+    moment's share (none when 1 or without ``--ignition``)."""
     from experiments.fault_id import ship
 
     seen = []
@@ -495,6 +496,9 @@ def test_the_ship_flies_a_candidate_with_its_ignition_seconds(monkeypatch):
     ship.validation("x.npz", 10, ignition=4.0)
     ship.validation("x.npz", 10)
     ship.validation("x.npz", 10, lead=3, average=6)
+    ship.validation("x.npz", 10, ignition=4.0, ignition_share=0.5)
+    ship.validation("x.npz", 10, ignition_share=0.5)
     assert seen[0]["ignition"] == 4.0 and "ignition" not in seen[1]
     assert seen[0]["path"] == "x.npz" and seen[0]["lead"] == 0
     assert "average" not in seen[0] and (seen[2]["lead"], seen[2]["average"]) == (3, 6)
+    assert "ignition_share" not in seen[0] and seen[3]["ignition_share"] == 0.5 and "ignition_share" not in seen[4]

@@ -136,19 +136,20 @@ def test_the_shipped_observers_are_their_records(stem, suite, lead):
     assert Observer.load(TRAINED / f"{stem}.npz").outputs == len(TERMS)
 
 
-@pytest.mark.parametrize(("name", "suite", "lead", "average", "ignition_steps"),
-                         [("inversion-id", "smile-v2-faults", 3, 6, 200),
-                          ("inversion-id-stratos", "stratos-tvc-v2", 3, 1, 0),
-                          ("inversion-id-smile", "smile-v2", 5, 1, 0)])
-def test_the_shipped_policies_are_registered_learned_and_causal(name, suite, lead, average, ignition_steps):
+@pytest.mark.parametrize(("name", "suite", "lead", "average", "ignition_steps", "share"),
+                         [("inversion-id", "smile-v2-faults", 3, 6, 200, 0.5),
+                          ("inversion-id-stratos", "stratos-tvc-v2", 3, 1, 0, 1.0),
+                          ("inversion-id-smile", "smile-v2", 5, 1, 0, 1.0)])
+def test_the_shipped_policies_are_registered_learned_and_causal(name, suite, lead, average, ignition_steps, share):
     """Each flies its record's options: ``inversion-id`` its moment averaged over 6 steps and carried 3 ahead,
-    and the measured moment for 4 s (200 control steps) after the next stage's ignition."""
+    and half the measured moment and half its estimate for 4 s (200 control steps) after the next stage's
+    ignition."""
     spec = resolve_policy(name)
     assert policy_kind(spec) == "learned"
     assert name in lvgym.benchmark.get_suite(suite).policies
     pol = build_policy(spec, lvgym.make_env(suite, "rigid"))
     assert isinstance(pol, InversionPolicy) and pol.name == name and pol.lead == lead
-    assert pol.average == average and pol.staging.steps == ignition_steps
+    assert pol.average == average and pol.staging.steps == ignition_steps and pol.staging.share == share
 
 
 @pytest.mark.parametrize(("name", "suite", "key"), [("inversion-id", "stratos-tvc-v2", "vehicle"),

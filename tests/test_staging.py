@@ -59,14 +59,16 @@ def _flight(env, steps: int, rng: np.random.Generator, rows: int = 1) -> np.ndar
     return o
 
 
-def test_a_policy_flies_the_measured_moment_for_its_seconds_after_ignition_and_its_batch_is_its_rows():
+@pytest.mark.parametrize("share", [1.0, 0.5])
+def test_a_policy_flies_the_measured_moment_for_its_seconds_after_ignition_and_its_batch_is_its_rows(share):
     """``ignition=0.1`` (5 control steps): from the ignition's step for 5 steps the law cancels the measured
     moment (on the observer's ``a``) less the observer's misalignment in place of the observer's aerodynamic
-    moment, before and after it the observer's; the batch of two rows gives each row its single policy's
-    actions to the bit; ``ignition`` out of range and an observation without the signals are refused."""
+    moment (``ignition_share`` 0.5: half of it and half the observer's), before and after it the observer's;
+    the batch of two rows gives each row its single policy's actions to the bit; ``ignition`` and
+    ``ignition_share`` out of range and an observation without the signals are refused by name."""
     env = lvgym.make_env("smile-v2-faults", "nonrigid", mission_time_s=3.0)
     terms = np.array([0.2, -0.1, 0.03, -0.02, 0.6, 0.7, 0.1])
-    p = InversionPolicy(env, lambda window: terms.copy(), ignition=0.1)
+    p = InversionPolicy(env, lambda window: terms.copy(), ignition=0.1, ignition_share=share)
     assert p.staging.steps == 5
     hand = Measured(1, signal_index(env, RATES), signal_index(env, GIMBAL), 0.02)
     row = np.zeros(1, dtype=np.int64)
@@ -75,14 +77,14 @@ def test_a_policy_flies_the_measured_moment_for_its_seconds_after_ignition_and_i
         hand.push(row, o[None])
         t = terms.copy()
         if 12 <= k < 17:
-            t[0:2] = hand.moment(row, terms[None, 4:6])[0] - terms[2:4]
+            t[0:2] = share * (hand.moment(row, terms[None, 4:6])[0] - terms[2:4]) + (1.0 - share) * terms[0:2]
         np.testing.assert_allclose(got, command(o[None], t[None], p.index, p.w, p.z)[0], rtol=1e-6, atol=1e-7)
 
     def observer(window):
         return np.r_[window[-3:, :2].mean(axis=0), 0.01, 0.0, 0.5 + window[-1, 2:4] ** 2, 0.1]
 
-    single = [InversionPolicy(env, observer, ignition=0.1) for _ in range(2)]
-    batch = InversionPolicy(env, observer, ignition=0.1).batch(2)
+    single = [InversionPolicy(env, observer, ignition=0.1, ignition_share=share) for _ in range(2)]
+    batch = InversionPolicy(env, observer, ignition=0.1, ignition_share=share).batch(2)
     batch.reset([0, 1])
     obs = _flight(env, 24, np.random.default_rng(1), rows=2)
     for k in range(24):
@@ -92,5 +94,8 @@ def test_a_policy_flies_the_measured_moment_for_its_seconds_after_ignition_and_i
             np.testing.assert_array_equal(got[j], single[r].act(obs[k, r], {}))
     with pytest.raises(ConfigError, match="ignition"):
         InversionPolicy(env, observer, ignition=-1.0)
+    for bad in (0.0, 1.5):
+        with pytest.raises(ConfigError, match=r"ignition share.*more than 0 and at most 1"):
+            InversionPolicy(env, observer, ignition=0.1, ignition_share=bad)
     with pytest.raises(ConfigError, match="gimbal_pitch"):
         signal_index(env, ("gimbal_pitch", "no_such_signal"))

@@ -32,8 +32,9 @@ class Student:
     """A configuration of the study: the training runs' file prefix (``results/fault_id/<prefix>-s<k>.pt``), the
     label its policies fly under, and how the law flies the observer: ``lead``, ``span``, ``average``
     (:class:`lvgym.agents.inversion.Lead`), ``bandwidth`` (the non-rigid law's, ``train.py --bandwidth``;
-    0: the reference's) and ``ignition`` (the seconds after the next stage's ignition it cancels the moment
-    measured from the rigid body, :class:`lvgym.agents.inversion.Staging`; 0: never)."""
+    0: the reference's), ``ignition`` (the seconds after the next stage's ignition it cancels the moment
+    measured from the rigid body, :class:`lvgym.agents.inversion.Staging`; 0: never) and ``ignition_share`` (the
+    measured moment's share there, the rest the estimate's)."""
 
     prefix: str
     label: str
@@ -42,6 +43,7 @@ class Student:
     bandwidth: float = 0.0
     average: int = 1
     ignition: float = 0.0
+    ignition_share: float = 1.0
 
 
 #: the configurations by attribute prefix
@@ -67,6 +69,9 @@ STUDENTS = {
                                       ignition=4.0),
     "gain6_avg6_lead3_ignition4_": Student("inversion-gain6", "inversion-id-gain6-avg6-lead3-ignition4", lead=3,
                                            average=6, ignition=4.0),
+    # ... with half the measured moment and half the estimate there (the increment loop's gain margin)
+    "gain6_avg6_lead3_ignition4_half_": Student("inversion-gain6", "inversion-id-gain6-avg6-lead3-ignition4-half",
+                                                lead=3, average=6, ignition=4.0, ignition_share=0.5),
     "gain6_upset_avg6_lead3_": Student("inversion-upset0.5-gain6", "inversion-id-gain6-upset-avg6-lead3", lead=3,
                                        average=6),
     # Stratos III's student of the present moment as trained, and with its moment carried 5 steps ahead along
@@ -95,7 +100,7 @@ def seeded(attribute: str, k: int) -> Callable[[Any], InversionPolicy]:
     def factory(env: Any) -> InversionPolicy:
         return from_file(env, RESULTS / f"{student.prefix}-s{k}.pt", name=f"{student.label}-s{k}", lead=student.lead,
                          span=student.span, law=own_law(student.bandwidth), average=student.average,
-                         ignition=student.ignition)
+                         ignition=student.ignition, ignition_share=student.ignition_share)
     factory.__name__ = f"{attribute}s{k}"
     factory.kind = "learned"                          # the headline's column (lvgym.benchmark.headline)
     return factory
@@ -120,11 +125,26 @@ def shipped_avg6_lead3_ignition4(env: Any) -> InversionPolicy:
                      ignition=4.0)
 
 
-for _factory in (shipped_avg6_lead3, shipped_ignition4, shipped_avg6_lead3_ignition4):
+def shipped_avg6_lead3_ignition4_half(env: Any) -> InversionPolicy:
+    """:func:`shipped_avg6_lead3_ignition4` with half the measured moment and half the estimate for the 4 s
+    after the ignition (validation seeds: 2026-12-07, afternoon)."""
+    return from_file(env, TRAINED / f"{SHIPPED}.npz", name="inversion-id-ignition4-half", lead=3, average=6,
+                     ignition=4.0, ignition_share=0.5)
+
+
+def shipped_avg6_lead3_ignition4_share06(env: Any) -> InversionPolicy:
+    """:func:`shipped_avg6_lead3_ignition4` with 0.6 of the measured moment and 0.4 of the estimate for the 4 s
+    after the ignition (validation seeds: 2026-12-07, afternoon)."""
+    return from_file(env, TRAINED / f"{SHIPPED}.npz", name="inversion-id-ignition4-share06", lead=3, average=6,
+                     ignition=4.0, ignition_share=0.6)
+
+
+for _factory in (shipped_avg6_lead3, shipped_ignition4, shipped_avg6_lead3_ignition4,
+                 shipped_avg6_lead3_ignition4_half, shipped_avg6_lead3_ignition4_share06):
     _factory.kind = "learned"  # type: ignore[attr-defined]
 FACTORIES = {f"{attribute}s{k}": seeded(attribute, k) for attribute in STUDENTS for k in SEEDS}
 globals().update(FACTORIES)                           # evaluate.py --policies experiments.fault_id.inversion:s0
 
 __all__ = ["A_MAX", "ERRORS", "FACTORIES", "NO_THRUST", "STUDENTS", "TERMS", "InversionPolicy", "Student", "command",
            "error_index", "gains", "law_terms", "seeded", "shipped_avg6_lead3", "shipped_avg6_lead3_ignition4",
-           "shipped_ignition4", *FACTORIES]
+           "shipped_avg6_lead3_ignition4_half", "shipped_avg6_lead3_ignition4_share06", "shipped_ignition4", *FACTORIES]

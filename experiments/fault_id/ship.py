@@ -19,8 +19,8 @@ validation seeds ``0 .. --validation - 1`` of ``--suite``, both flight models; t
 the fewest failed or unflyable non-rigid flights, then the lowest non-rigid mean ``score_v2``. The test seeds are
 not flown. The record (``<stem>.json``) holds the training command, the validation of every candidate, the
 choice, the env the observer was trained on (:func:`lvgym.agents.inversion.env_record`, which the policy
-checks), the law's lead, gains, ``--average`` and ``--ignition`` (which the policy flies) and the observer
-file's SHA-256.
+checks), the law's lead, gains, ``--average``, ``--ignition`` and ``--ignition-share`` (which the policy flies)
+and the observer file's SHA-256.
 """
 
 from __future__ import annotations
@@ -63,6 +63,9 @@ class Args:
     ignition: float = arg(0.0, lo=0.0, hi=60.0)
     """the seconds after the next stage's ignition the law cancels the moment measured from the rigid body
     (:class:`lvgym.agents.inversion.Staging`; 0: never), flown and recorded"""
+    ignition_share: float = arg(1.0, lo=0.01, hi=1.0)
+    """the measured moment's share there, the rest the estimate's (:class:`lvgym.agents.inversion.Staging`; 1:
+    the measured alone), flown and recorded"""
     average: int = arg(1, lo=1, hi=50)
     """the control steps the estimated moment is averaged over before its lead
     (:class:`lvgym.agents.inversion.Lead`; 1: none), flown and recorded"""
@@ -90,16 +93,17 @@ def per_model(records: list[dict]) -> dict[str, dict[str, float]]:
 
 def validation(path: str, episodes: int, suite: str = SUITE, lead: int = 0,
                law: dict[str, list[float]] | None = None, ignition: float = 0.0,
-               average: int = 1) -> dict[str, dict[str, float]]:
+               average: int = 1, ignition_share: float = 1.0) -> dict[str, dict[str, float]]:
     """:func:`per_model` of the observer at ``path`` (``.npz``, flown with ``lead`` after an ``average`` over
     that many steps, the gains ``law``, :func:`lvgym.agents.inversion.gains`, and the measured moment for
-    ``ignition`` seconds after the next stage's ignition) on ``suite``'s first ``episodes`` validation seeds,
-    flown by the benchmark."""
+    ``ignition`` seconds after the next stage's ignition, ``ignition_share`` of it) on ``suite``'s first
+    ``episodes`` validation seeds, flown by the benchmark."""
     pairs = tuple((model, tuple(v)) for model, v in sorted((law or {}).items()))   # a spec's options hash
     spec = PolicySpec("inversion-id", "lvgym.agents.inversion:from_file",
                       (("lead", lead), ("path", path)) + ((("law", pairs),) if pairs else ())
                       + ((("ignition", ignition),) if ignition else ())
-                      + ((("average", average),) if average > 1 else ()))
+                      + ((("average", average),) if average > 1 else ())
+                      + ((("ignition_share", ignition_share),) if ignition and ignition_share != 1.0 else ()))
     return per_model(evaluate([spec], [get_suite(suite)], episodes, seed_set="validation", progress=False))
 
 
@@ -109,7 +113,8 @@ def main(argv: Sequence[str] | None = None) -> None:
     for k in a.seeds:
         npz = RESULTS / f"{a.prefix}-s{k}.npz"
         to_observer(load(RESULTS / f"{a.prefix}-s{k}.pt")).save(npz)
-        candidates[k] = validation(str(npz.resolve()), a.validation, a.suite, a.lead, law, a.ignition, a.average)
+        candidates[k] = validation(str(npz.resolve()), a.validation, a.suite, a.lead, law, a.ignition, a.average,
+                                   a.ignition_share)
         print(f"seed {k}: " + ", ".join(f"{m} {v['score_v2_mean']:.3f} ({v['failed_or_unflyable']})"
                                          for m, v in candidates[k].items()), flush=True)
     best = min(candidates, key=lambda k: (candidates[k]["nonrigid"]["failed_or_unflyable"],
@@ -128,6 +133,7 @@ def main(argv: Sequence[str] | None = None) -> None:
         "lead": a.lead,
         **({"law": law} if law else {}),
         **({"ignition": a.ignition} if a.ignition else {}),
+        **({"ignition_share": a.ignition_share} if a.ignition and a.ignition_share != 1.0 else {}),
         **({"average": a.average} if a.average > 1 else {}),
         "training": {"command": f"python -m experiments.fault_id.train --scheme inversion --seed {best} "
                                 f"--flights {a.flights} --rounds 4 --validation 50{options}",
