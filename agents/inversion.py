@@ -30,9 +30,9 @@ models, with the reference's law on the true terms as the teacher and DAgger rou
 (:func:`gains`, the record's ``law``). A policy refuses an env its observer was not trained for
 (:func:`check_env`). ``ignition``: for its first seconds after the next stage's ignition the law can cancel
 the moment measured from the rigid body (:class:`Staging`, :mod:`lvgym.agents.staging`; the record's
-``ignition``). ``inversion-id`` flies its moment averaged over 6 steps and carried 3 ahead, and the measured
-moment for 4 s after the ignition: options chosen after training on validation seeds 0-1,999 (the record's
-``flight``, docs/training-results.md).
+``ignition``, and its share ``ignition_share``). ``inversion-id`` flies its moment averaged over 6 steps and
+carried 3 ahead, and for 4 s after the ignition half the measured moment and half its estimate: options chosen
+after training on validation seeds (the record's ``flight``, docs/training-results.md).
 """
 
 from __future__ import annotations
@@ -216,8 +216,8 @@ class Staging:
     misalignment, in place of the observer's estimate, while the observer's window still holds the coast;
     ``share`` < 1: that share of the measured moment and the rest of the estimate. The measured moment closes
     an incremental loop on the gimbal whose gain is the observer's error in the control power (and a gain
-    between the command and the servo, as the margin test's); half of it keeps that loop's gain margin
-    (docs/training-results.md)."""
+    between the command and the servo, as the margin test's); the share scales that loop's gain
+    (``inversion-id``: half, for 6 dB of gain margin; docs/training-results.md)."""
 
     def __init__(self, env: Any, seconds: float = 0.0, share: float = 1.0) -> None:
         if not 0.0 <= seconds <= 60.0:

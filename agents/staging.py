@@ -16,9 +16,11 @@ coast is large beside the new stage's control moment, and an estimate 40 % short
   disturbance observer; its ``a`` is the learned observer's estimate). Over the coast its steps hold the
   aerodynamic moment alone, which the new stage meets at once. The law on it is an incremental dynamic
   inversion, ``delta = delta_mean + a (alpha - omega_dot)`` (INDI; Sieberling, Chu and Mulder, J. Guid.
-  Control Dyn. 33(6), 2010): its increment loop needs the estimated ``a`` under twice the true one, and less
-  behind the servo's lag (on one validation flight it starts a 2 Hz oscillation whose cause is not found yet:
-  docs/training-results.md).
+  Control Dyn. 33(6), 2010): its increment loop feeds ``1 - a / a_true`` of the gimbal position back, so it
+  needs the estimated ``a`` under twice the true one, and less behind the servo's lag; a gain ``k`` between
+  the command and the servo that the observer reads into its ``a`` (``a_true / k``) feeds back ``k - 1``. Flying a share of
+  the measured moment (:class:`lvgym.agents.inversion.Staging`) scales that loop's gain by it
+  (docs/training-results.md).
 """
 
 from __future__ import annotations
