@@ -18,9 +18,9 @@ coast is large beside the new stage's control moment, and an estimate 40 % short
   inversion, ``delta = delta_mean + a (alpha - omega_dot)`` (INDI; Sieberling, Chu and Mulder, J. Guid.
   Control Dyn. 33(6), 2010): its increment loop feeds ``1 - a / a_true`` of the gimbal position back, so it
   needs the estimated ``a`` under twice the true one, and less behind the servo's lag; a gain ``k`` between
-  the command and the servo that the observer reads into its ``a`` (``a_true / k``) feeds back ``k - 1``. Flying a share of
-  the measured moment (:class:`lvgym.agents.inversion.Staging`) scales that loop's gain by it
-  (docs/training-results.md).
+  the command and the servo that the observer reads into its ``a`` (``a_true / k``) feeds back ``k - 1``.
+  Flying a share of the measured moment (:class:`lvgym.agents.inversion.Staging`) scales that loop's gain by
+  it (docs/training-results.md).
 """
 
 from __future__ import annotations

@@ -127,14 +127,14 @@ def shipped_avg6_lead3_ignition4(env: Any) -> InversionPolicy:
 
 def shipped_avg6_lead3_ignition4_half(env: Any) -> InversionPolicy:
     """:func:`shipped_avg6_lead3_ignition4` with half the measured moment and half the estimate for the 4 s
-    after the ignition (validation seeds: 2026-12-07, afternoon)."""
+    after the ignition (validation seeds: 2026-12-07, later)."""
     return from_file(env, TRAINED / f"{SHIPPED}.npz", name="inversion-id-ignition4-half", lead=3, average=6,
                      ignition=4.0, ignition_share=0.5)
 
 
 def shipped_avg6_lead3_ignition4_share06(env: Any) -> InversionPolicy:
     """:func:`shipped_avg6_lead3_ignition4` with 0.6 of the measured moment and 0.4 of the estimate for the 4 s
-    after the ignition (validation seeds: 2026-12-07, afternoon)."""
+    after the ignition (validation seeds: 2026-12-07, later)."""
     return from_file(env, TRAINED / f"{SHIPPED}.npz", name="inversion-id-ignition4-share06", lead=3, average=6,
                      ignition=4.0, ignition_share=0.6)
 
