@@ -31,6 +31,7 @@ import json
 import shutil
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Any
 
 from lvgym.agents.inversion import SHIPPED, TRAINED, env_record
 from lvgym.agents.observer_fit import load, to_observer
@@ -91,6 +92,15 @@ def per_model(records: list[dict]) -> dict[str, dict[str, float]]:
     return out
 
 
+def flown(lead: int = 0, law: dict[str, list[float]] | None = None, ignition: float = 0.0, average: int = 1,
+          ignition_share: float = 1.0) -> dict[str, Any]:
+    """The options the policy flies (:func:`lvgym.agents.inversion.from_file`'s), those at their defaults left
+    out but the lead: what a candidate's validation flies and what the record names."""
+    return {"lead": lead, **({"law": law} if law else {}), **({"ignition": ignition} if ignition else {}),
+            **({"average": average} if average > 1 else {}),
+            **({"ignition_share": ignition_share} if ignition and ignition_share != 1.0 else {})}
+
+
 def validation(path: str, episodes: int, suite: str = SUITE, lead: int = 0,
                law: dict[str, list[float]] | None = None, ignition: float = 0.0,
                average: int = 1, ignition_share: float = 1.0) -> dict[str, dict[str, float]]:
@@ -98,12 +108,10 @@ def validation(path: str, episodes: int, suite: str = SUITE, lead: int = 0,
     that many steps, the gains ``law``, :func:`lvgym.agents.inversion.gains`, and the measured moment for
     ``ignition`` seconds after the next stage's ignition, ``ignition_share`` of it) on ``suite``'s first
     ``episodes`` validation seeds, flown by the benchmark."""
-    pairs = tuple((model, tuple(v)) for model, v in sorted((law or {}).items()))   # a spec's options hash
-    spec = PolicySpec("inversion-id", "lvgym.agents.inversion:from_file",
-                      (("lead", lead), ("path", path)) + ((("law", pairs),) if pairs else ())
-                      + ((("ignition", ignition),) if ignition else ())
-                      + ((("average", average),) if average > 1 else ())
-                      + ((("ignition_share", ignition_share),) if ignition and ignition_share != 1.0 else ()))
+    options = dict(flown(lead, law, ignition, average, ignition_share), path=path)
+    if "law" in options:                                  # a spec's options hash
+        options["law"] = tuple((model, tuple(v)) for model, v in sorted(options["law"].items()))
+    spec = PolicySpec("inversion-id", "lvgym.agents.inversion:from_file", tuple(sorted(options.items())))
     return per_model(evaluate([spec], [get_suite(suite)], episodes, seed_set="validation", progress=False))
 
 
@@ -130,11 +138,7 @@ def main(argv: Sequence[str] | None = None) -> None:
         "policy": a.name,
         "suite": a.suite,
         "env": env_record(condition("nonrigid", a.suite).make_env()),
-        "lead": a.lead,
-        **({"law": law} if law else {}),
-        **({"ignition": a.ignition} if a.ignition else {}),
-        **({"ignition_share": a.ignition_share} if a.ignition and a.ignition_share != 1.0 else {}),
-        **({"average": a.average} if a.average > 1 else {}),
+        **flown(a.lead, law, a.ignition, a.average, a.ignition_share),
         "training": {"command": f"python -m experiments.fault_id.train --scheme inversion --seed {best} "
                                 f"--flights {a.flights} --rounds 4 --validation 50{options}",
                      "seeds": list(a.seeds), "file": f"{a.prefix}-s{best}.pt"},
