@@ -27,7 +27,7 @@ from typing import Any
 import numpy as np
 from stable_baselines3.common.vec_env import VecEnvWrapper
 
-from lvgym.benchmark.scoring import FlightLog, gimbal_command
+from lvgym.benchmark.scoring import FlightFacts, gimbal_command
 from lvgym.errors import ConfigError, check_number
 
 __all__ = ["CommandRate", "CommandRateVecEnv", "command_rate_options", "command_rate_venv"]
@@ -53,11 +53,11 @@ def command_rate_options(weight: float) -> dict[str, float] | None:
 class CommandRateVecEnv(VecEnvWrapper):
     """``venv`` (a batched lvgym TVC env, or one wrapping it) with the command-rate charge (module docstring)
     added to every row's reward; the control period, the gimbal limit and the servo's rate limit are the
-    env's (:meth:`lvgym.benchmark.scoring.FlightLog.for_env`)."""
+    env's (:meth:`lvgym.benchmark.scoring.FlightFacts.for_env`)."""
 
     def __init__(self, venv: Any, charge: CommandRate) -> None:
         super().__init__(venv)
-        facts = FlightLog.for_env(venv)
+        facts = FlightFacts.for_env(venv)
         if not facts.gimbal_limit_rad > 0.0:
             raise ConfigError("command_rate_charge", charge.weight, "0 on an env without a gimbal (an RCS task)")
         self.charge = charge

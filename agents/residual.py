@@ -26,7 +26,7 @@ from stable_baselines3.common.vec_env import VecEnvWrapper
 
 from lvgym.benchmark.policy import Policy
 import lvgym.baselines  # noqa: F401  (registers the baselines a residual policy flies on)
-from lvgym.benchmark.batch import RowPolicies, as_batch
+from lvgym.benchmark.batch import PerRow as RowPolicies, as_batch
 from lvgym.benchmark.registry import POLICIES
 from lvgym.benchmark.runner import build_policy
 from lvgym.errors import ConfigError, check_number

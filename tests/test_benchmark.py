@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from lvgym.benchmark import (SUITES, ZERO, PolicySpec, Trajectory, TrajectoryBuilder, ZeroPolicy, cvar,
+from lvgym.benchmark import (SUITES, ZERO, PolicySpec, Trajectory, ZeroPolicy, cvar,
                              degradation, episode_metrics, evaluate, get_suite, markdown_table, play_episode,
                              run_episode, summarize)
 from lvgym.benchmark.results import csv_text
@@ -65,21 +65,6 @@ def test_episode_metrics_by_hand():
     assert m["failed"] is True and m["failure_reason"] == "q-alpha beyond the structural limit"
     ok = episode_metrics(hand_trajectory(termination=""))
     assert ok["failed"] is False and ok["failure_reason"] == ""
-
-
-def test_trajectory_builder_reads_the_step_rate_errors():
-    b = TrajectoryBuilder(dt_s=0.5)
-    cum = np.zeros(3)
-    for k, e in enumerate([[0.1, 0.2, 0.0], [0.0, 0.4, 0.1]]):
-        cum = cum + np.array(e) * 0.5
-        b.add(-1.0, {"rate_error": np.array(e), "gimbal": np.array([0.01, 0.0]), "alpha_total": 0.1,
-                     "qalpha_pa_deg": 5.0, "time": 0.5 * (k + 1), "qbar": 1e4,
-                     "termination": "" if k == 0 else "attitude error beyond the limit"})
-    t = b.build()
-    np.testing.assert_array_equal(t.rate_error_radps, [[0.1, 0.2, 0.0], [0.0, 0.4, 0.1]])
-    m = episode_metrics(t)
-    assert m["rate_error_rad"] == pytest.approx(cum[1] + cum[2])
-    assert m["failure_reason"] == "attitude error beyond the limit"
 
 
 def test_cvar_is_the_mean_of_the_worst_tenth():

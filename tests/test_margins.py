@@ -11,7 +11,8 @@ import lvgym.cli.policies  # noqa: F401  (registers the built-in policies: pid)
 from lvgym.benchmark import get_suite
 from lvgym.benchmark.margins import (EXPERIMENTS, RATE_ERROR_FLOOR_RADPS, RATE_LIMIT_FLOOR_S, MarginOptions, _summary, bounds,
                                      margins_table, time_domain_margins, verdict)
-from lvgym.benchmark.perturb import ActuatorDelay, GainPolicy, db_to_gain, find_threshold, gain_to_db
+from lvgym.benchmark.perturb import db_to_gain, find_threshold, gain_to_db
+from lvgym.benchmark.rows import OneRowEnv, RowDelay, scaled
 from lvgym.benchmark.registry import POLICIES
 from lvgym.benchmark.suites import Condition
 from lvgym.cli.margins import main
@@ -36,35 +37,32 @@ class Fixed:
         return self.action.copy()
 
 
-def test_gain_policy_multiplies_the_action():
-    inner = Fixed(np.array([0.3, -0.5], dtype=np.float32))
-    doubled = GainPolicy(inner, 2.0)
-    a = doubled.act(np.zeros(14), {})
-    assert a.dtype == np.float32 and a.tolist() == pytest.approx([0.6, -1.0])
-    assert GainPolicy(inner, 0.5).act(np.zeros(14), {}).tolist() == pytest.approx([0.15, -0.25])
-    assert GainPolicy(inner, 0.0).act(np.zeros(14), {}).tolist() == [0.0, 0.0]
-    assert doubled.name == "fixed*2"
-    doubled.reset()
-    assert inner.resets == 1
+def test_the_gain_multiplies_each_rows_action():
+    a = np.array([[0.3, -0.5], [0.25, 1.0]], dtype=np.float32)
+    doubled = scaled(a, np.array([2.0, 0.5]), "fixed")
+    assert doubled.dtype == np.float32
+    np.testing.assert_allclose(doubled, [[0.6, -1.0], [0.125, 0.5]], rtol=1e-7)
+    assert scaled(a, np.zeros(2), "fixed").tolist() == [[0.0, 0.0], [0.0, 0.0]]
     with pytest.raises(ValueError, match="Box"):
-        GainPolicy(Fixed(np.array([1, 2])), 2.0).act(np.zeros(14), {})
-    with pytest.raises(ValueError, match="gain"):
-        GainPolicy(inner, -1.0)
+        scaled(np.array([[1, 2]]), np.array([2.0]), "fixed")
     assert db_to_gain(20.0) == pytest.approx(10.0) and db_to_gain(-6.0) == pytest.approx(0.501187, rel=1e-5)
     assert gain_to_db(0.5) == pytest.approx(-6.0206, abs=1e-4) and gain_to_db(0.0) == -math.inf
 
 
-def _open_loop_run(env, actions, seed=3, servo_delay=None):
-    """Commands and gimbal angles per control step of an open-loop action sequence."""
-    env.reset(seed=seed)
+def _open_loop_run(env, actions, seed=3, servo_delay=None, delay_steps=0):
+    """Commands and gimbal angles per control step of an open-loop action sequence, delayed by ``delay_steps``
+    physics steps (:class:`RowDelay` over the single env as a batch of one row)."""
+    one = OneRowEnv(env)
+    one.reset(seed=[seed])
     if servo_delay is not None:
         ACTUATOR.view(env.unwrapped.state.sim.actuator, "delay")[0, 0] = servo_delay
+    delay = RowDelay(one, [delay_steps]) if delay_steps else None
     commands, gimbals = [], []
     for a in actions:
-        *_, terminated, truncated, info = env.step(a)
+        *_, terminated, truncated, info = one.step(a[None] if delay is None else delay.apply(a[None]))
         commands.append(ACTUATOR.view(env.unwrapped.state.sim.actuator, "command")[0].copy())
-        gimbals.append(np.asarray(info["gimbal"]).copy())
-        if terminated or truncated:
+        gimbals.append(np.asarray(info["gimbal"][0]).copy())
+        if terminated[0] or truncated[0]:
             break
     return np.array(commands), np.array(gimbals)
 
@@ -84,9 +82,7 @@ def test_delay_shifts_the_commands_by_whole_periods(open_loop_env):
     per = env.unwrapped.task.substeps
     assert per == 2 and len(c0) == 50
     for periods in (1, 2, 3):
-        delayed = ActuatorDelay(env, periods * per)
-        assert delayed.delay_s == pytest.approx(periods * 0.02)
-        c, _ = _open_loop_run(delayed, actions)
+        c, _ = _open_loop_run(env, actions, delay_steps=periods * per)
         np.testing.assert_array_equal(c[periods:], c0[:-periods])
         np.testing.assert_array_equal(c[:periods], 0.0)           # the buffer starts neutral
 
@@ -95,32 +91,34 @@ def test_delay_of_single_physics_steps_goes_to_the_servo(open_loop_env):
     env = open_loop_env
     actions = np.random.default_rng(2).uniform(-1.0, 1.0, (50, 2)).astype(np.float32)
     c0, g0 = _open_loop_run(env, actions)
-    one = ActuatorDelay(env, 1)
-    c1, g1 = _open_loop_run(one, actions)
+    c1, g1 = _open_loop_run(env, actions, delay_steps=1)
     assert ACTUATOR.view(env.unwrapped.state.sim.actuator, "delay")[0, 0] == 1.0
     np.testing.assert_array_equal(c1, c0)                          # the command is on time ...
     assert not np.array_equal(g1, g0)                              # ... the servo follows it 10 ms late
     # a whole period through the servo's delay field is the same pure shift as a period in the buffer
     _, g_servo = _open_loop_run(env, actions, servo_delay=2)
-    _, g_buffer = _open_loop_run(ActuatorDelay(env, 2), actions)
+    _, g_buffer = _open_loop_run(env, actions, delay_steps=2)
     np.testing.assert_array_equal(g_servo, g_buffer)
-    with pytest.raises(ValueError, match="whole number"):
-        ActuatorDelay(env, 1.5)
+    one = OneRowEnv(env)
+    one.reset(seed=[3])
+    with pytest.raises(ValueError, match="whole numbers"):
+        RowDelay(one, [1.5])
 
 
 def test_delay_adds_to_the_dispersed_servo_delay():
     env = Condition("t", "lvgym/SmileAscent-v1", model="rigid", randomize=("servo_delay",),
                     options=(("mission_time_s", 0.1),)).make_env()
+    one = OneRowEnv(env)
     dispersed = {}
     for seed in range(8):
-        env.reset(seed=seed)
+        one.reset(seed=[seed])
         dispersed[seed] = int(ACTUATOR.view(env.unwrapped.state.sim.actuator, "delay")[0, 0])
     assert set(dispersed.values()) == {0, 1}
-    wrapped = ActuatorDelay(env, 1)
     for seed, d0 in dispersed.items():
-        wrapped.reset(seed=seed)
+        one.reset(seed=[seed])
+        delay = RowDelay(one, [1])
         field = int(ACTUATOR.view(env.unwrapped.state.sim.actuator, "delay")[0, 0])
-        assert field + 2 * len(wrapped._queue) == d0 + 1 and field < 2
+        assert field + 2 * int(delay.length[0]) == d0 + 1 and field < 2
 
 
 def test_search_finds_a_known_threshold():

@@ -1,6 +1,8 @@
 """The frozen benchmark protocol: named suites of conditions with fixed seeds, metrics, and the runner.
 
-- :mod:`.policy`: the :class:`Policy` interface (``name``, ``reset()``, ``act(observation, info)``);
+- :mod:`.batch`, :mod:`.policy`: the controllers' one interface, the batch law (``reset(rows)``,
+  ``act(rows, observations, info)``), and its one-row face, the :class:`Policy` (``name``, ``reset()``,
+  ``act(observation, info)``) that a user's controller implements;
 - :mod:`.suites`: :data:`SUITES` (conditions and seed sets, :data:`PROTOCOL_VERSION`);
 - :mod:`.metrics`: per-episode metrics of v0, per-suite mean with its interval / std / CVaR10 / failure
   rate, ranks, degradation;
@@ -19,8 +21,9 @@
 """
 
 from .compare import compare, protocol_metric, run_groups
-from .metrics import (CVAR_LEVEL, SUMMARY_METRICS, V1_METRICS, Trajectory, TrajectoryBuilder, cvar, degradation,
+from .metrics import (CVAR_LEVEL, SUMMARY_METRICS, V1_METRICS, Trajectory, cvar, degradation,
                       episode_metrics, normalise, rank, summarize)
+from .batch import BatchLaw, BatchPolicy, RowFace
 from .policy import Policy, ZeroPolicy
 from .results import atomic_write, atomic_write_text, markdown_table, write_results
 from .registry import register_policy, register_policy_loader
@@ -29,8 +32,8 @@ from .runner import (EXECUTORS, ZERO, PolicyError, PolicySpec, build_policy, eva
 from .suites import (DEFAULT_SUITE, PROTOCOL_VERSION, SEED_SETS, SUITES, TEST_SEED0, VALIDATION_SEED0, Condition,
                      Suite, condition, get_suite)
 
-__all__ = ["CVAR_LEVEL", "Condition", "DEFAULT_SUITE", "EXECUTORS", "PROTOCOL_VERSION", "Policy", "PolicySpec",
-           "SEED_SETS", "SUITES", "SUMMARY_METRICS", "Suite", "TEST_SEED0", "Trajectory", "TrajectoryBuilder",
+__all__ = ["BatchLaw", "BatchPolicy", "RowFace", "CVAR_LEVEL", "Condition", "DEFAULT_SUITE", "EXECUTORS", "PROTOCOL_VERSION", "Policy", "PolicySpec",
+           "SEED_SETS", "SUITES", "SUMMARY_METRICS", "Suite", "TEST_SEED0", "Trajectory",
            "V1_METRICS", "VALIDATION_SEED0", "ZERO", "ZeroPolicy", "atomic_write", "atomic_write_text", "build_policy",
            "compare", "condition", "cvar", "degradation", "episode_metrics", "evaluate", "get_suite", "make_tasks",
            "protocol_metric", "markdown_table", "normalise", "play_episode", "rank", "register_policy",

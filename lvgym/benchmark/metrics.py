@@ -51,7 +51,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -91,34 +91,6 @@ class Trajectory:
     time_s: np.ndarray
     qbar_pa: np.ndarray
     termination: str = ""
-
-
-@dataclass
-class TrajectoryBuilder:
-    """Collects a :class:`Trajectory` from the ``info`` dicts of ``env.step`` (lvgym envs): the step's
-    rate error is the env's own ``info["rate_error"]`` (the one it integrates into
-    ``info["cumulative_rate_error"]``)."""
-
-    dt_s: float
-    _rows: list[tuple[Any, ...]] = field(default_factory=list)
-    termination: str = ""
-
-    def add(self, reward: float, info: dict[str, Any]) -> None:
-        """Record one step's reward and info."""
-        rate = np.asarray(info["rate_error"], dtype=float)
-        self._rows.append((rate, np.asarray(info["gimbal"], dtype=float), float(info["alpha_total"]),
-                           float(info["qalpha_pa_deg"]), float(reward), float(info["time"]), float(info["qbar"])))
-        if info.get("termination"):
-            self.termination = str(info["termination"])
-
-    def build(self) -> Trajectory:
-        """The trajectory so far."""
-        n = len(self._rows)
-        cols = list(zip(*self._rows)) if n else [[]] * 7
-        return Trajectory(self.dt_s, np.reshape(np.array(cols[0], dtype=float), (n, 3)),
-                          np.reshape(np.array(cols[1], dtype=float), (n, 2)), np.array(cols[2], dtype=float),
-                          np.array(cols[3], dtype=float), np.array(cols[4], dtype=float),
-                          np.array(cols[5], dtype=float), np.array(cols[6], dtype=float), self.termination)
 
 
 def _nanmax(x: np.ndarray) -> float:

@@ -2,8 +2,9 @@
 
 A policy sees what a Gymnasium env returns and nothing else: the observation (SMILE's 14 entries by
 default, named in order by the env's ``unwrapped.observation_layout``,
-:data:`lvgym.envs.layouts.OBSERVATIONS`) and the ``info`` dict of the last step (an empty dict right after
-a reset). It returns an action of the env's action space.
+:data:`lvgym.envs.layouts.OBSERVATIONS`) and the ``info`` dict of the last step (right after a reset, the
+reset's). It returns an action of the env's action space. The shipped controllers are batch laws
+(:mod:`.batch`) and this interface is their one-row face; a user's policy needs only this interface.
 
 >>> policy = ZeroPolicy()
 >>> policy.reset()
@@ -13,9 +14,12 @@ array([0., 0.], dtype=float32)
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
+
+from .batch import BatchLaw, RowFace
 
 
 @runtime_checkable
@@ -30,38 +34,31 @@ class Policy(Protocol):
     def act(self, observation: np.ndarray, info: dict[str, Any]) -> np.ndarray: ...
 
 
-class ZeroPolicy:
-    """No control: the gimbal stays centred (``Box`` actions of zeros; ``rcs``: the no-pulse action 1)."""
+class ZeroLaw(BatchLaw):
+    """No control for the rows of a batched env: every row's action is the gimbal centred (``Box`` actions of
+    zeros) or, for ``discrete`` (``rcs``), the no-pulse action 1."""
 
-    name = "zero"
+    def __init__(self, n_actions: int = 2, discrete: bool = False, n: int = 1, name: str = "zero") -> None:
+        self.name = name
+        self.action = (np.ones(int(n_actions), dtype=np.int64) if discrete
+                       else np.zeros(int(n_actions), dtype=np.float32))
+        self.allocate(n)
 
-    def __init__(self, n_actions: int = 2, discrete: bool = False) -> None:
-        self.n_actions = int(n_actions)
-        self.discrete = bool(discrete)
-
-    def reset(self) -> None:
+    def _rows(self, n: int) -> None:
         pass
-
-    def act(self, observation: np.ndarray, info: dict[str, Any]) -> np.ndarray:
-        if self.discrete:
-            return np.ones(self.n_actions, dtype=np.int64)
-        return np.zeros(self.n_actions, dtype=np.float32)
-
-    def batch(self, n: int) -> ZeroBatch:
-        """The same for ``n`` rows of a batched env (:mod:`.batch`)."""
-        return ZeroBatch(self)
-
-
-class ZeroBatch:
-    """:class:`ZeroPolicy` for the rows of a batched env (the interface of :mod:`.batch`): every row's
-    action is the policy's own."""
-
-    def __init__(self, policy: ZeroPolicy) -> None:
-        self.name = policy.name
-        self._action = policy.act(np.zeros(0, np.float32), {})
 
     def reset(self, rows: Any) -> None:
         pass
 
-    def act(self, rows: Any, observations: np.ndarray, info: dict[str, Any]) -> np.ndarray:
-        return np.tile(self._action, (np.size(rows), 1))
+    def act(self, rows: Any, observations: np.ndarray, info: Mapping[str, Any]) -> np.ndarray:
+        return np.tile(self.action, (np.size(rows), 1))
+
+
+class ZeroPolicy(RowFace):
+    """No control (:class:`ZeroLaw`, one row)."""
+
+    name = "zero"
+
+    def __init__(self, n_actions: int = 2, discrete: bool = False) -> None:
+        self.law = ZeroLaw(n_actions, discrete)
+        self.n_actions, self.discrete = int(n_actions), bool(discrete)

@@ -1,16 +1,17 @@
-"""Episodes flown as rows of a batched env: one policy call per step for many seeds, the single env's records.
+"""The one way the benchmark flies episodes: as rows of a batched env, one policy call per step for all rows.
 
 :func:`fly_rows` resets a batched lvgym env (``Condition.make_vec_env(n)``, a Gymnasium ``VectorEnv``) with
 one seed per row (row ``i`` flies exactly the single env's episode of ``seeds[i]``) and steps every row
 together: each step, each :class:`~.batch.BatchPolicy` acts for its rows still flying; a row that ends
 (terminated or truncated) is masked out (no more policy calls, nothing more recorded; the env's autoreset
 flies it on with the neutral action, unseen) and the flight stops when every row has ended. Per row it can
-scale the actions by a gain and delay them by whole physics steps (the margins' perturbations,
-:mod:`.perturb`).
+scale the actions by a gain (:func:`scaled`) and delay them by whole physics steps (:class:`RowDelay`): the
+margins' perturbations (:mod:`.margins`). A single env flies the same way as a batch of one
+(:class:`OneRowEnv`: :func:`~.runner.play_episode`).
 
-:class:`RowsLog` keeps whole steps as arrays (one entry per row) and cuts each row's episode out at the end,
-so the records are those of :func:`~.runner.play_episode` on the single env, to the bit: the same
-:func:`~.metrics.episode_metrics` and :func:`~.scoring.flight_metrics` of the same arrays.
+:class:`RowsLog` keeps whole steps as arrays (one entry per row) and cuts each row's episode out at the end
+into its record: protocol v0's :func:`~.metrics.episode_metrics`, v1's :func:`~.scoring.flight_metrics` and
+v2's :func:`~.flyability.flyability_metrics` of the same arrays.
 """
 
 from __future__ import annotations
@@ -20,14 +21,16 @@ from typing import Any
 
 import numpy as np
 
-from .batch import BatchPolicy
-from .metrics import Trajectory, combined_record, episode_metrics
+from lvgym.simulator.layouts import ACTUATOR
+
+from .batch import BatchPolicy, OneRowInfo
 from .flyability import flyability_metrics
-from .scoring import FlightColumns, FlightLog, flight_metrics, gimbal_command
+from .metrics import Trajectory, combined_record, episode_metrics
+from .scoring import FlightColumns, FlightFacts, flight_metrics, gimbal_command
 
-__all__ = ["RowsLog", "fly_rows", "neutral_action"]
+__all__ = ["OneRowEnv", "RowDelay", "RowsLog", "fly_rows", "neutral_action", "scaled"]
 
-#: the info entries kept per step (the single env's TrajectoryBuilder and FlightLog read these)
+#: the info entries kept per step (what the records read)
 STEP_KEYS = ("rate_error", "gimbal", "alpha_total", "qalpha_pa_deg", "time", "qbar", "gimbal_rate", "eta",
              "slosh_angles", "controller_on", "qalpha_limit_pa_deg")
 
@@ -41,13 +44,12 @@ def neutral_action(space: Any) -> np.ndarray:
 
 class RowsLog:
     """The steps of every row of a batched env, kept whole (``add`` after each ``step``, ``end`` for the rows
-    that ended), and each row's record (:meth:`records`) as the single env's :func:`~.runner.play_episode`
-    gives it."""
+    that ended), and each row's record (:meth:`records`)."""
 
     def __init__(self, env: Any) -> None:
         u = env.unwrapped
         self.env, self.n = env, int(env.num_envs)
-        self.facts = FlightLog.for_env(env)                # the task's facts (control period, limits, gyro)
+        self.facts = FlightFacts.for_env(env)              # the task's facts (control period, limits, gyro)
         self.dt_s = float(u.task.control_dt_s)
         self.steps: dict[str, list[np.ndarray]] = {key: [] for key in ("reward", "gyro", "action", *STEP_KEYS)}
         self.length = np.zeros(self.n, dtype=np.int64)
@@ -58,14 +60,14 @@ class RowsLog:
     def add(self, live: np.ndarray, observations: np.ndarray, reward: np.ndarray, info: dict[str, Any],
             actions: np.ndarray | None = None) -> None:
         """One step of every row; ``live``: the rows still flying before it (they count it); ``actions``:
-        the policies' actions of the step (before any delay; kept with a gimbal, as ``FlightLog.step``)."""
+        the policies' actions of the step (before any delay; kept with a gimbal: protocol v2's commands)."""
         steps = self.steps
         steps["reward"].append(np.asarray(reward, dtype=float))
         if actions is not None and self.facts.gimbal_limit_rad > 0.0:
             steps["action"].append(np.array(actions, dtype=float))
         for key in STEP_KEYS:
             steps[key].append(np.asarray(info[key]))
-        if self.facts.gyro_index is not None:        # the gyro's view against the body rate, as FlightLog.step
+        if self.facts.gyro_index is not None:        # the gyro's view against the body rate
             u = self.env.unwrapped
             w = u.sim.state(u.state.sim, "omega_bi_b")
             ip, iy, iref = self.facts.gyro_index
@@ -121,12 +123,88 @@ class RowsLog:
         return out
 
 
-def _scaled(actions: np.ndarray, gains: np.ndarray, name: str) -> np.ndarray:
-    """``actions`` (m, n_a) times the rows' ``gains`` (m,), in the actions' own precision (as
-    :class:`~.perturb.GainPolicy` scales one row's)."""
+def scaled(actions: np.ndarray, gains: np.ndarray, name: str) -> np.ndarray:
+    """``actions`` (m, n_a) times the rows' ``gains`` (m,) [-], in the actions' own precision (a ``Box``
+    action; the env then clips it to the action space, as it clips every action): the margins' gain,
+    ``20 log10 k`` dB."""
     if actions.dtype.kind not in "fc":
         raise ValueError(f"policy {name!r} gave actions of dtype {actions.dtype}: a gain needs a Box (TVC) action")
     return (actions * gains.astype(actions.dtype)[:, None]).astype(actions.dtype, copy=False)
+
+
+class RowDelay:
+    """A pure extra delay of ``steps[b]`` physics steps (``physics_dt_s``, 10 ms by default; 0: none) between the
+    policy of row ``b`` of a batched lvgym TVC env and its actuator. ``steps = n P + m`` (``P`` physics steps
+    per control period): the whole periods ``n`` are a first-in first-out buffer of actions that starts with
+    the neutral action (zeros; the env's own computational delay, ``action_delay_steps``, is such a buffer too);
+    the ``m`` steps are added to the row's servo delay, on top of its dispersed one (layout
+    :data:`lvgym.simulator.layouts.ACTUATOR`, field ``delay``: the first so many physics steps of a control
+    period follow the previous period's command; when the sum reaches ``P`` a period moves into the buffer),
+    written here, right after the env's reset. The gimbal command is held over a control period, so both are
+    the same pure shift of the command signal, and no equation is written twice. :meth:`apply` takes the
+    actions the policies gave every row and returns those the env gets (float64, which holds every action's
+    value exactly). The buffer sits, as the env's own delay does, before the env masks the command while the
+    controller is off; the servo's part acts after it."""
+
+    def __init__(self, env: Any, steps: Any) -> None:
+        u = env.unwrapped
+        task = u.task
+        if task.control != "tvc":
+            raise ValueError(f"control = {task.control!r}: an actuator delay needs a TVC env")
+        n = int(env.num_envs)
+        raw = np.asarray(steps).reshape(-1)
+        if raw.size != n or np.any(raw < 0) or np.any(raw != np.round(raw)):
+            raise ValueError(f"steps = {raw.tolist()!r}: {n} whole numbers of physics steps >= 0, one per row")
+        steps = raw.astype(np.int64)
+        per = int(task.substeps)
+        self.physics_dt_s = float(task.control_dt_s) / per
+        delay = ACTUATOR.view(u.state.sim.actuator, "delay")
+        self.length = np.zeros(n, dtype=np.int64)
+        for b in np.flatnonzero(steps).tolist():
+            periods, servo_steps = divmod(int(steps[b]), per)
+            more, delay[b, 0] = divmod(int(round(delay[b, 0])) + servo_steps, per)
+            self.length[b] = periods + more
+        self.rows = np.flatnonzero(self.length)
+        n_a = int(np.prod(env.single_action_space.shape))
+        self._buffer = np.zeros((n, max(1, int(self.length.max(initial=0))), n_a))
+        self._next = np.zeros(n, dtype=np.int64)
+
+    def apply(self, actions: np.ndarray) -> np.ndarray:
+        """The actions (n, n_a) the env gets this step: a buffered row's oldest action (its buffer takes
+        this one), the others' own."""
+        q = self.rows
+        if not q.size:
+            return actions
+        a = np.asarray(actions)
+        out = a.astype(np.float64)
+        k = self._next[q]
+        out[q] = self._buffer[q, k]
+        self._buffer[q, k] = a[q]
+        self._next[q] = (k + 1) % self.length[q]
+        return out
+
+
+class OneRowEnv:
+    """A single lvgym env (``gymnasium.Env``, wrapped or not) as a batched env of one row, the face
+    :func:`fly_rows` flies: ``reset(seed=[s])`` and ``step(actions (1, n_a))`` return the single env's results
+    with a leading axis of one (its info read as one row, :class:`~.batch.OneRowInfo`)."""
+
+    num_envs = 1
+
+    def __init__(self, env: Any) -> None:
+        self.env = env
+        self.unwrapped = env.unwrapped
+        self.single_action_space = env.action_space
+
+    def reset(self, seed: Sequence[int]) -> tuple[np.ndarray, OneRowInfo]:
+        (s,) = seed
+        obs, info = self.env.reset(seed=int(s))
+        return np.asarray(obs)[None], OneRowInfo(info)
+
+    def step(self, actions: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, OneRowInfo]:
+        obs, reward, terminated, truncated, info = self.env.step(actions[0])
+        return (np.asarray(obs)[None], np.array([reward], dtype=float), np.array([terminated]),
+                np.array([truncated]), OneRowInfo(info))
 
 
 def fly_rows(env: Any, seeds: Sequence[int], groups: Sequence[tuple[BatchPolicy, Sequence[int]]], *,
@@ -135,11 +213,11 @@ def fly_rows(env: Any, seeds: Sequence[int], groups: Sequence[tuple[BatchPolicy,
     """One episode per row of the batched lvgym env ``env`` (``env.num_envs == len(seeds)``), row ``i``
     reset with ``seeds[i]``; ``groups``: (batch policy, its rows) pairs that cover every row once (a
     policy's batch holds at least ``num_envs`` rows and is addressed by the env's row numbers). ``gains``
-    (per row, 1: none) scales each row's actions (:class:`~.perturb.GainPolicy`), ``delay_steps`` (per row,
-    0: none) delays them by whole physics steps (:class:`~.perturb.RowDelay`). Returns the rows' records in
-    row order, each as :func:`~.runner.play_episode` gives it for the single env with that seed (and
-    perturbation); ``first_observations``, if given, receives the reset's observation of every row;
-    ``flyability``: add protocol v2's flyability fields (:mod:`.flyability`) to every record."""
+    (per row, 1: none) scales each row's actions (:func:`scaled`), ``delay_steps`` (per row, 0: none) delays
+    them by whole physics steps (:class:`RowDelay`). Returns the rows' records in row order, each that of the
+    single env's episode with that seed (and perturbation); ``first_observations``, if given, receives the
+    reset's observation of every row; ``flyability``: add protocol v2's flyability fields
+    (:mod:`.flyability`) to every record."""
     n = int(env.num_envs)
     if len(seeds) != n:
         raise ValueError(f"{len(seeds)} seeds for a batched env of {n} rows")
@@ -155,10 +233,8 @@ def fly_rows(env: Any, seeds: Sequence[int], groups: Sequence[tuple[BatchPolicy,
         first_observations.extend(np.array(o) for o in obs)
     delay = None
     if delay_steps is not None and np.any(np.asarray(delay_steps) != 0):
-        from .perturb import RowDelay
-
         delay = RowDelay(env, delay_steps)
-    neutral = neutral_action(env.unwrapped.single_action_space)
+    neutral = neutral_action(env.single_action_space)
     log = RowsLog(env)
     for policy, rows in groups:
         policy.reset(rows)
@@ -169,7 +245,7 @@ def fly_rows(env: Any, seeds: Sequence[int], groups: Sequence[tuple[BatchPolicy,
             live = rows[~done[rows]]
             if live.size:
                 a = np.asarray(policy.act(live, obs[live], info))
-                acted.append((live, a if gain is None else _scaled(a, gain[live], policy.name)))
+                acted.append((live, a if gain is None else scaled(a, gain[live], policy.name)))
         dtype = np.result_type(neutral.dtype, *(a.dtype for _, a in acted))
         actions = np.broadcast_to(neutral.astype(dtype), (n, *neutral.shape)).copy()
         for live, a in acted:

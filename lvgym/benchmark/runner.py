@@ -24,13 +24,11 @@ import numpy as np
 from lvgym.errors import ConfigError
 from lvgym.parallel import EXECUTORS, check_workers, default_workers, run_map
 
-from .batch import BatchPolicy, as_batch
+from .batch import BatchPolicy, as_batch, own_rows
 from .factory import load_factory
-from .flyability import applies, flyability_metrics
-from .metrics import TrajectoryBuilder, combined_record, episode_metrics
+from .flyability import applies
 from .policy import Policy, ZeroPolicy
-from .rows import fly_rows
-from .scoring import FlightLog, flight_metrics
+from .rows import OneRowEnv, fly_rows
 from .suites import PROTOCOL_VERSION, Condition, Suite
 
 
@@ -115,32 +113,23 @@ def _env(condition: Condition) -> Any:
     return _ENVS[condition]
 
 
-def play_episode(policy: Policy, env: Any, seed: int, *, flyability: bool = False) -> dict[str, Any]:
-    """Fly one episode of a policy object on an lvgym env reset with ``seed``; returns protocol v0's
+def play_episode(policy: Policy, env: Any, seed: int, *, flyability: bool = False, gain: float = 1.0,
+                 delay_steps: int = 0) -> dict[str, Any]:
+    """Fly one episode of a policy object on an lvgym env (single, wrapped or not) reset with ``seed``: the
+    env as a batched env of one row and the policy's own state (:func:`~.batch.own_rows`) through
+    :func:`~.rows.fly_rows`, the one path every flight of the benchmark takes. Returns protocol v0's
     :func:`~.metrics.episode_metrics` (frozen) and, beside them, the v1 metrics of
     :func:`~.scoring.flight_metrics` (``score``, the per-phase rate errors, the flexibility metrics,
     ``qalpha_cost_s``; its ``rate_error_rad`` and failure fields are v0's, bit for bit); with
     ``flyability`` (protocol v2), also :func:`~.flyability.flyability_metrics` (``flyable``, ``score_v2``,
     the commanded gimbal rate); with an env that draws in-flight faults, ``fault`` (its name, ``""`` for
-    none; :mod:`lvgym.envs.faults`). In-process (e.g. a validation callback during training:
+    none; :mod:`lvgym.envs.faults`). ``gain`` [-] and ``delay_steps`` [physics steps] perturb the loop as the
+    margins do (1 and 0: none). In-process (e.g. a validation callback during training:
     ``play_episode(policy, condition.make_env(), seed)`` over ``suite.seeds("validation", n)``)."""
-    obs, info = env.reset(seed=int(seed))
-    policy.reset()
-    traj = TrajectoryBuilder(float(env.unwrapped.task.control_dt_s))
-    log = FlightLog.for_env(env)
-    while True:
-        action = policy.act(obs, info)
-        obs, reward, terminated, truncated, info = env.step(action)
-        traj.add(reward, info)
-        log.step(env, obs, reward, info, action)
-        if terminated or truncated:
-            break
-    record = combined_record(episode_metrics(traj.build()), flight_metrics(log))
-    if flyability:
-        record.update(flyability_metrics(log, log.columns(), record))
-    if "fault" in info:                       # an env that draws faults names the episode's at its end
-        record["fault"] = str(info["fault"])
-    return record
+    gains = None if gain == 1.0 else [float(gain)]
+    delays = [int(delay_steps)] if delay_steps else None
+    return fly_rows(OneRowEnv(env), [int(seed)], [(own_rows(policy), [0])], gains=gains, delay_steps=delays,
+                    flyability=flyability)[0]
 
 
 def episode_objects(policy_spec: PolicySpec, condition: Condition) -> tuple[Any, Policy]:

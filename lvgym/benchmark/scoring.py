@@ -1,8 +1,8 @@
 """Episode metrics for protocol v1: a headline score that charges failures, rate errors per flight phase,
 what flexibility does, and a q-alpha constraint cost (protocol v0's metrics, :mod:`.metrics`, are frozen).
 
-:class:`FlightLog` collects an episode from the ``info`` dicts of ``env.step`` and the task's options;
-:func:`flight_metrics` gives, in SI units and radians:
+:class:`~.rows.RowsLog` collects an episode's steps from the ``info`` dicts of the env's steps and
+:class:`FlightFacts` holds the task's options; :func:`flight_metrics` gives, in SI units and radians:
 
 ==========================  ======  =================================================================
 score                       rad     ``rate_error_rad`` plus, for a failed episode, ``failure_penalty_rad_per_s``
@@ -35,12 +35,12 @@ failed, failure_reason      -       as v0
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
-__all__ = ["FlightColumns", "FlightLog", "IDEAL_OBSERVATIONS", "MAX_Q_FRACTION", "PHASES", "QALPHA_COST_FRACTION",
+__all__ = ["FlightColumns", "FlightFacts", "IDEAL_OBSERVATIONS", "MAX_Q_FRACTION", "PHASES", "QALPHA_COST_FRACTION",
            "flight_metrics", "gimbal_command"]
 
 PHASES = ("boost", "max_q", "coast", "upper")
@@ -54,14 +54,14 @@ IDEAL_OBSERVATIONS = ("state",)
 GYRO_ENTRIES = ("pitch_rate_error", "yaw_rate_error", "pitch_rate_reference")
 
 
-@dataclass
-class FlightLog:
-    """One episode, step by step (``add(reward, info)``, or :meth:`step` with the env and observation),
-    with the task's facts: ``dt_s`` control period, ``mission_time_s``, ``failure_penalty_rad_per_s``,
-    ``qalpha_limit_pa_deg``, ``gimbal_rate_limit_radps`` (0: not counted), ``gyro_index``: the
-    observation's indices of :data:`GYRO_ENTRIES` (None: an ideal-state observation, no gyro) and
-    ``gimbal_limit_rad`` (0: no gimbal, an RCS task; else the actions are kept as gimbal commands for
-    protocol v2's :mod:`.flyability`). Build it from an lvgym env with :meth:`for_env`."""
+@dataclass(frozen=True)
+class FlightFacts:
+    """The task's facts a flight's metrics need: ``dt_s`` control period, ``mission_time_s``,
+    ``failure_penalty_rad_per_s``, ``qalpha_limit_pa_deg``, ``gimbal_rate_limit_radps`` (0: not counted),
+    ``gyro_index``: the observation's indices of :data:`GYRO_ENTRIES` (None: an ideal-state observation, no gyro)
+    and ``gimbal_limit_rad`` (0: no gimbal, an RCS task; else the actions are kept as gimbal commands for
+    protocol v2's :mod:`.flyability`). Build them from an lvgym env with :meth:`for_env`; the flight's steps are
+    kept by :class:`~.rows.RowsLog`."""
 
     dt_s: float
     mission_time_s: float
@@ -70,16 +70,9 @@ class FlightLog:
     gimbal_rate_limit_radps: float = 0.0
     gyro_index: tuple[int, int, int] | None = None
     gimbal_limit_rad: float = 0.0
-    rows: list[tuple[Any, ...]] = field(default_factory=list)
-    gyro_rows: list[tuple[float, float]] = field(default_factory=list)
-    actions: list[np.ndarray] = field(default_factory=list)
-    eta: list[Any] = field(default_factory=list)
-    slosh: list[Any] = field(default_factory=list)
-    events: list[tuple[float, str]] = field(default_factory=list)
-    termination: str = ""
 
     @classmethod
-    def for_env(cls, env: Any) -> FlightLog:
+    def for_env(cls, env: Any) -> FlightFacts:
         u = env.unwrapped
         s = u.task
         gyro = None
@@ -88,43 +81,6 @@ class FlightLog:
         limit = float(u.gimbal_limit) if s.control == "tvc" else 0.0
         return cls(s.control_dt_s, s.mission_time_s, s.failure_penalty_rad_per_s, s.qalpha_limit_pa_deg,
                    math.radians(s.gimbal_rate_limit_degps), gyro, limit)
-
-    def add(self, reward: float, info: dict[str, Any], gyro_minus_body_radps: tuple[float, float] | None = None,
-            action: Any = None) -> None:
-        """Record one step's info (and, with a gyro, the step's gyro minus body rate, pitch and yaw [rad/s];
-        with a gimbal, the step's ``action``: the policy's, before the env clips it). Arrays are kept as
-        they come (an env's info holds fresh arrays every step) and reduced by :func:`flight_metrics`."""
-        self.rows.append((info["time"], info["rate_error"], info["qbar"], info["qalpha_pa_deg"],
-                          info.get("gimbal_rate", (0.0, 0.0)), info.get("controller_on", True),
-                          info.get("qalpha_limit_pa_deg", self.qalpha_limit_pa_deg)))
-        if gyro_minus_body_radps is not None:
-            self.gyro_rows.append(gyro_minus_body_radps)
-        if action is not None and self.gimbal_limit_rad > 0.0:
-            self.actions.append(np.asarray(action, dtype=float))
-        if "eta" in info:
-            self.eta.append(info["eta"])
-        if "slosh_angles" in info:
-            self.slosh.append(info["slosh_angles"])
-        if info.get("events"):
-            self.events += [(float(t), str(text)) for t, text in info["events"]]
-        if info.get("termination"):
-            self.termination = str(info["termination"])
-
-    def step(self, env: Any, observation: np.ndarray, reward: float, info: dict[str, Any], action: Any = None) -> None:
-        """Record one ``env.step``'s result: :meth:`add`, with the gyro's view read from ``observation``
-        against the body rate of the env's state (lvgym envs) when the observation has a gyro, and the
-        ``action`` the step was given."""
-        diff = None
-        if self.gyro_index is not None:
-            u = env.unwrapped
-            w = u.flight.state("omega_bi_b")[0]
-            ip, iy, iref = self.gyro_index
-            diff = (float(observation[ip]) + float(observation[iref]) - w[1], float(observation[iy]) - w[2])
-        self.add(reward, info, diff, action)
-
-    def columns(self) -> FlightColumns:
-        """The steps so far as arrays (:class:`FlightColumns`)."""
-        return _columns(self)
 
 
 def _phase_masks(t: np.ndarray, qbar: np.ndarray, events: list[tuple[float, str]]) -> dict[str, np.ndarray]:
@@ -156,8 +112,7 @@ def _peak(arrays: Any) -> float:
 
 @dataclass
 class FlightColumns:
-    """One episode as arrays, one entry per control step (what :meth:`FlightLog.columns` gives, or a batched
-    flight's row, :mod:`.rows`): ``time_s`` (N,) [s], ``rate_error_radps`` (N, 3) [rad/s], ``qbar_pa`` (N,)
+    """One episode as arrays, one entry per control step (a flight's row of :class:`~.rows.RowsLog`): ``time_s`` (N,) [s], ``rate_error_radps`` (N, 3) [rad/s], ``qbar_pa`` (N,)
     [Pa], ``qalpha_pa_deg`` (N,) [Pa deg], ``gimbal_rate_radps`` (N, n) [rad/s], ``gyro_minus_body_radps``
     (N, 2) [rad/s] or None (no gyro), ``eta`` (N, ...) and ``slosh_angles_rad`` (N, ...) (or lists of one
     array per step), ``events`` ((t [s], text) pairs) and ``termination``; for protocol v2's
@@ -188,34 +143,10 @@ def gimbal_command(actions: np.ndarray, gimbal_limit_rad: float) -> np.ndarray:
     return np.clip(np.asarray(actions, dtype=float), -1.0, 1.0) * float(gimbal_limit_rad)
 
 
-def _columns(log: FlightLog) -> FlightColumns:
-    """The steps of ``log`` as arrays."""
-    n = len(log.rows)
-    if n:
-        cols = list(zip(*log.rows))
-        t, qbar, qalpha = (np.array(cols[i], dtype=float) for i in (0, 2, 3))
-        e = np.array(cols[1], dtype=float)
-        rate = np.array(cols[4], dtype=float)
-        on = np.array(cols[5], dtype=bool).reshape(n)
-        limit = np.array(cols[6], dtype=float)
-    else:
-        t = qbar = qalpha = rate = limit = np.zeros(0)
-        e = np.zeros((0, 3))
-        on = np.zeros(0, dtype=bool)
-    gyro = np.array(log.gyro_rows, dtype=float) if log.gyro_rows else None
-    command = None
-    if n and len(log.actions) == n:                    # every step's action (a v2 record's gimbal command)
-        command = gimbal_command(np.array(log.actions, dtype=float), log.gimbal_limit_rad)
-    return FlightColumns(t, e, qbar, qalpha, rate, gyro, log.eta, log.slosh, log.events, log.termination, command,
-                         on, limit)
-
-
-def flight_metrics(log: FlightLog, columns: FlightColumns | None = None) -> dict[str, Any]:
-    """The v1 metrics of one episode (see the module docstring): of ``log``'s steps, or of ``columns`` (the
-    same steps as arrays; ``log`` then gives only the task's facts). ``rate_error_rad`` is summed as
-    protocol v0's :func:`~.metrics.episode_metrics` sums it (per axis, then pitch + yaw), so the two agree
-    bit for bit."""
-    c = _columns(log) if columns is None else columns
+def flight_metrics(log: FlightFacts, c: FlightColumns) -> dict[str, Any]:
+    """The v1 metrics of one episode (see the module docstring) of its steps ``c``, with the task's facts
+    ``log``. ``rate_error_rad`` is summed as protocol v0's :func:`~.metrics.episode_metrics` sums it (per
+    axis, then pitch + yaw), so the two agree bit for bit."""
     dt = float(log.dt_s)
     t, qbar, qalpha = c.time_s, c.qbar_pa, c.qalpha_pa_deg
     n = len(t)
