@@ -1,8 +1,9 @@
 """PID and gain-scheduled PID TVC baselines (thesis 6.3), adaptive augmenting control on them (SLS-style,
 docs/adaptive-control.md) and a bang-bang roll controller (thesis 5.3).
 
-Every controller implements the benchmark's policy interface (:class:`lvgym.benchmark.Policy`):
-``reset()`` and ``act(observation, info) -> action``. ``lvgym design pid --vehicle smile``
+Every controller is a batch law (:class:`lvgym.benchmark.batch.BatchLaw`: ``reset(rows)``, ``act(rows,
+observations, info)``) with a one-row face, the benchmark's policy interface (:class:`lvgym.benchmark.Policy`:
+``reset()`` and ``act(observation, info) -> action``). ``lvgym design pid --vehicle smile``
 tunes a gain schedule on the rigid linearisation (into ``results/schedules/``; ``--overwrite`` replaces
 the shipped one in ``schedules/``); ``python -m experiments.control_study.study`` runs the
 thesis's control study (docs/control-study.md).
@@ -18,7 +19,7 @@ from lvgym.benchmark.registry import register_policy
 from .aac import AACParams, AdaptiveAugmentingPolicy, flex_aac, smile_aac
 from .bangbang import BangBangRollPolicy
 from .lqg import smile_lqg
-from .pid import (DiscretePID, GainSchedule, GainScheduledPIDPolicy, PIDPolicy, flex_pid, smile_scheduled_pid,
+from .pid import (GainSchedule, GainScheduledPIDPolicy, PIDLaw, PIDPolicy, flex_pid, smile_scheduled_pid,
                   smile_single_pid, smile_tuned_pid)
 
 # their kind in protocol v2's headline (lvgym.benchmark.headline): classical designs
@@ -65,5 +66,5 @@ register_policy("fixed-lqg", "lvgym.baselines.designed:fixed_policy", name="fixe
 # OSQP per control period (lvgym.baselines.mpc, docs/mpc.md; needs the control extra)
 register_policy("mpc", "lvgym.baselines.mpc:smile_mpc", name="mpc")
 
-__all__ = ["AACParams", "AdaptiveAugmentingPolicy", "BangBangRollPolicy", "DiscretePID", "GainSchedule",
+__all__ = ["AACParams", "AdaptiveAugmentingPolicy", "BangBangRollPolicy", "GainSchedule", "PIDLaw",
            "GainScheduledPIDPolicy", "PIDPolicy", "smile_aac", "smile_scheduled_pid", "smile_single_pid"]

@@ -1,5 +1,7 @@
 """Adaptive augmenting control (AAC) in the manner of the SLS flight control: a bounded multiplicative
-forward-loop gain ``k_T`` per axis on a classical (PID-type) baseline, as benchmark policies.
+forward-loop gain ``k_T`` per axis on a classical baseline. One batch law, :class:`AACLaw`, on any base law
+that keeps its rows' last gimbal commands (the PID family's :class:`.pid.PIDLaw`); its compiled inner loop in
+:mod:`.aackernel`; :class:`AdaptiveAugmentingPolicy` is its one-row face.
 
 What it follows: Orr and VanZwieten, "Robust, practical adaptive control for launch vehicles" (AIAA GNC
 2012, NTRS 20120015662) and Wall, Orr and VanZwieten, "Space Launch System implementation of adaptive
@@ -38,18 +40,20 @@ Shared gain (``per_axis=False``): one ``k`` for both axes from ``e_pitch^2 + e_y
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import asdict, dataclass, fields
 from typing import Any
 
 import numpy as np
 
+from lvgym.benchmark.batch import BatchLaw, RowFace
 from lvgym.errors import ConfigError, check_bool, check_number
 
-from .aacbatch import AACBatch
-from .batch import RowCopies
-from .pid import PIDPolicy, flex_pid, smile_scheduled_pid
+from .aackernel import AAC_ROW, AACConsts, aac_act_k, dead_zone, first_order
+from .pid import flex_pid, smile_scheduled_pid
+from .pidkernel import ObsColumns
 
-__all__ = ["AACParams", "AdaptiveAugmentingPolicy", "AdaptiveGainLaw", "FLEX_AAC", "FirstOrderFilter", "flex_aac", "smile_aac"]
+__all__ = ["AACLaw", "AACParams", "AdaptiveAugmentingPolicy", "FLEX_AAC", "flex_aac", "smile_aac"]
 
 
 @dataclass(frozen=True)
@@ -119,131 +123,31 @@ class AACParams:
         return AACParams(**{**asdict(self), **changes})
 
 
-class FirstOrderFilter:
-    """``w/(s+w)`` (``kind="low"``) or ``s/(s+w)`` (``"high"``), Tustin's transform pre-warped at ``w``,
-    on arrays of channels: ``step(x) -> y``; ``restart()`` makes the next sample the first (the high-pass
-    then outputs 0 for it, the low-pass starts from 0)."""
-
-    def __init__(self, kind: str, cutoff_hz: float, dt: float, channels: int) -> None:
-        if kind not in ("low", "high"):
-            raise ValueError(f"kind = {kind!r}: 'low' or 'high'")
-        w = 2.0 * math.pi * cutoff_hz
-        k = w / math.tan(w * dt / 2.0)                # pre-warped 2/dt
-        self.kind = kind
-        self.pole = (k - w) / (k + w)                 # y[n] = pole y[n-1] + gain (x[n] +- x[n-1])
-        self.gain = (w if kind == "low" else k) / (k + w)
-        self.y = np.zeros(channels)
-        self.x_prev = np.zeros(channels)
-        self.fresh = True
-
-    def restart(self) -> None:
-        self.y[:] = 0.0
-        self.x_prev[:] = 0.0
-        self.fresh = True
-
-    def step(self, x: np.ndarray) -> np.ndarray:
-        x = np.asarray(x, dtype=float)
-        if self.kind == "high":
-            prev = x if self.fresh else self.x_prev
-            self.y = self.pole * self.y + self.gain * (x - prev)
-        else:
-            prev = np.zeros_like(x) if self.fresh else self.x_prev
-            self.y = self.pole * self.y + self.gain * (x + prev)
-        self.x_prev = x.copy()
-        self.fresh = False
-        return self.y.copy()
+def consts(params: AACParams, dt: float, limit: float) -> AACConsts:
+    """The law's constants for the control period ``dt`` [s] and the gimbal ``limit`` [rad] (the cut-offs
+    checked against the Nyquist frequency)."""
+    params.check_rate(dt)
+    p = params
+    e_pole, e_gain = first_order("low", p.error_lp_hz, dt)
+    hp_pole, hp_gain = first_order("high", p.damper_hp_hz, dt)
+    lp_pole, lp_gain = first_order("low", p.damper_lp_hz, dt)
+    return AACConsts(p.k_min, p.k_max, p.error_gain, p.damper_gain, p.leak_rate, p.error_deadzone_radps,
+                     p.damper_deadzone_rad2, float(dt), float(limit), math.exp(-p.ref_model_radps * dt),
+                     bool(p.per_axis), bool(p.reset_on_engage), e_pole, e_gain, hp_pole, hp_gain, lp_pole, lp_gain)
 
 
-class AdaptiveGainLaw:
-    """The adaptive law of the module docstring without a vehicle: ``step(u, rate_error, rate_ref, on)
-    -> command``, arrays over the axes, in the base's units (gimbal rad)."""
-
-    def __init__(self, params: AACParams, dt: float, limit: float, axes: int = 2) -> None:
-        params.check_rate(dt)
-        self.p, self.dt, self.limit, self.axes = params, float(dt), float(limit), int(axes)
-        self.n_gains = axes if params.per_axis else 1
-        self.p_ref = math.exp(-params.ref_model_radps * dt)
-        self.e_lp = FirstOrderFilter("low", params.error_lp_hz, dt, axes)
-        self.hp = FirstOrderFilter("high", params.damper_hp_hz, dt, axes)
-        self.lp = FirstOrderFilter("low", params.damper_lp_hz, dt, axes)
-        self.reset()
-
-    def reset(self) -> None:
-        self.k = np.ones(self.n_gains)
-        self.w_m = 0.0                                # reference model's pitch rate [rad/s]
-        self.on = False
-        self.e = np.zeros(self.axes)                  # dead-zoned, filtered error [rad/s]
-        self.y = np.zeros(self.axes)                  # spectral damper output [rad^2]
-        for f in (self.e_lp, self.hp, self.lp):
-            f.restart()
-
-    def engage(self) -> None:
-        """The loop switches on: filters restart (and k returns to 1 with ``reset_on_engage``)."""
-        for f in (self.e_lp, self.hp, self.lp):
-            f.restart()
-        self.y[:] = 0.0
-        self.e[:] = 0.0
-        self.w_m = 0.0
-        if self.p.reset_on_engage:
-            self.k[:] = 1.0
-
-    def gain_step(self, k: np.ndarray, e2: np.ndarray, y: np.ndarray) -> np.ndarray:
-        """One exact (zero-order-hold) step of ``dk/dt = a e2 - b y (k - k_min) - c (k - 1)``, clipped. The
-        decay ``exp(-r dt)`` is ``math.exp`` (the C library's), as the compiled batch
-        (:mod:`.aacbatch`) computes it: numpy's own ``exp`` of float arrays differs from it in the last bit
-        for a few per cent of arguments on CPUs with AVX-512."""
-        p = self.p
-        r = p.damper_gain * y + p.leak_rate
-        drive = p.error_gain * e2 + p.damper_gain * y * p.k_min + p.leak_rate
-        decay = np.array([math.exp(-v * self.dt) if v > 0.0 else 1.0 for v in np.ravel(r)]).reshape(np.shape(r))
-        with np.errstate(divide="ignore", invalid="ignore"):
-            k_inf = np.where(r > 0.0, drive / np.where(r > 0.0, r, 1.0), 0.0)
-            k_new = np.where(r > 0.0, k_inf + (k - k_inf) * decay, k + drive * self.dt)
-        return np.clip(k_new, p.k_min, p.k_max)
-
-    def step(self, u: np.ndarray, rate_error: np.ndarray, rate_ref: np.ndarray, on: bool) -> np.ndarray:
-        u = np.asarray(u, dtype=float)
-        if not on:
-            self.on = False
-            return np.zeros(self.axes)
-        if not self.on:
-            self.engage()
-            self.on = True
-        p = self.p
-        ref = np.asarray(rate_ref, dtype=float)
-        self.w_m = self.p_ref * self.w_m + (1.0 - self.p_ref) * float(ref[0])
-        model = np.zeros(self.axes)
-        model[0] = self.w_m
-        e = (model - ref) - np.asarray(rate_error, dtype=float)
-        e_f = self.e_lp.step(e)
-        self.e = np.sign(e_f) * np.maximum(np.abs(e_f) - p.error_deadzone_radps, 0.0)
-        e2, y = self.e ** 2, self.y
-        if p.damper_deadzone_rad2 > 0.0:
-            y = np.maximum(y - p.damper_deadzone_rad2, 0.0)
-        if not p.per_axis:
-            e2, y = np.array([e2.sum()]), np.array([y.sum()])
-        self.k = self.gain_step(self.k, e2, y)
-        command = np.clip(self.gains() * u, -self.limit, self.limit)
-        self.y = self.lp.step(self.hp.step(command) ** 2)
-        return command
-
-    def gains(self) -> np.ndarray:
-        """k_T of each axis."""
-        return self.k if self.p.per_axis else np.repeat(self.k, self.axes)
-
-
-class AdaptiveAugmentingPolicy:
-    """AAC around a PID-type baseline policy ``base`` (a benchmark Policy with ``last_gimbal`` [rad] per
-    axis after ``act``, ``dt`` [s] and ``limit`` [rad], as :class:`lvgym.baselines.pid.PIDPolicy` and its
-    subclasses): the base flies as designed and its command is multiplied by ``k_T`` per axis.
-
-    ``env``: the lvgym env (its observation layout: ``pitch_rate_error``, ``yaw_rate_error``,
-    ``pitch_rate_reference``, ``controller_on``). ``record``: keep ``history`` (time, k_T per axis, the
-    dead-zoned error, the spectral damper output) of the last episode.
-    """
+class AACLaw(BatchLaw):
+    """AAC (module docstring) for ``n`` rows around a ``base`` batch law that keeps each row's last gimbal
+    command [rad] in ``base.gimbal`` (n, 2) after ``act``, as :class:`.pid.PIDLaw` does: the base flies as
+    designed and its command is multiplied by ``k_T`` per axis. ``env``: the lvgym env (its observation layout:
+    ``pitch_rate_error``, ``yaw_rate_error``, ``pitch_rate_reference``, ``controller_on``; its control period
+    and gimbal limit unless the base has ``dt`` and ``limit``). :attr:`gimbal` (n, 2) [rad]: the commands sent."""
 
     def __init__(self, base: Any, *, env: Any, params: AACParams | None = None, name: str | None = None,
-                 record: bool = False) -> None:
+                 n: int = 1) -> None:
+        if not (callable(getattr(base, "batch", None)) and hasattr(base, "gimbal")):
+            raise ConfigError("aac base", type(base).__name__, "a batch law that keeps its rows' gimbal commands "
+                              "(the PID family's PIDLaw, or a policy face over one)")
         task = env.unwrapped
         lay = task.observation_layout
         self.base = base
@@ -251,43 +155,90 @@ class AdaptiveAugmentingPolicy:
         self.name = name or f"aac({getattr(base, 'name', 'base')})"
         self.dt = float(getattr(base, "dt", task.task.control_dt_s))
         self.limit = float(getattr(base, "limit", task.gimbal_limit))
-        self._i_err = [lay.index("pitch_rate_error"), lay.index("yaw_rate_error")]
-        self._i_ref = lay.index("pitch_rate_reference")
-        self._i_on = lay.index("controller_on")
-        self.law = AdaptiveGainLaw(self.params, self.dt, self.limit, axes=2)
+        self.law = consts(self.params, self.dt, self.limit)
+        none = np.full(2, -1, np.int64)
+        self.oc = ObsColumns(np.asarray([lay.index("pitch_rate_error"), lay.index("yaw_rate_error")], np.int64), none,
+                             int(lay.index("controller_on")), -1, int(lay.index("pitch_rate_reference")), none)
+        self.allocate(n)
+
+    def _rows(self, n: int) -> None:
+        self.base = self.base.batch(n)
+        self.rows = AAC_ROW.pack({"k": 1.0, "fresh": 1.0}, n)
+
+    @property
+    def gimbal(self) -> np.ndarray:
+        return AAC_ROW.view(self.rows, "gimbal")
+
+    def gains(self, rows: Any) -> np.ndarray:
+        """``k_T`` (len(rows), 2) of each axis of the rows ``rows`` (a shared gain on both)."""
+        k = AAC_ROW.view(self.rows, "k")[np.asarray(rows, dtype=np.int64).reshape(-1)]
+        return k.copy() if self.params.per_axis else np.repeat(k[:, :1], 2, axis=1)
+
+    def errors(self, rows: Any) -> np.ndarray:
+        """The dead-zoned, filtered errors ``e_d`` (len(rows), 2) [rad/s] of the rows' last engaged step."""
+        e = AAC_ROW.view(self.rows, "e_y")[np.asarray(rows, dtype=np.int64).reshape(-1)]
+        return dead_zone(e, self.params.error_deadzone_radps)
+
+    def damper(self, rows: Any) -> np.ndarray:
+        """The spectral damper's output ``y`` (len(rows), 2) [rad^2] of the rows."""
+        return AAC_ROW.view(self.rows, "lp_y")[np.asarray(rows, dtype=np.int64).reshape(-1)].copy()
+
+    def reset(self, rows: Any) -> None:
+        """Rows ``rows`` start an episode: the base's reset, ``k_T`` 1 and the filters' restart."""
+        w = np.asarray(rows, dtype=np.int64).reshape(-1)
+        self.base.reset(w)
+        self.rows[w] = AAC_ROW.pack({"k": 1.0, "fresh": 1.0})
+
+    def act(self, rows: Any, observations: np.ndarray, info: Mapping[str, Any]) -> np.ndarray:
+        """Actions (len(rows), 2) float32 of the rows ``rows``: the base acts, then the adaptive law scales
+        its commands (:func:`.aackernel.aac_act_k`)."""
+        rows = np.asarray(rows, dtype=np.int64).reshape(-1)
+        obs = np.ascontiguousarray(observations).reshape(rows.size, -1)
+        self.base.act(rows, obs, info)
+        u = np.ascontiguousarray(self.base.gimbal[rows], dtype=np.float64)
+        out = np.empty((rows.size, 2), np.float32)
+        aac_act_k(self.law, self.oc, self.rows, rows, u, obs, out)
+        return out
+
+
+class AdaptiveAugmentingPolicy(RowFace):
+    """AAC around a baseline ``base`` (a policy face over a batch law that keeps its gimbal commands, as
+    :class:`.pid.PIDPolicy` and :class:`.pid.GainScheduledPIDPolicy`, or such a batch law itself): one row of
+    :class:`AACLaw`. ``record``: keep ``history`` (time, on, k_T per axis, the dead-zoned error, the spectral
+    damper output) of the last episode (:meth:`trajectory`)."""
+
+    def __init__(self, base: Any, *, env: Any, params: AACParams | None = None, name: str | None = None,
+                 record: bool = False) -> None:
+        law = getattr(base, "law", base)
+        self.law = AACLaw(law, env=env, params=params, name=name or f"aac({getattr(base, 'name', 'base')})")
         self.record = bool(record)
         self.history: list[tuple[float, ...]] = []
-        self.last_gimbal = np.zeros(2)
+        self._i_on = env.unwrapped.observation_layout.index("controller_on")
 
     @property
     def k_T(self) -> np.ndarray:
         """The current forward-loop gain of each axis (pitch, yaw)."""
-        return self.law.gains().copy()
+        return self.law.gains([0])[0]
+
+    @property
+    def last_gimbal(self) -> np.ndarray:
+        return self.law.gimbal[0].copy()
 
     def reset(self) -> None:
-        self.base.reset()
-        self.law.reset()
+        super().reset()
         self.history = []
-        self.last_gimbal = np.zeros(2)
 
-    def act(self, observation: np.ndarray, info: dict[str, Any]) -> np.ndarray:
-        obs = np.asarray(observation, dtype=float)
-        self.base.act(observation, info)
-        u = np.asarray(self.base.last_gimbal, dtype=float)
-        on = float(obs[self._i_on]) >= 0.5
-        ref = np.array([obs[self._i_ref], 0.0])
-        self.last_gimbal = self.law.step(u, obs[self._i_err], ref, on)
+    def act(self, observation: np.ndarray, info: Mapping[str, Any]) -> np.ndarray:
+        action = super().act(observation, info)
         if self.record:
-            k = self.law.gains()
-            self.history.append((float(info.get("time", math.nan)), float(on), *k, *self.law.e, *self.law.y))
-        return np.clip(self.last_gimbal / self.limit, -1.0, 1.0).astype(np.float32)
+            on = float(np.asarray(observation)[self._i_on]) >= 0.5
+            self.history.append((float(info.get("time", math.nan)), float(on), *self.law.gains([0])[0],
+                                 *self.law.errors([0])[0], *self.law.damper([0])[0]))
+        return action
 
-    def batch(self, n: int) -> AACBatch | RowCopies:
-        """The same controller for ``n`` rows of a batched env, stepped together (:mod:`.batch`): the compiled
-        :class:`.aacbatch.AACBatch` on a PID-family base it knows (:meth:`.pid.PIDPolicy.batch`), else one
-        copy of the policy per row. The batch keeps no ``history``."""
-        known = type(self) is AdaptiveAugmentingPolicy and isinstance(self.base, PIDPolicy) and self.base._batchable()
-        return AACBatch(self, n) if known else RowCopies(self, n)
+    def batch(self, n: int) -> AACLaw:
+        """The law for ``n`` rows (it keeps no ``history``)."""
+        return self.law.batch(n)
 
     def trajectory(self) -> dict[str, np.ndarray]:
         """The recorded history as arrays: ``time``, ``on``, ``k`` (n, 2), ``e`` (n, 2), ``y`` (n, 2)."""

@@ -1,4 +1,5 @@
-"""LQG rate control of pitch and yaw, scheduled over the flight, as a benchmark policy.
+"""LQG rate control of pitch and yaw, scheduled over the flight: one batch law (:class:`LQGLaw`, its compiled
+inner loop :func:`.lqgkernel.lqg_act_k`), its one-row face :class:`LQGPolicy`.
 
 The compensators are designed by :mod:`.lqg_design` (``python -m lvgym.baselines.design.lqg_design --vehicle smile``)
 on the flight computer's non-rigid plant at frozen flight times (the rows of
@@ -36,6 +37,7 @@ the tests).
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
@@ -43,6 +45,7 @@ from typing import Any
 
 import numpy as np
 
+from lvgym.benchmark.batch import BatchLaw, RowFace
 from lvgym.errors import ConfigError, check_number
 
 from .filecache import read_once
@@ -154,12 +157,11 @@ def _read_only(a: np.ndarray) -> np.ndarray:
     return out
 
 
-class LQGLaw:
-    """One plane's law (module docstring) for ``n`` independent rows (episodes) of one schedule:
-    ``update(y, t, on, which) -> u`` [rad] steps the rows ``which`` with their gyro samples ``y`` [rad/s],
-    flight times ``t`` [s] and switches ``on``. One row is :class:`LQGPolicy`; many are a residual
-    policy's baselines in training (:meth:`LQGPolicy.batch`). Both run the compiled step
-    :func:`.lqgkernel.lqg_step_k` on the schedule's stacked tables; ``aw``: its anti-windup
+class LQGPlane:
+    """One plane's law (module docstring) for ``n`` independent rows (episodes) of one schedule, its state in
+    :attr:`state` (:class:`.lqgkernel.LQGState`): ``update(y, t, on, which) -> u`` [rad] steps the rows
+    ``which`` with their gyro samples ``y`` [rad/s], flight times ``t`` [s] and switches ``on`` (the compiled
+    :func:`.lqgkernel.lqg_step_k`, the step :class:`LQGLaw` runs for each plane); ``aw``: its anti-windup
     (:class:`.lqgkernel.AntiWindup`; the default is ``lqg``'s plain law)."""
 
     def __init__(self, rows: tuple[LQGRow, ...], schedule: LQGSchedule, u_limit: float, n: int = 1,
@@ -198,16 +200,17 @@ class LQGLaw:
         return u
 
 
-class LQGPolicy:
-    """Pitch and yaw LQG (module docstring) as a benchmark :class:`~lvgym.benchmark.policy.Policy` of
-    the TVC envs. ``env``: the lvgym env it flies (the gimbal limit, the control period, the delay and
-    the observation's layout come from it); ``schedule``: an :class:`LQGSchedule`, a path or a name in
-    ``baselines/schedules``; ``back_gain``: None for ``lqg``'s plain law, else the anti-windup of
-    ``lqg-aw`` with this back-calculation gain per period [-] in [0, 1] and the command held to the env's
-    gimbal rate limit (:class:`.lqgkernel.AntiWindup`). ``act`` needs ``info["time"]``."""
+class LQGLaw(BatchLaw):
+    """Pitch and yaw LQG (module docstring) for ``n`` rows of the TVC envs. ``env``: the lvgym env it flies
+    (the gimbal limit, the control period, the delay and the observation's layout come from it, checked
+    against the schedule); ``schedule``: an :class:`LQGSchedule`, a path or a name in ``baselines/schedules``;
+    ``back_gain``: None for ``lqg``'s plain law, else the anti-windup of ``lqg-aw`` with this back-calculation
+    gain per period [-] in [0, 1] and the command held to the env's gimbal rate limit
+    (:class:`.lqgkernel.AntiWindup`). ``act`` reads ``info["time"]`` of every row. :attr:`gimbal` (n, 2)
+    [rad]: each row's last command."""
 
     def __init__(self, *, env: Any, schedule: LQGSchedule | str | Path = "smile_lqg", name: str = "lqg",
-                 back_gain: float | None = None) -> None:
+                 back_gain: float | None = None, n: int = 1) -> None:
         task = env.unwrapped
         self.name = name
         self.schedule = schedule if isinstance(schedule, LQGSchedule) else LQGSchedule.load(schedule)
@@ -226,59 +229,45 @@ class LQGPolicy:
             rate = math.radians(float(task.task.gimbal_rate_limit_degps))        # rad/s
             self.aw = AntiWindup(True, rate * self.dt, gain)
         lay = task.observation_layout
-        self._i_err = [lay.index("pitch_rate_error"), lay.index("yaw_rate_error")]
-        self._i_on = lay.index("controller_on")
-        self.axes = [LQGLaw(self.schedule.rows[p], self.schedule, self.limit, aw=self.aw) for p in PLANES]
-        self.last_gimbal = np.zeros(2)
+        none = np.full(2, -1, np.int64)
+        self.oc = ObsColumns(np.asarray([lay.index("pitch_rate_error"), lay.index("yaw_rate_error")], np.int64),
+                             none, int(lay.index("controller_on")), -1, -1, none)
+        self.allocate(n)
 
-    def reset(self) -> None:
-        for law in self.axes:
-            law.reset()
-        self.last_gimbal = np.zeros(2)
-
-    def act(self, observation: np.ndarray, info: dict[str, Any]) -> np.ndarray:
-        obs = np.asarray(observation, dtype=float)
-        on = float(obs[self._i_on]) >= 0.5
-        t = float(info["time"])
-        self.last_gimbal = np.array([law.update(obs[i], t, on)[0] for law, i in zip(self.axes, self._i_err)])
-        return np.clip(self.last_gimbal / self.limit, -1.0, 1.0).astype(np.float32)
-
-    def batch(self, n: int) -> "LQGBatch":
-        """The same law for ``n`` independent rows of a batched env, stepped together (:class:`LQGBatch`)."""
-        return LQGBatch(self, n)
-
-
-class LQGBatch:
-    """``n`` independent copies of an :class:`LQGPolicy` (one per env row), stepped together: the batched
-    interface of :mod:`.batch` (``act(rows, observations, info)`` with the batched env's info, of which it
-    reads ``info["time"]``); an :class:`LQGPolicy` per row would give the same actions, each in its own
-    Python call. Used for the rows of a batched evaluation and a residual's baselines
-    (``lvgym.agents.residual``). ``gimbal`` (n, 2) [rad]: each row's last command (the policy's
-    ``last_gimbal``)."""
-
-    def __init__(self, policy: LQGPolicy, n: int) -> None:
-        self.name, self.limit, self.aw = policy.name, policy.limit, policy.aw
-        self.axes = [LQGLaw(policy.schedule.rows[p], policy.schedule, policy.limit, n, policy.aw) for p in PLANES]
-        self.oc = ObsColumns(np.asarray(policy._i_err, dtype=np.int64), np.full(2, -1, np.int64), int(policy._i_on),
-                             -1, -1, np.full(2, -1, np.int64))
-        self.gimbal = np.zeros((int(n), 2))
+    def _rows(self, n: int) -> None:
+        self.planes = [LQGPlane(self.schedule.rows[p], self.schedule, self.limit, n, self.aw) for p in PLANES]
+        self.gimbal = np.zeros((n, 2))
 
     def reset(self, rows: Any) -> None:
         """Rows ``rows`` start an episode."""
-        for law in self.axes:
-            law.reset(rows)
+        for plane in self.planes:
+            plane.reset(rows)
         self.gimbal[np.asarray(rows, dtype=np.int64).reshape(-1)] = 0.0
 
-    def act(self, rows: Any, observations: np.ndarray, info: dict[str, Any]) -> np.ndarray:
+    def act(self, rows: Any, observations: np.ndarray, info: Mapping[str, Any]) -> np.ndarray:
         """Actions (len(rows), 2) float32 of the rows ``rows`` for their observations (len(rows), n_obs) and
         the batched env's ``info`` (every row's ``time``): one call of :func:`.lqgkernel.lqg_act_k`."""
         rows = np.asarray(rows, dtype=np.int64).reshape(-1)
         obs = np.ascontiguousarray(observations).reshape(rows.size, -1)
         out = np.empty((rows.size, 2), np.float32)
-        pitch, yaw = self.axes
+        pitch, yaw = self.planes
         lqg_act_k(pitch.tables, yaw.tables, pitch.state, yaw.state, self.oc, rows, obs,
                   np.asarray(info["time"], dtype=np.float64), self.limit, self.aw, self.gimbal, out)
         return out
+
+
+class LQGPolicy(RowFace):
+    """Pitch and yaw LQG as a benchmark :class:`~lvgym.benchmark.policy.Policy` of the TVC envs: one row of
+    :class:`LQGLaw` (its arguments). ``act`` needs ``info["time"]``; ``last_gimbal`` (2,) [rad]: the last
+    command."""
+
+    def __init__(self, *, env: Any, schedule: LQGSchedule | str | Path = "smile_lqg", name: str = "lqg",
+                 back_gain: float | None = None) -> None:
+        self.law = LQGLaw(env=env, schedule=schedule, name=name, back_gain=back_gain)
+
+    @property
+    def last_gimbal(self) -> np.ndarray:
+        return self.law.gimbal[0].copy()
 
 
 def smile_lqg(env: Any, name: str = "lqg", schedule: str = "smile_lqg", back_gain: float | None = None) -> LQGPolicy:

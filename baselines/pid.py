@@ -1,7 +1,9 @@
-"""Discrete PID rate controllers for thrust-vector control (thesis 6.3), as benchmark policies.
+"""Discrete PID rate controllers for thrust-vector control (thesis 6.3): one batch law (:class:`PIDLaw`) for
+fixed gains, gain schedules, structural filters, load relief and the attitude channel, its compiled inner loop
+in :mod:`.pidkernel`; :class:`PIDPolicy` and :class:`GainScheduledPIDPolicy` are its one-row faces.
 
-The law of one axis (:class:`DiscretePID`), on the error ``e = reference - measured`` sampled every ``dt``
-seconds, discretised with backward Euler (Simulink's "backward Euler" discrete PID, parallel form)::
+The law of one axis, on the error ``e = reference - measured`` sampled every ``dt`` seconds, discretised with
+backward Euler (Simulink's "backward Euler" discrete PID, parallel form)::
 
     P_k = Kp e_k
     I_k = I_{k-1} + Ki dt e_k                                   (held while clamped, see below)
@@ -80,28 +82,26 @@ filters in series and both channels::
          notch_radps: 59.7, notch_damping: 0.51, notch_depth: 0.022}
       - {lowpass_radps: 5000.0, notch_radps: 140.0, notch_damping: 0.2, notch_depth: 0.1}
 
-The compiled batch (:mod:`.pidbatch`) flies up to :data:`.pidkernel.FILTERS_MAX` filters per row; a schedule
-with more flies as one copy of the policy per row.
+The law flies up to :data:`.pidkernel.FILTERS_MAX` filters in series per row; a schedule with more is refused.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Hashable
+from collections.abc import Hashable, Mapping
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from lvgym.envs.layouts import G0
+from lvgym.benchmark.batch import BatchLaw, RowFace
 from lvgym.envs.presets import SLENDER_V1
 from lvgym.errors import ConfigError
 
-from .batch import RowCopies
-from .filters import FilterChain
+from .filters import Filter
 from .gainschedule import INTERPOLATIONS, ROW_COLUMNS, SCHEDULES, VARIABLES, GainSchedule  # noqa: F401  (here as before)
-from .pidbatch import PIDBatch
-from .pidkernel import FILTERS_MAX
+from .pidkernel import (FILTER_ROW, FILTERS_MAX, FILTERS_ROWS, PID_ROW, VAR_MACH, VAR_VALUE, coefficients, fixed_tables,
+                        new_state, obs_columns, pid_act_k, schedule_tables)
 
 #: per axis (pitch, yaw): the sign ``s_axis`` of the load-relief term, so that ``+k_a s f`` commands the
 #: body rate that turns the nose into the relative wind. A positive angle of attack (the air from below,
@@ -114,193 +114,129 @@ ACCEL_SIGNS = (1.0, -1.0)
 THESIS_SINGLE = {"kp": 8.98, "ki": 3.92, "kd": 4.57, "n": 500.0}
 
 
-class DiscretePID:
-    """One axis of the discrete PID law (see the module docstring): ``update(e) -> u``."""
+#: the info key of each scheduling variable read from the info (Mach comes from the observation)
+_INFO_KEY = {"mass": "mass", "time": "time"}
 
-    def __init__(self, kp: float, ki: float = 0.0, kd: float = 0.0, n: float | None = None, dt: float = 0.02,
-                 u_min: float = -math.inf, u_max: float = math.inf) -> None:
-        if not dt > 0.0:
-            raise ValueError(f"dt = {dt!r}: a sampling period > 0 s")
-        if not u_min < u_max:
-            raise ValueError(f"output limits ({u_min!r}, {u_max!r}): u_min must be below u_max")
-        self.dt, self.u_min, self.u_max = float(dt), float(u_min), float(u_max)
-        self.set_gains(kp, ki, kd, n)
-        self.reset()
 
-    def set_gains(self, kp: float, ki: float, kd: float, n: float | None = None) -> None:
-        """New gains (bumpless for Ki: the integral state holds the integrated ``Ki e``)."""
-        n = math.inf if n is None else float(n)
-        for key, v in (("kp", kp), ("ki", ki), ("kd", kd)):
-            if not (math.isfinite(v) and v >= 0.0):
-                raise ValueError(f"{key} = {v!r}: a finite gain >= 0")
-        if not n > 0.0:
-            raise ValueError(f"n = {n!r}: a derivative filter coefficient > 0 rad/s (inf: unfiltered)")
-        self.kp, self.ki, self.kd, self.n = float(kp), float(ki), float(kd), n
+def _check_gains(kp: float, ki: float, kd: float, n: float | None) -> float:
+    """Fixed gains checked by name; returns the derivative filter coefficient (None: inf, unfiltered)."""
+    for key, v in (("kp", kp), ("ki", ki), ("kd", kd)):
+        if not (isinstance(v, (int, float)) and math.isfinite(v) and v >= 0.0):
+            raise ConfigError(f"pid.{key}", v, "a finite gain >= 0")
+    n = math.inf if n is None else float(n)
+    if not n > 0.0:
+        raise ConfigError("pid.n", n, "a derivative filter coefficient > 0 rad/s (inf or None: unfiltered)")
+    return n
 
-    def reset(self) -> None:
-        self.integral = 0.0
-        self.deriv = 0.0
-        self.e_prev: float | None = None
-        self.saturated = False
 
-    def update(self, e: float, enabled: bool = True) -> float:
-        e = float(e)
-        if not enabled:
-            self.deriv, self.e_prev, self.saturated = 0.0, None, False
-            return 0.0
-        de = 0.0 if self.e_prev is None else e - self.e_prev
-        if math.isinf(self.n):
-            d = self.kd * de / self.dt
+class PIDLaw(BatchLaw):
+    """Pitch and yaw rate PID (the module docstring) for ``n`` rows of the TVC envs: fixed ``gains`` (kp, ki,
+    kd, n) or a ``schedule`` (:class:`GainSchedule`, its structural filters and channels), the same law on both
+    axes (the vehicle is axisymmetric). ``env``: the lvgym env (single or vector) it flies; the gimbal limit
+    (the action is gimbal / limit, also the output limit), the control period and the observation's layout
+    come from it. The controller acts while the observation's ``controller_on`` entry is 1; a schedule on mass
+    or time reads ``info["mass"]`` or ``info["time"]`` of every row. :attr:`gimbal` (n, 2) [rad]: each row's
+    last command."""
+
+    def __init__(self, env: Any, *, gains: tuple[float, float, float, float | None] | None = None,
+                 schedule: GainSchedule | None = None, name: str = "pid", n: int = 1) -> None:
+        if (gains is None) == (schedule is None):
+            raise ValueError("PIDLaw: give fixed gains or a schedule, not both")
+        task = env.unwrapped
+        lay = task.observation_layout
+        self.name = name
+        self.dt = float(task.task.control_dt_s)
+        self.limit = float(task.gimbal_limit)
+        self.oc = obs_columns(lay)
+        self.schedule = schedule
+        signs = np.asarray(ACCEL_SIGNS, dtype=float)
+        if schedule is None:
+            kp, ki, kd, d = gains
+            self.tb, self.su = fixed_tables(float(kp), float(ki), float(kd), _check_gains(kp, ki, kd, d), self.dt,
+                                            self.limit, signs)
+            self._key = None
         else:
-            d = (self.deriv + self.kd * self.n * de) / (1.0 + self.n * self.dt)
-        p = self.kp * e
-        i = self.integral + self.ki * self.dt * e
-        v = p + i + d
-        if (v > self.u_max and e * self.ki > 0.0) or (v < self.u_min and e * self.ki < 0.0):
-            i = self.integral                       # clamp: do not integrate further into the limit
-            v = p + i + d
-        self.integral, self.deriv, self.e_prev = i, d, e
-        u = min(max(v, self.u_min), self.u_max)
-        self.saturated = u != v
-        return u
+            if schedule.accel_gain is not None and self.oc.acc[0] < 0:
+                raise ConfigError("accel_gain", list(schedule.accel_gain), "a schedule without load relief: the "
+                                  "env's observation has no accelerometers (observation 'sensors' or 'flight')")
+            if schedule.attitude_gain is not None and self.oc.att[0] < 0:
+                raise ConfigError("attitude_gain", list(schedule.attitude_gain), "a schedule without an attitude "
+                                  "channel: the env's observation has no attitude errors")
+            if schedule.filter_count > FILTERS_MAX:
+                raise ConfigError("filter", schedule.filter_count, f"at most {FILTERS_MAX} filters in series per row")
+            self.tb, self.su = schedule_tables(schedule, self.dt, self.limit, signs)
+            self._key = _INFO_KEY.get(schedule.variable)
+        self.allocate(n)
+
+    def _rows(self, n: int) -> None:
+        self.st = new_state(n)
+        self._filters: list[Filter | None] = [None] * n      # FILTERS_ROWS: each row's filter
+        self._none = np.zeros(n)
+
+    @property
+    def gimbal(self) -> np.ndarray:
+        return PID_ROW.view(self.st.pid, "gimbal")
+
+    def reset(self, rows: Any) -> None:
+        """Rows ``rows`` start an episode: the PIDs and the filters' start (the filter in use stays)."""
+        w = np.asarray(rows, dtype=np.int64).reshape(-1)
+        filt = self.st.pid[w, PID_ROW.index("filt")]
+        self.st.pid[w] = PID_ROW.zeros()
+        self.st.pid[w, PID_ROW.index("filt")] = filt
+
+    def values(self, info: Mapping[str, Any]) -> np.ndarray:
+        """Each row's scheduling value (n,) from the batched ``info`` (mass [kg] or time [s]), or zeros."""
+        if self.su.variable != VAR_VALUE:
+            return self._none
+        return np.asarray(info[self._key], dtype=np.float64)
+
+    def prepare(self, rows: np.ndarray, obs: np.ndarray, value: np.ndarray) -> None:
+        """Before the kernel: the filter of each row of a linearly interpolated schedule with filters, at its
+        value of the scheduling variable, discretised when it changed (no shipped schedule is such a one)."""
+        if self.su.filters != FILTERS_ROWS:
+            return
+        coeffs = self.st.filters[:, FILTER_ROW.slice("coeffs")]
+        for j, b in enumerate(rows.tolist()):
+            v = float(obs[j, self.oc.mach]) * 10.0 if self.su.variable == VAR_MACH else float(value[b])
+            filt = self.schedule.filter_at(v)
+            if filt != self._filters[b]:
+                coeffs[b] = coefficients(filt, self.dt)
+                self._filters[b] = filt
+
+    def act(self, rows: Any, observations: np.ndarray, info: Mapping[str, Any]) -> np.ndarray:
+        """Actions (len(rows), 2) float32 of the rows ``rows`` for their observations (len(rows), n_obs)."""
+        rows = np.asarray(rows, dtype=np.int64).reshape(-1)
+        obs = np.ascontiguousarray(observations).reshape(rows.size, -1)
+        value = self.values(info)
+        self.prepare(rows, obs, value)
+        out = np.empty((rows.size, 2), np.float32)
+        pid_act_k(self.tb, self.su, self.oc, self.st, rows, obs, value, out)
+        return out
 
 
-class PIDPolicy:
-    """Pitch and yaw rate PID (identical gains per axis, the vehicle being axisymmetric) as a benchmark
-    :class:`~lvgym.benchmark.policy.Policy` of the TVC envs.
-
-    ``env``: the lvgym env (single or vector) it flies; the gimbal limit (the action is gimbal / limit,
-    also the output limit), the control period and the observation's layout come from it. The controller
-    acts while the observation's ``controller_on`` entry is 1. ``act`` needs ``info["time"]`` (every lvgym
-    ``info`` has it, the reset's too).
-    """
+class PIDPolicy(RowFace):
+    """Fixed-gain pitch and yaw rate PID as a benchmark :class:`~lvgym.benchmark.policy.Policy` of the TVC envs:
+    one row of :class:`PIDLaw` (``act`` needs ``info["time"]``, as every lvgym ``info`` has it).
+    ``last_gimbal`` (2,) [rad]: the last command."""
 
     def __init__(self, kp: float = THESIS_SINGLE["kp"], ki: float = THESIS_SINGLE["ki"],
                  kd: float = THESIS_SINGLE["kd"], n: float | None = THESIS_SINGLE["n"], *, env: Any,
                  name: str = "pid") -> None:
-        task = env.unwrapped
-        self.name = name
-        self.dt = float(task.task.control_dt_s)
-        self.limit = float(task.gimbal_limit)
-        lay = task.observation_layout
-        self._i_err = [lay.index("pitch_rate_error"), lay.index("yaw_rate_error")]
-        self._i_on, self._i_mach = lay.index("controller_on"), lay.index("mach_over_10")
-        self.axes = [DiscretePID(kp, ki, kd, n, self.dt, -self.limit, self.limit) for _ in range(2)]
-        #: the accelerometers (pitch: accel_z, yaw: accel_y) where the observation has them
-        self._i_acc = [lay.index("accel_z"), lay.index("accel_y")] if "accel_z" in lay.names else None
-        #: the attitude errors (pitch, yaw) where the observation has them
-        self._i_att = ([lay.index("pitch_attitude_error"), lay.index("yaw_attitude_error")]
-                       if "pitch_attitude_error" in lay.names else None)
-        self.accel_gain = 0.0                             # load relief [rad/s per m/s^2], see the module docstring
-        self.attitude_gain = 0.0                          # attitude channel [rad/s per rad], see the module docstring
-        self.accel_signs = np.asarray(ACCEL_SIGNS)        # s_axis of the load-relief term, per axis
-        self.chains: list[FilterChain] | None = None      # structural filters of the error, per axis
-        self._filtering = False
-        self.last_gimbal = np.zeros(2)
+        self.law = PIDLaw(env, gains=(kp, ki, kd, n), name=name)
 
-    def reset(self) -> None:
-        for pid in self.axes:
-            pid.reset()
-        self._filtering = False
-        self.last_gimbal = np.zeros(2)
-
-    def filtered(self, errors: np.ndarray, on: bool) -> np.ndarray:
-        """The errors through the axes' structural filters (unchanged without filters or while off);
-        the filters start in the steady state of the error when the controller switches on."""
-        if self.chains is None or not on:
-            self._filtering = False
-            return errors
-        if not self._filtering:
-            for chain, e in zip(self.chains, errors):
-                chain.reset(e)
-            self._filtering = True
-        return np.array([chain.update(e) for chain, e in zip(self.chains, errors)])
-
-    def enabled(self, observation: np.ndarray) -> bool:
-        """The env's controller-on flag for the coming step."""
-        return float(observation[self._i_on]) >= 0.5
-
-    def schedule_gains(self, observation: np.ndarray, info: dict[str, Any]) -> None:
-        """Hook for gain scheduling (nothing for fixed gains)."""
-
-    def errors(self, obs: np.ndarray) -> np.ndarray:
-        """The loop's errors [rad/s], pitch and yaw: reference - rate, minus ``k_theta`` times the attitude
-        error when ``attitude_gain`` is not zero, plus the load-relief rate command ``k_a s_axis f_axis``
-        when ``accel_gain`` is not zero (module docstring)."""
-        e = -obs[self._i_err]
-        if self.attitude_gain != 0.0:
-            e = e - self.attitude_gain * obs[self._i_att]
-        if self.accel_gain != 0.0:
-            e = e + self.accel_gain * G0 * self.accel_signs * obs[self._i_acc]
-        return e
-
-    def act(self, observation: np.ndarray, info: dict[str, Any]) -> np.ndarray:
-        obs = np.asarray(observation, dtype=float)
-        on = self.enabled(obs)
-        self.schedule_gains(obs, info)
-        errors = self.filtered(self.errors(obs), on)
-        self.last_gimbal = np.array([pid.update(e, on) for pid, e in zip(self.axes, errors)])
-        return np.clip(self.last_gimbal / self.limit, -1.0, 1.0).astype(np.float32)
-
-    def batch(self, n: int) -> PIDBatch | RowCopies:
-        """The same controller for ``n`` rows of a batched env, stepped together (:mod:`.batch`): the compiled
-        :class:`.pidbatch.PIDBatch` for a PIDPolicy or GainScheduledPIDPolicy as built (both axes with the
-        same gains, limits and period; filters only from a schedule), else one copy of the policy per row."""
-        return PIDBatch(self, n) if self._batchable() else RowCopies(self, n)
-
-    def _batchable(self) -> bool:
-        kind = type(self)
-        if kind not in (PIDPolicy, GainScheduledPIDPolicy):        # a subclass may change the law
-            return False
-        a, b = self.axes
-        if not (a.dt == b.dt and a.u_min == b.u_min == -self.limit and a.u_max == b.u_max == self.limit):
-            return False
-        if kind is GainScheduledPIDPolicy:
-            return (self.chains is None) == (self.schedule.filters is None) and self.schedule.filter_count <= FILTERS_MAX
-        return self.chains is None and (a.kp, a.ki, a.kd, a.n) == (b.kp, b.ki, b.kd, b.n)
+    @property
+    def last_gimbal(self) -> np.ndarray:
+        return self.law.gimbal[0].copy()
 
 
 class GainScheduledPIDPolicy(PIDPolicy):
-    """:class:`PIDPolicy` with gains from a :class:`GainSchedule` updated at every step: on ``mass``
-    (``info["mass"]`` [kg]), ``time`` (``info["time"]`` [s]) or ``mach`` (the observation's Mach entry)."""
+    """:class:`PIDPolicy` with gains from a :class:`GainSchedule` (a schedule object, a name in
+    ``baselines/schedules`` or a path) on ``mass`` (``info["mass"]`` [kg]), ``time`` (``info["time"]`` [s]) or
+    ``mach`` (the observation's Mach entry): one row of :class:`PIDLaw`."""
 
     def __init__(self, schedule: GainSchedule | str | Path, *, env: Any, name: str = "gs-pid") -> None:
-        self.schedule = schedule if isinstance(schedule, GainSchedule) else GainSchedule.load(schedule)
-        g = self.schedule.gains(self.schedule.points[0])
-        super().__init__(*g, env=env, name=name)
-        if self.schedule.accel_gain is not None and self._i_acc is None:
-            raise ConfigError("accel_gain", list(self.schedule.accel_gain), "a schedule without load relief: the "
-                              "env's observation has no accelerometers (observation 'sensors' or 'flight')")
-        if self.schedule.attitude_gain is not None and self._i_att is None:
-            raise ConfigError("attitude_gain", list(self.schedule.attitude_gain), "a schedule without an attitude "
-                              "channel: the env's observation has no attitude errors")
-        if self.schedule.filters is not None:
-            f0 = self.schedule.filter_at(self.schedule.points[0])
-            self.chains = [FilterChain(f0, self.dt) for _ in self.axes]
-        self.value = float("nan")
-
-    def variable(self, observation: np.ndarray, info: dict[str, Any]) -> float:
-        v = self.schedule.variable
-        if v == "mass":
-            return float(info["mass"])
-        if v == "time":
-            return float(info["time"])
-        return float(observation[self._i_mach]) * 10.0
-
-    def schedule_gains(self, observation: np.ndarray, info: dict[str, Any]) -> None:
-        self.value = self.variable(observation, info)
-        g = self.schedule.gains(self.value)
-        for pid in self.axes:
-            pid.set_gains(*g)
-        self.accel_gain = self.schedule.accel_gain_at(self.value)
-        self.attitude_gain = self.schedule.attitude_gain_at(self.value)
-        if self.chains is not None:
-            filt = self.schedule.filter_at(self.value)
-            if filt == self.chains[0].filter:             # unchanged (a nearest-row schedule, mostly)
-                return
-            coeffs = filt.discrete(self.dt)               # the same filter on both axes
-            for chain in self.chains:
-                chain.set_filter(filt, coeffs)
+        schedule = schedule if isinstance(schedule, GainSchedule) else GainSchedule.load(schedule)
+        self.law = PIDLaw(env, schedule=schedule, name=name)
 
 
 # ---------------------------------------------------------------------------- presets

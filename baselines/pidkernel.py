@@ -1,10 +1,7 @@
 """The compiled act of the PID family (:mod:`.pid`: fixed gains, a gain schedule, structural filters, load
-relief, the attitude channel) for any number of rows: what :class:`.pidbatch.PIDBatch` runs for the rows of
-a batched env.
-
-The same floating-point operations in the same order as the per-row policy (:meth:`.pid.PIDPolicy.act`,
-:class:`.pid.DiscretePID`, :class:`.filters.FilterChain`), so that row ``b`` of a batch and a policy of its
-own give the same actions to the bit (``tests/test_policy_batch.py``). The blocks:
+relief, the attitude channel) for any number of rows: the inner loop of :class:`.pid.PIDLaw`, one row after
+the other, each row's operations its own (so a batch of one gives the bits of the same row of any batch,
+``tests/test_policy_batch.py``). The blocks:
 
 * :class:`ObsColumns`: where the observation holds what the laws read (from the env's observation layout);
 * :class:`PIDTable`: the schedule's breakpoints and columns (layout :data:`GAINS`; a fixed-gain policy is
@@ -17,7 +14,7 @@ own give the same actions to the bit (``tests/test_policy_batch.py``). The block
 
 :func:`interp_k` is ``np.interp`` of one value (numpy's ``arr_interp``: the interval by search, the
 slope, the retry from the right end when the left gives NaN); :func:`nearest_k` is
-:meth:`.pid.GainSchedule._nearest` (``argmin`` of the distance, the first of equals).
+:meth:`.gainschedule.GainSchedule._nearest` (``argmin`` of the distance, the first of equals).
 
 The row layouts::
 
@@ -28,7 +25,7 @@ The row layouts::
 
 from __future__ import annotations
 
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 import numba as nb
 import numpy as np
@@ -38,8 +35,8 @@ from lvgym.packing import Field, Packed
 
 __all__ = ["COEFFS", "FILTERS_MAX", "FILTERS_NONE", "FILTERS_ROWS", "FILTERS_TABLE", "FILTER_ROW", "GAINS", "ObsColumns",
            "PID_ROW", "PIDSetup", "PIDState", "PIDTable", "SECTIONS", "SECTIONS_PER_FILTER", "TAPS", "VAR_FIXED",
-           "VAR_MACH", "VAR_VALUE", "clip_k",
-           "interp_k", "nearest_k", "pid_act_k", "pid_row_k"]
+           "VAR_MACH", "VAR_VALUE", "clip_k", "coefficients", "fixed_tables", "interp_k", "nearest_k", "new_state",
+           "obs_columns", "pid_act_k", "pid_row_k", "schedule_tables"]
 
 #: how a row's scheduling variable is read (:attr:`PIDSetup.variable`): fixed gains (no variable), a value
 #: per row handed in (``info["mass"]`` or ``info["time"]``), the observation's Mach entry times 10
@@ -48,7 +45,7 @@ VAR_FIXED, VAR_VALUE, VAR_MACH = 0, 1, 2
 #: schedule row in use (a nearest-row schedule), each row's own (set from Python, a linear schedule)
 FILTERS_NONE, FILTERS_TABLE, FILTERS_ROWS = 0, 1, 2
 #: sections of a structural filter (lead-lag, low-pass, notch: :meth:`.filters.StructuralFilter.discrete`),
-#: the most filters in series a row holds (a schedule with more flies as per-row copies, :meth:`.pid.PIDPolicy.batch`),
+#: the most filters in series a row holds (a schedule with more is refused, :class:`.pid.PIDLaw`),
 #: so the most sections, and coefficients per section's numerator and denominator
 SECTIONS_PER_FILTER, FILTERS_MAX, TAPS = 3, 4, 3
 SECTIONS = SECTIONS_PER_FILTER * FILTERS_MAX
@@ -154,6 +151,76 @@ class PIDState(NamedTuple):
     filters: np.ndarray
 
 
+def obs_columns(layout: Any) -> ObsColumns:
+    """Where an observation of ``layout`` (an env's ``observation_layout``) holds what the PID family reads:
+    the rate errors, the controller flag and Mach; the accelerometers and the attitude errors where it has them
+    (-1 otherwise); no pitch rate reference (-1: AAC's :class:`.aac.AACLaw` reads its own)."""
+    names = layout.names
+    acc = [layout.index("accel_z"), layout.index("accel_y")] if "accel_z" in names else [-1, -1]
+    att = ([layout.index("pitch_attitude_error"), layout.index("yaw_attitude_error")]
+           if "pitch_attitude_error" in names else [-1, -1])
+    return ObsColumns(np.asarray([layout.index("pitch_rate_error"), layout.index("yaw_rate_error")], dtype=np.int64),
+                      np.asarray(acc, dtype=np.int64), int(layout.index("controller_on")),
+                      int(layout.index("mach_over_10")), -1, np.asarray(att, dtype=np.int64))
+
+
+def coefficients(filt: Any, dt: float, out: np.ndarray | None = None) -> np.ndarray:
+    """The discrete sections of ``filt`` (one filter or a series) at ``dt`` [s]
+    (:meth:`.filters.StructuralFilter.discrete`) packed by :data:`COEFFS` into ``out`` (a new vector by default;
+    the sections beyond the filter's left as they are), with the sums a restart in the steady state divides by
+    (``b.sum()``, ``a.sum()``)."""
+    out = COEFFS.zeros() if out is None else out
+    sections = filt.discrete(dt)
+    if len(sections) > SECTIONS:
+        raise ValueError(f"a structural filter of {len(sections)} sections: the kernel runs at most {SECTIONS}")
+    b, a = COEFFS.view(out, "b"), COEFFS.view(out, "a")
+    bsum, asum = COEFFS.view(out, "bsum"), COEFFS.view(out, "asum")
+    for s, (bz, az) in enumerate(sections):
+        b[s], a[s], bsum[s], asum[s] = bz, az, bz.sum(), az.sum()
+    return out
+
+
+def fixed_tables(kp: float, ki: float, kd: float, n: float, dt: float, limit: float,
+                 signs: np.ndarray) -> tuple[PIDTable, PIDSetup]:
+    """The blocks of fixed gains ``kp``, ``ki``, ``kd``, ``n`` (a table of one row, read as nearest; no
+    channels, no filters) at the control period ``dt`` [s] and the gimbal ``limit`` [rad]."""
+    gains = GAINS.pack({"kp": kp, "ki": ki, "kd": kd, "n": n, "accel": 0.0, "attitude": 0.0})
+    tb = PIDTable(np.zeros(1), np.zeros(1), np.zeros(1, np.int64), gains.reshape(-1, 1), np.zeros((1, COEFFS.size)))
+    return tb, PIDSetup(dt, limit, VAR_FIXED, True, False, FILTERS_NONE, signs, False, 0)
+
+
+def schedule_tables(schedule: Any, dt: float, limit: float, signs: np.ndarray) -> tuple[PIDTable, PIDSetup]:
+    """The blocks of a :class:`.gainschedule.GainSchedule` at the control period ``dt`` [s] and the gimbal
+    ``limit`` [rad]: its columns in ascending order of the breakpoints and, for a nearest-row schedule with
+    filters, each row's discrete filter (a linear schedule's filters change with every value and are
+    discretised when a row's changes, :meth:`.pid.PIDLaw.prepare`)."""
+    x, xs, cols = schedule._table
+    rank = np.empty(x.size, np.int64)
+    rank[np.argsort(x)] = np.arange(x.size)
+    gains = np.zeros((GAINS.size, x.size))
+    for name, col in (("kp", "kp"), ("ki", "ki"), ("kd", "kd"), ("n", "n"), ("accel", "accel_gain"),
+                      ("attitude", "attitude_gain")):
+        gains[GAINS.index(name)] = cols.get(col, 0.0)
+    nearest = schedule.interpolation == "nearest"
+    no_filters = np.zeros((1, COEFFS.size))
+    if schedule.filters is None:
+        coeffs, filters = no_filters, FILTERS_NONE
+    elif nearest:
+        coeffs, filters = np.array([coefficients(f, dt) for f in schedule.filters]), FILTERS_TABLE
+    else:
+        coeffs, filters = no_filters, FILTERS_ROWS
+    variable = VAR_MACH if schedule.variable == "mach" else VAR_VALUE
+    tb = PIDTable(x, xs, rank, np.ascontiguousarray(gains), coeffs)
+    return tb, PIDSetup(dt, limit, variable, nearest, schedule.accel_gain is not None, filters, signs,
+                        schedule.attitude_gain is not None, SECTIONS_PER_FILTER * schedule.filter_count)
+
+
+def new_state(n: int) -> PIDState:
+    """The state of ``n`` rows, as after a reset (no filter in use yet; the coefficient sums 1, so that a row
+    without filters divides by nothing else)."""
+    return PIDState(PID_ROW.pack({"filt": -1.0}, n), FILTER_ROW.pack({"bsum": 1.0, "asum": 1.0}, n))
+
+
 @nb.njit(cache=True, inline="always")
 def interp_k(x, xp, fp):
     """``np.interp(x, xp, fp)`` of one value ``x`` on ascending breakpoints ``xp`` (the ends held)."""
@@ -203,7 +270,7 @@ def clip_k(x, lo, hi):
 @nb.njit(cache=True, inline="always")
 def _filter_reset(f, ax, x0, sections):
     """The first ``sections`` sections of the filter row ``f``'s axis ``ax`` in the steady state of the input
-    ``x0`` (:meth:`.filters.FilterChain.reset`)."""
+    ``x0`` (direct form II transposed, each section's states at the input's steady state)."""
     x = x0
     for s in range(sections):
         b, a = F.b + TAPS * s, F.a + TAPS * s
@@ -217,7 +284,7 @@ def _filter_reset(f, ax, x0, sections):
 @nb.njit(cache=True, inline="always")
 def _filter_update(f, ax, x, sections):
     """One sample ``x`` through the first ``sections`` sections of the filter row ``f``'s axis ``ax``
-    (:meth:`.filters.FilterChain.update`)."""
+    (direct form II transposed per section)."""
     y = x
     for s in range(sections):
         b, a = F.b + TAPS * s, F.a + TAPS * s
@@ -233,7 +300,7 @@ def _filter_update(f, ax, x, sections):
 @nb.njit(cache=True, inline="always")
 def _pid_update(su, r, ax, e, on, g):
     """One step of the PID row ``r``'s axis ``ax`` on the error ``e`` with the gains ``g`` (kp, ki, kd, n)
-    (:meth:`.pid.DiscretePID.update`)."""
+    (the module docstring of :mod:`.pid`)."""
     if not on:
         r[P.deriv + ax], r[P.has_prev + ax], r[P.saturated + ax] = 0.0, 0.0, 0.0
         return 0.0

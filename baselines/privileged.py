@@ -30,14 +30,16 @@ that option adds keys to the info and changes nothing of the flight.
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
 
+from lvgym.benchmark.batch import BatchLaw, RowFace
 from lvgym.envs.privileged import PREVIEW_PERIODS
 from lvgym.errors import ConfigError
 
-__all__ = ["PrivilegedPolicy", "control_lever", "privileged", "relief_hold"]
+__all__ = ["PrivilegedLaw", "PrivilegedPolicy", "control_lever", "privileged", "relief_hold"]
 
 #: (bandwidth [rad/s], damping) of the attitude loop per flight model, with :data:`RELIEF`: the lowest mean
 #: ``score_v2`` over protocol v2's three SMILE suites on validation seeds 0-19 of a sweep of bandwidths 1, 1.5
@@ -65,22 +67,26 @@ def relief_hold(share: float | np.ndarray, onset: float, full: float) -> float |
     return 1.0 - np.clip((share - onset) / (full - onset), 0.0, 1.0)
 
 
-def control_lever(info: dict[str, Any]) -> float:
-    """The vectored thrust times its arm about the CG [N m per rad of gimbal] from a privileged step's info."""
-    return float(info["thrust"]) * float(info.get("vectored_share", 1.0)) * float(info["gimbal_arm"])
+def control_lever(info: Mapping[str, Any], rows: np.ndarray) -> np.ndarray:
+    """The vectored thrust times its arm about the CG [N m per rad of gimbal] of the rows ``rows`` from a
+    privileged step's batched info."""
+    share = np.asarray(info["vectored_share"], dtype=float)[rows] if "vectored_share" in info else 1.0
+    return np.asarray(info["thrust"], dtype=float)[rows] * share * np.asarray(info["gimbal_arm"], dtype=float)[rows]
 
 
-class PrivilegedPolicy:
-    """The privileged reference (module docstring) for a TVC env of the ascent task: ``bandwidth_radps`` [rad/s]
-    and ``damping`` [-] of its attitude loop (default: :data:`GAINS` of the env's flight model), ``relief``
-    (default :data:`RELIEF`), ``preview_periods``: how many control periods ahead it reads the aerodynamic moment
-    (default :data:`PREVIEW`; 0: as it acts), ``plant``: whether it uses the true misalignment and actuator
-    effectiveness; ``env``: the env it flies (its gimbal limit, its observation's reference pitch rate, its
-    model)."""
+class PrivilegedLaw(BatchLaw):
+    """The privileged reference (module docstring) for ``n`` rows of a TVC env of the ascent task:
+    ``bandwidth_radps`` [rad/s] and ``damping`` [-] of its attitude loop (default: :data:`GAINS` of the env's
+    flight model), ``relief`` (default :data:`RELIEF`), ``preview_periods``: how many control periods ahead it
+    reads the aerodynamic moment (default :data:`PREVIEW`; 0: as it acts), ``plant``: whether it uses the true
+    misalignment and actuator effectiveness; ``env``: the env it flies (its gimbal limit, its observation's
+    reference pitch rate, its model). The law has no state: each row's action is a function of its
+    observation and its row of the step's privileged info (elementwise, the same operations for any number of
+    rows)."""
 
     def __init__(self, env: Any, bandwidth_radps: float | None = None, damping: float | None = None,
                  name: str = "privileged", relief: tuple[float, float] | None = None,
-                 preview_periods: int | None = None, plant: bool = True) -> None:
+                 preview_periods: int | None = None, plant: bool = True, n: int = 1) -> None:
         func = env.unwrapped.func
         w0, z0 = GAINS["rigid" if func.spec.model == "rigid" else "nonrigid"]
         bandwidth_radps = w0 if bandwidth_radps is None else bandwidth_radps
@@ -110,35 +116,58 @@ class PrivilegedPolicy:
         self.limit = float(func.gimbal_limit)
         names = list(func.observation_layout.names)
         self._i_ref = names.index("pitch_rate_reference") if "pitch_rate_reference" in names else None
+        self.allocate(n)
 
-    def reset(self) -> None:
+    def _rows(self, n: int) -> None:
+        pass
+
+    def reset(self, rows: Any) -> None:
         """Nothing to forget: the law has no state."""
 
-    def act(self, observation: np.ndarray, info: dict[str, Any]) -> np.ndarray:
-        """The gimbal action (pitch, yaw) in [-1, 1] from the step's privileged info (zero before the first step,
-        whose info holds none)."""
+    def act(self, rows: Any, observations: np.ndarray, info: Mapping[str, Any]) -> np.ndarray:
+        """The gimbal actions (len(rows), 2) in [-1, 1] of the rows ``rows`` from the step's privileged info
+        (zero before the first step, whose info holds none, and for a row without thrust)."""
+        rows = np.asarray(rows, dtype=np.int64).reshape(-1)
+        out = np.zeros((rows.size, 2), dtype=np.float32)
         if "m_aero_b" not in info:                          # the reset's info
-            return np.zeros(2, dtype=np.float32)
-        lever = control_lever(info)
-        if lever < 1.0:                                     # no thrust: no moment to command
-            return np.zeros(2, dtype=np.float32)
-        w = np.asarray(info["omega_bi_b"], dtype=float)
-        att = np.asarray(info["attitude_error"], dtype=float)
-        m_aero = np.asarray(info["m_aero_b"] if self.preview == 0 else info["m_aero_ahead_b"][self.preview - 1],
-                            dtype=float)
-        J = np.asarray(info["J_b_diag"], dtype=float)
-        ref = float(observation[self._i_ref]) if self._i_ref is not None else 0.0
-        e_rate = np.array([w[1] - ref, w[2]])
+            return out
+        lever = control_lever(info, rows)
+        go = lever >= 1.0                                   # no thrust: no moment to command
+        if not go.any():
+            return out
+        k, lever = rows[go], lever[go]
+        w = np.asarray(info["omega_bi_b"], dtype=float)[k]
+        att = np.asarray(info["attitude_error"], dtype=float)[k]
+        m_aero = np.asarray(info["m_aero_b"] if self.preview == 0 else info["m_aero_ahead_b"][:, self.preview - 1],
+                            dtype=float)[k]
+        J = np.asarray(info["J_b_diag"], dtype=float)[k]
+        obs = np.asarray(observations)[go]
+        ref = obs[:, self._i_ref].astype(float) if self._i_ref is not None else np.zeros(k.size)
+        e_rate = np.stack([w[:, 1] - ref, w[:, 2]], axis=1)
         # load relief: from ``onset`` to ``full`` of the q-alpha limit the law lets go of the attitude and of the
         # aerodynamic moment (the statically stable vehicle turns into the relative wind); the rate damping stays
-        share = float(info.get("qalpha_pa_deg", 0.0)) / float(info.get("qalpha_limit_pa_deg", self.qalpha_limit))
-        hold = relief_hold(share, *self.relief)
+        qalpha = np.asarray(info["qalpha_pa_deg"], dtype=float)[k] if "qalpha_pa_deg" in info else np.zeros(k.size)
+        limit = (np.asarray(info["qalpha_limit_pa_deg"], dtype=float)[k] if "qalpha_limit_pa_deg" in info
+                 else np.full(k.size, self.qalpha_limit))
+        hold = relief_hold(qalpha / limit, *self.relief)[:, None]
         alpha = -2.0 * self.z * self.w * e_rate - hold * self.w * self.w * att
-        delta = (J[1:] * alpha - hold * m_aero[1:]) / lever
+        delta = (J[:, 1:] * alpha - hold * m_aero[:, 1:]) / lever[:, None]
         if self.plant:                                      # the true thrust direction and actuator authority
-            delta = (delta - np.asarray(info.get("misalignment", 0.0), dtype=float)) / np.maximum(
-                np.asarray(info.get("actuator_effectiveness", 1.0), dtype=float), 0.1)
-        return np.clip(delta / self.limit, -1.0, 1.0).astype(np.float32)
+            mis = np.asarray(info["misalignment"], dtype=float)[k] if "misalignment" in info else 0.0
+            eff = (np.asarray(info["actuator_effectiveness"], dtype=float)[k] if "actuator_effectiveness" in info
+                   else 1.0)
+            delta = (delta - mis) / np.maximum(eff, 0.1)
+        out[go] = np.clip(delta / self.limit, -1.0, 1.0).astype(np.float32)
+        return out
+
+
+class PrivilegedPolicy(RowFace):
+    """The privileged reference as a benchmark policy: one row of :class:`PrivilegedLaw` (its arguments)."""
+
+    def __init__(self, env: Any, bandwidth_radps: float | None = None, damping: float | None = None,
+                 name: str = "privileged", relief: tuple[float, float] | None = None,
+                 preview_periods: int | None = None, plant: bool = True) -> None:
+        self.law = PrivilegedLaw(env, bandwidth_radps, damping, name, relief, preview_periods, plant)
 
 
 def privileged(env: Any, bandwidth_radps: float | None = None, damping: float | None = None,

@@ -141,8 +141,10 @@ class PlantKnown:
             a = a - known / self.limit
         if self.aero:
             from lvgym.baselines.privileged import control_lever
+            from lvgym.benchmark.batch import ROW, OneRowInfo
 
-            a = a - np.asarray(info["m_aero_b"], dtype=np.float64)[1:] / max(control_lever(info), 1.0) / self.limit
+            lever = float(control_lever(OneRowInfo(info), ROW)[0])
+            a = a - np.asarray(info["m_aero_b"], dtype=np.float64)[1:] / max(lever, 1.0) / self.limit
         if self.eff:
             a = a / np.maximum(np.asarray(info["actuator_effectiveness"], dtype=np.float64), 0.1)
         return np.clip(a, -1.0, 1.0).astype(np.float32)

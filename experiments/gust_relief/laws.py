@@ -11,6 +11,7 @@ import numpy as np
 
 from lvgym.baselines.lqg import SCHEDULES as LQG_SCHEDULES
 from lvgym.baselines.privileged import PrivilegedPolicy, control_lever, relief_hold
+from lvgym.benchmark.batch import ROW, OneRowInfo
 from lvgym.benchmark.registry import resolve_policy
 from lvgym.benchmark.runner import build_policy
 
@@ -43,7 +44,7 @@ class SoftLaw(PrivilegedPolicy):
         if "m_aero_b" not in info:                          # the reset's info
             self.integral[:] = 0.0
             return np.zeros(2, dtype=np.float32)
-        lever = control_lever(info)
+        lever = float(control_lever(OneRowInfo(info), ROW)[0])
         if lever < 1.0:
             return np.zeros(2, dtype=np.float32)
         if self.signals == "true":

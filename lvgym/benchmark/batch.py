@@ -128,6 +128,12 @@ class RowFace:
 
     law: BatchLaw
 
+    def __getattr__(self, key: str) -> Any:
+        """The law's attributes read through the face (its constants: ``dt``, ``limit``, ``schedule``, ...)."""
+        if key == "law" or key.startswith("__"):
+            raise AttributeError(key)
+        return getattr(self.law, key)
+
     @property
     def name(self) -> str:
         return self.law.name

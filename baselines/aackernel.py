@@ -1,13 +1,11 @@
-"""Adaptive augmenting control for the rows of a batched env (:class:`AACBatch`): what
-:meth:`.aac.AdaptiveAugmentingPolicy.batch` gives for an AAC on a PID-family base.
+"""The compiled step of adaptive augmenting control (:mod:`.aac`) for any number of rows: the inner loop of
+:class:`.aac.AACLaw`, after its base law has acted.
 
-One compiled call (:func:`aac_act_k`) steps each row's base (:func:`.pidkernel.pid_row_k`) and then the
-adaptive law of :class:`.aac.AdaptiveGainLaw` with the per-row policy's operations in its order: the
-reference model, the error's low-pass and dead zone, the exact step of ``k_T`` (``math.exp``, as the
-per-row law), the command ``clip(k_T u)``, the spectral damper. The blocks: :class:`AACLaw` (the law's
-constants) and each row's state packed by :data:`AAC_ROW`, beside the base's blocks of
-:mod:`.pidkernel`. The three first-order filters of a row restart and step together (one ``fresh`` flag
-per row)::
+:func:`aac_act_k` takes each row's base command and steps the adaptive law of the module docstring of
+:mod:`.aac`: the reference model, the error's low-pass and dead zone, the exact step of ``k_T``
+(:func:`gain_step_k`, ``math.exp``), the command ``clip(k_T u)``, the spectral damper. The blocks:
+:class:`AACConsts` (the law's constants) and each row's state packed by :data:`AAC_ROW`. The three
+first-order filters of a row (:func:`first_order`) restart and step together (one ``fresh`` flag per row)::
 
 {AAC_ROW}
 """
@@ -22,10 +20,9 @@ import numpy as np
 
 from lvgym.packing import Field, Packed
 
-from .pidbatch import PIDBatch
-from .pidkernel import AXES, PID_ROW, clip_k, pid_row_k
+from .pidkernel import AXES, clip_k
 
-__all__ = ["AACBatch", "AACLaw", "AAC_ROW", "aac_act_k"]
+__all__ = ["AACConsts", "AAC_ROW", "aac_act_k", "dead_zone", "first_order", "gain_step_k"]
 
 #: a row of the adaptive law (per axis: pitch, yaw)
 AAC_ROW = Packed("adaptive law row", [
@@ -39,17 +36,33 @@ AAC_ROW = Packed("adaptive law row", [
     Field("hp_x", AXES, "rad", "the spectral damper's high-pass last input (the command sent)"),
     Field("lp_y", AXES, "rad^2", "the spectral damper's output y"),
     Field("lp_x", AXES, "rad^2", "the spectral damper's low-pass last input"),
-    Field("gimbal", AXES, "rad", "the last command sent (the policy's last_gimbal)"),
+    Field("gimbal", AXES, "rad", "the last command sent"),
 ])
 
 __doc__ = __doc__.format(AAC_ROW=AAC_ROW.table())
 
 A = AAC_ROW.at
-P = PID_ROW.at
 
 
-class AACLaw(NamedTuple):
-    """The constants of :class:`.aac.AdaptiveGainLaw`: the bounds of ``k_T``, the rates ``a`` (error),
+def first_order(kind: str, cutoff_hz: float, dt: float) -> tuple[float, float]:
+    """``(pole, gain)`` of the first-order filter ``w/(s+w)`` (``kind="low"``) or ``s/(s+w)`` (``"high"``) at
+    ``cutoff_hz`` [Hz], Tustin's transform pre-warped at ``w`` for the period ``dt`` [s]:
+    ``y[n] = pole y[n-1] + gain (x[n] + x[n-1])`` (low) or ``gain (x[n] - x[n-1])`` (high). A restart makes the
+    next sample the first: the low-pass starts from 0 (the previous input 0), the high-pass outputs 0."""
+    if kind not in ("low", "high"):
+        raise ValueError(f"kind = {kind!r}: 'low' or 'high'")
+    w = 2.0 * math.pi * cutoff_hz
+    k = w / math.tan(w * dt / 2.0)                    # pre-warped 2/dt
+    return (k - w) / (k + w), (w if kind == "low" else k) / (k + w)
+
+
+def dead_zone(e: np.ndarray, dz: float) -> np.ndarray:
+    """``sign(e) max(|e| - dz, 0)`` [rad/s]: the error the law's ``a e^2`` term sees."""
+    return np.sign(e) * np.maximum(np.abs(e) - dz, 0.0)
+
+
+class AACConsts(NamedTuple):
+    """The constants of the adaptive law (:mod:`.aac`): the bounds of ``k_T``, the rates ``a`` (error),
     ``b`` (damper), ``c`` (leakage), the dead zones ``e_dz`` [rad/s] and ``y_dz`` [rad^2], ``dt`` [s], the
     gimbal ``limit`` [rad], the reference model's ``p_ref``, ``per_axis``, ``reset_on_engage``, and each
     filter's ``pole`` and ``gain`` (error low-pass ``e_``, damper high-pass ``hp_`` and low-pass ``lp_``)."""
@@ -74,9 +87,10 @@ class AACLaw(NamedTuple):
     lp_gain: float
 
 
-@nb.njit(cache=True, inline="always")
-def _gain_step(law, k, e2, y):
-    """One exact step of ``dk/dt = a e2 - b y (k - k_min) - c (k - 1)``, clipped (:meth:`.aac.AdaptiveGainLaw.gain_step`)."""
+@nb.njit(cache=True)
+def gain_step_k(law, k, e2, y):
+    """One exact (zero-order-hold) step of ``dk/dt = a e2 - b y (k - k_min) - c (k - 1)`` over ``law.dt``,
+    clipped to ``[k_min, k_max]``; the decay ``exp(-r dt)`` is ``math.exp`` (the C library's)."""
     r = law.b * y + law.c
     drive = law.a * e2 + law.b * y * law.k_min + law.c
     if r > 0.0:
@@ -111,7 +125,7 @@ def _damped(law, y):
 def _law_row(law, w, u0, u1, ref, re0, re1, on):
     """One step of the law row ``w`` on the base's commands ``u0``, ``u1`` [rad], the pitch rate reference
     ``ref`` and the rate errors ``re0``, ``re1`` [rad/s]: the commands sent into ``w[A.gimbal:]``
-    (:meth:`.aac.AdaptiveGainLaw.step`)."""
+    (the adaptive law of :mod:`.aac`)."""
     if not on:
         w[A.on] = 0.0
         w[A.gimbal], w[A.gimbal + 1] = 0.0, 0.0
@@ -137,10 +151,10 @@ def _law_row(law, w, u0, u1, ref, re0, re1, on):
     e20, e21 = _dead_zone_sq(ef0, law.e_dz), _dead_zone_sq(ef1, law.e_dz)
     y0, y1 = _damped(law, w[A.lp_y]), _damped(law, w[A.lp_y + 1])
     if law.per_axis:
-        w[A.k] = _gain_step(law, w[A.k], e20, y0)
-        w[A.k + 1] = _gain_step(law, w[A.k + 1], e21, y1)
+        w[A.k] = gain_step_k(law, w[A.k], e20, y0)
+        w[A.k + 1] = gain_step_k(law, w[A.k + 1], e21, y1)
     else:
-        w[A.k] = _gain_step(law, w[A.k], e20 + e21, y0 + y1)
+        w[A.k] = gain_step_k(law, w[A.k], e20 + e21, y0 + y1)
     for ax in range(AXES):
         k = w[A.k + ax] if law.per_axis else w[A.k]
         cmd = clip_k(k * (u0 if ax == 0 else u1), -law.limit, law.limit)
@@ -156,55 +170,15 @@ def _law_row(law, w, u0, u1, ref, re0, re1, on):
 
 
 @nb.njit(cache=True)
-def aac_act_k(tb, su, oc, base, law, rows_law, rows, obs, value, out):
-    """The actions ``out`` (k, 2) float32 of the rows ``rows`` (k,): each row's base (``tb``, ``su``,
-    ``base``: :mod:`.pidkernel`'s blocks) acts on its observation ``obs[j]`` and scheduling value
-    ``value[b]``, then its adaptive law (``law``; its row of ``rows_law``, layout :data:`AAC_ROW`) scales
-    the command; gimbal / limit, clipped."""
-    pid, filters = base.pid, base.filters
+def aac_act_k(law, oc, rows_law, rows, u, obs, out):
+    """The actions ``out`` (k, 2) float32 of the rows ``rows`` (k,): each row's base commands ``u[j]`` [rad]
+    scaled by its adaptive law (``law``; its row of ``rows_law``, layout :data:`AAC_ROW`) on its observation
+    ``obs[j]`` (``oc``: the rate errors, the pitch rate reference, the controller flag); gimbal / limit,
+    clipped."""
     err = oc.err
     for j in range(rows.size):
-        b = rows[j]
-        r, w, o = pid[b], rows_law[b], obs[j]
-        pid_row_k(tb, su, oc, r, filters[b], o, value[b])
-        _law_row(law, w, r[P.gimbal], r[P.gimbal + 1], float(o[oc.ref]), float(o[err[0]]), float(o[err[1]]),
+        w, o = rows_law[rows[j]], obs[j]
+        _law_row(law, w, u[j, 0], u[j, 1], float(o[oc.ref]), float(o[err[0]]), float(o[err[1]]),
                  float(o[oc.on]) >= 0.5)
         for ax in range(AXES):
             out[j, ax] = np.float32(clip_k(w[A.gimbal + ax] / law.limit, -1.0, 1.0))
-
-
-class AACBatch:
-    """``n`` rows of an :class:`.aac.AdaptiveAugmentingPolicy` on a PID-family base, stepped together (the
-    batched interface of :mod:`.batch`; no ``history`` is kept). :attr:`gimbal` (n, 2) [rad]: each row's
-    last command (the policy's ``last_gimbal``)."""
-
-    def __init__(self, policy: Any, n: int) -> None:
-        self.name, self.n = policy.name, int(n)
-        self.base = PIDBatch(policy.base, self.n)
-        lw, p = policy.law, policy.params
-        self.law = AACLaw(p.k_min, p.k_max, p.error_gain, p.damper_gain, p.leak_rate, p.error_deadzone_radps,
-                          p.damper_deadzone_rad2, lw.dt, lw.limit, lw.p_ref, bool(p.per_axis), bool(p.reset_on_engage),
-                          lw.e_lp.pole, lw.e_lp.gain, lw.hp.pole, lw.hp.gain, lw.lp.pole, lw.lp.gain)
-        self.oc = self.base.oc._replace(ref=int(policy._i_ref), on=int(policy._i_on))
-        self.rows = AAC_ROW.pack({"k": 1.0, "fresh": 1.0}, self.n)
-
-    @property
-    def gimbal(self) -> np.ndarray:
-        return AAC_ROW.view(self.rows, "gimbal")
-
-    def reset(self, rows: Any) -> None:
-        """Rows ``rows`` start an episode: the base's reset and :meth:`.aac.AdaptiveGainLaw.reset`."""
-        w = np.asarray(rows, dtype=np.int64).reshape(-1)
-        self.base.reset(w)
-        self.rows[w] = AAC_ROW.pack({"k": 1.0, "fresh": 1.0})
-
-    def act(self, rows: Any, observations: np.ndarray, info: dict[str, Any]) -> np.ndarray:
-        """Actions (len(rows), 2) float32 of the rows ``rows`` for their observations (len(rows), n_obs)."""
-        rows = np.asarray(rows, dtype=np.int64).reshape(-1)
-        obs = np.ascontiguousarray(observations).reshape(rows.size, -1)
-        base = self.base
-        value = base.values(info)
-        base.prepare(rows, obs, value)
-        out = np.empty((rows.size, 2), np.float32)
-        aac_act_k(base.tb, base.su, self.oc, base.st, self.law, self.rows, rows, obs, value, out)
-        return out
