@@ -19,17 +19,20 @@ it (its default path: ``runs/bc.pt``, or ``LVGYM_BC_PATH``).
 from __future__ import annotations
 
 import os
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from lvgym.benchmark.batch import BatchLaw, RowFace
 from lvgym.cli.args import arg, parse
 from lvgym.errors import ConfigError
 
-__all__ = ["BCPolicy", "features", "policy", "train"]
+from .mlp import MlpNet
+
+__all__ = ["BCLaw", "BCPolicy", "features", "policy", "train"]
 
 PROG = "lvgym bc"
 
@@ -91,10 +94,12 @@ def train(dataset_id: str, out: str | Path, history: int = 8, hidden: int = 128,
     return content
 
 
-class BCPolicy:
-    """A cloned policy (module docstring) flying an env of the ascent task."""
+class BCLaw(BatchLaw):
+    """A cloned policy (module docstring) flying ``n`` rows of an env of the ascent task: each row's last
+    ``history`` observations (zeros before its first), normalised, through the cloned network's compiled
+    forward (:mod:`lvgym.agents.mlp`: each row on its own)."""
 
-    def __init__(self, env: Any, path: str | Path, name: str = "bc") -> None:
+    def __init__(self, env: Any, path: str | Path, name: str = "bc", n: int = 1) -> None:
         import torch
 
         content = torch.load(path, weights_only=False)
@@ -102,26 +107,37 @@ class BCPolicy:
         if n_obs != content["n_obs"]:
             raise ConfigError("bc path", str(path), f"a policy cloned on this env's observation ({n_obs} entries; "
                               f"the file's has {content['n_obs']})")
-        self.name, self.history = name, int(content["history"])
-        self.net = _network(n_obs * self.history, content["n_act"], int(content["hidden"]))
-        self.net.load_state_dict(content["state_dict"])
-        self.net.eval()
-        self.mean, self.std = content["mean"], content["std"]
-        self._past: list[np.ndarray] = []
+        self.name, self.history, self.n_obs = name, int(content["history"]), n_obs
+        net = _network(n_obs * self.history, content["n_act"], int(content["hidden"]))
+        net.load_state_dict(content["state_dict"])
+        self.net = MlpNet.from_torch(list(net))
+        self.mean = np.asarray(content["mean"])
+        self.std = np.asarray(content["std"])
+        self.allocate(n)
 
-    def reset(self) -> None:
-        """A new episode: no past observations."""
-        self._past = []
+    def _rows(self, n: int) -> None:
+        self.past = np.zeros((n, self.history, self.n_obs), np.float32)
 
-    def act(self, observation: np.ndarray, info: dict[str, Any]) -> np.ndarray:
-        """The action of the last ``history`` observations."""
-        import torch
+    def reset(self, rows: Any) -> None:
+        """The rows ``rows`` start an episode: no past observations."""
+        self.past[np.asarray(rows, dtype=np.int64).reshape(-1)] = 0.0
 
-        self._past = (self._past + [np.asarray(observation, np.float32).ravel()])[-self.history:]
-        x = features(np.array(self._past), self.history)[-1]
-        with torch.no_grad():
-            out = self.net(torch.as_tensor(((x - self.mean) / self.std)[None].astype(np.float32)))
-        return out.numpy()[0].astype(np.float32)
+    def act(self, rows: Any, observations: np.ndarray, info: Mapping[str, Any]) -> np.ndarray:
+        """The actions of the rows' last ``history`` observations."""
+        rows = np.asarray(rows, dtype=np.int64).reshape(-1)
+        past = self.past[rows]
+        past[:, :-1] = past[:, 1:]
+        past[:, -1] = np.asarray(observations, np.float32).reshape(rows.size, -1)
+        self.past[rows] = past
+        x = ((past.reshape(rows.size, -1) - self.mean) / self.std).astype(np.float32)
+        return self.net(x)
+
+
+class BCPolicy(RowFace):
+    """A cloned policy flying an env of the ascent task: one row of :class:`BCLaw`."""
+
+    def __init__(self, env: Any, path: str | Path, name: str = "bc") -> None:
+        self.law = BCLaw(env, path, name)
 
 
 def policy(env: Any, path: str | Path | None = None, name: str | None = None) -> BCPolicy:

@@ -39,18 +39,19 @@ from __future__ import annotations
 
 import json
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from lvgym.benchmark.batch import BatchLaw, RowFace
 from lvgym.errors import ConfigError
 
 from .observer import N_OBS, Observer, Window
 from .staging import GIMBAL, RATES, Ignition, Measured, signal_index
 
-__all__ = ["A_MAX", "ERRORS", "SHIPPED", "SPAN", "TERMS", "InversionBatch", "InversionPolicy", "Lead", "Staging",
+__all__ = ["A_MAX", "ERRORS", "SHIPPED", "SPAN", "TERMS", "InversionLaw", "InversionPolicy", "Lead", "Staging",
            "carry", "check_env", "command", "env_record", "error_index", "from_file", "gains", "law_terms",
            "shipped_inversion"]
 
@@ -236,56 +237,38 @@ class Staging:
         return (Ignition(n, self.on), Measured(n, self.rates, self.gimbal, self.dt)) if self.steps else None
 
 
-class InversionPolicy:
-    """The law of the module docstring on the observer's estimated terms; one env row (the benchmark's
-    policy; no privileged information). ``observer``: a window ``(WINDOW, FEATURES)`` -> the terms ``(7,)``
-    (an :class:`~lvgym.agents.observer.Observer`); ``trained``: the :func:`env_record` it was trained on (it
-    refuses another env: :func:`check_env`); ``lead``, ``span``: the control steps the estimated aerodynamic
-    moment is carried ahead along its slope over ``span`` steps (:class:`Lead`; 0: the moment as estimated),
-    after its average over ``average`` steps (1: none); ``law``: the law's gains per flight model where they
-    are not the reference's (:func:`gains`); ``ignition``: for that long [s] after the next stage's ignition
-    the law cancels the moment measured from the rigid body (:class:`Staging`) in place of the estimated
-    aerodynamic moment (0: never), ``ignition_share`` of it and the rest of the estimate (1: the measured
-    alone)."""
+class InversionLaw(BatchLaw):
+    """The law of the module docstring on the observer's estimated terms for ``n`` rows (the benchmark's
+    policy; no privileged information): one window per row, the observer on every row's window in one call
+    (:meth:`~lvgym.agents.observer.Observer.rows`), the law on the rows at once (elementwise: a row's action does
+    not depend on the others). ``observer``: an :class:`~lvgym.agents.observer.Observer`; ``trained``: the
+    :func:`env_record` it was trained on (it refuses another env: :func:`check_env`); ``lead``, ``span``: the
+    control steps the estimated aerodynamic moment is carried ahead along its slope over ``span`` steps
+    (:class:`Lead`; 0: the moment as estimated), after its average over ``average`` steps (1: none); ``law``:
+    the law's gains per flight model where they are not the reference's (:func:`gains`); ``ignition``: for that
+    long [s] after the next stage's ignition the law cancels the moment measured from the rigid body
+    (:class:`Staging`) in place of the estimated aerodynamic moment (0: never), ``ignition_share`` of it and the
+    rest of the estimate (1: the measured alone)."""
 
-    def __init__(self, env: Any, observer: Callable[[np.ndarray], np.ndarray], name: str = "inversion-id",
+    def __init__(self, env: Any, observer: Observer, name: str = "inversion-id",
                  trained: dict[str, Any] | None = None, lead: int = 0, span: int = SPAN,
                  law: Law | None = None, average: int = 1, ignition: float = 0.0,
-                 ignition_share: float = 1.0) -> None:
+                 ignition_share: float = 1.0, n: int = 1) -> None:
         check_env(env, trained or {})
         self.observer = observer
         self.name = name
         self.index, (self.w, self.z) = error_index(env), gains(env, law)
         self.lead, self.span, self.average = int(lead), int(span), int(average)
         self.staging = Staging(env, ignition, ignition_share)
-        self.reset()
+        self.allocate(n)
 
-    def reset(self) -> None:
-        """Forget the flight: the window starts from zeros, the lead from no slope, the ignition's clock."""
-        self.window, self.ahead = Window(1), Lead(1, self.lead, self.span, self.average)
-        self.fresh = self.staging.rows(1)
-
-    def act(self, observation: np.ndarray, info: dict[str, Any]) -> np.ndarray:
-        """The gimbal action (pitch, yaw) in [-1, 1] from the observation (``info`` is not read)."""
-        return InversionBatch.step(self, np.zeros(1, dtype=np.int64), np.asarray(observation)[None])[0]
-
-    def batch(self, n: int) -> InversionBatch:
-        """The same policy for ``n`` rows of a batched env (each row's actions are its single env's, to the bit)."""
-        return InversionBatch(self, n)
-
-
-class InversionBatch:
-    """:class:`InversionPolicy` for the rows of a batched env (the interface of :mod:`lvgym.benchmark.batch`):
-    one window per row, the observer on each row's window, the law on the rows at once (elementwise: a row's
-    action does not depend on the others)."""
-
-    def __init__(self, policy: InversionPolicy, n: int) -> None:
-        self.name, self.observer = policy.name, policy.observer
-        self.index, self.w, self.z = policy.index, policy.w, policy.z
-        self.window, self.ahead = Window(int(n)), Lead(int(n), policy.lead, policy.span, policy.average)
-        self.staging, self.fresh = policy.staging, policy.staging.rows(int(n))
+    def _rows(self, n: int) -> None:
+        self.window, self.ahead = Window(n), Lead(n, self.lead, self.span, self.average)
+        self.fresh = self.staging.rows(n)
 
     def reset(self, rows: Any) -> None:
+        """Forget the flights of ``rows``: the window starts from zeros, the lead from no slope, the ignition's
+        clock."""
         rows = np.asarray(rows, dtype=np.int64).reshape(-1)
         self.window.reset(rows)
         self.ahead.reset(rows)
@@ -293,28 +276,35 @@ class InversionBatch:
             for part in self.fresh:
                 part.reset(rows)
 
-    def act(self, rows: Any, observations: np.ndarray, info: dict[str, Any]) -> np.ndarray:
-        return self.step(self, np.asarray(rows, dtype=np.int64).reshape(-1), np.asarray(observations))
-
-    @staticmethod
-    def step(law: InversionPolicy | InversionBatch, rows: np.ndarray, observations: np.ndarray) -> np.ndarray:
-        """The actions of ``rows`` for their ``(len(rows), 14)`` observations, their windows moved on by one."""
+    def act(self, rows: Any, observations: np.ndarray, info: Mapping[str, Any]) -> np.ndarray:
+        """The actions of ``rows`` for their ``(len(rows), 14)`` observations (``info`` is not read), their
+        windows moved on by one."""
+        rows = np.asarray(rows, dtype=np.int64).reshape(-1)
         o = np.asarray(observations, dtype=np.float32)
-        windows = law.window.push(rows, o)
-        terms = np.stack([law.observer(w) for w in windows])
-        terms[:, 0:2] = law.ahead.push(rows, terms[:, 0:2])
-        if law.fresh is not None:                      # the next stage's first seconds: the measured moment
-            lit, measured = law.fresh
+        terms = self.observer.rows(self.window.push(rows, o))
+        terms[:, 0:2] = self.ahead.push(rows, terms[:, 0:2])
+        if self.fresh is not None:                     # the next stage's first seconds: the measured moment
+            lit, measured = self.fresh
             since = lit.push(rows, o)
             measured.push(rows, o)
-            now = (since >= 0) & (since < law.staging.steps)
+            now = (since >= 0) & (since < self.staging.steps)
             if now.any():
-                w = law.staging.share
+                w = self.staging.share
                 terms[now, 0:2] = (w * (measured.moment(rows[now], terms[now, 4:6]) - terms[now, 2:4])
                                    + (1.0 - w) * terms[now, 0:2])
-        a = command(o, terms, law.index, law.w, law.z)
-        law.window.sent(rows, a)
+        a = command(o, terms, self.index, self.w, self.z)
+        self.window.sent(rows, a)
         return a
+
+
+class InversionPolicy(RowFace):
+    """:class:`InversionLaw` (its arguments) for one env row: the benchmark's policy."""
+
+    def __init__(self, env: Any, observer: Observer, name: str = "inversion-id",
+                 trained: dict[str, Any] | None = None, lead: int = 0, span: int = SPAN,
+                 law: Law | None = None, average: int = 1, ignition: float = 0.0,
+                 ignition_share: float = 1.0) -> None:
+        self.law = InversionLaw(env, observer, name, trained, lead, span, law, average, ignition, ignition_share)
 
 
 def from_file(env: Any, path: str | Path, name: str = "inversion-id", trained: dict[str, Any] | None = None,
@@ -328,7 +318,7 @@ def from_file(env: Any, path: str | Path, name: str = "inversion-id", trained: d
     if Path(path).suffix == ".pt":
         from .observer_fit import load, to_observer
 
-        observer: Callable[[np.ndarray], np.ndarray] = to_observer(load(path))
+        observer = to_observer(load(path))
     else:
         observer = Observer.load(path)
     return InversionPolicy(env, observer, name=name, trained=trained, lead=lead, span=span, law=law,

@@ -65,7 +65,8 @@ class Observer:
     For speed (one window per row and step) the members are fused once, in float64, then kept in float32: the
     standardisations folded into the first layer and the members' first layers stacked (one product), the
     second layers as one batched product, the label scaling and the mean over members folded into one last
-    product. The same window gives the same estimate to the bit, whichever row it comes from."""
+    product. The same window gives the same estimate to the bit, whichever row of whichever batch it comes
+    from (:meth:`rows`)."""
 
     def __init__(self, members: list[Mapping[str, np.ndarray]]) -> None:
         if not members:
@@ -88,10 +89,19 @@ class Observer:
         self.hidden = self.w1.shape[1]
         self.outputs = int(self.b2.shape[0])
 
+    def rows(self, windows: np.ndarray) -> np.ndarray:
+        """The estimates ``(m, outputs)`` (float64) of ``m`` windows ``(m, WINDOW, FEATURES)``, one per row in one
+        call: numpy's stacked products take each window's matrix-vector product on its own, so a window's estimate
+        is the same bits in a batch of one as in any batch."""
+        z = np.asarray(windows, dtype=np.float32).reshape(len(windows), -1)
+        h = np.tanh(np.matmul(self.w0, z[:, :, None])[..., 0] + self.b0)
+        h = h.reshape(len(z), len(self.members), self.hidden, 1)
+        h = np.tanh(np.matmul(self.w1[None], h)[..., 0] + self.b1)
+        return np.matmul(self.w2, h.reshape(len(z), -1, 1))[..., 0].astype(np.float64) + self.b2
+
     def __call__(self, window: np.ndarray) -> np.ndarray:
-        h = np.tanh(self.w0 @ np.asarray(window, dtype=np.float32).reshape(-1) + self.b0)
-        h = np.tanh(np.matmul(self.w1, h.reshape(len(self.members), self.hidden, 1))[..., 0] + self.b1)
-        return (self.w2 @ h.reshape(-1)).astype(np.float64) + self.b2
+        """The estimate ``(outputs,)`` of one window ``(WINDOW, FEATURES)``."""
+        return self.rows(np.asarray(window)[None])[0]
 
     def save(self, path: str | Path) -> None:
         """Write the members' arrays to ``path`` (``.npz``, :meth:`load`)."""

@@ -1,5 +1,5 @@
-"""A trained stable-baselines3 model as a benchmark :class:`~lvgym.benchmark.policy.Policy`, and the files
-a saved policy is made of.
+"""A trained stable-baselines3 model as a batch law (:class:`SB3Law`) with its one-row face, the benchmark
+:class:`~lvgym.benchmark.policy.Policy` (:class:`SB3Policy`), and the files a saved policy is made of.
 
 A saved policy is three files with one stem::
 
@@ -22,15 +22,18 @@ import json
 import pickle
 import shutil
 import zipfile
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from lvgym.benchmark.batch import BatchLaw, RowFace
 from lvgym.benchmark.results import atomic_path, atomic_write_text
 from lvgym.cli.args import arg
 
 from .config import ALGOS, algo_class, algo_name
+from .mlp import MlpNet
 
 VECNORM_SUFFIX = "_vecnormalize.pkl"
 
@@ -180,22 +183,135 @@ def load_vecnormalize(zip_path: str | Path) -> Any:
     return vn
 
 
-class SB3Policy:
-    """A trained SB3 model behind the benchmark's Policy interface: ``act`` normalises the observation
-    with the training run's frozen VecNormalize statistics and returns ``model.predict(...,
-    deterministic=True)`` (actions inside the action space). ``name`` defaults to the file stem (the run
-    name for a run folder)."""
+def actor_net(model: Any) -> MlpNet | None:
+    """The deterministic actor of ``model`` as an :class:`~lvgym.agents.mlp.MlpNet` when its ``predict`` of a
+    flat observation is that network and a clip to the action's Box: an actor-critic MLP policy (PPO, A2C: a
+    flattened observation, linear layers and :data:`~lvgym.agents.mlp.ACTIVATIONS`, a diagonal Gaussian whose
+    deterministic action is its mean; on the CPU, no squashing). None otherwise."""
+    from gymnasium import spaces
+    from stable_baselines3.common.distributions import DiagGaussianDistribution
+    from stable_baselines3.common.policies import ActorCriticPolicy
+    from stable_baselines3.common.torch_layers import FlattenExtractor, MlpExtractor
+
+    pol = getattr(model, "policy", None)
+    if (type(pol) is not ActorCriticPolicy or not isinstance(pol.action_dist, DiagGaussianDistribution)
+            or type(pol.pi_features_extractor) is not FlattenExtractor or type(pol.mlp_extractor) is not MlpExtractor
+            or not isinstance(model.action_space, spaces.Box) or not isinstance(model.observation_space, spaces.Box)
+            or len(model.observation_space.shape) != 1 or getattr(pol, "squash_output", False)):
+        return None
+    return MlpNet.from_torch([*pol.mlp_extractor.policy_net, pol.action_net])
+
+
+class SB3Law(BatchLaw):
+    """A trained SB3 model flying ``n`` rows: each row's observation normalised with the training run's frozen
+    VecNormalize statistics (``normalizer``) and, for a model trained with ``history`` flown on a plain
+    observation, stacked per row with the action the row last applied (:meth:`note_applied`); the action is the
+    model's deterministic one, inside the action space. An actor-critic MLP (every shipped policy) flies through
+    its compiled forward (:func:`actor_net`, :mod:`lvgym.agents.mlp`: each row on its own, the same bits in any
+    batch); another model (a recurrent, SAC or TD3 model) through its own batched ``predict``, with each row's
+    LSTM state kept (its rows then agree with a batch of one to float32 rounding)."""
+
+    def __init__(self, model: Any, normalizer: Any = None, name: str = "agent", deterministic: bool = True,
+                 meta: dict[str, Any] | None = None, path: str = "", n: int = 1) -> None:
+        self.model, self.normalizer, self.name, self.path = model, normalizer, name, path
+        self.meta = dict(meta or {})
+        self.deterministic = bool(deterministic)
+        self.recurrent = algo_name(type(model).__name__) == "RecurrentPPO"
+        self.history = int((self.meta.get("env_kwargs") or {}).get("history", 0) or 0)
+        self.expected = tuple(model.observation_space.shape)
+        self.net = actor_net(model) if self.deterministic and not self.recurrent else None
+        if self.net is not None:
+            self.low, self.high = model.action_space.low, model.action_space.high
+        self.allocate(n)
+
+    def _rows(self, n: int) -> None:
+        self._fresh = np.ones(n, dtype=bool)
+        self._last = np.zeros((n, 0), np.float32)
+        self._stack: Any = None
+        self._buf = np.zeros((n, 0), np.float32)
+        self._lstm: tuple[np.ndarray, np.ndarray] | None = None     # (layers, n, hidden) each
+
+    def reset(self, rows: Any) -> None:
+        """The rows ``rows`` start an episode (their history and LSTM state restart)."""
+        self._fresh[np.asarray(rows, dtype=np.int64).reshape(-1)] = True
+
+    def note_applied(self, rows: Any, actions: np.ndarray) -> None:
+        """The actions the env got this step for the rows ``rows`` (a residual policy's mix): the history
+        records them."""
+        rows = np.asarray(rows, dtype=np.int64).reshape(-1)
+        a = np.asarray(actions, dtype=np.float32).reshape(rows.size, -1)
+        if self._last.shape[1] != a.shape[1]:
+            self._last = np.zeros((self.n, a.shape[1]), np.float32)
+        self._last[rows] = a
+
+    def _stacked(self, rows: np.ndarray, obs: np.ndarray) -> np.ndarray:
+        """The rows' observations as the model saw them in training: themselves, or (a plain observation of a
+        model trained with ``history``) the stack of each row's last samples and actions."""
+        if obs.shape[1:] == self.expected or not self.history:
+            return obs
+        from lvgym.envs.history import HistoryStack, recorded_action
+        from lvgym.envs.layouts import ACTIONS
+
+        if self._stack is None:
+            stack = HistoryStack(_plain_layout(int(obs.shape[1])), ACTIONS["tvc"], self.history)
+            if (stack.size,) != self.expected:
+                raise ValueError(f"policy {self.name!r}: observation of shape {obs.shape[1:]} with history "
+                                 f"{self.history} stacks to ({stack.size},), trained on {self.expected}")
+            self._stack, self._buf = stack, stack.zeros(self.n)
+        fresh = self._fresh[rows]
+        if fresh.any():
+            self._stack.reset(self._buf, rows[fresh], obs[fresh])
+        if not fresh.all():
+            old = rows[~fresh]
+            part = self._buf[old]
+            self._stack.push(part, obs[~fresh], recorded_action("tvc", self._last[old]))
+            self._buf[old] = part
+        return self._buf[rows].copy()
+
+    def act(self, rows: Any, observations: np.ndarray, info: Mapping[str, Any]) -> np.ndarray:
+        """Actions (len(rows), n_a) of the rows ``rows`` for their observations."""
+        rows = np.asarray(rows, dtype=np.int64).reshape(-1)
+        obs = self._stacked(rows, np.asarray(observations, dtype=np.float32).reshape(rows.size, -1))
+        if obs.shape[1:] != self.expected:
+            raise ValueError(f"policy {self.name!r}: observation of shape {obs.shape[1:]}, trained on {self.expected}")
+        if self.normalizer is not None and getattr(self.normalizer, "norm_obs", True):
+            obs = np.asarray(self.normalizer.normalize_obs(obs), dtype=np.float32)
+        if self.net is not None:
+            actions = np.clip(self.net(obs), self.low, self.high)
+        elif self.recurrent:
+            actions = self._recurrent(rows, obs)
+        else:
+            actions = np.asarray(self.model.predict(obs, deterministic=self.deterministic)[0])
+        self._fresh[rows] = False
+        self.note_applied(rows, actions)
+        return actions
+
+    def _recurrent(self, rows: np.ndarray, obs: np.ndarray) -> np.ndarray:
+        """A recurrent model's actions for the rows, each row's LSTM state kept (restarted at its first step)."""
+        starts = self._fresh[rows].copy()
+        state = None
+        if self._lstm is not None:
+            state = (self._lstm[0][:, rows], self._lstm[1][:, rows])
+        action, (h, c) = self.model.predict(obs, state=state, episode_start=starts, deterministic=self.deterministic)
+        if self._lstm is None:
+            self._lstm = (np.zeros((h.shape[0], self.n, h.shape[2]), h.dtype), np.zeros((c.shape[0], self.n,
+                                                                                         c.shape[2]), c.dtype))
+        self._lstm[0][:, rows], self._lstm[1][:, rows] = h, c
+        return np.asarray(action)
+
+
+class SB3Policy(RowFace):
+    """A trained SB3 model behind the benchmark's Policy interface: one row of :class:`SB3Law`. It accepts a
+    saved ``.zip``, its stem, or a run folder of ``train.py`` (``runs/<name>``: its best model by validation,
+    else its final model, else its last checkpoint); ``name`` defaults to the file stem (the run name for a run
+    folder)."""
 
     def __init__(self, path: str | Path, name: str | None = None, deterministic: bool = True) -> None:
         zip_path = resolve_model_path(path)
-        self.path = str(zip_path)
-        self.meta = read_meta(zip_path)
-        self.model = load_model(zip_path)
-        self.normalizer = load_vecnormalize(zip_path)
-        self.deterministic = bool(deterministic)
         p = Path(path)
-        self.name = name or (p.resolve().name if p.is_dir() else zip_path.stem)
-        self._setup()
+        self.law = SB3Law(load_model(zip_path), load_vecnormalize(zip_path),
+                          name or (p.resolve().name if p.is_dir() else zip_path.stem), deterministic,
+                          read_meta(zip_path), str(zip_path))
 
     @classmethod
     def from_model(cls, model: Any, normalizer: Any = None, name: str = "agent",
@@ -203,135 +319,16 @@ class SB3Policy:
         """A live model (and a VecNormalize whose statistics it was trained with) as a policy. The
         statistics are copied and frozen: later training does not change this policy. ``meta``: the
         run's sidecar fields (its ``env_kwargs`` say whether the observation has a ``history``)."""
-        self = cls.__new__(cls)
-        self.path, self.meta, self.model, self.name = "", dict(meta or {}), model, name
-        self.deterministic = bool(deterministic)
-        self.normalizer = None
+        frozen = None
         if normalizer is not None:
             import copy
 
-            self.normalizer = copy.copy(normalizer)
-            self.normalizer.obs_rms = copy.deepcopy(normalizer.obs_rms)
-            self.normalizer.training = False
-        self._setup()
+            frozen = copy.copy(normalizer)
+            frozen.obs_rms = copy.deepcopy(normalizer.obs_rms)
+            frozen.training = False
+        self = cls.__new__(cls)
+        self.law = SB3Law(model, frozen, name, deterministic, meta)
         return self
-
-    def _setup(self) -> None:
-        """What the model needs besides its weights: the observation history of its training env
-        (``env_kwargs["history"]``: k samples and actions, stacked here from a plain observation with the
-        env's own :class:`lvgym.envs.history.HistoryStack`) and, for a recurrent model, its LSTM state."""
-        self.recurrent = algo_name(type(self.model).__name__) == "RecurrentPPO"
-        self.history = int((self.meta.get("env_kwargs") or {}).get("history", 0) or 0)
-        self._stack: Any = None
-        self._buf = np.zeros((1, 0), np.float32)
-        self._last = np.zeros(0, np.float32)
-        self.reset()
-
-    def reset(self) -> None:
-        """A new episode: the LSTM state (recurrent models) and the stacked history start afresh."""
-        self._lstm: Any = None
-        self._starts = np.ones(1, dtype=bool)
-        self._fresh = True
-
-    def note_applied(self, action: np.ndarray) -> None:
-        """The action the env got this step (a residual policy's mix): the history records it."""
-        self._last = np.asarray(action, dtype=np.float32)
-
-    def _stacked(self, obs: np.ndarray) -> np.ndarray:
-        """``obs`` as the model saw it in training: itself, or (a plain observation of a model trained with
-        ``history``) the stack of the last samples and actions."""
-        expected = self.model.observation_space.shape
-        if obs.shape == expected or not self.history:
-            return obs
-        if self._stack is None:
-            from lvgym.envs.history import HistoryStack
-            from lvgym.envs.layouts import ACTIONS
-
-            base = _plain_layout(int(obs.shape[0]))
-            stack = HistoryStack(base, ACTIONS["tvc"], self.history)
-            if (stack.size,) != expected:
-                raise ValueError(f"policy {self.name!r}: observation of shape {obs.shape} with history "
-                                 f"{self.history} stacks to ({stack.size},), trained on {expected}")
-            self._stack, self._buf = stack, stack.zeros(1)
-        if self._fresh:
-            self._stack.reset(self._buf, [0], obs[None])
-        else:
-            from lvgym.envs.history import recorded_action
-
-            self._stack.push(self._buf, obs[None], recorded_action("tvc", self._last[None]))
-        return self._buf[0].copy()
-
-    def act(self, observation: np.ndarray, info: dict[str, Any]) -> np.ndarray:
-        """The action for one observation of the env's observation space (or, for a model trained with
-        ``history``, of the plain observation: the history is stacked here)."""
-        obs = self._stacked(np.asarray(observation, dtype=np.float32))
-        self._fresh = False
-        expected = self.model.observation_space.shape
-        if obs.shape != expected:
-            raise ValueError(f"policy {self.name!r}: observation of shape {obs.shape}, trained on {expected}")
-        action = self._predict(obs)
-        self._last = np.asarray(action, dtype=np.float32)
-        return action
-
-    def batch(self, n: int) -> Any:
-        """The same policy for ``n`` rows of a batched env (:class:`lvgym.agents.policybatch.SB3Batch`, the
-        interface of :mod:`lvgym.benchmark.batch`): each row's actions are the bits :meth:`act` gives it."""
-        from .policybatch import SB3Batch
-
-        return SB3Batch(self, n)
-
-    def act_batch(self, observations: np.ndarray, episode_start: np.ndarray) -> np.ndarray:
-        """Actions (B, n_a) for the observations (B, n_obs) of B env rows (a batched env's, with the
-        model's own observation: a ``history`` env stacks natively); ``episode_start`` (B,) bool marks the
-        rows whose episode begins with this observation (their LSTM state restarts)."""
-        obs = np.asarray(observations, dtype=np.float32)
-        if self.normalizer is not None and getattr(self.normalizer, "norm_obs", True):
-            obs = np.asarray(self.normalizer.normalize_obs(obs), dtype=np.float32)
-        starts = np.asarray(episode_start, dtype=bool)
-        if not self.recurrent:
-            return np.asarray(self.model.predict(obs, deterministic=self.deterministic)[0])
-        if self._lstm is not None and np.shape(self._lstm[0])[1] != obs.shape[0]:
-            self._lstm = None
-        action, self._lstm = self.model.predict(obs, state=self._lstm, episode_start=starts,
-                                                deterministic=self.deterministic)
-        return np.asarray(action)
-
-    def _predict(self, obs: np.ndarray) -> np.ndarray:
-        if self.normalizer is not None and getattr(self.normalizer, "norm_obs", True):
-            obs = np.asarray(self.normalizer.normalize_obs(obs), dtype=np.float32)
-        if self.recurrent:                         # the LSTM state goes on, restarted at an episode's start
-            action, self._lstm = self.model.predict(obs[None], state=self._lstm, episode_start=self._starts,
-                                                    deterministic=self.deterministic)
-            self._starts = np.zeros(1, dtype=bool)
-            return np.asarray(action)[0]
-        fast = self._fast_path()
-        if fast is None:
-            action, _ = self.model.predict(obs, deterministic=self.deterministic)
-            return np.asarray(action)
-        import torch
-
-        policy, low, high = fast
-        with torch.no_grad():                      # what model.predict does, without its per-call checks
-            out = policy._predict(torch.as_tensor(obs[None]), deterministic=self.deterministic)
-        return np.clip(out.cpu().numpy().reshape(low.shape), low, high)
-
-    def _fast_path(self) -> tuple[Any, np.ndarray, np.ndarray] | None:
-        """``(policy, low, high)`` when ``model.predict`` of one flat observation reduces to the policy's
-        ``_predict`` and a clip to the Box (no image transposition, no squashing, on the CPU), else None.
-        About three times faster per step than ``predict`` (tests/test_agents.py checks both agree)."""
-        if not hasattr(self, "_fast"):
-            from gymnasium import spaces
-
-            m = self.model
-            pol = getattr(m, "policy", None)
-            ok = (pol is not None and isinstance(m.action_space, spaces.Box)
-                  and isinstance(m.observation_space, spaces.Box) and len(m.observation_space.shape) == 1
-                  and not getattr(pol, "squash_output", False) and str(getattr(m, "device", "cpu")) == "cpu"
-                  and not self.recurrent)
-            if ok:
-                pol.set_training_mode(False)
-            self._fast = (pol, m.action_space.low, m.action_space.high) if ok else None
-        return self._fast
 
 
 #: the folder of the shipped policies (each ``<file>.zip`` beside its ``_vecnormalize.pkl`` and its sidecar
@@ -438,5 +435,5 @@ if __name__ == "__main__":
     main()
 
 
-__all__ = ["PRIVILEGED_OBSERVATIONS", "SB3Policy", "adapt", "copy_policy", "load_model", "load_policy",
+__all__ = ["PRIVILEGED_OBSERVATIONS", "SB3Law", "SB3Policy", "actor_net", "adapt", "copy_policy", "load_model", "load_policy",
            "load_vecnormalize", "policy_files", "privileged_env_options", "privileged_options", "read_meta", "resolve_model_path", "save_policy"]

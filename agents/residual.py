@@ -7,16 +7,17 @@ designed on the non-rigid v1 flight loop, ``lvgym.baselines.pid:smile_scheduled_
 0.2 lets the learned part move the gimbal by at most 20 % of its limit), clipped to the action space.
 So a learned policy that outputs zero flies the baseline's episode exactly.
 
-One code path for training and evaluation: :class:`ResidualRows` holds one baseline per env row and
-mixes the actions (:func:`combine`); :class:`ResidualVecEnv` (an SB3 ``VecEnvWrapper`` over the batched
-lvgym ``VecEnv``, what ``train.py --residual`` trains on), :class:`ResidualEnv` (a Gymnasium wrapper of a
-single env) and :class:`ResidualPolicy` (the saved policy's adapter, :func:`lvgym.agents.policy.load_policy`)
-all use it. The baseline sees the env's own observation (with ``history`` it reads the newest sample by
+The baseline is its batch law in training and in evaluation: :class:`ResidualRows` holds it for the env rows
+and mixes the actions (:func:`combine`) for :class:`ResidualVecEnv` (an SB3 ``VecEnvWrapper`` over the batched
+lvgym ``VecEnv``, what ``train.py --residual`` trains on) and :class:`ResidualEnv` (a Gymnasium wrapper of a
+single env); :class:`ResidualLaw` (with its one-row face :class:`ResidualPolicy`, the saved policy's adapter,
+:func:`lvgym.agents.policy.load_policy`) flies the baseline's law and the learned law side by side. The baseline sees the env's own observation (with ``history`` it reads the newest sample by
 name); the learned policy sees the same observation.
 """
 
 from __future__ import annotations
 
+import copy
 from dataclasses import asdict, dataclass
 from typing import Any
 
@@ -24,14 +25,13 @@ import gymnasium as gym
 import numpy as np
 from stable_baselines3.common.vec_env import VecEnvWrapper
 
-from lvgym.benchmark.policy import Policy
 import lvgym.baselines  # noqa: F401  (registers the baselines a residual policy flies on)
-from lvgym.benchmark.batch import PerRow as RowPolicies, as_batch
+from lvgym.benchmark.batch import BatchLaw, RowFace, as_batch
 from lvgym.benchmark.registry import POLICIES
 from lvgym.benchmark.runner import build_policy
 from lvgym.errors import ConfigError, check_number
 
-__all__ = ["DEFAULT_BASELINE", "INFO_KEYS", "ResidualBatch", "ResidualConfig", "ResidualEnv", "ResidualPolicy",
+__all__ = ["DEFAULT_BASELINE", "INFO_KEYS", "ResidualConfig", "ResidualEnv", "ResidualLaw", "ResidualPolicy",
            "ResidualRows",
            "ResidualVecEnv", "combine", "residual_options", "residual_venv", "stack_infos"]
 
@@ -100,43 +100,31 @@ def stack_infos(infos: list[dict[str, Any]]) -> dict[str, np.ndarray]:
 
 
 class ResidualRows:
-    """One baseline per env row (built by its registry factory on ``env``, a single or batched lvgym env)
-    and the baseline action of each row for its coming step (:attr:`base`, (rows, n_a) float32). A baseline
-    whose policy has ``batch(n)`` (the classical ones: :mod:`lvgym.baselines.batch`) flies every row in one
-    object, stepped together; the others, one policy per row."""
+    """The baseline's batch law for the env rows (built by its registry factory on ``env``, a single or batched
+    lvgym env; a policy without one flies through :class:`lvgym.benchmark.batch.PerRow`) and the baseline
+    action of each row for its coming step (:attr:`base`, (rows, n_a) float32)."""
 
     def __init__(self, config: ResidualConfig, env: Any, rows: int) -> None:
         if not hasattr(env.action_space, "low"):
             raise ValueError("a residual policy needs a Box (TVC) action space")
         self.config = config
         spec = POLICIES[config.baseline]
-        first = build_policy(spec, env)
-        self.batch = first.batch(int(rows)) if hasattr(first, "batch") else None
-        self.policies: list[Policy] = [] if self.batch is not None else [first] + [
-            build_policy(spec, env) for _ in range(int(rows) - 1)]
+        self.batch = as_batch(build_policy(spec, env), int(rows), lambda: build_policy(spec, env))
         n_a = int(np.prod(env.action_space.shape[-1:]))
         self.base = np.zeros((int(rows), n_a), np.float32)
 
     def reset(self, rows: Any, obs: np.ndarray, infos: list[dict[str, Any]]) -> None:
         """Rows ``rows`` start an episode whose first observation is ``obs[b]`` and info ``infos[b]``."""
         rows = np.asarray(list(rows), dtype=int)
-        if self.batch is not None:
-            self.batch.reset(rows)
-        else:
-            for b in rows:
-                self.policies[b].reset()
+        self.batch.reset(rows)
         self.advance(rows, obs, infos)
 
     def advance(self, rows: Any, obs: np.ndarray, infos: list[dict[str, Any]]) -> None:
         """Rows ``rows`` went one step on: their baselines act on the new observation (``infos``: every
         row's info)."""
-        if self.batch is not None:
-            rows = np.asarray(list(rows), dtype=int)
-            if rows.size:
-                self.base[rows] = self.batch.act(rows, obs[rows], stack_infos(infos))
-            return
-        for b in rows:
-            self.base[b] = self.policies[b].act(obs[b], infos[b])
+        rows = np.asarray(list(rows), dtype=int)
+        if rows.size:
+            self.base[rows] = self.batch.act(rows, obs[rows], stack_infos(infos))
 
     def apply(self, learned: np.ndarray) -> np.ndarray:
         """The env's actions for the learned actions ``learned`` (rows, n_a)."""
@@ -184,62 +172,32 @@ class ResidualEnv(gym.Wrapper):
         return obs, reward, terminated, truncated, info
 
 
-class ResidualPolicy:
-    """A learned policy on a baseline, as a benchmark Policy: ``act`` returns ``baseline + scale *
-    learned`` (:class:`ResidualRows`, one row, built on ``env``). ``learned``: a Policy whose actions are
-    the residual's (an :class:`lvgym.agents.policy.SB3Policy`); if it has ``note_applied``, it is told the action
-    the env gets (its observation history records that one, as the env's does)."""
+class ResidualLaw(BatchLaw):
+    """A learned policy on a baseline for ``n`` rows: the baseline's batch law (built by its registry factory
+    on ``env``) and the learned law, mixed by :func:`combine`. ``learned``: a policy whose actions are the
+    residual's (an :class:`lvgym.agents.policy.SB3Policy`, or its law); a learned law with ``note_applied`` is
+    told the action the env gets (its observation history records that one, as the env's does). The baseline
+    starts its episode at the row's first step."""
 
-    def __init__(self, learned: Any, config: ResidualConfig, env: Any, name: str | None = None) -> None:
-        self.learned, self.config, self.env = learned, config, env
-        self.rows = ResidualRows(config, env, 1)
+    def __init__(self, learned: Any, config: ResidualConfig, env: Any, name: str | None = None, n: int = 1) -> None:
+        self.config, self.env = config, env
+        self.spec = POLICIES[config.baseline]
+        self.source = learned
         self.name = name or getattr(learned, "name", "residual")
-        self._fresh = True
+        self.allocate(n)
 
-    def reset(self) -> None:
-        self.learned.reset()
-        self._fresh = True
-
-    def act(self, observation: np.ndarray, info: dict[str, Any]) -> np.ndarray:
-        obs = np.asarray(observation)[None]
-        if self._fresh:
-            self.rows.reset([0], obs, [info])
-            self._fresh = False
-        else:
-            self.rows.advance([0], obs, [info])
-        action = self.rows.apply(self.learned.act(observation, info))[0]
-        if hasattr(self.learned, "note_applied"):
-            self.learned.note_applied(action)
-        return action
-
-    def batch(self, n: int) -> Any:
-        """The same policy for ``n`` rows of a batched env (:class:`ResidualBatch`; the interface of
-        :mod:`lvgym.benchmark.batch`); a learned policy without ``batch`` flies as one residual policy per row."""
-        if callable(getattr(self.learned, "batch", None)):
-            return ResidualBatch(self, n)
-        import copy
-
-        return RowPolicies(self, n, lambda: ResidualPolicy(copy.deepcopy(self.learned), self.config, self.env, self.name))
-
-
-class ResidualBatch:
-    """:class:`ResidualPolicy` for ``n`` rows: the baseline's batch (its ``batch(n)``, else one baseline per
-    row) and the learned policy's, mixed by :func:`combine`; each row's actions are the bits the residual
-    policy gives that row alone."""
-
-    def __init__(self, policy: ResidualPolicy, n: int) -> None:
-        self.name, self.config = policy.name, policy.config
-        spec = POLICIES[policy.config.baseline]
-        self.baseline = as_batch(build_policy(spec, policy.env), n, lambda: build_policy(spec, policy.env))
-        self.learned = policy.learned.batch(n)
-        self._fresh = np.ones(int(n), dtype=bool)
+    def _rows(self, n: int) -> None:
+        env, spec, source = self.env, self.spec, self.source
+        self.baseline = as_batch(build_policy(spec, env), n, lambda: build_policy(spec, env))
+        self.learned = as_batch(source, n, lambda: copy.deepcopy(source))
+        self._fresh = np.ones(n, dtype=bool)
 
     def reset(self, rows: Any) -> None:
         rows = np.asarray(rows, dtype=np.int64).reshape(-1)
         self.learned.reset(rows)
         self._fresh[rows] = True
 
-    def act(self, rows: Any, observations: np.ndarray, info: dict[str, Any]) -> np.ndarray:
+    def act(self, rows: Any, observations: np.ndarray, info: Any) -> np.ndarray:
         rows = np.asarray(rows, dtype=np.int64).reshape(-1)
         fresh = rows[self._fresh[rows]]
         if fresh.size:                               # the baseline starts its episode at the row's first step
@@ -250,3 +208,11 @@ class ResidualBatch:
         if hasattr(self.learned, "note_applied"):
             self.learned.note_applied(rows, action)
         return action
+
+
+class ResidualPolicy(RowFace):
+    """A learned policy on a baseline as a benchmark Policy: one row of :class:`ResidualLaw` (``act`` returns
+    ``baseline + scale * learned``, built on ``env``)."""
+
+    def __init__(self, learned: Any, config: ResidualConfig, env: Any, name: str | None = None) -> None:
+        self.law = ResidualLaw(learned, config, env, name)

@@ -11,45 +11,58 @@ the observation layout (:data:`lvgym.envs.layouts.OBSERVATIONS`; both modes have
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
 
+from lvgym.benchmark.batch import BatchLaw, RowFace
 from lvgym.envs.layouts import OBS_STATE
+from lvgym.errors import ConfigError
 
 NEGATIVE, NONE, POSITIVE = 0, 1, 2
 _ROLL, _ON = OBS_STATE.index("roll_rate"), OBS_STATE.index("controller_on")
 
 
-class BangBangRollPolicy:
-    """Roll bang-bang with deadband ``deadband_degps`` [deg/s] and hysteresis (see the module docstring)."""
+class BangBangLaw(BatchLaw):
+    """Roll bang-bang with deadband ``deadband_degps`` [deg/s] and hysteresis (see the module docstring) for
+    ``n`` rows; :attr:`firing` (n,) each row's pulse."""
 
-    def __init__(self, deadband_degps: float = 1.0, release_fraction: float = 0.25, name: str = "bang-bang") -> None:
+    def __init__(self, deadband_degps: float = 1.0, release_fraction: float = 0.25, name: str = "bang-bang",
+                 n: int = 1) -> None:
         if not deadband_degps >= 0.0:
-            raise ValueError(f"deadband_degps = {deadband_degps!r}: >= 0 deg/s")
+            raise ConfigError("bang-bang deadband_degps", deadband_degps, ">= 0 deg/s")
         if not 0.0 <= release_fraction <= 1.0:
-            raise ValueError(f"release_fraction = {release_fraction!r}: in [0, 1]")
+            raise ConfigError("bang-bang release_fraction", release_fraction, "in [0, 1]")
         self.name = name
         self.deadband = math.radians(deadband_degps)
         self.release = release_fraction * self.deadband
-        self.firing = NONE
+        self.allocate(n)
 
-    def reset(self) -> None:
-        self.firing = NONE
+    def _rows(self, n: int) -> None:
+        self.firing = np.full(n, NONE, dtype=np.int64)
 
-    def command(self, roll_rate: float, on: bool = True) -> int:
-        """The pulse for a roll rate [rad/s]."""
-        if not on:
-            self.firing = NONE
-        elif roll_rate > self.deadband:
-            self.firing = NEGATIVE
-        elif roll_rate < -self.deadband:
-            self.firing = POSITIVE
-        elif abs(roll_rate) <= self.release or (self.firing == NEGATIVE and roll_rate < 0) or (
-                self.firing == POSITIVE and roll_rate > 0):
-            self.firing = NONE
-        return self.firing
+    def reset(self, rows: Any) -> None:
+        self.firing[np.asarray(rows, dtype=np.int64).reshape(-1)] = NONE
 
-    def act(self, observation: np.ndarray, info: dict[str, Any]) -> np.ndarray:
-        obs = np.asarray(observation, dtype=float)
-        return np.array([self.command(float(obs[_ROLL]), float(obs[_ON]) >= 0.5)], dtype=np.int64)
+    def command(self, rows: Any, roll_rate: np.ndarray, on: np.ndarray) -> np.ndarray:
+        """The pulses of the rows ``rows`` for their roll rates [rad/s], the law on where ``on``."""
+        rows = np.asarray(rows, dtype=np.int64).reshape(-1)
+        w, f = np.asarray(roll_rate, dtype=float).reshape(-1), self.firing[rows]
+        held = (f == NEGATIVE) & (w < 0) | (f == POSITIVE) & (w > 0)
+        stop = (np.abs(w) <= self.release) | held
+        f = np.where(w > self.deadband, NEGATIVE, np.where(w < -self.deadband, POSITIVE, np.where(stop, NONE, f)))
+        f = np.where(np.asarray(on, dtype=bool).reshape(-1), f, NONE)
+        self.firing[rows] = f
+        return f
+
+    def act(self, rows: Any, observations: np.ndarray, info: Mapping[str, Any]) -> np.ndarray:
+        obs = np.asarray(observations, dtype=float)
+        return self.command(rows, obs[:, _ROLL], obs[:, _ON] >= 0.5)[:, None].astype(np.int64)
+
+
+class BangBangRollPolicy(RowFace):
+    """:class:`BangBangLaw` for one row (its arguments)."""
+
+    def __init__(self, deadband_degps: float = 1.0, release_fraction: float = 0.25, name: str = "bang-bang") -> None:
+        self.law = BangBangLaw(deadband_degps, release_fraction, name)

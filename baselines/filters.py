@@ -11,15 +11,15 @@ and a filter started in steady state passes a constant through unchanged):
 * notch ``(s^2 + 2 r z_n w_n s + w_n^2) / (s^2 + 2 z_n w_n s + w_n^2)`` (``notch_radps``, width
   ``notch_damping`` z_n, ``notch_depth`` r = the gain at ``w_n``; 1: off).
 
-:class:`StructuralFilter` holds the parameters (frozen, validated); :class:`FilterChain` runs the
-discrete filter sample by sample (direct form II transposed per section), with coefficients that may
-change between samples (a scheduled filter); :meth:`StructuralFilter.tf` is the same discrete filter
-as a python-control transfer function, for the linear design and the tests.
+:class:`StructuralFilter` holds the parameters (frozen, validated); the PID family's compiled law runs
+the discrete filter sample by sample (direct form II transposed per section, :mod:`.pidkernel`), with
+coefficients that may change between samples (a scheduled filter); :meth:`StructuralFilter.tf` is the same
+discrete filter as a python-control transfer function, for the linear design and the tests.
 
 :class:`FilterSeries` is several structural filters in series (a second notch for the second bending
 mode, a slosh notch, ...): the same interface (:meth:`~FilterSeries.continuous`,
 :meth:`~FilterSeries.discrete`, :meth:`~FilterSeries.tf`), its sections those of its filters in order,
-so :class:`FilterChain` runs either. In a gain schedule's YAML a row's ``filter`` is one mapping (a
+so the law runs either. In a gain schedule's YAML a row's ``filter`` is one mapping (a
 :class:`StructuralFilter`) or a list of mappings (a :class:`FilterSeries`, applied first to last):
 :func:`filter_from_yaml`, :func:`filter_to_yaml`.
 """
@@ -34,7 +34,7 @@ import numpy as np
 
 from lvgym.errors import ConfigError, require
 
-__all__ = ["StructuralFilter", "FilterSeries", "FilterChain", "FILTER_KEYS", "Filter", "filter_count",
+__all__ = ["StructuralFilter", "FilterSeries", "FILTER_KEYS", "Filter", "filter_count",
            "filter_from_yaml", "filter_to_yaml"]
 
 
@@ -109,7 +109,7 @@ FILTER_KEYS = tuple(f.name for f in fields(StructuralFilter))
 class FilterSeries:
     """Structural filters applied in series, first to last (``filters``: one or more
     :class:`StructuralFilter`); its sections are its filters' sections in that order, so it has their
-    interface and :class:`FilterChain` runs it. Each filter has unit gain at zero frequency, so the series
+    interface and the PID law runs it. Each filter has unit gain at zero frequency, so the series
     does too."""
 
     filters: tuple[StructuralFilter, ...]
@@ -208,43 +208,3 @@ def _bilinear(c: list[float], k: float) -> np.ndarray:
     c0, c1, c2 = c
     kk = k * k
     return np.array([c0 * kk + c1 * k + c2, 2.0 * (c2 - c0 * kk), c0 * kk - c1 * k + c2])
-
-
-class FilterChain:
-    """The discrete :class:`StructuralFilter` (or :class:`FilterSeries`) run sample by sample: ``update(x) -> y``.
-
-    Direct form II transposed per section. :meth:`set_filter` changes the coefficients and keeps the
-    states (a filter scheduled over the flight changes slowly); :meth:`reset` puts every section in
-    the steady state of a constant input ``x0`` (0 by default), so that a loop switched on does not
-    see a filter transient."""
-
-    def __init__(self, filt: Filter, dt: float) -> None:
-        if not dt > 0.0:
-            raise ValueError(f"dt = {dt!r}: a sampling period > 0 s")
-        self.dt = float(dt)
-        self.set_filter(filt)
-        self.reset()
-
-    def set_filter(self, filt: Filter, coeffs: list | None = None) -> None:
-        """New coefficients (``coeffs``: ``filt.discrete(dt)`` when already computed), states kept (the
-        new filter has the same number of sections)."""
-        self.filter = filt
-        self.coeffs = filt.discrete(self.dt) if coeffs is None else coeffs
-
-    def reset(self, x0: float = 0.0) -> None:
-        self.state = np.zeros((len(self.coeffs), 2))
-        x = float(x0)
-        for i, (b, a) in enumerate(self.coeffs):
-            y = x * b.sum() / a.sum()                    # the section's DC gain (1) times its input
-            s2 = b[2] * x - a[2] * y
-            self.state[i] = (b[1] * x - a[1] * y + s2, s2)
-            x = y
-
-    def update(self, x: float) -> float:
-        y = float(x)
-        for i, (b, a) in enumerate(self.coeffs):
-            s1, s2 = self.state[i]
-            out = b[0] * y + s1
-            self.state[i] = (b[1] * y - a[1] * out + s2, b[2] * y - a[2] * out)
-            y = out
-        return y

@@ -35,7 +35,7 @@ from lvgym.packing import Field, Packed
 
 __all__ = ["COEFFS", "FILTERS_MAX", "FILTERS_NONE", "FILTERS_ROWS", "FILTERS_TABLE", "FILTER_ROW", "GAINS", "ObsColumns",
            "PID_ROW", "PIDSetup", "PIDState", "PIDTable", "SECTIONS", "SECTIONS_PER_FILTER", "TAPS", "VAR_FIXED",
-           "VAR_MACH", "VAR_VALUE", "clip_k", "coefficients", "fixed_tables", "interp_k", "nearest_k", "new_state",
+           "VAR_MACH", "VAR_VALUE", "clip_k", "coefficients", "filter_reset_k", "filter_row", "filter_update_k", "fixed_tables", "interp_k", "nearest_k", "new_state",
            "obs_columns", "pid_act_k", "pid_row_k", "schedule_tables"]
 
 #: how a row's scheduling variable is read (:attr:`PIDSetup.variable`): fixed gains (no variable), a value
@@ -215,6 +215,15 @@ def schedule_tables(schedule: Any, dt: float, limit: float, signs: np.ndarray) -
                         schedule.attitude_gain is not None, SECTIONS_PER_FILTER * schedule.filter_count)
 
 
+def filter_row(filt: Any, dt: float) -> tuple[np.ndarray, int]:
+    """A row's filter state (layout :data:`FILTER_ROW`, states zero) holding ``filt`` (one filter or a series)
+    discretised at ``dt`` [s], and its number of sections: what :func:`filter_update_k` and
+    :func:`filter_reset_k` run one sample at a time (the law's own filter, for the tests and the design tools)."""
+    f = FILTER_ROW.zeros()
+    coefficients(filt, dt, f[FILTER_ROW.slice("coeffs")])
+    return f, len(filt.discrete(dt))
+
+
 def new_state(n: int) -> PIDState:
     """The state of ``n`` rows, as after a reset (no filter in use yet; the coefficient sums 1, so that a row
     without filters divides by nothing else)."""
@@ -267,8 +276,8 @@ def clip_k(x, lo, hi):
     return y if y < hi else hi
 
 
-@nb.njit(cache=True, inline="always")
-def _filter_reset(f, ax, x0, sections):
+@nb.njit(cache=True)
+def filter_reset_k(f, ax, x0, sections):
     """The first ``sections`` sections of the filter row ``f``'s axis ``ax`` in the steady state of the input
     ``x0`` (direct form II transposed, each section's states at the input's steady state)."""
     x = x0
@@ -281,8 +290,8 @@ def _filter_reset(f, ax, x0, sections):
         x = y
 
 
-@nb.njit(cache=True, inline="always")
-def _filter_update(f, ax, x, sections):
+@nb.njit(cache=True)
+def filter_update_k(f, ax, x, sections):
     """One sample ``x`` through the first ``sections`` sections of the filter row ``f``'s axis ``ax``
     (direct form II transposed per section)."""
     y = x
@@ -365,11 +374,11 @@ def pid_row_k(tb, su, oc, r, f, obs, value):
         r[P.filtering] = 0.0
     else:
         if r[P.filtering] == 0.0:                      # switched on: the filters start in steady state
-            _filter_reset(f, 0, e0, su.sections)
-            _filter_reset(f, 1, e1, su.sections)
+            filter_reset_k(f, 0, e0, su.sections)
+            filter_reset_k(f, 1, e1, su.sections)
             r[P.filtering] = 1.0
-        e0 = _filter_update(f, 0, e0, su.sections)
-        e1 = _filter_update(f, 1, e1, su.sections)
+        e0 = filter_update_k(f, 0, e0, su.sections)
+        e1 = filter_update_k(f, 1, e1, su.sections)
     g = (kp, ki, kd, n)
     r[P.gimbal] = _pid_update(su, r, 0, e0, on, g)
     r[P.gimbal + 1] = _pid_update(su, r, 1, e1, on, g)

@@ -10,9 +10,10 @@ import numpy as np
 import pytest
 
 import lvgym  # noqa: F401
-from lvgym.baselines.aac import (FLEX_AAC, AACParams, AdaptiveAugmentingPolicy, AdaptiveGainLaw, FirstOrderFilter, flex_aac,
-                          smile_aac)
+from lvgym.baselines.aac import FLEX_AAC, AACLaw, AACParams, AdaptiveAugmentingPolicy, consts, flex_aac, smile_aac
+from lvgym.baselines.aackernel import AAC_ROW, first_order, gain_step_k
 from lvgym.baselines.pid import FLEX_SCHEDULES, flex_pid
+from lvgym.benchmark.batch import BatchLaw
 from lvgym.benchmark.policy import Policy
 from lvgym.envs.layouts import OBS_FLIGHT
 from lvgym.errors import ConfigError
@@ -20,47 +21,82 @@ from lvgym.errors import ConfigError
 DT, LIMIT = 0.02, math.radians(5.0)
 
 
+class _Commands(BatchLaw):
+    """A base law whose rows' commands [rad] are set from outside (``next``), for the adaptive law alone."""
+
+    name, dt, limit = "stub", DT, LIMIT
+
+    def __init__(self, n: int = 1) -> None:
+        self.allocate(n)
+
+    def _rows(self, n: int) -> None:
+        self.gimbal, self.next = np.zeros((n, 2)), np.zeros((n, 2))
+
+    def reset(self, rows) -> None:
+        self.gimbal[rows] = 0.0
+
+    def act(self, rows, observations, info):
+        self.gimbal[rows] = self.next[rows]
+        return (self.gimbal[rows] / LIMIT).astype(np.float32)
+
+
+def _fake_env():
+    return SimpleNamespace(unwrapped=SimpleNamespace(observation_layout=OBS_FLIGHT, gimbal_limit=LIMIT,
+                                                     task=SimpleNamespace(control_dt_s=DT)))
+
+
 def law(**changes):
-    return AdaptiveGainLaw(AACParams().replace(**changes), DT, LIMIT)
+    """The adaptive law for one row on a base whose commands the test sets."""
+    return AACLaw(_Commands(), env=_fake_env(), params=AACParams().replace(**changes))
+
+
+def step(lw, u, err, on=True, ref=(0.0, 0.0)):
+    """One step of the law's row 0: base commands ``u`` (2,) [rad], rate errors ``err`` (2,) [rad/s], the pitch
+    rate reference ``ref[0]``; the command sent (2,) [rad]."""
+    lw.base.next[0] = u
+    obs = OBS_FLIGHT.pack({"pitch_rate_error": err[0], "yaw_rate_error": err[1], "pitch_rate_reference": ref[0],
+                           "controller_on": 1.0 if on else 0.0})[None].astype(np.float32)
+    lw.act([0], obs, {})
+    return lw.gimbal[0].copy()
 
 
 def run(lw, u, err, on=True, ref=(0.0, 0.0)):
     """Steps of the law over rows of ``u`` and ``err`` (n, 2); returns the gains (n, 2)."""
     ks = []
     for ui, ei in zip(u, err):
-        lw.step(ui, ei, np.asarray(ref), on)
-        ks.append(lw.gains().copy())
+        step(lw, ui, ei, on, ref)
+        ks.append(lw.gains([0])[0])
     return np.array(ks)
 
 
 def test_one_step_of_the_law_by_hand():
-    lw = law(error_gain=3000.0, damper_gain=2.0e4, leak_rate=0.5, k_min=0.5, k_max=2.0)
+    c = consts(AACParams(error_gain=3000.0, damper_gain=2.0e4, leak_rate=0.5, k_min=0.5, k_max=2.0), DT, LIMIT)
     # a e^2 = 3000 * 0.01^2 = 0.3, no damper: r = c = 0.5, k_inf = (0.3 + 0.5) / 0.5 = 1.6
-    k = lw.gain_step(np.array([1.0]), np.array([1e-4]), np.array([0.0]))
-    assert k[0] == pytest.approx(1.6 - 0.6 * math.exp(-0.5 * DT), rel=1e-12)   # 1.0059700...
-    assert k[0] == pytest.approx(1.0 + 0.3 * DT, rel=1e-4)                    # forward Euler, to first order
+    k = gain_step_k(c, 1.0, 1e-4, 0.0)
+    assert k == pytest.approx(1.6 - 0.6 * math.exp(-0.5 * DT), rel=1e-12)       # 1.0059700...
+    assert k == pytest.approx(1.0 + 0.3 * DT, rel=1e-4)                        # forward Euler, to first order
     # damper: b y = 2e4 * 1e-4 = 2, r = 2.5, k_inf = (0 + 2 * 0.5 + 0.5) / 2.5 = 0.6
-    k = lw.gain_step(np.array([1.0]), np.array([0.0]), np.array([1e-4]))
-    assert k[0] == pytest.approx(0.6 + 0.4 * math.exp(-2.5 * DT), rel=1e-12)  # 0.98039...
+    assert gain_step_k(c, 1.0, 0.0, 1e-4) == pytest.approx(0.6 + 0.4 * math.exp(-2.5 * DT), rel=1e-12)  # 0.98039...
     # no leakage, no damper: k grows by a e^2 dt exactly
-    lw0 = law(error_gain=3000.0, leak_rate=0.0)
-    assert lw0.gain_step(np.array([1.0]), np.array([1e-4]), np.array([0.0]))[0] == pytest.approx(1.0 + 0.3 * DT)
+    c0 = consts(AACParams(error_gain=3000.0, leak_rate=0.0), DT, LIMIT)
+    assert gain_step_k(c0, 1.0, 1e-4, 0.0) == pytest.approx(1.0 + 0.3 * DT)
     # the exact step never overshoots the lower bound, however stiff the damper
-    assert law(damper_gain=1e12).gain_step(np.array([1.0]), np.array([0.0]), np.array([1.0]))[0] >= 0.5
+    assert gain_step_k(consts(AACParams(damper_gain=1e12), DT, LIMIT), 1.0, 0.0, 1.0) >= 0.5
 
 
 def test_filters_by_hand():
-    lo = FirstOrderFilter("low", 1.0, DT, 1)
     w = 2 * math.pi
     kk = w / math.tan(w * DT / 2)
-    assert lo.step([1.0])[0] == pytest.approx(w / (kk + w))                  # first sample: previous input 0
-    ys = [lo.step([1.0])[0] for _ in range(2000)]
-    assert ys[-1] == pytest.approx(1.0)                                       # unit DC gain
-    hi = FirstOrderFilter("high", 1.0, DT, 1)
-    assert hi.step([3.0])[0] == 0.0                                           # a restart is not a step
-    assert [hi.step([3.0])[0] for _ in range(5)] == [0.0] * 5
+    pole, gain = first_order("low", 1.0, DT)
+    assert (pole, gain) == (pytest.approx((kk - w) / (kk + w)), pytest.approx(w / (kk + w)))   # first sample: w/(k+w)
+    assert 2.0 * gain / (1.0 - pole) == pytest.approx(1.0)                    # unit DC gain
+    assert first_order("high", 1.0, DT)[1] == pytest.approx(kk / (kk + w))
     with pytest.raises(ValueError):
-        FirstOrderFilter("band", 1.0, DT, 1)
+        first_order("band", 1.0, DT)
+    # in the law: a constant command is no high-frequency content (the high-pass restarts at the engagement)
+    lw = law()
+    run(lw, np.full((50, 2), 0.03), np.zeros((50, 2)))
+    assert np.all(lw.damper([0]) == 0.0)
 
 
 def test_nominal_gain_stays_at_one_and_leaks_back_after_a_disturbance():
@@ -86,7 +122,7 @@ def test_tracking_error_raises_the_gain_and_the_dead_zone_holds_it():
     e = p.error_deadzone_radps + 0.01                                  # 0.01 rad/s beyond the dead zone
     lw = law()
     ks = run(lw, np.zeros((1000, 2)), np.tile([e, 0.0], (1000, 1)))
-    assert lw.e[0] == pytest.approx(-0.01, rel=1e-3)     # dead-zoned, filtered; e = model - gyro = -rate error
+    assert lw.errors([0])[0, 0] == pytest.approx(-0.01, rel=1e-3)   # dead-zoned, filtered; e = model - gyro = -rate error
     k_inf = 1.0 + p.error_gain * 0.01 ** 2 / p.leak_rate               # equilibrium of a e^2 = c (k - 1): 1.6
     assert ks[-1, 0] == pytest.approx(k_inf, rel=1e-3)
     assert np.all(ks[:, 1] == 1.0)                                     # per axis: yaw saw no error
@@ -119,57 +155,53 @@ def test_bounds_hold_under_extreme_inputs():
     u = np.column_stack([LIMIT * np.sign(np.sin(2 * math.pi * 12.5 * t + 0.3))] * 2)
     ks = run(hf, u, np.zeros((300, 2)))
     assert np.all(ks >= p.k_min) and ks.min() < 0.6
-    out = big.step(np.array([1.0, -1.0]), np.zeros(2), np.zeros(2), True)
+    out = step(big, np.array([1.0, -1.0]), np.zeros(2))
     assert np.all(np.abs(out) <= LIMIT)                                # the command stays within the gimbal limit
 
 
 def test_controller_off_freezes_and_engagement_resets():
     lw = law()
     run(lw, np.zeros((100, 2)), np.full((100, 2), 0.05))
-    k_on = lw.gains().copy()
+    k_on = lw.gains([0])[0]
     assert k_on[0] > 1.0
-    out = lw.step(np.array([0.05, 0.05]), np.full(2, 0.5), np.zeros(2), False)
+    out = step(lw, np.array([0.05, 0.05]), np.full(2, 0.5), on=False)
     ks_off = run(lw, np.zeros((50, 2)), np.full((50, 2), 0.5), on=False)
     assert np.all(out == 0.0) and np.all(ks_off == k_on)               # frozen while off, the gimbal at 0
-    lw.step(np.zeros(2), np.zeros(2), np.zeros(2), True)
-    assert np.all(lw.gains() < k_on) and lw.gains()[0] == pytest.approx(1.0, abs=1e-12)   # engaged again: from 1
+    step(lw, np.zeros(2), np.zeros(2))
+    k = lw.gains([0])[0]
+    assert np.all(k < k_on) and k[0] == pytest.approx(1.0, abs=1e-12)  # engaged again: from 1
     hold = law(reset_on_engage=False)
     run(hold, np.zeros((100, 2)), np.full((100, 2), 0.05))
-    k_hold = hold.gains().copy()
+    k_hold = hold.gains([0])[0]
     run(hold, np.zeros((10, 2)), np.zeros((10, 2)), on=False)
-    hold.step(np.zeros(2), np.zeros(2), np.zeros(2), True)
-    assert hold.gains()[0] == pytest.approx(k_hold[0], rel=0.02)       # held, then one step of leakage
+    step(hold, np.zeros(2), np.zeros(2))
+    assert hold.gains([0])[0, 0] == pytest.approx(k_hold[0], rel=0.02)  # held, then one step of leakage
 
 
-class _Base:
-    """A PID-type base for the policy wrapper: commands a fixed pattern of gimbal angles [rad]."""
+class _Pattern(_Commands):
+    """A base law commanding a 9 Hz pitch pattern and a constant yaw [rad], each row on its own clock."""
 
-    name, dt, limit = "stub", DT, LIMIT
+    def _rows(self, n: int) -> None:
+        super()._rows(n)
+        self.k = np.zeros(n, dtype=np.int64)
 
-    def __init__(self):
-        self.reset()
+    def reset(self, rows) -> None:
+        super().reset(rows)
+        self.k[rows] = 0
 
-    def reset(self):
-        self.n = 0
-        self.last_gimbal = np.zeros(2)
-
-    def act(self, observation, info):
-        self.last_gimbal = np.array([0.01 * math.sin(2 * math.pi * 9.0 * self.n * DT), 0.002])
-        self.n += 1
-        return self.last_gimbal / self.limit
-
-
-def _fake_env():
-    return SimpleNamespace(unwrapped=SimpleNamespace(observation_layout=OBS_FLIGHT, gimbal_limit=LIMIT,
-                                                     task=SimpleNamespace(control_dt_s=DT)))
+    def act(self, rows, observations, info):
+        self.next[rows, 0] = 0.01 * np.sin(2 * math.pi * 9.0 * self.k[rows] * DT)
+        self.next[rows, 1] = 0.002
+        self.k[rows] += 1
+        return super().act(rows, observations, info)
 
 
 def test_policy_wrapper_is_deterministic_and_respects_controller_on():
     env = _fake_env()
-    pol = AdaptiveAugmentingPolicy(_Base(), env=env, record=True)
+    pol = AdaptiveAugmentingPolicy(_Pattern(), env=env, record=True)
     assert isinstance(pol, Policy) and pol.name == "aac(stub)"
     rng = np.random.default_rng(3)
-    obs = np.zeros((300, OBS_FLIGHT.size))
+    obs = np.zeros((300, OBS_FLIGHT.size), np.float32)
     i_on, i_err = OBS_FLIGHT.index("controller_on"), OBS_FLIGHT.index("pitch_rate_error")
     obs[50:, i_on] = 1.0
     obs[:, i_err] = rng.normal(0.0, 0.03, 300)
@@ -184,6 +216,12 @@ def test_policy_wrapper_is_deterministic_and_respects_controller_on():
     assert np.all(a1[:50] == 0.0) and np.all(tr1["k"][:50] == 1.0)     # off: no command, k_T untouched
     assert tr1["k"][-1, 0] < 1.0                                       # the 9 Hz pitch command is damped
     assert a1.dtype == np.float32 and np.all(np.abs(a1) <= 1.0)
+    # the same rows in a batch of three, each its own flight: row 1 flies the one-row policy's actions to the bit
+    batch = pol.batch(3)
+    batch.reset(np.arange(3))
+    many = [batch.act(np.arange(3), np.stack([rng.normal(size=o.shape).astype(np.float32) * o[i_on], o, o]), {})[1]
+            for o in obs]
+    assert np.array_equal(np.array(many), a1)
 
 
 def test_parameters_are_checked_by_name():
@@ -196,7 +234,9 @@ def test_parameters_are_checked_by_name():
     with pytest.raises(ConfigError, match=r"aac.per_axis = 1: true or false"):
         AACParams(per_axis=1)
     with pytest.raises(ConfigError, match=r"aac.damper_hp_hz = 30.0: must be below the Nyquist"):
-        AdaptiveGainLaw(AACParams(damper_hp_hz=30.0), DT, LIMIT)
+        consts(AACParams(damper_hp_hz=30.0), DT, LIMIT)
+    with pytest.raises(ConfigError, match=r"aac base = 'list'"):
+        AdaptiveAugmentingPolicy([], env=_fake_env())
     with pytest.raises(ConfigError, match=r"aac.gain = 2"):
         smile_aac(_fake_env(), gain=2)
     assert AACParams().replace(k_max=1.5).k_max == 1.5
@@ -225,17 +265,16 @@ def test_aac_flies_smile_v1_rigid(v1_rigid):
 def test_damper_dead_zone_acts_on_the_excess_only():
     # y below the dead zone: the law is the leak and the error term alone; above: the damper sees y - y_dz
     dz = 3e-3
-    plain, zoned = law(damper_gain=2.0e4), law(damper_gain=2.0e4, damper_deadzone_rad2=dz)
+    plain = consts(AACParams(damper_gain=2.0e4), DT, LIMIT)
+    zoned = law(damper_gain=2.0e4, damper_deadzone_rad2=dz)
     for y, y_seen in ((1e-3, 0.0), (5e-3, 5e-3 - dz)):
-        k0 = np.array([1.4, 1.4])
-        for lw in (plain, zoned):
-            lw.reset()
-            lw.on = True
-            lw.k[:] = k0
-            lw.y[:] = y
-        zoned.step(np.zeros(2), np.zeros(2), np.zeros(2), True)
-        expected = plain.gain_step(k0, np.zeros(2), np.full(2, y_seen))
-        np.testing.assert_allclose(zoned.gains(), expected, rtol=1e-12)
+        zoned.reset([0])
+        row = zoned.rows[0]
+        row[AAC_ROW.slice("k")], row[AAC_ROW.slice("lp_y")] = 1.4, y     # engaged, k_T and y as given
+        row[AAC_ROW.index("on")], row[AAC_ROW.index("fresh")] = 1.0, 0.0
+        step(zoned, np.zeros(2), np.zeros(2))
+        expected = gain_step_k(plain, 1.4, 0.0, y_seen)
+        np.testing.assert_allclose(zoned.gains([0])[0], expected, rtol=1e-12)
     # default 0: the published law, y as it is
     assert AACParams().damper_deadzone_rad2 == 0.0
     with pytest.raises(ConfigError, match=r"aac.damper_deadzone_rad2 = -1"):
@@ -271,18 +310,9 @@ def test_aac_sweep_variants_and_the_scaled_base():
     with pytest.raises(ConfigError, match="key=value"):
         parse_variant("damper_gain")
 
-    class Base:
-        name, dt, limit = "base", 0.02, 0.1
-
-        def reset(self):
-            self.last_gimbal = np.zeros(2)
-
-        def act(self, observation, info):
-            self.last_gimbal = np.array([0.02, -0.05])
-            return (self.last_gimbal / self.limit).astype(np.float32)
-
-    b = ScaledBase(Base(), 2.0)
+    b = ScaledBase(_Commands(), 2.0)
+    b.law.base.next[0] = [0.002, -0.005]
     b.reset()
-    np.testing.assert_allclose(b.act(np.zeros(3), {}), [0.4, -1.0], rtol=1e-6)
-    np.testing.assert_allclose(b.last_gimbal, [0.04, -0.1])
-    assert (b.dt, b.limit, b.name) == (0.02, 0.1, "base*2")
+    np.testing.assert_allclose(b.act(np.zeros(3), {}), [2 * 0.002 / LIMIT, -2 * 0.005 / LIMIT], rtol=1e-6)
+    np.testing.assert_allclose(b.last_gimbal, [0.004, -0.01])
+    assert (b.dt, b.limit, b.name) == (DT, LIMIT, "stub*2")

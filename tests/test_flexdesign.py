@@ -12,7 +12,8 @@ import pytest
 import lvgym  # noqa: F401
 from lvgym.baselines.design import flexdesign as FD
 from lvgym.baselines.design import linearize as L
-from lvgym.baselines.filters import FilterChain, StructuralFilter
+from lvgym.baselines.filters import StructuralFilter
+from lvgym.baselines.pidkernel import filter_reset_k, filter_row, filter_update_k
 from lvgym.baselines.pid import SCHEDULES, GainSchedule, GainScheduledPIDPolicy
 
 DT = 0.02
@@ -40,16 +41,16 @@ def test_filter_sections_by_hand():
     assert hi == pytest.approx(abs((100j / 2 + 1) / (100j / 20 + 1)), rel=0.05)  # Tustin warps a little at 100 rad/s
 
 
-def test_filter_chain_runs_the_transfer_function_and_starts_in_steady_state():
+def test_the_laws_filter_runs_the_transfer_function_and_starts_in_steady_state():
     x = np.random.default_rng(0).normal(size=80)
-    chain = FilterChain(FILT, DT)
-    y = [chain.update(v) for v in x]
+    f, sections = filter_row(FILT, DT)
+    y = [filter_update_k(f, 0, v, sections) for v in x]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         ref = np.ravel(control.forced_response(FILT.tf(DT), U=x).outputs)
     np.testing.assert_allclose(y, ref, atol=1e-12)
-    chain.reset(0.3)
-    assert [chain.update(0.3) for _ in range(5)] == pytest.approx([0.3] * 5, abs=1e-12)
+    filter_reset_k(f, 1, 0.3, sections)
+    assert [filter_update_k(f, 1, 0.3, sections) for _ in range(5)] == pytest.approx([0.3] * 5, abs=1e-12)
 
 
 def test_filter_values_are_checked():

@@ -3,6 +3,7 @@ bang-bang law and a short closed loop."""
 
 import math
 import warnings
+from types import SimpleNamespace
 
 import gymnasium as gym
 import numpy as np
@@ -12,47 +13,76 @@ import lvgym  # noqa: F401
 from lvgym.baselines.design import linearize as lin
 from lvgym.baselines.design import tune
 from lvgym.baselines.bangbang import NEGATIVE, NONE, POSITIVE, BangBangRollPolicy
-from lvgym.baselines.pid import DiscretePID, GainSchedule, GainScheduledPIDPolicy, PIDPolicy, smile_scheduled_pid
+from lvgym.baselines.pid import GainSchedule, GainScheduledPIDPolicy, PIDLaw, PIDPolicy, smile_scheduled_pid
+from lvgym.baselines.pidkernel import PID_ROW
+from lvgym.envs.layouts import OBS_FLIGHT
+from lvgym.errors import ConfigError
 from lvgym.benchmark.policy import Policy, ZeroPolicy
 
 
+def _law(kp, ki, kd, n=None, dt=0.1, limit=1e6):
+    """The PID law for one row on an env of SMILE's flight observation, control period ``dt`` [s] and gimbal
+    limit ``limit`` [rad] (the law's output limit)."""
+    env = SimpleNamespace(unwrapped=SimpleNamespace(observation_layout=OBS_FLIGHT, gimbal_limit=limit,
+                                                    task=SimpleNamespace(control_dt_s=dt)))
+    return PIDLaw(env, gains=(kp, ki, kd, n))
+
+
+def _update(law, e, on=True):
+    """One step of the pitch axis on the error ``e = -(rate error)``; the command [rad]."""
+    obs = OBS_FLIGHT.pack({"pitch_rate_error": -e, "controller_on": 1.0 if on else 0.0})[None].astype(np.float32)
+    law.act([0], obs, {})
+    return float(law.gimbal[0, 0])
+
+
+def _state(law, field):
+    return float(PID_ROW.view(law.st.pid, field)[0, 0])
+
+
 def test_pid_step_response_by_hand():
-    pid = DiscretePID(2.0, 1.0, 0.5, n=None, dt=0.1)
+    pid = _law(2.0, 1.0, 0.5, n=None, dt=0.1)
     # e = 1 from the first sample: P 2, I 0.1 per step (backward Euler), D 0 at the first sample
-    assert pid.update(1.0) == pytest.approx(2.1)
-    assert pid.update(1.0) == pytest.approx(2.2)
+    assert _update(pid, 1.0) == pytest.approx(2.1)
+    assert _update(pid, 1.0) == pytest.approx(2.2)
     # a step to e = 3: D = 0.5 * 2 / 0.1 = 10, I = 0.2 + 0.3
-    assert pid.update(3.0) == pytest.approx(6.0 + 0.5 + 10.0)
+    assert _update(pid, 3.0) == pytest.approx(6.0 + 0.5 + 10.0)
 
 
 def test_filtered_derivative_by_hand():
-    pid = DiscretePID(0.0, 0.0, 1.0, n=10.0, dt=0.1)          # N dt = 1
-    pid.update(0.0)
-    d1 = pid.update(1.0)                                      # (0 + 1*10*1) / 2 = 5
-    d2 = pid.update(1.0)                                      # (5 + 0) / 2 = 2.5
+    pid = _law(0.0, 0.0, 1.0, n=10.0, dt=0.1)                # N dt = 1
+    _update(pid, 0.0)
+    d1 = _update(pid, 1.0)                                    # (0 + 1*10*1) / 2 = 5
+    d2 = _update(pid, 1.0)                                    # (5 + 0) / 2 = 2.5
     assert (d1, d2) == (pytest.approx(5.0), pytest.approx(2.5))
-    big = DiscretePID(0.0, 0.0, 1.0, n=1e9, dt=0.1)            # N -> inf: the difference quotient
-    big.update(0.0)
-    assert big.update(1.0) == pytest.approx(10.0, rel=1e-6)
+    big = _law(0.0, 0.0, 1.0, n=1e9, dt=0.1)                  # N -> inf: the difference quotient
+    _update(big, 0.0)
+    assert _update(big, 1.0) == pytest.approx(10.0, rel=1e-6)
 
 
 def test_output_limits_and_anti_windup():
-    pid = DiscretePID(1.0, 10.0, 0.0, dt=0.1, u_min=-1.0, u_max=1.0)
-    outs = [pid.update(5.0) for _ in range(20)]
-    assert max(outs) == 1.0 and pid.saturated
-    assert pid.integral == 0.0                                # clamped from the first (saturated) sample
+    pid = _law(1.0, 10.0, 0.0, dt=0.1, limit=1.0)
+    outs = [_update(pid, 5.0) for _ in range(20)]
+    assert max(outs) == 1.0 and _state(pid, "saturated") == 1.0
+    assert _state(pid, "integral") == 0.0                     # clamped from the first (saturated) sample
     # the error reverses: without windup the output leaves the limit at once
-    assert pid.update(-0.5) < 0.0
+    assert _update(pid, -0.5) < 0.0
 
 
 def test_off_freezes_integral_and_avoids_kick():
-    pid = DiscretePID(1.0, 1.0, 1.0, n=None, dt=0.1)
-    pid.update(1.0)
-    i = pid.integral
-    assert pid.update(5.0, enabled=False) == 0.0 and pid.integral == i
-    assert pid.update(5.0) == pytest.approx(5.0 + i + 0.5)     # no derivative kick on switching on
-    pid.reset()
-    assert pid.integral == 0.0 and pid.e_prev is None
+    pid = _law(1.0, 1.0, 1.0, n=None, dt=0.1)
+    _update(pid, 1.0)
+    i = _state(pid, "integral")
+    assert _update(pid, 5.0, on=False) == 0.0 and _state(pid, "integral") == i
+    assert _update(pid, 5.0) == pytest.approx(5.0 + i + 0.5)   # no derivative kick on switching on
+    pid.reset([0])
+    assert _state(pid, "integral") == 0.0 and _state(pid, "has_prev") == 0.0
+
+
+def test_gains_are_checked_by_name():
+    with pytest.raises(ConfigError, match=r"pid.kd = -1"):
+        _law(1.0, 0.0, -1)
+    with pytest.raises(ConfigError, match=r"pid.n = 0.0"):
+        _law(1.0, 0.0, 0.0, n=0.0)
 
 
 @pytest.fixture(scope="module")
@@ -103,9 +133,14 @@ def test_schedule_interpolation_and_monotonic_check():
     env = gym.make("lvgym/SmileAscent-v0", model="rigid")
     pol = smile_scheduled_pid(env)                            # mass from the env: 6346 kg at 28.8 s
     mass = float(env.unwrapped.timeline.interp("mass", [28.8])[0])
-    pol.schedule_gains(np.zeros(14), {"mass": mass, "time": 28.8})
-    assert pol.value == pytest.approx(6347.0, abs=5.0)
-    assert pol.axes[0].kp == pytest.approx(8.98, abs=0.02)
+    assert mass == pytest.approx(6347.0, abs=5.0)
+    kp, ki, kd, n = pol.schedule.gains(mass)
+    assert kp == pytest.approx(8.98, abs=0.02)
+    lay = env.unwrapped.observation_layout
+    e = float(np.float32(1e-4))
+    pol.reset()
+    pol.act(lay.pack({"pitch_rate_error": -e, "controller_on": 1.0}).astype(np.float32), {"mass": mass, "time": 28.8})
+    assert pol.last_gimbal[0] == pytest.approx((kp + ki * pol.dt) * e, rel=1e-9)   # the first sample: P + I, no D
     tuned = GainScheduledPIDPolicy("smile", env=env)
     assert tuned.schedule.variable == "mass" and len(tuned.schedule.points) >= 4
 
@@ -142,13 +177,14 @@ def test_margins_finite_rigid_and_nonrigid(op_rigid):
 
 
 def test_bangbang_law():
-    bb = BangBangRollPolicy(deadband_degps=1.0, release_fraction=0.5)
+    law = BangBangRollPolicy(deadband_degps=1.0, release_fraction=0.5).law.batch(3)
     d = math.radians(1.0)
-    assert bb.command(2 * d) == NEGATIVE
-    assert bb.command(0.8 * d) == NEGATIVE                            # hysteresis: keeps firing
-    assert bb.command(0.4 * d) == NONE
-    assert bb.command(-2 * d) == POSITIVE
-    assert bb.command(-2 * d, on=False) == NONE
+    on = np.ones(3, bool)
+    # three rows at once: each row's pulse from its own rate and its own history
+    assert law.command([0, 1, 2], [2 * d, -2 * d, 0.0], on).tolist() == [NEGATIVE, POSITIVE, NONE]
+    assert law.command([0, 1, 2], [0.8 * d, -0.8 * d, 0.8 * d], on).tolist() == [NEGATIVE, POSITIVE, NONE]  # hysteresis
+    assert law.command([0, 1], [0.4 * d, -2 * d], on[:2]).tolist() == [NONE, POSITIVE]
+    assert law.command([1], [-2 * d], [False]).tolist() == [NONE]
     env = gym.make("lvgym/StratosIII-v0", model="rigid")
     obs, info = env.reset(seed=0)
     for _ in range(60):                                               # spin up with positive pulses

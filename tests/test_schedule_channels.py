@@ -11,10 +11,9 @@ import numpy as np
 import pytest
 
 import lvgym
-from lvgym.baselines.batch import RowCopies
-from lvgym.baselines.filters import FilterChain, FilterSeries, StructuralFilter, filter_from_yaml
+from lvgym.baselines.filters import FilterSeries, StructuralFilter, filter_from_yaml
+from lvgym.baselines.pidkernel import filter_row, filter_update_k
 from lvgym.baselines.pid import GainSchedule, GainScheduledPIDPolicy
-from lvgym.baselines.pidbatch import PIDBatch
 from lvgym.errors import ConfigError
 
 DT = 0.02
@@ -56,10 +55,10 @@ def test_a_series_is_the_product_of_its_filters():
 def test_a_chain_of_a_series_runs_its_filters_one_after_the_other():
     rng = np.random.default_rng(0)
     x = rng.normal(size=200)
-    both = FilterChain(FilterSeries((NOTCH_A, NOTCH_B)), DT)
-    a, b = FilterChain(NOTCH_A, DT), FilterChain(NOTCH_B, DT)
+    both, a, b = (filter_row(f, DT) for f in (FilterSeries((NOTCH_A, NOTCH_B)), NOTCH_A, NOTCH_B))
     for v in x:
-        assert both.update(v) == b.update(a.update(v))
+        assert filter_update_k(*both[:1], 0, v, both[1]) == filter_update_k(b[0], 0, filter_update_k(a[0], 0, v, a[1]),
+                                                                            b[1])
 
 
 ROW = {"lead_zero_radps": 8.0, "lead_pole_radps": 200.0, "lowpass_radps": 120.0, "lowpass_damping": 0.5,
@@ -105,29 +104,28 @@ def test_the_filters_of_a_series_interpolate_filter_by_filter():
 
 
 def _fly_both(schedule: GainSchedule, steps: int) -> tuple[np.ndarray, np.ndarray]:
-    """The per-row policy's and the compiled batch's actions on the same short non-rigid SMILE flight."""
-    out = []
-    for batched in (False, True):
-        env = lvgym.make_env("smile-v1", model="nonrigid")
-        pol = GainScheduledPIDPolicy(schedule, env=env)
-        obs, info = env.reset(seed=5)
-        if batched:
-            b = pol.batch(1)
-            assert isinstance(b, PIDBatch)
-            b.reset([0])
-        else:
-            pol.reset()
-        acts = []
-        for _ in range(steps):
-            if batched:
-                a = b.act([0], obs[None], {"mass": np.array([info["mass"]]), "time": np.array([info["time"]])})[0]
-            else:
-                a = pol.act(obs, info)
-            acts.append(a)
-            obs, _, term, trunc, info = env.step(a)
-            assert not (term or trunc)
-        out.append(np.array(acts))
-    return out[0], out[1]
+    """The actions of the one-row policy on the single env (seed 5) and of row 1 of the law for three rows
+    on the batched env (seeds 4, 5, 6), on the same short non-rigid SMILE flight."""
+    env = lvgym.make_env("smile-v1", model="nonrigid")
+    pol = GainScheduledPIDPolicy(schedule, env=env)
+    obs, info = env.reset(seed=5)
+    pol.reset()
+    single = []
+    for _ in range(steps):
+        single.append(pol.act(obs, info))
+        obs, _, term, trunc, info = env.step(single[-1])
+        assert not (term or trunc)
+    venv = lvgym.make_vec_env("smile-v1", model="nonrigid", num_envs=3)
+    law = pol.batch(3)
+    rows = np.arange(3)
+    obs, info = venv.reset(seed=[4, 5, 6])
+    law.reset(rows)
+    batch = []
+    for _ in range(steps):
+        a = law.act(rows, obs, info)
+        batch.append(a[1])
+        obs, *_, info = venv.step(a)
+    return np.array(single), np.array(batch)
 
 
 @pytest.mark.parametrize("interpolation", ["nearest", "linear"])
@@ -138,11 +136,12 @@ def test_the_batch_flies_two_filters_and_the_attitude_channel_as_the_policy(inte
     np.testing.assert_array_equal(single, batch)
 
 
-def test_more_filters_than_the_kernel_holds_fly_as_row_copies():
+def test_more_filters_than_the_law_holds_are_refused_by_name():
     env = lvgym.make_env("smile-v1", model="nonrigid")
     s = GainSchedule.from_dict(_doc(filters=[ROW] + [SECOND] * 4))
     assert s.filter_count == 5
-    assert isinstance(GainScheduledPIDPolicy(s, env=env).batch(2), RowCopies)
+    with pytest.raises(ConfigError, match="filter = 5: at most 4 filters in series"):
+        GainScheduledPIDPolicy(s, env=env)
 
 
 @pytest.mark.parametrize("edit, key, allowed", [

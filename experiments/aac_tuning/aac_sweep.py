@@ -19,6 +19,7 @@ from typing import Any
 
 import numpy as np
 
+from lvgym.benchmark.batch import BatchLaw, RowFace
 from lvgym.benchmark.runner import play_episode
 from lvgym.benchmark.suites import SUITES, get_suite
 from lvgym.cli import fail
@@ -28,32 +29,43 @@ from lvgym.errors import ConfigError
 from lvgym.baselines.aac import FLEX_AAC, AACParams, AdaptiveAugmentingPolicy, _check_keywords
 from lvgym.baselines.pid import flex_pid
 
-__all__ = ["ScaledBase", "parse_variant", "sweep"]
+__all__ = ["ScaledBase", "ScaledLaw", "parse_variant", "sweep"]
 
 
-class ScaledBase:
-    """A base policy whose command is multiplied by ``scale`` [-] (inside the adaptive gain, which reads
-    the base's ``last_gimbal`` [rad]; alone, its action, which the env clips to [-1, 1])."""
+class ScaledLaw(BatchLaw):
+    """A base law whose commands are multiplied by ``scale`` [-]: its rows' ``gimbal`` [rad] (what the adaptive
+    gain reads) and, alone, its actions (which the env clips to [-1, 1])."""
 
     def __init__(self, base: Any, scale: float) -> None:
-        self.base, self.scale = base, float(scale)
-        self.name = f"{base.name}*{scale:g}"
+        self.base, self.scale = getattr(base, "law", base), float(scale)
+        self.name = f"{self.base.name}*{scale:g}"
+        self.dt, self.limit = self.base.dt, self.base.limit
+        self.allocate(self.base.n)
 
-    def __getattr__(self, key: str) -> Any:          # the adaptive law reads the base's dt and limit
-        if key == "base":                             # not set yet (a copy being built): nothing to delegate to
-            raise AttributeError(key)
-        return getattr(self.base, key)
+    def _rows(self, n: int) -> None:
+        self.base = self.base.batch(n)
+
+    @property
+    def gimbal(self) -> np.ndarray:
+        return np.asarray(self.base.gimbal, dtype=float) * self.scale
+
+    def reset(self, rows: Any) -> None:
+        self.base.reset(rows)
+
+    def act(self, rows: Any, observations: np.ndarray, info: Any) -> np.ndarray:
+        a = np.asarray(self.base.act(rows, observations, info))
+        return (a * np.asarray(self.scale, dtype=a.dtype)).astype(a.dtype, copy=False)
+
+
+class ScaledBase(RowFace):
+    """:class:`ScaledLaw` for one row: a policy (a PID-family face or law) with its command scaled."""
+
+    def __init__(self, base: Any, scale: float) -> None:
+        self.law = ScaledLaw(base, scale)
 
     @property
     def last_gimbal(self) -> np.ndarray:
-        return np.asarray(self.base.last_gimbal, dtype=float) * self.scale
-
-    def reset(self) -> None:
-        self.base.reset()
-
-    def act(self, observation: np.ndarray, info: dict[str, Any]) -> np.ndarray:
-        a = np.asarray(self.base.act(observation, info))
-        return (a * np.asarray(self.scale, dtype=a.dtype)).astype(a.dtype, copy=False)
+        return self.law.gimbal[0].copy()
 
 
 def parse_variant(text: str) -> dict[str, Any] | None:
