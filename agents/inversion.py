@@ -152,8 +152,9 @@ def check_env(env: Any, trained: dict[str, Any]) -> None:
     for key, value in env_record(env).items():
         if key in trained and trained[key] != value:
             raise ConfigError(f"inversion-id env {key}", value, f"{trained[key]!r}: the observer was trained on it")
-    if tuple(env.observation_space.shape) != (N_OBS,):
-        raise ConfigError("env observation", list(env.observation_space.shape),
+    shape = tuple(getattr(env, "single_observation_space", env.observation_space).shape)
+    if shape != (N_OBS,):
+        raise ConfigError("env observation", list(shape),
                           f"({N_OBS},): the observer reads SMILE's flight observation")
 
 

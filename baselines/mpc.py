@@ -18,23 +18,28 @@ Without active limits the QP's solution is the unconstrained one, whose first mo
 command ``-K_x x_f - K_i xi``: the MPC then flies ``lqg``'s law (to rounding; checked in the tests). The
 rows are scheduled as in ``lqg`` (:func:`.lqgkernel.row_index`; at a switch the estimate is carried by
 state name, the integral and the last command kept); off (``controller_on`` below 0.5) the command is 0
-and the law frozen, restarting from zero at each engagement. Needs OSQP (``pip install 'lvgym[control]'``).
+and the law frozen, restarting from zero at each engagement. One batch law, :class:`MPCLaw` (its compiled
+period in :mod:`.mpckernel`, OSQP only for the rows whose plan breaks a limit), and its one-row face
+:class:`MPCPolicy`. Needs OSQP (``pip install 'lvgym[control]'``).
 """
 
 from __future__ import annotations
 
+import copy
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from lvgym.benchmark.batch import BatchLaw, RowFace
 from lvgym.errors import ConfigError, require
 
-from .lqg import PLANES, LQGPolicy, LQGRow, LQGSchedule
-from .lqgkernel import row_index
+from .lqg import PLANES, LQGLaw, LQGRow, LQGSchedule
+from .mpckernel import OFF, QP, Limits, MPCState, PlanTables, mpc_finish_k, mpc_plan_k
 from .mpcqp import CondensedQP, QPOptions, condense, terminal_weight
 
-__all__ = ["MPCLaw", "MPCPolicy", "row_qp", "smile_mpc"]
+__all__ = ["MPCLaw", "MPCPolicy", "plan_tables", "row_qp", "smile_mpc"]
 
 
 def row_qp(row: LQGRow, limit: float, rate_step: float, options: QPOptions = QPOptions()) -> CondensedQP:
@@ -61,95 +66,111 @@ def row_qp(row: LQGRow, limit: float, rate_step: float, options: QPOptions = QPO
     return CondensedQP(H, F, limit, rate_step, options)
 
 
-class MPCLaw:
-    """One plane's MPC (module docstring) for one episode: ``update(y, t, on) -> u`` [rad] with the gyro
-    sample ``y`` [rad/s] at flight time ``t`` [s]. ``qps``: one :class:`.mpcqp.CondensedQP` per row."""
-
-    def __init__(self, rows: tuple[LQGRow, ...], schedule: LQGSchedule, limit: float, rate_step: float,
-                 options: QPOptions = QPOptions()) -> None:
-        self.rows, self.tables = rows, schedule.tables(rows)
-        self.qps = [row_qp(r, limit, rate_step, options) for r in rows]
-        self.x = np.zeros(self.tables.A.shape[1])
-        self.reset()
-
-    def reset(self) -> None:
-        """Restart as at the start of an episode."""
-        self.row, self.xi, self.u, self.was_on, self.saturated = -1, 0.0, 0.0, False, False
-        self.x[:] = 0.0
-        for qp in self.qps:
-            qp.reset()
-
-    def update(self, y: float, t: float, on: bool) -> float:
-        """The command [rad] for the gyro sample ``y`` [rad/s] at flight time ``t`` [s], the law on if ``on``."""
-        if not on:
-            self.was_on, self.saturated, self.u = False, False, 0.0
-            return 0.0
-        if not self.was_on:                                   # engagement: restart from zero
-            self.reset()
-            self.was_on = True
-        i = int(row_index(self.tables, float(t)))
-        if i != self.row:
-            src = self.tables.carry[self.row, i] if self.row >= 0 else np.full(self.x.size, -1)
-            self.x = np.where(src >= 0, self.x[np.maximum(src, 0)], 0.0)
-            self.row = i
-            self.qps[i].reset()
-        r, qp = self.rows[i], self.qps[i]
-        m = r.A.shape[0]
-        xp = self.x[:m]
-        xf = xp + r.M[:, 0] * (y - float(r.C[0] @ xp))
-        z0 = np.append(xf, self.xi)
-        U = qp.solve(z0, self.u)
-        u = float(U[0])
-        v = float(qp.gain[0] @ z0)                            # the unconstrained (lqg) command
-        self.saturated = abs(u - v) > 1e-9 * qp.limit
-        dxi = (r.a - 1.0) * self.xi - r.dt * y
-        if not (self.saturated and (v - u) * (qp.gain[0, -1] * dxi) > 0.0):
-            self.xi += dxi
-        self.x[:m] = r.A @ xf + r.B[:, 0] * u
-        self.u = u
-        return u
+def plan_tables(qps: list[CondensedQP], N: int) -> PlanTables:
+    """The plans' gains (and the servo's predicted rates) of one plane's schedule rows, padded to ``N`` states
+    plus the integral (:class:`.mpckernel.PlanTables`)."""
+    R, H = len(qps), qps[0].H.shape[0]
+    gain, Pr, Gr = np.zeros((R, H, N + 1)), np.zeros((R, H, N + 1)), np.zeros((R, H, H))
+    for i, qp in enumerate(qps):
+        nz = qp.gain.shape[1]
+        gain[i, :, :nz] = qp.gain
+        if qp.servo:
+            Pr[i, :, :nz], Gr[i] = qp.Pr, qp.Gr
+    return PlanTables(gain, Pr, Gr)
 
 
-class MPCPolicy:
-    """Pitch and yaw MPC (module docstring) as a benchmark :class:`~lvgym.benchmark.policy.Policy` of the
-    TVC envs. ``env``: the env it flies (gimbal limit [rad], rate limit, control period, delay and the
-    observation's layout come from it, checked as :class:`.lqg.LQGPolicy` checks them); ``schedule``: an
-    :class:`.lqg.LQGSchedule`, a path or a name in ``baselines/schedules``; ``horizon`` [periods];
-    ``rate``: the rate limit on the model's ``servo`` rate or on the ``command`` (:class:`.mpcqp.QPOptions`).
-    ``act`` needs ``info["time"]``."""
+class MPCLaw(BatchLaw):
+    """Pitch and yaw MPC (module docstring) for ``n`` rows of the TVC envs. ``env``: the env it flies (gimbal
+    limit [rad], rate limit, control period, delay and the observation's layout come from it, checked as
+    :class:`.lqg.LQGLaw` checks them); ``schedule``: an :class:`.lqg.LQGSchedule`, a path or a name in
+    ``baselines/schedules``; ``horizon`` [periods]; ``rate``: the rate limit on the model's ``servo`` rate or on
+    the ``command`` (:class:`.mpcqp.QPOptions`). ``act`` reads ``info["time"]`` of every row. Each period the
+    compiled :func:`.mpckernel.mpc_plan_k` plans every row; only a row whose plan breaks a limit calls OSQP,
+    with a solver of its own per plane and schedule row (kept, as OSQP's own warm state, over the flights)."""
 
     def __init__(self, *, env: Any, schedule: LQGSchedule | str | Path = "smile_lqg", name: str = "mpc",
-                 horizon: int = 15, rate: str = "servo") -> None:
+                 horizon: int = 15, rate: str = "servo", n: int = 1) -> None:
         require("osqp", "control", "the mpc policy")
         require("control", "control", "the mpc policy")
-        lqg = LQGPolicy(env=env, schedule=schedule, name=name)         # its checks of the env and schedule
-        self.name, self.schedule, self.limit, self.dt = name, lqg.schedule, lqg.limit, lqg.dt
-        self._i_err, self._i_on = lqg._i_err, lqg._i_on
+        lqg = LQGLaw(env=env, schedule=schedule, name=name)            # its checks of the env and schedule
+        self.name, self.schedule, self.limit, self.dt, self.oc = name, lqg.schedule, lqg.limit, lqg.dt, lqg.oc
         self.options = QPOptions(horizon=horizon, rate=rate)
-        rate = np.radians(float(env.unwrapped.task.gimbal_rate_limit_degps))     # rad/s
-        self.rate_step = float(rate) * self.dt
-        self.axes = [MPCLaw(self.schedule.rows[p], self.schedule, self.limit, self.rate_step, self.options)
-                     for p in PLANES]
-        self.last_gimbal = np.zeros(2)
+        rate_radps = float(np.radians(float(env.unwrapped.task.gimbal_rate_limit_degps)))
+        self.rate_step = rate_radps * self.dt
+        self.qps = {p: [row_qp(r, self.limit, self.rate_step, self.options) for r in self.schedule.rows[p]]
+                    for p in PLANES}
+        self.tables = {p: self.schedule.tables(self.schedule.rows[p]) for p in PLANES}
+        self.plans = {p: plan_tables(self.qps[p], self.tables[p].A.shape[1]) for p in PLANES}
+        self.limits = Limits(self.options.rate == "servo", self.limit, rate_radps, self.rate_step)
+        self.allocate(n)
 
-    def reset(self) -> None:
-        for law in self.axes:
-            law.reset()
-        self.last_gimbal = np.zeros(2)
+    def _rows(self, n: int) -> None:
+        H = self.options.horizon
+        self.states = {p: MPCState(np.zeros((n, self.tables[p].A.shape[1])), np.zeros(n), np.full(n, -1, np.int64),
+                                   np.zeros(n, bool), np.zeros(n, bool), np.zeros(n), np.zeros((n, H)), np.zeros(n, bool))
+                       for p in PLANES}
+        self.solvers: dict[tuple[str, int, int], CondensedQP] = {}
+        self.gimbal = np.zeros((n, 2))
 
-    def act(self, observation: np.ndarray, info: dict[str, Any]) -> np.ndarray:
-        obs = np.asarray(observation, dtype=float)
-        on = float(obs[self._i_on]) >= 0.5
-        t = float(info["time"])
-        self.last_gimbal = np.array([law.update(float(obs[i]), t, on) for law, i in zip(self.axes, self._i_err)])
-        return np.clip(self.last_gimbal / self.limit, -1.0, 1.0).astype(np.float32)
+    def reset(self, rows: Any) -> None:
+        """Rows ``rows`` start an episode."""
+        w = np.asarray(rows, dtype=np.int64).reshape(-1)
+        for st in self.states.values():
+            st.row[w], st.x[w], st.xi[w], st.was_on[w], st.saturated[w], st.u[w] = -1, 0.0, 0.0, False, False, 0.0
+            st.has_warm[w] = False
+        self.gimbal[w] = 0.0
+
+    def _solver(self, plane: str, b: int, i: int) -> CondensedQP:
+        key = (plane, b, i)
+        if key not in self.solvers:
+            self.solvers[key] = copy.copy(self.qps[plane][i])
+        return self.solvers[key]
+
+    def act(self, rows: Any, observations: np.ndarray, info: Mapping[str, Any]) -> np.ndarray:
+        """Actions (len(rows), 2) float32 of the rows ``rows`` for their observations and the batched env's
+        ``info`` (every row's ``time``)."""
+        rows = np.asarray(rows, dtype=np.int64).reshape(-1)
+        obs = np.asarray(observations, dtype=float).reshape(rows.size, -1)
+        on = obs[:, self.oc.on] >= 0.5
+        t = np.asarray(info["time"], dtype=np.float64)[rows]
+        for ax, plane in enumerate(PLANES):
+            tb, pt, st = self.tables[plane], self.plans[plane], self.states[plane]
+            y = np.ascontiguousarray(obs[:, self.oc.err[ax]])
+            z0, v = np.zeros((rows.size, tb.A.shape[1] + 1)), np.zeros(rows.size)
+            status = np.zeros(rows.size, np.int64)
+            mpc_plan_k(tb, pt, self.limits, st, rows, y, t, on, z0, v, status)
+            solve = np.flatnonzero(status == QP)
+            if solve.size:                           # a limit binds: OSQP for these rows
+                u = np.empty(solve.size)
+                for k, j in enumerate(solve.tolist()):
+                    b = int(rows[j])
+                    i = int(st.row[b])
+                    nz = tb.dim[i] + 1
+                    warm = st.warm[b] if st.has_warm[b] else None
+                    U, s = self._solver(plane, b, i).qp(z0[j, :nz], float(st.u[b]), warm)
+                    u[k] = U[0]
+                    st.has_warm[b] = s is not None
+                    if s is not None:
+                        st.warm[b] = s
+                mpc_finish_k(tb, pt, self.limits, st, rows[solve], y[solve], z0[solve], u, v[solve])
+            self.gimbal[rows, ax] = np.where(status == OFF, 0.0, st.u[rows])
+        return np.clip(self.gimbal[rows] / self.limit, -1.0, 1.0).astype(np.float32)
 
     @property
     def qp_counts(self) -> dict[str, int]:
-        """OSQP's calls, fallbacks and iterations summed over both planes and every row (since construction)."""
-        qps = [qp for law in self.axes for qp in law.qps]
+        """OSQP's calls, fallbacks and iterations summed over both planes, every row and schedule row."""
+        qps = list(self.solvers.values())
         return {"solves": sum(q.solves for q in qps), "fallbacks": sum(q.fallbacks for q in qps),
                 "iterations": sum(q.iterations for q in qps)}
+
+
+class MPCPolicy(RowFace):
+    """Pitch and yaw MPC as a benchmark :class:`~lvgym.benchmark.policy.Policy` of the TVC envs: one row of
+    :class:`MPCLaw` (its arguments). ``act`` needs ``info["time"]``."""
+
+    def __init__(self, *, env: Any, schedule: LQGSchedule | str | Path = "smile_lqg", name: str = "mpc",
+                 horizon: int = 15, rate: str = "servo") -> None:
+        self.law = MPCLaw(env=env, schedule=schedule, name=name, horizon=horizon, rate=rate)
 
 
 def smile_mpc(env: Any, name: str = "mpc", schedule: str = "smile_lqg", horizon: int = 15,

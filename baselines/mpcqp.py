@@ -158,11 +158,20 @@ class CondensedQP:
 
     def solve(self, z0: np.ndarray, u_prev: float) -> np.ndarray:
         """The commands ``U`` (N,) [rad] that minimise the cost from the state ``z0`` (nz,) after the command
-        ``u_prev`` [rad] under the limits (module docstring)."""
+        ``u_prev`` [rad] under the limits (module docstring): the unconstrained plan where it meets them, else
+        :meth:`qp`, warm-started from the last plan."""
         U = self.gain @ z0
         if self.feasible(U, u_prev, z0):
             self._last = U / self.limit
             return U
+        U, self._last = self.qp(z0, u_prev, self._last)
+        return U
+
+    def qp(self, z0: np.ndarray, u_prev: float, warm: np.ndarray | None) -> tuple[np.ndarray, np.ndarray | None]:
+        """OSQP's commands ``U`` (N,) [rad] from the state ``z0`` after the command ``u_prev`` [rad], warm-started
+        from the last plan ``warm`` (N,) [gimbal limits] (None: none), and the plan to warm-start the next
+        period from (None after a fallback: the unconstrained first move held to the limits)."""
+        U = self.gain @ z0
         s_prev = u_prev / self.limit
         q = 2.0 * self.limit * (self.F @ z0)
         lo, hi = self.lo.copy(), self.hi.copy()
@@ -178,8 +187,8 @@ class CondensedQP:
             self._solver.update(l=lo, u=hi)
         else:
             self._solver.update(q=q, l=lo, u=hi)
-        if self._last is not None:
-            self._solver.warm_start(x=np.append(self._last[1:], self._last[-1]))
+        if warm is not None:
+            self._solver.warm_start(x=np.append(warm[1:], warm[-1]))
         res = self._solver.solve(raise_error=False)
         self.solves += 1
         self.iterations += int(res.info.iter)
@@ -187,13 +196,11 @@ class CondensedQP:
             self.fallbacks += 1
             step = np.inf if self.servo else self.rate_step
             u0 = min(max(U[0], -self.limit, u_prev - step), self.limit, u_prev + step)
-            self._last = None
-            return np.full(N, u0)
+            return np.full(N, u0), None
         s = np.clip(res.x, -1.0, 1.0)
         if not self.servo:                                      # OSQP's tolerance: the first move exactly
             s[0] = min(max(s[0], s_prev - self.r), s_prev + self.r)
-        self._last = s
-        return s * self.limit
+        return s * self.limit, s
 
     def reset(self) -> None:
         """Forget the warm start (a new episode or engagement)."""

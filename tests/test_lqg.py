@@ -13,7 +13,7 @@ from lvgym.baselines.design import flightloop as F
 from lvgym.baselines.design import linearize as L
 from lvgym.baselines.design import lqg_design as D
 from lvgym.baselines.design import lqg_row as R
-from lvgym.baselines.lqg import LQGLaw, LQGPolicy, LQGRow, LQGSchedule, smile_lqg
+from lvgym.baselines.lqg import LQGPlane, LQGPolicy, LQGRow, LQGSchedule, smile_lqg
 from lvgym.errors import ConfigError
 
 T0 = 28.8
@@ -100,7 +100,7 @@ def test_law_equals_the_linear_compensator(shipped):
     for i in (3, 6):
         r = shipped.rows["pitch"][i]
         one = LQGSchedule({p: (r,) for p in ("pitch", "yaw")}, "one row")
-        law = LQGLaw(one.rows["pitch"], one, u_limit=1e6)
+        law = LQGPlane(one.rows["pitch"], one, u_limit=1e6)
         y = 1e-3 * rng.standard_normal(200)
         u_law = np.array([law.update(v, r.time_s, True)[0] for v in y])
         d = R.RowDesign(r.time_s, "pitch", r.A, r.B, r.C, r.Kx, r.Ki, r.M, r.a, r.dt, R.LQGWeights(), r.labels)

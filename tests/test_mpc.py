@@ -8,7 +8,7 @@ import pytest
 
 import lvgym
 import lvgym.baselines  # noqa: F401  (registers the policies)
-from lvgym.baselines.lqg import LQGLaw, LQGSchedule, smile_lqg
+from lvgym.baselines.lqg import LQGPlane, LQGSchedule, smile_lqg
 from lvgym.baselines.lqgkernel import AntiWindup
 from lvgym.baselines.mpc import row_qp, smile_mpc
 from lvgym.baselines.mpcqp import CondensedQP, QPOptions, condense
@@ -122,7 +122,7 @@ def test_lqg_aw_rate_limit_and_back_calculation_by_hand():
     rows = sched.rows["pitch"]
     row = rows[sched.index(28.8)]
     g = 0.1
-    law = LQGLaw(rows, sched, LIMIT, aw=AntiWindup(True, RATE_STEP, g))
+    law = LQGPlane(rows, sched, LIMIT, aw=AntiWindup(True, RATE_STEP, g))
     y = 0.05                                  # rad/s
     u = law.update([y], [28.8], [True])[0]
     v = float(-row.Kx[0] @ (row.M[:, 0] * y))

@@ -1,8 +1,8 @@
-"""The batched act of the classical controllers (``policy.batch(n)``, lvgym.baselines.batch) against the
-per-row policies: rows of the v1 suites' VectorEnv flown with the batch's actions, each row's own policy
-object fed that row's observation and the single env's info of that row, the actions and the gimbal
-commands before them (float64) equal (==) at every step; rows reset at different steps, stepped in changing subsets, through the controller's switch-on and
-an episode's end."""
+"""Every registered controller is one batch law: a batch of one (its one-row face on the single env's info of
+that row) equals the same row of a batch of four, to the bit, on the rows of the VectorEnv of the suite it is made
+for, the actions and the commands before them, with rows reset at different steps, stepped in changing subsets,
+through the controller's switch-on and an episode's end. Also: a user's per-row policy through the one adapter
+(PerRow), a subclass that changes a face's law, and the laws' compiled schedule look-ups."""
 
 from __future__ import annotations
 
@@ -12,21 +12,24 @@ import numpy as np
 import pytest
 
 import lvgym
+import lvgym.agents  # noqa: F401  (registers the learned policies)
 import lvgym.baselines  # noqa: F401  (registers the baselines)
-from lvgym.baselines.aac import AdaptiveAugmentingPolicy, flex_aac
-from lvgym.baselines.aacbatch import AACBatch
-from lvgym.baselines.batch import RowCopies
-from lvgym.baselines.lqg import LQGBatch
-from lvgym.baselines.pid import GainSchedule, GainScheduledPIDPolicy, PIDPolicy, flex_pid
-from lvgym.baselines.pidbatch import PIDBatch
+from lvgym.baselines.aac import flex_aac
+from lvgym.baselines.pid import GainSchedule, GainScheduledPIDPolicy, PIDPolicy
 from lvgym.baselines.pidkernel import interp_k, nearest_k
+from lvgym.benchmark.batch import BatchLaw, PerRow, RowFace, as_batch, own_rows
 from lvgym.benchmark.registry import POLICIES
-from lvgym.benchmark.runner import build_policy
-from lvgym.envs.core import row_info as _row
+from lvgym.benchmark.runner import build_policy, policy_options
+from lvgym.envs.core import row_info
 
 N = 4
 MISSION_S = 3.0           # the controller switches on at 1-2 s; the episodes end at 3 s and start again
 STEPS = 230
+#: the suite each registered controller is made for (smile-v1 unless named); the automatic designs are made for
+#: a vehicle file on first use (tests/test_auto_design.py flies them)
+SUITE = {"ppo": "smile-windy", "inversion-id": "smile-v2-faults", "inversion-id-smile": "smile-v2",
+         "inversion-id-stratos": "stratos-tvc-v2", "privileged": "smile-v2"}
+REGISTERED = sorted(n for n in POLICIES if not n.startswith(("auto-", "fixed-")))
 
 
 def registered(name):
@@ -46,24 +49,21 @@ def scheduled(variable=None, interpolation=None, schedule="smile_flex"):
     return make
 
 
-class Halved(PIDPolicy):
-    """A subclass that changes the law: the batch must not compile it."""
-
-    def act(self, observation, info):
-        return super().act(observation, info) * np.float32(0.5)
-
-
-def fly(suite, make, kind, seed=0, model="nonrigid"):
-    env = lvgym.make_vec_env(suite, model=model, num_envs=N, mission_time_s=MISSION_S)
+def fly(suite, make, seed=0, model="nonrigid", law=True, **options):
+    """Rows of ``suite``'s VectorEnv flown by ``make(env)``'s batch of N rows, each row's actions checked against
+    a one-row policy of its own fed that row's observation and single-env info (``law``: the batch is the
+    policy's batch law, and the commands it keeps agree too). Returns the batch."""
+    env = lvgym.make_vec_env(suite, model=model, num_envs=N, mission_time_s=MISSION_S, **options)
     singles = [make(env) for _ in range(N)]
-    batch = make(env).batch(N)
-    assert isinstance(batch, kind) and batch.name == singles[0].name
+    batch = as_batch(make(env), N, lambda: make(env))
+    assert batch.name == singles[0].name
+    assert isinstance(batch, BatchLaw) == law, type(batch)
     rng = np.random.default_rng(seed)
     obs, info = env.reset(seed=seed)
     batch.reset(np.arange(N))
     for p in singles:
         p.reset()
-    actions = np.zeros((N, 2), np.float32)
+    actions = np.zeros((N, *env.single_action_space.shape), env.single_action_space.dtype)
     engaged = np.zeros(N, bool)
     for step in range(STEPS):
         rows = np.flatnonzero(rng.random(N) < 0.9) if step % 7 else np.arange(N)
@@ -72,49 +72,92 @@ def fly(suite, make, kind, seed=0, model="nonrigid"):
         for b in restart:
             singles[b].reset()
         got = batch.act(rows, obs[rows], info)
-        want = np.array([singles[b].act(obs[b], _row(info, b)) for b in rows], np.float32).reshape(-1, 2)
-        assert got.dtype == np.float32 and got.shape == (rows.size, 2)
+        want = np.array([singles[b].act(obs[b], row_info(info, int(b))) for b in rows]).reshape(got.shape)
+        assert got.dtype == want.dtype and got.shape == (rows.size, *actions.shape[1:])
         assert np.array_equal(got, want), (step, rows, got, want)
-        if kind is not RowCopies:                                  # the commands [rad] before the float32 action
-            assert np.array_equal(batch.gimbal[rows], [singles[b].last_gimbal for b in rows]), step
+        if hasattr(batch, "gimbal"):                              # the commands [rad] before the float32 action
+            assert np.array_equal(batch.gimbal[rows], [singles[b].law.gimbal[0] for b in rows]), step
         actions[rows] = got
         engaged[rows] |= np.any(got != 0.0, axis=1)
         obs, _, terminated, truncated, info = env.step(actions)
     assert engaged.all()                                           # every row's controller flew
+    return batch
 
 
-@pytest.mark.parametrize("name", ["pid", "pid-thesis", "gs-pid", "gs-pid-thesis", "gs-pid-flex", "aac", "lqg",
-                                  "lqg-front", "gs-pd-relief"])
-def test_every_baseline_batch_is_its_policy_per_row_on_smile(name):
-    kind = {"aac": AACBatch, "lqg": LQGBatch, "lqg-front": LQGBatch}.get(name, PIDBatch)
-    fly("smile-v1", registered(name), kind)
+@pytest.mark.parametrize("name", REGISTERED)
+def test_every_registered_controller_is_one_law(name):
+    if name == "zero":
+        return fly_zero()
+    spec = POLICIES[name]
+    options = policy_options(spec)
+    fly(SUITE.get(name, "smile-v1"), registered(name), **options)
+
+
+def fly_zero():
+    policy = build_policy(POLICIES["zero"], lvgym.make_env("smile-v1"))
+    law = policy.batch(3)
+    assert isinstance(law, BatchLaw)
+    np.testing.assert_array_equal(law.act([0, 2], np.zeros((2, 14), np.float32), {}), np.zeros((2, 2)))
+    assert np.array_equal(policy.act(np.zeros(14, np.float32), {}), np.zeros(2, np.float32))
 
 
 @pytest.mark.parametrize("suite", ["stratos-tvc-v1", "slender-v1"])
-def test_flex_and_aac_batches_on_the_other_vehicles(suite):
+def test_flex_and_aac_on_the_other_vehicles(suite):
     """gs-pid-flex and aac of each vehicle's flex schedule (slender's with load relief)."""
-    fly(suite, registered("gs-pid-flex"), PIDBatch, seed=3)
-    fly(suite, registered("aac"), AACBatch, seed=4)
+    fly(suite, registered("gs-pid-flex"), seed=3)
+    fly(suite, registered("aac"), seed=4)
 
 
 def test_schedules_read_other_ways_and_aac_options():
-    """A linear schedule with filters (discretised in Python per row), schedules on time and on Mach, a
+    """A linear schedule with filters (discretised per row when they change), schedules on time and on Mach, a
     rigid flight, and the adaptive law with one shared gain and no restart at engagement."""
-    fly("smile-v1", scheduled(interpolation="linear"), PIDBatch, seed=1)
-    fly("smile-v1", scheduled(variable="time"), PIDBatch, seed=2)
-    fly("smile-v1", scheduled(variable="mach", interpolation="linear", schedule="smile"), PIDBatch, seed=3,
-        model="rigid")
+    fly("smile-v1", scheduled(interpolation="linear"), seed=1)
+    fly("smile-v1", scheduled(variable="time"), seed=2)
+    fly("smile-v1", scheduled(variable="mach", interpolation="linear", schedule="smile"), seed=3, model="rigid")
     fly("smile-v1", lambda env: flex_aac(env, per_axis=False, reset_on_engage=False, damper_deadzone_rad2=0.0),
-        AACBatch, seed=5)
+        seed=5)
 
 
-def test_a_law_the_kernels_do_not_know_flies_as_copies():
-    """A subclass of PIDPolicy, and aac on a base that is no PID of the kernels (the AAC tuning study's
-    scaled base, which delegates its attributes and must survive the copy)."""
-    from experiments.aac_tuning.aac_sweep import ScaledBase
+def test_mpc_solves_its_qps_row_by_row_as_one_row_does():
+    """With a 10 deg/s servo the MPC's plans break the rate limit and OSQP solves them, a solver per row: each
+    row's commands are still those of the one-row policy."""
+    batch = fly("smile-v1", registered("mpc"), seed=8, gimbal_rate_limit_degps=10.0)
+    assert batch.qp_counts["solves"] > 0
 
-    fly("smile-v1", lambda env: Halved(env=env, name="halved"), RowCopies, seed=6)
-    fly("smile-v1", lambda env: AdaptiveAugmentingPolicy(ScaledBase(flex_pid(env), 2.0), env=env), RowCopies, seed=7)
+
+class Halved(PIDPolicy):
+    """A subclass that changes the law: it flies as one object per row."""
+
+    def act(self, observation, info):
+        return super().act(observation, info) * np.float32(0.5)
+
+
+class UserPD:
+    """A user's controller: the benchmark's Policy interface only, its own state (a step counter)."""
+
+    name = "user-pd"
+
+    def __init__(self):
+        self.steps = 0
+
+    def reset(self):
+        self.steps = 0
+
+    def act(self, observation, info):
+        self.steps += 1
+        return np.clip(-5.7 * observation[1:3] - 2.3 * observation[3:5], -1.0, 1.0).astype(np.float32)
+
+
+def test_a_users_policy_and_a_changed_law_fly_through_the_one_adapter():
+    fly("smile-v1", lambda env: Halved(env=env, name="halved"), seed=6, law=False)
+    user = UserPD()
+    rows = as_batch(user, N, UserPD)
+    assert isinstance(rows, PerRow) and own_rows(user).policies[0] is user
+    fly("smile-v1", lambda env: UserPD(), seed=7, law=False)
+    face = build_policy(POLICIES["lqg"], lvgym.make_env("smile-v1"))
+    assert isinstance(face, RowFace) and own_rows(face) is face.law
+    with pytest.raises(ValueError, match="need a factory"):
+        as_batch(UserPD(), 2).act([1], np.zeros((1, 14), np.float32), {"time": np.zeros(2)})
 
 
 def test_the_schedule_lookups_are_numpys():
@@ -130,13 +173,3 @@ def test_the_schedule_lookups_are_numpys():
                 assert got == want or (np.isnan(got) and np.isnan(want)), (m, x)
             for x in np.r_[xp, rng.uniform(90.0, 210.0, 50), 0.5 * (xp[:-1] + xp[1:])]:
                 assert nearest_k(xp[::-1].copy(), float(x)) == int(np.argmin(np.abs(xp[::-1] - x)))
-
-
-def test_the_speed_study_replays_the_same_actions():
-    """experiments/policy_batch_speed: the recorded flight replayed through per-row policies and the batch
-    (it raises where their actions differ) gives a time per call of each."""
-    from experiments.policy_batch_speed.act_speed import time_policy
-
-    r = time_policy("aac", "smile-v1", rows=2, steps=120, repeats=1)
-    assert r["policy"] == "aac" and r["batch"] == "AACBatch"
-    assert r["row_us"] > 0.0 and r["batch_row_us"] > 0.0 and r["batch_call_us"] == pytest.approx(2 * r["batch_row_us"])
