@@ -295,16 +295,20 @@ def test_validation_flies_a_batched_policys_seeds_as_rows_to_the_bit():
     assert ev.evaluate(policy)["episodes"] == 3
 
 
-def test_the_fast_action_path_equals_predict():
-    """SB3Policy.act skips model.predict's per-call checks for a flat Box observation; the action must be
-    exactly predict's."""
+def test_the_compiled_actor_is_predict_to_float32_rounding_and_the_same_bits_in_any_batch():
+    """SB3Policy flies an actor-critic MLP through its compiled forward (lvgym.agents.mlp): each action agrees
+    with model.predict's to float32 rounding, and a row's action is the same bits alone and in a batch."""
     from lvgym.agents.policy import shipped_policy
     p = shipped_policy()
-    assert p._fast_path() is not None
+    assert p.net is not None
     rng = np.random.default_rng(3)
-    for _ in range(200):
-        obs = (rng.normal(size=14) * rng.choice([0.01, 1.0, 10.0])).astype(np.float32)
-        a = p.act(obs, {})
-        o = np.asarray(p.normalizer.normalize_obs(obs), dtype=np.float32)
+    obs = (rng.normal(size=(200, 14)) * rng.choice([0.01, 1.0, 10.0], size=(200, 1))).astype(np.float32)
+    law = p.batch(200)
+    law.reset(np.arange(200))
+    many = law.act(np.arange(200), obs, {})
+    for k in range(200):
+        a = p.act(obs[k], {})
+        o = np.asarray(p.normalizer.normalize_obs(obs[k]), dtype=np.float32)
         b, _ = p.model.predict(o, deterministic=True)
-        assert a.dtype == b.dtype and np.array_equal(a, b)
+        assert a.dtype == b.dtype and np.array_equal(a, many[k])
+        np.testing.assert_allclose(a, b, rtol=0, atol=2e-6)

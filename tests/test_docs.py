@@ -4,6 +4,7 @@ import doctest
 import pathlib
 import re
 
+import pytest
 
 import lvgym
 import lvgym.dynamics.model
@@ -60,3 +61,19 @@ def test_family_example_runs():
 def test_docstring_examples():
     result = doctest.testmod(lvgym.dynamics.model)
     assert result.attempted > 0 and result.failed == 0
+
+
+def test_the_add_a_controller_example_flies_as_one_law():
+    """docs/baselines.md's batch law: its one-row face and a batch of three agree, and the benchmark flies it."""
+    import numpy as np
+
+    from lvgym.benchmark import play_episode
+
+    (block,) = _python_blocks("baselines.md")
+    ns = _run("baselines.md", block)
+    face, law = ns["MyPD"](), ns["MyPD"]().batch(3)
+    obs = np.random.default_rng(0).normal(0.0, 0.1, (3, 14)).astype(np.float32)
+    law.reset(np.arange(3))
+    assert np.array_equal(law.act(np.arange(3), obs, {})[1], face.act(obs[1], {}))
+    record = play_episode(face, lvgym.make_env("smile-v1", mission_time_s=4.0), 0)
+    assert record["duration_s"] == pytest.approx(4.0) and not record["failed"]
