@@ -95,11 +95,11 @@ def _handle(ax: Any, label: str, style: Style, **kw: Any) -> Any:
     return line
 
 
-def _save(fig: Any, handles: Mapping[str, Any], write_to: IO[bytes], title: str = "") -> None:
+def _save(fig: Any, handles: Mapping[str, Any], write_to: IO[bytes]) -> None:
     """The figure with its legend to the right of the axes (outside the data), written as PNG."""
     if handles:
         fig.legend(list(handles.values()), list(handles), loc="upper left", bbox_to_anchor=(1.0, 1.0), fontsize=8,
-                   title=title or None, title_fontsize=8, frameon=False)
+                   frameon=False)
     fig.tight_layout()
     fig.savefig(write_to, format="png", bbox_inches="tight")
 
@@ -200,7 +200,8 @@ def plot_degradation(degradation: Sequence[Mapping[str, Any]], write_to: IO[byte
                 if not math.isfinite(y):
                     continue
                 ratios += [y, float(g.get("ratio_ci_low", y)), float(g.get("ratio_ci_high", y))]
-                ax.bar([x], [y], width * 0.85, color=st.colour, alpha=0.75, edgecolor="black", lw=0.4)
+                ax.bar([x], [y - 1.0], width * 0.85, bottom=1.0, color=st.colour, alpha=0.75, edgecolor="black",
+                       lw=0.4)                                      # from 1: no change
                 _errorbar(ax, x, y, float(g.get("ratio_ci_low", math.nan)), float(g.get("ratio_ci_high", math.nan)),
                           st, size=5)
             handles.setdefault(pol, _handle(ax, pol, st))
@@ -223,7 +224,8 @@ def plot_headline(headline: Sequence[Mapping[str, Any]], write_to: IO[bytes], ot
     """Protocol v2's headline (:func:`~.headline.headline`): per suite and flight model, left to right, the
     best classical, the best learned and the privileged ``score_v2`` [rad] with their 95 % intervals, then
     each other policy flown (``others``: :func:`~.headline.others`); "none flyable" where a kind flew but no
-    policy of it qualified. Returns the styles used."""
+    policy of it qualified; above a point, its failed or unflyable flights of the seeds when there are any.
+    Returns the styles used."""
     keys = list(dict.fromkeys((h["suite"], h["condition"]) for h in headline))
     extra = {key: [o for o in others if (o["suite"], o["condition"]) == key] for key in keys}
     names = list(dict.fromkeys([h[k]["policy"] for h in headline for k in _KINDS if h.get(k)]
@@ -246,6 +248,10 @@ def plot_headline(headline: Sequence[Mapping[str, Any]], write_to: IO[bytes], ot
                 continue
             st = look[cell["policy"]]
             _errorbar(ax, x, float(cell["mean"]), float(cell["low"]), float(cell["high"]), st)
+            failed = round(float(cell["failed_or_unflyable"]) * int(cell["n"]))
+            if failed:                                              # failed or unflyable of the seeds
+                ax.annotate(f"{failed}/{cell['n']}", (x, float(cell["high"])), xytext=(0, 3),
+                            textcoords="offset points", fontsize=7, ha="center", va="bottom", color="0.3")
             values += [float(cell["low"]), float(cell["high"])]
             label = f"{cell['policy']} ({kind})"
             handles.setdefault(label, _handle(ax, label, st))
@@ -256,9 +262,10 @@ def plot_headline(headline: Sequence[Mapping[str, Any]], write_to: IO[bytes], ot
     ax.set_xticks(range(len(headline)), [f"{w}\n{h['model']}" for w, h in zip(where, headline)], fontsize=7)
     ax.set_xlim(-0.5, len(headline) - 0.5)
     ax.set_ylabel("score_v2 [rad], lower is better", fontsize=8)
-    ax.set_title("Headline (protocol v2), in each suite and model left to right:\nthe best classical, the best "
-                 "learned, the privileged reference" + (", the other policies" if others else "")
-                 + "; means with their 95 % intervals", fontsize=9)
+    ax.set_xlabel("left to right in each: the best classical, the best learned, the privileged reference"
+                  + (", the other policies" if others else "") + "; n/m: failed or unflyable of the seeds",
+                  fontsize=8)
+    ax.set_title("Headline (protocol v2): means with their 95 % intervals", fontsize=9)
     ax.grid(alpha=0.3, axis="y")
     _save(fig, handles, write_to)
     return {p: look[p] for p in names}
