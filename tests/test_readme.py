@@ -39,7 +39,7 @@ SHORTEN = {
         "policy.net_arch=[8,8] --env-kwargs mission_time_s=2 controller_on_after_s=0.2 --checkpoint-freq 128 "
         "--eval-episodes 1 --eval-mission-time-s 0.5 --no-progress",
     "lvgym campaign agents/campaigns/v2_faults_gust.yaml --dry-run": "",
-    "python evaluate.py --policies my_policy.py:make gs-pid-flex": SHORT_EVAL,
+    "python evaluate.py --policies my_policy.py:make lqg-front": SHORT_EVAL,
     "cp lvgym/vehicles/smile_v1.yaml my_rocket.yaml": "",
     "lvgym design pid-flex --vehicle smile": "--times 28.8 --starts 0",
     "lvgym design lqg --vehicle smile": "--rows 28.8",
@@ -143,7 +143,8 @@ def test_own_controller_evaluated(tmp_path):
     (tmp_path / "my_policy.py").write_text(_python(1), encoding="utf-8")
     (command,) = _sh(3)
     proc = _run(command, tmp_path)
-    assert "my-pd" in proc.stdout and "gs-pid-flex" in proc.stdout
+    assert "my-pd" in proc.stdout and "lqg-front" in proc.stdout
+    assert "### Other policies beside the headline" in proc.stdout and "| `my-pd` | other |" in proc.stdout
 
 
 def test_own_vehicle(tmp_path, monkeypatch):

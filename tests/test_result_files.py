@@ -54,7 +54,7 @@ def test_an_interrupted_write_leaves_no_partial_file(tmp_path, monkeypatch):
     first = write_results(tmp_path, recs, s, degradation(s), {"run": 1})
     before = {n: p.read_bytes() for n, p in first.items()}
 
-    def broken_plot(records, f):                    # writes half a PNG, then fails
+    def broken_plot(records, f, *args):             # writes half a PNG, then fails
         f.write(b"\x89PNG\r\n\x1a\n" + b"\0" * 100)
         raise KeyboardInterrupt("killed while writing")
 
@@ -110,8 +110,8 @@ def _alive(pid: int) -> bool:
 @pytest.mark.parametrize("sig, executor", [(signal.SIGKILL, "local"), (signal.SIGTERM, "serial")])
 def test_a_killed_evaluation_leaves_no_result_file(tmp_path, sig, executor):
     out = tmp_path / "results"
-    proc = subprocess.Popen(_evaluate_cmd(out, "--policies", "zero", "--episodes", "2000", "--executor", executor,
-                                          "--workers", "2"),
+    proc = subprocess.Popen(_evaluate_cmd(out, "--policies", "zero", "--only", "--episodes", "2000", "--executor",
+                                          executor, "--workers", "2"),
                             cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
     seen = b""
     deadline = time.time() + 60

@@ -10,10 +10,12 @@
 - :mod:`.stats`: bootstrap intervals, paired tests, the IQM and probability of improvement (stratified bootstrap),
   the normalised score and the room;
 - :mod:`.flyability`, :mod:`.headline`: protocol v2's flyability rule and ``score_v2``; its headline (the
-  best causal classical and learned policies, the privileged reference and the room between them);
+  best flyable classical and learned policies the suite reports, the privileged reference and the room
+  between them) and a row for each other policy flown;
 - :mod:`.compare`: the paired comparison of policies and agents over training runs;
 - :mod:`.runner`: :func:`run_episode` and :func:`evaluate` (serial, local process pool or Ray);
-- :mod:`.tables`, :mod:`.results`: the Markdown tables; atomic CSV / JSON / Markdown / PNG result files;
+- :mod:`.tables`, :mod:`.results`, :mod:`.plots`: the Markdown tables; atomic CSV / JSON / Markdown / PNG result
+  files; the figures (each policy in one colour and marker, means with their intervals);
 - :mod:`.registry`: the policies the command lines know by name (:func:`register_policy`: the controllers
   and agents register themselves; the command layer imports them) and how ``--policies`` resolves;
 - :mod:`.margins`, :mod:`.perturb`: time-domain gain and delay margins of any policy

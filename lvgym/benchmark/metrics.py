@@ -58,7 +58,7 @@ import numpy as np
 
 from .flyability import V2_METRICS
 from .scoring import PHASES
-from .stats import bootstrap_ci, paired
+from .stats import bootstrap_ci, paired, ratio
 
 #: metrics summarised per suite (all "lower is better" except those in :data:`HIGHER_IS_BETTER`)
 SUMMARY_METRICS = ("rate_error_rad", "rate_error_pitch_rad", "rate_error_yaw_rad", "max_rate_radps", "effort_rad_s",
@@ -264,7 +264,8 @@ def degradation(summary: Iterable[dict[str, Any]], metric: str = "rate_error_rad
     ``failure_rate_diff``. A zero reference mean gives a ratio of ``inf`` (or NaN for 0/0). With
     ``records``: the paired comparison of the two conditions on their common seeds
     (:func:`.stats.paired` of ``metric``, model minus reference): ``paired_n``, ``diff_ci_low``,
-    ``diff_ci_high``, ``p_wilcoxon``, ``p_ttest`` (NaN without common seeds)."""
+    ``diff_ci_high``, ``p_wilcoxon``, ``p_ttest``, and the interval of the ratio of the means on those seeds
+    (:func:`.stats.ratio`): ``ratio_ci_low``, ``ratio_ci_high`` (NaN without common seeds)."""
     rows = list(summary)
     seeds = per_seed(records, metric) if records is not None else None
     ref = {(r["suite"], r.get("group", r["suite"]), r["policy"]): r for r in rows if r.get("model") == reference_model}
@@ -292,9 +293,12 @@ def degradation(summary: Iterable[dict[str, Any]], metric: str = "rate_error_rad
             common = sorted(set(mine) & set(theirs))
             d["paired_n"] = len(common)
             if common:
-                p = paired([mine[s] for s in common], [theirs[s] for s in common])
+                a, b = [mine[s] for s in common], [theirs[s] for s in common]
+                p = paired(a, b)
                 d.update(diff_ci_low=p.ci_low, diff_ci_high=p.ci_high, p_wilcoxon=p.p_wilcoxon, p_ttest=p.p_ttest)
+                d["ratio_ci_low"], d["ratio_ci_high"] = ratio(a, b)[1:]
             else:
-                d.update(diff_ci_low=math.nan, diff_ci_high=math.nan, p_wilcoxon=math.nan, p_ttest=math.nan)
+                d.update(diff_ci_low=math.nan, diff_ci_high=math.nan, p_wilcoxon=math.nan, p_ttest=math.nan,
+                         ratio_ci_low=math.nan, ratio_ci_high=math.nan)
         out.append(d)
     return out

@@ -10,8 +10,11 @@ Files (:func:`write_results`): ``episodes.csv`` (one row per episode, SI units a
 ``summary.csv`` (per suite, condition and policy, with intervals and ranks), ``degradation.csv`` (one row
 per policy, condition and metric: ``rate_error_rad`` and ``score``), ``comparison.csv`` (the paired
 comparison, :mod:`.compare`), ``run_groups.csv`` (agents over training runs, when there are any),
-``table.md`` (what :func:`~.tables.markdown_table` prints), ``results.json`` (all of it with the run's
-metadata; written last), ``rate_error.png`` and ``degradation.png``.
+``headline.csv`` and ``headline_others.csv`` (protocol v2's headline and the other policies flown beside
+it, :mod:`.headline`), ``table.md`` (what :func:`~.tables.markdown_table` prints), ``results.json`` (all of it
+with the run's metadata; written last), and the figures of :mod:`.plots`: ``rate_error.png``,
+``degradation.png`` and, when a v2 suite was flown, ``headline.png``, each policy in one colour and marker
+in all of them.
 """
 
 from __future__ import annotations
@@ -29,12 +32,12 @@ from typing import IO, Any
 
 import numpy as np
 
-from ..errors import require
 from .headline import flat
+from .plots import plot_degradation, plot_headline, plot_rate_error, styles
 from .tables import markdown_table
 
 __all__ = ["atomic_path", "atomic_write", "atomic_write_text", "csv_text", "json_text", "markdown_table",
-           "plot_degradation", "plot_rate_error", "remove_stale_temporaries", "write_results"]
+           "plot_degradation", "plot_headline", "plot_rate_error", "remove_stale_temporaries", "write_results"]
 
 _TMP = re.compile(r"^\..+\.(\d+)\.tmp$")
 
@@ -130,90 +133,16 @@ def json_text(obj: Any) -> str:
     return json.dumps(_plain(obj), indent=1, sort_keys=False) + "\n"
 
 
-# ---------------------------------------------------------------------------------------------- plots
-def _figure(width: float, height: float) -> Any:
-    """A matplotlib Figure on the Agg canvas (no pyplot, no global backend change)."""
-    require("matplotlib", "benchmark", "the benchmark's plots")
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
-
-    fig = Figure(figsize=(width, height), dpi=110)
-    FigureCanvasAgg(fig)
-    return fig
-
-
-def plot_rate_error(records: Sequence[Mapping[str, Any]], write_to: IO[bytes]) -> None:
-    """Box plots of the cumulative rate error [rad] per suite: one box per condition and policy; failed
-    episodes (their error integrated up to the failure) marked with red crosses."""
-    suites = list(dict.fromkeys(r["suite"] for r in records))
-    fig = _figure(max(5.0, 4.2 * len(suites)), 4.0)
-    for k, suite in enumerate(suites):
-        ax = fig.add_subplot(1, len(suites), k + 1)
-        recs = [r for r in records if r["suite"] == suite]
-        conds = list(dict.fromkeys(r["condition"] for r in recs))
-        pols = list(dict.fromkeys(r["policy"] for r in recs))
-        width = 0.8 / len(pols)
-        for j, pol in enumerate(pols):
-            data = [[r["rate_error_rad"] for r in recs if r["condition"] == c and r["policy"] == pol] for c in conds]
-            pos = [i + (j - (len(pols) - 1) / 2) * width for i in range(len(conds))]
-            bp = ax.boxplot(data, positions=pos, widths=width * 0.9, patch_artist=True, manage_ticks=False)
-            for box in bp["boxes"]:
-                box.set_facecolor(f"C{j}")
-                box.set_alpha(0.6)
-            ax.plot([], [], "s", color=f"C{j}", label=pol)
-            for x, c in zip(pos, conds):             # failed episodes as red crosses
-                ys = [r["rate_error_rad"] for r in recs if r["condition"] == c and r["policy"] == pol and r["failed"]]
-                ax.plot([x] * len(ys), ys, "x", color="red", ms=6)
-        if any(r["failed"] for r in recs):
-            ax.plot([], [], "x", color="red", ms=6, label="failed episode (error up to the failure)")
-        ax.set_xticks(range(len(conds)), [c.split("/")[-1] for c in conds])
-        ax.set_title(suite)
-        ax.set_ylabel("cumulative pitch + yaw rate error [rad]")
-        ax.grid(alpha=0.3)
-        ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(write_to, format="png")
-
-
-def plot_degradation(degradation: Sequence[Mapping[str, Any]], write_to: IO[bytes]) -> None:
-    """Bars of the rigid-to-non-rigid ratio of the mean per suite and policy (1 = no change), one panel
-    per metric of the rows (``score``, which counts failures, and ``rate_error_rad``)."""
-    labels_of = {"score": "score", "rate_error_rad": "rate error"}
-    metrics = list(dict.fromkeys(g.get("metric", "rate_error_rad") for g in degradation))
-    fig = _figure(6.0 * max(1, len(metrics)), 3.8)
-    for k, metric in enumerate(metrics):
-        rows = [g for g in degradation if g.get("metric", "rate_error_rad") == metric]
-        ax = fig.add_subplot(1, len(metrics), k + 1)
-        labels = list(dict.fromkeys(f"{g['suite']}\n{g['condition'].split('/')[-1]}" for g in rows))
-        pols = list(dict.fromkeys(g["policy"] for g in rows))
-        width = 0.8 / max(1, len(pols))
-        for j, pol in enumerate(pols):
-            xs, ys = [], []
-            for g in rows:
-                if g["policy"] == pol:
-                    label = f"{g['suite']}\n{g['condition'].split('/')[-1]}"
-                    xs.append(labels.index(label) + (j - (len(pols) - 1) / 2) * width)
-                    ys.append(g["mean_ratio"] if math.isfinite(g["mean_ratio"]) else np.nan)
-            ax.bar(xs, ys, width * 0.9, color=f"C{j}", label=pol)
-        ax.axhline(1.0, color="k", lw=0.8)
-        ax.set_xticks(range(len(labels)), labels, fontsize=8)
-        ax.set_ylabel(f"{labels_of.get(metric, metric)}, non-rigid / rigid")
-        ax.grid(alpha=0.3, axis="y")
-        if pols:
-            ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(write_to, format="png")
-
-
 # ---------------------------------------------------------------------------------------------- all files
 def write_results(out: str | os.PathLike[str], records: Sequence[Mapping[str, Any]],
                   summary: Sequence[Mapping[str, Any]], degradation: Sequence[Mapping[str, Any]],
                   meta: Mapping[str, Any], plots: bool = True, comparison: Sequence[Mapping[str, Any]] = (),
                   groups: Sequence[Mapping[str, Any]] = (), headline: Sequence[Mapping[str, Any]] = (),
-                  family: Sequence[str] = ()) -> dict[str, Path]:
+                  family: Sequence[str] = (), others: Sequence[Mapping[str, Any]] = ()) -> dict[str, Path]:
     """Write every result file into ``out`` (created if missing), each atomically; ``results.json``
-    last (``headline``: protocol v2's rows, :func:`~.headline.headline`, also as ``headline.csv``). Returns
-    the paths by name."""
+    last (``headline``: protocol v2's rows, :func:`~.headline.headline`, also as ``headline.csv`` and
+    ``headline.png``; ``others``: the other policies flown beside it, :func:`~.headline.others`, also as
+    ``headline_others.csv``). Returns the paths by name."""
     folder = Path(out)
     folder.mkdir(parents=True, exist_ok=True)
     remove_stale_temporaries(folder)
@@ -227,15 +156,23 @@ def write_results(out: str | os.PathLike[str], records: Sequence[Mapping[str, An
         paths["run_groups.csv"] = atomic_write_text(folder / "run_groups.csv", csv_text(groups))
     if headline:
         paths["headline.csv"] = atomic_write_text(folder / "headline.csv", csv_text(flat(headline)))
+    if others:
+        paths["headline_others.csv"] = atomic_write_text(folder / "headline_others.csv", csv_text(others))
     paths["table.md"] = atomic_write_text(folder / "table.md",
                                           markdown_table(summary, degradation, meta, comparison, groups, headline,
-                                                         family))
-    if plots:
-        paths["rate_error.png"] = atomic_write(folder / "rate_error.png", lambda f: plot_rate_error(records, f), True)
+                                                         family, others))
+    if plots:                                       # one colour and marker per policy in every figure
+        look = styles([r["policy"] for r in records] + [r["policy"] for r in (*summary, *degradation, *others)])
+        paths["rate_error.png"] = atomic_write(folder / "rate_error.png",
+                                               lambda f: plot_rate_error(records, f, summary, look), True)
         if degradation:
             paths["degradation.png"] = atomic_write(folder / "degradation.png",
-                                                    lambda f: plot_degradation(degradation, f), True)
+                                                    lambda f: plot_degradation(degradation, f, look), True)
+        if headline:
+            paths["headline.png"] = atomic_write(folder / "headline.png",
+                                                 lambda f: plot_headline(headline, f, others, look), True)
     paths["results.json"] = atomic_write_text(folder / "results.json", json_text(
         {"meta": meta, "summary": summary, "degradation": degradation, "comparison": list(comparison),
-         "run_groups": list(groups), **({"headline": list(headline)} if headline else {}), "episodes": records}))
+         "run_groups": list(groups), **({"headline": list(headline)} if headline else {}),
+         **({"headline_others": list(others)} if others else {}), "episodes": records}))
     return paths

@@ -14,6 +14,8 @@ probability of improvement) for results over several training seeds.
   a paired bootstrap interval over the seeds (all three flown on the same seeds).
 - :func:`room`: the share of the best causal score that a privileged reference does without, with a
   paired bootstrap interval over the seeds.
+- :func:`ratio`: the ratio of two means of paired values (non-rigid over rigid), with a paired bootstrap
+  interval over the seeds.
 - :func:`iqm` and :func:`probability_of_improvement`: the interquartile mean (``scipy.stats.trim_mean``)
   and the probability of improvement (the Mann-Whitney U statistic over ``m n``, ``scipy.stats.mannwhitneyu``)
   over ``(runs, episodes)`` score matrices, with stratified-bootstrap percentile intervals that resample
@@ -35,7 +37,8 @@ from typing import Any
 import numpy as np
 from scipy import stats
 
-__all__ = ["PairedResult", "bootstrap_ci", "iqm", "normalised", "paired", "probability_of_improvement", "room"]
+__all__ = ["PairedResult", "bootstrap_ci", "iqm", "normalised", "paired", "probability_of_improvement", "ratio",
+           "room"]
 
 LEVEL = 0.95
 REPS = 2000
@@ -143,6 +146,23 @@ def room(best: Sequence[float], reference: Sequence[float], level: float = LEVEL
     ok = bs > 0.0
     lo, hi = _percentile_interval((bs[ok] - rs[ok]) / bs[ok], level) if ok.any() else (math.nan, math.nan)
     return value, lo, hi
+
+
+def ratio(a: Sequence[float], b: Sequence[float], level: float = LEVEL, reps: int = REPS,
+          seed: int = 0) -> tuple[float, float, float]:
+    """``(value, low, high)``: ``mean(a) / mean(b)`` of values flown on the same seeds (``a[i]`` and ``b[i]``
+    seed i's), with the percentile interval of the same ratio over ``reps`` resamplings of the seeds (both
+    values of a seed kept together). NaNs when ``mean(b)`` is not positive."""
+    x, y = (np.asarray(v, dtype=float) for v in (a, b))
+    if not x.shape == y.shape or x.ndim != 1 or x.size == 0:
+        raise ValueError(f"paired values of shapes {x.shape} and {y.shape}: one value per common seed each")
+    if not y.mean() > 0.0:
+        return math.nan, math.nan, math.nan
+    idx = np.random.default_rng(seed).integers(0, x.size, (reps, x.size))
+    xs, ys = x[idx].mean(axis=1), y[idx].mean(axis=1)
+    ok = ys > 0.0
+    lo, hi = _percentile_interval(xs[ok] / ys[ok], level) if ok.any() else (math.nan, math.nan)
+    return float(x.mean() / y.mean()), lo, hi
 
 
 def _matrix(scores: Any) -> np.ndarray:

@@ -16,8 +16,8 @@ from typing import Any
 from .metrics import rank
 from .scoring import PHASES
 
-__all__ = ["comparison_table", "degradation_table", "flyability_table", "markdown_table", "phase_table",
-           "run_groups_table", "summary_table"]
+__all__ = ["comparison_table", "degradation_table", "flyability_table", "headline_table", "markdown_table",
+           "others_table", "phase_table", "run_groups_table", "summary_table"]
 
 Row = Mapping[str, Any]
 
@@ -99,29 +99,61 @@ def flyability_table(summary: Sequence[Row]) -> list[str]:
     return out
 
 
-def _headline_cell(cell: Mapping[str, Any] | None, named: bool = True) -> str:
+def _headline_cell(cell: Mapping[str, Any] | None, named: bool = True, none_flyable: bool = False) -> str:
     if not cell:
-        return "-"
+        return "none flyable" if none_flyable else "-"
     failed = round(cell["failed_or_unflyable"] * cell["n"])
     who = f"`{cell['policy']}` " if named else ""
     return f"{who}{_interval(cell['mean'], cell['low'], cell['high'], '.3f')}, {failed}/{cell['n']}"
 
 
+def _room(h: Row, of: str | None) -> str:
+    if not math.isfinite(h["room"]):
+        return "-"
+    text = f"{100.0 * h['room']:.0f} % [{100.0 * h['room_low']:.0f}, {100.0 * h['room_high']:.0f}]"
+    return f"{text} of `{of}`" if of else text
+
+
+def _where(h: Row) -> str:
+    cond = h.get("condition", "")
+    return cond.rsplit("/", 1)[0] if "/" in cond else h["suite"]          # a family suite: the vehicle
+
+
+#: the note under the headline when a kind had no flyable policy
+NONE_FLYABLE_NOTE = ("none flyable: every such policy the suite reports failed or was unflyable on more than half "
+                     "its flights (its rows in the suite's flyability table); none of them is named best")
+
+
 def headline_table(headline: Sequence[Row]) -> list[str]:
-    """Lines of protocol v2's headline (:func:`~.headline.headline`): per suite and model the best causal
-    classical, the best learned and the privileged ``score_v2`` (mean [95 % CI], failed or unflyable of the
-    seeds) and the room with its interval; none without rows."""
+    """Lines of protocol v2's headline (:func:`~.headline.headline`): per suite and model the best classical
+    design the suite reports, the best learned policy and the privileged ``score_v2`` (mean [95 % CI], failed
+    or unflyable of the seeds) and the room with its interval; "none flyable" (and a note under the table) for
+    a kind whose every policy failed or was unflyable on more than half its flights; none without rows."""
     if not headline:
         return []
     out = ["| suite | model | best causal classical | best learned | privileged reference | room [95 % CI] of the best causal |",
            "|---|---|---|---|---|---:|"]
     for h in headline:
-        room = "-" if not math.isfinite(h["room"]) else (
-            f"{100.0 * h['room']:.0f} % [{100.0 * h['room_low']:.0f}, {100.0 * h['room_high']:.0f}] of `{h['causal']}`")
-        cond = h.get("condition", "")
-        where = cond.rsplit("/", 1)[0] if "/" in cond else h["suite"]          # a family suite: the vehicle
-        out.append(f"| {where} | {h['model']} | {_headline_cell(h['classical'])} | {_headline_cell(h['learned'])} "
-                   f"| {_headline_cell(h['privileged'])} | {room} |")
+        gone = h.get("none_flyable", "").split()
+        out.append(f"| {_where(h)} | {h['model']} | {_headline_cell(h['classical'], none_flyable='classical' in gone)} "
+                   f"| {_headline_cell(h['learned'], none_flyable='learned' in gone)} "
+                   f"| {_headline_cell(h['privileged'])} | {_room(h, h['causal'])} |")
+    if any(h.get("none_flyable") for h in headline):
+        out += ["", NONE_FLYABLE_NOTE]
+    return out
+
+
+def others_table(others: Sequence[Row]) -> list[str]:
+    """Lines of the headline's table of the other policies flown (:func:`~.headline.others`: a user's), with
+    the headline's columns: per suite, model and policy its ``score_v2`` (mean [95 % CI], failed or unflyable
+    of the seeds), the privileged reference and its room against it; none without rows."""
+    if not others:
+        return []
+    out = ["| suite | model | policy | kind | score_v2 [rad] [95 % CI], failed or unflyable | privileged reference "
+           "| room [95 % CI] against the reference |", "|---|---|---|---|---|---|---:|"]
+    for o in others:
+        out.append(f"| {_where(o)} | {o['model']} | `{o['policy']}` | {o['kind']} | {_headline_cell(o, named=False)} "
+                   f"| {'`' + o['reference'] + '`' if o.get('reference') else '-'} | {_room(o, None)} |")
     return out
 
 
@@ -210,12 +242,14 @@ def _section(title: str, lines: list[str]) -> list[str]:
 
 def markdown_table(summary: Sequence[Row], degradation: Sequence[Row], meta: Mapping[str, Any] | None = None,
                    comparison: Sequence[Row] = (), groups: Sequence[Row] = (), headline: Sequence[Row] = (),
-                   family: Sequence[str] = ()) -> str:
+                   family: Sequence[str] = (), others: Sequence[Row] = ()) -> str:
     """The comparison as Markdown: a family suite's table over its vehicles (``family``: the lines of
     :func:`~.family.family_table`, when given), protocol v2's headline over every suite (:func:`headline_table`,
-    when ``headline`` has rows; a family suite's rows named by their vehicle's group), then per suite: the ranked summary (:func:`summary_table`), the rate
-    error per phase (:func:`phase_table`), the degradation (:func:`degradation_table`), the paired
-    comparison (:func:`comparison_table`) and the agents over training runs (:func:`run_groups_table`)."""
+    when ``headline`` has rows; a family suite's rows named by their vehicle's group) and the other policies
+    flown beside it (``others``: :func:`others_table`, when given), then per suite: the ranked summary
+    (:func:`summary_table`), the rate error per phase (:func:`phase_table`), the degradation
+    (:func:`degradation_table`), the paired comparison (:func:`comparison_table`) and the agents over training
+    runs (:func:`run_groups_table`)."""
     meta = dict(meta or {})
     out: list[str] = []
     if family:                                      # a family suite's vehicles gathered (:mod:`.family`)
@@ -224,9 +258,14 @@ def markdown_table(summary: Sequence[Row], degradation: Sequence[Row], meta: Map
                 "unflyable flight of the vehicle. Per vehicle: the tables below.", "", *family, ""]
     if headline:
         out += ["### Headline (protocol v2)", "", "score_v2 [rad] (lower is better): mean [95 % CI], failed or "
-                "unflyable of the seeds; the room is the best causal policy's score minus the privileged "
-                "reference's, of the former, on the same seeds (under 10 %: solved by design)", "",
+                "unflyable of the seeds; the best of a kind among the policies the suite reports, never one failed "
+                "or unflyable on more than half its flights; the room is the best causal policy's score minus the "
+                "privileged reference's, of the former, on the same seeds (under 10 %: solved by design)", "",
                 *headline_table(headline), ""]
+    if others:
+        out += ["### Other policies beside the headline (protocol v2)", "", "Policies flown that the suite does "
+                "not report (yours): score_v2 [rad] as in the headline; the room is the policy's score minus the "
+                "privileged reference's, of the former, on the same seeds", "", *others_table(others), ""]
     for suite in _suites(summary):
         rows = _of_suite(summary, suite)
         info = meta.get("suites", {}).get(suite, {}) if isinstance(meta.get("suites"), Mapping) else {}

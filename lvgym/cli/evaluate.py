@@ -18,16 +18,22 @@ observations) or of ``train.py`` run folders, or your own policy: ``module:facto
 ``name``, ``reset()`` and ``act(observation, info)``; the file is loaded by path in every worker and needs
 no ``__main__`` guard); ``label=...`` in front names any of them in the tables. Without ``--policies`` each
 suite flies the policies its protocol reports on it (``Suite.policies``; :data:`DEFAULT_POLICIES` for a v0
-or v1 suite). Suites are names of ``lvgym.benchmark.SUITES``; the default is protocol v2's five
-(:data:`DEFAULT_SUITES`), or its main suite ``smile-v2`` when ``--policies`` is given. Episodes
+or v1 suite); with them, a suite that reports policies (protocol v2's) flies its reported classical designs
+and its privileged reference beside them, so that the headline names its best classical design and gives
+each of yours a row with its room against the reference (``--only``: the given policies alone; with
+``--vehicle`` too, since the shipped designs are made for the shipped vehicles). Suites are names of
+``lvgym.benchmark.SUITES``; the default is protocol v2's five (:data:`DEFAULT_SUITES`), or its main suite
+``smile-v2`` when ``--policies`` is given. Episodes
 run on a local process pool by default; the Markdown table is printed, and CSV, JSON, the table and PNG
 plots go to ``--out`` (each file written atomically: an interrupted run leaves no half-written file).
 ``--seed-set validation`` evaluates on the training seeds; reported numbers use the ``test`` seeds (the
 default).
 
 The tables (every mean with its 95 % bootstrap interval over the seeds, lower is better): for protocol v2,
-first the headline over every suite (the best causal classical, the best learned and the privileged
-``score_v2`` and the room between them, :mod:`lvgym.benchmark.headline`); then per suite:
+first the headline over every suite (the best classical design the suite reports, the best learned policy
+and the privileged ``score_v2`` and the room between them, never naming a policy failed or unflyable on
+more than half its flights, :mod:`lvgym.benchmark.headline`) and a row for each other policy flown (yours)
+with its room against the reference; then per suite:
   1. summary: condition x policy, ranked by failure rate, then by score (the rate error plus, for a failed
      episode, the env's failure penalty for the mission left), with the rate error, CVaR10, max rate,
      effort, max alpha and q-alpha;
@@ -48,15 +54,15 @@ from __future__ import annotations
 import datetime as dt
 import sys
 import time
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 from typing import Any
 
-from lvgym.benchmark import (DEFAULT_SUITE, EXECUTORS, SEED_SETS, SUITES, PolicySpec, compare,
+from lvgym.benchmark import (DEFAULT_SUITE, EXECUTORS, SEED_SETS, SUITES, PolicySpec, Suite, compare,
                              degradation, evaluate, get_suite, markdown_table, normalise, protocol_metric,
                              run_groups, summarize, write_results)
 from lvgym.benchmark.family import family_room, family_rows, family_table
-from lvgym.benchmark.headline import headline, policy_kind
+from lvgym.benchmark.headline import headline, others, policy_kind
 from lvgym.cli.policies import POLICIES, resolve_policy  # (registers the built-in policies)
 from lvgym.errors import ConfigError
 from lvgym.parallel import TaskFailed, exit_on_sigterm
@@ -65,8 +71,8 @@ from . import fail
 from .args import arg, command_name, parse
 from .flights import check_vehicle
 
-__all__ = ["Args", "DEFAULT_EPISODES", "DEFAULT_POLICIES", "DEFAULT_SUITE", "DEFAULT_SUITES", "POLICIES", "main", "parse_args",
-           "resolve_policy"]
+__all__ = ["Args", "BESIDE_KINDS", "DEFAULT_EPISODES", "DEFAULT_POLICIES", "DEFAULT_SUITE", "DEFAULT_SUITES",
+           "POLICIES", "main", "parse_args", "resolve_policy", "suite_policies"]
 
 PROG = "evaluate.py"
 #: the policies of a suite that names none (v0, v1): no control, the rigid-designed gs-pid (the thesis's
@@ -77,6 +83,8 @@ DEFAULT_POLICIES = ["zero", "gs-pid", "gs-pid-flex", "lqg", "lqg-front", "aac", 
 DEFAULT_SUITES = ["smile-v2", "smile-v2-maxq-gust", "smile-v2-faults", "stratos-tvc-v2", "slender-v2"]
 #: episodes per condition and policy of the default run
 DEFAULT_EPISODES = 50
+#: the kinds of a suite's reported policies flown beside a user's ``--policies`` (unless ``--only``)
+BESIDE_KINDS = ("classical", "privileged")
 #: the longest episode an env takes (``lvgym.envs.TaskSpec.mission_time_s``) [s]
 MAX_MISSION_TIME_S = 3600.0
 
@@ -88,7 +96,11 @@ class Args:
     policies: list[str] | None = arg(None, metavar="POLICY")
     """registered policy names (zero, pid, gs-pid, gs-pid-flex, lqg, aac, ppo-res-lqg, ...), module:factory,
     path/to/file.py:factory, paths of stable-baselines3 .zip models or train.py run folders (runs/<name>: its
-    best model); label=... in front names any of them (default: each suite's own, Suite.policies)"""
+    best model); label=... in front names any of them (default: each suite's own, Suite.policies; given, a v2
+    suite's reported classical designs and privileged reference fly beside them unless --only)"""
+    only: bool = False
+    """fly only the given --policies, not the suite's reported classical designs and privileged reference
+    beside them"""
     suites: list[str] | None = arg(None, metavar="SUITE", choices=lambda: sorted(SUITES))
     """suite names of the protocol (default: protocol v2's suites; with --policies, its main suite smile-v2,
     since a policy made for one vehicle flies no other)"""
@@ -129,8 +141,26 @@ def _unique(specs: list[PolicySpec]) -> list[PolicySpec]:
     out = []
     for s in specs:
         seen[s.name] = seen.get(s.name, 0) + 1
-        out.append(s if seen[s.name] == 1 else PolicySpec(f"{s.name}-{seen[s.name]}", s.factory, s.kwargs))
+        out.append(s if seen[s.name] == 1 else replace(s, name=f"{s.name}-{seen[s.name]}"))
     return out
+
+
+def suite_policies(suite: Suite, given: list[PolicySpec] | None, only: bool = False,
+                   vehicle: str | None = None, prog: str = PROG) -> tuple[list[PolicySpec], list[str]]:
+    """The policies ``suite`` flies and the labels of those it reports (``Suite.policies``, each flown as
+    registered under its own name). Without ``given``: its reported ones (:data:`DEFAULT_POLICIES` for a v0
+    or v1 suite); with them: ``given``, then the reported policies of a kind of :data:`BESIDE_KINDS` whose
+    label ``given`` lacks, unless ``only`` or ``vehicle`` (the shipped designs fly the shipped vehicles)."""
+    reported = {n: resolve_policy(n, prog) for n in suite.policies}
+    if given is None:
+        specs = [reported[n] for n in suite.policies] or [resolve_policy(n, prog) for n in DEFAULT_POLICIES]
+    else:
+        specs = list(given)
+        if not (only or vehicle is not None):
+            labels = {p.name for p in specs}
+            specs += [p for n, p in reported.items() if n not in labels and policy_kind(p) in BESIDE_KINDS]
+    specs = _unique(specs)
+    return specs, [p.name for p in specs if reported.get(p.name) == p]
 
 
 def main(argv: list[str] | None = None) -> dict[str, Any]:
@@ -147,9 +177,10 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
         suites = [get_suite(n) for n in args.suites]
     except ValueError as exc:
         fail(prog, exc)
-    names = {s.name: args.policies or list(s.policies) or DEFAULT_POLICIES for s in suites}
-    resolved = {n: resolve_policy(n, prog) for n in dict.fromkeys(n for v in names.values() for n in v)}
-    per_suite = {s: _unique([resolved[n] for n in v]) for s, v in names.items()}
+    given = [resolve_policy(n, prog) for n in args.policies] if args.policies else None
+    chosen = {s.name: suite_policies(s, given, args.only, args.vehicle, prog) for s in suites}
+    per_suite = {s: v[0] for s, v in chosen.items()}
+    reported = {s: v[1] for s, v in chosen.items() if get_suite(s).policies}
     policies = list({p.name: p for v in per_suite.values() for p in v}.values())
     if args.reference is not None and args.reference not in [p.name for p in policies]:
         raise SystemExit(f"{prog}: --reference = {args.reference!r}: one of the policy labels "
@@ -176,7 +207,9 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
         metric = protocol_metric(of_suite)
         comparison += compare(of_suite, [r for r in summary if r["suite"] == name], metric, args.reference)
         groups += run_groups(of_suite, metric)
-    rows = headline(summary, records, {p.name: policy_kind(p) for p in policies})
+    kinds = {p.name: policy_kind(p) for p in policies}
+    rows = headline(summary, records, kinds, reported)
+    beside = others(summary, records, kinds, reported)
     meta = {
         "protocol": ", ".join(sorted({s.version for s in suites})), "seed_set": args.seed_set,
         "episodes": args.episodes, "args": asdict(args),
@@ -189,16 +222,16 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
         "wall_time_s": round(wall, 3), "created_utc": dt.datetime.now(dt.timezone.utc).isoformat(timespec="seconds"),
     }
     family = family_rows(records)                   # a family suite: its vehicles gathered
-    family_lines = family_table(family, family_room(records, {p.name: policy_kind(p) for p in policies})) \
-        if family else []
-    table = markdown_table(summary, deg, meta, comparison, groups, rows, family_lines)
+    family_lines = family_table(family, family_room(records, kinds)) if family else []
+    table = markdown_table(summary, deg, meta, comparison, groups, rows, family_lines, beside)
     paths = write_results(args.out, records, summary, deg, meta, plots=args.plots, comparison=comparison,
-                          groups=groups, headline=rows, family=family_lines)
+                          groups=groups, headline=rows, family=family_lines, others=beside)
     print(table)
     print(f"{len(records)} episodes in {wall:.1f} s ({args.executor}); results in {Path(args.out)}/: "
           f"{', '.join(sorted(paths))}", file=sys.stderr)
     return {"records": records, "summary": summary, "degradation": deg, "comparison": comparison,
-            "run_groups": groups, "headline": rows, "meta": meta, "table": table, "family": family}
+            "run_groups": groups, "headline": rows, "headline_others": beside, "meta": meta, "table": table,
+            "family": family}
 
 
 if __name__ == "__main__":
