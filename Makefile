@@ -29,7 +29,7 @@ bench: $(STAMP)
 
 # rollouts of every classical baseline and shipped learned policy on every v2 suite, as Minari datasets
 # (validation seeds; into MINARI_DATASETS_PATH, default ~/.minari/datasets): the data offline RL starts from
-# (docs/training.md)
+# (docs/datasets.md)
 DATASET_SUITES ?= smile-v2 smile-v2-maxq-gust smile-v2-faults stratos-tvc-v2 slender-v2
 DATASET_EPISODES ?= 50
 datasets: $(STAMP)

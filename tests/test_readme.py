@@ -29,17 +29,17 @@ SETUP = ("make ", "pip ")
 #: README command -> the options appended to run it in seconds (each a documented option of the command)
 SHORT_EVAL = "--episodes 2 --mission-time-s 5 --executor serial --no-plots --no-progress --out results"
 SHORTEN = {
-    "python train.py --name my-ppo --total-timesteps 2e6":
+    "lvgym train --name my-ppo --total-timesteps 2e6":
         "--total-timesteps 128 --n-envs 2 --hp algo.n_steps=64 algo.batch_size=64 algo.n_epochs=1 "
         "policy.net_arch=[8,8] --env-kwargs mission_time_s=2 controller_on_after_s=0.2 --checkpoint-freq 128 "
         "--eval-episodes 1 --eval-mission-time-s 0.5 --no-progress",
-    "python evaluate.py --policies runs/my-ppo lqg gs-pid-flex": SHORT_EVAL,
-    "python train.py --suite smile-v2-faults --name my-faults":
+    "lvgym evaluate --policies runs/my-ppo lqg gs-pid-flex": SHORT_EVAL,
+    "lvgym train --suite smile-v2-faults --name my-faults":
         "--total-timesteps 128 --n-envs 2 --hp algo.n_steps=64 algo.batch_size=64 algo.n_epochs=1 "
         "policy.net_arch=[8,8] --env-kwargs mission_time_s=2 controller_on_after_s=0.2 --checkpoint-freq 128 "
         "--eval-episodes 1 --eval-mission-time-s 0.5 --no-progress",
     "lvgym campaign agents/campaigns/v2_faults_gust.yaml --dry-run": "",
-    "python evaluate.py --policies my_policy.py:make lqg-front": SHORT_EVAL,
+    "lvgym evaluate --policies my_policy.py:make lqg-front": SHORT_EVAL,
     "cp lvgym/vehicles/smile_v1.yaml my_rocket.yaml": "",
     "lvgym design pid-flex --vehicle smile": "--times 28.8 --starts 0",
     "lvgym design lqg --vehicle smile": "--rows 28.8",
@@ -101,7 +101,7 @@ def test_fly_an_env():
 
 
 def test_train_then_evaluate(tmp_path):
-    """The train-then-evaluate quick start: a tiny run, then evaluate.py on its folder and two baselines."""
+    """The train-then-evaluate quick start: a tiny run, then lvgym evaluate on its folder and two baselines."""
     train, evaluate = _sh(2)[:2]
     _run(train, tmp_path)
     assert (tmp_path / "runs" / "my-ppo" / "config.yaml").exists()

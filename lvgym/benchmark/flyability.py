@@ -23,7 +23,7 @@ score_v2                    rad     the v2 headline: ``score`` for a flyable fli
                                     ``failure_penalty_rad_per_s`` times the mission time left
 ==========================  ======  =================================================================
 
-The rule (docs/benchmark.md, "Flyability (protocol v2)", has the reasons and the sources):
+The rule (docs/flyability.md has the reasons and the sources):
 
 - **budget**: ``cmd_rate_rms <= RMS_FRACTION`` (1/3): the rate limit is at least three standard deviations of
   the commanded rate (a Gaussian command exceeds it in 0.27 % of the steps). It breaks when the running sum

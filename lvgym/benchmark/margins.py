@@ -1,5 +1,5 @@
 """Time-domain margins of any policy in the nonlinear simulation: gain margins up and down [dB] and the
-delay margin [ms] (docs/benchmark.md, "Time-domain margins").
+delay margin [ms] (docs/metrics.md, "Time-domain margins").
 
     lvgym margins                                          # the default policies on smile-v1, 5 test seeds
     lvgym margins --policies zero pid gs-pid ppo --seeds 10 --models rigid

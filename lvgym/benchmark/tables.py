@@ -277,7 +277,7 @@ def markdown_table(summary: Sequence[Row], degradation: Sequence[Row], meta: Map
                 "penalty for the mission left); means with 95 % bootstrap intervals over the seeds.", "",
                 *summary_table(rows)]
         out += _section(f"Flyability ({suite}, protocol v2): the rank is by failed or unflyable (the commanded "
-                        "gimbal rate over the rate limit, docs/benchmark.md), then by score_v2 (an unflyable "
+                        "gimbal rate over the rate limit, docs/flyability.md), then by score_v2 (an unflyable "
                         "flight charged as a failure from the breach)", flyability_table(rows))
         out += _section(f"Cumulative pitch + yaw rate error per flight phase ({suite}): boost to max q, the max-q "
                         "region, the staging coast, the upper stage; the phases add up to the total",

@@ -46,7 +46,7 @@ with its room against the reference; then per suite:
      wins/ties/losses, Wilcoxon and t p-values, the IQM and the probability of improvement
      (:mod:`lvgym.benchmark.stats`);
   5. agents over training runs (policies labelled ``<agent>-s<seed>``): the IQM over the runs.
-docs/benchmark.md defines every metric.
+docs/metrics.md defines every metric.
 """
 
 from __future__ import annotations
