@@ -7,8 +7,8 @@ Per env row and episode: a gain ``k = 10 ** (g / 20)`` with ``g`` uniform in ``[
 (``d * control_dt_s`` seconds; 20 ms per period on the v1 envs). The env gets ``k`` times the action the
 policy (or, with ``--residual``, the residual's baseline plus the learned part) gave ``d`` periods
 earlier, the neutral action (zeros) before that, and clips it to its action space as it clips any
-action, exactly as the margins command's :class:`~lvgym.benchmark.perturb.GainPolicy` and
-:class:`~lvgym.benchmark.perturb.ActuatorDelay` do (the latter also has a sub-period part, through the
+action, exactly as the margins command's gain (:func:`lvgym.benchmark.rows.scaled`) and delay
+(:class:`lvgym.benchmark.rows.RowDelay`) do (the latter also has a sub-period part, through the
 servo's delay; training uses whole periods only). The dispersion is a training device, like the
 ``--randomize`` dispersions: validation and evaluation fly the nominal loop.
 

@@ -24,8 +24,8 @@ from lvgym.packing import Field, Packed, is_offsets, offsets_layout
 KERNEL_MODULES = ["lvgym.dynamics.kernels", "lvgym.dynamics.stepper", "lvgym.dynamics.invariants",
                   "lvgym.simulator.advance", "lvgym.simulator.flight", "lvgym.simulator.servo", "lvgym.simulator.strips",
                   "lvgym.simulator.imu", "lvgym.simulator.timeline", "lvgym.simulator.piece", "lvgym.envs.signals",
-                  "lvgym.envs.flightcomputer", "lvgym.baselines.pidkernel", "lvgym.baselines.aacbatch",
-                  "lvgym.baselines.lqgkernel"]
+                  "lvgym.envs.flightcomputer", "lvgym.baselines.pidkernel", "lvgym.baselines.aackernel",
+                  "lvgym.baselines.lqgkernel", "lvgym.baselines.mpckernel", "lvgym.agents.mlp"]
 #: a component index added to an offset whose field size the check cannot see (a local name): a quaternion's
 _COMPONENT = 4
 

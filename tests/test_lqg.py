@@ -175,7 +175,7 @@ def test_bad_inputs_raise_clear_errors(tmp_path):
 
 
 def test_a_batch_of_rows_is_the_policy_of_each_row():
-    """LQGBatch steps n rows together (what a residual's baselines in training use); each row's actions
+    """LQGLaw steps n rows together (what a residual's baselines in training use); each row's actions
     equal an LQGPolicy's flying the same inputs to the bit, with the rows at different flight times
     (other schedule rows, the boost and the upper stage at once), switched off through a coast, reset at
     different steps and stepped in changing subsets."""

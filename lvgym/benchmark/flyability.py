@@ -140,7 +140,7 @@ def v2_score(rate_error_radps: np.ndarray, time_s: np.ndarray, dt: float, score:
 def flyability_metrics(facts: Any, columns: Any, record: dict[str, Any]) -> dict[str, Any]:
     """The v2 fields of one flight: :func:`command_metrics` of ``columns`` (a :class:`~.scoring.FlightColumns`
     with ``command_rad`` and ``controller_on``) and ``score_v2`` (:func:`v2_score`, from ``record``'s v1
-    ``score``); ``facts``: the :class:`~.scoring.FlightLog` of the task's facts."""
+    ``score``); ``facts``: the task's :class:`~.scoring.FlightFacts`."""
     dt = float(facts.dt_s)
     t = np.asarray(columns.time_s, dtype=float)
     on = columns.controller_on if columns.controller_on is not None else np.ones(len(t), dtype=bool)

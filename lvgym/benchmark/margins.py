@@ -6,8 +6,8 @@ delay margin [ms] (docs/metrics.md, "Time-domain margins").
     lvgym margins --policies runs/ppo_smile --physics-dt-s 0.005   # 5 ms delay resolution
 
 
-Between the policy and the actuator a multiplicative gain ``k`` (:class:`~.perturb.GainPolicy`), and
-separately a pure delay (:class:`~.perturb.ActuatorDelay`, in whole physics steps), are raised, per seed,
+Between the policy and the actuator a multiplicative gain ``k`` (:func:`~.rows.scaled`), and
+separately a pure delay (:class:`~.rows.RowDelay`, in whole physics steps), are raised, per seed,
 outwards from the nominal in doubling steps and then by bisection (:func:`~.perturb.find_threshold`),
 until the episode leaves the bound (:func:`verdict`): it fails (any failure of the metrics), its
 cumulative pitch + yaw rate error ``rate_error_rad`` exceeds ``error_ratio`` (default 2) times that of the
