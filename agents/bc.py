@@ -26,7 +26,7 @@ from typing import Any
 
 import numpy as np
 
-from lvgym.cli.args import arg, parse
+from lvgym.commandline import arg, parse
 from lvgym.errors import ConfigError
 
 __all__ = ["BCPolicy", "features", "policy", "train"]

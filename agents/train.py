@@ -43,8 +43,7 @@ from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 from typing import Any
 
-from lvgym.cli import fail
-from lvgym.cli.args import arg, command_name, parse_given
+from lvgym.commandline import arg, command_name, fail, parse_given
 from lvgym.errors import ConfigError
 from lvgym.parallel import exit_on_sigterm
 

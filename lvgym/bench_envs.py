@@ -55,7 +55,7 @@ import gymnasium as gym
 import numpy as np
 
 import lvgym  # noqa: F401  (registers the envs)
-from lvgym.cli.args import arg, parse
+from lvgym.commandline import arg, parse
 from lvgym.envs import make_sb3_vec_env
 
 #: the env measured for each protocol (``--protocol``)

@@ -27,7 +27,7 @@ from lvgym.baselines.batch import row_info
 from lvgym.benchmark.registry import POLICIES
 from lvgym.benchmark.runner import build_policy
 from lvgym.benchmark.suites import SUITES
-from lvgym.cli.args import arg, parse
+from lvgym.commandline import arg, parse
 
 __all__ = ["POLICY_NAMES", "record", "replay", "time_policy"]
 

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from lvgym.cli.args import arg, parse
+from lvgym.commandline import arg, parse
 
 
 @dataclass

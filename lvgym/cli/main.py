@@ -18,7 +18,7 @@ from __future__ import annotations
 import sys
 from collections.abc import Sequence
 
-from .args import Command, dispatch
+from lvgym.commandline import Command, dispatch
 
 __all__ = ["COMMANDS", "main"]
 

@@ -278,8 +278,7 @@ class Args:
 def main(argv: list[str] | None = None) -> None:
     """``python -m lvgym.vehicle.slender``: print the vehicle file of the factors (the defaults:
     ``lvgym/vehicles/slender.yaml``)."""
-    from lvgym.cli import fail
-    from lvgym.cli.args import command_name, parse
+    from lvgym.commandline import command_name, fail, parse
 
     prog = "python -m lvgym.vehicle.slender"
     args = parse(Args, argv, prog, "Print the YAML vehicle file of the parametric slender vehicle (thesis 6.1-6.2).")

@@ -46,7 +46,7 @@ from typing import Any
 
 import numpy as np
 
-from lvgym.cli.args import arg, parse
+from lvgym.commandline import arg, parse
 from lvgym.environment import make
 from lvgym.errors import require
 from lvgym.simulator import EnvironmentSpec, LaunchSpec, Simulator, TimelineSpec

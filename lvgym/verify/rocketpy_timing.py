@@ -29,7 +29,7 @@ import tempfile
 import time
 from dataclasses import dataclass, replace
 
-from lvgym.cli.args import arg, parse
+from lvgym.commandline import arg, parse
 from lvgym.simulator.cache import using
 from lvgym.vehicle import clear_vehicle_cache
 
