@@ -177,7 +177,7 @@ def test_the_console_script_has_every_command_with_its_help(capsys):
     listed = [line.split("  ")[1] for line in capsys.readouterr().out.splitlines() if line.startswith("  ")]
     expected = ["evaluate", "train", "campaign", "margins", "fingerprint", "verify", "verify rocketpy", "verify rocketpy-timing",
                 "bench", "bench-envs", "studies", "render", "export-policy", "dataset", "bc", "design pid", "design pid-flex",
-                "design lqg", "design pd-relief", "design charts", "design auto"]
+                "design lqg", "design pd-relief", "design charts", "design auto", "vehicle beam", "vehicle slender"]
     assert listed == expected
     for name in expected:
         with pytest.raises(SystemExit) as exc:

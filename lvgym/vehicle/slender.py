@@ -261,7 +261,7 @@ def slender_yaml(**parameters: Any) -> str:
 
 @dataclass
 class Args:
-    """Command-line arguments (``python -m lvgym.vehicle.slender --help``): the thesis's five factors."""
+    """Command-line arguments (``lvgym vehicle slender --help``): the thesis's five factors."""
 
     length: float = 8.5
     """overall length L [m], in [3, 30]"""
@@ -276,8 +276,8 @@ class Args:
 
 
 def main(argv: list[str] | None = None) -> None:
-    """``python -m lvgym.vehicle.slender``: print the vehicle file of the factors (the defaults:
-    ``lvgym/vehicles/slender.yaml``)."""
+    """``lvgym vehicle slender`` (``python -m lvgym.vehicle.slender``): print the vehicle file of the factors
+    (the defaults: ``lvgym/vehicles/slender.yaml``)."""
     from lvgym.commandline import command_name, fail, parse
 
     prog = "python -m lvgym.vehicle.slender"
