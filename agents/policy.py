@@ -77,7 +77,7 @@ def resolve_model_path(path: str | Path) -> Path:
     model, its final model or its latest checkpoint (``FileNotFoundError`` otherwise)."""
     p = Path(path)
     if p.is_dir():
-        from lvgym.agents.callbacks import latest_checkpoint
+        from lvgym.agents.checkpoints import latest_checkpoint
 
         for stem in ("best_model", "final_model"):
             if (p / f"{stem}.zip").is_file() and (p / f"{stem}.json").is_file():

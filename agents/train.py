@@ -275,8 +275,8 @@ def train(argv: list[str] | None = None) -> Path:
 def _train(args: Args, given: set[str], stop: Any, t0: float) -> Path:
     import torch
 
-    from lvgym.agents.callbacks import (CheckpointCallback, ValidationEvaluator, clean_incomplete, latest_checkpoint,
-                                        load_replay_buffer, load_rng)
+    from lvgym.agents.callbacks import CheckpointCallback, ValidationEvaluator, load_replay_buffer, load_rng
+    from lvgym.agents.checkpoints import clean_incomplete, latest_checkpoint
     from lvgym.agents.config import ALGOS, algo_class, build_config
     from lvgym.agents.policy import policy_files, privileged_env_options
     from lvgym.agents.progress import ProgressBarCallback, ProgressLineCallback

@@ -44,7 +44,8 @@ import yaml
 
 from lvgym.errors import ConfigError
 
-from .config import Vehicle, parse_vehicle
+from .config import parse_vehicle
+from .definition import Vehicle
 from .sections import MATERIALS, tube_area
 
 __all__ = ["DEFAULTS", "TABLE_6_3", "WALL_THICKNESS", "SlenderGeometry", "slender_mapping", "slender_vehicle",
@@ -166,7 +167,7 @@ def slender_mapping(length: float = 8.5, diameter: float = 0.3, fill: float = 1.
 
 def slender_vehicle(length: float = 8.5, diameter: float = 0.3, fill: float = 1.0, mass_flow: float = 30.0,
                     slosh_damping: float = 0.5, **options: Any) -> Vehicle:
-    """The slender vehicle as a checked :class:`~lvgym.vehicle.config.Vehicle`.
+    """The slender vehicle as a checked :class:`~lvgym.vehicle.definition.Vehicle`.
 
     ``length`` [m], ``diameter`` [m], ``fill`` [-], ``mass_flow`` [kg/s], ``slosh_damping`` [-] are
     the factors of Table 6.3; ``options`` are the keyword options of :func:`slender_mapping`
