@@ -1,8 +1,7 @@
 """Command lines for every layer: a command's options declared as a dataclass, its one-line refusals, and
 the subcommands of a console script. Beside the layers: it imports nothing of lvgym but
 :mod:`lvgym.errors`, so the vehicle layer, the envs, the controllers' design tools and the agents declare
-their command lines with it, and the command layer (:mod:`lvgym.cli`, the console script ``lvgym``) runs
-them.
+their command lines with it, and the command layer (the console script ``lvgym``) runs them.
 
 - :mod:`.options`: a command line declared as a dataclass (help from the fields' docstrings, ranges and
   choices on the fields; :func:`arg`, :func:`parse`, :func:`parse_given`, :func:`check_fields`);
