@@ -4,7 +4,8 @@ lvgym envs.
 - :mod:`lvgym.agents.config`: per-env hyperparameters (``agents/hyperparams/<algo>.yaml``) as validated dataclasses;
 - :mod:`lvgym.agents.train`: the training command (``lvgym train``; ``train.py`` at the repository root runs
   it), with :mod:`lvgym.agents.trainsetup` (recipes, env keywords, seeds, the vectorised env);
-- :mod:`lvgym.agents.callbacks`: crash-safe checkpoints, validation on the protocol's validation seeds;
+- :mod:`lvgym.agents.callbacks`: crash-safe checkpoints (named and listed by :mod:`lvgym.agents.checkpoints`),
+  validation on the protocol's validation seeds;
 - :mod:`lvgym.agents.progress`: the progress bar and the progress line;
 - :mod:`lvgym.agents.policy`: :class:`~lvgym.agents.policy.SB3Policy`, a trained model behind the benchmark Policy interface;
 - :mod:`lvgym.agents.residual`: residual policies on a classical baseline (training wrapper and adapter);

@@ -27,7 +27,7 @@ from typing import Any
 import numpy as np
 
 from lvgym.benchmark.batch import BatchLaw, RowFace
-from lvgym.cli.args import arg, parse
+from lvgym.commandline import arg, parse
 from lvgym.errors import ConfigError
 
 from .mlp import MlpNet

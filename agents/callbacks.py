@@ -42,13 +42,13 @@ from lvgym.benchmark.flyability import applies
 from lvgym.benchmark.metrics import summarize
 from lvgym.benchmark.policy import Policy
 from lvgym.benchmark.runner import play_episode
-from lvgym.benchmark.results import atomic_path, atomic_write_text, json_text, remove_stale_temporaries
+from lvgym.benchmark.results import atomic_path, atomic_write_text, json_text
 from lvgym.benchmark.suites import Suite, family_validation_suite, get_suite
 
+from .checkpoints import checkpoint_stem, list_checkpoints
 from .policy import SB3Policy, adapt, copy_policy, policy_files
 from .progress import ProgressBarCallback  # noqa: F401  (its old place)
 
-_STEM = re.compile(r"^step_(\d{12})$")
 #: what a validation's ``score`` is: compared lexicographically, lower is better (older runs' checkpoints
 #: without this key ranked on ``[failure rate, rate error]``)
 SELECTION = "failure_rate, score"
@@ -57,45 +57,6 @@ SELECTION = "failure_rate, score"
 SELECTION_V2 = "failure_rate_v2, score_v2"
 RNG_SUFFIX = "_rng.pkl"
 BUFFER_SUFFIX = "_replay_buffer.pkl"
-
-
-def checkpoint_stem(folder: Path, step: int) -> Path:
-    return folder / f"step_{int(step):012d}"
-
-
-def list_checkpoints(folder: str | Path) -> list[tuple[int, Path]]:
-    """Complete checkpoints (their JSON exists) of ``folder``, oldest first: ``(step, stem)``."""
-    folder = Path(folder)
-    out = []
-    if folder.is_dir():
-        for p in folder.glob("step_*.json"):
-            m = _STEM.match(p.stem)
-            if m and p.with_suffix(".zip").is_file():
-                out.append((int(m.group(1)), p.with_suffix("")))
-    return sorted(out)
-
-
-def latest_checkpoint(folder: str | Path) -> tuple[Path, dict[str, Any]] | None:
-    """``(zip path, state)`` of the newest complete checkpoint of ``folder``, or None."""
-    ckpts = list_checkpoints(folder)
-    if not ckpts:
-        return None
-    stem = ckpts[-1][1]
-    return policy_files(stem)[0], json.loads(policy_files(stem)[2].read_text(encoding="utf-8"))
-
-
-def clean_incomplete(folder: str | Path) -> list[Path]:
-    """Remove the files of checkpoints whose JSON was never written (a run killed while saving) and
-    stale temporaries; returns what was removed."""
-    folder = Path(folder)
-    removed = remove_stale_temporaries(folder)
-    complete = {stem.name for _, stem in list_checkpoints(folder)}
-    for p in sorted(folder.glob("step_*")) if folder.is_dir() else []:
-        stem = p.name[:len("step_") + 12]
-        if _STEM.match(stem) and stem not in complete:
-            p.unlink()
-            removed.append(p)
-    return removed
 
 
 def save_rng(path: Path) -> None:
@@ -474,5 +435,5 @@ def evaluate_saved(path: str | Path, suite: str = "smile-windy", episodes: int =
         ev.close()
 
 
-__all__ = ["CheckpointCallback", "ProgressBarCallback", "SignalStop", "ValidationEvaluator", "checkpoint_stem", "clean_incomplete",
-           "evaluate_saved", "latest_checkpoint", "list_checkpoints", "load_replay_buffer", "load_rng", "save_rng"]
+__all__ = ["CheckpointCallback", "ProgressBarCallback", "SignalStop", "ValidationEvaluator", "evaluate_saved",
+           "load_replay_buffer", "load_rng", "save_rng"]

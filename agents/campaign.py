@@ -52,8 +52,7 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
-from lvgym.cli import fail
-from lvgym.cli.args import arg, command_name, parse
+from lvgym.commandline import arg, command_name, fail, parse
 from lvgym.errors import ConfigError
 from lvgym.parallel import TaskFailed, default_workers, exit_on_sigterm, run_map
 
@@ -312,8 +311,9 @@ def _evaluate_all(campaign: Campaign, executor: str, workers: int | None, progre
     """Every run's and baseline's evaluation records; those not written yet (with these settings) flown now,
     in one evaluation: a run on the suites its configuration flies (:meth:`Campaign.suites_of`: the family's
     informed runs on the informed suite, the others on the rest), a baseline on every suite."""
+    import lvgym.baselines  # noqa: F401  (registers the controllers by name)
     from lvgym.benchmark import evaluate, get_suite
-    from lvgym.cli.policies import resolve_policy
+    from lvgym.benchmark.registry import resolve_policy
 
     from .campaign_compare import evaluation_settings, read_evaluation, write_evaluation
 

@@ -114,7 +114,7 @@ def train_fields() -> dict[str, dataclasses.Field]:
     the flag without its dashes (``max_wall_time`` for ``max_wall_time_s``)."""
     from lvgym.agents.train import Args
 
-    from lvgym.cli.args import _spec
+    from lvgym.commandline.options import _spec
 
     out = {}
     for f in dataclasses.fields(Args):
@@ -125,7 +125,7 @@ def train_fields() -> dict[str, dataclasses.Field]:
 
 
 def _flag(f: dataclasses.Field) -> str:
-    from lvgym.cli.args import _spec
+    from lvgym.commandline.options import _spec
 
     return _spec(f).flag or "--" + f.name.replace("_", "-")
 
@@ -143,7 +143,7 @@ def _option(path: str, f: dataclasses.Field, raw: Any, source: str) -> tuple[Any
     """``raw`` of train option ``f`` (at ``path``) as train.py's value and its command-line words."""
     from lvgym.agents.train import Args
 
-    from lvgym.cli.args import _hints, _kind, _spec, _value
+    from lvgym.commandline.options import _hints, _kind, _spec, _value
 
     kind, spec, flag = _kind(_hints(Args)[f.name]), _spec(f), _flag(f)
     if raw is None:
@@ -319,8 +319,9 @@ def _evaluation(data: Any, source: str) -> Evaluation:
                               f"{sorted(SUITES)}", source)
 
     def baseline(path: str, name: str) -> None:
+        import lvgym.baselines  # noqa: F401  (registers the controllers by name)
         from lvgym.benchmark.headline import policy_kind
-        from lvgym.cli.policies import resolve_policy
+        from lvgym.benchmark.registry import resolve_policy
 
         try:
             spec = resolve_policy(name, "campaign")

@@ -29,11 +29,11 @@ from typing import Any
 
 import numpy as np
 
-import lvgym.cli.policies  # noqa: F401  (registers the built-in policies by name)
+import lvgym.baselines  # noqa: F401  (registers the controllers by name; lvgym.agents, the learned policies)
 from lvgym.benchmark.registry import resolve_policy
 from lvgym.benchmark.runner import build_policy, policy_options
 from lvgym.benchmark.suites import SEED_SETS, condition, get_suite
-from lvgym.cli.args import arg, parse
+from lvgym.commandline import arg, parse
 from lvgym.errors import ConfigError
 
 __all__ = ["NOISE_STREAM", "collect", "dataset_id", "suite_policies"]

@@ -30,7 +30,7 @@ import numpy as np
 
 from lvgym.benchmark.batch import BatchLaw, RowFace
 from lvgym.benchmark.results import atomic_path, atomic_write_text
-from lvgym.cli.args import arg
+from lvgym.commandline import arg
 
 from .config import ALGOS, algo_class, algo_name
 from .mlp import MlpNet
@@ -80,7 +80,7 @@ def resolve_model_path(path: str | Path) -> Path:
     model, its final model or its latest checkpoint (``FileNotFoundError`` otherwise)."""
     p = Path(path)
     if p.is_dir():
-        from lvgym.agents.callbacks import latest_checkpoint
+        from lvgym.agents.checkpoints import latest_checkpoint
 
         for stem in ("best_model", "final_model"):
             if (p / f"{stem}.zip").is_file() and (p / f"{stem}.json").is_file():
@@ -410,8 +410,7 @@ class ExportArgs:
 def export_main(argv: list[str] | None = None) -> None:
     """``lvgym export-policy RUN STEM``: copy a run's policy (best, else final, else latest) to STEM.zip,
     STEM_vecnormalize.pkl and STEM.json."""
-    from lvgym.cli import fail
-    from lvgym.cli.args import command_name, parse
+    from lvgym.commandline import command_name, fail, parse
 
     prog = "python -m lvgym.agents.policy export"
     args = parse(ExportArgs, argv, prog, export_main.__doc__)
@@ -425,7 +424,7 @@ def export_main(argv: list[str] | None = None) -> None:
 
 def main(argv: list[str] | None = None) -> None:
     """``python -m lvgym.agents.policy export RUN STEM`` (``lvgym export-policy RUN STEM``)."""
-    from lvgym.cli.args import Command, dispatch
+    from lvgym.commandline import Command, dispatch
 
     dispatch([Command("export", "lvgym.agents.policy:export_main", "copy a run's policy to STEM.zip, "
                       "STEM_vecnormalize.pkl, STEM.json")], argv, "python -m lvgym.agents.policy")

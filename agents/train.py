@@ -43,8 +43,7 @@ from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 from typing import Any
 
-from lvgym.cli import fail
-from lvgym.cli.args import arg, command_name, parse_given
+from lvgym.commandline import arg, command_name, fail, parse_given
 from lvgym.errors import ConfigError
 from lvgym.parallel import exit_on_sigterm
 
@@ -276,8 +275,8 @@ def train(argv: list[str] | None = None) -> Path:
 def _train(args: Args, given: set[str], stop: Any, t0: float) -> Path:
     import torch
 
-    from lvgym.agents.callbacks import (CheckpointCallback, ValidationEvaluator, clean_incomplete, latest_checkpoint,
-                                        load_replay_buffer, load_rng)
+    from lvgym.agents.callbacks import CheckpointCallback, ValidationEvaluator, load_replay_buffer, load_rng
+    from lvgym.agents.checkpoints import clean_incomplete, latest_checkpoint
     from lvgym.agents.config import ALGOS, algo_class, build_config
     from lvgym.agents.policy import policy_files, privileged_env_options
     from lvgym.agents.progress import ProgressBarCallback, ProgressLineCallback

@@ -107,7 +107,7 @@ def check_options(args: Any) -> None:
     from lvgym.agents.loadmargin import load_margin_options
     from lvgym.agents.loop_dispersion import loop_dispersion_options
     from lvgym.agents.residual import residual_options
-    from lvgym.cli.args import check_fields
+    from lvgym.commandline import check_fields
     from lvgym.envs.spec import RANDOMIZE
 
     check_fields(args)

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .cli.args import arg, parse
+from .commandline import arg, parse
 from .dynamics import NonRigidModel, step_batch, zoh_loads
 
 CONFIGS = (("rigid", 0, 0), ("1 slosh + 1 mode/plane", 1, 1), ("6 slosh + 2 modes/plane", 6, 2))

@@ -28,7 +28,7 @@ process after a warm-up (imports done, Numba's kernels loaded from its disk cach
 cache, so the mass and mode tables are built (a new or dispersed vehicle); **warm**, the same cache folder
 again, the tables read back (:mod:`lvgym.simulator.cache`). Both read the vehicle file and build the
 aerodynamic tables. Cases: the rigid Stratos III simulator of the RocketPy validation (240 s, 4,803 table rows;
-:func:`lvgym.verify.rocketpy_case.lvgym_simulator`) and ``gymnasium.make`` plus ``reset`` of SmileAscent-v0
+:func:`lvgym.verify.rocketpy_flights.lvgym_simulator`) and ``gymnasium.make`` plus ``reset`` of SmileAscent-v0
 (non-rigid, 1,224 rows, modes at lift-off and at the separation), SmileAscent-v1 (modes every 2 s: 33 beam
 eigen-solves), SlenderAscent-v0 (10 s) and SlenderAscent-v1 (6 eigen-solves). A third column, **new
 process**, times a fresh interpreter's ``import lvgym`` and the same start with the tables cached
@@ -55,7 +55,7 @@ import gymnasium as gym
 import numpy as np
 
 import lvgym  # noqa: F401  (registers the envs)
-from lvgym.cli.args import arg, parse
+from lvgym.commandline import arg, parse
 from lvgym.envs import make_sb3_vec_env
 
 #: the env measured for each protocol (``--protocol``)
@@ -195,7 +195,7 @@ def _start(what: str) -> None:
     functional.cached_vehicle.cache_clear()
     functional.cached_timeline.cache_clear()
     if what == "stratos3":
-        from lvgym.verify.rocketpy_case import lvgym_simulator
+        from lvgym.verify.rocketpy_flights import lvgym_simulator
         lvgym_simulator().reset()
     else:
         gym.make(what).reset(seed=0)
@@ -256,7 +256,7 @@ def start():
     functional.cached_vehicle.cache_clear()
     functional.cached_timeline.cache_clear()
     if what == "stratos3":
-        from lvgym.verify.rocketpy_case import lvgym_simulator
+        from lvgym.verify.rocketpy_flights import lvgym_simulator
         lvgym_simulator().reset()
     else:
         gym.make(what).reset(seed=0)

@@ -20,7 +20,7 @@ import pytest
 import torch
 
 import lvgym  # noqa: F401
-from lvgym.agents.callbacks import latest_checkpoint, list_checkpoints
+from lvgym.agents.checkpoints import latest_checkpoint, list_checkpoints
 from lvgym.agents.config import ALGOS, load_config, read_entries
 from lvgym.agents.policy import SB3Policy, load_model
 from lvgym.benchmark.policy import Policy

@@ -283,7 +283,20 @@ def test_thesis_beams_are_uniform_tubes_and_docs_are_current():
         assert row["defl"] == pytest.approx(2.0 / math.sqrt(mpl_t * row["length"]), rel=1e-4)
     doc = (ROOT / "docs" / "structure.md").read_text()
     for line in thesis_comparison_markdown().splitlines():
-        assert line in doc, f"docs/structure.md is stale; regenerate with python -m lvgym.vehicle.beam: {line}"
+        assert line in doc, f"docs/structure.md is stale; regenerate with lvgym vehicle beam: {line}"
+
+
+def test_lvgym_vehicle_beam_prints_the_comparison(capsys):
+    """``lvgym vehicle beam`` prints the comparison table; its first row's tube, by hand: a 2 mm aluminium
+    wall (2770 kg/m^3) of 0.26 m outer diameter and 8.5 m is rho pi (D^2 - (D - 2t)^2) / 4 L = 38.17 kg."""
+    from lvgym.cli.main import main
+
+    assert main(["vehicle", "beam"]) == 0
+    out = capsys.readouterr().out
+    assert out == thesis_comparison_markdown() + "\n"
+    mass = 2770.0 * math.pi * (0.26**2 - 0.256**2) / 4.0 * 8.5
+    assert f"{mass:.2f}" == "38.17"
+    assert "| Table 6.4 | 8.5 | 0.26 | 38.17 | 28.43 |" in out
 
 
 def test_docs_examples_run():

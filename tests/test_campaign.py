@@ -369,7 +369,7 @@ def test_the_evaluation_flies_each_run_on_its_own_suites_and_the_baselines_on_al
     for r in c.runs():
         Path(r.folder).mkdir(parents=True)
         (Path(r.folder) / "final_model.json").write_text("{}")
-    monkeypatch.setattr("lvgym.cli.policies.resolve_policy", lambda ref, prog: ref.split("=")[0])
+    monkeypatch.setattr("lvgym.benchmark.registry.resolve_policy", lambda ref, prog: ref.split("=")[0])
     calls = []
 
     def fake(per_suite, suites, episodes, seed_set, executor, workers, progress):

@@ -1,4 +1,4 @@
-"""The dataclass-to-command-line helper (lvgym.cli.args) and the console script ``lvgym`` (lvgym.cli.main):
+"""The dataclass-to-command-line helper (lvgym.commandline) and the console script ``lvgym`` (lvgym.cli.main):
 help from the fields' docstrings with the defaults, every supported type, the checks declared on a field
 refused in one line before any work, "did you mean" for a mistyped option or command, the subcommands and
 their extras; and that every command line of the project is declared with the helper."""
@@ -13,7 +13,7 @@ from typing import Literal
 
 import pytest
 
-from lvgym.cli.args import Command, arg, build_parser, check_fields, command_name, dispatch, parse, parse_given
+from lvgym.commandline import arg, build_parser, check_fields, Command, command_name, dispatch, parse, parse_given
 from lvgym.errors import ConfigError
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -177,7 +177,7 @@ def test_the_console_script_has_every_command_with_its_help(capsys):
     listed = [line.split("  ")[1] for line in capsys.readouterr().out.splitlines() if line.startswith("  ")]
     expected = ["evaluate", "train", "campaign", "margins", "fingerprint", "verify", "verify rocketpy", "verify rocketpy-timing",
                 "bench", "bench-envs", "studies", "render", "export-policy", "dataset", "bc", "design pid", "design pid-flex",
-                "design lqg", "design pd-relief", "design charts", "design auto"]
+                "design lqg", "design pd-relief", "design charts", "design auto", "vehicle beam", "vehicle slender"]
     assert listed == expected
     for name in expected:
         with pytest.raises(SystemExit) as exc:
@@ -199,15 +199,17 @@ def _imports(path: Path) -> set[str]:
 
 
 def test_every_command_line_is_declared_with_the_helper():
-    """No module builds an argparse parser of its own: lvgym.cli.args does, from each command's dataclass."""
+    """No module builds an argparse parser of its own: lvgym.commandline does, from each command's dataclass."""
     files = [p for d in ("lvgym", "agents", "baselines", "experiments") for p in (ROOT / d).rglob("*.py")]
     files += [ROOT / "train.py", ROOT / "evaluate.py"]
     own = sorted(str(p.relative_to(ROOT)) for p in files if "argparse" in _imports(p))
-    assert own == ["lvgym/cli/__init__.py", "lvgym/cli/args.py"]
+    assert own == ["lvgym/commandline/messages.py", "lvgym/commandline/options.py"]
 
 
 def test_the_helpers_of_the_lower_layers_import_no_upper_layer():
-    """lvgym.cli and lvgym.cli.args (which any layer may use) import nothing of lvgym but lvgym.errors and each other."""
-    for name in ("__init__.py", "args.py"):
-        mods = {m for m in _imports(ROOT / "lvgym" / "cli" / name) if m.startswith(("lvgym", "."))}
-        assert mods <= {"lvgym.errors", ".", "lvgym.cli"}, (name, mods)
+    """lvgym.commandline (which any layer may use) imports nothing of lvgym but lvgym.errors and its own modules."""
+    names = sorted(p.name for p in (ROOT / "lvgym" / "commandline").glob("*.py"))
+    assert names == ["__init__.py", "messages.py", "options.py", "subcommands.py"]
+    for name in names:
+        mods = {m for m in _imports(ROOT / "lvgym" / "commandline" / name) if m.startswith(("lvgym", "."))}
+        assert mods <= {"lvgym.errors", ".messages", ".options", ".subcommands"}, (name, mods)

@@ -2,10 +2,16 @@
 
 The dynamics core imports neither gymnasium nor the environment models nor the vehicle layer; the
 environment models and the vehicle layer are independent of each other and of everything above them; the
-simulator imports no gymnasium; the benchmark names no controller or agent. Checked on the import
-statements of every module of a layer, and on the import paths it writes as strings (a policy's factory
+simulator imports no gymnasium; the benchmark names no controller or agent; the thesis's studies and the
+verification cases sit on the simulator (no envs, no benchmark); the modules beside the layers
+(``lvgym.packing``, ``lvgym.errors``, ``lvgym.rotations``, ``lvgym.borrow``, ``lvgym.parallel``,
+``lvgym.commandline``) import none of them; the package root reaches no controller, agent or command; and
+nothing imports the command layer (``lvgym.cli``) but its own modules and the entry scripts
+(``python -m lvgym``, ``evaluate.py``, ``train.py``). Checked on the import statements of every module of a
+layer (function-level ones too), and on the import paths it writes as strings (a policy's factory
 ``"package.module:function"``, a module name handed to importlib), followed through the lvgym modules they
-import (the package root only registers env names with Gymnasium).
+import (the package root only registers env names with Gymnasium: it is checked on its own, and not followed
+from the others).
 
 The policy registry's dependencies point the other way: ``lvgym.baselines`` and ``lvgym.agents`` register
 their policies with the benchmark, and the command layer (``evaluate.py``, ``lvgym.cli.policies``) imports
@@ -23,16 +29,46 @@ import pytest
 import lvgym
 
 ON_TOP = ("lvgym.agents", "lvgym.baselines", "baselines_pid", "experiments")   # controllers and agents on top
+COMMANDS = ("lvgym.cli",)                                                        # the command layer, above all
+TOOLS = ("lvgym.studies", "lvgym.verify", "lvgym.bench")       # the studies, verification, speed benchmarks
 ABOVE_ALL = ("gymnasium", "stable_baselines3", "torch", "lvgym.envs", "lvgym.simulator", "lvgym.benchmark") + ON_TOP
+#: the modules beside the layers import none of the layers (nor one another's upper neighbours: each is a
+#: base any layer may use)
+BESIDE = ABOVE_ALL + ("lvgym.dynamics", "lvgym.environment", "lvgym.vehicle") + TOOLS + COMMANDS
 
 FORBIDDEN = {
-    "lvgym.dynamics": ABOVE_ALL + ("lvgym.environment", "lvgym.vehicle"),
-    "lvgym.environment": ABOVE_ALL + ("lvgym.dynamics", "lvgym.vehicle"),
-    "lvgym.vehicle": ABOVE_ALL + ("lvgym.dynamics", "lvgym.environment"),
-    "lvgym.simulator": ("gymnasium", "stable_baselines3", "torch", "lvgym.envs", "lvgym.benchmark") + ON_TOP,
-    "lvgym.envs": ("stable_baselines3.common.policies", "torch", "lvgym.benchmark") + ON_TOP,
-    "lvgym.benchmark": ("torch",) + ON_TOP,
+    "lvgym.dynamics": ABOVE_ALL + ("lvgym.environment", "lvgym.vehicle") + TOOLS + COMMANDS,
+    "lvgym.environment": ABOVE_ALL + ("lvgym.dynamics", "lvgym.vehicle") + TOOLS + COMMANDS,
+    "lvgym.vehicle": ABOVE_ALL + ("lvgym.dynamics", "lvgym.environment") + TOOLS + COMMANDS,
+    "lvgym.simulator": ("gymnasium", "stable_baselines3", "torch", "lvgym.envs", "lvgym.benchmark") + ON_TOP + TOOLS
+    + COMMANDS,
+    "lvgym.envs": ("stable_baselines3.common.policies", "torch", "lvgym.benchmark") + ON_TOP + TOOLS + COMMANDS,
+    "lvgym.benchmark": ("torch",) + ON_TOP + TOOLS + COMMANDS,
+    # the thesis's studies and the verification cases fly the simulator: no envs, no benchmark
+    "lvgym.studies": ("gymnasium", "stable_baselines3", "torch", "lvgym.envs", "lvgym.benchmark", "lvgym.verify",
+                      "lvgym.bench") + ON_TOP + COMMANDS,
+    "lvgym.verify": ("gymnasium", "stable_baselines3", "torch", "lvgym.envs", "lvgym.benchmark", "lvgym.studies",
+                     "lvgym.bench") + ON_TOP + COMMANDS,
+    # the speed benchmarks: of the dynamics core (as the core itself), of the envs (as the envs)
+    "lvgym.bench": ABOVE_ALL + ("lvgym.environment", "lvgym.vehicle", "lvgym.studies", "lvgym.verify") + COMMANDS,
+    "lvgym.bench_envs": ("stable_baselines3.common.policies", "torch", "lvgym.benchmark", "lvgym.studies") + ON_TOP
+    + COMMANDS,
+    # beside the layers
+    "lvgym.packing": BESIDE,
+    "lvgym.errors": BESIDE,
+    "lvgym.rotations": BESIDE,
+    "lvgym.borrow": BESIDE,
+    "lvgym.parallel": BESIDE,
+    "lvgym.commandline": BESIDE,
+    # the controllers, then the agents, on top of the benchmark
+    "lvgym.baselines": ("lvgym.agents", "baselines_pid", "experiments") + TOOLS + COMMANDS,
+    "lvgym.agents": ("baselines_pid", "experiments") + TOOLS + COMMANDS,
+    # the package root (env ids, make_env on the benchmark's suites) and the command layer on top
+    "lvgym": ("torch",) + ON_TOP + COMMANDS,
+    "lvgym.cli": ("baselines_pid", "experiments"),
 }
+#: what imports the command layer: its own modules and the entry scripts (``python -m lvgym``)
+ENTRY = ("lvgym.__main__",)
 ROOT = Path(lvgym.__file__).parent
 
 
@@ -112,7 +148,14 @@ def _follow(todo: list[str], names: set[str]) -> set[str]:
 
 
 def _closure(package: str) -> set[str]:
+    """What the modules of ``package`` (a package, a module, or the package root ``lvgym`` alone) import,
+    followed through the lvgym modules."""
+    if package == "lvgym":
+        names = _imports("lvgym")
+        return _follow([n for n in names if n.startswith("lvgym.") and _is_module(n)], set(names))
     pkg = importlib.import_module(package)
+    if not hasattr(pkg, "__path__"):
+        return _follow([package], set())
     return _follow([package] + [m.name for m in pkgutil.walk_packages(pkg.__path__, package + ".")], set())
 
 
@@ -134,15 +177,43 @@ def _registering_modules() -> set[str]:
     return out
 
 
+def _under(name: str, packages: tuple[str, ...]) -> bool:
+    """Whether module ``name`` is one of ``packages`` or inside one (``lvgym.bench`` is not ``lvgym.benchmark``)."""
+    return any(name == p or name.startswith(p + ".") for p in packages)
+
+
 @pytest.mark.parametrize("package", sorted(FORBIDDEN))
 def test_layer_imports_nothing_above_it(package):
-    bad = sorted(n for n in _closure(package) if n.startswith(FORBIDDEN[package]))
+    bad = sorted(n for n in _closure(package) if _under(n, FORBIDDEN[package]))
     assert not bad, f"{package} reaches {bad}"
 
 
 def test_the_check_sees_an_upward_import():
     assert any(n.startswith("lvgym.simulator") for n in _closure("lvgym.envs"))
     assert "gymnasium" in _closure("lvgym.envs")
+    assert "lvgym.commandline" in _closure("lvgym.vehicle")                 # beam's and slender's main
+    assert "lvgym.benchmark.suites" in _closure("lvgym")                      # make_env
+    assert "lvgym.envs.ascent" in _closure("lvgym")                           # the env ids' entry points
+    assert {"lvgym.agents", "lvgym.baselines"} <= _closure("lvgym.cli")       # the policies command line
+
+
+def test_every_installed_module_is_in_a_checked_layer():
+    """Each installed module is a key of FORBIDDEN or under one (the package root is checked alone; the
+    entry script ``python -m lvgym`` runs the command layer)."""
+    unchecked = [m for m in _installed_modules() if m not in ENTRY and m not in FORBIDDEN
+                 and not any(m.startswith(k + ".") for k in FORBIDDEN if k != "lvgym")]
+    assert not unchecked, f"modules no layer rule covers: {unchecked}"
+
+
+def test_nothing_below_the_command_layer_imports_it():
+    """Only the command layer's own modules and the entry scripts import ``lvgym.cli``: a layer that declares
+    a command line uses ``lvgym.commandline``, beside the layers. Every installed module, the controllers'
+    and the agents' too, by an import statement (function-level ones too) or a string."""
+    bad = {m: sorted(n for n in _imports(m) | _loads_by_name(m) if n == "lvgym.cli" or n.startswith("lvgym.cli."))
+           for m in _installed_modules() if not (m == "lvgym.cli" or m.startswith("lvgym.cli.")) and m not in ENTRY}
+    bad = {m: names for m, names in bad.items() if names}
+    assert not bad, f"modules below the command layer import it: {bad}"
+    assert "lvgym.cli.main" in _imports("lvgym.__main__")                     # the check sees an import of it
 
 
 def test_the_check_sees_an_import_path_written_as_a_string():

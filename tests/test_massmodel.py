@@ -3,7 +3,8 @@
 import numpy as np
 import pytest
 
-from lvgym.vehicle.config import G0, load_vehicle, parse_vehicle
+from lvgym.vehicle.config import load_vehicle, parse_vehicle
+from lvgym.vehicle.definition import G0
 from lvgym.vehicle.massmodel import MassModel, combine
 from lvgym.vehicle.propulsion import EngineModel
 from lvgym.vehicle.tanks import MIN_SLOSH_HEIGHT, XI, grain_properties, slosh_fraction, tank_properties
@@ -73,7 +74,7 @@ def test_parallel_axis_by_hand():
 
 
 def test_grain_thick_cylinder():
-    from lvgym.vehicle.config import Grain
+    from lvgym.vehicle.definition import Grain
     grain = Grain("grain", top=-1.0, length=1.0, outer_radius=0.1, port_radius=0.05, density=1000.0,
                   engine="e", key="g")
     assert grain.capacity == pytest.approx(np.pi * (0.01 - 0.0025) * 1000.0)

@@ -9,7 +9,8 @@ import pytest
 
 pytest.importorskip("rocketpy")
 
-from lvgym.verify.rocketpy_case import CASES, compare, lvgym_simulator, rocketpy_flight  # noqa: E402
+from lvgym.verify.rocketpy_case import CASES, compare  # noqa: E402
+from lvgym.verify.rocketpy_flights import lvgym_simulator, rocketpy_flight  # noqa: E402
 
 TOL = 0.02
 

@@ -11,7 +11,7 @@ import gymnasium as gym
 import pytest
 
 import lvgym  # noqa: F401
-from lvgym.cli.args import field_docs
+from lvgym.commandline import field_docs
 from lvgym.envs import ENVS, SensorOptions, TaskSpec, TimingOptions
 from lvgym.envs.options import rule_of
 from lvgym.envs.spec import GROUPS, KEYWORDS, OPTION_GROUP

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from lvgym.simulator import build_timeline
-from lvgym.simulator import cache, timeline
+from lvgym.simulator import cache, tabulate
 from lvgym.vehicle import MassModel, load_vehicle
 from lvgym.vehicle.config import VEHICLE_DIR
 from lvgym.vehicle.slender import slender_vehicle
@@ -39,7 +39,7 @@ def test_a_hit_is_the_timeline_without_building_it(folder, monkeypatch):
 
     def no_build(*_):
         raise AssertionError("a cache hit must not build the timeline")
-    monkeypatch.setattr(timeline, "_pieces", no_build)
+    monkeypatch.setattr(tabulate, "_pieces", no_build)
     again = build_timeline(mm, *args)
     _same(again, fresh)
     _same(built, again)

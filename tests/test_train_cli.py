@@ -14,7 +14,7 @@ from pathlib import Path
 
 import pytest
 
-from lvgym.agents.callbacks import latest_checkpoint, list_checkpoints
+from lvgym.agents.checkpoints import latest_checkpoint, list_checkpoints
 
 from test_agents import ROOT, TRAIN, _argv
 

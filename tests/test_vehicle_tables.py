@@ -14,10 +14,10 @@ import pytest
 
 import lvgym
 from lvgym.errors import ConfigError
-from lvgym.simulator.timeline import build_timeline
+from lvgym.simulator.tabulate import build_timeline
 from lvgym.vehicle import MassModel, load_vehicle
-from lvgym.vehicle.massmodel import combine
-from lvgym.vehicle.timetables import TimeTable, body_minus_pendulums, snap_jumps
+from lvgym.vehicle.massmodel import body_minus_pendulums, combine
+from lvgym.vehicle.timetables import TimeTable, snap_jumps
 
 ROOT = Path(__file__).resolve().parents[1]
 #: the Kestrel of docs/own-launcher.md (one stage, two slosh tanks, two modes, 118 s burn)

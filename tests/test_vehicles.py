@@ -17,7 +17,7 @@ import lvgym.environment.barrowman  # noqa: F401  (registers the 'barrowman' aer
 from lvgym.environment.registry import make
 from lvgym.errors import ConfigError
 from lvgym.vehicle.beam import stack_modes
-from lvgym.vehicle.config import VEHICLE_DIR, load_vehicle
+from lvgym.vehicle.config import VEHICLE_DIR, load_vehicle, parse_vehicle
 from lvgym.vehicle.massmodel import MassModel
 from lvgym.vehicle.sections import MATERIALS, Section, tube
 import lvgym.vehicle.slender
@@ -213,6 +213,21 @@ def test_slender_errors_name_the_parameter(kwargs, key):
         slender_vehicle(**kwargs)
     assert info.value.key == key
     assert str(info.value).startswith(f"slender_vehicle: {key} = ")
+
+
+def test_lvgym_vehicle_slender_prints_the_vehicle_file(capsys):
+    """``lvgym vehicle slender`` prints the shipped file at the defaults, a vehicle of the factors given, and
+    refuses a factor out of range in one line naming the option."""
+    from lvgym.cli.main import main
+
+    assert main(["vehicle", "slender"]) == 0
+    assert capsys.readouterr().out == (VEHICLE_DIR / "slender.yaml").read_text(encoding="utf-8")
+    assert main(["vehicle", "slender", "--length", "10", "--diameter", "0.4"]) == 0
+    v = parse_vehicle(yaml.safe_load(capsys.readouterr().out))
+    assert v.length == pytest.approx(10.0) and v.stages[0].outer_diameter == pytest.approx(0.4)
+    with pytest.raises(SystemExit) as exc:
+        main(["vehicle", "slender", "--length", "100"])
+    assert exc.value.code == "lvgym vehicle slender: --length = 100.0: must be in [3, 30]"
 
 
 def test_slender_docstring_examples():

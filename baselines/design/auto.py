@@ -56,7 +56,7 @@ from typing import Any
 
 import yaml
 
-from lvgym.cli.args import arg
+from lvgym.commandline import arg
 from lvgym.errors import ConfigError, check_number
 
 from .target import vehicle_option
@@ -309,8 +309,7 @@ class Args:
 
 def main(argv: list[str] | None = None) -> int:
     """``lvgym design auto``: design (or read from the cache) and print the summary."""
-    from lvgym.cli import fail
-    from lvgym.cli.args import command_name, parse
+    from lvgym.commandline import command_name, fail, parse
 
     prog = "python -m lvgym.baselines.design.auto"
     a = parse(Args, argv, prog, __doc__)

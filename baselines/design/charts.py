@@ -34,7 +34,7 @@ from typing import Any
 import control
 import numpy as np
 
-from lvgym.cli.args import arg
+from lvgym.commandline import arg
 
 from .flightloop import flight_plant, frequency_response, mode_frequencies
 from .linearize import margins, operating_point, pid_tf
@@ -223,7 +223,7 @@ class Args:
 
 def main(argv: list[str] | None = None) -> int:
     """``lvgym design charts`` (``python -m lvgym.baselines.design.charts``): write the charts."""
-    from lvgym.cli.args import parse
+    from lvgym.commandline import parse
 
     a = parse(Args, argv, "python -m lvgym.baselines.design.charts", __doc__)
     from .target import stem

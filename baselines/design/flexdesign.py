@@ -32,7 +32,7 @@ from typing import Any, Callable
 import control
 import numpy as np
 
-from lvgym.cli.args import arg
+from lvgym.commandline import arg
 from lvgym.errors import ConfigError
 
 from ..filters import Filter, StructuralFilter
@@ -393,8 +393,7 @@ def main(argv: list[str] | None = None) -> int:
     import yaml
 
     from lvgym.benchmark.results import atomic_write_text
-    from lvgym.cli import fail
-    from lvgym.cli.args import command_name, parse
+    from lvgym.commandline import command_name, fail, parse
 
     from .tune import SCHEDULES, default_times, output_path
 

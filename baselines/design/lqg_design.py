@@ -25,7 +25,7 @@ import control
 import numpy as np
 import scipy.linalg as sla
 
-from lvgym.cli.args import arg
+from lvgym.commandline import arg
 from lvgym.errors import ConfigError, check_number
 
 from .flightloop import flight_plant, mode_frequencies
@@ -396,8 +396,7 @@ class Args:
 
 def main(argv: list[str] | None = None) -> int:
     """``lvgym design lqg`` (``python -m lvgym.baselines.design.lqg_design``): design and write the schedule."""
-    from lvgym.cli import fail
-    from lvgym.cli.args import command_name, parse
+    from lvgym.commandline import command_name, fail, parse
 
     from .target import burn_phases, file_times, is_shipped, stem
 

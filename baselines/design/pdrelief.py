@@ -33,7 +33,7 @@ from typing import Any
 
 import numpy as np
 
-from lvgym.cli.args import arg
+from lvgym.commandline import arg
 from lvgym.errors import ConfigError
 
 from ..pid import SCHEDULES
@@ -119,8 +119,7 @@ class Args:
 
 def main(argv: list[str] | None = None) -> int:
     """``lvgym design pd-relief``: design and write the schedule."""
-    from lvgym.cli import fail
-    from lvgym.cli.args import command_name, parse
+    from lvgym.commandline import command_name, fail, parse
 
     from .tune import output_path, write_schedule
 

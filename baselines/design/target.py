@@ -150,7 +150,7 @@ def describe(fly: str) -> str:
 
 
 def vehicle_option(option: str, value: str) -> str:
-    """A command line's ``--vehicle`` (an :func:`lvgym.cli.args.arg` check): a shipped vehicle's name or the
+    """A command line's ``--vehicle`` (an :func:`lvgym.commandline.arg` check): a shipped vehicle's name or the
     path of a vehicle file that reads (its errors name the file, line, key, value and what is allowed)."""
     try:
         return check_vehicle(value)
@@ -161,7 +161,7 @@ def vehicle_option(option: str, value: str) -> str:
 
 
 def fly_option(option: str, value: str) -> str:
-    """A command line's ``--fly`` (an :func:`lvgym.cli.args.arg` check): :func:`check_fly`."""
+    """A command line's ``--fly`` (an :func:`lvgym.commandline.arg` check): :func:`check_fly`."""
     return check_fly(value, option)
 
 

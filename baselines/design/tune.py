@@ -29,7 +29,7 @@ import control
 import numpy as np
 import yaml
 
-from lvgym.cli.args import arg
+from lvgym.commandline import arg
 
 from .linearize import linearize, loop, margins, operating_point, reused_flights
 from .target import fly_option, is_shipped, stem, vehicle_option
@@ -251,8 +251,7 @@ class Args:
 
 def main(argv: list[str] | None = None) -> int:
     """``lvgym design pid`` (``python -m lvgym.baselines.design.tune``): tune and write the schedule."""
-    from lvgym.cli import fail
-    from lvgym.cli.args import command_name, parse
+    from lvgym.commandline import command_name, fail, parse
     from lvgym.errors import ConfigError
 
     a = parse(Args, argv, "python -m lvgym.baselines.design.tune", __doc__)

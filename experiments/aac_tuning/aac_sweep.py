@@ -22,8 +22,7 @@ import numpy as np
 from lvgym.benchmark.batch import BatchLaw, RowFace
 from lvgym.benchmark.runner import play_episode
 from lvgym.benchmark.suites import SUITES, get_suite
-from lvgym.cli import fail
-from lvgym.cli.args import arg, command_name, parse
+from lvgym.commandline import arg, command_name, fail, parse
 from lvgym.errors import ConfigError
 
 from lvgym.baselines.aac import FLEX_AAC, AACParams, AdaptiveAugmentingPolicy, _check_keywords

@@ -33,7 +33,7 @@ from typing import Any
 
 import numpy as np
 
-from lvgym.cli.args import arg
+from lvgym.commandline import arg
 from lvgym.vehicle.sections import MATERIALS, tube_area, tube_second_moment
 
 from experiments.aeroelastic_divergence.divergence import Beam, Lift, vehicle_beam, vehicle_lift
@@ -146,7 +146,7 @@ def main(argv: list[str] | None = None) -> int:
     """``python -m experiments.aeroelastic_divergence.structural_limit [times...]``: the limit at flight times [s] of
     ``SlenderAscent-v1`` (default 4, 6, 8 s), with the thrust and axial drag of its calm flight there."""
     from lvgym.baselines.design.linearize import aero_slopes, operating_point
-    from lvgym.cli.args import parse
+    from lvgym.commandline import parse
 
     times = parse(Args, argv, "python -m experiments.aeroelastic_divergence.structural_limit", main.__doc__).times
     print("| t [s] | mass [kg] | thrust / drag [kN] | bending moment per q S alpha, free / trimmed [m] | station [m] "

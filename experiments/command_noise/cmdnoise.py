@@ -29,7 +29,7 @@ from typing import Any
 import numpy as np
 
 import lvgym.cli.policies  # noqa: F401  (registers the built-in policies the command line names)
-from lvgym.cli.args import arg, command_name, parse
+from lvgym.commandline import arg, command_name, parse
 from lvgym.parallel import EXECUTORS, exit_on_sigterm, run_map
 
 from lvgym.benchmark.runner import PolicySpec, build_policy

@@ -22,7 +22,7 @@ import numpy as np
 
 import lvgym  # noqa: F401
 from lvgym.benchmark.policy import ZeroPolicy
-from lvgym.cli.args import arg, parse
+from lvgym.commandline import arg, parse
 
 from lvgym.baselines.pid import GainSchedule, PIDPolicy, smile_scheduled_pid, smile_single_pid
 

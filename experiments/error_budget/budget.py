@@ -38,7 +38,7 @@ from typing import Any
 import numpy as np
 
 import lvgym.cli.policies  # noqa: F401  (registers the built-in policies the command line names)
-from lvgym.cli.args import arg, command_name, parse
+from lvgym.commandline import arg, command_name, parse
 from lvgym.cli.flights import FlightArgs, resolve_flights
 from lvgym.parallel import exit_on_sigterm
 

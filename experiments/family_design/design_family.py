@@ -22,7 +22,7 @@ from pathlib import Path
 
 import yaml
 
-from lvgym.cli.args import arg, parse
+from lvgym.commandline import arg, parse
 
 POLICIES = ("zero", "privileged", "auto-gs-pid", "auto-gs-pid-flex", "auto-lqg", "fixed-gs-pid-flex", "fixed-lqg")
 

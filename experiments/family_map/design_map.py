@@ -36,7 +36,7 @@ from pathlib import Path
 
 import numpy as np
 
-from lvgym.cli.args import arg, parse
+from lvgym.commandline import arg, parse
 
 PROG = "python -m experiments.family_map.design_map"
 POLICIES = ("privileged", "auto-gs-pid", "auto-gs-pid-flex", "auto-lqg", "fixed-gs-pid-flex", "fixed-lqg")

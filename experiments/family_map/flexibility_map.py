@@ -28,7 +28,7 @@ import numpy as np
 import lvgym
 from lvgym.baselines.privileged import PrivilegedPolicy
 from lvgym.benchmark.runner import play_episode
-from lvgym.cli.args import arg, parse
+from lvgym.commandline import arg, parse
 from lvgym.vehicle.generator import FamilyRanges, generate
 
 PROG = "python -m experiments.family_map.flexibility_map"

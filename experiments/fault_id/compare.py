@@ -19,7 +19,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
-from lvgym.cli.args import arg, parse
+from lvgym.commandline import arg, parse
 
 BASELINES = ("lqg", "lqg-front", "aac-quiet", "gs-pd-relief", "gs-pid-flex-quiet")
 

@@ -12,7 +12,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-from lvgym.cli.args import arg, parse
+from lvgym.commandline import arg, parse
 
 from .estimator import RESULTS, load
 from .train import validate

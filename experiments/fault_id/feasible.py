@@ -20,7 +20,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
-from lvgym.cli.args import arg, parse
+from lvgym.commandline import arg, parse
 
 from .privileges import reference
 from .train import SUITE, condition, lost

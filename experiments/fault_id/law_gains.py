@@ -17,7 +17,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
-from lvgym.cli.args import arg, parse
+from lvgym.commandline import arg, parse
 
 from .privileges import Withheld
 from .train import condition, scored

@@ -18,7 +18,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
-from lvgym.cli.args import arg, parse
+from lvgym.commandline import arg, parse
 
 from .privileges import reference
 from .train import condition, scored

@@ -19,7 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from lvgym.cli.args import arg, parse
+from lvgym.commandline import arg, parse
 from lvgym.envs.faults import FAULT_NAMES
 
 from .train import condition, lost

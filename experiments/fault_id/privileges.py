@@ -25,7 +25,7 @@ from typing import Any
 import numpy as np
 
 from lvgym.agents.inversion import SPAN, carry
-from lvgym.cli.args import arg, parse
+from lvgym.commandline import arg, parse
 
 #: a relief that never acts (from five times the q-alpha limit)
 NO_RELIEF = (5.0, 6.0)

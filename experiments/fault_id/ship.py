@@ -36,7 +36,7 @@ from typing import Any
 from lvgym.agents.inversion import SHIPPED, TRAINED, env_record
 from lvgym.agents.observer_fit import load, to_observer
 from lvgym.benchmark import PolicySpec, evaluate, get_suite
-from lvgym.cli.args import arg, parse
+from lvgym.commandline import arg, parse
 
 from .estimator import RESULTS
 from .train import SUITE, condition, own_law, scored

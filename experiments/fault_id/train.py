@@ -49,7 +49,7 @@ from lvgym.agents.inversion import TERMS, Lead, command, error_index, gains, law
 from lvgym.agents.observer import Window
 from lvgym.agents.staging import Ignition, signal_index
 from lvgym.agents.observer_fit import Ensemble, Estimator, load, save
-from lvgym.cli.args import arg, parse
+from lvgym.commandline import arg, parse
 
 from .estimator import RESULTS, base_lqg, corrected
 from .fitting import Data, fit

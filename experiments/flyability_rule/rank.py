@@ -26,7 +26,7 @@ from lvgym.benchmark.flyability import RMS_FRACTION, WINDOW_FRACTION, WINDOW_S
 from lvgym.benchmark.metrics import summarize
 from lvgym.benchmark.runner import PolicySpec, evaluate
 from lvgym.benchmark.suites import SEED_SETS, SUITES, get_suite
-from lvgym.cli.args import arg, command_name, parse
+from lvgym.commandline import arg, command_name, parse
 from lvgym.parallel import EXECUTORS, exit_on_sigterm
 
 __all__ = ["V2_LABEL", "fly", "rank_table"]

@@ -20,7 +20,7 @@ import numpy as np
 
 from lvgym.benchmark import evaluate, get_suite
 from lvgym.benchmark.runner import PolicySpec
-from lvgym.cli.args import arg, parse
+from lvgym.commandline import arg, parse
 from lvgym.errors import ConfigError
 
 from .laws import released_schedule

@@ -29,7 +29,7 @@ from typing import Any
 import numpy as np
 from scipy import linalg, optimize
 
-from lvgym.cli.args import arg, parse
+from lvgym.commandline import arg, parse
 
 from lvgym.baselines.design.linearize import aero_slopes, analytic_rigid, operating_point
 

@@ -26,7 +26,7 @@ import numpy as np
 
 from lvgym.benchmark.runner import PolicySpec, build_policy
 from lvgym.benchmark.suites import SUITES, get_suite
-from lvgym.cli.args import arg, command_name, parse
+from lvgym.commandline import arg, command_name, parse
 
 __all__ = ["fly", "summary", "hold_qalpha"]
 

@@ -22,7 +22,7 @@ import yaml
 
 from lvgym.benchmark.runner import play_episode
 from lvgym.benchmark.suites import SUITES, get_suite
-from lvgym.cli.args import arg, parse
+from lvgym.commandline import arg, parse
 
 from lvgym.baselines.pid import GainSchedule, GainScheduledPIDPolicy
 

@@ -51,8 +51,7 @@ import control
 import numpy as np
 import scipy.linalg as sla
 
-from lvgym.cli import option_number
-from lvgym.cli.args import arg, parse
+from lvgym.commandline import arg, option_number, parse
 from lvgym.environment.turbulence import INTENSITIES, dryden_scales
 from lvgym.errors import ConfigError
 

@@ -27,7 +27,7 @@ import numpy as np
 import lvgym.cli.policies  # noqa: F401  (registers the built-in policies the command line names)
 from lvgym.benchmark.runner import PolicySpec, build_policy, play_episode
 from lvgym.benchmark.suites import SEED_SETS, SUITES, Condition, get_suite
-from lvgym.cli.args import arg, command_name, parse
+from lvgym.commandline import arg, command_name, parse
 from lvgym.parallel import EXECUTORS, exit_on_sigterm, run_map
 
 __all__ = ["SatTask", "TimedPolicy", "fly", "run", "table"]

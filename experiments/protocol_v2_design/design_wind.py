@@ -29,7 +29,7 @@ import numpy as np
 import lvgym.cli.policies  # noqa: F401  (registers the built-in policies the command line names)
 from lvgym.benchmark.runner import build_policy
 from lvgym.benchmark.suites import condition as suite_condition
-from lvgym.cli.args import arg, parse
+from lvgym.commandline import arg, parse
 from lvgym.environment import make
 from lvgym.envs import functional
 

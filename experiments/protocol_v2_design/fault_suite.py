@@ -25,7 +25,7 @@ import lvgym.cli.policies  # noqa: F401  (registers the built-in policies the co
 from lvgym.benchmark.metrics import normalise, summarize
 from lvgym.benchmark.runner import PolicySpec, evaluate
 from lvgym.benchmark.suites import SEED_SETS, Suite, get_suite
-from lvgym.cli.args import arg, command_name, parse
+from lvgym.commandline import arg, command_name, parse
 from lvgym.envs.faults import FAULT_NAMES
 from lvgym.parallel import EXECUTORS, exit_on_sigterm
 

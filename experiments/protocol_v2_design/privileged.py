@@ -47,7 +47,7 @@ from experiments.lqg_headroom.headroom import (
     shipped_row,
     wind_input,
 )
-from lvgym.cli.args import arg, parse
+from lvgym.commandline import arg, parse
 
 __all__ = ["constrained", "lqg_figures", "lqr_figures", "matched", "privileged_rows", "stationary"]
 

@@ -39,7 +39,7 @@ import sys
 from dataclasses import dataclass
 from pathlib import Path
 
-from lvgym.cli.args import arg, parse
+from lvgym.commandline import arg, parse
 
 ROOT = Path(__file__).resolve().parents[2]
 MODELS = ("nonrigid", "rigid")   # non-rigid first: the policy to ship, if time runs short

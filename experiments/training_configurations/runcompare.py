@@ -33,8 +33,7 @@ from typing import Any
 
 import numpy as np
 
-from lvgym.cli import fail
-from lvgym.cli.args import arg, command_name, parse
+from lvgym.commandline import arg, command_name, fail, parse
 from lvgym.errors import ConfigError
 from lvgym.benchmark.compare import RUN_LABEL
 from lvgym.benchmark.metrics import per_seed

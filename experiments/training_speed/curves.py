@@ -23,7 +23,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from lvgym.cli.args import arg, command_name, parse
+from lvgym.commandline import arg, command_name, parse
 from lvgym.errors import ConfigError
 
 __all__ = ["load_curves", "main", "reached", "summary_rows"]

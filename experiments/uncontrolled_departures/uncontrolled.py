@@ -30,7 +30,7 @@ from typing import Any
 import numpy as np
 import yaml
 
-from lvgym.cli.args import parse
+from lvgym.commandline import parse
 from lvgym.envs.spec import wind_spec
 from lvgym.simulator import LaunchSpec, Simulator, TimelineSpec
 from lvgym.vehicle.config import VEHICLE_DIR

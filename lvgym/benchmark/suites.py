@@ -105,12 +105,11 @@ class Condition:
         return {"model": self.model, "wind": self.wind, "randomize": list(self.randomize), **dict(self.options)}
 
     def make_env(self) -> Any:
-        """A fresh env of this condition (``gymnasium.make``; imports ``lvgym`` to register the ids)."""
+        """A fresh env of this condition (``gymnasium.make``: the package ``lvgym``, imported with this
+        module, registered the ids)."""
         import warnings
 
         import gymnasium
-
-        import lvgym  # noqa: F401  (registers the env ids)
 
         with warnings.catch_warnings():            # a frozen v0 suite flies its v0 env on purpose
             warnings.filterwarnings("ignore", message=".*is out of date", category=DeprecationWarning)
@@ -123,8 +122,6 @@ class Condition:
         import warnings
 
         import gymnasium
-
-        import lvgym  # noqa: F401  (registers the env ids)
 
         with warnings.catch_warnings():            # a frozen v0 suite flies its v0 env on purpose
             warnings.filterwarnings("ignore", message=".*is out of date", category=DeprecationWarning)

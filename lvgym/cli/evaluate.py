@@ -64,11 +64,10 @@ from lvgym.benchmark import (DEFAULT_SUITE, EXECUTORS, SEED_SETS, SUITES, Policy
 from lvgym.benchmark.family import family_room, family_rows, family_table
 from lvgym.benchmark.headline import headline, others, policy_kind
 from lvgym.cli.policies import POLICIES, resolve_policy  # (registers the built-in policies)
+from lvgym.commandline import arg, command_name, fail, parse
 from lvgym.errors import ConfigError
 from lvgym.parallel import TaskFailed, exit_on_sigterm
 
-from . import fail
-from .args import arg, command_name, parse
 from .flights import check_vehicle
 
 __all__ = ["Args", "BESIDE_KINDS", "DEFAULT_EPISODES", "DEFAULT_POLICIES", "DEFAULT_SUITE", "DEFAULT_SUITES",

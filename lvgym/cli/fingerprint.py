@@ -14,9 +14,7 @@ from typing import Literal
 
 from lvgym.benchmark.fingerprint import FINGERPRINTS, POLICIES, compare, fingerprint, stored
 from lvgym.benchmark.suites import SUITES
-
-from . import fail
-from .args import arg, command_name, parse
+from lvgym.commandline import arg, command_name, fail, parse
 
 __all__ = ["Args", "main"]
 

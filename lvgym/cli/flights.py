@@ -18,13 +18,12 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
-from .policies import resolve_policy  # (registers the built-in policies)
 from lvgym.benchmark.runner import PolicySpec
 from lvgym.benchmark.suites import SUITES, Condition, Suite, get_suite
+from lvgym.commandline import arg, fail
 from lvgym.parallel import EXECUTORS
 
-from . import fail
-from .args import arg
+from .policies import resolve_policy  # (registers the built-in policies)
 
 __all__ = ["FlightArgs", "check_vehicle", "resolve_flights"]
 

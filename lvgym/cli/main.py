@@ -6,11 +6,13 @@
     lvgym train --total-timesteps 2e6 --max-wall-time 3600
     lvgym campaign agents/campaigns/v2_example.yaml --dry-run
     lvgym design pid --vehicle smile
+    lvgym vehicle slender --length 10 > slender10.yaml
 
 ``python -m lvgym`` is the same. Each subcommand is the command line of a module (``lvgym evaluate`` is
-``evaluate.py``, ``lvgym design pid`` is ``python -m lvgym.baselines.design.tune``, ...), declared once as a
-dataclass (:mod:`lvgym.cli.args`); the module is imported only when its command runs, after checking that
-the extra it needs is installed (``lvgym train`` without stable-baselines3: ``pip install 'lvgym[train]'``).
+``evaluate.py``, ``lvgym design pid`` is ``python -m lvgym.baselines.design.tune``, ``lvgym vehicle beam`` is
+``python -m lvgym.vehicle.beam``, ...), declared once as a dataclass (:mod:`lvgym.commandline`); the module
+is imported only when its command runs, after checking that the extra it needs is installed (``lvgym train``
+without stable-baselines3: ``pip install 'lvgym[train]'``).
 """
 
 from __future__ import annotations
@@ -18,7 +20,7 @@ from __future__ import annotations
 import sys
 from collections.abc import Sequence
 
-from .args import Command, dispatch
+from lvgym.commandline import Command, dispatch
 
 __all__ = ["COMMANDS", "main"]
 
@@ -67,6 +69,12 @@ COMMANDS: tuple[Command, ...] = (
                 "open loops", "control", _CONTROL),
         Command("auto", "lvgym.baselines.design.auto:main", "design gs-pid, gs-pid-flex and lqg for a vehicle file "
                 "in about a minute, cached by its content", "control", _CONTROL),
+    )),
+    Command("vehicle", None, "the vehicle layer's tools", sub=(
+        Command("beam", "lvgym.vehicle.beam:main", "the beam's bending modes against the thesis's (Tables 6.8 and "
+                "6.9, Eq. 6.2 and 6.3) as a Markdown table"),
+        Command("slender", "lvgym.vehicle.slender:main", "print the YAML vehicle file of the parametric slender "
+                "vehicle (thesis 6.1-6.2)"),
     )),
 )
 

@@ -23,11 +23,10 @@ from typing import Any
 from lvgym.benchmark.margins import (DEFAULT_POLICIES, DEFAULT_SEEDS, DEFAULT_SUITE, EXPERIMENTS, MarginOptions,
                                      margins_table, run_margins, write_margins)
 from lvgym.benchmark.suites import SEED_SETS, SUITES, Condition
+from lvgym.commandline import arg, command_name, fail, parse
 from lvgym.errors import ConfigError
 from lvgym.parallel import TaskFailed, exit_on_sigterm
 
-from . import fail
-from .args import arg, command_name, parse
 from .flights import FlightArgs, check_vehicle, resolve_flights
 
 __all__ = ["Args", "main", "parse_args"]

@@ -6,7 +6,7 @@ from compiled loads functions). Models are chosen by name with :func:`make`; imp
 registers them all.
 """
 
-from . import aerodynamics, aeroelastic, atmosphere, barrowman, datasheet, earth, gravity, wind
+from . import aerodynamics, aeroelastic, atmosphere, barrowman, datasheet, earth, gravity, turbulence, wind
 from .aerodynamics import AeroState, AxisymmetricAero, Tables6Aero
 from .aeroelastic import StripAeroelastic
 from .barrowman import BarrowmanAero
@@ -16,4 +16,4 @@ from .registry import make, names, register
 
 __all__ = ["AeroState", "AxisymmetricAero", "BarrowmanAero", "Environment", "FlightConditions", "LaunchSite", "StripAeroelastic", "Tables6Aero",
            "aerodynamics", "aeroelastic", "atmosphere", "barrowman", "datasheet", "earth", "gravity", "make", "names",
-           "register", "wind"]
+           "register", "turbulence", "wind"]

@@ -457,6 +457,3 @@ class SumWind(_Wind):
         for child, child_rng in zip(self.children, (np.random.default_rng(int(k)) for k in seeds)):
             child.reset(child_rng)
         self._build()
-
-
-from . import turbulence as _turbulence  # noqa: E402,F401  registers "dryden" (needs _Wind above)

@@ -50,7 +50,7 @@ from matplotlib.collections import LineCollection, PatchCollection  # noqa: E402
 from matplotlib.figure import Figure  # noqa: E402
 from matplotlib.patches import Circle, Polygon  # noqa: E402
 
-from lvgym.cli.args import arg  # noqa: E402
+from lvgym.commandline import arg, parse  # noqa: E402
 from lvgym.errors import ConfigError  # noqa: E402
 
 _DPI = 100.0
@@ -462,8 +462,6 @@ class Args:
 def main(argv: list[str] | None = None) -> None:
     """``lvgym render [OUT.png]`` (``python -m lvgym.envs.render``): draw :func:`example_frame` to a PNG."""
     import matplotlib.image
-
-    from lvgym.cli.args import parse
 
     args = parse(Args, argv, "python -m lvgym.envs.render", "Draw the renderer's example frame (a made-up "
                  "8.5 m vehicle at t = 21 s, bending and two slosh pendulums) to a PNG.")

@@ -39,7 +39,7 @@ class FuncViews:
 
     @property
     def vehicle(self) -> Any:
-        """The :class:`~lvgym.vehicle.config.Vehicle` in force."""
+        """The :class:`~lvgym.vehicle.definition.Vehicle` in force."""
         return self.func.vehicle
 
     @property

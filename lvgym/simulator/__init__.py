@@ -12,7 +12,8 @@ from .layouts import CONDITIONS, CONTEXT
 from .piece import SLOSH_FREQUENCIES
 from .record import Recorder, fly, load
 from .spec import EnvironmentSpec, LaunchSpec, PhysicsSpec, TimelineSpec
-from .timeline import MODE_BASES, MODELS, Tables, Timeline, build_timeline
+from .tabulate import build_timeline
+from .timeline import MODE_BASES, MODELS, Tables, Timeline
 from .view import SimView
 
 __all__ = ["CONDITIONS", "aeroelastic_strips", "CONTEXT", "EnvironmentSpec", "Kernel", "LaunchSpec", "MODE_BASES",

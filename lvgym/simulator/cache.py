@@ -5,7 +5,7 @@ The key is a SHA-256 of the vehicle's whole content (its frozen dataclasses, pic
 the file it was read from: a copy of a file under another name hits the same entry), the mass model's
 CG convention, the timeline's arguments, whether layouts are padded, and the source files of the code that
 builds a timeline (the vehicle layer, the beam, the dynamics layout and parameter builder, the mode
-resampling at the aeroelastic strips, this package's timeline), so an edited vehicle file or an edited
+resampling at the aeroelastic strips, this package's timeline and its build), so an edited vehicle file or an edited
 mass model never reads a stale entry. The folder is ``$LVGYM_CACHE_DIR`` (default
 ``~/.cache/lvgym``), its ``timelines/`` subfolder one file per entry (``SUFFIX``; a JSON header and the raw arrays,
 read back in one call), written atomically; ``off``
@@ -62,11 +62,10 @@ def using(folder: str | os.PathLike[str]) -> Iterator[None]:
 @functools.lru_cache(maxsize=1)
 def _source_digest() -> str:
     """A digest of the source files that a timeline depends on."""
-    import lvgym
-    root = Path(lvgym.__file__).parent
+    root = Path(__file__).resolve().parents[1]                # the package lvgym
     files = sorted([*root.glob("vehicle/*.py"), root / "dynamics" / "layout.py", root / "dynamics" / "model.py",
                     root / "environment" / "aeroelastic.py", root / "packing.py", root / "simulator" / "timeline.py",
-                    root / "simulator" / "tabled.py", Path(__file__)])
+                    root / "simulator" / "tabulate.py", root / "simulator" / "tabled.py", Path(__file__)])
     h = hashlib.sha256()
     for f in files:
         h.update(f.name.encode())

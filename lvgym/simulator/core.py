@@ -65,7 +65,8 @@ from .spec import SITES, EnvironmentSpec, LaunchSpec, PhysicsSpec, TimelineSpec
 from .strips import StripSetup, strip_stations
 from .threads import ROWS_PER_THREAD, Kernel, default_threads, pool
 from .view import SimView
-from .timeline import MODELS, Timeline, build_timeline
+from .tabulate import build_timeline
+from .timeline import MODELS, Timeline
 from .vehicleaero import aeroelastic_strips, stage_aerodynamics, vehicle_strips
 
 _ADVANCE, _SLOSH = Kernel(advance_range), Kernel(slosh_angles_range)

@@ -49,7 +49,7 @@ from lvgym.errors import ConfigError
 from lvgym.vehicle import MassModel, Vehicle, load_vehicle
 
 from .strips import N_STRIPS, strip_models, strip_stations
-from .timeline import build_timeline
+from .tabulate import build_timeline
 from .vehicleaero import stage_aerodynamics
 
 __all__ = ["divergence_qbar", "divergence_ratio", "flight_divergence_qbar", "pitch_stiffness_ratio"]

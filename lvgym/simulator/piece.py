@@ -1,7 +1,7 @@
 """What the compiled step changes in a row at the start of a piece, besides the timeline's parameters.
 
 :func:`.advance.advance_range` cuts every physics step at the timeline's event times and, with
-``mode_basis="projected"``, at the times the bending modes are recomputed (:func:`.timeline.build_timeline`).
+``mode_basis="projected"``, at the times the bending modes are recomputed (:func:`.tabulate.build_timeline`).
 At the start of each piece it
 
 - carries the modal state across a change of basis (:func:`project_modes_k`): the modal coordinates

@@ -93,7 +93,7 @@ class EnvironmentSpec:
 
 @dataclass(frozen=True)
 class TimelineSpec:
-    """What the timeline (:func:`.timeline.build_timeline`) tabulates. ``t_end``: mission time [s];
+    """What the timeline (:func:`.tabulate.build_timeline`) tabulates. ``t_end``: mission time [s];
     ``timeline_dt``: the table step [s]; ``n_modes``: bending modes per plane (None: the vehicle file's;
     modes above the Nyquist frequency of the RK4 step are decoupled); ``sensor_stations`` [m]: where the mode
     slopes are tabulated (an IMU); ``cg_convention``: ``static`` or ``thesis``; ``mode_interval`` [s]:

@@ -17,7 +17,8 @@ from __future__ import annotations
 import numpy as np
 
 from lvgym.errors import ConfigError
-from lvgym.vehicle.timetables import VehicleTables, before_rows, body_minus_pendulums, snap_jumps, stack_at
+from lvgym.vehicle.massmodel import body_minus_pendulums
+from lvgym.vehicle.timetables import VehicleTables, before_rows, snap_jumps, stack_at
 
 __all__ = ["apply_mass", "apply_modes"]
 
@@ -53,7 +54,7 @@ def apply_mass(tables: VehicleTables | None, c: dict[str, np.ndarray], events, w
 def apply_modes(tables: VehicleTables | None, md: dict, t: np.ndarray, K: int, cutoff_hz: float, events,
                 source: str | None, modes_rows: list) -> None:
     """Replace, in place, the frequency and damping of each tabled mode (of the first ``K``) in the mode
-    columns ``md`` of the rows ``t`` (n,) [s] (:func:`~lvgym.simulator.timeline._mode_rows`, built without
+    columns ``md`` of the rows ``t`` (n,) [s] (:func:`~lvgym.simulator.tabulate._mode_rows`, built without
     the cut-off; ``modes_rows`` each row's :class:`~lvgym.vehicle.structure.VehicleModes`), scale its shapes
     to the table's gimbal slope and its sensor shapes to the IMU slope when it gives them, carry the scale
     through the changes of basis (``eta' = eta / c``: ``T' = diag(1 / c_after) T diag(c_before)``), and decouple every

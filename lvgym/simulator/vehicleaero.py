@@ -83,7 +83,7 @@ def vehicle_strips(vehicle: Vehicle, stages: list[Any]) -> list[Any]:
 def aeroelastic_strips(vehicle: Vehicle, aerodynamics: Any = "vehicle", aeroelastic: bool | None = None
                        ) -> np.ndarray | None:
     """The strip stations (n_stages, n) [m] a timeline needs for a simulator of ``vehicle`` with these
-    options (None: no aeroelastic loads), for :func:`.timeline.build_timeline`'s ``strip_stations``."""
+    options (None: no aeroelastic loads), for :func:`.tabulate.build_timeline`'s ``strip_stations``."""
     on = vehicle.structure.aeroelastic if aeroelastic is None else aeroelastic
     stages = stage_aerodynamics(vehicle, aerodynamics) if on else [None]
     return None if stages[0] is None else strip_stations(vehicle_strips(vehicle, stages))

@@ -15,8 +15,7 @@ import sys
 from dataclasses import dataclass
 from typing import Literal
 
-from lvgym.cli import fail, option_number
-from lvgym.cli.args import arg, command_name, parse
+from lvgym.commandline import arg, command_name, fail, option_number, parse
 from lvgym.errors import ConfigError
 from lvgym.parallel import EXECUTORS
 

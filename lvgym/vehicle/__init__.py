@@ -4,7 +4,8 @@ Imports neither the environment models nor the dynamics core: it hands plain num
 simulator, which composes them.
 """
 
-from .config import Vehicle, clear_vehicle_cache, load_vehicle, parse_vehicle
+from .config import clear_vehicle_cache, load_vehicle, parse_vehicle
+from .definition import Vehicle
 from .massmodel import MassModel, MassProperties, MassState
 
 __all__ = ["MassModel", "MassProperties", "MassState", "Vehicle", "clear_vehicle_cache", "load_vehicle", "parse_vehicle"]

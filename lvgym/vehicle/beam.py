@@ -383,8 +383,9 @@ def thesis_comparison_markdown(material: Material = MATERIALS["al_ansys"], t_wal
 
 
 def main(argv: list[str] | None = None) -> None:
-    """``python -m lvgym.vehicle.beam``: print :func:`thesis_comparison_markdown` (no options)."""
-    from lvgym.cli.args import parse
+    """``lvgym vehicle beam`` (``python -m lvgym.vehicle.beam``): print :func:`thesis_comparison_markdown` (no
+    options)."""
+    from lvgym.commandline import parse
 
     @dataclass
     class Args:

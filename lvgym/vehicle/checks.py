@@ -3,21 +3,25 @@
 Overlapping tanks, a gimbal outside the vehicle, a tank that feeds an engine its stage does not have,
 a mixture with no oxidiser, a staging sequence that skips a stage; a tank, grain or nozzle wider than its
 stage; an engine or a structure whose CG or gimbal is outside its stage (along the axis or off it); a
-sensor off the stack: each raises :class:`lvgym.errors.ConfigError` naming the file, the key path, the
-value and what is allowed.
+sensor off the stack; a file's tables over flight time against the rest of the vehicle (:func:`check_tables`:
+stations on it, jumps at separations, the mass drop against the engines' flow): each raises
+:class:`lvgym.errors.ConfigError` naming the file, the key path, the value and what is allowed.
 """
 
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
+
+import numpy as np
 
 from lvgym.errors import ConfigError
 
+from .definition import Vehicle
+from .massmodel import MassModel
 from .sections import MATERIALS
+from .timetables import FLOW_ATOL_SHARE, FLOW_RTOL, JUMP_SNAP_S, TimeTable, snap_jumps
 
-if TYPE_CHECKING:
-    from .config import Vehicle
+__all__ = ["check_tables", "check_vehicle", "separations"]
 
 _TOL = 1e-9
 
@@ -196,3 +200,58 @@ def _check_mixture(stage, engine, src: str | None) -> None:
         if not grain_feeds and abs(total - 1.0) > 1e-6:
             raise ConfigError(f"{tanks[0].key}.share", [t.share for t in tanks],
                               f"the shares of the {role!r} tanks of engine {engine.name!r} must add up to 1", src)
+
+
+# ---------------------------------------------------------------------------- the tables
+def separations(vehicle: Vehicle, t_end: float) -> list[float]:
+    """The times [s] of the separations and the fairing jettison up to ``t_end``."""
+    mm = MassModel(vehicle)
+    _, events = mm.advance(mm.initial_state(), t_end)
+    return sorted({t for t, e in events if e.endswith("separation") or e == "fairing jettison"})
+
+
+def check_tables(vehicle: Vehicle) -> None:
+    """The tables against the rest of the vehicle: CG stations on it, no more mode tables than
+    ``structure.n_modes``, jumps at separations, and the mass drop against the engines' flow (module
+    docstring). A :class:`ConfigError` names the row, its numbers and what is allowed."""
+    tables = vehicle.tables
+    if tables is None:
+        return
+    if len(tables.modes) > vehicle.structure.n_modes:
+        raise ConfigError("tables.modes", len(tables.modes), f"at most structure.n_modes = "
+                          f"{vehicle.structure.n_modes} mode tables, one per mode from the first", vehicle.source)
+    every = ([tables.mass_properties] if tables.mass_properties else []) + list(tables.modes)
+    end = max(float(tb.t[-1]) for tb in every)
+    events = separations(vehicle, end + JUMP_SNAP_S)
+    for i, tb in enumerate(tables.modes):
+        snap_jumps(tb, events)
+        if tb.imu_station is not None and tb.imu_station < -vehicle.length:
+            raise ConfigError(f"tables.modes[{i}].imu_station", tb.imu_station, f"a station on the vehicle: in "
+                              f"[{-vehicle.length:g}, 0] m", vehicle.source)
+    mass = tables.mass_properties
+    if mass is None:
+        return
+    for k, x in enumerate(mass.values[:, 1]):
+        if x < -vehicle.length:
+            raise mass.error(k, f"a CG station on the vehicle: in [{-vehicle.length:g}, 0] m")
+    _check_flow(vehicle, snap_jumps(mass, events))
+
+
+def _check_flow(vehicle: Vehicle, mass: TimeTable) -> None:
+    """The table's mass drop from its first row (jumps left out) against the propellant the engines burn."""
+    mm = MassModel(vehicle)
+    times = np.unique(mass.t)
+    stretches, _ = mm.history(times)
+    left = np.concatenate([s.tank_mass.sum(axis=1) + s.grain_mass.sum(axis=1) for s in stretches])
+    burnt = left[0] - left[np.searchsorted(times, mass.t)]                  # [kg] per row
+    m = mass.values[:, 0]
+    steps = np.where(np.diff(mass.t) > 0.0, -np.diff(m), 0.0)
+    drop = np.concatenate([[0.0], np.cumsum(steps)])                         # [kg] per row, jumps left out
+    tol = FLOW_RTOL * burnt[-1] + FLOW_ATOL_SHARE * m[0]
+    for k in range(m.size):
+        if abs(drop[k] - burnt[k]) > tol:
+            raise mass.error(k, f"a mass drop from {mass.t[0]:g} s to {mass.t[k]:g} s (jumps aside) of "
+                             f"{drop[k]:.6g} kg: the engines burn {burnt[k]:.6g} kg by their mass flow, and the two "
+                             f"must agree within {tol:.4g} kg ({FLOW_RTOL:g} of the {burnt[-1]:.6g} kg burnt over "
+                             f"the table plus {FLOW_ATOL_SHARE:g} of the first mass); a staging drop is a jump "
+                             "(its time given twice)")

@@ -32,7 +32,8 @@ import math
 
 import numpy as np
 
-from .config import G0, Vehicle, load_vehicle
+from .config import load_vehicle
+from .definition import G0, Vehicle
 from .massmodel import MassModel
 from .propulsion import P_SEA_LEVEL
 from .structure import vehicle_modes

@@ -26,7 +26,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from .config import G0
+from .definition import G0
 from .propulsion import P_SEA_LEVEL
 
 __all__ = ["stage_file", "stage_geometry", "stage_masses"]

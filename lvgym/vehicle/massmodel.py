@@ -1,6 +1,6 @@
 """Mass model of a multi-stage vehicle at any time: depletion, staging, whole-stack mass properties.
 
-:class:`MassModel` turns a :class:`~lvgym.vehicle.config.Vehicle` into
+:class:`MassModel` turns a :class:`~lvgym.vehicle.definition.Vehicle` into
 
 - a :class:`MassState` (time, propellant left in every tank and grain, the phase of every stage), advanced
   exactly over time by :meth:`MassModel.advance`, which processes every event on the way (tank or grain
@@ -29,7 +29,9 @@ from dataclasses import dataclass, replace
 import numba as nb
 import numpy as np
 
-from .config import Vehicle
+from lvgym.errors import ConfigError
+
+from .definition import Vehicle
 from .propulsion import EngineModel
 from .tanks import CG_CONVENTIONS, TankProperties, grain_properties, tank_properties
 
@@ -183,6 +185,27 @@ def _combine_k(m, c, J, out_m, out_cg, out_J):
             out_cg[b, i] = (cg[i] if some else 0.0) + 0.0
             for j in range(3):
                 out_J[b, i, j] = (Jacc[i, j] if some else 0.0) + 0.0
+
+
+def body_minus_pendulums(t: np.ndarray, mass: np.ndarray, cg: np.ndarray, J: np.ndarray, slosh_mass: np.ndarray,
+                         rest: np.ndarray, key: str, source: str | None):
+    """The rigid body B of a stack (``mass`` (B,) [kg], ``cg`` (B, 3) [m], ``J`` (B, 3, 3) [kg m^2] about it)
+    without its slosh pendulums (``slosh_mass`` (B, N) [kg] at rest at ``rest`` (B, N, 3) [m], point masses):
+    ``m_b`` (B,), ``r_cg_b`` (B, 3), ``J_b`` (B, 3, 3) about B's CG, so that B and the pendulums together are
+    the stack (the parallel-axis sum of :func:`combine_rows` with the pendulums' masses negative); the stack
+    of a vehicle file's ``mass_properties`` table (:mod:`.timetables`). A :class:`ConfigError` naming ``key``
+    when B would have no mass or an impossible inertia at a time ``t`` (B,) [s]."""
+    n = slosh_mass.shape[1]
+    parts = [(mass, cg, J)] + [(-slosh_mass[:, j], rest[:, j], np.zeros((3, 3))) for j in range(n)]
+    m_b, r_b, J_b = combine_rows(parts, mass.size)
+    moments = np.linalg.eigvalsh(J_b) if n else np.ones((mass.size, 3))
+    bad = (m_b <= 0.0) | np.any(moments <= 0.0, axis=1)
+    if bad.any():
+        k = int(np.argmax(bad))
+        raise ConfigError(key, f"t = {t[k]:g} s: {mass[k]:g} kg, slosh masses {slosh_mass[k].sum():g} kg",
+                          "a stack that holds its slosh pendulums: the rigid body left without them needs a "
+                          "positive mass and inertia", source)
+    return m_b, r_b, J_b
 
 
 class MassModel:

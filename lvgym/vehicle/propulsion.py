@@ -14,14 +14,14 @@ from __future__ import annotations
 
 import numpy as np
 
-from .config import G0, Engine
+from .definition import G0, Engine
 
 #: sea-level pressure of a thrust table [Pa]
 P_SEA_LEVEL = 101325.0
 
 
 class EngineModel:
-    """Flow and thrust of one :class:`~lvgym.vehicle.config.Engine`.
+    """Flow and thrust of one :class:`~lvgym.vehicle.definition.Engine`.
 
     ``tau`` is the time since the engine's ignition [s]; ``throttle`` is clipped to the engine's range.
     """

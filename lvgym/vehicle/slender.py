@@ -44,7 +44,8 @@ import yaml
 
 from lvgym.errors import ConfigError
 
-from .config import Vehicle, parse_vehicle
+from .config import parse_vehicle
+from .definition import Vehicle
 from .sections import MATERIALS, tube_area
 
 __all__ = ["DEFAULTS", "TABLE_6_3", "WALL_THICKNESS", "SlenderGeometry", "slender_mapping", "slender_vehicle",
@@ -166,7 +167,7 @@ def slender_mapping(length: float = 8.5, diameter: float = 0.3, fill: float = 1.
 
 def slender_vehicle(length: float = 8.5, diameter: float = 0.3, fill: float = 1.0, mass_flow: float = 30.0,
                     slosh_damping: float = 0.5, **options: Any) -> Vehicle:
-    """The slender vehicle as a checked :class:`~lvgym.vehicle.config.Vehicle`.
+    """The slender vehicle as a checked :class:`~lvgym.vehicle.definition.Vehicle`.
 
     ``length`` [m], ``diameter`` [m], ``fill`` [-], ``mass_flow`` [kg/s], ``slosh_damping`` [-] are
     the factors of Table 6.3; ``options`` are the keyword options of :func:`slender_mapping`
@@ -261,7 +262,7 @@ def slender_yaml(**parameters: Any) -> str:
 
 @dataclass
 class Args:
-    """Command-line arguments (``python -m lvgym.vehicle.slender --help``): the thesis's five factors."""
+    """Command-line arguments (``lvgym vehicle slender --help``): the thesis's five factors."""
 
     length: float = 8.5
     """overall length L [m], in [3, 30]"""
@@ -276,10 +277,9 @@ class Args:
 
 
 def main(argv: list[str] | None = None) -> None:
-    """``python -m lvgym.vehicle.slender``: print the vehicle file of the factors (the defaults:
-    ``lvgym/vehicles/slender.yaml``)."""
-    from lvgym.cli import fail
-    from lvgym.cli.args import command_name, parse
+    """``lvgym vehicle slender`` (``python -m lvgym.vehicle.slender``): print the vehicle file of the factors
+    (the defaults: ``lvgym/vehicles/slender.yaml``)."""
+    from lvgym.commandline import command_name, fail, parse
 
     prog = "python -m lvgym.vehicle.slender"
     args = parse(Args, argv, prog, "Print the YAML vehicle file of the parametric slender vehicle (thesis 6.1-6.2).")

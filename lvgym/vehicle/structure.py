@@ -28,7 +28,7 @@ import numpy as np
 from lvgym.errors import ConfigError
 
 from .beam import BeamModes, stack_modes, transfer
-from .config import Vehicle
+from .definition import Vehicle
 from .massmodel import SEPARATED, MassModel, MassProperties, MassState
 from .sections import MATERIALS, DistributedMass, PointMass, Section, tube
 

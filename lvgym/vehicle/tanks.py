@@ -24,7 +24,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .config import Grain, Tank
+from .definition import Grain, Tank
 
 #: first root of the derivative of the Bessel function J1 [-]
 XI = 1.84119

@@ -12,7 +12,7 @@ for a vehicle known by its published design data rather than by its parts.
 
 ``mass_properties`` replaces the rigid-equivalent stack's mass, CG station and inertia at every row of the
 timeline (Izz = Iyy when the column is left out; the CG on the axis, the inertia diagonal); with slosh
-pendulums, the rigid body B is the table's stack minus the pendulums at rest (:func:`body_minus_pendulums`),
+pendulums, the rigid body B is the table's stack minus the pendulums at rest (:func:`~.massmodel.body_minus_pendulums`),
 so the totals are the table's. Each ``modes`` entry replaces the beam's frequency [Hz] and damping ratio of
 that mode; the mode shape stays the beam's, scaled as a whole (one factor per mode and row, at the gimbal,
 the slosh hinges, the sensors and the aeroelastic strips alike) to the ``slope_gimbal`` column when it is
@@ -26,7 +26,7 @@ twice is a jump (the row before the event, then the row after it), allowed only 
 :data:`JUMP_SNAP_S` of a separation or the fairing jettison, and moved onto that event's time. The mass never
 increases, and its drop between rows (jumps aside) must be what the engines burn by their mass flow within
 :data:`FLOW_RTOL` of the propellant burnt over the table plus :data:`FLOW_ATOL_SHARE` of the first mass
-(:func:`check_tables`). A CSV file has a header line naming the columns (``#`` lines are comments), its
+(:func:`~.checks.check_tables`). A CSV file has a header line naming the columns (``#`` lines are comments), its
 path relative to the vehicle file's folder. Every bad value names the file, the line, the key path, the value
 and what is allowed.
 """
@@ -38,7 +38,7 @@ import hashlib
 import math
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
@@ -46,12 +46,8 @@ from lvgym.errors import ConfigError
 
 from .reader import Reader
 
-if TYPE_CHECKING:
-    from .config import Vehicle
-
 __all__ = ["FLOW_ATOL_SHARE", "FLOW_RTOL", "JUMP_SNAP_S", "MASS_COLUMNS", "MODE_COLUMNS", "TimeTable",
-           "VehicleTables", "before_rows", "body_minus_pendulums", "check_tables", "file_digests", "read_tables",
-           "snap_jumps", "stack_at", "tables_beside"]
+           "VehicleTables", "before_rows", "file_digests", "read_tables", "snap_jumps", "stack_at", "tables_beside"]
 
 #: the columns of ``mass_properties``, the last optional (Izz = Iyy)
 MASS_COLUMNS = ("t", "mass", "cg", "Ixx", "Iyy", "Izz")
@@ -292,16 +288,6 @@ def _check_modes(table: TimeTable, i: int) -> None:
                                   f"[1/(m sqrt(kg))] ({'fourth' if j == 2 else 'fifth'} column)")
 
 
-# ---------------------------------------------------------------------------- the whole vehicle
-def separations(vehicle: Vehicle, t_end: float) -> list[float]:
-    """The times [s] of the separations and the fairing jettison up to ``t_end``."""
-    from .massmodel import MassModel
-
-    mm = MassModel(vehicle)
-    _, events = mm.advance(mm.initial_state(), t_end)
-    return sorted({t for t, e in events if e.endswith("separation") or e == "fairing jettison"})
-
-
 def snap_jumps(table: TimeTable, events: list[float]) -> TimeTable:
     """``table`` with each jump moved onto the separation or jettison time in ``events`` [s] within
     :data:`JUMP_SNAP_S` of it (a :class:`ConfigError` when there is none, or the move would pass a row)."""
@@ -317,55 +303,6 @@ def snap_jumps(table: TimeTable, events: list[float]) -> TimeTable:
             raise table.error(int(k), f"a jump that moves onto the event at {e:.4f} s without passing a row")
         t[k] = t[k + 1] = e
     return replace(table, t=t)
-
-
-def check_tables(vehicle: Vehicle) -> None:
-    """The tables against the rest of the vehicle: CG stations on it, no more mode tables than
-    ``structure.n_modes``, jumps at separations, and the mass drop against the engines' flow (module
-    docstring). A :class:`ConfigError` names the row, its numbers and what is allowed."""
-    tables = vehicle.tables
-    if tables is None:
-        return
-    if len(tables.modes) > vehicle.structure.n_modes:
-        raise ConfigError("tables.modes", len(tables.modes), f"at most structure.n_modes = "
-                          f"{vehicle.structure.n_modes} mode tables, one per mode from the first", vehicle.source)
-    every = ([tables.mass_properties] if tables.mass_properties else []) + list(tables.modes)
-    end = max(float(tb.t[-1]) for tb in every)
-    events = separations(vehicle, end + JUMP_SNAP_S)
-    for i, tb in enumerate(tables.modes):
-        snap_jumps(tb, events)
-        if tb.imu_station is not None and tb.imu_station < -vehicle.length:
-            raise ConfigError(f"tables.modes[{i}].imu_station", tb.imu_station, f"a station on the vehicle: in "
-                              f"[{-vehicle.length:g}, 0] m", vehicle.source)
-    mass = tables.mass_properties
-    if mass is None:
-        return
-    for k, x in enumerate(mass.values[:, 1]):
-        if x < -vehicle.length:
-            raise mass.error(k, f"a CG station on the vehicle: in [{-vehicle.length:g}, 0] m")
-    _check_flow(vehicle, snap_jumps(mass, events))
-
-
-def _check_flow(vehicle: Vehicle, mass: TimeTable) -> None:
-    """The table's mass drop from its first row (jumps left out) against the propellant the engines burn."""
-    from .massmodel import MassModel
-
-    mm = MassModel(vehicle)
-    times = np.unique(mass.t)
-    stretches, _ = mm.history(times)
-    left = np.concatenate([s.tank_mass.sum(axis=1) + s.grain_mass.sum(axis=1) for s in stretches])
-    burnt = left[0] - left[np.searchsorted(times, mass.t)]                  # [kg] per row
-    m = mass.values[:, 0]
-    steps = np.where(np.diff(mass.t) > 0.0, -np.diff(m), 0.0)
-    drop = np.concatenate([[0.0], np.cumsum(steps)])                         # [kg] per row, jumps left out
-    tol = FLOW_RTOL * burnt[-1] + FLOW_ATOL_SHARE * m[0]
-    for k in range(m.size):
-        if abs(drop[k] - burnt[k]) > tol:
-            raise mass.error(k, f"a mass drop from {mass.t[0]:g} s to {mass.t[k]:g} s (jumps aside) of "
-                             f"{drop[k]:.6g} kg: the engines burn {burnt[k]:.6g} kg by their mass flow, and the two "
-                             f"must agree within {tol:.4g} kg ({FLOW_RTOL:g} of the {burnt[-1]:.6g} kg burnt over "
-                             f"the table plus {FLOW_ATOL_SHARE:g} of the first mass); a staging drop is a jump "
-                             "(its time given twice)")
 
 
 # ---------------------------------------------------------------------------- applied
@@ -384,26 +321,3 @@ def stack_at(mass: TimeTable, t: Any, before: Any = False) -> tuple[np.ndarray, 
     J = np.zeros((v.shape[0], 3, 3))
     J[:, 0, 0], J[:, 1, 1], J[:, 2, 2] = v[:, 2], v[:, 3], v[:, 4]
     return v[:, 0].copy(), cg, J
-
-
-def body_minus_pendulums(t: np.ndarray, mass: np.ndarray, cg: np.ndarray, J: np.ndarray, slosh_mass: np.ndarray,
-                         rest: np.ndarray, key: str, source: str | None):
-    """The rigid body B of a stack (``mass`` (B,) [kg], ``cg`` (B, 3) [m], ``J`` (B, 3, 3) [kg m^2] about it)
-    without its slosh pendulums (``slosh_mass`` (B, N) [kg] at rest at ``rest`` (B, N, 3) [m], point masses):
-    ``m_b`` (B,), ``r_cg_b`` (B, 3), ``J_b`` (B, 3, 3) about B's CG, so that B and the pendulums together are
-    the stack (the parallel-axis sum of :func:`~.massmodel.combine_rows` with the pendulums' masses
-    negative). A :class:`ConfigError` naming ``key`` when B would have no mass or an impossible inertia at a
-    time ``t`` (B,) [s]."""
-    from .massmodel import combine_rows
-
-    n = slosh_mass.shape[1]
-    parts = [(mass, cg, J)] + [(-slosh_mass[:, j], rest[:, j], np.zeros((3, 3))) for j in range(n)]
-    m_b, r_b, J_b = combine_rows(parts, mass.size)
-    moments = np.linalg.eigvalsh(J_b) if n else np.ones((mass.size, 3))
-    bad = (m_b <= 0.0) | np.any(moments <= 0.0, axis=1)
-    if bad.any():
-        k = int(np.argmax(bad))
-        raise ConfigError(key, f"t = {t[k]:g} s: {mass[k]:g} kg, slosh masses {slosh_mass[k].sum():g} kg",
-                          "a stack that holds its slosh pendulums: the rigid body left without them needs a "
-                          "positive mass and inertia", source)
-    return m_b, r_b, J_b

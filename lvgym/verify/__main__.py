@@ -8,7 +8,7 @@ import sys
 import time
 from dataclasses import dataclass
 
-from lvgym.cli.args import parse
+from lvgym.commandline import parse
 
 from . import ALL_CASES, table
 

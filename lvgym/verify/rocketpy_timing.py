@@ -2,8 +2,8 @@
 
 ``lvgym verify rocketpy`` prints this table after its comparisons (``--no-timing`` skips it);
 ``lvgym verify rocketpy-timing`` (``python -m lvgym.verify.rocketpy_timing``) prints it alone. Both simulators fly the main case of
-:mod:`.rocketpy_case` (85 deg, 10 m rail) twice in one process, after the imports and after Numba has
-loaded its compiled kernels (a warm-up flight of each, or the comparisons, ran first):
+:mod:`.rocketpy_case` (85 deg, 10 m rail; the flights of :mod:`.rocketpy_flights`) twice in one process, after the
+imports and after Numba has loaded its compiled kernels (a warm-up flight of each, or the comparisons, ran first):
 
 * lvgym **cold**: an empty timeline cache (a fresh ``$LVGYM_CACHE_DIR``) and the process's vehicles
   forgotten (:func:`lvgym.vehicle.clear_vehicle_cache`), so its set-up parses the vehicle file, builds its
@@ -17,7 +17,7 @@ loaded its compiled kernels (a warm-up flight of each, or the comparisons, ran f
   ``Flight`` (LSODA to apogee).
 
 lvgym's flight: 3,300 calls of 50 ms from Python, each reading the conditions back (how
-:func:`~.rocketpy_case.fly_lvgym` records the histories it compares), and in a third row the same flight
+:func:`~.rocketpy_flights.fly_lvgym` records the histories it compares), and in a third row the same flight
 as one ``Simulator.step`` call from lift-off to the time the recorded flight stopped (RocketPy's numbers
 of that row are those of its second flight).
 """
@@ -29,11 +29,11 @@ import tempfile
 import time
 from dataclasses import dataclass, replace
 
-from lvgym.cli.args import arg, parse
+from lvgym.commandline import arg, parse
 from lvgym.simulator.cache import using
 from lvgym.vehicle import clear_vehicle_cache
 
-from .rocketpy_case import ELEVATION_DEG, RAIL_LENGTH, VEHICLE, Trajectory, fly_lvgym, fly_rocketpy, lvgym_simulator
+from .rocketpy_flights import ELEVATION_DEG, RAIL_LENGTH, VEHICLE, Trajectory, fly_lvgym, fly_rocketpy, lvgym_simulator
 
 
 def timings(elevation_deg: float = ELEVATION_DEG, rail_length: float = RAIL_LENGTH, warm_up: bool = True
