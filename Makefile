@@ -24,7 +24,7 @@ test: $(STAMP)
 	$(PY) -m pytest -n auto
 
 bench: $(STAMP)
-	$(PY) -m lvgym.bench
+	$(VENV)/bin/lvgym bench
 	$(PY) -m lvgym.bench_envs
 
 # rollouts of every classical baseline and shipped learned policy on every v2 suite, as Minari datasets

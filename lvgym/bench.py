@@ -84,10 +84,8 @@ class Args:
     """seconds per measurement"""
 
 
-def main(argv: list[str] | None = None) -> None:
-    """``lvgym bench`` (``python -m lvgym.bench``): print the table."""
-    args = parse(Args, argv, "python -m lvgym.bench", __doc__)
-    rows = run(args.min_time)
+def print_table(rows: list[dict]) -> None:
+    """Print :func:`run`'s rows as a Markdown table."""
     print(f"# RK4 steps per second, one core ({platform.processor() or platform.machine()}, "
           f"{os.cpu_count()} cores, numba)\n")
     print("| model | vehicles | vehicle-steps/s | one step per Python call |")
@@ -95,6 +93,13 @@ def main(argv: list[str] | None = None) -> None:
     for r in rows:
         extra = f"{r['python_call_steps_per_s']:,.0f}" if "python_call_steps_per_s" in r else ""
         print(f"| {r['model']} | {r['vehicles']} | {r['steps_per_s']:,.0f} | {extra} |")
+
+
+def main(argv: list[str] | None = None) -> None:
+    """``python -m lvgym.bench``: print the table of the dynamics core (``lvgym bench`` prints it and the control
+    laws')."""
+    args = parse(Args, argv, "python -m lvgym.bench", __doc__)
+    print_table(run(args.min_time))
 
 
 if __name__ == "__main__":

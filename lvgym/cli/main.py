@@ -44,7 +44,8 @@ COMMANDS: tuple[Command, ...] = (
         Command("rocketpy-timing", "lvgym.verify.rocketpy_timing:main", "wall times of lvgym and RocketPy, the "
                 "same flight", "dev", ("rocketpy",)),
     )),
-    Command("bench", "lvgym.bench:main", "speed of the dynamics core (RK4 steps per second)"),
+    Command("bench", "lvgym.cli.bench:main", "speed of the dynamics core (RK4 steps per second) and of the shipped "
+            "control laws (microseconds per row-step at 1 and 1,024 rows)", "benchmark", _BENCHMARK),
     Command("bench-envs", "lvgym.bench_envs:main", "speed of the ascent envs (env steps per second, construction)"),
     Command("studies", "lvgym.studies.__main__:main", "the thesis's studies: doe, ld-sweep, tw-sweep", "studies",
             ("pandas", "statsmodels", "matplotlib")),
