@@ -39,7 +39,7 @@ from __future__ import annotations
 
 import json
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -242,7 +242,8 @@ class InversionLaw(BatchLaw):
     """The law of the module docstring on the observer's estimated terms for ``n`` rows (the benchmark's
     policy; no privileged information): one window per row, the observer on every row's window in one call
     (:meth:`~lvgym.agents.observer.Observer.rows`), the law on the rows at once (elementwise: a row's action does
-    not depend on the others). ``observer``: an :class:`~lvgym.agents.observer.Observer`; ``trained``: the
+    not depend on the others). ``observer``: an :class:`~lvgym.agents.observer.Observer` (or a callable of one
+    window, applied to each row's window in turn); ``trained``: the
     :func:`env_record` it was trained on (it refuses another env: :func:`check_env`); ``lead``, ``span``: the
     control steps the estimated aerodynamic moment is carried ahead along its slope over ``span`` steps
     (:class:`Lead`; 0: the moment as estimated), after its average over ``average`` steps (1: none); ``law``:
@@ -251,12 +252,16 @@ class InversionLaw(BatchLaw):
     (:class:`Staging`) in place of the estimated aerodynamic moment (0: never), ``ignition_share`` of it and the
     rest of the estimate (1: the measured alone)."""
 
-    def __init__(self, env: Any, observer: Observer, name: str = "inversion-id",
+    def __init__(self, env: Any, observer: Observer | Callable[[np.ndarray], np.ndarray], 
+                 name: str = "inversion-id",
                  trained: dict[str, Any] | None = None, lead: int = 0, span: int = SPAN,
                  law: Law | None = None, average: int = 1, ignition: float = 0.0,
                  ignition_share: float = 1.0, n: int = 1) -> None:
         check_env(env, trained or {})
         self.observer = observer
+        #: the observer on every row's window: an Observer's own rows, else (a study's callable of one window)
+        #: the callable on each window
+        self.estimate = getattr(observer, "rows", None) or (lambda ws: np.stack([observer(w) for w in ws]))
         self.name = name
         self.index, (self.w, self.z) = error_index(env), gains(env, law)
         self.lead, self.span, self.average = int(lead), int(span), int(average)
@@ -282,7 +287,7 @@ class InversionLaw(BatchLaw):
         windows moved on by one."""
         rows = np.asarray(rows, dtype=np.int64).reshape(-1)
         o = np.asarray(observations, dtype=np.float32)
-        terms = self.observer.rows(self.window.push(rows, o))
+        terms = self.estimate(self.window.push(rows, o))
         terms[:, 0:2] = self.ahead.push(rows, terms[:, 0:2])
         if self.fresh is not None:                     # the next stage's first seconds: the measured moment
             lit, measured = self.fresh
@@ -301,7 +306,7 @@ class InversionLaw(BatchLaw):
 class InversionPolicy(RowFace):
     """:class:`InversionLaw` (its arguments) for one env row: the benchmark's policy."""
 
-    def __init__(self, env: Any, observer: Observer, name: str = "inversion-id",
+    def __init__(self, env: Any, observer: Observer | Callable[[np.ndarray], np.ndarray], name: str = "inversion-id",
                  trained: dict[str, Any] | None = None, lead: int = 0, span: int = SPAN,
                  law: Law | None = None, average: int = 1, ignition: float = 0.0,
                  ignition_share: float = 1.0) -> None:

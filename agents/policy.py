@@ -434,5 +434,6 @@ if __name__ == "__main__":
     main()
 
 
-__all__ = ["PRIVILEGED_OBSERVATIONS", "SB3Law", "SB3Policy", "actor_net", "adapt", "copy_policy", "load_model", "load_policy",
-           "load_vecnormalize", "policy_files", "privileged_env_options", "privileged_options", "read_meta", "resolve_model_path", "save_policy"]
+__all__ = ["PRIVILEGED_OBSERVATIONS", "SB3Law", "SB3Policy", "actor_net", "adapt", "copy_policy", "load_model",
+           "load_policy", "load_vecnormalize", "policy_files", "privileged_env_options", "privileged_options", "read_meta",
+           "resolve_model_path", "save_policy"]
