@@ -4,7 +4,8 @@ disturbance observer, trained, chosen and recorded in one command.
     lvgym train --recipe teacher-student --suite smile-v2-faults --seeds 0 1 2 --flights 100 --rounds 4 \\
         --validation 50 --loop-gain-db 6 --flight-options lead=3,average=6,ignition=4,ignition_share=0.5
     lvgym train --recipe teacher-student --suite smile-v2 --flights 200 --epochs 16 --lead 5 --bandwidth 1.25
-    lvgym evaluate --suites smile-v2-faults --policies results/teacher-student/smile-v2-faults/inversion_id_smile_v2_faults.json
+    lvgym evaluate --suites smile-v2-faults \
+        --policies results/teacher-student/smile-v2-faults/inversion_id_smile_v2_faults.json
 
 1. **Per training seed** (:mod:`lvgym.agents.dagger`): the teacher (the law on the true terms from the env's
    privileged info, an exploration noise on its action; :mod:`lvgym.agents.teacher`) flies ``--flights`` per
@@ -178,7 +179,8 @@ def run(a: Args, argv: Sequence[str]) -> Path:
     from .teacher import condition, own_law, scheme, validate
 
     env_opts = {"mission_time_s": a.mission_time_s} if a.mission_time_s else {}
-    suite, margin_suite = get_suite(a.suite).with_options(**env_opts), get_suite(a.margin_suite).with_options(**env_opts)
+    suite = get_suite(a.suite).with_options(**env_opts)
+    margin_suite = get_suite(a.margin_suite).with_options(**env_opts)
     trained_env = env_record(condition("nonrigid", a.suite).make_env())
     if a.flight_options and env_record(margin_suite.conditions[-1].make_env()) != trained_env:
         raise ConfigError("--margin-suite", a.margin_suite, f"a suite of {a.suite}'s env {trained_env}")
@@ -235,17 +237,18 @@ def run(a: Args, argv: Sequence[str]) -> Path:
     options = dict(base)
     if a.flight_options:
         rule = Rule(a.min_gain_margin_db, a.min_delay_margin_ms, a.max_extra_losses, a.max_worse)
-        say(f"flight options on validation seeds 0-{a.option_validation - 1} ({rule.text(a.option_validation, a.margin_suite, a.margin_seeds)}):")
-        folder = out / "options"
+        text = rule.text(a.option_validation, a.margin_suite, a.margin_seeds)
+        say(f"flight options on validation seeds 0-{a.option_validation - 1} ({text}):")
+        kept = out / "options"
 
         def write(label: str, opts: dict[str, Any]) -> Path:
-            return write_record(folder / f"{label}.json", record(weights, opts, folder))
+            return write_record(kept / f"{label}.json", record(weights, opts, kept))
 
         picked = choose_options(base, [parse_option("--flight-options", t) for t in a.flight_options], write,
                                 suite, a.option_validation, margin_suite, a.margin_seeds, rule, a.workers, say)
         options = picked["options"]
         flight = {"options": {k: v for k, v in flown(**options).items() if k != "law"},
-                  "rule": rule.text(a.option_validation, a.margin_suite, a.margin_seeds),
+                  "rule": text,
                   "seeds": f"0-{a.option_validation - 1}", "chosen": picked["label"],
                   "candidates": {label: {k: v for k, v in flown(**o).items() if k != "law"}
                                  for label, o in picked["labels"].items()},
@@ -260,8 +263,8 @@ def run(a: Args, argv: Sequence[str]) -> Path:
     training = ({"command": command, "observer": str(a.observer)} if a.observer is not None else
                 {"command": command, "seeds": list(a.seeds), "file": f"seed{best}/observer.pt",
                  **{k: getattr(a, k) for k in ("flights", "rounds", "epochs", "loop_gain_db", "lead", "bandwidth")},
-                 "env_seeds": f"{TRAIN_SEED0:,} + {SEED_STRIDE:,} seed + {ROUND_STRIDE:,} round + i (neither validation "
-                              f"nor test seeds)", **({"wall_time_s": walls} if walls else {})})
+                 "env_seeds": f"{TRAIN_SEED0:,} + {SEED_STRIDE:,} seed + {ROUND_STRIDE:,} round + i (neither "
+                              "validation nor test seeds)", **({"wall_time_s": walls} if walls else {})})
     final = {k: v for k, v in record(target, options, out).items() if k != "observer"}
     final.update(training=training, date=datetime.date.today().isoformat(),
                  validation={"seeds": f"0-{a.selection - 1}", "candidates": scores, "chosen": _key(best),

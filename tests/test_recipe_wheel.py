@@ -41,7 +41,8 @@ def _run(args: list, cwd: Path, **env: str) -> subprocess.CompletedProcess:
 def test_the_installed_recipe_trains_records_and_its_record_flies(tmp_path):
     src = tmp_path / "src"
     shutil.copytree(ROOT, src, ignore=SKIP)
-    _run([sys.executable, "-m", "pip", "wheel", "--no-deps", "--quiet", "--wheel-dir", tmp_path / "dist", src], tmp_path)
+    _run([sys.executable, "-m", "pip", "wheel", "--no-deps", "--quiet", "--wheel-dir", tmp_path / "dist", src],
+         tmp_path)
     (wheel,) = (tmp_path / "dist").glob("lvgym-*.whl")
     venv = tmp_path / "venv"
     _run([sys.executable, "-m", "venv", venv], tmp_path)

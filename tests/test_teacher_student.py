@@ -187,7 +187,8 @@ def test_the_recipe_end_to_end_on_a_short_mission(tmp_path, capsys):
     assert record["training"]["command"] == "lvgym train --recipe teacher-student " + " ".join(argv)
     assert record["sha256"] == sha256(out / "inversion_id_smile_v2.npz") and "observer" not in record
     cands = record["validation"]["candidates"]
-    best = min(cands, key=lambda k: (cands[k]["nonrigid"]["failed_or_unflyable"], cands[k]["nonrigid"]["score_v2_mean"]))
+    best = min(cands, key=lambda k: (cands[k]["nonrigid"]["failed_or_unflyable"],
+                                     cands[k]["nonrigid"]["score_v2_mean"]))
     assert record["validation"]["chosen"] == int(best) and set(cands) == {"0", "1"}
     assert sha256(out / f"seed{best}" / "observer.npz") == record["sha256"]
     flight = record["flight"]

@@ -35,8 +35,8 @@ After each fit the student flies validation seeds ``0 .. --validation - 1`` of b
 mean ``score_v2`` and its failed or unflyable flights are printed (``lqg``: 0.994 (6) rigid, 1.109 (7)
 non-rigid on seeds 0-99; ``lqg`` with the true misalignment 0.778 (2), 0.900 (2): README.md). A run's memory
 is its data (float32 windows, 1.6 kB per step; the fit's standard deviation is taken in chunks of rows,
-:func:`lvgym.agents.observer_fit.row_std`): SMILE's ``--flights 200 --rounds 4`` reach 3.9 M steps, 6.3 GB, and about 7 GB per
-process at round 3; three such runs at once outgrow 24 GB in round 4.
+:func:`lvgym.agents.observer_fit.row_std`): SMILE's ``--flights 200 --rounds 4`` reach 3.9 M steps, 6.3 GB,
+and about 7 GB per process at round 3; three such runs at once outgrow 24 GB in round 4.
 """
 
 from __future__ import annotations
