@@ -3,9 +3,10 @@ dependencies into a fresh virtual environment that sees this interpreter's packa
 numba, ...) after its own, ``lvgym train --recipe teacher-student`` trains, chooses and records an observer on a
 short mission, and ``lvgym evaluate --policies <record>.json`` flies the policy the record names.
 
-Marked ``slow``: the fresh environment compiles the flight model's numba kernels again (its cache follows the
-installed files' paths), 100-160 s of the 3-4 minutes this takes on 2 shared cores; the recipe itself at
-this budget takes about 15 s (tests/test_teacher_student.py runs it in the development environment).
+Marked ``slow``: the fresh environment compiles the flight model's numba kernels again (numba's cache follows
+the installed files' paths): a single env's first reset and step took 163 s on a cold cache, and the whole test
+412 s, on 2 cores shared with other runs. The recipe itself at this budget takes about 15 s with the kernels
+compiled (tests/test_teacher_student.py runs it in the development environment).
 """
 
 from __future__ import annotations
