@@ -99,7 +99,8 @@ class Args:
     selection: int = arg(100, lo=1, hi=10_000)
     """validation seeds per flight model on which the seed that ships is chosen"""
     observer: Path | None = None
-    """a trained observer (.npz or .pt) to choose flight options for, in place of training (default: train)"""
+    """a trained observer (.npz or .pt) to choose flight options for, in place of training: --seeds and the
+    training options are then not used (default: train)"""
     flight_options: list[str] = arg(default_factory=list, nargs="*", check=_options, metavar="KEY=VALUE,...")
     """candidate flight options tried in order, each comma-separated pairs of lead, average, ignition [s] and
     ignition_share (e.g. lead=3,average=6,ignition=4,ignition_share=0.5; default: none, the options as trained)"""
