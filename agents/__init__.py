@@ -11,13 +11,17 @@ lvgym envs.
 - :mod:`lvgym.agents.residual`: residual policies on a classical baseline (training wrapper and adapter);
 - :mod:`lvgym.agents.inversion`: ``inversion-id``, the privileged reference's law on a learned disturbance
   observer (:mod:`lvgym.agents.observer`, NumPy at flight time; fitted with :mod:`lvgym.agents.observer_fit`);
+- :mod:`lvgym.agents.teacher_student`: its recipe (``lvgym train --recipe teacher-student``), with
+  :mod:`lvgym.agents.teacher` (the teacher's and the student's flights), :mod:`lvgym.agents.dagger` (one training
+  seed's rounds), :mod:`lvgym.agents.flight_options` (the choices on validation seeds) and
+  :mod:`lvgym.agents.inversion_record` (the record and the policy it names);
 - :mod:`experiments.rigid_vs_nonrigid_training.robustness`: the rigid-trained vs nonrigid-trained experiment.
 
 Training is ``lvgym train`` (``docs/training.md``). Nothing in ``lvgym`` imports this package (the command
 layer names it); importing it does not import stable-baselines3 (the submodules do). Importing it registers
 the shipped learned policies with the benchmark (``ppo``, ``ppo-res-lqg``, ``inversion-id``,
 ``inversion-id-stratos``, ``inversion-id-smile``) and the loaders of saved models (``evaluate.py --policies
-runs/my_run``, ``model.zip`` or a cloned ``bc.pt``); their factories are named as strings, imported only where
+runs/my_run``, ``model.zip``, a cloned ``bc.pt`` or an observer's record ``.json``); their factories are named as strings, imported only where
 a policy flies.
 """
 
@@ -40,5 +44,9 @@ register_policy("inversion-id-smile", "lvgym.agents.inversion:shipped_inversion"
 # observations) or a train.py run folder (its best model)
 register_policy_loader("lvgym.agents.policy:load_policy", suffixes=(".zip",), folders=True,
                        description="a stable-baselines3 .zip model or a train.py run folder")
+# a learned disturbance observer's record (.json beside its .npz: lvgym train --recipe teacher-student writes one,
+# agents/trained holds the shipped ones): evaluate.py --policies results/teacher-student/smile-v2/inversion_id_smile_v2.json
+register_policy_loader("lvgym.agents.inversion_record:from_record", suffixes=(".json",),
+                       description="a disturbance observer's record .json (lvgym train --recipe teacher-student)")
 # a policy cloned by ``lvgym bc`` (its .pt file): evaluate.py --policies runs/student-s0.pt
 register_policy_loader("lvgym.agents.bc:policy", suffixes=(".pt",), description="a cloned policy .pt (lvgym bc)")

@@ -24,7 +24,7 @@ the observation only.
 
 The shipped observer (:data:`SHIPPED`, ``agents/trained``) was trained on SMILE's fault suite, both flight
 models, with the reference's law on the true terms as the teacher and DAgger rounds
-(``python -m experiments.fault_id.train --scheme inversion``); ``inversion-id-stratos``'s on Stratos III and
+(``lvgym train --recipe teacher-student``, :mod:`lvgym.agents.teacher_student`); ``inversion-id-stratos``'s on Stratos III and
 ``inversion-id-smile``'s on ``smile-v2``, the law flying its estimated moment carried 3 and 5 steps ahead
 (:class:`Lead`, the record's ``lead``), ``inversion-id-smile``'s law at a non-rigid bandwidth of 1.25 rad/s
 (:func:`gains`, the record's ``law``). A policy refuses an env its observer was not trained for

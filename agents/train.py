@@ -11,6 +11,7 @@
     lvgym train --residual gs-pid-flex --residual-scale 0.2
     lvgym train --suite smile-v2-faults --residual lqg-front   # a v2 suite's condition, validated on it
     lvgym train --suite family-v2-informed --family-vehicles 8 --residual auto-lqg   # the family's train vehicles
+    lvgym train --recipe teacher-student --help            # inversion-id's recipe: its own options
 
 (``python train.py`` in a checkout is the same command.) A run lives in ``runs/<name>/``: ``config.yaml``
 (every argument, the resolved hyperparameters and env keywords, lvgym version, git commit),
@@ -30,6 +31,10 @@ next env step, says so and exits normally (status 0; ``--resume`` continues it).
 ``--progress-interval-s`` seconds gives the step, the speed, the time spent and left and the latest
 validation score. Every option is checked before the run folder is made: a bad value is a one-line error
 and leaves nothing behind.
+
+``--recipe teacher-student`` hands the rest of the command line over to the recipe of the shipped
+``inversion-id`` policies (:mod:`lvgym.agents.teacher_student`: a privileged teacher, DAgger rounds, a learned
+disturbance observer, its flight options chosen on validation seeds), which has its own options.
 """
 
 from __future__ import annotations
@@ -56,6 +61,9 @@ __all__ = ["Args", "DEFAULT_EVAL_SUITES", "RECIPES", "RESUME_OVERRIDABLE", "chec
            "training_seed"]
 
 PROG = "train.py"
+#: the recipes ``--recipe`` chooses: stable-baselines3's runs (this module) or the teacher-student recipe
+#: (:mod:`lvgym.agents.teacher_student`, its own options)
+TRAINERS = ("sb3", "teacher-student")
 #: the options a resumed run takes from the command line (the rest from its config.yaml)
 RESUME_OVERRIDABLE = ("resume", "progress", "torch_threads", "verbose", "total_timesteps", "checkpoint_interval_s",
                       "max_wall_time_s", "progress_interval_s")
@@ -78,6 +86,9 @@ def _choices(name: str) -> Any:
 class Args:
     """Command-line arguments (``lvgym train --help``)."""
 
+    recipe: str = arg("sb3", choices=TRAINERS)
+    """sb3: a stable-baselines3 run (the options below); teacher-student: the recipe of the shipped inversion-id
+    policies, with its own options (lvgym train --recipe teacher-student --help)"""
     env_id: str = arg("lvgym/SmileAscent-v1", choices=_choices("env_id"))
     """registered lvgym env id (the options an id's recipe sets, RECIPES, default to it)"""
     suite: str | None = arg(None, check=suite_option)
@@ -388,8 +399,31 @@ def _train(args: Args, given: set[str], stop: Any, t0: float) -> Path:
     return run_dir
 
 
+def _recipe(argv: list[str]) -> tuple[str, list[str]]:
+    """The ``--recipe`` named on ``argv`` (``sb3`` when none) and ``argv`` without it."""
+    for i, word in enumerate(argv):
+        if word == "--":
+            break
+        if word == "--recipe" and i + 1 < len(argv):
+            return argv[i + 1], argv[:i] + argv[i + 2:]
+        if word.startswith("--recipe="):
+            return word.partition("=")[2], argv[:i] + argv[i + 1:]
+    return "sb3", argv
+
+
 def main(argv: list[str] | None = None) -> None:
-    """``lvgym train`` / ``python train.py``: run (or resume) a training run."""
+    """``lvgym train`` / ``python train.py``: run (or resume) a training run; ``--recipe teacher-student``: the
+    teacher-student recipe (:mod:`lvgym.agents.teacher_student`) with the rest of the command line."""
+    argv = list(sys.argv[1:] if argv is None else argv)
+    recipe, rest = _recipe(argv)
+    if recipe == "teacher-student":
+        from lvgym.cli.args import running_as
+
+        from .teacher_student import main as teacher_student
+
+        with running_as(f"{_prog()} --recipe teacher-student"):
+            teacher_student(rest)
+        return
     exit_on_sigterm()                                # SIGTERM before training: clean up and exit
     train(argv)
 

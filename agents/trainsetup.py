@@ -111,6 +111,9 @@ def check_options(args: Any) -> None:
     from lvgym.envs.spec import RANDOMIZE
 
     check_fields(args)
+    if getattr(args, "recipe", "sb3") != "sb3":
+        raise ConfigError("--recipe", args.recipe, "sb3 for a stable-baselines3 run (lvgym train --recipe "
+                                                   "teacher-student takes its own options, not these)")
     residual_options(args.residual, args.residual_scale)
     loop_dispersion_options(args.loop_gain_db, args.loop_delay_periods)
     load_margin_options(args.load_margin, args.load_margin_threshold)

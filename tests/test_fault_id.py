@@ -132,16 +132,6 @@ def test_the_inversion_teacher_flies_a_family_vehicle_and_the_thrust_scheme_refu
         main(["--suite", "family-v2", "--scheme", "thrust"])
 
 
-def test_the_ship_scores_each_flight_model_apart():
-    """``nonrigid`` ends in ``rigid``: the split is on the condition's last part (it once mixed them)."""
-    from experiments.fault_id.ship import per_model
-    recs = [{"condition": "smile-v2-faults/rigid", "score_v2": 1.0, "failed": False, "flyable": True},
-            {"condition": "smile-v2-faults/nonrigid", "score_v2": 3.0, "failed": True, "flyable": True},
-            {"condition": "smile-v2-faults/nonrigid", "score_v2": 2.0, "failed": False, "flyable": False}]
-    assert per_model(recs) == {"rigid": {"score_v2_mean": 1.0, "failed_or_unflyable": 0},
-                               "nonrigid": {"score_v2_mean": 2.5, "failed_or_unflyable": 2}}
-
-
 def test_the_feasibility_study_lists_each_lost_flight_once_with_who_lost_it():
     from experiments.fault_id.feasible import failed
     recs = [{"suite": "smile-v2-faults", "condition": "smile-v2-faults/nonrigid", "seed": 7, "policy": p,
@@ -289,7 +279,7 @@ def test_a_configuration_of_the_study_is_a_row_of_factories_and_a_label_to_compa
 def test_the_rounds_data_grows_in_place_as_their_concatenation():
     """Batches of windows appended (past the room reserved, then grown by a quarter) read as the batches
     concatenated, as views of one array."""
-    from experiments.fault_id.fitting import Data
+    from lvgym.agents.observer_fit import Data
 
     rng = np.random.default_rng(0)
     xs = [rng.normal(size=(n, 3, 2)).astype(np.float32) for n in (5, 7, 2, 9)]
@@ -312,10 +302,11 @@ def test_a_resumed_run_takes_the_finished_rounds_fits_and_ends_as_the_whole_run(
     """``--resume``: the rounds' flights are flown again (the same data), each round whose fit was left on disk
     is read, not fitted, and the final ensemble is the uninterrupted run's to the bit."""
     from experiments.fault_id import train
+    from lvgym.agents import dagger
     from lvgym.agents.observer_fit import load
 
-    real = train.fly
-    monkeypatch.setattr(train, "fly", lambda *a, **k: real(*a, mission_time_s=2.0, **k))
+    real = dagger.fly
+    monkeypatch.setattr(dagger, "fly", lambda *a, **k: real(*a, mission_time_s=2.0, **k))
     monkeypatch.setattr(train, "RESULTS", tmp_path)
     argv = ["--scheme", "inversion", "--suite", "smile-v2", "--flights", "10", "--rounds", "2", "--epochs", "1",
             "--validation", "0"]
@@ -337,9 +328,10 @@ def test_a_resumed_run_takes_the_finished_rounds_fits_and_ends_as_the_whole_run(
 
 def test_the_bandwidth_names_the_runs_files_and_the_thrust_scheme_refuses_it(monkeypatch, tmp_path):
     from experiments.fault_id import train
+    from lvgym.agents import dagger
 
-    real = train.fly
-    monkeypatch.setattr(train, "fly", lambda *a, **k: real(*a, mission_time_s=2.0, **k))
+    real = dagger.fly
+    monkeypatch.setattr(dagger, "fly", lambda *a, **k: real(*a, mission_time_s=2.0, **k))
     monkeypatch.setattr(train, "RESULTS", tmp_path)
     train.main(["--scheme", "inversion", "--suite", "smile-v2", "--flights", "10", "--rounds", "0", "--epochs", "1",
                 "--validation", "0", "--lead", "5", "--bandwidth", "1.25"])
@@ -352,7 +344,7 @@ def test_the_bandwidth_names_the_runs_files_and_the_thrust_scheme_refuses_it(mon
 @pytest.mark.parametrize(("n", "rows"), [(1, 4), (37, 5), (1000, 64), (20_001, 1 << 16)])
 def test_the_fits_standard_deviation_is_numpys_to_the_bit(n, rows):
     """``row_std`` (chunks of ``rows`` rows, no temporary of the whole data) is ``std(0)`` bit for bit."""
-    from experiments.fault_id.fitting import row_std
+    from lvgym.agents.observer_fit import row_std
     flat = np.random.default_rng(n).normal(3.0, 2.0, (n, 16)).astype(np.float32)
     assert np.array_equal(row_std(flat, flat.mean(0), rows), flat.std(0))
 
@@ -394,7 +386,7 @@ def test_the_rounds_weights_grow_with_their_data_and_weigh_the_fits_mean_error(c
     """The weights appended beside the windows (1 where none are given; None, the plain mean, when all are
     1), and a fit's first epoch in one batch reports the weighted mean of the initial network's errors:
     sum(w mean_j e_j^2) / sum(w), the network drawn from the same seed."""
-    from experiments.fault_id.fitting import Data
+    from lvgym.agents.observer_fit import Data
     from lvgym.agents.observer_fit import Estimator
 
     rng = np.random.default_rng(1)
@@ -411,7 +403,7 @@ def test_the_rounds_weights_grow_with_their_data_and_weigh_the_fits_mean_error(c
     reported = float(capsys.readouterr().out.split("mean squared error ")[1].split()[0])
     torch.manual_seed(3)
     flat = x.reshape(-1, FEATURES)
-    from experiments.fault_id.fitting import row_std
+    from lvgym.agents.observer_fit import row_std
     first = Estimator(flat.mean(0), row_std(flat, flat.mean(0)) + 1e-6, outputs=3, label_mean=y.mean(0),
                       label_std=y.std(0) + 1e-6)
     with torch.no_grad():
@@ -425,8 +417,9 @@ def test_the_ignition_weight_names_the_runs_files_and_weighs_the_windows_after_i
     (the flights' times since it, here every other step 0.5 s after, the rest before) weigh 10 in the fit;
     the files end ``-ign10``."""
     from experiments.fault_id import train
+    from lvgym.agents import dagger
 
-    real, seen = train.fly, []
+    real, seen = dagger.fly, []
 
     def fly_short(*a, **k):
         x, y, r, _ = real(*a, mission_time_s=2.0, **k)
@@ -436,9 +429,9 @@ def test_the_ignition_weight_names_the_runs_files_and_weighs_the_windows_after_i
         seen.append(weight.copy())
         return real_fit(x, y, seed, epochs, scaled, weight)
 
-    real_fit = train.fit
-    monkeypatch.setattr(train, "fly", fly_short)
-    monkeypatch.setattr(train, "fit", fit_seen)
+    real_fit = dagger.fit
+    monkeypatch.setattr(dagger, "fly", fly_short)
+    monkeypatch.setattr(dagger, "fit", fit_seen)
     monkeypatch.setattr(train, "RESULTS", tmp_path)
     train.main(["--scheme", "inversion", "--suite", "smile-v2", "--flights", "10", "--rounds", "0", "--epochs", "1",
                 "--validation", "0", "--ignition-weight", "10", "--ignition-s", "1"])
@@ -476,29 +469,3 @@ def test_the_teachers_upset_cancels_a_drawn_share_of_the_moment_for_a_drawn_whil
         fly("rigid", [7], None, np.random.default_rng(0), upset=0.5, mission_time_s=1.0)
     with pytest.raises(ConfigError, match="--upset"):
         train.main(["--upset", "0.5"])
-
-
-def test_the_ship_flies_a_candidate_with_its_ignition_seconds(monkeypatch):
-    """``ship.py --ignition``: a candidate's validation flies the policy spec with the seconds of the measured
-    moment after ignition among its options (none when 0), so the record's ``ignition`` is what was chosen on;
-    ``--average`` the same for the moment's average (none when 1), ``--ignition-share`` for the measured
-    moment's share (none when 1 or without ``--ignition``)."""
-    from experiments.fault_id import ship
-
-    seen = []
-
-    def evaluate(specs, suites, episodes, **kw):
-        seen.append(dict(specs[0].kwargs))
-        return [{"condition": f"smile-v2-faults/{m}", "score_v2": 1.0, "failed": False, "flyable": True}
-                for m in ("rigid", "nonrigid")]
-
-    monkeypatch.setattr(ship, "evaluate", evaluate)
-    ship.validation("x.npz", 10, ignition=4.0)
-    ship.validation("x.npz", 10)
-    ship.validation("x.npz", 10, lead=3, average=6)
-    ship.validation("x.npz", 10, ignition=4.0, ignition_share=0.5)
-    ship.validation("x.npz", 10, ignition_share=0.5)
-    assert seen[0]["ignition"] == 4.0 and "ignition" not in seen[1]
-    assert seen[0]["path"] == "x.npz" and seen[0]["lead"] == 0
-    assert "average" not in seen[0] and (seen[2]["lead"], seen[2]["average"]) == (3, 6)
-    assert "ignition_share" not in seen[0] and seen[3]["ignition_share"] == 0.5 and "ignition_share" not in seen[4]

@@ -123,13 +123,16 @@ def test_the_shipped_observers_are_their_records(stem, suite, lead):
     assert hashlib.sha256(data).hexdigest() == record["sha256"]
     env = lvgym.make_env(suite, "nonrigid")
     assert record["env"] == env_record(env) and record["suite"] == suite
-    assert "--scheme inversion" in record["training"]["command"] and record.get("lead", 0) == lead
+    command = record["training"]["command"]
+    assert command.startswith("lvgym train --recipe teacher-student ") and record.get("lead", 0) == lead
+    assert f"--suite {suite}" in command
     flight = record.get("flight", {}).get("options", {})
-    trained = f"--lead {lead}" in record["training"]["command"]
+    trained = f"--lead {lead}" in command
     assert trained == (bool(lead) and "lead" not in flight) and (trained or flight.get("lead", 0) == lead)
     if flight:                                          # chosen after training: flown, and on validation seeds
         assert all(record[key] == value for key, value in flight.items())
-        assert all("--seed-set validation" in c for c in record["flight"]["commands"])
+        assert all("--seed-set validation" in c or c.startswith("lvgym train --recipe teacher-student ")
+                   for c in record["flight"]["commands"])
         assert "as trained" in record["flight"]["validation"]
     chosen = record["validation"]["chosen"]
     assert str(chosen) in record["validation"]["candidates"] and len(record["validation"]["candidates"]) >= 3

@@ -239,7 +239,8 @@ def test_every_registered_factory_lives_at_or_below_the_package_that_registers_i
     modules = {f.partition(":")[0] for f in factories}
     assert modules == {"lvgym.benchmark.runner", "lvgym.baselines.pid", "lvgym.baselines.aac", "lvgym.baselines.lqg",
                        "lvgym.baselines.mpc", "lvgym.baselines.privileged", "lvgym.baselines.designed",
-                       "lvgym.agents.policy", "lvgym.agents.bc", "lvgym.agents.inversion"}
+                       "lvgym.agents.policy", "lvgym.agents.bc", "lvgym.agents.inversion",
+                       "lvgym.agents.inversion_record"}
     for module in modules:                          # a worker imports it: the factory reaches no study
         assert not any(n.startswith("experiments") for n in _follow([module], set())), module
 

@@ -2,7 +2,8 @@
 (the privileged reference's law on the terms a learned observer estimates from the flight computer's signals;
 its module docstring gives the law) flown on each seed's ``results/fault_id`` file, written by :mod:`.train`
 with ``--scheme inversion``. The policies shipped as ``inversion-id``, ``inversion-id-stratos`` and
-``inversion-id-smile`` are three of them (:mod:`.ship`, docs/training-results.md).
+``inversion-id-smile`` were three of them; the installed recipe ``lvgym train --recipe teacher-student`` trains
+them again (:mod:`lvgym.agents.teacher_student`, docs/training.md).
 
     python evaluate.py --suites smile-v2-faults --policies experiments.fault_id.inversion:s0
 
@@ -19,9 +20,9 @@ from typing import Any
 
 from lvgym.agents.inversion import (A_MAX, ERRORS, NO_THRUST, SHIPPED, SPAN, TERMS, TRAINED, InversionPolicy, command,
                                     error_index, from_file, gains, law_terms)
+from lvgym.agents.teacher import own_law
 
 from .estimator import RESULTS
-from .train import own_law
 
 #: training seeds with a factory per configuration
 SEEDS = (0, 1, 2)
