@@ -46,8 +46,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from lvgym.cli import fail
-from lvgym.cli.args import arg, command_name, parse
+from lvgym.commandline import arg, command_name, fail, parse
 from lvgym.errors import ConfigError
 
 from .flight_options import Rule, choose_options, choose_seed, parse_option

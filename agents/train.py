@@ -417,7 +417,7 @@ def main(argv: list[str] | None = None) -> None:
     argv = list(sys.argv[1:] if argv is None else argv)
     recipe, rest = _recipe(argv)
     if recipe == "teacher-student":
-        from lvgym.cli.args import running_as
+        from lvgym.commandline import running_as
 
         from .teacher_student import main as teacher_student
 
