@@ -8,7 +8,7 @@ torch at flight time), as the shipped disturbance-observer policy uses it (:mod:
   features and labels, their outputs averaged) from a ``.npz`` file (:meth:`Observer.load`).
 
 The networks are fitted with torch (:mod:`lvgym.agents.observer_fit`, which writes the ``.npz``); training is
-``lvgym train --recipe teacher-student`` (:mod:`lvgym.agents.teacher_student`, docs/training.md).
+``lvgym train --recipe teacher-student`` (:mod:`lvgym.agents.teacher_student`, docs/teacher-student.md).
 """
 
 from __future__ import annotations

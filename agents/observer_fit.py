@@ -5,7 +5,7 @@ features and labels), :class:`Ensemble` (the mean of several), their ``.pt`` fil
 weights in arrays that grow in place (:class:`Data`) and the fit by weighted mean squared error (:func:`fit`).
 The features are :mod:`lvgym.agents.observer`'s (:class:`~lvgym.agents.observer.Window`).
 
-Training is ``lvgym train --recipe teacher-student`` (:mod:`lvgym.agents.teacher_student`, docs/training.md).
+Training is ``lvgym train --recipe teacher-student`` (:mod:`lvgym.agents.teacher_student`, docs/teacher-student.md).
 """
 
 from __future__ import annotations

@@ -30,7 +30,7 @@ The run folder (``--out``) keeps each round's fit (``seed<k>/round<r>.pt``), eac
 ``--resume`` continues a stopped run from them. ``--observer FILE`` takes a trained observer (``.npz`` or
 ``.pt``) in place of training: its flight options chosen on validation seeds alone. One training seed of the
 fault suite at ``--flights 100 --rounds 4 --validation 50`` takes about 19 minutes on one core and 8-10 GB at
-its last fit (docs/training.md).
+its last fit (docs/teacher-student.md).
 """
 
 from __future__ import annotations
