@@ -3,10 +3,14 @@ dependencies into a fresh virtual environment that sees this interpreter's packa
 numba, ...) after its own, ``lvgym train --recipe teacher-student`` trains, chooses and records an observer on a
 short mission, and ``lvgym evaluate --policies <record>.json`` flies the policy the record names.
 
-Marked ``slow``: the fresh environment compiles the flight model's numba kernels again (numba's cache follows
-the installed files' paths): a single env's first reset and step took 163 s on a cold cache, and the whole test
-412 s, on 2 cores shared with other runs. The recipe itself at this budget takes about 15 s with the kernels
-compiled (tests/test_teacher_student.py runs it in the development environment).
+Numba's cache of a compiled function sits where its source file sits (or under ``NUMBA_CACHE_DIR``, in a folder
+named by the source's folder) and is keyed by a hash of the source's content: the installed wheel's files would
+compile again (a single env's first reset and step: 163 s on a cold cache, the whole test 412 s, on 2 cores shared
+with other runs). So the test first flies a short flight here, which compiles the development tree's kernels or
+finds them cached, and copies those caches to where the fresh environment looks for its own files' (the same
+content, so the same keys): the installed code then runs without compiling (a first env step in about 5 s). The
+recipe itself at this budget takes about 15 s (tests/test_teacher_student.py runs it in the development
+environment).
 """
 
 from __future__ import annotations
@@ -22,8 +26,6 @@ from pathlib import Path
 
 import pytest
 
-pytestmark = pytest.mark.slow
-
 ROOT = Path(__file__).resolve().parents[1]
 #: what a build does not read: environments, build output, caches, results, docs
 SKIP = shutil.ignore_patterns(".git", ".venv", "venv", "build", "dist", "*.egg-info", "__pycache__", "*.pyc",
@@ -37,6 +39,40 @@ def _run(args: list, cwd: Path, **env: str) -> subprocess.CompletedProcess:
     proc = subprocess.run([str(a) for a in args], env=clean, cwd=cwd, capture_output=True, text=True, timeout=1200)
     assert proc.returncode == 0, f"{args[:5]} failed:\n{proc.stdout[-3000:]}\n{proc.stderr[-3000:]}"
     return proc
+
+
+def _warm_caches() -> None:
+    """Compile (or load) the development tree's flight kernels: a step of a single and of a batched env."""
+    import numpy as np
+
+    import lvgym
+
+    for env in (lvgym.make_env("smile-v2", model="nonrigid", mission_time_s=0.1),
+                lvgym.make_vec_env("smile-v2", model="nonrigid", num_envs=2, mission_time_s=0.1)):
+        env.reset(seed=0)
+        env.step(np.zeros(env.action_space.shape, np.float32))
+        env.close()
+
+
+def _copy_caches(purelib: Path, cache_dir: Path) -> int:
+    """Copy each development source file's numba caches (its ``__pycache__``'s ``.nbi``/``.nbc``) to the folder
+    numba looks in for the installed copy of that file under ``cache_dir`` (numba's own naming: the source
+    folder's name and the SHA-1 of its absolute path). Returns how many files were copied."""
+    where = {"agents": ROOT / "agents", "baselines": ROOT / "baselines"}
+    copied = 0
+    for py in (purelib / "lvgym").rglob("*.py"):
+        rel = py.relative_to(purelib / "lvgym")
+        src = where[rel.parts[0]].joinpath(*rel.parts[1:]) if rel.parts[0] in where else ROOT / "lvgym" / rel
+        caches = sorted((src.parent / "__pycache__").glob(src.stem + ".*.nb[ic]"))
+        if not caches:
+            continue
+        folder = str(py.parent.resolve())
+        target = cache_dir / f"{os.path.basename(folder)}_{hashlib.sha1(folder.encode()).hexdigest()}"
+        target.mkdir(parents=True, exist_ok=True)
+        for f in caches:
+            shutil.copy2(f, target / f.name)
+            copied += 1
+    return copied
 
 
 def test_the_installed_recipe_trains_records_and_its_record_flies(tmp_path):
@@ -54,6 +90,8 @@ def test_the_installed_recipe_trains_records_and_its_record_flies(tmp_path):
     # this interpreter's packages after the venv's own (a .pth line is appended to sys.path): the wheel's lvgym
     # is found first, torch and the rest here
     (purelib / "zz_development_packages.pth").write_text(sysconfig.get_paths()["purelib"] + "\n")
+    _warm_caches()
+    assert _copy_caches(purelib, tmp_path / "numba") > 20
     env = {"NUMBA_CACHE_DIR": str(tmp_path / "numba")}
     where = json.loads(_run([python, "-c", "import json, lvgym, torch, lvgym.agents.teacher_student as t; "
                                            "print(json.dumps([lvgym.__file__, t.__file__]))"], tmp_path).stdout)
@@ -80,7 +118,7 @@ def test_the_installed_recipe_trains_records_and_its_record_flies(tmp_path):
     # the same numbers as the recipe's own validation of the options it chose
     _run([venv / "bin" / "lvgym", "evaluate", "--policies", "run/inversion_id_smile_v2.json", "--suites", "smile-v2",
           "--seed-set", "validation", "--episodes", "1", "--mission-time-s", SHORT, "--executor", "serial",
-          "--no-plots", "--no-progress", "--out", "flown"], tmp_path, **env)
+          "--no-plots", "--no-progress", "--only", "--out", "flown"], tmp_path, **env)
     flown = json.loads((tmp_path / "flown" / "results.json").read_text())
     episodes = flown["episodes"]
     assert sorted(e["model"] for e in episodes) == ["nonrigid", "rigid"]
