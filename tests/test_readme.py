@@ -33,7 +33,7 @@ SHORTEN = {
         "--total-timesteps 128 --n-envs 2 --hp algo.n_steps=64 algo.batch_size=64 algo.n_epochs=1 "
         "policy.net_arch=[8,8] --env-kwargs mission_time_s=2 controller_on_after_s=0.2 --checkpoint-freq 128 "
         "--eval-episodes 1 --eval-mission-time-s 0.5 --no-progress",
-    "lvgym evaluate --policies runs/my-ppo lqg gs-pid-flex": SHORT_EVAL,
+    "lvgym evaluate --policies runs/my-ppo": SHORT_EVAL,
     "lvgym train --suite smile-v2-faults --name my-faults":
         "--total-timesteps 128 --n-envs 2 --hp algo.n_steps=64 algo.batch_size=64 algo.n_epochs=1 "
         "policy.net_arch=[8,8] --env-kwargs mission_time_s=2 controller_on_after_s=0.2 --checkpoint-freq 128 "
@@ -101,12 +101,13 @@ def test_fly_an_env():
 
 
 def test_train_then_evaluate(tmp_path):
-    """The train-then-evaluate quick start: a tiny run, then lvgym evaluate on its folder and two baselines."""
+    """The train-then-evaluate quick start: a tiny run, then lvgym evaluate on its folder, beside the suite's
+    classical designs and its privileged reference."""
     train, evaluate = _sh(2)[:2]
     _run(train, tmp_path)
     assert (tmp_path / "runs" / "my-ppo" / "config.yaml").exists()
     proc = _run(evaluate, tmp_path)
-    for label in ("my-ppo", "lqg", "gs-pid-flex"):
+    for label in ("my-ppo", "lqg-front", "privileged"):
         assert label in proc.stdout, proc.stdout[-2000:]
 
 

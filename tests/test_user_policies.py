@@ -128,8 +128,9 @@ def test_a_failing_factory_is_one_line_naming_the_policy_and_the_cause(user_fold
     ("missing.py:make", r"^evaluate\.py: policy 'missing\.py:make': no such file '.*missing\.py'$"),
     ("no_such_module:make", r"^evaluate\.py: policy 'no_such_module:make': cannot import 'no_such_module' "),
     ("lqq", r"^evaluate\.py: policy 'lqq' \(did you mean 'lqg'\?\): not a registered name, module:factory, "
-            r"path/to/file\.py:factory, a stable-baselines3 \.zip model or a train\.py run folder, a cloned policy "
-            r"\.pt \(lvgym bc\); the registered "
+            r"path/to/file\.py:factory, a stable-baselines3 \.zip model or a train\.py run folder, a disturbance "
+            r"observer's record \.json \(lvgym train --recipe teacher-student\), a cloned policy \.pt \(lvgym bc\); "
+            r"the registered "
             r"names: \[.*'zero'\]$"),
 ])
 def test_a_bad_policy_is_refused_in_one_line_before_any_episode(user_folder, arg, message):
