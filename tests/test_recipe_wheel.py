@@ -55,7 +55,7 @@ def test_the_installed_recipe_trains_records_and_its_record_flies(tmp_path):
     # is found first, torch and the rest here
     (purelib / "zz_development_packages.pth").write_text(sysconfig.get_paths()["purelib"] + "\n")
     env = {"NUMBA_CACHE_DIR": str(tmp_path / "numba")}
-    where = json.loads(_run([python, "-c", "import json, lvgym, torch, lvgym.agents.teacher_student as t; "
+    where = json.loads(_run([python, "-c", "import json, lvgym, torch, lvgym.agents.training.teacher_student as t; "
                                            "print(json.dumps([lvgym.__file__, t.__file__]))"], tmp_path).stdout)
     assert all(Path(f).is_relative_to(venv) for f in where), where
 

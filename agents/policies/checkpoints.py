@@ -1,7 +1,9 @@
-"""A training run's checkpoints: their names (``checkpoints/step_<N>``, N the env steps in 12 digits; the
-files of one are listed in :mod:`lvgym.agents.callbacks`), the complete ones (their JSON exists, and their
-``.zip``) and the removal of a half-written one. A saved policy's files are :func:`lvgym.agents.policy.policy_files`
-of the stem: ``<stem>.zip`` the model, ``<stem>.json`` its record, written last."""
+"""A training run's checkpoints: their names (``checkpoints/step_<N>``, N the env steps in 12 digits), the complete
+ones (their JSON exists, and their ``.zip``) and the removal of a half-written one. The training callbacks write
+them (:mod:`lvgym.agents.training.callbacks` lists the files of one); the loader of a run folder flies the newest
+when the run has no best or final model (:func:`lvgym.agents.policies.saved.resolve_model_path`). A saved policy's
+files are :func:`lvgym.agents.policies.saved.policy_files` of the stem: ``<stem>.zip`` the model, ``<stem>.json``
+its record, written last."""
 
 from __future__ import annotations
 

@@ -14,25 +14,25 @@ three numbers of the plant and one of the flight (:data:`TERMS`, :func:`law_term
   power, over the gimbal limit; 0 without thrust, where the law commands nothing);
 - ``share``, the q-alpha over its limit (one for both axes);
 
-and commands ``delta = a alpha - h f_aero - f_mis`` with ``alpha = -2 zeta w e_rate - h w^2 e_att``
-(:func:`command`; ``w``, ``zeta``: the reference's :data:`~lvgym.baselines.privileged.GAINS` of the flight
-model; ``h``: the reference's relief, :func:`~lvgym.baselines.privileged.relief_hold`). The env knows the terms
-(its ``privileged_info``); a flight computer does not. :class:`InversionPolicy` flies the law with them
-estimated by a :class:`~lvgym.agents.observer.Estimator` (an :class:`~lvgym.agents.observer.Ensemble`) from the
-last :data:`~lvgym.agents.observer.WINDOW` steps of observations and actions sent. It is causal: it reads
+and commands ``delta = a alpha - h f_aero - f_mis`` with ``alpha = -2 zeta w e_rate - h w^2 e_att`` (:func:`command`;
+``w``, ``zeta``: the reference's :data:`~lvgym.baselines.privileged.GAINS` of the flight model; ``h``: the reference's
+relief, :func:`~lvgym.baselines.privileged.relief_hold`). The env knows the terms (its ``privileged_info``); a flight
+computer does not. :class:`InversionPolicy` flies the law with them estimated by a
+:class:`~lvgym.agents.policies.observer_net.Estimator` (an :class:`~lvgym.agents.policies.observer_net.Ensemble`) from
+the last :data:`~lvgym.agents.policies.observer.WINDOW` steps of observations and actions sent. It is causal: it reads
 the observation only.
 
-The shipped observer (:data:`SHIPPED`, ``agents/trained``) was trained on SMILE's fault suite, both flight
-models, with the reference's law on the true terms as the teacher and DAgger rounds
-(``lvgym train --recipe teacher-student``, :mod:`lvgym.agents.teacher_student`); ``inversion-id-stratos``'s on Stratos III and
-``inversion-id-smile``'s on ``smile-v2``, the law flying its estimated moment carried 3 and 5 steps ahead
-(:class:`Lead`, the record's ``lead``), ``inversion-id-smile``'s law at a non-rigid bandwidth of 1.25 rad/s
-(:func:`gains`, the record's ``law``). A policy refuses an env its observer was not trained for
-(:func:`check_env`). ``ignition``: for its first seconds after the next stage's ignition the law can cancel
-the moment measured from the rigid body (:class:`Staging`, :mod:`lvgym.agents.staging`; the record's
-``ignition``, and its share ``ignition_share``). ``inversion-id`` flies its moment averaged over 6 steps and
-carried 3 ahead, and for 4 s after the ignition half the measured moment and half its estimate: options chosen
-after training on validation seeds (the record's ``flight``, docs/training-results.md).
+The shipped observer (:data:`SHIPPED`, ``agents/trained``) was trained on SMILE's fault suite, both flight models, with
+the reference's law on the true terms as the teacher and DAgger rounds (``lvgym train --recipe teacher-student``,
+:mod:`lvgym.agents.training.teacher_student`); ``inversion-id-stratos``'s on Stratos III and ``inversion-id-smile``'s on
+``smile-v2``, the law flying its estimated moment carried 3 and 5 steps ahead (:class:`Lead`, the record's ``lead``),
+``inversion-id-smile``'s law at a non-rigid bandwidth of 1.25 rad/s (:func:`gains`, the record's ``law``). A policy
+refuses an env its observer was not trained for (:func:`check_env`). ``ignition``: for its first seconds after the next
+stage's ignition the law can cancel the moment measured from the rigid body (:class:`Staging`,
+:mod:`lvgym.agents.policies.staging`; the record's ``ignition``, and its share ``ignition_share``). ``inversion-id``
+flies its moment averaged over 6 steps and carried 3 ahead, and for 4 s after the ignition half the measured moment and
+half its estimate: options chosen after training on validation seeds (the record's ``flight``,
+docs/training-results.md).
 """
 
 from __future__ import annotations
@@ -68,7 +68,7 @@ Law = dict[str, Any] | Sequence[tuple[str, Any]]
 NO_THRUST = 1.0
 #: the shipped observer (``<stem>.npz``) and its record (``<stem>.json``: how it was trained, the env)
 SHIPPED = "inversion_id_smile_v2_faults"
-TRAINED = Path(__file__).resolve().parent / "trained"
+TRAINED = Path(__file__).resolve().parents[1] / "trained"
 
 
 def law_terms(info: dict[str, Any], n: int, limit: float, ahead: int = 0) -> np.ndarray:
@@ -214,7 +214,7 @@ class Lead:
 class Staging:
     """How a policy flies the next stage's ignition: for ``seconds`` after it (0: never; ``steps``: in control
     periods of ``env``) the aerodynamic moment is the moment measured from the rigid body
-    (:class:`~lvgym.agents.staging.Measured`, on the observer's control power) less the observer's
+    (:class:`~lvgym.agents.policies.staging.Measured`, on the observer's control power) less the observer's
     misalignment, in place of the observer's estimate, while the observer's window still holds the coast;
     ``share`` < 1: that share of the measured moment and the rest of the estimate. The measured moment closes
     an incremental loop on the gimbal whose gain is the observer's error in the control power (and a gain
@@ -239,18 +239,17 @@ class Staging:
 
 
 class InversionLaw(BatchLaw):
-    """The law of the module docstring on the observer's estimated terms for ``n`` rows (the benchmark's
-    policy; no privileged information): one window per row, the observer on every row's window in one call
-    (:meth:`~lvgym.agents.observer.Observer.rows`), the law on the rows at once (elementwise: a row's action does
-    not depend on the others). ``observer``: an :class:`~lvgym.agents.observer.Observer` (or a callable of one
-    window, applied to each row's window in turn); ``trained``: the
-    :func:`env_record` it was trained on (it refuses another env: :func:`check_env`); ``lead``, ``span``: the
-    control steps the estimated aerodynamic moment is carried ahead along its slope over ``span`` steps
-    (:class:`Lead`; 0: the moment as estimated), after its average over ``average`` steps (1: none); ``law``:
-    the law's gains per flight model where they are not the reference's (:func:`gains`); ``ignition``: for that
-    long [s] after the next stage's ignition the law cancels the moment measured from the rigid body
-    (:class:`Staging`) in place of the estimated aerodynamic moment (0: never), ``ignition_share`` of it and the
-    rest of the estimate (1: the measured alone)."""
+    """The law of the module docstring on the observer's estimated terms for ``n`` rows (the benchmark's policy; no
+    privileged information): one window per row, the observer on every row's window in one call
+    (:meth:`~lvgym.agents.policies.observer.Observer.rows`), the law on the rows at once (elementwise: a row's action
+    does not depend on the others). ``observer``: an :class:`~lvgym.agents.policies.observer.Observer` (or a callable of
+    one window, applied to each row's window in turn); ``trained``: the :func:`env_record` it was trained on (it refuses
+    another env: :func:`check_env`); ``lead``, ``span``: the control steps the estimated aerodynamic moment is carried
+    ahead along its slope over ``span`` steps (:class:`Lead`; 0: the moment as estimated), after its average over
+    ``average`` steps (1: none); ``law``: the law's gains per flight model where they are not the reference's
+    (:func:`gains`); ``ignition``: for that long [s] after the next stage's ignition the law cancels the moment measured
+    from the rigid body (:class:`Staging`) in place of the estimated aerodynamic moment (0: never), ``ignition_share``
+    of it and the rest of the estimate (1: the measured alone)."""
 
     def __init__(self, env: Any, observer: Observer | Callable[[np.ndarray], np.ndarray], 
                  name: str = "inversion-id",
@@ -316,13 +315,13 @@ class InversionPolicy(RowFace):
 def from_file(env: Any, path: str | Path, name: str = "inversion-id", trained: dict[str, Any] | None = None,
               lead: int = 0, span: int = SPAN, law: Law | None = None, average: int = 1,
               ignition: float = 0.0, ignition_share: float = 1.0) -> InversionPolicy:
-    """The policy on the observer saved at ``path``: an :class:`~lvgym.agents.observer.Observer`'s ``.npz``, or
-    a training run's torch ``.pt`` (:func:`lvgym.agents.observer_fit.load`; needs torch); ``lead``, ``span``,
+    """The policy on the observer saved at ``path``: an :class:`~lvgym.agents.policies.observer.Observer`'s ``.npz``, or
+    a training run's torch ``.pt`` (:func:`lvgym.agents.policies.observer_net.load`; needs torch); ``lead``, ``span``,
     ``average``: the :class:`Lead` of its aerodynamic moment [control steps]; ``law``: its gains per flight
     model (:func:`gains`; None: the reference's); ``ignition``: the seconds after the next stage's ignition
     it flies the measured moment, ``ignition_share`` of it (:class:`Staging`)."""
     if Path(path).suffix == ".pt":
-        from .observer_fit import load, to_observer
+        from .observer_net import load, to_observer
 
         observer = to_observer(load(path))
     else:

@@ -2,7 +2,7 @@
 how it was made (the shipped ``agents/trained/inversion_id_*.json``, and those ``lvgym train --recipe
 teacher-student`` writes), and the policy it names.
 
-A record holds the env the observer was trained on (``env``: :func:`lvgym.agents.inversion.env_record`, which
+A record holds the env the observer was trained on (``env``: :func:`lvgym.agents.policies.inversion.env_record`, which
 the policy checks), the options the law flies (``lead``, ``law``, ``average``, ``ignition``,
 ``ignition_share``: :func:`flown`; absent ones at their defaults), the training command and its validation,
 and the observer file's SHA-256 (``sha256``); ``observer`` names that file relative to the record (absent:
@@ -31,7 +31,7 @@ OPTIONS = {"lead": 0, "law": None, "average": 1, "ignition": 0.0, "ignition_shar
 
 def flown(lead: int = 0, law: dict[str, list[float]] | None = None, ignition: float = 0.0, average: int = 1,
           ignition_share: float = 1.0) -> dict[str, Any]:
-    """The options a policy flies (:func:`lvgym.agents.inversion.from_file`'s), those at their defaults left
+    """The options a policy flies (:func:`lvgym.agents.policies.inversion.from_file`'s), those at their defaults left
     out but the lead (a record's keys; the share only with an ``ignition``)."""
     return {"lead": int(lead), **({"law": law} if law else {}), **({"ignition": float(ignition)} if ignition else {}),
             **({"average": int(average)} if average > 1 else {}),

@@ -1,5 +1,5 @@
 """A trained multilayer perceptron flown for many rows at once, each row on its own (the learned laws' inner
-loop, :mod:`lvgym.agents.policy` and :mod:`lvgym.agents.bc`).
+loop, :mod:`lvgym.agents.policies.sb3` and :mod:`lvgym.agents.policies.bc`).
 
 Torch's batched forward is not its one-row forward: a linear layer of one observation runs as a matrix-vector
 product, of many as a matrix-matrix product, and the two sum in other orders, so a row's action would depend

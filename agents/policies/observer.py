@@ -1,14 +1,16 @@
 """A learned observer as a flight computer flies it: the last half second of the flight computer's signals
 (the env's observation and the actions sent) in, an estimate of what it cannot measure out, in NumPy (no
-torch at flight time), as the shipped disturbance-observer policy uses it (:mod:`lvgym.agents.inversion`).
+torch at flight time), as the shipped disturbance-observer policy uses it
+(:mod:`lvgym.agents.policies.inversion`).
 
 - :class:`Window`: the last :data:`WINDOW` control steps' features of each row of a batch (:data:`FEATURES`:
   the observation's :data:`N_OBS` entries, then the action sent the step before);
 - :class:`Observer`: the trained network's forward pass (an ensemble of two-layer tanh MLPs on standardised
   features and labels, their outputs averaged) from a ``.npz`` file (:meth:`Observer.load`).
 
-The networks are fitted with torch (:mod:`lvgym.agents.observer_fit`, which writes the ``.npz``); training is
-``lvgym train --recipe teacher-student`` (:mod:`lvgym.agents.teacher_student`, docs/teacher-student.md).
+The networks are fitted with torch (:mod:`lvgym.agents.training.observer_fit`; their torch form:
+:mod:`lvgym.agents.policies.observer_net`, which gives the ``.npz``'s arrays); training is ``lvgym train --recipe
+teacher-student`` (:mod:`lvgym.agents.training.teacher_student`, docs/teacher-student.md).
 """
 
 from __future__ import annotations

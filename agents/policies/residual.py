@@ -1,18 +1,17 @@
 """Residual policies: a classical baseline flies, a learned policy adds a correction.
 
-The action the env gets is ``clip(baseline(obs, info) + residual_scale * learned, -1, 1)``: the baseline's
-action (a policy of :data:`lvgym.benchmark.registry.POLICIES`, by default ``gs-pid-flex``, the PID
+The action the env gets is ``clip(baseline(obs, info) + residual_scale * learned, -1, 1)`` (:func:`combine`): the
+baseline's action (a policy of :data:`lvgym.benchmark.registry.POLICIES`, by default ``gs-pid-flex``, the PID
 designed on the non-rigid v1 flight loop, ``lvgym.baselines.pid:smile_scheduled_pid`` with schedule
 ``smile_flex``) plus the learned action in [-1, 1] scaled by ``residual_scale`` (gimbal units: a scale of
 0.2 lets the learned part move the gimbal by at most 20 % of its limit), clipped to the action space.
 So a learned policy that outputs zero flies the baseline's episode exactly.
 
-The baseline is its batch law in training and in evaluation: :class:`ResidualRows` holds it for the env rows
-and mixes the actions (:func:`combine`) for :class:`ResidualVecEnv` (an SB3 ``VecEnvWrapper`` over the batched
-lvgym ``VecEnv``, what ``train.py --residual`` trains on) and :class:`ResidualEnv` (a Gymnasium wrapper of a
-single env); :class:`ResidualLaw` (with its one-row face :class:`ResidualPolicy`, the saved policy's adapter,
-:func:`lvgym.agents.policy.load_policy`) flies the baseline's law and the learned law side by side. The baseline sees the env's own observation (with ``history`` it reads the newest sample by
-name); the learned policy sees the same observation.
+:class:`ResidualLaw` (with its one-row face :class:`ResidualPolicy`, the saved policy's adapter,
+:func:`lvgym.agents.policies.sb3.load_policy`) flies the baseline's batch law and the learned law side by side,
+as :class:`ResidualConfig` (what a saved run records) says. The baseline sees the env's own observation (with
+``history`` it reads the newest sample by name); the learned policy sees the same observation. Training flies
+the same mix through :mod:`lvgym.agents.wrappers.residual` (``train.py --residual``).
 """
 
 from __future__ import annotations
@@ -21,9 +20,7 @@ import copy
 from dataclasses import asdict, dataclass
 from typing import Any
 
-import gymnasium as gym
 import numpy as np
-from stable_baselines3.common.vec_env import VecEnvWrapper
 
 import lvgym.baselines  # noqa: F401  (registers the baselines a residual policy flies on)
 from lvgym.benchmark.batch import BatchLaw, RowFace, as_batch
@@ -31,9 +28,7 @@ from lvgym.benchmark.registry import POLICIES
 from lvgym.benchmark.runner import build_policy
 from lvgym.errors import ConfigError, check_number
 
-__all__ = ["DEFAULT_BASELINE", "INFO_KEYS", "ResidualConfig", "ResidualEnv", "ResidualLaw", "ResidualPolicy",
-           "ResidualRows",
-           "ResidualVecEnv", "combine", "residual_options", "residual_venv", "stack_infos"]
+__all__ = ["DEFAULT_BASELINE", "ResidualConfig", "ResidualLaw", "ResidualPolicy", "combine"]
 
 DEFAULT_BASELINE = "gs-pid-flex"
 #: registered policies that cannot be a residual's baseline (learned ones: the residual is on a classical law)
@@ -65,117 +60,16 @@ class ResidualConfig:
         return None if not r else cls(**r)
 
 
-def residual_options(baseline: str | None, scale: float) -> dict[str, Any] | None:
-    """``train.py``'s ``--residual`` and ``--residual-scale`` as a run records them (None: not residual);
-    a bad value is a ConfigError naming the option."""
-    if baseline in (None, "none"):
-        return None
-    try:
-        return ResidualConfig(baseline, scale).to_dict()
-    except ConfigError as exc:
-        raise ConfigError("--residual" if exc.key.endswith("baseline") else "--residual-scale", exc.value,
-                          exc.allowed) from None
-
-
-def residual_venv(venv: Any, residual: dict[str, Any] | None) -> Any:
-    """``venv`` (the batched lvgym SB3 VecEnv) wrapped residual as ``residual`` records, or itself."""
-    return venv if residual is None else ResidualVecEnv(venv, ResidualConfig(**residual))
-
-
 def combine(base: np.ndarray, learned: np.ndarray, scale: float) -> np.ndarray:
     """``clip(base + scale * learned, -1, 1)`` as float32 (rows or one action)."""
     mixed = np.asarray(base, dtype=np.float32) + np.float32(scale) * np.asarray(learned, dtype=np.float32)
     return np.clip(mixed, -1.0, 1.0).astype(np.float32)
 
 
-#: the info keys a baseline's batch reads from the stacked infos (:func:`stack_infos`): a reset's info has
-#: these and no more (lvgym.baselines.batch)
-INFO_KEYS = ("time", "cumulative_rate_error", "mass", "controller_on")
-
-
-def stack_infos(infos: list[dict[str, Any]]) -> dict[str, np.ndarray]:
-    """The per-row ``infos`` (one dict per row, as an SB3 ``VecEnv`` gives them) as a batched info dict:
-    each of :data:`INFO_KEYS` that every row has, as an array with a leading axis of the rows."""
-    return {k: np.array([i[k] for i in infos]) for k in INFO_KEYS if all(k in i for i in infos)}
-
-
-class ResidualRows:
-    """The baseline's batch law for the env rows (built by its registry factory on ``env``, a single or batched
-    lvgym env; a policy without one flies through :class:`lvgym.benchmark.batch.PerRow`) and the baseline
-    action of each row for its coming step (:attr:`base`, (rows, n_a) float32)."""
-
-    def __init__(self, config: ResidualConfig, env: Any, rows: int) -> None:
-        if not hasattr(env.action_space, "low"):
-            raise ValueError("a residual policy needs a Box (TVC) action space")
-        self.config = config
-        spec = POLICIES[config.baseline]
-        self.batch = as_batch(build_policy(spec, env), int(rows), lambda: build_policy(spec, env))
-        n_a = int(np.prod(env.action_space.shape[-1:]))
-        self.base = np.zeros((int(rows), n_a), np.float32)
-
-    def reset(self, rows: Any, obs: np.ndarray, infos: list[dict[str, Any]]) -> None:
-        """Rows ``rows`` start an episode whose first observation is ``obs[b]`` and info ``infos[b]``."""
-        rows = np.asarray(list(rows), dtype=int)
-        self.batch.reset(rows)
-        self.advance(rows, obs, infos)
-
-    def advance(self, rows: Any, obs: np.ndarray, infos: list[dict[str, Any]]) -> None:
-        """Rows ``rows`` went one step on: their baselines act on the new observation (``infos``: every
-        row's info)."""
-        rows = np.asarray(list(rows), dtype=int)
-        if rows.size:
-            self.base[rows] = self.batch.act(rows, obs[rows], stack_infos(infos))
-
-    def apply(self, learned: np.ndarray) -> np.ndarray:
-        """The env's actions for the learned actions ``learned`` (rows, n_a)."""
-        return combine(self.base, np.reshape(learned, self.base.shape), self.config.scale)
-
-
-class ResidualVecEnv(VecEnvWrapper):
-    """The batched lvgym SB3 ``VecEnv`` (:class:`lvgym.envs.sb3.AscentSB3VecEnv`, wrapped directly: it
-    reads its ``reset_infos``) with residual actions: ``step(learned)`` flies ``baseline + scale * learned``."""
-
-    def __init__(self, venv: Any, config: ResidualConfig) -> None:
-        super().__init__(venv)
-        self.rows = ResidualRows(config, venv, venv.num_envs)
-
-    def reset(self) -> np.ndarray:
-        obs = self.venv.reset()
-        self.rows.reset(range(self.num_envs), obs, self.venv.reset_infos)
-        return obs
-
-    def step_async(self, actions: np.ndarray) -> None:
-        self.venv.step_async(self.rows.apply(actions))
-
-    def step_wait(self):
-        obs, reward, done, infos = self.venv.step_wait()
-        self.rows.advance(np.flatnonzero(~done), obs, infos)
-        self.rows.reset(np.flatnonzero(done), obs, self.venv.reset_infos)
-        return obs, reward, done, infos
-
-
-class ResidualEnv(gym.Wrapper):
-    """A single lvgym env with residual actions (the same :class:`ResidualRows`, one row)."""
-
-    def __init__(self, env: gym.Env, config: ResidualConfig) -> None:
-        super().__init__(env)
-        self.rows = ResidualRows(config, env, 1)
-
-    def reset(self, **kwargs: Any):
-        obs, info = self.env.reset(**kwargs)
-        self.rows.reset([0], obs[None], [info])
-        return obs, info
-
-    def step(self, action: Any):
-        obs, reward, terminated, truncated, info = self.env.step(self.rows.apply(action)[0])
-        self.rows.advance([0], obs[None], [info])
-        return obs, reward, terminated, truncated, info
-
-
 class ResidualLaw(BatchLaw):
     """A learned policy on a baseline for ``n`` rows: the baseline's batch law (built by its registry factory
     on ``env``) and the learned law, mixed by :func:`combine`. ``learned``: a policy whose actions are the
-    residual's (an :class:`lvgym.agents.policy.SB3Policy`, or its law); a learned law with ``note_applied`` is
+    residual's (an :class:`lvgym.agents.policies.sb3.SB3Policy`, or its law); a learned law with ``note_applied`` is
     told the action the env gets (its observation history records that one, as the env's does). The baseline
     starts its episode at the row's first step."""
 

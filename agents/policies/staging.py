@@ -1,5 +1,5 @@
 """The next stage's ignition as a flight computer sees it, and the disturbance it can measure there from the
-rigid body while a learned observer's window still holds the staging coast (:mod:`lvgym.agents.inversion`).
+rigid body while a learned observer's window still holds the staging coast (:mod:`lvgym.agents.policies.inversion`).
 
 SMILE's first stage burns out at about 43 s; the gimbal is held at zero through a coast of about ten seconds
 (the observation's ``controller_on`` is 0) and the next stage ignites at about 54 s. Its first seconds are
@@ -19,7 +19,7 @@ coast is large beside the new stage's control moment, and an estimate 40 % short
   Control Dyn. 33(6), 2010): its increment loop feeds ``1 - a / a_true`` of the gimbal position back, so it
   needs the estimated ``a`` under twice the true one, and less behind the servo's lag; a gain ``k`` between
   the command and the servo that the observer reads into its ``a`` (``a_true / k``) feeds back ``k - 1``.
-  Flying a share of the measured moment (:class:`lvgym.agents.inversion.Staging`) scales that loop's gain by
+  Flying a share of the measured moment (:class:`lvgym.agents.policies.inversion.Staging`) scales that loop's gain by
   it (docs/training-results.md).
 """
 

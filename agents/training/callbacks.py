@@ -1,5 +1,5 @@
 """Training callbacks: crash-safe checkpoints with validation on the benchmark protocol (the progress bar
-and line: :mod:`lvgym.agents.progress`).
+and line: :mod:`lvgym.agents.training.progress`).
 
 A checkpoint ``checkpoints/step_<N>`` (N = env steps, 12 digits) is::
 
@@ -18,7 +18,7 @@ Checkpoints are taken at rollout boundaries (after a PPO update, before the next
 the optimiser, the step counter and the statistics agree. Validation (when due) runs at a checkpoint, on
 the checkpointed model, with the protocol's validation seeds; its result is part of the checkpoint's JSON,
 so the evaluation history and the best model are restored with it. ``best_model.*`` and ``final_model.*``
-next to ``checkpoints/`` are copies in the :mod:`lvgym.agents.policy` layout (loadable by ``evaluate.py``).
+next to ``checkpoints/`` are copies in the :mod:`lvgym.agents.policies.saved` layout (loadable by ``evaluate.py``).
 """
 
 from __future__ import annotations
@@ -41,13 +41,13 @@ from stable_baselines3.common.callbacks import BaseCallback
 from lvgym.benchmark.flyability import applies
 from lvgym.benchmark.metrics import summarize
 from lvgym.benchmark.policy import Policy
-from lvgym.benchmark.runner import play_episode
 from lvgym.benchmark.results import atomic_path, atomic_write_text, json_text
+from lvgym.benchmark.runner import play_episode
 from lvgym.benchmark.suites import Suite, family_validation_suite, get_suite
 
-from .checkpoints import checkpoint_stem, list_checkpoints
-from .policy import SB3Policy, adapt, copy_policy, policy_files
-from .progress import ProgressBarCallback  # noqa: F401  (its old place)
+from ..policies.checkpoints import checkpoint_stem, list_checkpoints
+from ..policies.saved import copy_policy, policy_files
+from ..policies.sb3 import SB3Policy, adapt
 
 #: what a validation's ``score`` is: compared lexicographically, lower is better (older runs' checkpoints
 #: without this key ranked on ``[failure rate, rate error]``)
@@ -266,12 +266,12 @@ class CheckpointCallback(BaseCallback):
         self.out_of_time = False                     # the deadline passed: training stops as on a signal
         self.wall0 = float(state.get("train_wall_s", 0.0))
         self.t_start = self.last_save_time = time.monotonic()
-        self.clock = None                            # the venv's EnvClock (lvgym.agents.timing), found at the start
+        self.clock = None                   # the venv's EnvClock (lvgym.agents.training.timing), found at the start
         self.env0 = float(state.get("env_wall_s", 0.0))
         self.env_at_start = 0.0
 
     def _init_callback(self) -> None:
-        from lvgym.agents.timing import find_clock
+        from lvgym.agents.training.timing import find_clock
 
         self.folder.mkdir(parents=True, exist_ok=True)
         self.t_start = self.last_save_time = time.monotonic()
@@ -296,7 +296,8 @@ class CheckpointCallback(BaseCallback):
         return self.wall0 + time.monotonic() - self.t_start
 
     def timing(self) -> dict[str, float]:
-        """``train_wall_s`` and, with an :class:`lvgym.agents.timing.EnvClock` in the venv, ``env_wall_s`` [s]."""
+        """``train_wall_s`` and, with an :class:`lvgym.agents.training.timing.EnvClock` in the venv, ``env_wall_s``
+        [s]."""
         out = {"train_wall_s": round(self.train_wall_s(), 3)}
         if self.clock is not None:
             out["env_wall_s"] = round(self.env_wall_s(), 3)
@@ -426,7 +427,7 @@ def evaluate_saved(path: str | Path, suite: str = "smile-windy", episodes: int =
                    overrides: dict[str, Any] | None = None) -> dict[str, Any]:
     """Validation of a saved policy (a ``.zip`` or a run folder) as the training run does it (a teacher with
     its privileged observation options)."""
-    from .policy import privileged_options
+    from ..policies.sb3 import privileged_options
 
     ev = ValidationEvaluator(suite, episodes, {**privileged_options(path), **(overrides or {})} or None)
     try:
@@ -435,5 +436,5 @@ def evaluate_saved(path: str | Path, suite: str = "smile-windy", episodes: int =
         ev.close()
 
 
-__all__ = ["CheckpointCallback", "ProgressBarCallback", "SignalStop", "ValidationEvaluator", "evaluate_saved",
+__all__ = ["CheckpointCallback", "SignalStop", "ValidationEvaluator", "evaluate_saved",
            "load_replay_buffer", "load_rng", "save_rng"]

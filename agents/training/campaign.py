@@ -1,12 +1,12 @@
 """Training campaigns: configurations x seeds trained on this machine or on a Ray cluster, then every run
 evaluated on the test seeds, then the comparison over the runs (issue 35).
 
-    lvgym campaign agents/campaigns/v2_example.yaml --dry-run     # check the whole file, list the runs
+    lvgym campaign agents/training/campaigns/v2_example.yaml --dry-run     # check the whole file, list the runs
     lvgym campaign my_campaign.yaml                                # run it here (workers train.py processes at once)
     lvgym campaign my_campaign.yaml --executor ray                 # on a local Ray, or the cluster at $RAY_ADDRESS
     RAY_ADDRESS=head-node:6379 lvgym campaign my_campaign.yaml --executor ray
 
-The campaign file (docs/training.md, "Campaigns"; :mod:`lvgym.agents.campaign_schema`) names the
+The campaign file (docs/training.md, "Campaigns"; :mod:`lvgym.agents.training.campaign_schema`) names the
 configurations (``train.py`` options), the training seeds, the options common to every run and the
 evaluation. The whole file is checked before anything runs, each configuration by ``train.py``'s own
 checks: a bad value is one line naming the file, the key path, the value and what is allowed, and no
@@ -14,7 +14,7 @@ folder is made.
 
 Everything lives in ``<runs_dir>/<name>/``: the run folders ``<configuration>-s<seed>/`` (``train.py``'s),
 ``logs/<run>.log`` (each run's output, every attempt), ``evaluation/<run or baseline>.json`` (the episodes
-of the test seeds), ``comparison.md`` and ``comparison.json`` (:mod:`lvgym.agents.campaign_compare`) and
+of the test seeds), ``comparison.md`` and ``comparison.json`` (:mod:`lvgym.agents.training.campaign_compare`) and
 ``campaign.json`` (the file's text and every run's ``train.py`` options).
 
 Each run is one task: a ``train.py`` process started by a worker of the executor (``local``: ``workers``
@@ -111,7 +111,7 @@ except Exception:
 if os.getppid() != int(os.environ.pop("LVGYM_CAMPAIGN_PARENT", os.getppid())):
     sys.exit(128 + signal.SIGTERM)
 sys.argv[0] = "train.py"
-runpy.run_module("lvgym.agents.train", run_name="__main__", alter_sys=True)
+runpy.run_module("lvgym.agents.training.train", run_name="__main__", alter_sys=True)
 """
 
 
@@ -148,7 +148,8 @@ def train_run(task: RunTask) -> dict[str, Any]:
         cmd = _command(task)
         with open(task.log, "ab") as log:
             log.write(f"== {dt.datetime.now(dt.timezone.utc).isoformat(timespec='seconds')} on {out['host']} "
-                      f"(worker {os.getpid()}): {sys.executable} -m lvgym.agents.train {' '.join(cmd)}\n".encode())
+                      f"(worker {os.getpid()}): {sys.executable} -m lvgym.agents.training.train "
+                      f"{' '.join(cmd)}\n".encode())
             log.flush()
             cwd = task.cwd if os.path.isdir(task.cwd) else str(Path(task.folder).parent)
             with _GUARD:

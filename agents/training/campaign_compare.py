@@ -1,4 +1,4 @@
-"""A campaign's evaluation files and its comparison over the runs (:mod:`lvgym.agents.campaign`).
+"""A campaign's evaluation files and its comparison over the runs (:mod:`lvgym.agents.training.campaign`).
 
 Each run and each baseline has its evaluation file ``<campaign>/evaluation/<label>.json``: the episode
 records of the test seeds and the settings they were flown with (suites, episodes, seed set, mission time,

@@ -1,6 +1,6 @@
 """A campaign file: read, checked whole, and made into frozen dataclasses before anything runs.
 
-A campaign (``lvgym campaign FILE``, :mod:`lvgym.agents.campaign`) is training configurations x seeds,
+A campaign (``lvgym campaign FILE``, :mod:`lvgym.agents.training.campaign`) is training configurations x seeds,
 then the evaluation of every run on the test seeds, then the comparison over the runs. Its YAML file::
 
     name: v2-example                     # the campaign's folder: <runs_dir>/<name>/
@@ -14,11 +14,11 @@ then the evaluation of every run on the test seeds, then the comparison over the
     executor: local                      # local (train.py processes on this machine) or ray
     workers: 2                           # runs at once (local; a local Ray's CPUs)
 
-A train option is named as ``train.py`` names it (``residual_scale`` or ``residual-scale``; ``hp`` and
-``env_kwargs`` also take a mapping). Every value is checked here with ``train.py``'s own checks (its
-fields' ranges and choices, :func:`~lvgym.agents.trainsetup.check_options`, :func:`~lvgym.agents.train.prepare`
-and the env's keywords by building one env): a bad one is a :class:`~lvgym.errors.ConfigError` naming the
-file, the key path (``configurations.res-lqg.hp``), the value and what is allowed.
+A train option is named as ``train.py`` names it (``residual_scale`` or ``residual-scale``; ``hp`` and ``env_kwargs``
+also take a mapping). Every value is checked here with ``train.py``'s own checks (its fields' ranges and choices,
+:func:`~lvgym.agents.training.trainsetup.check_options`, :func:`~lvgym.agents.training.train.prepare` and the env's
+keywords by building one env): a bad one is a :class:`~lvgym.errors.ConfigError` naming the file, the key path
+(``configurations.res-lqg.hp``), the value and what is allowed.
 """
 
 from __future__ import annotations
@@ -112,7 +112,7 @@ class Campaign:
 def train_fields() -> dict[str, dataclasses.Field]:
     """``train.py``'s options by every name a campaign file may give them: the field name, with dashes, and
     the flag without its dashes (``max_wall_time`` for ``max_wall_time_s``)."""
-    from lvgym.agents.train import Args
+    from lvgym.agents.training.train import Args
 
     from lvgym.commandline.options import _spec
 
@@ -141,7 +141,7 @@ def _text(value: Any) -> str:
 
 def _option(path: str, f: dataclasses.Field, raw: Any, source: str) -> tuple[Any, list[str]]:
     """``raw`` of train option ``f`` (at ``path``) as train.py's value and its command-line words."""
-    from lvgym.agents.train import Args
+    from lvgym.agents.training.train import Args
 
     from lvgym.commandline.options import _hints, _kind, _spec, _value
 
@@ -209,7 +209,7 @@ def _check_configuration(name: str, options: dict[str, tuple[str, Any, list[str]
                          runs_dir: str, source: str, envs_checked: set[str]) -> None:
     """One configuration's options checked by train.py itself, for every seed (its ``prepare``: nothing is
     written), and its env's keywords by building one env. A refusal names the option's key path."""
-    from lvgym.agents.train import Args, check_options, env_kwargs_of, prepare
+    from lvgym.agents.training.train import Args, check_options, env_kwargs_of, prepare
 
     by_flag = {_flag(f): f.name for f in dataclasses.fields(Args)}
     values = {k: v for k, (_, v, _) in options.items()}
@@ -267,7 +267,7 @@ def suites_flown(name: str, options: dict[str, tuple[str, Any, list[str]]], suit
     family's informed track, ``vehicle_info``) flies the suites that give them (``family-v2-informed``);
     any other run the suites that do not (``family-v2``, the blind track, and the one-vehicle suites).
     None of them: a ConfigError naming the configuration."""
-    from lvgym.agents.train import Args, env_kwargs_of
+    from lvgym.agents.training.train import Args, env_kwargs_of
     from lvgym.benchmark.suites import get_suite
 
     values = {k: v for k, (_, v, _) in options.items()}

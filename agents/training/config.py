@@ -1,4 +1,4 @@
-"""Per-env hyperparameters of the learning agents: ``agents/hyperparams/<algo>.yaml`` read into frozen,
+"""Per-env hyperparameters of the learning agents: ``agents/training/hyperparams/<algo>.yaml`` read into frozen,
 validated dataclasses.
 
 A YAML file maps env ids to one entry each::
@@ -29,41 +29,14 @@ import yaml
 
 from lvgym.errors import ConfigError, check_bool, check_choice, check_number
 
+from ..policies.algos import ALGOS
+
 HYPERPARAMS_DIR = Path(__file__).resolve().parent / "hyperparams"
-#: the algorithms train.py trains: name -> stable-baselines3 class (the one list of them)
-ALGOS = {"ppo": "PPO", "sac": "SAC", "td3": "TD3", "recurrent-ppo": "RecurrentPPO"}
-#: the algorithms of sb3-contrib (the others are stable-baselines3's)
-CONTRIB = ("RecurrentPPO",)
 #: the on-policy algorithms (their ``algo:`` keys are :class:`PPOConfig`'s)
 ON_POLICY = ("ppo", "recurrent-ppo")
 ACTIVATIONS = ("tanh", "relu", "elu", "leaky_relu")
 LR_SCHEDULES = ("constant", "linear")
 ACTION_NOISES = ("none", "normal", "ornstein_uhlenbeck")
-
-
-def algo_name(algo: str) -> str:
-    """The class name of ``algo`` (a key of :data:`ALGOS` or a class name, any case), e.g. ``RecurrentPPO``;
-    an unknown name comes back upper-cased."""
-    for key, name in ALGOS.items():
-        if algo.lower() in (key, name.lower()):
-            return name
-    return algo.upper()
-
-
-def algo_class(algo: str) -> type:
-    """The stable-baselines3 (or sb3-contrib) class of ``algo`` (``ValueError`` for an unknown one,
-    ``ImportError`` when sb3-contrib is missing)."""
-    name = algo_name(algo)
-    if name in CONTRIB:
-        import sb3_contrib
-
-        return getattr(sb3_contrib, name)
-    import stable_baselines3 as sb3
-
-    cls = getattr(sb3, name, None)
-    if cls is None:
-        raise ValueError(f"algo = {algo!r}: one of {sorted(ALGOS.values())}")
-    return cls
 
 
 # ------------------------------------------------------------------------------------------ validation
@@ -406,7 +379,7 @@ def build_config(algo: str, env_id: str, entry: Mapping[str, Any], source: str =
 
 def load_config(algo: str, env_id: str, overrides: Mapping[str, Any] | None = None,
                 path: str | Path | None = None) -> AgentConfig:
-    """The validated configuration of ``algo`` on ``env_id`` from ``agents/hyperparams/<algo>.yaml``
+    """The validated configuration of ``algo`` on ``env_id`` from ``agents/training/hyperparams/<algo>.yaml``
     (or ``path``), the ``default`` entry standing in for env ids the file does not list."""
     data, src = read_entries(algo, path)
     if env_id in data:
@@ -420,6 +393,6 @@ def load_config(algo: str, env_id: str, overrides: Mapping[str, Any] | None = No
     return build_config(algo, env_id, entry, src, overrides)
 
 
-__all__ = ["ALGOS", "CONTRIB", "ON_POLICY", "AgentConfig", "algo_class", "algo_name", "HYPERPARAMS_DIR", "LinearSchedule", "NormalizeConfig", "OffPolicyConfig",
+__all__ = ["ON_POLICY", "AgentConfig", "HYPERPARAMS_DIR", "LinearSchedule", "NormalizeConfig", "OffPolicyConfig",
            "PPOConfig", "PolicyConfig", "build_config", "linear_schedule", "load_config", "parse_overrides",
            "read_entries"]

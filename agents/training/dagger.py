@@ -1,12 +1,12 @@
-"""One training seed of the teacher-student recipe (:mod:`lvgym.agents.teacher_student`): the teacher's flights,
-the observer's fit and the DAgger rounds.
+"""One training seed of the teacher-student recipe (:mod:`lvgym.agents.training.teacher_student`): the teacher's
+flights, the observer's fit and the DAgger rounds.
 
 1. **The teacher's flights**: ``flights`` per flight model of the suite's condition, in batches of 100 rows,
-   every step recorded as the student sees it with its label (:func:`lvgym.agents.teacher.fly`).
-2. **The fit**: :func:`lvgym.agents.observer_fit.fit` on every window so far (the labels standardised).
+   every step recorded as the student sees it with its label (:func:`lvgym.agents.training.teacher.fly`).
+2. **The fit**: :func:`lvgym.agents.training.observer_fit.fit` on every window so far (the labels standardised).
 3. **DAgger rounds** (``rounds``): the student flies half as many flights again, labelled the same way; they
    are added to the data and the observer is fitted again. The policy is the mean of the last three fits
-   (:class:`lvgym.agents.observer_fit.Ensemble`; of the last one for a pilot whose ``ensemble`` is 1).
+   (:class:`lvgym.agents.policies.observer_net.Ensemble`; of the last one for a pilot whose ``ensemble`` is 1).
 
 **Seeds.** Training flights draw their env seeds from :func:`training_seeds`: ``100,000 + 10,000 seed +
 5,000 round + i``, above every validation and test seed of a suite (``0 .. 9,999`` and ``10,000 ..
@@ -25,7 +25,8 @@ from typing import Any
 
 import numpy as np
 
-from .observer_fit import Data, Ensemble, Estimator, fit, load, save
+from ..policies.observer_net import Ensemble, Estimator, load, save
+from .observer_fit import Data, fit
 from .teacher import Pilot, fly
 
 __all__ = ["ROUND_STRIDE", "SEED_STRIDE", "TRAIN_SEED0", "check_training_seeds", "train_seed", "training_seeds"]
@@ -65,7 +66,7 @@ def train_seed(seed: int, flights: int, rounds: int, epochs: int, pilot: Pilot, 
                log: Callable[[str], None] = print, **options: Any) -> Estimator | Ensemble:
     """The observer of training seed ``seed`` (module docstring): ``flights`` teacher flights per flight model,
     ``rounds`` DAgger rounds of half as many, ``epochs`` per fit; ``pilot`` flies them
-    (:data:`lvgym.agents.teacher.Pilot`); each round's fit is written to ``round_file(rnd)`` and, with
+    (:data:`lvgym.agents.training.teacher.Pilot`); each round's fit is written to ``round_file(rnd)`` and, with
     ``resume``, read from it where a run of the same options left it (the round's flights are flown again, the
     same flights; its fit is not). ``places``: env keywords the seeds of a batch are dealt over (a family's
     vehicles); ``weight``: each window's weight in the fits from its time since ignition (None: 1);

@@ -1,13 +1,13 @@
-"""The teacher-student recipe's choices on validation seeds (:mod:`lvgym.agents.teacher_student`): which training
-seed's observer ships, and which flight options it flies.
+"""The teacher-student recipe's choices on validation seeds (:mod:`lvgym.agents.training.teacher_student`): which
+training seed's observer ships, and which flight options it flies.
 
-- **The seed** (:func:`choose_seed`): each candidate's record (:mod:`lvgym.agents.inversion_record`) is flown by
-  the benchmark (:func:`lvgym.benchmark.runner.evaluate`, as the shipped policy flies) on the suite's first
-  validation seeds, both flight models; the seed with the fewest failed or unflyable non-rigid flights, then
-  the lowest non-rigid mean ``score_v2``, ships.
+- **The seed** (:func:`choose_seed`): each candidate's record (:mod:`lvgym.agents.policies.inversion_record`) is flown
+  by the benchmark (:func:`lvgym.benchmark.runner.evaluate`, as the shipped policy flies) on the suite's first
+  validation seeds, both flight models; the seed with the fewest failed or unflyable non-rigid flights, then the lowest
+  non-rigid mean ``score_v2``, ships.
 - **The flight options** (:func:`choose_options`): candidates of the law's options (:class:`FlightOption`: the
-  moment's ``average`` and ``lead``, :class:`lvgym.agents.inversion.Lead`; the measured moment's ``ignition``
-  seconds and ``ignition_share`` after the next stage's ignition, :class:`lvgym.agents.inversion.Staging`) are
+  moment's ``average`` and ``lead``, :class:`lvgym.agents.policies.inversion.Lead`; the measured moment's ``ignition``
+  seconds and ``ignition_share`` after the next stage's ignition, :class:`lvgym.agents.policies.inversion.Staging`) are
   tried in order against the options kept so far (at first the options as trained). A candidate replaces them
   if (:class:`Rule`) its non-rigid gain margin up is at least ``gain_db`` and its delay margin at least
   ``delay_ms`` on the margin suite's first validation seeds (:func:`lvgym.benchmark.margins.time_domain_margins`),
@@ -116,7 +116,8 @@ def per_model(records: Sequence[dict[str, Any]]) -> dict[str, dict[str, float]]:
 def _spec(record: Path, name: str) -> Any:
     from lvgym.benchmark.runner import PolicySpec
 
-    return PolicySpec(name, "lvgym.agents.inversion_record:from_record", (("path", str(Path(record).resolve())),))
+    return PolicySpec(name, "lvgym.agents.policies.inversion_record:from_record",
+                      (("path", str(Path(record).resolve())),))
 
 
 def _executor(workers: int) -> dict[str, Any]:

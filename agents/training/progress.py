@@ -71,7 +71,7 @@ class ProgressLineCallback(BaseCallback):
     """One line on ``stream`` (stdout) at the end of the first rollout at least ``interval_s`` seconds of
     wall time after the last line, and one at the end of training: the step of the ``target``, the steps
     per second and the wall time of this segment, the time left at that rate, and the latest validation
-    score of ``checkpoint`` (a :class:`lvgym.agents.callbacks.CheckpointCallback`) if any. ``interval_s``
+    score of ``checkpoint`` (a :class:`lvgym.agents.training.callbacks.CheckpointCallback`) if any. ``interval_s``
     <= 0: no lines. Written through tqdm, so that a bar on stderr stays whole."""
 
     def __init__(self, interval_s: float, target: int, checkpoint: Any = None, prog: str = "train.py",

@@ -16,7 +16,7 @@ import yaml
 
 __all__ = ["create_run", "make_logger", "provenance", "write_yaml"]
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def provenance() -> dict[str, Any]:

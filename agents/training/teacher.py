@@ -1,15 +1,15 @@
-"""The teacher-student recipe's flights (:mod:`lvgym.agents.teacher_student`): the privileged teacher and the
+"""The teacher-student recipe's flights (:mod:`lvgym.agents.training.teacher_student`): the privileged teacher and the
 student flying a suite's condition as the rows of its batched env, every step recorded as the student sees it
 with its label.
 
-- :class:`InversionScheme`: the law of :mod:`lvgym.agents.inversion` on the true terms (the teacher: the env's
-  privileged info, :func:`lvgym.agents.inversion.law_terms`), with an exploration noise on its action, or on
+- :class:`InversionScheme`: the law of :mod:`lvgym.agents.policies.inversion` on the true terms (the teacher: the env's
+  privileged info, :func:`lvgym.agents.policies.inversion.law_terms`), with an exploration noise on its action, or on
   the student's estimate of them; its labels are the true terms, as the action must carry them under a loop
   gain (``loop_gain``: the margins' perturbation as a training device).
 - :func:`fly`: the rows of ``seeds`` flown by a pilot (the teacher, or the student on an estimator's output)
-  through :func:`lvgym.benchmark.rows.fly_rows`; returns the windows (:class:`lvgym.agents.observer.Window`),
+  through :func:`lvgym.benchmark.rows.fly_rows`; returns the windows (:class:`lvgym.agents.policies.observer.Window`),
   their labels, the flights' records and each window's time since the next stage's ignition
-  (:class:`lvgym.agents.staging.Ignition`).
+  (:class:`lvgym.agents.policies.staging.Ignition`).
 - :func:`validate`: the student's mean ``score_v2`` and lost flights on a suite's validation seeds.
 
 Without the teacher's exploration the action sent last holds the label (it is ``a alpha - f``) and a student
@@ -23,9 +23,9 @@ from typing import Any
 
 import numpy as np
 
-from .inversion import TERMS, Lead, command, error_index, gains, law_terms
-from .observer import Window
-from .staging import Ignition, signal_index
+from ..policies.inversion import TERMS, Lead, command, error_index, gains, law_terms
+from ..policies.observer import Window
+from ..policies.staging import Ignition, signal_index
 
 __all__ = ["NOISE", "NOISE_PHI", "SUITE", "InversionScheme", "Recorder", "condition", "fly", "lost", "own_law",
            "scored", "validate"]
@@ -47,7 +47,7 @@ def condition(model: str, suite: str = SUITE, **options: Any) -> Any:
 
 
 def own_law(bandwidth: float) -> dict[str, list[float]] | None:
-    """The law's gains per flight model (:func:`lvgym.agents.inversion.gains`) of a non-rigid bandwidth
+    """The law's gains per flight model (:func:`lvgym.agents.policies.inversion.gains`) of a non-rigid bandwidth
     [rad/s] with the reference's damping; None (the reference's gains) for 0."""
     from lvgym.baselines.privileged import GAINS
 
@@ -55,14 +55,14 @@ def own_law(bandwidth: float) -> dict[str, list[float]] | None:
 
 
 class InversionScheme:
-    """The law of :mod:`lvgym.agents.inversion` for ``n`` rows of ``env1``'s batched env, on the true terms (the
-    teacher, with ``rng``: its exploration is drawn from it) or on the student's estimate (``rng`` None).
-    ``loop_gain``: per row, the gain after the action (labels: the terms in gimbal angles over it, as the action
-    must carry them; the q-alpha share stays); ``lead``: the law flies the moment terms carried that many
-    control periods along their slope (:class:`lvgym.agents.inversion.Lead`: the teacher's of the truth, the
-    student's of its estimates; the labels stay the present terms); ``law``: its gains per flight model where
-    they are not the reference's (:func:`lvgym.agents.inversion.gains`); ``noise``: the teacher's exploration
-    levels (default :data:`NOISE`).
+    """The law of :mod:`lvgym.agents.policies.inversion` for ``n`` rows of ``env1``'s batched env, on the true terms
+    (the teacher, with ``rng``: its exploration is drawn from it) or on the student's estimate (``rng`` None).
+    ``loop_gain``: per row, the gain after the action (labels: the terms in gimbal angles over it, as the action must
+    carry them; the q-alpha share stays); ``lead``: the law flies the moment terms carried that many control periods
+    along their slope (:class:`lvgym.agents.policies.inversion.Lead`: the teacher's of the truth, the student's of its
+    estimates; the labels stay the present terms); ``law``: its gains per flight model where they are not the
+    reference's (:func:`lvgym.agents.policies.inversion.gains`); ``noise``: the teacher's exploration levels (default
+    :data:`NOISE`).
 
     :meth:`true_terms` and :meth:`upset` are the places a study changes the labels or the teacher's terms."""
 
@@ -81,7 +81,7 @@ class InversionScheme:
         self.noise = np.zeros((n, 2))
 
     def true_terms(self, info: dict[str, Any]) -> np.ndarray:
-        """``(n, 7)``: the step's true terms (:func:`lvgym.agents.inversion.law_terms`)."""
+        """``(n, 7)``: the step's true terms (:func:`lvgym.agents.policies.inversion.law_terms`)."""
         return law_terms(info, self.n, self.limit)
 
     def labels(self, info: dict[str, Any]) -> np.ndarray:
@@ -198,7 +198,7 @@ def validate(estimator: Any, episodes: int, pilot: Pilot, suite: str = SUITE, **
     """Per flight model, the mean ``score_v2`` and the lost flights of the student (``estimator`` flown by
     ``pilot``'s law, in rows of up to 100) on ``suite``'s first ``episodes`` validation seeds
     (:meth:`lvgym.benchmark.suites.Suite.seeds`); the benchmark flies the same law one row at a time through
-    :class:`lvgym.agents.inversion.InversionPolicy`."""
+    :class:`lvgym.agents.policies.inversion.InversionPolicy`."""
     from lvgym.benchmark.suites import get_suite
 
     seeds = get_suite(suite).seeds("validation", episodes)

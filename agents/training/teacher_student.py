@@ -7,23 +7,23 @@ disturbance observer, trained, chosen and recorded in one command.
     lvgym evaluate --suites smile-v2-faults \
         --policies results/teacher-student/smile-v2-faults/inversion_id_smile_v2_faults.json
 
-1. **Per training seed** (:mod:`lvgym.agents.dagger`): the teacher (the law on the true terms from the env's
-   privileged info, an exploration noise on its action; :mod:`lvgym.agents.teacher`) flies ``--flights`` per
+1. **Per training seed** (:mod:`lvgym.agents.training.dagger`): the teacher (the law on the true terms from the env's
+   privileged info, an exploration noise on its action; :mod:`lvgym.agents.training.teacher`) flies ``--flights`` per
    flight model under the loop dispersion (``--loop-gain-db``: a gain on each flight's action, uniform in dB);
-   the observer (:mod:`lvgym.agents.observer_fit`) is fitted to every step's window and true terms; then
+   the observer (:mod:`lvgym.agents.training.observer_fit`) is fitted to every step's window and true terms; then
    ``--rounds`` DAgger rounds (the student flies half as many flights, labelled the same way, and the
    observer is fitted again). The observer is the mean of the last three fits. Training flights fly env seeds
    ``100,000 + 10,000 seed + 5,000 round + i``, none a validation or test seed of the suite.
-2. **The seed that ships** (:mod:`lvgym.agents.flight_options`): each seed's observer, in the NumPy form the
+2. **The seed that ships** (:mod:`lvgym.agents.training.flight_options`): each seed's observer, in the NumPy form the
    policy flies, on the suite's first ``--selection`` validation seeds through the benchmark: the fewest
    failed or unflyable non-rigid flights, then the lowest non-rigid mean ``score_v2``.
 3. **Its flight options** (``--flight-options``, tried in order): a candidate replaces the options kept if it
    reaches the rule's margins (``--min-gain-margin-db``, ``--min-delay-margin-ms`` on ``--margin-suite``'s
    first ``--margin-seeds`` validation seeds) and on ``--option-validation`` validation seeds loses at most
    ``--max-extra-losses`` more non-rigid flights with a non-rigid mean at most ``--max-worse`` worse.
-4. **The record**: ``<out>/<stem>.npz`` (:meth:`lvgym.agents.observer.Observer.save`) and ``<out>/<stem>.json``
+4. **The record**: ``<out>/<stem>.npz`` (:meth:`lvgym.agents.policies.observer.Observer.save`) and ``<out>/<stem>.json``
    (the env, the options the law flies, the validation numbers, this command, the file's SHA-256), which
-   ``lvgym evaluate --policies <stem>.json`` flies (:func:`lvgym.agents.inversion_record.from_record`).
+   ``lvgym evaluate --policies <stem>.json`` flies (:func:`lvgym.agents.policies.inversion_record.from_record`).
 
 The run folder (``--out``) keeps each round's fit (``seed<k>/round<r>.pt``), each seed's observer and record
 (``seed<k>/observer.npz``, ``seed<k>/record.json``) and each candidate's options (``options/<label>.json``);
@@ -49,8 +49,8 @@ from typing import Any
 from lvgym.commandline import arg, command_name, fail, parse
 from lvgym.errors import ConfigError
 
+from ..policies.inversion_record import flown, sha256, write_record
 from .flight_options import Rule, choose_options, choose_seed, parse_option
-from .inversion_record import flown, sha256, write_record
 
 __all__ = ["Args", "NAMES", "SUITES", "TRAINING", "main", "run"]
 
@@ -172,10 +172,10 @@ def run(a: Args, argv: Sequence[str]) -> Path:
 
     from lvgym.benchmark.suites import get_suite
 
+    from ..policies.inversion import env_record
+    from ..policies.observer import Observer
+    from ..policies.observer_net import load, save, to_observer
     from .dagger import ROUND_STRIDE, SEED_STRIDE, TRAIN_SEED0, train_seed
-    from .inversion import env_record
-    from .observer import Observer
-    from .observer_fit import load, save, to_observer
     from .teacher import condition, own_law, scheme, validate
 
     env_opts = {"mission_time_s": a.mission_time_s} if a.mission_time_s else {}
@@ -257,7 +257,8 @@ def run(a: Args, argv: Sequence[str]) -> Path:
                   "margin_suite": a.margin_suite, "margin_seeds": f"0-{a.margin_seeds - 1}",
                   "commands": [command],
                   "what": "chosen after training, on validation seeds only: the options the law flies "
-                          "(lvgym.agents.inversion.Lead's average and lead, Staging's ignition seconds and share)"}
+                          "(lvgym.agents.policies.inversion.Lead's average and lead, Staging's ignition seconds "
+                          "and share)"}
     target = out / f"{stem}.npz"
     shutil.copyfile(weights, target)
     training = ({"command": command, "observer": str(a.observer)} if a.observer is not None else

@@ -4,7 +4,7 @@
 wrapper, so a residual's baseline counts as env) and adds up the wall time spent in ``reset``,
 ``step_async`` and ``step_wait`` [s]. The rest of a run's wall time is the learner: the policy's forward
 passes during the rollout, the gradient updates, the validations and the checkpoints.
-:class:`lvgym.agents.callbacks.CheckpointCallback` logs ``time/env_share`` (env seconds over wall seconds since
+:class:`lvgym.agents.training.callbacks.CheckpointCallback` logs ``time/env_share`` (env seconds over wall seconds since
 the run started, resumed segments included, both counted from the start of learning: the first reset
 and its kernel loading come before) after every rollout and records ``train_wall_s`` and
 ``env_wall_s`` in every checkpoint and validation, which is what :mod:`experiments.training_speed.curves` plots the learning

@@ -17,8 +17,8 @@
 (every argument, the resolved hyperparameters and env keywords, lvgym version, git commit),
 ``segments.jsonl`` (one line per start or resume), ``tb/`` (TensorBoard: ``tensorboard --logdir runs``),
 ``progress_<step>.csv``, ``checkpoints/`` (model, VecNormalize statistics, generator states, replay
-buffer; see ``agents/callbacks.py``), ``evaluations.json`` (validation on the benchmark protocol's
-validation seeds), ``best_model.*`` and ``final_model.*`` (load with ``lvgym.agents.policy.SB3Policy`` or
+buffer; see ``agents/training/callbacks.py``), ``evaluations.json`` (validation on the benchmark protocol's
+validation seeds), ``best_model.*`` and ``final_model.*`` (load with ``lvgym.agents.policies.sb3.SB3Policy`` or
 pass the ``.zip`` to ``lvgym evaluate``). ``--resume`` restarts from the newest complete checkpoint with the
 run's own configuration, the same target step count, the normalisation statistics and the step counter
 (``reset_num_timesteps=False``), and says what it resumed from (or that there was no checkpoint yet).
@@ -33,7 +33,7 @@ validation score. Every option is checked before the run folder is made: a bad v
 and leaves nothing behind.
 
 ``--recipe teacher-student`` hands the rest of the command line over to the recipe of the shipped
-``inversion-id`` policies (:mod:`lvgym.agents.teacher_student`: a privileged teacher, DAgger rounds, a learned
+``inversion-id`` policies (:mod:`lvgym.agents.training.teacher_student`: a privileged teacher, DAgger rounds, a learned
 disturbance observer, its flight options chosen on validation seeds), which has its own options.
 """
 
@@ -62,7 +62,7 @@ __all__ = ["Args", "DEFAULT_EVAL_SUITES", "RECIPES", "RESUME_OVERRIDABLE", "chec
 
 PROG = "train.py"
 #: the recipes ``--recipe`` chooses: stable-baselines3's runs (this module) or the teacher-student recipe
-#: (:mod:`lvgym.agents.teacher_student`, its own options)
+#: (:mod:`lvgym.agents.training.teacher_student`, its own options)
 TRAINERS = ("sb3", "teacher-student")
 #: the options a resumed run takes from the command line (the rest from its config.yaml)
 RESUME_OVERRIDABLE = ("resume", "progress", "torch_threads", "verbose", "total_timesteps", "checkpoint_interval_s",
@@ -73,7 +73,7 @@ def _choices(name: str) -> Any:
     """The allowed values of an option that names things, looked up when the parser is built."""
     def choices() -> tuple[str, ...]:
         import lvgym
-        from lvgym.agents.config import ALGOS
+        from lvgym.agents.policies.algos import ALGOS
         from lvgym.envs.spec import OBSERVATIONS, WIND_TIERS
         from lvgym.simulator import MODELS
 
@@ -96,7 +96,7 @@ class Args:
     smile-v2-faults' faults; rows reset with training seeds) and validate on the suite (default: --env-id's);
     a family suite trains on the family's train vehicles and validates on its validation vehicles"""
     family_vehicles: int = arg(8, lo=1, hi=1000)
-    """with a family --suite: the rows fly the family's first N train vehicles (lvgym.agents.familytrain)"""
+    """with a family --suite: the rows fly the family's first N train vehicles (lvgym.agents.training.familytrain)"""
     model: str = arg("nonrigid", choices=_choices("model"))
     """flight model: rigid, slosh, flex or nonrigid"""
     wind: str = arg("protocol", choices=_choices("wind"))
@@ -115,21 +115,23 @@ class Args:
     algo: str = arg("ppo", choices=_choices("algo"))
     """ppo, sac, td3 or recurrent-ppo (sb3-contrib's RecurrentPPO with MlpLstmPolicy)"""
     residual: str | None = None
-    """fly residual on this registered baseline, e.g. gs-pid-flex (lvgym.agents.residual; default: not residual)"""
+    """fly residual on this registered baseline, e.g. gs-pid-flex (lvgym.agents.wrappers.residual; default: not
+    residual)"""
     residual_scale: float = 0.2
     """with --residual: gimbal units per unit of learned action, in (0, 2]"""
     loop_gain_db: float = 0.0
-    """train with the loop gain drawn per episode uniformly in +-this many dB (lvgym.agents.loop_dispersion; 0: off)"""
+    """train with the loop gain drawn per episode uniformly in +-this many dB (lvgym.agents.wrappers.loop_dispersion;
+    0: off)"""
     loop_delay_periods: int = 0
     """train with an extra loop delay drawn per episode from 0 to this many control periods (0: off)"""
     load_margin: float = 0.0
     """train with the q-alpha load charged above --load-margin-threshold of its limit, this many rad/s per
-    unit of ratio (lvgym.agents.loadmargin; 0: off)"""
+    unit of ratio (lvgym.agents.wrappers.loadmargin; 0: off)"""
     load_margin_threshold: float = 0.8
     """with --load-margin: the load's ratio to its limit above which it is charged"""
     command_rate_charge: float = arg(0.0, lo=0.0, hi=100.0)
     """train with the gimbal command's rate charged as protocol v2's flyability rule measures it, this many
-    rad/s per unit of (rate / rate limit)^2 (lvgym.agents.commandrate; 0: off)"""
+    rad/s per unit of (rate / rate limit)^2 (lvgym.agents.wrappers.commandrate; 0: off)"""
     total_timesteps: int | None = arg(None, lo=1, hi=10**12)
     """env steps of the whole run, e.g. 2e6 (default: n_timesteps of the hyperparameter file)"""
     seed: int = 0
@@ -139,7 +141,7 @@ class Args:
     hp: list[str] = arg(default_factory=list, nargs="*", extend=True)
     """hyperparameter overrides KEY=VALUE with dotted keys, e.g. algo.n_steps=128 policy.net_arch=[32,32]"""
     hyperparams: str | None = None
-    """hyperparameter YAML file (default agents/hyperparams/<algo>.yaml)"""
+    """hyperparameter YAML file (default agents/training/hyperparams/<algo>.yaml)"""
     runs_dir: str = "runs"
     """folder of the run folders"""
     name: str | None = None
@@ -195,11 +197,11 @@ def parse_args(argv: list[str] | None = None) -> tuple[Args, set[str]]:
 def prepare(args: Args, given: set[str]) -> tuple[Args, dict[str, Any], Path, bool]:
     """The run's arguments, its ``config.yaml`` content, its folder and whether it resumes: every option
     checked, nothing written (:func:`create_run` writes). Raises ConfigError or SystemExit (one line)."""
-    from lvgym.agents.config import build_config, load_config, parse_overrides
-    from lvgym.agents.loop_dispersion import loop_dispersion_options
-    from lvgym.agents.commandrate import command_rate_options
-    from lvgym.agents.loadmargin import load_margin_options
-    from lvgym.agents.residual import residual_options
+    from lvgym.agents.training.config import build_config, load_config, parse_overrides
+    from lvgym.agents.wrappers.commandrate import command_rate_options
+    from lvgym.agents.wrappers.loadmargin import load_margin_options
+    from lvgym.agents.wrappers.loop_dispersion import loop_dispersion_options
+    from lvgym.agents.wrappers.residual import residual_options
 
     check_options(args)
     if args.resume:
@@ -236,7 +238,7 @@ def prepare(args: Args, given: set[str]) -> tuple[Args, dict[str, Any], Path, bo
     training_seed(args.seed, 0, cfg.n_envs, _prog())
     family = is_family(args.suite)
     if family:
-        from lvgym.agents.familytrain import row_split
+        from lvgym.agents.training.familytrain import row_split
 
         row_split(cfg.n_envs, args.family_vehicles)                  # a row for every vehicle
     env_kwargs = env_kwargs_of(args)
@@ -274,7 +276,7 @@ def _resume_note(run_dir: Path, state: dict[str, Any] | None, target: int) -> st
 def train(argv: list[str] | None = None) -> Path:
     """Run (or resume) a training run; returns its folder. SIGTERM and SIGINT write a checkpoint and
     then exit with ``SystemExit(128 + signal)``; a spent ``--max-wall-time`` writes one and returns."""
-    from lvgym.agents.callbacks import SignalStop
+    from lvgym.agents.training.callbacks import SignalStop
 
     t0 = time.monotonic()
     args, given = parse_args(argv)
@@ -286,11 +288,13 @@ def train(argv: list[str] | None = None) -> Path:
 def _train(args: Args, given: set[str], stop: Any, t0: float) -> Path:
     import torch
 
-    from lvgym.agents.callbacks import CheckpointCallback, ValidationEvaluator, load_replay_buffer, load_rng
-    from lvgym.agents.checkpoints import clean_incomplete, latest_checkpoint
-    from lvgym.agents.config import ALGOS, algo_class, build_config
-    from lvgym.agents.policy import policy_files, privileged_env_options
-    from lvgym.agents.progress import ProgressBarCallback, ProgressLineCallback
+    from lvgym.agents.policies.algos import ALGOS, algo_class
+    from lvgym.agents.policies.checkpoints import clean_incomplete, latest_checkpoint
+    from lvgym.agents.policies.saved import policy_files
+    from lvgym.agents.policies.sb3 import privileged_env_options
+    from lvgym.agents.training.callbacks import CheckpointCallback, ValidationEvaluator, load_replay_buffer, load_rng
+    from lvgym.agents.training.config import build_config
+    from lvgym.agents.training.progress import ProgressBarCallback, ProgressLineCallback
 
     prog = _prog()
     try:                                             # everything checked before the run folder is made
@@ -311,7 +315,7 @@ def _train(args: Args, given: set[str], stop: Any, t0: float) -> Path:
     try:                                             # the env's keywords (--model, --wind, --env-kwargs, ...)
         vehicles = None
         if config.get("family_vehicles"):            # a family run: its train vehicles' files
-            from lvgym.agents.familytrain import train_vehicle_files
+            from lvgym.agents.training.familytrain import train_vehicle_files
 
             vehicles = [str(v) for v in train_vehicle_files(config["family_vehicles"])]
             config["vehicles"] = [Path(v).name for v in vehicles]
@@ -413,7 +417,7 @@ def _recipe(argv: list[str]) -> tuple[str, list[str]]:
 
 def main(argv: list[str] | None = None) -> None:
     """``lvgym train`` / ``python train.py``: run (or resume) a training run; ``--recipe teacher-student``: the
-    teacher-student recipe (:mod:`lvgym.agents.teacher_student`) with the rest of the command line."""
+    teacher-student recipe (:mod:`lvgym.agents.training.teacher_student`) with the rest of the command line."""
     argv = list(sys.argv[1:] if argv is None else argv)
     recipe, rest = _recipe(argv)
     if recipe == "teacher-student":

@@ -1,4 +1,4 @@
-"""What a training run is made of, besides its command line (:mod:`lvgym.agents.train`): the recipes of the
+"""What a training run is made of, besides its command line (:mod:`lvgym.agents.training.train`): the recipes of the
 env ids, the protocol's wind and randomisation, the env keywords, the checks no field declares, the
 training seeds and the vectorised env.
 
@@ -34,7 +34,7 @@ def suite_condition(suite: str, model: str) -> Any:
     """The condition of suite ``suite`` a run on ``--suite`` trains on: its condition of flight model
     ``model`` (its env id, wind, dispersions and options; the run's rows still reset with training
     seeds). For a family suite, whose conditions are its test vehicles, the condition without its
-    ``vehicle``: the run's rows fly the family's train vehicles (:mod:`lvgym.agents.familytrain`)."""
+    ``vehicle``: the run's rows fly the family's train vehicles (:mod:`lvgym.agents.training.familytrain`)."""
     from lvgym.benchmark.suites import SUITES_FAMILY, condition, get_suite
 
     s = get_suite(suite)
@@ -67,7 +67,7 @@ def protocol_training(env_id: str) -> tuple[str, list[str]]:
 
 
 def env_kwargs_of(args: Any) -> dict[str, Any]:
-    """The env keywords of a run (``args``: :class:`lvgym.agents.train.Args`): model, wind, randomisation,
+    """The env keywords of a run (``args``: :class:`lvgym.agents.training.train.Args`): model, wind, randomisation,
     observation and the ``--env-kwargs``. With ``--suite``, ``--wind protocol`` and ``--randomize protocol``
     mean the suite condition's, whose further options (faults, a mission time, a vehicle) come first and
     ``--env-kwargs`` after them."""
@@ -100,13 +100,13 @@ def env_kwargs_of(args: Any) -> dict[str, Any]:
 
 
 def check_options(args: Any) -> None:
-    """The values of ``args`` (:class:`lvgym.agents.train.Args`) checked: the ranges and choices its fields
+    """The values of ``args`` (:class:`lvgym.agents.training.train.Args`) checked: the ranges and choices its fields
     declare (as on the command line, for Args built in Python) and what they cannot say (the residual,
     the loop dispersion, the randomisation's names); a ConfigError names the option."""
-    from lvgym.agents.commandrate import command_rate_options
-    from lvgym.agents.loadmargin import load_margin_options
-    from lvgym.agents.loop_dispersion import loop_dispersion_options
-    from lvgym.agents.residual import residual_options
+    from lvgym.agents.wrappers.commandrate import command_rate_options
+    from lvgym.agents.wrappers.loadmargin import load_margin_options
+    from lvgym.agents.wrappers.loop_dispersion import loop_dispersion_options
+    from lvgym.agents.wrappers.residual import residual_options
     from lvgym.commandline import check_fields
     from lvgym.envs.spec import RANDOMIZE
 
@@ -162,24 +162,24 @@ def training_seed(seed: int, step: int, n_envs: int, prog: str = "train.py") -> 
 def make_venv(env_id: str, n_envs: int, seed: int, env_kwargs: dict[str, Any], norm: Any, gamma: float,
               stats: Path | None, residual: dict[str, Any] | None = None, loop: dict[str, Any] | None = None,
               vehicles: list[str] | None = None, charges: dict[str, Any] | None = None) -> Any:
-    """Batched SB3 VecEnv (-> :class:`lvgym.agents.loop_dispersion.LoopDispersedVecEnv` with ``loop`` ->
-    :class:`lvgym.agents.commandrate.CommandRateVecEnv` with ``charges["command_rate"]`` ->
-    :class:`lvgym.agents.residual.ResidualVecEnv` with ``residual`` ->
-    :class:`lvgym.agents.loadmargin.LoadMarginVecEnv` with ``charges["load_margin"]``) -> EnvClock (the env's
-    wall time, :mod:`lvgym.agents.timing`) -> VecMonitor (episode returns) -> VecNormalize (new, or loaded
+    """Batched SB3 VecEnv (-> :class:`lvgym.agents.wrappers.loop_dispersion.LoopDispersedVecEnv` with ``loop`` ->
+    :class:`lvgym.agents.wrappers.commandrate.CommandRateVecEnv` with ``charges["command_rate"]`` ->
+    :class:`lvgym.agents.wrappers.residual.ResidualVecEnv` with ``residual`` ->
+    :class:`lvgym.agents.wrappers.loadmargin.LoadMarginVecEnv` with ``charges["load_margin"]``) -> EnvClock (the env's
+    wall time, :mod:`lvgym.agents.training.timing`) -> VecMonitor (episode returns) -> VecNormalize (new, or loaded
     from ``stats``). ``charges``: the run config's records of the training charges (absent: off).
     ``vehicles``: vehicle files whose rows share ``n_envs`` (one such stack per vehicle, joined by
-    :class:`lvgym.agents.familytrain.ConcatVecEnv`)."""
+    :class:`lvgym.agents.training.familytrain.ConcatVecEnv`)."""
     from stable_baselines3.common.vec_env import VecMonitor, VecNormalize
 
     import lvgym  # noqa: F401
     from lvgym.envs import make_sb3_vec_env
 
-    from lvgym.agents.commandrate import command_rate_venv
-    from lvgym.agents.loadmargin import load_margin_venv
-    from lvgym.agents.loop_dispersion import loop_venv
-    from lvgym.agents.residual import residual_venv
-    from lvgym.agents.timing import EnvClock
+    from lvgym.agents.training.timing import EnvClock
+    from lvgym.agents.wrappers.commandrate import command_rate_venv
+    from lvgym.agents.wrappers.loadmargin import load_margin_venv
+    from lvgym.agents.wrappers.loop_dispersion import loop_venv
+    from lvgym.agents.wrappers.residual import residual_venv
 
     charges = dict(charges or {})
 
@@ -190,7 +190,7 @@ def make_venv(env_id: str, n_envs: int, seed: int, env_kwargs: dict[str, Any], n
                                 base.task.control_dt_s)
 
     if vehicles:
-        from lvgym.agents.familytrain import concat_venv
+        from lvgym.agents.training.familytrain import concat_venv
 
         inner = concat_venv(lambda v, rows, first: part({**env_kwargs, "vehicle": v}, rows, first), vehicles, n_envs,
                             seed)
