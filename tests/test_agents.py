@@ -209,6 +209,57 @@ def test_off_policy_runs_resume_with_their_replay_buffer(tmp_path, algo):
     assert SB3Policy(run).act(np.zeros(14, dtype=np.float32), {}).shape == (2,)
 
 
+def _rename_schedules(zip_path: Path, module: str) -> None:
+    """Rewrite a checkpoint's pickled learning rate and schedule to name the class as ``module`` defined it (a run
+    saved when the schedule lived there: ``lvgym.agents.config`` before the agents' sub-packages)."""
+    import base64
+    import types
+    import zipfile
+
+    import cloudpickle
+
+    from lvgym.agents.training.config import LinearSchedule
+
+    with zipfile.ZipFile(zip_path) as z:
+        files = {n: z.read(n) for n in z.namelist()}
+    data = json.loads(files["data"])
+    old = type("LinearSchedule", (LinearSchedule,), {"__module__": module})
+    sys.modules[module] = types.ModuleType(module)
+    sys.modules[module].LinearSchedule = old
+    try:
+        for key, obj in (("learning_rate", old(data["learning_rate"]["initial"])), ("lr_schedule", old(1.0))):
+            data[key][":serialized:"] = base64.b64encode(cloudpickle.dumps(obj)).decode()
+    finally:
+        del sys.modules[module]
+    files["data"] = json.dumps(data).encode()
+    with zipfile.ZipFile(zip_path, "w") as z:
+        for name, content in files.items():
+            z.writestr(name, content)
+
+
+def test_a_run_saved_before_its_schedule_moved_resumes(tmp_path):
+    """A checkpoint pickles its learning rate schedule by reference to the module that defined it; a resumed run
+    loads the schedules rebuilt from its config.yaml, so a run saved before they moved resumes (and a model's
+    training is the same either way)."""
+    run = TRAIN.train(_argv(tmp_path, "old", steps=128, extra=("--eval-freq", "0")))
+    zip0, _ = latest_checkpoint(run / "checkpoints")
+    _rename_schedules(zip0, "lvgym.agents.config")
+    from stable_baselines3 import PPO
+
+    with pytest.raises(ModuleNotFoundError, match="lvgym.agents.config"):
+        PPO.load(str(zip0), device="cpu")                   # the schedules as pickled: their module is gone
+    TRAIN.train(["--resume", str(run), "--total-timesteps", "256", "--no-progress"])
+    zip1, state1 = latest_checkpoint(run / "checkpoints")
+    assert state1["num_timesteps"] >= 256
+    import zipfile
+
+    with zipfile.ZipFile(zip1) as z:
+        data = json.loads(z.read("data"))
+    assert "lvgym.agents.training.config.LinearSchedule" in data["learning_rate"][":type:"]
+    lr = load_config("ppo", "lvgym/SmileAscent-v0").hyper.learning_rate
+    assert data["learning_rate"]["initial"] == lr and data["lr_schedule"]["value_schedule"] == f"LinearSchedule({lr})"
+
+
 def test_resume_refuses_arguments_that_would_change_the_run(tmp_path):
     run = TRAIN.train(_argv(tmp_path, "r", steps=128, extra=("--eval-freq", "0")))
     with pytest.raises(SystemExit, match="--seed"):

@@ -270,6 +270,14 @@ class AgentConfig:
             kw["action_noise_spec"] = (noise, sigma)        # built once the action space is known
         return {**kw, **h}
 
+    def schedules(self) -> dict[str, Any]:
+        """The learning rate and SB3's schedule of it as a resumed run loads them (``custom_objects``), rebuilt from
+        this configuration rather than unpickled: a checkpoint pickles a schedule by reference to the module that
+        defined it, and a run saved before :class:`LinearSchedule` moved here (from ``lvgym.agents.config``) names
+        a module that is gone. SB3 rebuilds its schedule from the learning rate on loading (``lr_schedule`` here is
+        a placeholder): the values are those the run trained with."""
+        return {"learning_rate": self.sb3_kwargs()["learning_rate"], "lr_schedule": None}
+
 
 _COMMON = ("learning_rate", "lr_schedule", "buffer_size", "learning_starts", "batch_size", "tau", "gamma",
            "train_freq", "gradient_steps", "action_noise", "action_noise_sigma")

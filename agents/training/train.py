@@ -334,7 +334,7 @@ def _train(args: Args, given: set[str], stop: Any, t0: float) -> Path:
         torch.set_num_threads(max(1, args.torch_threads))
         cls = algo_class(config["algo"])
         if stem is not None:
-            model = cls.load(str(policy_files(stem)[0]), env=venv, device="cpu")
+            model = cls.load(str(policy_files(stem)[0]), env=venv, device="cpu", custom_objects=cfg.schedules())
             load_rng(stem.with_name(stem.name + "_rng.pkl"))
             load_replay_buffer(model, stem)
             venv.seed(seed)                                      # fresh episodes for the new segment
