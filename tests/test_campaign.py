@@ -25,7 +25,7 @@ from pathlib import Path
 
 import pytest
 import yaml
-from lvgym.agents import campaign as camp
+from lvgym.agents.training import campaign as camp
 from lvgym.agents.training.campaign_schema import load_campaign
 from lvgym.errors import ConfigError
 
@@ -85,10 +85,10 @@ def test_a_bad_value_is_refused_naming_its_key_before_any_run_starts(tmp_path, o
     assert not (tmp_path / "runs").exists(), "a refused campaign made a folder"
 
 
-@pytest.mark.parametrize("name", sorted(p.stem for p in (Path(__file__).resolve().parents[1] / "agents" / "campaigns")
-                                         .glob("*.yaml")))
+@pytest.mark.parametrize("name", sorted(p.stem for p in (Path(__file__).resolve().parents[1] / "agents" / "training"
+                                                         / "campaigns").glob("*.yaml")))
 def test_the_shipped_campaigns_validate(name):
-    c = load_campaign(ROOT / "agents" / "campaigns" / f"{name}.yaml")
+    c = load_campaign(ROOT / "agents" / "training" / "campaigns" / f"{name}.yaml")
     assert len(c.runs()) == len(c.configurations) * len(c.seeds) >= 4 and len(c.seeds) >= 3
     assert c.evaluation.seed_set == "test" and c.evaluation.baselines
 
@@ -126,7 +126,7 @@ def _check_finished(folder: Path, runs: list[str], baselines: list[str]) -> dict
 
 
 def test_a_tiny_campaign_runs_resumes_a_killed_run_and_then_skips_everything(tmp_path, capsys):
-    from lvgym.agents import train
+    from lvgym.agents.training import train
 
     path = _file(tmp_path)
     folder = tmp_path / "runs" / "tiny"

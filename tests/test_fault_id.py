@@ -302,8 +302,8 @@ def test_a_resumed_run_takes_the_finished_rounds_fits_and_ends_as_the_whole_run(
     """``--resume``: the rounds' flights are flown again (the same data), each round whose fit was left on disk
     is read, not fitted, and the final ensemble is the uninterrupted run's to the bit."""
     from experiments.fault_id import train
-    from lvgym.agents import dagger
     from lvgym.agents.policies.observer_net import load
+    from lvgym.agents.training import dagger
 
     real = dagger.fly
     monkeypatch.setattr(dagger, "fly", lambda *a, **k: real(*a, mission_time_s=2.0, **k))
@@ -328,7 +328,7 @@ def test_a_resumed_run_takes_the_finished_rounds_fits_and_ends_as_the_whole_run(
 
 def test_the_bandwidth_names_the_runs_files_and_the_thrust_scheme_refuses_it(monkeypatch, tmp_path):
     from experiments.fault_id import train
-    from lvgym.agents import dagger
+    from lvgym.agents.training import dagger
 
     real = dagger.fly
     monkeypatch.setattr(dagger, "fly", lambda *a, **k: real(*a, mission_time_s=2.0, **k))
@@ -417,7 +417,7 @@ def test_the_ignition_weight_names_the_runs_files_and_weighs_the_windows_after_i
     (the flights' times since it, here every other step 0.5 s after, the rest before) weigh 10 in the fit;
     the files end ``-ign10``."""
     from experiments.fault_id import train
-    from lvgym.agents import dagger
+    from lvgym.agents.training import dagger
 
     real, seen = dagger.fly, []
 

@@ -73,7 +73,7 @@ def test_the_options_are_tried_in_order_against_those_kept(monkeypatch, tmp_path
     and the whole measured moment (4.25 dB) fall short of the margins and are not flown on the validation
     seeds; half of it reaches them and beats the options as trained, then a fourth candidate that loses 3
     more flights than it is refused."""
-    from lvgym.agents import flight_options
+    from lvgym.agents.training import flight_options
 
     measured = {"lead3-average6": (6.5, 20.0), "lead3-average6-ignition4": (4.25, 30.0),
                 "lead3-average6-ignition4-share0.5": (6.0, 30.0), "lead3-average4-ignition4-share0.5": (6.25, 40.0)}
@@ -245,7 +245,7 @@ def test_a_shipped_records_commands_are_installed_commands_that_parse(stem, monk
     records of the recipe: no study's factory, no script."""
     import shlex
 
-    from lvgym.agents import teacher_student
+    from lvgym.agents.training import teacher_student
     from lvgym.agents.training.train import _recipe
     from lvgym.cli import evaluate, margins
     from lvgym.cli.args import parse_given

@@ -48,9 +48,9 @@ from typing import Any
 import numpy as np
 import torch
 
-from lvgym.agents import teacher
 from lvgym.agents.policies.inversion import Lead, law_terms
 from lvgym.agents.policies.observer_net import Ensemble, Estimator, save
+from lvgym.agents.training import teacher
 from lvgym.agents.training.dagger import train_seed
 from lvgym.agents.training.observer_fit import fit
 from lvgym.agents.training.teacher import NOISE, SUITE, condition, lost, own_law, scored
