@@ -20,9 +20,11 @@ import pytest
 import torch
 
 import lvgym  # noqa: F401
-from lvgym.agents.checkpoints import latest_checkpoint, list_checkpoints
-from lvgym.agents.config import ALGOS, load_config, read_entries
-from lvgym.agents.policy import SB3Policy, load_model
+from lvgym.agents.policies.algos import ALGOS
+from lvgym.agents.policies.checkpoints import latest_checkpoint, list_checkpoints
+from lvgym.agents.policies.saved import load_model
+from lvgym.agents.policies.sb3 import SB3Policy
+from lvgym.agents.training.config import load_config, read_entries
 from lvgym.benchmark.policy import Policy
 from lvgym.errors import ConfigError
 
@@ -131,7 +133,8 @@ def test_train_saves_resumes_and_reloads_as_a_policy(tmp_path):
     assert steps[:len(state0["evaluations"])] == [e["num_timesteps"] for e in state0["evaluations"]]
     assert steps == sorted(set(steps))
     assert json.loads((run / "final_model.json").read_text())["num_timesteps"] == s1
-    # where the wall time went (lvgym.agents.timing): the env's seconds within the run's, carried across the resume
+    # where the wall time went (lvgym.agents.training.timing): the env's seconds within the run's, carried across
+    # the resume
     for state in (state0, state1):
         assert 0.0 < state["env_wall_s"] < state["train_wall_s"]
     assert state1["env_wall_s"] > state0["env_wall_s"] and state1["train_wall_s"] > state0["train_wall_s"]
@@ -206,6 +209,57 @@ def test_off_policy_runs_resume_with_their_replay_buffer(tmp_path, algo):
     assert SB3Policy(run).act(np.zeros(14, dtype=np.float32), {}).shape == (2,)
 
 
+def _rename_schedules(zip_path: Path, module: str) -> None:
+    """Rewrite a checkpoint's pickled learning rate and schedule to name the class as ``module`` defined it (a run
+    saved when the schedule lived there: ``lvgym.agents.config`` before the agents' sub-packages)."""
+    import base64
+    import types
+    import zipfile
+
+    import cloudpickle
+
+    from lvgym.agents.training.config import LinearSchedule
+
+    with zipfile.ZipFile(zip_path) as z:
+        files = {n: z.read(n) for n in z.namelist()}
+    data = json.loads(files["data"])
+    old = type("LinearSchedule", (LinearSchedule,), {"__module__": module})
+    sys.modules[module] = types.ModuleType(module)
+    sys.modules[module].LinearSchedule = old
+    try:
+        for key, obj in (("learning_rate", old(data["learning_rate"]["initial"])), ("lr_schedule", old(1.0))):
+            data[key][":serialized:"] = base64.b64encode(cloudpickle.dumps(obj)).decode()
+    finally:
+        del sys.modules[module]
+    files["data"] = json.dumps(data).encode()
+    with zipfile.ZipFile(zip_path, "w") as z:
+        for name, content in files.items():
+            z.writestr(name, content)
+
+
+def test_a_run_saved_before_its_schedule_moved_resumes(tmp_path):
+    """A checkpoint pickles its learning rate schedule by reference to the module that defined it; a resumed run
+    loads the schedules rebuilt from its config.yaml, so a run saved before they moved resumes (and a model's
+    training is the same either way)."""
+    run = TRAIN.train(_argv(tmp_path, "old", steps=128, extra=("--eval-freq", "0")))
+    zip0, _ = latest_checkpoint(run / "checkpoints")
+    _rename_schedules(zip0, "lvgym.agents.config")
+    from stable_baselines3 import PPO
+
+    with pytest.raises(ModuleNotFoundError, match="lvgym.agents.config"):
+        PPO.load(str(zip0), device="cpu")                   # the schedules as pickled: their module is gone
+    TRAIN.train(["--resume", str(run), "--total-timesteps", "256", "--no-progress"])
+    zip1, state1 = latest_checkpoint(run / "checkpoints")
+    assert state1["num_timesteps"] >= 256
+    import zipfile
+
+    with zipfile.ZipFile(zip1) as z:
+        data = json.loads(z.read("data"))
+    assert "lvgym.agents.training.config.LinearSchedule" in data["learning_rate"][":type:"]
+    lr = load_config("ppo", "lvgym/SmileAscent-v0").hyper.learning_rate
+    assert data["learning_rate"]["initial"] == lr and data["lr_schedule"]["value_schedule"] == f"LinearSchedule({lr})"
+
+
 def test_resume_refuses_arguments_that_would_change_the_run(tmp_path):
     run = TRAIN.train(_argv(tmp_path, "r", steps=128, extra=("--eval-freq", "0")))
     with pytest.raises(SystemExit, match="--seed"):
@@ -215,7 +269,7 @@ def test_resume_refuses_arguments_that_would_change_the_run(tmp_path):
 
 
 def test_shipped_checkpoint_loads_and_acts():
-    from lvgym.agents.policy import shipped_policy
+    from lvgym.agents.policies.sb3 import shipped_policy
 
     assert SHIPPED.is_file(), f"the shipped checkpoint {SHIPPED.relative_to(ROOT)} is missing"
     policy = shipped_policy()
@@ -233,7 +287,7 @@ def test_shipped_checkpoint_loads_and_acts():
 
 
 def test_validation_selects_on_the_training_model_or_on_every_condition():
-    from lvgym.agents.callbacks import ValidationEvaluator
+    from lvgym.agents.training.callbacks import ValidationEvaluator
 
     names = {m: ValidationEvaluator("smile-windy", 1, select_on=m).selected for m in ("rigid", "nonrigid", "flex", None)}
     assert names["rigid"] == ["smile-windy/rigid"] and names["nonrigid"] == ["smile-windy/nonrigid"]
@@ -243,7 +297,7 @@ def test_validation_selects_on_the_training_model_or_on_every_condition():
 def test_validation_ranks_on_failure_rate_then_the_failure_charged_score():
     """Two policies with equal failure rates: the one whose failures come late has the smaller rate error
     (its integral stops at the failure) but the larger failure-charged score; selection takes the score."""
-    from lvgym.agents.callbacks import ValidationEvaluator
+    from lvgym.agents.training.callbacks import ValidationEvaluator
 
     ev = ValidationEvaluator("smile-windy", 2, select_on="nonrigid")
     table = {"early": [(True, 0.5, 3.5), (False, 1.0, 1.0)], "late": [(True, 0.9, 1.4), (False, 1.0, 1.0)]}
@@ -279,8 +333,8 @@ def test_validation_ranks_on_failure_rate_then_the_failure_charged_score():
 def test_validation_flies_a_batched_policys_seeds_as_rows_to_the_bit():
     """A policy with ``batch(n)`` (or a factory of one) is validated on the rows of each condition's batched
     env: every record is the one-by-one episode's, to the bit."""
-    from lvgym.agents.callbacks import ValidationEvaluator
-    from lvgym.agents.policy import shipped_policy
+    from lvgym.agents.policies.sb3 import shipped_policy
+    from lvgym.agents.training.callbacks import ValidationEvaluator
 
     ev = ValidationEvaluator("smile-v2-faults", 3, {"mission_time_s": 8.0})
     policy = shipped_policy()
@@ -296,9 +350,9 @@ def test_validation_flies_a_batched_policys_seeds_as_rows_to_the_bit():
 
 
 def test_the_compiled_actor_is_predict_to_float32_rounding_and_the_same_bits_in_any_batch():
-    """SB3Policy flies an actor-critic MLP through its compiled forward (lvgym.agents.mlp): each action agrees
+    """SB3Policy flies an actor-critic MLP through its compiled forward (lvgym.agents.policies.mlp): each action agrees
     with model.predict's to float32 rounding, and a row's action is the same bits alone and in a batch."""
-    from lvgym.agents.policy import shipped_policy
+    from lvgym.agents.policies.sb3 import shipped_policy
     p = shipped_policy()
     assert p.net is not None
     rng = np.random.default_rng(3)

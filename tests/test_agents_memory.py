@@ -14,8 +14,9 @@ import numpy as np
 import pytest
 
 import lvgym  # noqa: F401
-from lvgym.agents.policy import SB3Policy, load_policy
-from lvgym.agents.residual import ResidualConfig, ResidualEnv, ResidualPolicy, ResidualVecEnv, combine
+from lvgym.agents.policies.residual import ResidualConfig, ResidualPolicy, combine
+from lvgym.agents.policies.sb3 import SB3Policy, load_policy
+from lvgym.agents.wrappers.residual import ResidualEnv, ResidualVecEnv
 from lvgym.benchmark.registry import POLICIES
 from lvgym.benchmark.runner import ZeroPolicy, build_policy, play_episode
 from lvgym.errors import ConfigError
@@ -170,7 +171,7 @@ def test_recurrent_ppo_trains_saves_and_flies_through_the_adapter(tmp_path):
 
 
 def test_recurrent_ppo_hyperparameters_are_validated():
-    from lvgym.agents.config import load_config
+    from lvgym.agents.training.config import load_config
     cfg = load_config("recurrent-ppo", ENV)
     assert cfg.sb3_kwargs()["policy_kwargs"]["lstm_hidden_size"] == 64
     with pytest.raises(ConfigError, match="policy.lstm_hidden_size = 0"):

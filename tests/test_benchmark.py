@@ -191,14 +191,14 @@ def tiny_sb3(tmp_path_factory):
 
 
 def test_sb3_model_acts_as_a_policy(tiny_sb3):
-    from lvgym.agents.policy import SB3Policy
+    from lvgym.agents.policies.sb3 import SB3Policy
 
     p = SB3Policy(str(tiny_sb3))
     assert p.name == "tiny" and p.normalizer is not None
     p.reset()
     a = p.act(np.zeros(14, dtype=np.float32), {})
     assert a.shape == (2,) and np.all(np.abs(a) <= 1.0)
-    spec = PolicySpec("tiny", "lvgym.agents.policy:load_policy", (("path", str(tiny_sb3)),))
+    spec = PolicySpec("tiny", "lvgym.agents.policies.sb3:load_policy", (("path", str(tiny_sb3)),))
     r = run_episode(spec, short_suite().conditions[0], 10_000)
     assert r["policy"] == "tiny" and r["duration_s"] == pytest.approx(SHORT)
 

@@ -25,8 +25,8 @@ from pathlib import Path
 
 import pytest
 import yaml
-from lvgym.agents import campaign as camp
-from lvgym.agents.campaign_schema import load_campaign
+from lvgym.agents.training import campaign as camp
+from lvgym.agents.training.campaign_schema import load_campaign
 from lvgym.errors import ConfigError
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -85,10 +85,10 @@ def test_a_bad_value_is_refused_naming_its_key_before_any_run_starts(tmp_path, o
     assert not (tmp_path / "runs").exists(), "a refused campaign made a folder"
 
 
-@pytest.mark.parametrize("name", sorted(p.stem for p in (Path(__file__).resolve().parents[1] / "agents" / "campaigns")
-                                         .glob("*.yaml")))
+@pytest.mark.parametrize("name", sorted(p.stem for p in (Path(__file__).resolve().parents[1] / "agents" / "training"
+                                                         / "campaigns").glob("*.yaml")))
 def test_the_shipped_campaigns_validate(name):
-    c = load_campaign(ROOT / "agents" / "campaigns" / f"{name}.yaml")
+    c = load_campaign(ROOT / "agents" / "training" / "campaigns" / f"{name}.yaml")
     assert len(c.runs()) == len(c.configurations) * len(c.seeds) >= 4 and len(c.seeds) >= 3
     assert c.evaluation.seed_set == "test" and c.evaluation.baselines
 
@@ -126,7 +126,7 @@ def _check_finished(folder: Path, runs: list[str], baselines: list[str]) -> dict
 
 
 def test_a_tiny_campaign_runs_resumes_a_killed_run_and_then_skips_everything(tmp_path, capsys):
-    from lvgym.agents import train
+    from lvgym.agents.training import train
 
     path = _file(tmp_path)
     folder = tmp_path / "runs" / "tiny"
@@ -318,7 +318,7 @@ def _kill_node(sid: int) -> None:
 
 def test_on_a_v2_suite_an_unflyable_flight_counts_as_failed_in_the_comparison():
     """score_v2 charges an unflyable flight like a failed one, so the comparison's failure rate counts both."""
-    from lvgym.agents.campaign_compare import comparison_rows
+    from lvgym.agents.training.campaign_compare import comparison_rows
 
     def rec(policy, seed, score, failed=False, flyable=True):
         return {"suite": "smile-v2", "condition": "smile-v2/rigid", "policy": policy, "seed": seed,
@@ -390,7 +390,7 @@ def test_the_evaluation_flies_each_run_on_its_own_suites_and_the_baselines_on_al
 def test_a_family_suite_is_compared_per_flight_model_over_its_vehicles():
     """Two vehicles, two seeds, one run and one baseline: the rows are each model over both vehicles, then
     all; the mean and the failure share by hand."""
-    from lvgym.agents.campaign_compare import comparison_rows
+    from lvgym.agents.training.campaign_compare import comparison_rows
 
     def rec(policy, vehicle, model, seed, score, failed=False):
         return {"suite": "family-v2", "condition": f"family-v2/{vehicle}/{model}", "policy": policy, "seed": seed,

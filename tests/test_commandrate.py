@@ -1,4 +1,4 @@
-"""The command-rate training charge (lvgym/agents/commandrate.py): hand numbers on a real batched env, the
+"""The command-rate training charge (lvgym/agents/wrappers/commandrate.py): hand numbers on a real batched env, the
 flyability rule's own measure over a whole flight, its checks, and train.py's option that records it."""
 
 from __future__ import annotations
@@ -15,7 +15,7 @@ KW = {"mission_time_s": 2.0, "controller_on_after_s": 0.2, "model": "rigid"}
 
 def _pair(weight: float, seed: int = 3):
     """The same two-row env, bare and charged."""
-    from lvgym.agents.commandrate import command_rate_venv
+    from lvgym.agents.wrappers.commandrate import command_rate_venv
     from lvgym.envs import make_sb3_vec_env
 
     bare = make_sb3_vec_env("lvgym/SmileAscent-v1", num_envs=2, seed=seed, **KW)
@@ -69,7 +69,7 @@ def test_over_a_flight_the_charges_add_up_to_the_rules_rms():
 
 
 def test_off_is_the_env_itself_and_a_bad_weight_names_its_key():
-    from lvgym.agents.commandrate import command_rate_options, command_rate_venv
+    from lvgym.agents.wrappers.commandrate import command_rate_options, command_rate_venv
 
     assert command_rate_options(0.0) is None and command_rate_options(0.5) == {"weight": 0.5}
     stub = object()
@@ -81,7 +81,7 @@ def test_off_is_the_env_itself_and_a_bad_weight_names_its_key():
 def test_train_records_the_charge_and_trains_with_it(tmp_path, capsys):
     import yaml
 
-    from lvgym.agents.train import main
+    from lvgym.agents.training.train import main
 
     main(["--suite", "smile-v2-faults", "--residual", "lqg-front", "--residual-scale", "0.1",
           "--command-rate-charge", "0.9", "--total-timesteps", "256", "--n-envs", "2", "--hp", "algo.n_steps=128",

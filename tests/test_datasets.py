@@ -1,6 +1,7 @@
-"""Minari datasets of the benchmark's policies (lvgym/agents/datasets.py) and behaviour cloning from them
-(lvgym/agents/bc.py): written, loaded by Minari's own API, the same steps as a single env's flight to the bit,
-with their provenance; the cloned policy trains, flies and refuses an env it was not cloned on."""
+"""Minari datasets of the benchmark's policies (agents/training/datasets.py) and behaviour cloning from them
+(agents/training/clone.py, the cloned policy agents/policies/bc.py): written, loaded by Minari's own API, the same
+steps as a single env's flight to the bit, with their provenance; the cloned policy trains, flies and refuses an
+env it was not cloned on."""
 
 from __future__ import annotations
 
@@ -20,7 +21,7 @@ def datasets(tmp_path, monkeypatch):
 
 
 def test_a_dataset_holds_the_flights_as_a_single_env_flies_them(datasets):
-    from lvgym.agents.datasets import collect, dataset_id
+    from lvgym.agents.training.datasets import collect, dataset_id
     from lvgym.benchmark.registry import resolve_policy
 
     collect("lqg", "smile-v2", "rigid", episodes=2, mission_time_s=3.0)
@@ -50,7 +51,7 @@ def test_a_dataset_holds_the_flights_as_a_single_env_flies_them(datasets):
 
 
 def test_the_reference_and_a_bad_seed_set_are_refused(datasets):
-    from lvgym.agents.datasets import collect
+    from lvgym.agents.training.datasets import collect
 
     with pytest.raises(ConfigError, match="privileged"):
         collect("privileged", "smile-v2", "rigid", episodes=1)
@@ -60,8 +61,9 @@ def test_the_reference_and_a_bad_seed_set_are_refused(datasets):
 
 def test_behaviour_cloning_trains_and_flies_and_knows_its_observation(datasets):
     pytest.importorskip("torch")
-    from lvgym.agents.bc import features, policy, train
-    from lvgym.agents.datasets import collect
+    from lvgym.agents.policies.bc import policy
+    from lvgym.agents.training.clone import features, train
+    from lvgym.agents.training.datasets import collect
 
     np.testing.assert_array_equal(features(np.array([[1.0, 2.0], [3.0, 4.0]]), 2),
                                   [[0.0, 0.0, 1.0, 2.0], [1.0, 2.0, 3.0, 4.0]])
@@ -83,7 +85,7 @@ def test_behaviour_cloning_trains_and_flies_and_knows_its_observation(datasets):
     from lvgym.benchmark.suites import get_suite
 
     spec = resolve_policy(str(out))
-    assert spec.name == "bc" and spec.factory == "lvgym.agents.bc:policy"
+    assert spec.name == "bc" and spec.factory == "lvgym.agents.policies.bc:policy"
     records = evaluate([spec], [get_suite("smile-v2").with_options(mission_time_s=1.0)], episodes=1,
                        seed_set="validation", workers=1, progress=False)
     assert [r["policy"] for r in records] == ["bc", "bc"]
@@ -93,8 +95,8 @@ def test_a_noise_injected_dataset_flies_the_noise_and_labels_with_the_policy(dat
     """DART's data: the env flew the policy's action plus seeded noise; the labels are the policy's own, so a
     clone trains on them."""
     pytest.importorskip("torch")
-    from lvgym.agents.bc import train
-    from lvgym.agents.datasets import NOISE_STREAM, collect, dataset_id
+    from lvgym.agents.training.clone import train
+    from lvgym.agents.training.datasets import NOISE_STREAM, collect, dataset_id
 
     assert dataset_id("lqg", "smile-v2", "rigid", 0.05) == "lvgym/smile-v2-rigid/lqg-noise0p05-v0"
     with pytest.raises(ConfigError, match="action_noise = 2"):
@@ -114,7 +116,7 @@ def test_a_noise_injected_dataset_flies_the_noise_and_labels_with_the_policy(dat
 @pytest.mark.parametrize(("policy", "suite"), [("ppo-res-lqg", "smile-v2-faults"), ("inversion-id", "smile-v2-faults"),
                                                ("inversion-id-stratos", "stratos-tvc-v2"), ("inversion-id-smile", "smile-v2")])
 def test_the_shipped_learned_policies_are_recorded_as_they_fly(datasets, policy, suite):
-    from lvgym.agents.datasets import collect, dataset_id
+    from lvgym.agents.training.datasets import collect, dataset_id
     from lvgym.benchmark.registry import resolve_policy
     from lvgym.benchmark.runner import build_policy
 

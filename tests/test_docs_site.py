@@ -31,7 +31,7 @@ def test_mkdocs_build_strict(tmp_path):
     rl = (site / "rl" / "index.html").read_text(encoding="utf-8")
     assert "pitch_rate_error" in rl and "q-alpha beyond the structural limit" in rl     # the generated tables
     agents = (site / "api" / "agents" / "index.html").read_text(encoding="utf-8")
-    assert 'id="lvgym.agents.policy.SB3Policy"' in agents          # agents/ documented as lvgym.agents
+    assert 'id="lvgym.agents.policies.sb3.SB3Policy"' in agents    # agents/ documented as lvgym.agents
     assert ":class:" not in agents                                  # Sphinx roles became code spans
 
 

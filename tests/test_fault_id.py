@@ -89,7 +89,7 @@ def test_the_inversion_teacher_is_the_reference_on_the_observation(monkeypatch, 
 
 def test_the_inversion_student_in_a_batch_flies_as_the_benchmark_flies_it():
     from experiments.fault_id.inversion import InversionPolicy
-    from lvgym.agents.observer_fit import to_observer
+    from lvgym.agents.policies.observer_net import to_observer
     torch.manual_seed(0)
     short = {"mission_time_s": 3.0}
     x, y, _, _ = fly("rigid", [0, 1], None, np.random.default_rng(0), scheme="inversion", **short)
@@ -250,7 +250,7 @@ def test_a_configuration_of_the_study_is_a_row_of_factories_and_a_label_to_compa
     lead, average and non-rigid bandwidth under ``<label>-s<k>``; ``compare`` groups by the rows' labels."""
     from experiments.fault_id import inversion
     from experiments.fault_id.compare import configurations
-    from lvgym.agents.observer_fit import Ensemble, Estimator, save
+    from lvgym.agents.policies.observer_net import Ensemble, Estimator, save
     from lvgym.baselines.privileged import GAINS
     rng = np.random.default_rng(0)
     save(Ensemble([Estimator(rng.normal(0.0, 0.1, FEATURES), np.ones(FEATURES), hidden=8, outputs=7)]),
@@ -279,7 +279,7 @@ def test_a_configuration_of_the_study_is_a_row_of_factories_and_a_label_to_compa
 def test_the_rounds_data_grows_in_place_as_their_concatenation():
     """Batches of windows appended (past the room reserved, then grown by a quarter) read as the batches
     concatenated, as views of one array."""
-    from lvgym.agents.observer_fit import Data
+    from lvgym.agents.training.observer_fit import Data
 
     rng = np.random.default_rng(0)
     xs = [rng.normal(size=(n, 3, 2)).astype(np.float32) for n in (5, 7, 2, 9)]
@@ -302,8 +302,8 @@ def test_a_resumed_run_takes_the_finished_rounds_fits_and_ends_as_the_whole_run(
     """``--resume``: the rounds' flights are flown again (the same data), each round whose fit was left on disk
     is read, not fitted, and the final ensemble is the uninterrupted run's to the bit."""
     from experiments.fault_id import train
-    from lvgym.agents import dagger
-    from lvgym.agents.observer_fit import load
+    from lvgym.agents.policies.observer_net import load
+    from lvgym.agents.training import dagger
 
     real = dagger.fly
     monkeypatch.setattr(dagger, "fly", lambda *a, **k: real(*a, mission_time_s=2.0, **k))
@@ -328,7 +328,7 @@ def test_a_resumed_run_takes_the_finished_rounds_fits_and_ends_as_the_whole_run(
 
 def test_the_bandwidth_names_the_runs_files_and_the_thrust_scheme_refuses_it(monkeypatch, tmp_path):
     from experiments.fault_id import train
-    from lvgym.agents import dagger
+    from lvgym.agents.training import dagger
 
     real = dagger.fly
     monkeypatch.setattr(dagger, "fly", lambda *a, **k: real(*a, mission_time_s=2.0, **k))
@@ -344,7 +344,7 @@ def test_the_bandwidth_names_the_runs_files_and_the_thrust_scheme_refuses_it(mon
 @pytest.mark.parametrize(("n", "rows"), [(1, 4), (37, 5), (1000, 64), (20_001, 1 << 16)])
 def test_the_fits_standard_deviation_is_numpys_to_the_bit(n, rows):
     """``row_std`` (chunks of ``rows`` rows, no temporary of the whole data) is ``std(0)`` bit for bit."""
-    from lvgym.agents.observer_fit import row_std
+    from lvgym.agents.training.observer_fit import row_std
     flat = np.random.default_rng(n).normal(3.0, 2.0, (n, 16)).astype(np.float32)
     assert np.array_equal(row_std(flat, flat.mean(0), rows), flat.std(0))
 
@@ -386,8 +386,8 @@ def test_the_rounds_weights_grow_with_their_data_and_weigh_the_fits_mean_error(c
     """The weights appended beside the windows (1 where none are given; None, the plain mean, when all are
     1), and a fit's first epoch in one batch reports the weighted mean of the initial network's errors:
     sum(w mean_j e_j^2) / sum(w), the network drawn from the same seed."""
-    from lvgym.agents.observer_fit import Data
-    from lvgym.agents.observer_fit import Estimator
+    from lvgym.agents.policies.observer_net import Estimator
+    from lvgym.agents.training.observer_fit import Data
 
     rng = np.random.default_rng(1)
     x = rng.normal(size=(40, WINDOW, FEATURES)).astype(np.float32)
@@ -403,7 +403,7 @@ def test_the_rounds_weights_grow_with_their_data_and_weigh_the_fits_mean_error(c
     reported = float(capsys.readouterr().out.split("mean squared error ")[1].split()[0])
     torch.manual_seed(3)
     flat = x.reshape(-1, FEATURES)
-    from lvgym.agents.observer_fit import row_std
+    from lvgym.agents.training.observer_fit import row_std
     first = Estimator(flat.mean(0), row_std(flat, flat.mean(0)) + 1e-6, outputs=3, label_mean=y.mean(0),
                       label_std=y.std(0) + 1e-6)
     with torch.no_grad():
@@ -417,7 +417,7 @@ def test_the_ignition_weight_names_the_runs_files_and_weighs_the_windows_after_i
     (the flights' times since it, here every other step 0.5 s after, the rest before) weigh 10 in the fit;
     the files end ``-ign10``."""
     from experiments.fault_id import train
-    from lvgym.agents import dagger
+    from lvgym.agents.training import dagger
 
     real, seen = dagger.fly, []
 
@@ -447,7 +447,7 @@ def test_the_teachers_upset_cancels_a_drawn_share_of_the_moment_for_a_drawn_whil
     before ignition (-1) and after it the law on the truth (without exploration noise); a student is never
     upset, and the thrust scheme refuses it."""
     from experiments.fault_id import train
-    from lvgym.agents.inversion import command, error_index, gains
+    from lvgym.agents.policies.inversion import command, error_index, gains
 
     monkeypatch.setattr(train, "NOISE", (0.0,))
     env1 = condition("nonrigid", privileged_info=True, mission_time_s=2.0).make_env()

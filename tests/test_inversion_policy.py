@@ -1,7 +1,7 @@
-"""The shipped disturbance-observer policy ``inversion-id`` (lvgym.agents.inversion, lvgym.agents.observer):
-the observer's window, the law's terms and command by hand, the NumPy observer against the torch network it
-was fitted as, the shipped file against its record, the envs it refuses, its batch against its single env to
-the bit, and that it flies without torch."""
+"""The shipped disturbance-observer policy ``inversion-id`` (lvgym.agents.policies.inversion,
+lvgym.agents.policies.observer): the observer's window, the law's terms and command by hand, the NumPy observer against
+the torch network it was fitted as, the shipped file against its record, the envs it refuses, its batch against its
+single env to the bit, and that it flies without torch."""
 
 from __future__ import annotations
 
@@ -16,10 +16,10 @@ import torch
 
 import lvgym
 import lvgym.cli.policies  # noqa: F401  (registers the built-in policies)
-from lvgym.agents.inversion import (A_MAX, SHIPPED, TERMS, TRAINED, InversionPolicy, Lead, command, env_record,
-                                    from_file, law_terms)
-from lvgym.agents.observer import FEATURES, N_OBS, WINDOW, Observer, Window
-from lvgym.agents.observer_fit import Ensemble, Estimator, load, save, to_observer
+from lvgym.agents.policies.inversion import (A_MAX, SHIPPED, TERMS, TRAINED, InversionPolicy, Lead, command,
+                                             env_record, from_file, law_terms)
+from lvgym.agents.policies.observer import FEATURES, N_OBS, WINDOW, Observer, Window
+from lvgym.agents.policies.observer_net import Ensemble, Estimator, load, save, to_observer
 from lvgym.benchmark.headline import policy_kind
 from lvgym.benchmark.registry import resolve_policy
 from lvgym.benchmark.runner import build_policy, play_episode
@@ -267,7 +267,7 @@ def test_the_laws_own_gains_per_flight_model_by_hand_and_refused_by_name():
     spec's pairs), the other keeps the reference's; the command is the law's with them (by hand: a rate error of
     0.1 rad/s with ``a`` = 0.5 commands -0.5 * 2 * z * w * 0.1); an unknown model or a bad value is refused by
     name, and a shipped record's ``law`` is what its policy flies."""
-    from lvgym.agents.inversion import gains
+    from lvgym.agents.policies.inversion import gains
     from lvgym.baselines.privileged import GAINS
 
     rigid, nonrigid = (lvgym.make_env("smile-v2", m, mission_time_s=2.0) for m in ("rigid", "nonrigid"))

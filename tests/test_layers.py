@@ -63,6 +63,10 @@ FORBIDDEN = {
     # the controllers, then the agents, on top of the benchmark
     "lvgym.baselines": ("lvgym.agents", "baselines_pid", "experiments") + TOOLS + COMMANDS,
     "lvgym.agents": ("baselines_pid", "experiments") + TOOLS + COMMANDS,
+    # inside the agents: training on the wrappers on the policies (what flies in the benchmark imports neither)
+    "lvgym.agents.policies": ("lvgym.agents.training", "lvgym.agents.wrappers", "baselines_pid", "experiments") + TOOLS
+    + COMMANDS,
+    "lvgym.agents.wrappers": ("lvgym.agents.training", "baselines_pid", "experiments") + TOOLS + COMMANDS,
     # the package root (env ids, make_env on the benchmark's suites) and the command layer on top
     "lvgym": ("torch",) + ON_TOP + COMMANDS,
     "lvgym.cli": ("baselines_pid", "experiments"),
@@ -72,7 +76,8 @@ ENTRY = ("lvgym.__main__",)
 ROOT = Path(lvgym.__file__).parent
 
 
-#: a string that names a module (``"lvgym.baselines.pid"``) or a factory in one (``"lvgym.agents.policy:load"``)
+#: a string that names a module (``"lvgym.baselines.pid"``) or a factory in one
+#: (``"lvgym.agents.policies.sb3:load_policy"``)
 #: (a dotted name or a factory: a bare word such as "experiments" may be a dict key)
 IMPORT_PATH = re.compile(r"^(?P<module>(?:lvgym|baselines_pid|experiments|gymnasium|stable_baselines3|sb3_contrib|torch)"
                          r"(?:\.\w+)*)(?::[\w.]+)?$")
@@ -195,6 +200,9 @@ def test_the_check_sees_an_upward_import():
     assert "lvgym.benchmark.suites" in _closure("lvgym")                      # make_env
     assert "lvgym.envs.ascent" in _closure("lvgym")                           # the env ids' entry points
     assert {"lvgym.agents", "lvgym.baselines"} <= _closure("lvgym.cli")       # the policies command line
+    # inside the agents: training reaches the wrappers and the policies, the wrappers the policies
+    assert {"lvgym.agents.wrappers.residual", "lvgym.agents.policies.sb3"} <= _closure("lvgym.agents.training")
+    assert "lvgym.agents.policies.residual" in _closure("lvgym.agents.wrappers")
 
 
 def test_every_installed_module_is_in_a_checked_layer():
@@ -217,7 +225,7 @@ def test_nothing_below_the_command_layer_imports_it():
 
 
 def test_the_check_sees_an_import_path_written_as_a_string():
-    assert "lvgym.agents.policy" in _imports("lvgym.agents")            # ppo's factory, registered as a string
+    assert "lvgym.agents.policies.sb3" in _imports("lvgym.agents")      # ppo's factory, registered as a string
     assert "lvgym.benchmark.runner" in _imports("lvgym.benchmark.registry")   # zero's
 
 
@@ -239,8 +247,8 @@ def test_every_registered_factory_lives_at_or_below_the_package_that_registers_i
     modules = {f.partition(":")[0] for f in factories}
     assert modules == {"lvgym.benchmark.runner", "lvgym.baselines.pid", "lvgym.baselines.aac", "lvgym.baselines.lqg",
                        "lvgym.baselines.mpc", "lvgym.baselines.privileged", "lvgym.baselines.designed",
-                       "lvgym.agents.policy", "lvgym.agents.bc", "lvgym.agents.inversion",
-                       "lvgym.agents.inversion_record"}
+                       "lvgym.agents.policies.sb3", "lvgym.agents.policies.bc", "lvgym.agents.policies.inversion",
+                       "lvgym.agents.policies.inversion_record"}
     for module in modules:                          # a worker imports it: the factory reaches no study
         assert not any(n.startswith("experiments") for n in _follow([module], set())), module
 
@@ -284,7 +292,8 @@ def test_nothing_installed_imports_the_experiments():
     """experiments/ (the one-off studies) is not installed: no module of lvgym, lvgym.agents or
     lvgym.baselines imports it, by an import statement or by name."""
     modules = _installed_modules()
-    assert {"lvgym.cli", "lvgym.agents.policy", "lvgym.baselines.pid", "lvgym.baselines.design.tune"} <= set(modules)
+    assert {"lvgym.cli", "lvgym.agents.policies.sb3", "lvgym.agents.training.train", "lvgym.agents.wrappers.residual",
+            "lvgym.baselines.pid", "lvgym.baselines.design.tune"} <= set(modules)
     found = {m: _experiments(_imports(m) | _loads_by_name(m)) for m in modules}
     bad = {m: names for m, names in found.items() if names}
     assert not bad, f"installed modules import experiments/: {bad}"

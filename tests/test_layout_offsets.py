@@ -25,7 +25,7 @@ KERNEL_MODULES = ["lvgym.dynamics.kernels", "lvgym.dynamics.stepper", "lvgym.dyn
                   "lvgym.simulator.advance", "lvgym.simulator.flight", "lvgym.simulator.servo", "lvgym.simulator.strips",
                   "lvgym.simulator.imu", "lvgym.simulator.timeline", "lvgym.simulator.piece", "lvgym.envs.signals",
                   "lvgym.envs.flightcomputer", "lvgym.baselines.pidkernel", "lvgym.baselines.aackernel",
-                  "lvgym.baselines.lqgkernel", "lvgym.baselines.mpckernel", "lvgym.agents.mlp"]
+                  "lvgym.baselines.lqgkernel", "lvgym.baselines.mpckernel", "lvgym.agents.policies.mlp"]
 #: a component index added to an offset whose field size the check cannot see (a local name): a quaternion's
 _COMPONENT = 4
 

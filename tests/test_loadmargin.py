@@ -1,4 +1,4 @@
-"""The load-margin training charge (lvgym/agents/loadmargin.py): hand numbers on a stub VecEnv, its checks,
+"""The load-margin training charge (lvgym/agents/wrappers/loadmargin.py): hand numbers on a stub VecEnv, its checks,
 and train.py's option that records it and flies it."""
 
 from __future__ import annotations
@@ -45,7 +45,7 @@ class _Stub(VecEnv):
 
 
 def test_the_charge_is_the_weight_times_the_ratio_above_the_threshold_times_the_period():
-    from lvgym.agents.loadmargin import load_margin_venv
+    from lvgym.agents.wrappers.loadmargin import load_margin_venv
 
     venv = load_margin_venv(_Stub([237_500.0, 150_000.0], [250_000.0, 250_000.0]),
                             {"weight": 2.0, "threshold": 0.8}, 0.02)
@@ -57,7 +57,7 @@ def test_the_charge_is_the_weight_times_the_ratio_above_the_threshold_times_the_
 
 
 def test_no_limit_no_charge_and_off_is_the_env_itself():
-    from lvgym.agents.loadmargin import load_margin_options, load_margin_venv
+    from lvgym.agents.wrappers.loadmargin import load_margin_options, load_margin_venv
 
     stub = _Stub([1e9, 1e9], [0.0, float("inf")])
     venv = load_margin_venv(stub, {"weight": 1.0, "threshold": 0.5}, 0.02)
@@ -69,7 +69,7 @@ def test_no_limit_no_charge_and_off_is_the_env_itself():
 
 @pytest.mark.parametrize("weight, threshold, key", [(-1.0, 0.8, "load_margin"), (1.0, 1.5, "load_margin_threshold")])
 def test_a_bad_value_names_its_key(weight, threshold, key):
-    from lvgym.agents.loadmargin import load_margin_options
+    from lvgym.agents.wrappers.loadmargin import load_margin_options
 
     with pytest.raises(ConfigError, match=key):
         load_margin_options(weight, threshold)
@@ -78,7 +78,7 @@ def test_a_bad_value_names_its_key(weight, threshold, key):
 def test_train_records_the_charge_and_trains_with_it(tmp_path):
     import yaml
 
-    from lvgym.agents.train import main
+    from lvgym.agents.training.train import main
 
     main(["--suite", "smile-v2-faults", "--residual", "lqg-front", "--residual-scale", "0.1", "--load-margin", "1.0",
           "--total-timesteps", "256", "--n-envs", "2", "--hp", "algo.n_steps=128", "algo.batch_size=64",

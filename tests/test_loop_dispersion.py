@@ -1,4 +1,4 @@
-"""Training with the loop gain and delay dispersed (lvgym.agents.loop_dispersion, ``train.py --loop-gain-db
+"""Training with the loop gain and delay dispersed (lvgym.agents.wrappers.loop_dispersion, ``train.py --loop-gain-db
 --loop-delay-periods``): the gain and the delay by hand on a recording env, the draws' ranges and
 seeding, the options' errors, and a residual run on the v1 env that records and flies it."""
 
@@ -9,7 +9,8 @@ import numpy as np
 import pytest
 from stable_baselines3.common.vec_env import DummyVecEnv
 
-from lvgym.agents.loop_dispersion import LoopDispersedVecEnv, LoopDispersion, loop_dispersion_options, loop_venv
+from lvgym.agents.wrappers.loop_dispersion import (LoopDispersedVecEnv, LoopDispersion, loop_dispersion_options,
+                                                   loop_venv)
 from lvgym.errors import ConfigError
 
 from test_agents import TRAIN, _argv
@@ -95,7 +96,7 @@ def test_a_residual_run_records_and_flies_the_dispersion(tmp_path):
     args, given = TRAIN.parse_args(_argv(tmp_path, "loop", steps=128, extra=extra))
     _, config, _, _ = TRAIN.prepare(args, given)
     assert config["loop_dispersion"] == {"gain_db": 3.0, "delay_periods": 1}
-    from lvgym.agents.config import build_config
+    from lvgym.agents.training.config import build_config
 
     norm = build_config(config["algo"], config["env_id"], config["hyperparams"], "-").normalize
     venv = TRAIN.make_venv(config["env_id"], 4, 0, {**config["env_kwargs"], "mission_time_s": 2.0}, norm, 0.99,

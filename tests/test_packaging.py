@@ -31,17 +31,26 @@ def _package(folder: Path) -> str:
 def test_packages_list_every_package_folder():
     found = {_package(init.parent) for d in set(SETUPTOOLS["package-dir"].values())
              for init in (ROOT / d).rglob("__init__.py") if "__pycache__" not in init.parts}
-    assert {"lvgym", "lvgym.envs", "lvgym.agents", "lvgym.baselines", "lvgym.baselines.design"} <= found
+    assert {"lvgym", "lvgym.envs", "lvgym.agents", "lvgym.agents.policies", "lvgym.baselines",
+            "lvgym.baselines.design"} <= found
     assert sorted(found - set(SETUPTOOLS["packages"])) == [], "folders with an __init__.py missing from packages"
     assert sorted(set(SETUPTOOLS["packages"]) - found) == [], "packages listed without a folder"
 
 
+def _folder(package: str) -> Path:
+    """The folder of the checkout that holds ``package`` by the ``package-dir`` mapping (``lvgym.agents.training``
+    is ``agents/training``): the inverse of :func:`_package`."""
+    name = max((n for n in SETUPTOOLS["package-dir"] if package == n or package.startswith(n + ".")), key=len)
+    return ROOT / SETUPTOOLS["package-dir"][name] / Path(*package[len(name):].split(".")[1:])
+
+
 def test_package_data_globs_find_files():
-    folders = {name: ROOT / d for name, d in SETUPTOOLS["package-dir"].items()}
+    assert _folder("lvgym.agents.training") == ROOT / "agents" / "training"
+    assert _package(_folder("lvgym.baselines.design")) == "lvgym.baselines.design"
     for package, globs in SETUPTOOLS["package-data"].items():
         assert package in SETUPTOOLS["packages"], package
         for pattern in globs:
-            assert list(folders[package].glob(pattern)), f"{package}: {pattern} matches no file"
+            assert list(_folder(package).glob(pattern)), f"{package}: {pattern} matches no file"
 
 
 def test_core_imports_load_no_extra(tmp_path):

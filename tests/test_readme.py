@@ -38,7 +38,7 @@ SHORTEN = {
         "--total-timesteps 128 --n-envs 2 --hp algo.n_steps=64 algo.batch_size=64 algo.n_epochs=1 "
         "policy.net_arch=[8,8] --env-kwargs mission_time_s=2 controller_on_after_s=0.2 --checkpoint-freq 128 "
         "--eval-episodes 1 --eval-mission-time-s 0.5 --no-progress",
-    "lvgym campaign agents/campaigns/v2_faults_gust.yaml --dry-run": "",
+    "lvgym campaign agents/training/campaigns/v2_faults_gust.yaml --dry-run": "",
     "lvgym evaluate --policies my_policy.py:make lqg-front": SHORT_EVAL,
     "cp lvgym/vehicles/smile_v1.yaml my_rocket.yaml": "",
     "lvgym design pid-flex --vehicle smile": "--times 28.8 --starts 0",

@@ -93,7 +93,7 @@ def test_the_installed_recipe_trains_records_and_its_record_flies(tmp_path):
     _warm_caches()
     assert _copy_caches(purelib, tmp_path / "numba") > 20
     env = {"NUMBA_CACHE_DIR": str(tmp_path / "numba")}
-    where = json.loads(_run([python, "-c", "import json, lvgym, torch, lvgym.agents.teacher_student as t; "
+    where = json.loads(_run([python, "-c", "import json, lvgym, torch, lvgym.agents.training.teacher_student as t; "
                                            "print(json.dumps([lvgym.__file__, t.__file__]))"], tmp_path).stdout)
     assert all(Path(f).is_relative_to(venv) for f in where), where
 

@@ -1,6 +1,6 @@
 """The next stage's ignition as the flight computer sees it and the moment it measures there from the rigid
-body (lvgym.agents.staging), by hand, and the disturbance-observer policy flying that moment for a while
-after ignition (lvgym.agents.inversion.Staging): the law by hand on it, its batch against its single env to
+body (lvgym.agents.policies.staging), by hand, and the disturbance-observer policy flying that moment for a while
+after ignition (lvgym.agents.policies.inversion.Staging): the law by hand on it, its batch against its single env to
 the bit, refusals by name."""
 
 from __future__ import annotations
@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 import lvgym
-from lvgym.agents.inversion import InversionPolicy, command
-from lvgym.agents.staging import GIMBAL, RATES, Ignition, Measured, signal_index
+from lvgym.agents.policies.inversion import InversionPolicy, command
+from lvgym.agents.policies.staging import GIMBAL, RATES, Ignition, Measured, signal_index
 from lvgym.errors import ConfigError
 
 

@@ -1,6 +1,6 @@
 """The teacher's privileged observation (the env option ``fault_info``, lvgym/envs/faults.py ``fault_info``) and
 what the tools do with a teacher: the benchmark flies it with its block and counts it privileged, a dataset of
-its rollouts holds what a blind student sees (lvgym/agents/datasets.py), a campaign configuration may leave the
+its rollouts holds what a blind student sees (lvgym/agents/training/datasets.py), a campaign configuration may leave the
 env keywords empty."""
 
 from __future__ import annotations
@@ -85,7 +85,7 @@ def saved_teacher(tmp_path):
     """An untrained PPO saved as a teacher: its sidecar's env keywords hold ``fault_info``."""
     from stable_baselines3 import PPO
 
-    from lvgym.agents.policy import save_policy
+    from lvgym.agents.policies.saved import save_policy
 
     env = lvgym.make_env("smile-v2-faults", "rigid", fault_info=True, **SHORT)
     model = PPO("MlpPolicy", env, n_steps=64, batch_size=64, seed=0, device="cpu")
@@ -114,8 +114,8 @@ def test_the_benchmark_flies_a_teacher_with_its_block_and_counts_it_privileged(s
 
 def test_a_teachers_dataset_holds_what_its_blind_student_sees(saved_teacher, tmp_path, monkeypatch):
     minari = pytest.importorskip("minari")
-    from lvgym.agents.datasets import collect
-    from lvgym.agents.policy import SB3Policy
+    from lvgym.agents.policies.sb3 import SB3Policy
+    from lvgym.agents.training.datasets import collect
 
     monkeypatch.setenv("MINARI_DATASETS_PATH", str(tmp_path / "minari"))
     data = collect(str(saved_teacher), "smile-v2-faults", "rigid", episodes=1, action_noise=0.1, **SHORT)
@@ -134,7 +134,7 @@ def test_a_teachers_dataset_holds_what_its_blind_student_sees(saved_teacher, tmp
 
 
 def test_classical_names_every_classical_baseline_a_suite_lists():
-    from lvgym.agents.datasets import suite_policies
+    from lvgym.agents.training.datasets import suite_policies
     from lvgym.errors import ConfigError
 
     got = suite_policies(["classical", "lqg", "zero"], "smile-v2-faults")
@@ -146,7 +146,7 @@ def test_classical_names_every_classical_baseline_a_suite_lists():
 
 
 def test_learned_names_the_shipped_learned_policies_a_suite_lists():
-    from lvgym.agents.datasets import suite_policies
+    from lvgym.agents.training.datasets import suite_policies
 
     assert suite_policies(["learned"], "smile-v2-faults") == ["ppo-res-lqg", "inversion-id", "inversion-id-smile"]
     assert suite_policies(["classical", "learned"], "smile-v2")[-3:] == ["ppo-res-lqg", "inversion-id",
@@ -156,7 +156,7 @@ def test_learned_names_the_shipped_learned_policies_a_suite_lists():
 
 
 def test_an_empty_env_keywords_mapping_adds_no_flag(tmp_path):
-    from lvgym.agents.campaign_schema import load_campaign
+    from lvgym.agents.training.campaign_schema import load_campaign
 
     text = ("name: t\nseeds: [0]\ntrain: {total_timesteps: 1000, suite: smile-v2-faults}\n"
             "configurations:\n  blind: {env_kwargs: {}}\n  teacher: {env_kwargs: {fault_info: true}}\n"

@@ -1,8 +1,7 @@
-"""The teacher-student recipe (``lvgym train --recipe teacher-student``, :mod:`lvgym.agents.teacher_student`): its
-seeds by hand, its flight-option rule on the shipped record's numbers, the record and the policy it names, the
-command end to end on a short mission against the benchmark's single env, and its command line. The installed
-wheel runs it in tests/test_recipe_wheel.py; the study's flights and fits against the installed ones:
-tests/test_fault_id.py."""
+"""The teacher-student recipe (``lvgym train --recipe teacher-student``, :mod:`lvgym.agents.training.teacher_student`):
+its seeds by hand, its flight-option rule on the shipped record's numbers, the record and the policy it names, the
+command end to end on a short mission against the benchmark's single env, and its command line. The installed wheel runs
+it in tests/test_recipe_wheel.py; the study's flights and fits against the installed ones: tests/test_fault_id.py."""
 
 from __future__ import annotations
 
@@ -12,12 +11,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from lvgym.agents.dagger import check_training_seeds, training_seeds
-from lvgym.agents.flight_options import FlightOption, Rule, choose_options, parse_option, per_model
-from lvgym.agents.inversion import SHIPPED, TRAINED, InversionPolicy, shipped_inversion
-from lvgym.agents.inversion_record import flown, from_record, sha256, write_record
-from lvgym.agents.observer import FEATURES
-from lvgym.agents.teacher import condition
+from lvgym.agents.policies.inversion import SHIPPED, TRAINED, InversionPolicy, shipped_inversion
+from lvgym.agents.policies.inversion_record import flown, from_record, sha256, write_record
+from lvgym.agents.policies.observer import FEATURES
+from lvgym.agents.training.dagger import check_training_seeds, training_seeds
+from lvgym.agents.training.flight_options import FlightOption, Rule, choose_options, parse_option, per_model
+from lvgym.agents.training.teacher import condition
 from lvgym.benchmark.runner import build_policy, play_episode
 from lvgym.errors import ConfigError
 
@@ -74,7 +73,7 @@ def test_the_options_are_tried_in_order_against_those_kept(monkeypatch, tmp_path
     and the whole measured moment (4.25 dB) fall short of the margins and are not flown on the validation
     seeds; half of it reaches them and beats the options as trained, then a fourth candidate that loses 3
     more flights than it is refused."""
-    from lvgym.agents import flight_options
+    from lvgym.agents.training import flight_options
 
     measured = {"lead3-average6": (6.5, 20.0), "lead3-average6-ignition4": (4.25, 30.0),
                 "lead3-average6-ignition4-share0.5": (6.0, 30.0), "lead3-average4-ignition4-share0.5": (6.25, 40.0)}
@@ -133,7 +132,7 @@ def test_a_shipped_record_is_the_policy_it_names(stem):
 
 
 def _observer(tmp_path: Path) -> Path:
-    from lvgym.agents.observer_fit import Ensemble, Estimator, to_observer
+    from lvgym.agents.policies.observer_net import Ensemble, Estimator, to_observer
 
     rng = np.random.default_rng(3)
     members = [Estimator(rng.normal(0.0, 0.1, FEATURES), np.ones(FEATURES), hidden=8, outputs=7) for _ in range(2)]
@@ -147,14 +146,14 @@ def test_a_record_flies_its_options_and_refuses_another_file_or_a_json_that_is_n
 
     npz = _observer(tmp_path)
     env = condition("nonrigid", "smile-v2", mission_time_s=SHORT).make_env()
-    from lvgym.agents.inversion import env_record
+    from lvgym.agents.policies.inversion import env_record
 
     record = {"policy": "mine", "suite": "smile-v2", "env": env_record(env), "observer": "o.npz", "sha256": sha256(npz),
               **flown(lead=5, law={"nonrigid": [1.25, 1.0]}, ignition=4.0, average=6, ignition_share=0.5)}
     assert set(flown(lead=0)) == {"lead"} and "ignition_share" not in flown(ignition_share=0.5)
     path = write_record(tmp_path / "mine.json", record)
     spec = resolve_policy(str(path))
-    assert spec.factory == "lvgym.agents.inversion_record:from_record" and spec.name == "mine"
+    assert spec.factory == "lvgym.agents.policies.inversion_record:from_record" and spec.name == "mine"
     pol = build_policy(spec, env)
     assert isinstance(pol, InversionPolicy) and (pol.lead, pol.average, pol.w, pol.z) == (5, 6, 1.25, 1.0)
     assert pol.staging.steps == 200 and pol.staging.share == 0.5
@@ -175,7 +174,7 @@ def test_the_recipe_end_to_end_on_a_short_mission(tmp_path, capsys):
     option: the record names the seed the rule chose, and its validation numbers are the single env's flights
     of the policy the record names; a folder with a run in it is refused without ``--resume``, and resumed it
     reads the seeds it finished and writes the same observer."""
-    from lvgym.agents.teacher_student import main
+    from lvgym.agents.training.teacher_student import main
 
     out = tmp_path / "run"
     argv = ["--suite", "smile-v2", "--seeds", "0", "1", "--flights", "2", "--rounds", "1", "--epochs", "1",
@@ -215,7 +214,7 @@ def test_the_train_command_hands_over_to_the_recipe(capsys):
     """``lvgym train --recipe teacher-student --help`` is the recipe's help, with its defaults; another recipe
     is refused naming the option, the value and the choices; a stable-baselines3 run's options refuse the
     recipe (a campaign builds them in Python)."""
-    from lvgym.agents.train import Args, check_options, main
+    from lvgym.agents.training.train import Args, check_options, main
 
     with pytest.raises(SystemExit):
         main(["--recipe", "teacher-student", "--help"])
@@ -246,8 +245,8 @@ def test_a_shipped_records_commands_are_installed_commands_that_parse(stem, monk
     records of the recipe: no study's factory, no script."""
     import shlex
 
-    from lvgym.agents import teacher_student
-    from lvgym.agents.train import _recipe
+    from lvgym.agents.training import teacher_student
+    from lvgym.agents.training.train import _recipe
     from lvgym.cli import evaluate, margins
     from lvgym.cli.args import parse_given
 

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import pytest
 
-from lvgym.agents.checkpoints import latest_checkpoint, list_checkpoints
+from lvgym.agents.policies.checkpoints import latest_checkpoint, list_checkpoints
 
 from test_agents import ROOT, TRAIN, _argv
 
@@ -216,7 +216,7 @@ def test_the_progress_line_on_a_v2_suite_gives_what_selection_ranks_on():
     like a failed one), not v1's failure rate, which would hide a policy that chatters."""
     from types import SimpleNamespace
 
-    from lvgym.agents.progress import ProgressLineCallback
+    from lvgym.agents.training.progress import ProgressLineCallback
 
     last = {"num_timesteps": 2_048_000, "score": [0.81, 1.739], "episode_score": 0.236, "failure_rate": 0.0,
             "score_v2": 1.739, "failure_rate_v2": 0.81}

@@ -9,7 +9,7 @@ import re
 
 import pytest
 
-from lvgym.agents.callbacks import SELECTION_V2
+from lvgym.agents.training.callbacks import SELECTION_V2
 from lvgym.benchmark.suites import condition
 from lvgym.vehicle.yamlfile import read_yaml
 
@@ -64,7 +64,7 @@ def test_concat_vecenv_rows_are_its_parts_rows():
     """Two vehicles' batched VecEnvs joined: each row steps as in its own part, seeded from its first row."""
     import numpy as np
 
-    from lvgym.agents.familytrain import ConcatVecEnv, concat_venv, row_split
+    from lvgym.agents.training.familytrain import ConcatVecEnv, concat_venv, row_split
     from lvgym.envs import make_sb3_vec_env
 
     kw = {"mission_time_s": 1.0, "wind": "turbulence", "randomize": ["wind", "mass"]}
@@ -94,7 +94,7 @@ def test_concat_vecenv_rows_are_its_parts_rows():
 
 
 def test_a_family_run_flies_train_vehicles_and_selects_on_validation_vehicles(tmp_path, monkeypatch):
-    from lvgym.agents.callbacks import ValidationEvaluator
+    from lvgym.agents.training.callbacks import ValidationEvaluator
     from lvgym.benchmark.suites import FAMILY_VALIDATION_VEHICLES, FAMILY_VEHICLES
 
     monkeypatch.setenv("LVGYM_CACHE_DIR", str(tmp_path / "cache"))

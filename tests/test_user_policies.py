@@ -176,7 +176,7 @@ def test_register_policy_by_callable_or_string_and_duplicates(monkeypatch):
 def test_the_built_in_names_are_the_registered_ones():
     assert registry.POLICIES["gs-pid"] == PolicySpec("gs-pid", "lvgym.baselines.pid:smile_scheduled_pid",
                                                      (("name", "gs-pid"), ("schedule", "smile")))
-    assert registry.POLICIES["ppo-res-lqg"] == PolicySpec("ppo-res-lqg", "lvgym.agents.policy:shipped_policy",
+    assert registry.POLICIES["ppo-res-lqg"] == PolicySpec("ppo-res-lqg", "lvgym.agents.policies.sb3:shipped_policy",
                                                           (("file", "ppo_res_lqg_smile_v1"), ("name", "ppo-res-lqg")))
     assert registry.POLICIES["auto-lqg"] == PolicySpec("auto-lqg", "lvgym.baselines.designed:auto_policy",
                                                        (("kind", "lqg"), ("name", "auto-lqg")))

@@ -66,7 +66,8 @@ def test_wheel_holds_lvgym_and_its_data_only(built):
     assert sorted(set(names) - want - set(info)) == []           # and nothing else
     data = [n for n in want if not n.endswith(".py")]
     for pattern in ("lvgym/vehicles/smile_v1.yaml", "lvgym/environment/data/", "lvgym/benchmark/data/v1.json",
-                    "lvgym/baselines/schedules/smile_lqg.npz", "lvgym/agents/hyperparams/", "lvgym/agents/trained/"):
+                    "lvgym/baselines/schedules/smile_lqg.npz", "lvgym/agents/training/hyperparams/",
+                    "lvgym/agents/training/campaigns/", "lvgym/agents/trained/"):
         assert any(n.startswith(pattern) for n in data), pattern
 
 

@@ -8,7 +8,7 @@ failed or unflyable, probability of improvement over the best classical design (
 
 (and the same with ``inversion-id-s0=experiments.fault_id.inversion:s0`` ...: every student flown is compared)
 
-(The same comparison a training campaign prints: :func:`lvgym.agents.campaign_compare.comparison_rows`.)
+(The same comparison a training campaign prints: :func:`lvgym.agents.training.campaign_compare.comparison_rows`.)
 """
 
 from __future__ import annotations
@@ -43,7 +43,7 @@ class Args:
 
 
 def main(argv: Sequence[str] | None = None) -> None:
-    from lvgym.agents.campaign_compare import comparison_rows, comparison_table
+    from lvgym.agents.training.campaign_compare import comparison_rows, comparison_table
 
     a = parse(Args, argv, "python -m experiments.fault_id.compare", __doc__)
     path = Path(a.folder) / "results.json"

@@ -3,10 +3,10 @@ the misalignment a network reads from the last half second of flight signals.
 
 The fault suite's room for ``lqg`` is knowing the thrust's direction (README.md, :mod:`.privileges`): ``lqg``
 given the true misalignment, ``delta = delta_lqg - misalignment``, fails 2 of 100 validation flights where
-``lqg`` fails 7. An :class:`~lvgym.agents.observer_fit.Estimator` learns that misalignment from what a flight
-computer has: a window of :data:`~lvgym.agents.observer.WINDOW` control steps of the env's observation (14
-entries) and of the two actions it sent (the shipped observer's features, :mod:`lvgym.agents.observer`;
-the network of :mod:`lvgym.agents.observer_fit`).
+``lqg`` fails 7. An :class:`~lvgym.agents.policies.observer_net.Estimator` learns that misalignment from what a flight
+computer has: a window of :data:`~lvgym.agents.policies.observer.WINDOW` control steps of the env's observation (14
+entries) and of the two actions it sent (the shipped observer's features, :mod:`lvgym.agents.policies.observer`;
+the network of :mod:`lvgym.agents.policies.observer_net`).
 :class:`FaultIdPolicy` flies ``lqg`` (its own Kalman filter sees its own command, as if the thrust went where
 the gimbal points) and subtracts the estimate, in units of the gimbal limit, once past a dead band
 (:data:`DEADBAND`, :func:`corrected`).
@@ -20,8 +20,8 @@ from typing import Any
 import numpy as np
 import torch
 
-from lvgym.agents.observer import FEATURES, N_OBS, WINDOW, Window
-from lvgym.agents.observer_fit import Ensemble, Estimator, load, save
+from lvgym.agents.policies.observer import FEATURES, N_OBS, WINDOW, Window
+from lvgym.agents.policies.observer_net import Ensemble, Estimator, load, save
 
 __all__ = ["DEADBAND", "FEATURES", "N_OBS", "RESULTS", "WINDOW", "Ensemble", "Estimator", "FaultIdPolicy", "Window",
            "base_lqg", "corrected", "from_file", "load", "save"]

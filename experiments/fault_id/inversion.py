@@ -1,9 +1,9 @@
-"""The disturbance-observer students of the study's training seeds: :class:`lvgym.agents.inversion.InversionPolicy`
-(the privileged reference's law on the terms a learned observer estimates from the flight computer's signals;
-its module docstring gives the law) flown on each seed's ``results/fault_id`` file, written by :mod:`.train`
-with ``--scheme inversion``. The policies shipped as ``inversion-id``, ``inversion-id-stratos`` and
-``inversion-id-smile`` were three of them; the installed recipe ``lvgym train --recipe teacher-student`` trains
-them again (:mod:`lvgym.agents.teacher_student`, docs/training.md).
+"""The disturbance-observer students of the study's training seeds:
+:class:`lvgym.agents.policies.inversion.InversionPolicy` (the privileged reference's law on the terms a learned observer
+estimates from the flight computer's signals; its module docstring gives the law) flown on each seed's
+``results/fault_id`` file, written by :mod:`.train` with ``--scheme inversion``. The policies shipped as
+``inversion-id``, ``inversion-id-stratos`` and ``inversion-id-smile`` were three of them; the installed recipe ``lvgym
+train --recipe teacher-student`` trains them again (:mod:`lvgym.agents.training.teacher_student`, docs/training.md).
 
     python evaluate.py --suites smile-v2-faults --policies experiments.fault_id.inversion:s0
 
@@ -18,9 +18,9 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
-from lvgym.agents.inversion import (A_MAX, ERRORS, NO_THRUST, SHIPPED, SPAN, TERMS, TRAINED, InversionPolicy, command,
-                                    error_index, from_file, gains, law_terms)
-from lvgym.agents.teacher import own_law
+from lvgym.agents.policies.inversion import (A_MAX, ERRORS, NO_THRUST, SHIPPED, SPAN, TERMS, TRAINED, InversionPolicy,
+                                             command, error_index, from_file, gains, law_terms)
+from lvgym.agents.training.teacher import own_law
 
 from .estimator import RESULTS
 
@@ -30,12 +30,12 @@ SEEDS = (0, 1, 2)
 
 @dataclass(frozen=True)
 class Student:
-    """A configuration of the study: the training runs' file prefix (``results/fault_id/<prefix>-s<k>.pt``), the
-    label its policies fly under, and how the law flies the observer: ``lead``, ``span``, ``average``
-    (:class:`lvgym.agents.inversion.Lead`), ``bandwidth`` (the non-rigid law's, ``train.py --bandwidth``;
-    0: the reference's), ``ignition`` (the seconds after the next stage's ignition it cancels the moment
-    measured from the rigid body, :class:`lvgym.agents.inversion.Staging`; 0: never) and ``ignition_share`` (the
-    measured moment's share there, the rest the estimate's)."""
+    """A configuration of the study: the training runs' file prefix (``results/fault_id/<prefix>-s<k>.pt``), the label
+    its policies fly under, and how the law flies the observer: ``lead``, ``span``, ``average``
+    (:class:`lvgym.agents.policies.inversion.Lead`), ``bandwidth`` (the non-rigid law's, ``train.py --bandwidth``; 0:
+    the reference's), ``ignition`` (the seconds after the next stage's ignition it cancels the moment measured from the
+    rigid body, :class:`lvgym.agents.policies.inversion.Staging`; 0: never) and ``ignition_share`` (the measured
+    moment's share there, the rest the estimate's)."""
 
     prefix: str
     label: str

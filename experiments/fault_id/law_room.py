@@ -5,7 +5,7 @@ design, on **validation** seeds (the family: on its validation vehicles; no test
     python -m experiments.fault_id.law_room --suite family-v2 --seeds 3 --models nonrigid rigid   # 7 minutes
     python -m experiments.fault_id.law_room --suite stratos-tvc-v2 --seeds 20
 
-The student (:mod:`lvgym.agents.inversion`) can at best fly the reference's law on the flight computer's
+The student (:mod:`lvgym.agents.policies.inversion`) can at best fly the reference's law on the flight computer's
 errors without the wind ahead (``observed, no preview``: what its teacher flies, the law on the true terms).
 Prints per variant and flight model the mean ``score_v2`` and the failed or unflyable flights over validation
 seeds ``0 .. --seeds - 1`` (on the family, of each of its 10 validation vehicles,

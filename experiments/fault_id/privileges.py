@@ -24,7 +24,7 @@ from typing import Any
 
 import numpy as np
 
-from lvgym.agents.inversion import SPAN, carry
+from lvgym.agents.policies.inversion import SPAN, carry
 from lvgym.commandline import arg, parse
 
 #: a relief that never acts (from five times the q-alpha limit)
@@ -32,7 +32,7 @@ NO_RELIEF = (5.0, 6.0)
 
 
 #: the span [control steps] of the slope an extrapolated aerodynamic moment is drawn along (the shipped law's
-#: :data:`lvgym.agents.inversion.SPAN`)
+#: :data:`lvgym.agents.policies.inversion.SPAN`)
 SLOPE_STEPS = SPAN
 
 

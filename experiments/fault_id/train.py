@@ -1,10 +1,10 @@
-"""Train a student of one training seed (a teacher-student scheme): the thrust-direction estimator
-(:mod:`.estimator`, ``--scheme thrust``) or the disturbance observer of the reference's law
-(:mod:`.inversion`, ``--scheme inversion``). The shipped observers' recipe is installed, ``lvgym train --recipe
-teacher-student`` (:mod:`lvgym.agents.teacher_student`); this study flies the same teacher, rounds and fits
-(:mod:`lvgym.agents.teacher`, :mod:`lvgym.agents.dagger`, :mod:`lvgym.agents.observer_fit`) with what was tried
-beside them: the thrust scheme, the labels ahead or extrapolated, the upset teacher, the ignition's weights,
-the family's vehicles.
+"""Train a student of one training seed (a teacher-student scheme): the thrust-direction estimator (:mod:`.estimator`,
+``--scheme thrust``) or the disturbance observer of the reference's law (:mod:`.inversion`, ``--scheme inversion``). The
+shipped observers' recipe is installed, ``lvgym train --recipe teacher-student``
+(:mod:`lvgym.agents.training.teacher_student`); this study flies the same teacher, rounds and fits
+(:mod:`lvgym.agents.training.teacher`, :mod:`lvgym.agents.training.dagger`, :mod:`lvgym.agents.training.observer_fit`)
+with what was tried beside them: the thrust scheme, the labels ahead or extrapolated, the upset teacher, the ignition's
+weights, the family's vehicles.
 
     python -m experiments.fault_id.train --seed 0            # results/fault_id/estimator-s0.pt
     python -m experiments.fault_id.train --scheme inversion --seed 0 --flights 100 --rounds 4 --validation 50
@@ -14,28 +14,28 @@ the family's vehicles.
 
 1. **Teacher's flights** on ``smile-v2-faults`` (both flight models, ``--flights`` each, training seeds
    ``100000 + 10000 seed ...``: neither validation nor test seeds), every step recorded as the student sees
-   it (:class:`lvgym.agents.observer.Window`) with its label (:class:`ThrustScheme`, :class:`InversionScheme`):
+   it (:class:`lvgym.agents.policies.observer.Window`) with its label (:class:`ThrustScheme`, :class:`InversionScheme`):
 
    - ``thrust``: ``lqg`` with the true misalignment (the env's privileged info) subtracted from its
      command, known late by a delay drawn per flight from :data:`DELAYS` (never known, for one flight in
      six), so the flights cover the states before and after the correction; label: the true misalignment
      over the gimbal limit.
-   - ``inversion``: the reference's law on the true terms (:func:`lvgym.agents.inversion.law_terms`), its
+   - ``inversion``: the reference's law on the true terms (:func:`lvgym.agents.policies.inversion.law_terms`), its
      action with an exploration noise of a standard deviation drawn per flight from :data:`NOISE` (else the
      action sent last holds the label, and the student reads it back from its own action); label: the true
      terms.
-2. **Regression.** :class:`lvgym.agents.observer_fit.Estimator` fitted by mean squared error (Adam, ``--epochs``; the
-   inversion's labels standardised; ``--ignition-weight``: the windows of the first ``--ignition-s`` after the
-   next stage's ignition weigh more, :class:`lvgym.agents.staging.Ignition`).
+2. **Regression.** :class:`lvgym.agents.policies.observer_net.Estimator` fitted by mean squared error (Adam,
+   ``--epochs``; the inversion's labels standardised; ``--ignition-weight``: the windows of the first
+   ``--ignition-s`` after the next stage's ignition weigh more, :class:`lvgym.agents.policies.staging.Ignition`).
 3. **DAgger rounds** (``--rounds``): the student flies half as many flights again, labelled the same way,
    added to the data, and the estimator is fitted again. The thrust scheme's policy is the last fit; the
-   inversion's the mean of the last three fits (:class:`lvgym.agents.observer_fit.Ensemble`).
+   inversion's the mean of the last three fits (:class:`lvgym.agents.policies.observer_net.Ensemble`).
 
 After each fit the student flies validation seeds ``0 .. --validation - 1`` of both flight models and the
 mean ``score_v2`` and its failed or unflyable flights are printed (``lqg``: 0.994 (6) rigid, 1.109 (7)
 non-rigid on seeds 0-99; ``lqg`` with the true misalignment 0.778 (2), 0.900 (2): README.md). A run's memory
 is its data (float32 windows, 1.6 kB per step; the fit's standard deviation is taken in chunks of rows,
-:func:`lvgym.agents.observer_fit.row_std`): SMILE's ``--flights 200 --rounds 4`` reach 3.9 M steps, 6.3 GB,
+:func:`lvgym.agents.training.observer_fit.row_std`): SMILE's ``--flights 200 --rounds 4`` reach 3.9 M steps, 6.3 GB,
 and about 7 GB per process at round 3; three such runs at once outgrow 24 GB in round 4.
 """
 
@@ -48,11 +48,12 @@ from typing import Any
 import numpy as np
 import torch
 
-from lvgym.agents import teacher
-from lvgym.agents.dagger import train_seed
-from lvgym.agents.inversion import Lead, law_terms
-from lvgym.agents.observer_fit import Ensemble, Estimator, fit, save
-from lvgym.agents.teacher import NOISE, SUITE, condition, lost, own_law, scored
+from lvgym.agents.policies.inversion import Lead, law_terms
+from lvgym.agents.policies.observer_net import Ensemble, Estimator, save
+from lvgym.agents.training import teacher
+from lvgym.agents.training.dagger import train_seed
+from lvgym.agents.training.observer_fit import fit
+from lvgym.agents.training.teacher import NOISE, SUITE, condition, lost, own_law, scored
 from lvgym.commandline import arg, parse
 
 from .estimator import RESULTS, base_lqg, corrected
@@ -99,16 +100,16 @@ class ThrustScheme:
 
 
 class InversionScheme(teacher.InversionScheme):
-    """The installed teacher and student (:class:`lvgym.agents.teacher.InversionScheme`: the law of
-    :mod:`lvgym.agents.inversion` on the true terms or the student's estimate, ``loop_gain``, ``lead``, ``law``)
-    with the study's other labels and teachers: the moment's label ``ahead`` control periods ahead (the
+    """The installed teacher and student (:class:`lvgym.agents.training.teacher.InversionScheme`: the law of
+    :mod:`lvgym.agents.policies.inversion` on the true terms or the student's estimate, ``loop_gain``, ``lead``,
+    ``law``) with the study's other labels and teachers: the moment's label ``ahead`` control periods ahead (the
     preview), or the moment as it acts carried ``extrapolated`` periods along its slope over the last
-    :data:`lvgym.agents.inversion.SPAN` (:class:`lvgym.agents.inversion.Lead`: a causal label, the estimate's
-    slope learned from the window instead of differenced from the student's own estimates); ``upset``: the
-    share of the teacher's flights that, after the next stage's ignition, cancel only a part of the
-    aerodynamic moment (a gain drawn from :data:`UPSET_GAIN`) for a while (drawn from :data:`UPSET_S`), then
-    fly it out on the truth: flights through the large moments a late estimate meets there, labelled. The
-    teacher's exploration levels are this module's :data:`NOISE`."""
+    :data:`lvgym.agents.policies.inversion.SPAN` (:class:`lvgym.agents.policies.inversion.Lead`: a causal label, the
+    estimate's slope learned from the window instead of differenced from the student's own estimates); ``upset``: the
+    share of the teacher's flights that, after the next stage's ignition, cancel only a part of the aerodynamic moment
+    (a gain drawn from :data:`UPSET_GAIN`) for a while (drawn from :data:`UPSET_S`), then fly it out on the truth:
+    flights through the large moments a late estimate meets there, labelled. The teacher's exploration levels are this
+    module's :data:`NOISE`."""
 
     prefix = "inversion"
 
@@ -146,7 +147,8 @@ SCHEMES = {"thrust": ThrustScheme, "inversion": InversionScheme}
 
 def pilot(scheme: str = "thrust", deadband: float = 0.0, ahead: int = 0, extrapolated: int = 0, lead: int = 0,
           law: dict[str, Any] | None = None, upset: float = 0.0) -> teacher.Pilot:
-    """The pilot factory (:data:`lvgym.agents.teacher.Pilot`) of ``scheme`` (:data:`SCHEMES`) with its options."""
+    """The pilot factory (:data:`lvgym.agents.training.teacher.Pilot`) of ``scheme`` (:data:`SCHEMES`) with its
+    options."""
     def make(env1: Any, n: int, rng: np.random.Generator | None, loop_gain: np.ndarray | None) -> Any:
         return SCHEMES[scheme](env1, n, rng, deadband, loop_gain, ahead, extrapolated, lead, law, upset)
     return make
@@ -157,7 +159,7 @@ def fly(model: str, seeds: Sequence[int], estimator: Estimator | Ensemble | None
         loop_gain: np.ndarray | None = None, suite: str = SUITE, ahead: int = 0, extrapolated: int = 0,
         lead: int = 0, law: dict[str, Any] | None = None, upset: float = 0.0, **options: Any
         ) -> tuple[np.ndarray, np.ndarray, list[dict], np.ndarray]:
-    """:func:`lvgym.agents.teacher.fly` with ``scheme``'s pilot (:data:`SCHEMES`, :func:`pilot`): the teacher
+    """:func:`lvgym.agents.training.teacher.fly` with ``scheme``'s pilot (:data:`SCHEMES`, :func:`pilot`): the teacher
     (``estimator`` None; ``rng`` draws its delays or exploration) or the student on the ``estimator``'s output
     (``deadband``: the thrust scheme's). ``loop_gain``, ``upset``: the inversion scheme's training devices;
     ``ahead``, ``extrapolated``: its moment label (its teacher flies on it); ``lead``, ``law``: how its law flies
@@ -173,7 +175,7 @@ def fly(model: str, seeds: Sequence[int], estimator: Estimator | Ensemble | None
 def validate(est: Estimator | Ensemble, episodes: int, deadband: float = 0.0, scheme: str = "thrust",
              suite: str = SUITE, lead: int = 0, law: dict[str, Any] | None = None) -> dict[str, tuple[float, int]]:
     """Mean ``score_v2`` and failed or unflyable flights of the student on validation seeds ``0 ..
-    episodes - 1`` per flight model (:func:`lvgym.agents.teacher.validate`); on the family, ``episodes``
+    episodes - 1`` per flight model (:func:`lvgym.agents.training.teacher.validate`); on the family, ``episodes``
     spread over its validation vehicles (:data:`lvgym.benchmark.suites.FAMILY_VALIDATION_VEHICLES`, seeds ``0 ..
     episodes / 10 - 1`` each); ``lead``, ``law``: :func:`fly`'s."""
     from lvgym.benchmark.suites import FAMILY_VALIDATION_VEHICLES
@@ -226,7 +228,7 @@ class Args:
     reference's gains, :data:`lvgym.baselines.privileged.GAINS`); files ``...-w<bandwidth>``"""
     ignition_weight: float = arg(1.0, lo=1.0, hi=100.0)
     """the weight in the fits of the windows of the first ``--ignition-s`` after the next stage's ignition
-    (:class:`lvgym.agents.staging.Ignition`: the law's terms change at once after a coast of ten seconds; 1:
+    (:class:`lvgym.agents.policies.staging.Ignition`: the law's terms change at once after a coast of ten seconds; 1:
     all weigh the same);
     files ``...-ign<weight>``"""
     ignition_s: float = arg(2.0, lo=0.02, hi=20.0)
@@ -262,7 +264,7 @@ def main(argv: Sequence[str] | None = None) -> None:
         raise ConfigError("--extrapolated", a.extrapolated, "0 with --ahead (one label of the moment)")
     places: list[dict[str, Any]] = [{}]
     if family:
-        from lvgym.agents.familytrain import train_vehicle_files
+        from lvgym.agents.training.familytrain import train_vehicle_files
 
         places = [{"vehicle": str(f)} for f in train_vehicle_files(a.family_vehicles)]
     where = "" if a.suite == SUITE else "-family" if family else f"-{a.suite}"

@@ -25,7 +25,7 @@ is continued with ``train.py --resume``, so the command can simply be run again 
 Each run's policy (best by validation) is exported as ``<runs-dir>/robustness-policies/<run>.zip`` (so
 that ``evaluate.py`` labels it by run), then ``evaluate.py`` runs on the test seeds.
 
-Campaigns now do this in general (``lvgym campaign FILE``, :mod:`lvgym.agents.campaign`, docs/training.md
+Campaigns now do this in general (``lvgym campaign FILE``, :mod:`lvgym.agents.training.campaign`, docs/training.md
 "Campaigns"): any configurations x seeds from one checked YAML file, on this machine or on a Ray cluster,
 then the evaluation on the test seeds and the comparison over the runs; this command is kept as the
 experiment ran.
@@ -73,7 +73,7 @@ def commands(args: Args) -> list[list[str]]:
             if not (folder / "final_model.json").is_file():
                 out.append(train_command(args, model, seed))
             stem = Path(args.runs_dir) / "robustness-policies" / name
-            out.append([sys.executable, "-m", "lvgym.agents.policy", "export", str(folder), str(stem)])
+            out.append([sys.executable, "-m", "lvgym.agents.policies.saved", "export", str(folder), str(stem)])
             exported.append(str(stem) + ".zip")
     out.append([sys.executable, str(ROOT / "evaluate.py"), "--policies", *args.baselines, *exported,
                 "--suites", *args.suites, "--episodes", str(args.episodes), "--out", args.out])

@@ -3,7 +3,7 @@ validation, per run, and when each run first reached a reference score.
 
     python -m experiments.training_speed.curves runs/v1/robust-*  --reference lqg/nonrigid=0.6715 lqg/rigid=0.6271 --out results/curves
 
-Reads each run folder's ``evaluations.json`` (written by :class:`lvgym.agents.callbacks.CheckpointCallback` at
+Reads each run folder's ``evaluations.json`` (written by :class:`lvgym.agents.training.callbacks.CheckpointCallback` at
 every validation: the validation seeds, never the test seeds). The wall time of a validation is its
 ``train_wall_s`` [s] (every segment of a resumed run included); runs made before that field existed take
 it from SB3's ``progress_*.csv`` (``time/time_elapsed`` at the validation's step, segments added up).

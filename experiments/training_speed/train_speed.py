@@ -4,15 +4,15 @@
         --common "--env-id lvgym/SmileAscent-v1 --residual lqg --residual-scale 0.05 --history 4" \\
         --variant default "" --variant threads2 "--torch-threads 2" --variant epochs5 "--hp algo.n_epochs=5"
 
-Each variant is a short ``train.py`` run (its own process, ``--eval-freq 0``, no wall-time checkpoints, in a
-temporary runs folder) of ``--steps`` env steps; the variants take turns, ``--repeats`` times, so that a
-change of the machine's load falls on all of them alike. From each run's progress table (SB3's ``time/``
-entries, written after every rollout and update): env steps per second of wall time after the first
-rollout-and-update (``steps/s``: start-up, imports and the first compilation left out), and the env's share
-of the wall time (``time/env_share``, :class:`lvgym.agents.timing.EnvClock`: the env and a residual's baselines;
-the rest is the learner: the policy's forward passes, the PPO epochs). Printed as a Markdown table: the
-median over the repeats and each repeat. Throughput only: whether a faster setting learns as well per
-env step is a training experiment (several seeds, learning curves against wall time; :mod:`experiments.training_speed.curves`).
+Each variant is a short ``train.py`` run (its own process, ``--eval-freq 0``, no wall-time checkpoints, in a temporary
+runs folder) of ``--steps`` env steps; the variants take turns, ``--repeats`` times, so that a change of the machine's
+load falls on all of them alike. From each run's progress table (SB3's ``time/`` entries, written after every rollout
+and update): env steps per second of wall time after the first rollout-and-update (``steps/s``: start-up, imports and
+the first compilation left out), and the env's share of the wall time (``time/env_share``,
+:class:`lvgym.agents.training.timing.EnvClock`: the env and a residual's baselines; the rest is the learner: the
+policy's forward passes, the PPO epochs). Printed as a Markdown table: the median over the repeats and each repeat.
+Throughput only: whether a faster setting learns as well per env step is a training experiment (several seeds, learning
+curves against wall time; :mod:`experiments.training_speed.curves`).
 """
 
 from __future__ import annotations

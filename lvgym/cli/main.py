@@ -4,7 +4,7 @@
     lvgym evaluate --help              # a command's options
     lvgym evaluate --policies zero lqg --suites smile-v1 --episodes 10
     lvgym train --total-timesteps 2e6 --max-wall-time 3600
-    lvgym campaign agents/campaigns/v2_example.yaml --dry-run
+    lvgym campaign agents/training/campaigns/v2_example.yaml --dry-run
     lvgym design pid --vehicle smile
     lvgym vehicle slender --length 10 > slender10.yaml
 
@@ -32,9 +32,10 @@ _CONTROL = ("control", "matplotlib")
 COMMANDS: tuple[Command, ...] = (
     Command("evaluate", "lvgym.cli.evaluate:main", "compare policies on the frozen benchmark protocol (evaluate.py)",
             "benchmark", _BENCHMARK),
-    Command("train", "lvgym.agents.train:main", "train a policy with stable-baselines3 (train.py)", "train", _TRAIN),
-    Command("campaign", "lvgym.agents.campaign:main", "a training campaign: configurations x seeds (locally or on "
-            "Ray), evaluation on the test seeds, comparison over the runs", "train", _TRAIN),
+    Command("train", "lvgym.agents.training.train:main", "train a policy with stable-baselines3 (train.py)", "train",
+            _TRAIN),
+    Command("campaign", "lvgym.agents.training.campaign:main", "a training campaign: configurations x seeds (locally "
+            "or on Ray), evaluation on the test seeds, comparison over the runs", "train", _TRAIN),
     Command("margins", "lvgym.cli.margins:main", "time-domain gain and delay margins of policies in the nonlinear "
             "simulation", "benchmark", _BENCHMARK),
     Command("fingerprint", "lvgym.cli.fingerprint:main", "check (or write) a frozen protocol's fingerprint"),
@@ -51,12 +52,12 @@ COMMANDS: tuple[Command, ...] = (
             ("pandas", "statsmodels", "matplotlib")),
     Command("render", "lvgym.envs.render:main", "draw the renderer's example frame to a PNG", "benchmark",
             ("matplotlib",)),
-    Command("export-policy", "lvgym.agents.policy:export_main", "copy a training run's policy to a stem "
+    Command("export-policy", "lvgym.agents.policies.saved:export_main", "copy a training run's policy to a stem "
             "(STEM.zip, STEM_vecnormalize.pkl, STEM.json)", "train", ("stable_baselines3", "torch")),
-    Command("dataset", "lvgym.agents.datasets:main", "record policies' flights as Minari datasets (offline RL)",
-            "datasets", ("minari", "pyarrow")),
-    Command("bc", "lvgym.agents.bc:main", "behaviour cloning of a policy from its Minari dataset", "datasets",
-            ("minari", "pyarrow", "torch")),
+    Command("dataset", "lvgym.agents.training.datasets:main", "record policies' flights as Minari datasets "
+            "(offline RL)", "datasets", ("minari", "pyarrow")),
+    Command("bc", "lvgym.agents.training.clone:main", "behaviour cloning of a policy from its Minari dataset",
+            "datasets", ("minari", "pyarrow", "torch")),
     Command("design", None, "the classical controllers' offline design tools", sub=(
         Command("pid", "lvgym.baselines.design.tune:main", "tune the rigid PID gain schedule (gs-pid)", "control",
                 _CONTROL),

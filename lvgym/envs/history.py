@@ -15,7 +15,7 @@ every older sample and every action is zero. The layout (:func:`history_layout`)
 
 :class:`HistoryStack` shifts and fills the stacked rows; the functional env applies it to every row of
 a batch after each transition (so the single env, the vector envs and the SB3 ``VecEnv`` share it), and
-a saved policy's adapter applies it to a plain protocol observation (``lvgym.agents.policy``).
+a saved policy's adapter applies it to a plain protocol observation (``lvgym.agents.policies.sb3``).
 """
 
 from __future__ import annotations
