@@ -5,7 +5,7 @@ short mission, and ``lvgym evaluate --policies <record>.json`` flies the policy 
 
 Marked ``slow``: the fresh environment compiles the flight model's numba kernels again (numba's cache follows
 the installed files' paths): a single env's first reset and step took 163 s on a cold cache, and the whole test
-412 s, on 2 cores shared with other runs. The recipe itself at this budget takes about 15 s with the kernels
+179-412 s, on 2 cores shared with other runs. The recipe itself at this budget takes about 15 s with the kernels
 compiled (tests/test_teacher_student.py runs it in the development environment).
 """
 
