@@ -3,21 +3,14 @@ dependencies into a fresh virtual environment that sees this interpreter's packa
 numba, ...) after its own, ``lvgym train --recipe teacher-student`` trains, chooses and records an observer on a
 short mission, and ``lvgym evaluate --policies <record>.json`` flies the policy the record names.
 
-<<<<<<< HEAD
 Numba's cache of a compiled function sits where its source file sits (or under ``NUMBA_CACHE_DIR``, in a folder
 named by the source's folder) and is keyed by a hash of the source's content: the installed wheel's files would
-compile again (a single env's first reset and step: 163 s on a cold cache, the whole test 412 s, on 2 cores shared
+compile again (a single env's first reset and step: 163 s on a cold cache, the whole test 179-412 s, on 2 cores shared
 with other runs). So the test first flies a short flight here, which compiles the development tree's kernels or
 finds them cached, and copies those caches to where the fresh environment looks for its own files' (the same
 content, so the same keys): the installed code then runs without compiling (a first env step in about 5 s). The
 recipe itself at this budget takes about 15 s (tests/test_teacher_student.py runs it in the development
 environment).
-=======
-Marked ``slow``: the fresh environment compiles the flight model's numba kernels again (numba's cache follows
-the installed files' paths): a single env's first reset and step took 163 s on a cold cache, and the whole test
-179-412 s, on 2 cores shared with other runs. The recipe itself at this budget takes about 15 s with the kernels
-compiled (tests/test_teacher_student.py runs it in the development environment).
->>>>>>> recipe
 """
 
 from __future__ import annotations
