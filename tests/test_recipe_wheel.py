@@ -5,9 +5,9 @@ short mission, and ``lvgym evaluate --policies <record>.json`` flies the policy 
 
 Numba's cache of a compiled function sits where its source file sits (or under ``NUMBA_CACHE_DIR``, in a folder
 named by the source's folder) and is keyed by a hash of the source's content: the installed wheel's files would
-compile again (a single env's first reset and step: 163 s on a cold cache, the whole test 179-412 s, on 2 cores shared
-with other runs). So the test first flies a short flight here, which compiles the development tree's kernels or
-finds them cached, and copies those caches to where the fresh environment looks for its own files' (the same
+compile again (a single env's first reset and step: 163 s on a cold cache, the whole test 179-412 s, on 2 shared
+cores with other runs). So the test first flies a short flight here, which compiles the development tree's kernels
+or finds them cached, and copies those caches to where the fresh environment looks for its own files' (the same
 content, so the same keys): the installed code then runs without compiling (a first env step in about 5 s). The
 recipe itself at this budget takes about 15 s (tests/test_teacher_student.py runs it in the development
 environment).
