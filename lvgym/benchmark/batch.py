@@ -60,12 +60,15 @@ class BatchPolicy(Protocol):
 
 class BatchLaw:
     """The base of the shipped controllers: a law for :attr:`n` rows (the module docstring). A subclass
-    allocates each row's state in ``_rows(n)`` (called by the constructor through :meth:`allocate` and by
-    :meth:`batch`; the constants stay shared) and implements ``reset(rows)`` and ``act(rows, observations,
-    info)``."""
+    implements ``act(rows, observations, info)``; a law with state allocates each row's state in ``_rows(n)``
+    (called through :meth:`allocate` by the constructor, ``__init__(n)`` or the subclass's own, and by
+    :meth:`batch`; the constants stay shared) and sets it back in ``reset(rows)``."""
 
     name: str = "law"
     n: int = 0
+
+    def __init__(self, n: int = 1) -> None:
+        self.allocate(n)
 
     def allocate(self, n: int) -> None:
         """Make the state of ``n`` rows (``n >= 1``), all as after a reset."""
@@ -75,7 +78,7 @@ class BatchLaw:
         self._rows(self.n)
 
     def _rows(self, n: int) -> None:
-        raise NotImplementedError
+        """Make the state of ``n`` rows (a law without state: nothing)."""
 
     def batch(self, n: int) -> BatchLaw:
         """The same law (its constants shared) for ``n`` rows, each as after a reset."""
@@ -84,7 +87,7 @@ class BatchLaw:
         return law
 
     def reset(self, rows: Any) -> None:
-        raise NotImplementedError
+        """The rows ``rows`` start an episode (a law without state: nothing to forget)."""
 
     def act(self, rows: Any, observations: np.ndarray, info: Mapping[str, Any]) -> np.ndarray:
         raise NotImplementedError
