@@ -90,6 +90,8 @@ class BatchLaw:
         """The rows ``rows`` start an episode (a law without state: nothing to forget)."""
 
     def act(self, rows: Any, observations: np.ndarray, info: Mapping[str, Any]) -> np.ndarray:
+        """The actions (len(rows), n_a) of the rows ``rows`` for their observations (len(rows), n_obs) and the
+        batched ``info`` of all the law's rows."""
         raise NotImplementedError
 
 
