@@ -87,7 +87,7 @@ class AACConsts(NamedTuple):
     lp_gain: float
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, inline="always")
 def gain_step_k(law, k, e2, y):
     """One exact (zero-order-hold) step of ``dk/dt = a e2 - b y (k - k_min) - c (k - 1)`` over ``law.dt``,
     clipped to ``[k_min, k_max]``; the decay ``exp(-r dt)`` is ``math.exp`` (the C library's)."""

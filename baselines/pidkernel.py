@@ -276,7 +276,7 @@ def clip_k(x, lo, hi):
     return y if y < hi else hi
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, inline="always")
 def filter_reset_k(f, ax, x0, sections):
     """The first ``sections`` sections of the filter row ``f``'s axis ``ax`` in the steady state of the input
     ``x0`` (direct form II transposed, each section's states at the input's steady state)."""
@@ -290,7 +290,7 @@ def filter_reset_k(f, ax, x0, sections):
         x = y
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, inline="always")
 def filter_update_k(f, ax, x, sections):
     """One sample ``x`` through the first ``sections`` sections of the filter row ``f``'s axis ``ax``
     (direct form II transposed per section)."""
