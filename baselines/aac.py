@@ -49,8 +49,8 @@ import numpy as np
 from lvgym.benchmark.batch import BatchLaw, RowFace
 from lvgym.errors import ConfigError, check_bool, check_number
 
-from .aackernel import AAC_ROW, AACConsts, aac_act_k, dead_zone, first_order
-from .pid import flex_pid, smile_scheduled_pid
+from .aackernel import AAC_ROW, AACConsts, aac_act_k, aac_pid_act_k, dead_zone, first_order
+from .pid import PIDLaw, flex_pid, smile_scheduled_pid
 from .pidkernel import ObsColumns
 
 __all__ = ["AACLaw", "AACParams", "AdaptiveAugmentingPolicy", "FLEX_AAC", "flex_aac", "smile_aac"]
@@ -191,12 +191,19 @@ class AACLaw(BatchLaw):
 
     def act(self, rows: Any, observations: np.ndarray, info: Mapping[str, Any]) -> np.ndarray:
         """Actions (len(rows), 2) float32 of the rows ``rows``: the base acts, then the adaptive law scales
-        its commands (:func:`.aackernel.aac_act_k`)."""
+        its commands (:func:`.aackernel.aac_act_k`; around a :class:`.pid.PIDLaw`, both in one compiled call,
+        :func:`.aackernel.aac_pid_act_k`)."""
         rows = np.asarray(rows, dtype=np.int64).reshape(-1)
         obs = np.ascontiguousarray(observations).reshape(rows.size, -1)
-        self.base.act(rows, obs, info)
-        u = np.ascontiguousarray(self.base.gimbal[rows], dtype=np.float64)
         out = np.empty((rows.size, 2), np.float32)
+        base = self.base
+        if type(base) is PIDLaw:        # the shipped bases: both laws in one compiled call
+            value = base.values(info)
+            base.prepare(rows, obs, value)
+            aac_pid_act_k(base.tb, base.su, base.oc, base.st, self.law, self.oc, self.rows, rows, obs, value, out)
+            return out
+        base.act(rows, obs, info)
+        u = np.ascontiguousarray(base.gimbal[rows], dtype=np.float64)
         aac_act_k(self.law, self.oc, self.rows, rows, u, obs, out)
         return out
 

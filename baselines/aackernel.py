@@ -20,9 +20,9 @@ import numpy as np
 
 from lvgym.packing import Field, Packed
 
-from .pidkernel import AXES, clip_k
+from .pidkernel import AXES, P, clip_k, pid_row_k
 
-__all__ = ["AACConsts", "AAC_ROW", "aac_act_k", "dead_zone", "first_order", "gain_step_k"]
+__all__ = ["AACConsts", "AAC_ROW", "aac_act_k", "aac_pid_act_k", "dead_zone", "first_order", "gain_step_k"]
 
 #: a row of the adaptive law (per axis: pitch, yaw)
 AAC_ROW = Packed("adaptive law row", [
@@ -179,6 +179,24 @@ def aac_act_k(law, oc, rows_law, rows, u, obs, out):
     for j in range(rows.size):
         w, o = rows_law[rows[j]], obs[j]
         _law_row(law, w, u[j, 0], u[j, 1], float(o[oc.ref]), float(o[err[0]]), float(o[err[1]]),
+                 float(o[oc.on]) >= 0.5)
+        for ax in range(AXES):
+            out[j, ax] = np.float32(clip_k(w[A.gimbal + ax] / law.limit, -1.0, 1.0))
+
+
+@nb.njit(cache=True)
+def aac_pid_act_k(tb, su, oc_pid, st, law, oc, rows_law, rows, obs, value, out):
+    """:func:`aac_act_k` around the PID family's law in one call: each row of ``rows`` steps its PID
+    (:func:`.pidkernel.pid_row_k` on ``tb``, ``su``, ``oc_pid``, the state ``st``, the scheduling values
+    ``value``) and then its adaptive law (``law``, ``oc``, ``rows_law``) on the PID's command, the actions into
+    ``out`` (k, 2) float32: the same numbers as :meth:`.pid.PIDLaw.act` followed by :func:`aac_act_k`."""
+    err = oc.err
+    pid, filters = st.pid, st.filters
+    for j in range(rows.size):
+        b = rows[j]
+        r, w, o = pid[b], rows_law[b], obs[j]
+        pid_row_k(tb, su, oc_pid, r, filters[b], o, value[b])
+        _law_row(law, w, r[P.gimbal], r[P.gimbal + 1], float(o[oc.ref]), float(o[err[0]]), float(o[err[1]]),
                  float(o[oc.on]) >= 0.5)
         for ax in range(AXES):
             out[j, ax] = np.float32(clip_k(w[A.gimbal + ax] / law.limit, -1.0, 1.0))

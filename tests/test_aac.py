@@ -316,3 +316,36 @@ def test_aac_sweep_variants_and_the_scaled_base():
     np.testing.assert_allclose(b.act(np.zeros(3), {}), [2 * 0.002 / LIMIT, -2 * 0.005 / LIMIT], rtol=1e-6)
     np.testing.assert_allclose(b.last_gimbal, [0.004, -0.01])
     assert (b.dt, b.limit, b.name) == (DT, LIMIT, "stub*2")
+
+
+def test_around_the_pid_law_one_compiled_call_gives_the_two_calls_numbers():
+    """Around a :class:`PIDLaw` the adaptive law and its base run in one compiled call
+    (``aac_pid_act_k``); around any other base law (here a subclass of it) the base acts first and
+    ``aac_act_k`` follows. Both give the same actions and states to the bit, three rows of a non-rigid flight
+    with dispersions and turbulence, the rows reset at different steps."""
+    from lvgym.baselines.pid import PIDLaw
+
+    class _OtherBase(PIDLaw):
+        pass
+
+    venv = gym.make_vec("lvgym/SmileAscent-v1", num_envs=3, vectorization_mode="vector_entry_point",
+                        model="nonrigid", wind="turbulence", randomize=True, mission_time_s=8.0)
+    single = gym.make("lvgym/SmileAscent-v1", model="nonrigid", mission_time_s=8.0)
+    fused = flex_aac(single).law.batch(3)
+    base = fused.base
+    other = AACLaw(_OtherBase(single, schedule=base.schedule, name="other"), env=single,
+                   params=fused.params).batch(3)
+    assert type(fused.base) is PIDLaw and type(other.base) is _OtherBase
+    rows = np.arange(3)
+    obs, info = venv.reset(seed=11)
+    fused.reset(rows), other.reset(rows)
+    for k in range(300):
+        a, b = fused.act(rows, obs, info), other.act(rows, obs, info)
+        np.testing.assert_array_equal(a, b)
+        if k in (120, 200):
+            fused.reset([k % 3]), other.reset([k % 3])
+        obs, _, term, trunc, info = venv.step(a)
+        assert not np.any(term | trunc)
+    np.testing.assert_array_equal(fused.rows, other.rows)
+    np.testing.assert_array_equal(fused.base.st.pid, other.base.st.pid)
+    assert np.abs(fused.gains(rows) - 1.0).max() > 0.0              # the adaptive gain moved
