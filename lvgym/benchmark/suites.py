@@ -72,6 +72,37 @@ N_VALIDATION_SEEDS = 10_000
 TEST_SEED0 = 10_000
 N_TEST_SEEDS = 10_000
 SEED_SETS = ("test", "validation")
+
+
+@dataclass(frozen=True)
+class SeedBlock:
+    """A named block of ``n`` consecutive seeds of ``seed_set``, from its ``first``-th seed on (the seeds
+    ``TEST_SEED0 + first`` .. ``TEST_SEED0 + first + n - 1`` of the test set)."""
+
+    name: str
+    seed_set: str
+    first: int
+    n: int
+
+    def seeds(self) -> list[int]:
+        """The block's seeds, in order."""
+        base = TEST_SEED0 if self.seed_set == "test" else VALIDATION_SEED0
+        return [base + self.first + i for i in range(self.n)]
+
+    def label(self) -> str:
+        """``<name> (<seed_set> seeds <first>-<last>)``."""
+        s = self.seeds()
+        return f"{self.name} ({self.seed_set} seeds {s[0]:,}-{s[-1]:,})"
+
+
+#: the 50 test seeds 10,000-10,049 that every table of protocols v0-v2 was flown on during development, many
+#: times (docs/data/test-flights.jsonl): the headline's continuity column, no longer a test
+DEVELOPMENT_BLOCK = SeedBlock("development-50", "test", 0, 50)
+#: the headline's test block: the 200 test seeds 12,000-12,199, never flown before it was named (2026-12-07; far
+#: from the development block and from the 150 seeds a re-flight study flew once beyond it, whose range is not
+#: recorded). ``lvgym headline fly`` flies the selected policies on it once per selection (docs/benchmark.md,
+#: "The headline's test block"); the frozen suites' own seeds are unchanged
+HEADLINE_BLOCK = SeedBlock("headline-200", "test", 2_000, 200)
 #: the main suite: protocol v2's SMILE ascent (the conditions of v1's ``smile-v1``, under the flyability rule)
 DEFAULT_SUITE = "smile-v2"
 
@@ -154,15 +185,19 @@ class Suite:
     """the registered policies the protocol reports on this suite (``evaluate.py``'s default for it; empty: the
     command's default list, as for v0 and v1)"""
 
-    def seeds(self, seed_set: str, n: int) -> list[int]:
-        """The first ``n`` seeds of ``seed_set`` (``"test"`` or ``"validation"``)."""
+    def seeds(self, seed_set: str, n: int, first: int = 0) -> list[int]:
+        """``n`` seeds of ``seed_set`` (``"test"`` or ``"validation"``) from its ``first``-th on (default: its
+        first ``n``; a named block such as :data:`HEADLINE_BLOCK` starts further on)."""
         if seed_set not in SEED_SETS:
             raise ValueError(f"seed_set = {seed_set!r}: one of {SEED_SETS}")
         limit = N_TEST_SEEDS if seed_set == "test" else N_VALIDATION_SEEDS
-        if not 1 <= int(n) <= limit:
-            raise ValueError(f"episodes = {n!r}: 1 .. {limit} per condition for the {seed_set} seed set")
+        if not 0 <= int(first) < limit:
+            raise ValueError(f"first = {first!r}: 0 .. {limit - 1} for the {seed_set} seed set")
+        if not 1 <= int(n) <= limit - int(first):
+            raise ValueError(f"episodes = {n!r}: 1 .. {limit - int(first)} per condition for the {seed_set} seed set"
+                             + (f" from its seed {first}" if first else ""))
         base = TEST_SEED0 if seed_set == "test" else VALIDATION_SEED0
-        return [base + i for i in range(int(n))]
+        return [base + int(first) + i for i in range(int(n))]
 
     def with_options(self, **options: Any) -> Suite:
         """This suite with env keywords overridden in every condition. The overrides are recorded

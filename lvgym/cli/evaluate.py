@@ -27,7 +27,8 @@ each of yours a row with its room against the reference (``--only``: the given p
 run on a local process pool by default; the Markdown table is printed, and CSV, JSON, the table and PNG
 plots go to ``--out`` (each file written atomically: an interrupted run leaves no half-written file).
 ``--seed-set validation`` evaluates on the training seeds; reported numbers use the ``test`` seeds (the
-default).
+default), and every run on them is logged in the ledger of test flights (``lvgym ledger``; ``--purpose``
+says why).
 
 The tables (every mean with its 95 % bootstrap interval over the seeds, lower is better): for protocol v2,
 first the headline over every suite (the best classical design the suite reports, the best learned policy
@@ -69,6 +70,7 @@ from lvgym.errors import ConfigError
 from lvgym.parallel import TaskFailed, exit_on_sigterm
 
 from .flights import check_vehicle
+from .ledger import announce
 
 __all__ = ["Args", "BESIDE_KINDS", "DEFAULT_EPISODES", "DEFAULT_POLICIES", "DEFAULT_SUITE", "DEFAULT_SUITES",
            "POLICIES", "main", "parse_args", "resolve_policy", "suite_policies"]
@@ -112,7 +114,10 @@ class Args:
     out: str = "results"
     """folder of the result files"""
     seed_set: str = arg("test", choices=SEED_SETS)
-    """test (reported numbers) or validation (training and tuning)"""
+    """test (reported numbers; every such run is logged in the ledger of test flights, lvgym ledger) or
+    validation (training and tuning)"""
+    purpose: str | None = arg(None, metavar="TEXT")
+    """why the test seeds are flown, for the ledger of test flights (default: the command's name)"""
     reference: str | None = arg(None, metavar="POLICY")
     """policy label every policy is compared with (default: the best-ranked policy of each condition)"""
     vehicle: str | None = arg(None, check=check_vehicle, metavar="NAME|PATH")
@@ -187,10 +192,11 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
     overrides = {k: v for k, v in (("mission_time_s", args.mission_time_s), ("vehicle", args.vehicle)) if v is not None}
     if overrides:
         suites = [s.with_options(**overrides) for s in suites]
+    announce(prog, suites[0].seeds(args.seed_set, args.episodes), "(reported numbers)")
     t0 = time.perf_counter()
     try:
         records = evaluate(per_suite, suites, args.episodes, args.seed_set, args.executor, args.workers,
-                           args.progress)
+                           args.progress, purpose=args.purpose)
     except TaskFailed as exc:                        # a bad value met in a worker: its message, in one line
         if isinstance(exc.__cause__, ConfigError):
             fail(prog, exc)

@@ -38,6 +38,8 @@ COMMANDS: tuple[Command, ...] = (
             "or on Ray), evaluation on the test seeds, comparison over the runs", "train", _TRAIN),
     Command("margins", "lvgym.cli.margins:main", "time-domain gain and delay margins of policies in the nonlinear "
             "simulation", "benchmark", _BENCHMARK),
+    Command("ledger", "lvgym.cli.ledger:main", "how often each policy has flown on test seeds, and on which "
+            "blocks (the ledger of test flights)"),
     Command("fingerprint", "lvgym.cli.fingerprint:main", "check (or write) a frozen protocol's fingerprint"),
     Command("verify", "lvgym.verify.__main__:main", "the verification table against the thesis (chapter 4)", sub=(
         Command("rocketpy", "lvgym.verify.rocketpy_case:main", "the rigid simulator against RocketPy (Stratos III)",
