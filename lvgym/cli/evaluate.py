@@ -62,6 +62,7 @@ from typing import Any
 from lvgym.benchmark import (DEFAULT_SUITE, EXECUTORS, SEED_SETS, SUITES, PolicySpec, Suite, compare,
                              degradation, evaluate, get_suite, markdown_table, normalise, protocol_metric,
                              run_groups, summarize, write_results)
+from lvgym.benchmark.decide import by_fault
 from lvgym.benchmark.family import family_room, family_rows, family_table
 from lvgym.benchmark.headline import headline, others, policy_kind
 from lvgym.cli.policies import POLICIES, resolve_policy  # (registers the built-in policies)
@@ -228,15 +229,16 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
     }
     family = family_rows(records)                   # a family suite: its vehicles gathered
     family_lines = family_table(family, family_room(records, kinds)) if family else []
-    table = markdown_table(summary, deg, meta, comparison, groups, rows, family_lines, beside)
+    faults = by_fault(records, {s.name: s.reference for s in suites if s.reference})
+    table = markdown_table(summary, deg, meta, comparison, groups, rows, family_lines, beside, faults)
     paths = write_results(args.out, records, summary, deg, meta, plots=args.plots, comparison=comparison,
-                          groups=groups, headline=rows, family=family_lines, others=beside)
+                          groups=groups, headline=rows, family=family_lines, others=beside, faults=faults)
     print(table)
     print(f"{len(records)} episodes in {wall:.1f} s ({args.executor}); results in {Path(args.out)}/: "
           f"{', '.join(sorted(paths))}", file=sys.stderr)
     return {"records": records, "summary": summary, "degradation": deg, "comparison": comparison,
             "run_groups": groups, "headline": rows, "headline_others": beside, "meta": meta, "table": table,
-            "family": family}
+            "family": family, "faults": faults}
 
 
 if __name__ == "__main__":
