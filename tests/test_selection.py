@@ -73,6 +73,12 @@ def test_fly_refuses_a_dirty_selection_and_a_short_test_flight(tmp_path):
         cli.fly_main(["--selection", str(_selection(tmp_path / "s.json", n_seeds=2)), "--out", str(tmp_path)])
     with pytest.raises(SystemExit, match="no selection file"):
         cli.fly_main(["--selection", str(tmp_path / "none.json"), "--out", str(tmp_path)])
+    flown = tmp_path / "headline.json"                              # the block flown from this selection already
+    flown.write_text(json.dumps({"meta": {"seed_set": "test", "made_utc": "2026-12-08T00:00:00+00:00",
+                                          "selection": {"made_utc": "2026-12-07T00:00:00+00:00"}}}))
+    with pytest.raises(SystemExit, match="flown once per selection"):
+        cli.fly_main(["--selection", str(_selection(tmp_path / "ok.json")), "--record", str(flown),
+                      "--out", str(tmp_path)])
     assert len(read()) == before                                    # nothing flew, nothing logged
 
 

@@ -6,8 +6,10 @@ with the same seed under every condition and for every policy (common random num
 the non-rigid episode of a seed fly the same wind and dispersions and the comparison is paired.
 
 Seeds: **validation** seeds ``0 .. 9_999`` are for training, tuning and model selection; **test**
-seeds ``10_000 ..`` are for reported numbers only. Episode ``i`` uses ``VALIDATION_SEED0 + i`` or
-``TEST_SEED0 + i``.
+seeds ``10_000 ..`` are for reported numbers only, and every flight on them is logged (:mod:`.ledger`).
+Episode ``i`` uses ``VALIDATION_SEED0 + i`` or ``TEST_SEED0 + i`` (from a named block's first seed on:
+:data:`DEVELOPMENT_BLOCK`, the 50 seeds flown throughout development, and :data:`HEADLINE_BLOCK`, the 200
+never-flown test seeds of the headline that decides).
 
 The protocol is versioned: :data:`PROTOCOL_VERSION` is written into every result record. A change of a
 suite's conditions, of a seed set or of a metric's definition is a new version (``v1``, ...) and leaves

@@ -139,6 +139,13 @@ def fly_main(argv: list[str] | None = None) -> dict[str, Any]:
     if test and (selection.get("overrides") or selection.get("n_seeds", 0) < HEADLINE_BLOCK.n or args.mission_time_s):
         fail(prog, f"{path}: the test block is flown only from a protocol selection (>= {HEADLINE_BLOCK.n} "
                    "validation seeds, no overrides) and without --mission-time-s")
+    out = Path(args.record or (_in_repo(RECORD_IN_REPO, str(Path(args.out) / "headline.json")) if test
+                               else Path(args.out) / "headline.json"))
+    if test and out.exists():
+        flown = json.loads(out.read_text(encoding="utf-8"))["meta"]
+        if flown.get("seed_set") == "test" and flown["selection"].get("made_utc") == selection.get("made_utc"):
+            fail(prog, f"{out}: the block was flown from this selection on {flown['made_utc'][:10]}: it is flown once "
+                       "per selection (a new selection, or remove the record on purpose)")
     block = ["--block", HEADLINE_BLOCK.name] if test else ["--seed-set", "validation", "--episodes", str(args.episodes)]
     t0 = time.perf_counter()
     records: list[dict[str, Any]] = []
@@ -155,8 +162,6 @@ def fly_main(argv: list[str] | None = None) -> dict[str, Any]:
                        f"validation seeds 0-{args.episodes - 1}", "selection": selection,
                        "wall_time_s": round(time.perf_counter() - t0, 1), "episodes_flown": len(records) + len(continuity)},
               "rows": rows, "episodes": records, "continuity": continuity}
-    out = Path(args.record or (_in_repo(RECORD_IN_REPO, str(Path(args.out) / "headline.json")) if test
-                               else Path(args.out) / "headline.json"))
     atomic_write_text(out, json_text(record))
     print("\n".join(block_table(rows)))
     print(f"{record['meta']['episodes_flown']} episodes in {record['meta']['wall_time_s']} s; record in {out}",
