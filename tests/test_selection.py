@@ -100,3 +100,30 @@ def test_fly_rehearsal_on_validation_seeds_then_page_and_compare(tmp_path, capsy
     capsys.readouterr()
     table = compare_main([str(tmp_path / "out" / "smile-v2"), "--record", str(path)])
     assert "| smile-v2 | rigid | `lqg` |" in table and "`lqg`: +0 % [+0, +0] (n 2)" in table
+
+
+def test_fly_on_the_test_block_asks_evaluate_for_the_block_and_the_continuity_seeds(tmp_path, monkeypatch):
+    """The test path without a flight: evaluate is replaced by a stand-in that records what it was asked."""
+    asked = []
+
+    def fake_evaluate(argv):
+        asked.append(argv)
+        seeds = range(12_000, 12_002) if "headline-200" in argv else range(10_000, 10_002)
+        return {"records": [_rec(p, m, s, 1.0 if p == "lqg" else 0.5) | {"suite": "smile-v2",
+                                                                          "condition": f"smile-v2/{m}"}
+                            for p in ("lqg", "gs-pid-flex", "privileged") for m in ("rigid", "nonrigid")
+                            for s in seeds]}
+
+    monkeypatch.setattr(cli, "evaluate_main", fake_evaluate)
+    record = cli.fly_main(["--selection", str(_selection(tmp_path / "sel.json")), "--record",
+                           str(tmp_path / "headline.json"), "--out", str(tmp_path / "out"), "--no-progress"])
+    block, cont = asked
+    assert block[block.index("--block") + 1] == "headline-200" and cont[cont.index("--block") + 1] == "development-50"
+    assert block[block.index("--policies") + 1:block.index("--only")] == ["lqg", "gs-pid-flex", "privileged"]
+    assert cont[cont.index("--purpose") + 1].endswith("(continuity: the development seeds)")
+    assert record["meta"]["block"] == "headline-200 (test seeds 12,000-12,199)"
+    row = record["rows"][0]
+    assert row["gain"]["gain"] == pytest.approx(0.5) and row["continuity"]["gain"] == pytest.approx(0.5)
+    with pytest.raises(SystemExit, match="flown once per selection"):               # and only once
+        cli.fly_main(["--selection", str(tmp_path / "sel.json"), "--record", str(tmp_path / "headline.json"),
+                      "--out", str(tmp_path / "out")])

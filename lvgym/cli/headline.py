@@ -117,8 +117,9 @@ class FlyArgs:
     progress: bool = True
 
 
-def _fly_suite(suite: str, names: list[str], seeds: list[str], out: Path, args: FlyArgs) -> list[dict[str, Any]]:
-    argv = ["--policies", *names, "--only", "--suites", suite, "--out", str(out), "--purpose", args.purpose,
+def _fly_suite(suite: str, names: list[str], seeds: list[str], out: Path, args: FlyArgs,
+               why: str = "") -> list[dict[str, Any]]:
+    argv = ["--policies", *names, "--only", "--suites", suite, "--out", str(out), "--purpose", args.purpose + why,
             "--executor", args.executor, "--no-plots", *seeds]
     argv += ["--workers", str(args.workers)] if args.workers else []
     argv += ["--mission-time-s", str(args.mission_time_s)] if args.mission_time_s is not None else []
@@ -155,7 +156,7 @@ def fly_main(argv: list[str] | None = None) -> dict[str, Any]:
         records += _fly_suite(suite, names, block, Path(args.out) / suite, args)
         if test and args.continuity:
             continuity += _fly_suite(suite, names, ["--block", "development-50"], Path(args.out) / suite / "continuity",
-                                     args)
+                                     args, " (continuity: the development seeds)")
     rows = block_rows(records, continuity, selection)
     record = {"meta": {"made_utc": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()), **source(),
                        "seed_set": args.seed_set, "block": HEADLINE_BLOCK.label() if test else
