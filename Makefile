@@ -5,7 +5,7 @@ VENV := .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 
-.PHONY: run test bench verify datasets clean
+.PHONY: run test bench verify datasets headline headline-select headline-fly clean
 
 $(STAMP): pyproject.toml
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
@@ -26,6 +26,20 @@ test: $(STAMP)
 bench: $(STAMP)
 	$(VENV)/bin/lvgym bench
 	$(PY) -m lvgym.bench_envs
+
+# the headline that decides (docs/benchmark.md, "The headline's test block"): every reported policy of the v2
+# suites on 200 validation seeds chooses the best classical and learned policy per suite (the selection file,
+# docs/data/headline-selection.json: commit it), then the selected policies fly the named test block 12,000-12,199
+# once (and the 50 development seeds for continuity; both logged in docs/data/test-flights.jsonl), and the
+# results page docs/results.md is written from the record docs/data/headline.json
+headline: headline-select headline-fly
+
+headline-select: $(STAMP)
+	$(VENV)/bin/lvgym headline select
+
+headline-fly: $(STAMP)
+	$(VENV)/bin/lvgym headline fly
+	$(VENV)/bin/lvgym headline page
 
 # rollouts of every classical baseline and shipped learned policy on every v2 suite, as Minari datasets
 # (validation seeds; into MINARI_DATASETS_PATH, default ~/.minari/datasets): the data offline RL starts from

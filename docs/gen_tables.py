@@ -1,7 +1,8 @@
 """The tables of docs/rl.md and docs/benchmark.md, generated from the code: the layouts of
 ``lvgym/envs/layouts.py``, the option groups of ``lvgym/envs/options.py`` (their field docstrings and
 ranges), the protocol presets of ``lvgym/envs/presets.py`` and the dispersion table of
-``lvgym/envs/dispersions.py``.
+``lvgym/envs/dispersions.py``; and how often each policy of protocol v2 has flown on test seeds, from the
+ledger of test flights (``docs/data/test-flights.jsonl``).
 
     python docs/gen_tables.py            # rewrite the generated blocks of the pages
     python docs/gen_tables.py --check    # exit 1 (and say which blocks) if a page is not what the code gives
@@ -24,7 +25,7 @@ from typing import Any, Callable
 PAGE = Path(__file__).resolve().parent / "rl.md"
 #: the pages with generated blocks, and their blocks
 PAGES = {PAGE: ("options", "presets", "observation", "action", "reward", "termination", "info"),
-         PAGE.parent / "benchmark.md": ("dispersions", "faults")}
+         PAGE.parent / "benchmark.md": ("dispersions", "faults", "test_flights")}
 
 #: the keys of a step's ``info`` (``AscentFuncEnv.transition_info``): unit and meaning. After a reset the
 #: ``info`` holds ``time``, ``cumulative_rate_error``, ``mass`` and ``controller_on`` only.
@@ -189,9 +190,19 @@ def faults() -> str:
     return _table(["kind", "what", "size", "axis", "why this range"], rows)
 
 
+def test_flights() -> str:
+    """How often each policy protocol v2 reports has flown on test seeds: the committed ledger of test flights
+    (``docs/data/test-flights.jsonl``; ``lvgym ledger --headline``)."""
+    from lvgym.benchmark.ledger import LEDGER_IN_REPO, read, table
+    from lvgym.benchmark.suites import SUITES_V2
+
+    names = list(dict.fromkeys(p for s in SUITES_V2.values() for p in s.policies))
+    return table(read(PAGE.parent.parent / LEDGER_IN_REPO), names).rstrip("\n")
+
+
 BLOCKS: dict[str, Callable[[], str]] = {"options": options, "presets": presets, "observation": observation,
                                         "action": action, "reward": reward, "termination": termination, "info": info,
-                                        "dispersions": dispersions, "faults": faults}
+                                        "dispersions": dispersions, "faults": faults, "test_flights": test_flights}
 _BLOCK = re.compile(r"(<!-- generated: (\w+) -->\n)(.*?)(<!-- end: \2 -->)", re.S)
 
 

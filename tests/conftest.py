@@ -6,3 +6,5 @@ import tempfile
 
 if "LVGYM_CACHE_DIR" not in os.environ:
     os.environ["LVGYM_CACHE_DIR"] = tempfile.mkdtemp(prefix="lvgym-test-cache-")
+# the ledger of test flights (lvgym.benchmark.ledger): a file of this session, never the committed one
+os.environ["LVGYM_TEST_FLIGHTS"] = os.path.join(tempfile.mkdtemp(prefix="lvgym-test-ledger-"), "test-flights.jsonl")

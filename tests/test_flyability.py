@@ -115,7 +115,8 @@ def test_v2_ranks_an_unflyable_policy_like_a_failing_one_and_v1_ranks_as_before(
     assert rows[1]["failure_rate_v2"] == 0.5 and rows[0]["score_v2_mean"] == rows[0]["score_mean"] == 2.0
     table = flyability_table(rows)                       # v2 rows: one line each, in rank order
     assert [line.split("|")[2].strip() for line in table[2:]] == ["smooth", "failing", "chatter"]
-    assert "| 100 % |" in table[-1] and flyability_table(summarize(v1)) == []
+    unflyable = table[-1].split("|")[5].strip()                # chatter: unflyable on every flight, exact interval
+    assert unflyable.startswith("100 % [") and unflyable.endswith(", 100]") and flyability_table(summarize(v1)) == []
 
 
 class WhiteChatter:

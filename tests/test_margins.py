@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 import lvgym.cli.policies  # noqa: F401  (registers the built-in policies: pid)
+from lvgym.benchmark import ledger
 from lvgym.benchmark import get_suite
 from lvgym.benchmark.margins import (EXPERIMENTS, RATE_ERROR_FLOOR_RADPS, RATE_LIMIT_FLOOR_S, MarginOptions, _summary, bounds,
                                      margins_table, time_domain_margins, verdict)
@@ -189,7 +190,9 @@ def test_end_to_end_pid_margins_are_finite_and_seeded(short_rigid):
     opts = MarginOptions(gain_tol_db=1.0, delay_max_s=0.2)
     r = time_domain_margins(POLICIES["pid"], short_rigid, [10000], options=opts, executor="serial")
     c = r["conditions"][short_rigid.name]
-    assert c["delay_resolution_ms"] == pytest.approx(10.0) and r["seeds"] == [10000]
+    assert c["delay_resolution_ms"] == pytest.approx(10.0) and r["seeds"] == [10000] and r["seed_set"] == "test"
+    logged = ledger.read()[-1]                                   # a test seed: the call is in the ledger
+    assert (logged["command"], logged["policies"], logged["seeds"]) == ("margins", ["pid"], [[10000, 10000]])
     up, delay = c["gain_up_dB"], c["delay_ms"]
     assert 0.0 < up["margin"] < up["failed_at"] <= 20.0 and up["bracket_width"] <= 1.0
     assert 0.0 < delay["margin"] < delay["failed_at"] <= 200.0 and delay["bracket_width"] == pytest.approx(10.0)
@@ -237,3 +240,10 @@ def test_cli_refuses_bad_values_and_writes_its_files(tmp_path, capsys):
     assert sorted(p.name for p in out.iterdir()) == ["margin_trials.csv", "margins.csv", "margins.json", "margins.md"]
     data = json.loads((out / "margins.json").read_text())
     assert data["meta"]["version"].endswith("+override") and data["results"][0]["experiments"] == ["delay"]
+    assert data["results"][0]["seeds"] == [0] and data["results"][0]["seed_set"] == "validation"    # the default
+    before = len(ledger.read())
+    main(["--policies", "pid", "--models", "rigid", "--seeds", "1", "--experiments", "delay", "--delay-max-s",
+          "0.02", "--mission-time-s", str(SHORT), "--executor", "serial", "--out", str(out), "--no-progress",
+          "--seed-set", "test", "--purpose", "a deliberate check"])
+    assert "lvgym margins: flying 1 test seeds (10,000-10,000) on purpose" in capsys.readouterr().err
+    assert len(ledger.read()) == before + 1 and ledger.read()[-1]["purpose"] == "a deliberate check"

@@ -13,6 +13,10 @@
   best flyable classical and learned policies the suite reports, the privileged reference and the room
   between them) and a row for each other policy flown;
 - :mod:`.compare`: the paired comparison of policies and agents over training runs;
+- :mod:`.decide`, :mod:`.selection`: the statistics that decide between two policies (exact failed and
+  unflyable rates, the paired relative gain, the score on flights both survived, the table by fault kind) and
+  the headline chosen on validation seeds, flown once on the named test block;
+- :mod:`.ledger`: the ledger of test flights (every flight on test seeds, one line per call);
 - :mod:`.runner`: :func:`run_episode` and :func:`evaluate` (serial, local process pool or Ray);
 - :mod:`.tables`, :mod:`.results`, :mod:`.plots`: the Markdown tables; atomic CSV / JSON / Markdown / PNG result
   files; the figures (each policy in one colour and marker, means with their intervals);

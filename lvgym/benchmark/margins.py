@@ -1,7 +1,7 @@
 """Time-domain margins of any policy in the nonlinear simulation: gain margins up and down [dB] and the
 delay margin [ms] (docs/metrics.md, "Time-domain margins").
 
-    lvgym margins                                          # the default policies on smile-v1, 5 test seeds
+    lvgym margins                                          # the default policies on smile-v1, 5 validation seeds
     lvgym margins --policies zero pid gs-pid ppo --seeds 10 --models rigid
     lvgym margins --policies runs/ppo_smile --physics-dt-s 0.005   # 5 ms delay resolution
 
@@ -20,8 +20,9 @@ one physics step in delay). Reported per policy and condition: the smallest marg
 margin) with its bracket, and the median. A seed whose nominal episode fails has no margin (counted, left
 out); a policy the injection never makes fail has a margin beyond the range searched (``>= gain_max_db``).
 
-Seeds: the ``test`` seeds by default: a margin is a measurement, not tuning (``--seed-set validation`` for
-design loops). Policies are names of :data:`~.registry.POLICIES`, SB3 ``.zip`` paths or ``train.py`` run
+Seeds: the ``validation`` seeds by default: margins are what a design is tuned by, and a test seed looked at
+during design is no test any more; ``--seed-set test`` measures on the test seeds on purpose, and every such
+call is logged in the ledger of test flights (:mod:`.ledger`). Policies are names of :data:`~.registry.POLICIES`, SB3 ``.zip`` paths or ``train.py`` run
 folders, as ``evaluate.py`` takes them. From Python: :func:`time_domain_margins` (one policy) and
 :func:`run_margins` (several, one process pool).
 
@@ -47,7 +48,7 @@ from lvgym.parallel import check_workers, default_workers, run_map
 from .perturb import db_to_gain, summary, threshold_search
 from .results import atomic_write_text, csv_text, json_text
 from .runner import PolicySpec, episode_objects, fly_block
-from .suites import SEED_SETS, SUITES, Condition, Suite
+from .suites import SEED_SETS, SUITES, TEST_SEED0, Condition, Suite
 
 __all__ = ["EXPERIMENTS", "MarginOptions", "MarginTask", "RATE_ERROR_FLOOR_RADPS", "RATE_LIMIT_FLOOR_S", "bounds",
            "margin_rows", "margins_table", "run_margin_task",
@@ -246,11 +247,13 @@ def _summary(seeds: list[dict[str, Any]], limit: float) -> dict[str, Any]:
 
 
 def run_margins(policies: Sequence[PolicySpec], where: Suite | Condition | Sequence[Condition],
-                seeds: int | Sequence[int] = DEFAULT_SEEDS, *, seed_set: str = "test",
+                seeds: int | Sequence[int] = DEFAULT_SEEDS, *, seed_set: str = "validation",
                 options: MarginOptions | None = None, experiments: Sequence[str] = EXPERIMENTS,
-                executor: str = "local", workers: int | None = None, progress: bool = False) -> list[dict[str, Any]]:
+                executor: str = "local", workers: int | None = None, progress: bool = False,
+                purpose: str | None = None) -> list[dict[str, Any]]:
     """:func:`time_domain_margins` of every policy, their searches on one process pool (``executor``,
-    ``workers`` as :func:`lvgym.parallel.run_map`); one result per policy, in order."""
+    ``workers`` as :func:`lvgym.parallel.run_map`); one result per policy, in order. A search on test seeds
+    is logged in the ledger of test flights first (:func:`~.ledger.log_flight`, with ``purpose``)."""
     options = options or MarginOptions()
     names = [p.name for p in policies]
     if len(set(names)) != len(names):
@@ -261,8 +264,15 @@ def run_margins(policies: Sequence[PolicySpec], where: Suite | Condition | Seque
     if seed_set not in SEED_SETS:
         raise ValueError(f"seed_set = {seed_set!r}: one of {SEED_SETS}")
     conds, seed_list = _conditions(where), _seeds(where, seeds, seed_set)
+    if not isinstance(seeds, int) and seed_list:                 # given seeds: the set they belong to
+        tested = [s >= TEST_SEED0 for s in seed_list]
+        seed_set = "test" if all(tested) else ("validation" if not any(tested) else "test and validation")
     if not conds or not seed_list:
         raise ValueError("margins need at least one condition and one seed")
+    from .ledger import log_flight
+
+    log_flight(seed_list, sorted({c.group or c.name for c in conds}), [c.model for c in conds], names,
+               purpose, command="margins")
     n_workers = 1 if executor == "serial" else (check_workers(workers) or default_workers())
     parts = min(len(policies), max(1, math.ceil(n_workers / len(conds))))     # enough tasks for the workers
     chunks = [tuple(policies[i::parts]) for i in range(parts)]
@@ -299,7 +309,7 @@ def time_domain_margins(policy_spec: PolicySpec, suite_or_condition: Suite | Con
                         seeds: int | Sequence[int] = DEFAULT_SEEDS, **kwargs: Any) -> dict[str, Any]:
     """The time-domain margins of one policy on every condition of a suite (or on the given conditions).
 
-    ``seeds``: a count (the first of ``seed_set``, default ``"test"``) or the seeds themselves; keywords of
+    ``seeds``: a count (the first of ``seed_set``, default ``"validation"``) or the seeds themselves; keywords of
     :func:`run_margins` (``options``: a :class:`MarginOptions`, ``experiments``, ``executor``, ``workers``,
     ``progress``). Returns ``{"policy", "seeds", "options", "conditions": {name: {...}}, "episodes",
     "wall_time_s"}``; per condition ``gain_up_dB``, ``gain_down_dB`` and ``delay_ms`` each hold ``margin``

@@ -33,7 +33,7 @@ Per suite, for each (suite, condition, policy) (:func:`summarize`): ``mean``, ``
 (the 95 % BCa bootstrap interval of the mean over the seeds, :func:`.stats.bootstrap_ci`), ``std``
 (sample standard deviation, ``ddof = 1``; 0 for one episode), ``cvar10`` (conditional value at risk at
 10 %: the mean of the worst ``ceil(0.1 n)`` episodes, at least one; worst is the largest value, the
-smallest for ``episode_return``), ``failure_rate`` (failed episodes over episodes, with its interval),
+smallest for ``episode_return``), ``failure_rate`` (failed episodes over episodes, with its exact interval),
 ``n`` and ``rank``: the place of the policy within its (suite, condition), by failure rate, then by mean
 ``score`` (lower is better for both; :func:`rank_key`). Protocol v2's records (:mod:`.flyability`) add
 ``unflyable_rate`` and ``failure_rate_v2`` (failed or unflyable) and rank by that, then by ``score_v2``.
@@ -58,7 +58,7 @@ import numpy as np
 
 from .flyability import V2_METRICS
 from .scoring import PHASES
-from .stats import bootstrap_ci, paired, ratio
+from .stats import bootstrap_ci, clopper_pearson, paired, ratio
 
 #: metrics summarised per suite (all "lower is better" except those in :data:`HIGHER_IS_BETTER`)
 SUMMARY_METRICS = ("rate_error_rad", "rate_error_pitch_rad", "rate_error_yaw_rad", "max_rate_radps", "effort_rad_s",
@@ -177,13 +177,19 @@ def rank(summary: Sequence[dict[str, Any]]) -> list[dict[str, Any]]:
     return out
 
 
+def _rate_ci(events: np.ndarray) -> tuple[float, float]:
+    """The Clopper-Pearson 95 % interval of the rate of the 0/1 ``events``."""
+    return clopper_pearson(int(np.sum(events)), int(events.size))[1:]
+
+
 def summarize(records: Iterable[dict[str, Any]], metrics: Sequence[str] | None = None) -> list[dict[str, Any]]:
     """One row per (suite, condition, policy), in order of first appearance: ``n``, ``failure_rate``
     with its interval, the failure reasons with their counts, ``<metric>_mean``, ``_ci_low``,
     ``_ci_high``, ``_std``, ``_cvar10`` of every metric (default: :data:`SUMMARY_METRICS` and those of
     :data:`V1_METRICS` and :data:`~.flyability.V2_METRICS` the records carry) and ``rank`` (:func:`rank`).
     Records of protocol v2 (with ``flyable``) add ``unflyable_rate`` and ``failure_rate_v2`` (failed or
-    unflyable), each with its interval."""
+    unflyable), each with its interval. A rate's interval is the exact (Clopper-Pearson) one
+    (:func:`~.stats.clopper_pearson`), every other the bootstrap's."""
     groups: dict[tuple[Any, ...], list[dict[str, Any]]] = {}
     for r in records:
         groups.setdefault(tuple(r[k] for k in GROUP_KEYS), []).append(r)
@@ -199,7 +205,7 @@ def summarize(records: Iterable[dict[str, Any]], metrics: Sequence[str] | None =
         row["n"] = len(recs)
         failed = np.array([bool(r["failed"]) for r in recs], dtype=float)
         row["failure_rate"] = float(np.mean(failed))
-        row["failure_rate_ci_low"], row["failure_rate_ci_high"] = bootstrap_ci(failed)
+        row["failure_rate_ci_low"], row["failure_rate_ci_high"] = _rate_ci(failed)
         reasons: dict[str, int] = {}
         for r in recs:
             if r["failed"]:
@@ -208,10 +214,10 @@ def summarize(records: Iterable[dict[str, Any]], metrics: Sequence[str] | None =
         if "flyable" in first:
             unflyable = np.array([not r["flyable"] for r in recs], dtype=float)
             row["unflyable_rate"] = float(np.mean(unflyable))
-            row["unflyable_rate_ci_low"], row["unflyable_rate_ci_high"] = bootstrap_ci(unflyable)
+            row["unflyable_rate_ci_low"], row["unflyable_rate_ci_high"] = _rate_ci(unflyable)
             either = np.maximum(failed, unflyable)
             row["failure_rate_v2"] = float(np.mean(either))
-            row["failure_rate_v2_ci_low"], row["failure_rate_v2_ci_high"] = bootstrap_ci(either)
+            row["failure_rate_v2_ci_low"], row["failure_rate_v2_ci_high"] = _rate_ci(either)
         for m in names:
             x = np.array([r[m] for r in recs], dtype=float)
             row[f"{m}_mean"] = float(np.mean(x))

@@ -138,11 +138,13 @@ def write_results(out: str | os.PathLike[str], records: Sequence[Mapping[str, An
                   summary: Sequence[Mapping[str, Any]], degradation: Sequence[Mapping[str, Any]],
                   meta: Mapping[str, Any], plots: bool = True, comparison: Sequence[Mapping[str, Any]] = (),
                   groups: Sequence[Mapping[str, Any]] = (), headline: Sequence[Mapping[str, Any]] = (),
-                  family: Sequence[str] = (), others: Sequence[Mapping[str, Any]] = ()) -> dict[str, Path]:
+                  family: Sequence[str] = (), others: Sequence[Mapping[str, Any]] = (),
+                  faults: Sequence[Mapping[str, Any]] = ()) -> dict[str, Path]:
     """Write every result file into ``out`` (created if missing), each atomically; ``results.json``
     last (``headline``: protocol v2's rows, :func:`~.headline.headline`, also as ``headline.csv`` and
     ``headline.png``; ``others``: the other policies flown beside it, :func:`~.headline.others`, also as
-    ``headline_others.csv``). Returns the paths by name."""
+    ``headline_others.csv``; ``faults``: the rows by kind of in-flight fault, :func:`~.decide.by_fault`, also
+    as ``faults.csv``). Returns the paths by name."""
     folder = Path(out)
     folder.mkdir(parents=True, exist_ok=True)
     remove_stale_temporaries(folder)
@@ -158,9 +160,11 @@ def write_results(out: str | os.PathLike[str], records: Sequence[Mapping[str, An
         paths["headline.csv"] = atomic_write_text(folder / "headline.csv", csv_text(flat(headline)))
     if others:
         paths["headline_others.csv"] = atomic_write_text(folder / "headline_others.csv", csv_text(others))
+    if faults:
+        paths["faults.csv"] = atomic_write_text(folder / "faults.csv", csv_text(faults))
     paths["table.md"] = atomic_write_text(folder / "table.md",
                                           markdown_table(summary, degradation, meta, comparison, groups, headline,
-                                                         family, others))
+                                                         family, others, faults))
     if plots:                                       # one colour and marker per policy in every figure
         look = styles([r["policy"] for r in records] + [r["policy"] for r in (*summary, *degradation, *others)])
         paths["rate_error.png"] = atomic_write(folder / "rate_error.png",
@@ -174,5 +178,6 @@ def write_results(out: str | os.PathLike[str], records: Sequence[Mapping[str, An
     paths["results.json"] = atomic_write_text(folder / "results.json", json_text(
         {"meta": meta, "summary": summary, "degradation": degradation, "comparison": list(comparison),
          "run_groups": list(groups), **({"headline": list(headline)} if headline else {}),
-         **({"headline_others": list(others)} if others else {}), "episodes": records}))
+         **({"headline_others": list(others)} if others else {}), **({"faults": list(faults)} if faults else {}),
+         "episodes": records}))
     return paths

@@ -240,12 +240,13 @@ def policy_options(policy: PolicySpec) -> dict[str, Any]:
 
 
 def make_tasks(policies: Sequence[PolicySpec] | Mapping[str, Sequence[PolicySpec]], suites: Sequence[Suite],
-               episodes: int, seed_set: str = "test") -> list[Task]:
+               episodes: int, seed_set: str = "test", first: int = 0) -> list[Task]:
     """Every episode of every policy on every condition of every suite, in the order of the results:
     suite, condition, policy, episode. ``policies``: one list for every suite, or a mapping of suite name to
     that suite's own list. A policy whose factory has ``privileged = True`` flies each condition with
     ``privileged_info=True`` (the same flight, with the true state in the info), one that sees privileged
-    observations (a teacher trained with ``fault_info``) with its options (:func:`policy_options`)."""
+    observations (a teacher trained with ``fault_info``) with its options (:func:`policy_options`). ``first``:
+    the index of the first seed of ``seed_set`` (:meth:`~.suites.Suite.seeds`)."""
     per_suite = _per_suite(policies, suites)
     options: dict[str, dict[str, Any]] = {}
     for suite in suites:
@@ -255,7 +256,7 @@ def make_tasks(policies: Sequence[PolicySpec] | Mapping[str, Sequence[PolicySpec
         options.update({p.name: policy_options(p) for p in per_suite[suite.name] if p.name not in options})
     tasks: list[Task] = []
     for suite in suites:
-        seeds = suite.seeds(seed_set, episodes)
+        seeds = suite.seeds(seed_set, episodes, first)
         for cond in suite.conditions:
             for pol in per_suite[suite.name]:
                 c = cond.with_options(**options[pol.name]) if options[pol.name] else cond
@@ -323,7 +324,7 @@ def _describe_block(block: Block) -> str:
 
 def evaluate(policies: Sequence[PolicySpec] | Mapping[str, Sequence[PolicySpec]], suites: Sequence[Suite], episodes: int, seed_set: str = "test",
              executor: str = "local", workers: int | None = None, progress: bool = True,
-             rows: int | None = None) -> list[dict[str, Any]]:
+             rows: int | None = None, purpose: str | None = None, first: int = 0) -> list[dict[str, Any]]:
     """Run ``episodes`` seeds of ``seed_set`` for every policy on every condition of every suite (``policies``:
     one list, or a list per suite name, :func:`make_tasks`) and return the episode records in the order of :func:`make_tasks` (whatever the executor, worker count and block
     size).
@@ -334,10 +335,19 @@ def evaluate(policies: Sequence[PolicySpec] | Mapping[str, Sequence[PolicySpec]]
     processes, default: the CPUs available), ``serial`` (this process) or ``ray`` (one Ray task per block:
     on the Ray already initialised in this process, else on the cluster at ``$RAY_ADDRESS``, else on a local
     Ray of ``workers`` CPUs started and stopped here). Ray workers import ``lvgym`` and the policy
-    factories, so install the project on every node."""
+    factories, so install the project on every node.
+
+    ``first``: the index of the first seed of ``seed_set`` flown (default 0: its first ``episodes`` seeds; a
+    named block of seeds, e.g. :data:`~.suites.HEADLINE_BLOCK`, starts further on). A flight on test seeds
+    is logged in the ledger of test flights before it starts (:func:`~.ledger.log_flight`, with ``purpose``)."""
     if executor not in EXECUTORS:
         raise ValueError(f"executor = {executor!r}: one of {EXECUTORS}")
-    tasks = make_tasks(policies, suites, episodes, seed_set)
+    tasks = make_tasks(policies, suites, episodes, seed_set, first)
+    if seed_set == "test" and tasks:
+        from .ledger import log_flight
+
+        log_flight({t.seed for t in tasks}, [s.name for s in suites], [c.model for s in suites for c in s.conditions],
+                   [t.policy.name for t in tasks], purpose)
     n_workers = 1 if executor == "serial" else (check_workers(workers) or default_workers())
     blocks = make_blocks(tasks, block_rows(len(tasks), n_workers) if rows is None else rows)
     done = run_map(run_block, blocks, executor, workers, progress, desc="blocks", unit="block",

@@ -6,8 +6,10 @@ with the same seed under every condition and for every policy (common random num
 the non-rigid episode of a seed fly the same wind and dispersions and the comparison is paired.
 
 Seeds: **validation** seeds ``0 .. 9_999`` are for training, tuning and model selection; **test**
-seeds ``10_000 ..`` are for reported numbers only. Episode ``i`` uses ``VALIDATION_SEED0 + i`` or
-``TEST_SEED0 + i``.
+seeds ``10_000 ..`` are for reported numbers only, and every flight on them is logged (:mod:`.ledger`).
+Episode ``i`` uses ``VALIDATION_SEED0 + i`` or ``TEST_SEED0 + i`` (from a named block's first seed on:
+:data:`DEVELOPMENT_BLOCK`, the 50 seeds flown throughout development, and :data:`HEADLINE_BLOCK`, the 200
+never-flown test seeds of the headline that decides).
 
 The protocol is versioned: :data:`PROTOCOL_VERSION` is written into every result record. A change of a
 suite's conditions, of a seed set or of a metric's definition is a new version (``v1``, ...) and leaves
@@ -72,6 +74,39 @@ N_VALIDATION_SEEDS = 10_000
 TEST_SEED0 = 10_000
 N_TEST_SEEDS = 10_000
 SEED_SETS = ("test", "validation")
+
+
+@dataclass(frozen=True)
+class SeedBlock:
+    """A named block of ``n`` consecutive seeds of ``seed_set``, from its ``first``-th seed on (the seeds
+    ``TEST_SEED0 + first`` .. ``TEST_SEED0 + first + n - 1`` of the test set)."""
+
+    name: str
+    seed_set: str
+    first: int
+    n: int
+
+    def seeds(self) -> list[int]:
+        """The block's seeds, in order."""
+        base = TEST_SEED0 if self.seed_set == "test" else VALIDATION_SEED0
+        return [base + self.first + i for i in range(self.n)]
+
+    def label(self) -> str:
+        """``<name> (<seed_set> seeds <first>-<last>)``."""
+        s = self.seeds()
+        return f"{self.name} ({self.seed_set} seeds {s[0]:,}-{s[-1]:,})"
+
+
+#: the 50 test seeds 10,000-10,049 that every table of protocols v0-v2 was flown on during development, many
+#: times (docs/data/test-flights.jsonl): the headline's continuity column, no longer a test
+DEVELOPMENT_BLOCK = SeedBlock("development-50", "test", 0, 50)
+#: the headline's test block: the 200 test seeds 12,000-12,199, never flown before it was named (2026-12-07; far
+#: from the development block and from the 150 seeds a re-flight study flew once beyond it, whose range is not
+#: recorded). ``lvgym headline fly`` flies the selected policies on it once per selection (docs/benchmark.md,
+#: "The headline's test block"); the frozen suites' own seeds are unchanged
+HEADLINE_BLOCK = SeedBlock("headline-200", "test", 2_000, 200)
+#: the named blocks of seeds, by name
+SEED_BLOCKS = {b.name: b for b in (DEVELOPMENT_BLOCK, HEADLINE_BLOCK)}
 #: the main suite: protocol v2's SMILE ascent (the conditions of v1's ``smile-v1``, under the flyability rule)
 DEFAULT_SUITE = "smile-v2"
 
@@ -153,16 +188,28 @@ class Suite:
     policies: tuple[str, ...] = ()
     """the registered policies the protocol reports on this suite (``evaluate.py``'s default for it; empty: the
     command's default list, as for v0 and v1)"""
+    joined: tuple[tuple[str, str], ...] = ()
+    """when each entry of ``policies`` joined the list: ``(policy, ISO date)`` pairs (empty: not recorded)"""
 
-    def seeds(self, seed_set: str, n: int) -> list[int]:
-        """The first ``n`` seeds of ``seed_set`` (``"test"`` or ``"validation"``)."""
+    def policies_joined(self) -> list[dict[str, str | None]]:
+        """``policies`` in order, each with the date it joined the list (``None``: not recorded): what the
+        result files record beside the list flown."""
+        when = dict(self.joined)
+        return [{"policy": p, "joined": when.get(p)} for p in self.policies]
+
+    def seeds(self, seed_set: str, n: int, first: int = 0) -> list[int]:
+        """``n`` seeds of ``seed_set`` (``"test"`` or ``"validation"``) from its ``first``-th on (default: its
+        first ``n``; a named block such as :data:`HEADLINE_BLOCK` starts further on)."""
         if seed_set not in SEED_SETS:
             raise ValueError(f"seed_set = {seed_set!r}: one of {SEED_SETS}")
         limit = N_TEST_SEEDS if seed_set == "test" else N_VALIDATION_SEEDS
-        if not 1 <= int(n) <= limit:
-            raise ValueError(f"episodes = {n!r}: 1 .. {limit} per condition for the {seed_set} seed set")
+        if not 0 <= int(first) < limit:
+            raise ValueError(f"first = {first!r}: 0 .. {limit - 1} for the {seed_set} seed set")
+        if not 1 <= int(n) <= limit - int(first):
+            raise ValueError(f"episodes = {n!r}: 1 .. {limit - int(first)} per condition for the {seed_set} seed set"
+                             + (f" from its seed {first}" if first else ""))
         base = TEST_SEED0 if seed_set == "test" else VALIDATION_SEED0
-        return [base + i for i in range(int(n))]
+        return [base + int(first) + i for i in range(int(n))]
 
     def with_options(self, **options: Any) -> Suite:
         """This suite with env keywords overridden in every condition. The overrides are recorded
@@ -249,27 +296,39 @@ V2_SMILE_POLICIES = ("zero", "gs-pid-flex", "gs-pid-flex-quiet", "aac-quiet", "l
 V2_STRATOS_POLICIES = ("zero", "gs-pid-flex", "gs-pid-flex-quiet", "aac-quiet", "inversion-id-stratos", "privileged")
 #: ... on the slender vehicle (its one design, the load-relief gs-pid-flex, has no quiet version that flies)
 V2_SLENDER_POLICIES = ("zero", "gs-pid-flex", "privileged")
+#: the day protocol v2 was frozen: the entries of its reported lists that joined with it
+V2_FROZEN_ON = "2026-12-05"
+#: when the entries of v2's reported lists that came after its suites joined them (the rest joined with v2,
+#: :data:`V2_FROZEN_ON`); a new entry's date is added here with it
+V2_JOINED = {"gs-pd-relief": "2026-12-05", "inversion-id": "2026-12-06", "inversion-id-smile": "2026-12-06",
+             "inversion-id-stratos": "2026-12-06"}
+
+
+def _joined(policies: tuple[str, ...]) -> tuple[tuple[str, str], ...]:
+    return tuple((p, V2_JOINED.get(p, V2_FROZEN_ON)) for p in policies)
+
+
 SUITES_V2: dict[str, Suite] = {s.name: s for s in (
     Suite("smile-v2", "smile-v1 under protocol v2's flyability rule",
           _pair("smile-v2", SMILE_V1, "turbulence_gust", V1_DISPERSIONS), version=PROTOCOL_V2, reference="lqg",
-          policies=V2_SMILE_POLICIES),
+          policies=V2_SMILE_POLICIES, joined=_joined(V2_SMILE_POLICIES)),
     Suite("smile-v2-maxq-gust", "smile-v1-maxq-gust under protocol v2's flyability rule: 35 s through max q, a "
           "random jet stream and a random 1-cosine gust at 8-11.5 km, where holding the rate and holding the "
           "structural load conflict",
           _pair("smile-v2-maxq-gust", SMILE_V1, "maxq_gust", V1_DISPERSIONS, mission_time_s=35.0),
-          version=PROTOCOL_V2, reference="lqg", policies=V2_SMILE_POLICIES),
+          version=PROTOCOL_V2, reference="lqg", policies=V2_SMILE_POLICIES, joined=_joined(V2_SMILE_POLICIES)),
     Suite("smile-v2-faults", "smile-v1 with one in-flight fault per episode (a loss of actuator effectiveness or "
           "bandwidth on one axis, a thrust loss, a gyro bias step or a thrust-direction step), its onset "
           "unannounced in 5-40 s",
           _pair("smile-v2-faults", SMILE_V1, "turbulence_gust", (*V1_DISPERSIONS, "fault"),
                 fault_kinds=V2_FAULT_KINDS, fault_onset_s=(5.0, 40.0)), version=PROTOCOL_V2, reference="lqg",
-          policies=V2_SMILE_POLICIES),
+          policies=V2_SMILE_POLICIES, joined=_joined(V2_SMILE_POLICIES)),
     Suite("stratos-tvc-v2", "stratos-tvc-v1 under protocol v2's flyability rule",
           _pair("stratos-tvc-v2", "lvgym/StratosIII-v1", "turbulence", V1_DISPERSIONS), version=PROTOCOL_V2,
-          reference="gs-pid-flex-quiet", policies=V2_STRATOS_POLICIES),
+          reference="gs-pid-flex-quiet", policies=V2_STRATOS_POLICIES, joined=_joined(V2_STRATOS_POLICIES)),
     Suite("slender-v2", "slender-v1 under protocol v2's flyability rule",
           _pair("slender-v2", "lvgym/SlenderAscent-v1", "turbulence", V1_DISPERSIONS, length=8.5, diameter=0.2833),
-          version=PROTOCOL_V2, policies=V2_SLENDER_POLICIES),
+          version=PROTOCOL_V2, policies=V2_SLENDER_POLICIES, joined=_joined(V2_SLENDER_POLICIES)),
 )}
 SUITES.update(SUITES_V2)
 

@@ -13,6 +13,7 @@ import math
 from collections.abc import Mapping, Sequence
 from typing import Any
 
+from .decide import fault_table
 from .metrics import rank
 from .scoring import PHASES
 
@@ -82,7 +83,7 @@ def flyability_table(summary: Sequence[Row]) -> list[str]:
     if not summary or "score_v2_mean" not in summary[0]:
         return []
     norm = any("score_v2_norm" in r for r in summary)        # the suite names a reference (metrics.normalise)
-    out = ["| condition | policy | rank | failed or unflyable [95 % CI] | unflyable | score_v2 [rad] "
+    out = ["| condition | policy | rank | failed or unflyable [95 % CI] | unflyable [95 % CI] | score_v2 [rad] "
            + ("| normalised (zero 0, reference 1) " if norm else "")
            + "| commanded rate RMS [% of limit] | 2 s peak [% of limit] |",
            "|---|---|---:|---:|---:|---:|" + ("---:|" if norm else "") + "---:|---:|"]
@@ -93,7 +94,9 @@ def flyability_table(summary: Sequence[Row]) -> list[str]:
         if norm:
             normalised = (f"| {_interval(r['score_v2_norm'], r['score_v2_norm_ci_low'], r['score_v2_norm_ci_high'], '.2f')} "
                           if "score_v2_norm" in r else "| - ")
-        out.append(f"| {_short(r['condition'])} | {r['policy']} | {r['rank']} | {either} | {_pct(r['unflyable_rate'])} "
+        unflyable = (f"{_pct(r['unflyable_rate'])} [{100.0 * r['unflyable_rate_ci_low']:.0f}, "
+                     f"{100.0 * r['unflyable_rate_ci_high']:.0f}]")
+        out.append(f"| {_short(r['condition'])} | {r['policy']} | {r['rank']} | {either} | {unflyable} "
                    f"| {_ci(r, 'score_v2')} {normalised}| {_ci(r, 'cmd_rate_rms', '.1f', 100.0)} "
                    f"| {_ci(r, 'cmd_rate_peak', '.1f', 100.0)} |")
     return out
@@ -242,14 +245,15 @@ def _section(title: str, lines: list[str]) -> list[str]:
 
 def markdown_table(summary: Sequence[Row], degradation: Sequence[Row], meta: Mapping[str, Any] | None = None,
                    comparison: Sequence[Row] = (), groups: Sequence[Row] = (), headline: Sequence[Row] = (),
-                   family: Sequence[str] = (), others: Sequence[Row] = ()) -> str:
+                   family: Sequence[str] = (), others: Sequence[Row] = (), faults: Sequence[Row] = ()) -> str:
     """The comparison as Markdown: a family suite's table over its vehicles (``family``: the lines of
     :func:`~.family.family_table`, when given), protocol v2's headline over every suite (:func:`headline_table`,
     when ``headline`` has rows; a family suite's rows named by their vehicle's group) and the other policies
     flown beside it (``others``: :func:`others_table`, when given), then per suite: the ranked summary
     (:func:`summary_table`), the rate error per phase (:func:`phase_table`), the degradation
     (:func:`degradation_table`), the paired comparison (:func:`comparison_table`) and the agents over training
-    runs (:func:`run_groups_table`)."""
+    runs (:func:`run_groups_table`); with ``faults`` (:func:`~.decide.by_fault`), a suite's table by kind of
+    in-flight fault (:func:`~.decide.fault_table`)."""
     meta = dict(meta or {})
     out: list[str] = []
     if family:                                      # a family suite's vehicles gathered (:mod:`.family`)
@@ -292,6 +296,9 @@ def markdown_table(summary: Sequence[Row], degradation: Sequence[Row], meta: Map
             out += _section(f"Paired comparison of the {comp[0]['metric']} ({suite}) with the reference policy of "
                             "each condition on the same seeds: diff = policy - reference (negative: better); P(better): "
                             "the probability that an episode of the policy scores lower", comparison_table(comp))
+        out += _section(f"score_v2 by kind of in-flight fault ({suite}): mean [rad] (the median over the seeds of "
+                        "the per-seed ratio to the suite's reference), flights failed or unflyable of the kind's",
+                        fault_table(_of_suite(faults, suite)))
         grp = _of_suite(groups, suite)
         out += _section(f"Agents over their training runs ({suite}): IQM of the "
                         f"{grp[0]['metric'] if grp else 'score'} over (runs, episodes)", run_groups_table(grp))

@@ -27,7 +27,8 @@ each of yours a row with its room against the reference (``--only``: the given p
 run on a local process pool by default; the Markdown table is printed, and CSV, JSON, the table and PNG
 plots go to ``--out`` (each file written atomically: an interrupted run leaves no half-written file).
 ``--seed-set validation`` evaluates on the training seeds; reported numbers use the ``test`` seeds (the
-default).
+default), and every run on them is logged in the ledger of test flights (``lvgym ledger``; ``--purpose``
+says why).
 
 The tables (every mean with its 95 % bootstrap interval over the seeds, lower is better): for protocol v2,
 first the headline over every suite (the best classical design the suite reports, the best learned policy
@@ -61,14 +62,17 @@ from typing import Any
 from lvgym.benchmark import (DEFAULT_SUITE, EXECUTORS, SEED_SETS, SUITES, PolicySpec, Suite, compare,
                              degradation, evaluate, get_suite, markdown_table, normalise, protocol_metric,
                              run_groups, summarize, write_results)
+from lvgym.benchmark.decide import by_fault
 from lvgym.benchmark.family import family_room, family_rows, family_table
 from lvgym.benchmark.headline import headline, others, policy_kind
+from lvgym.benchmark.suites import SEED_BLOCKS
 from lvgym.cli.policies import POLICIES, resolve_policy  # (registers the built-in policies)
 from lvgym.commandline import arg, command_name, fail, parse
 from lvgym.errors import ConfigError
 from lvgym.parallel import TaskFailed, exit_on_sigterm
 
 from .flights import check_vehicle
+from .ledger import announce
 
 __all__ = ["Args", "BESIDE_KINDS", "DEFAULT_EPISODES", "DEFAULT_POLICIES", "DEFAULT_SUITE", "DEFAULT_SUITES",
            "POLICIES", "main", "parse_args", "resolve_policy", "suite_policies"]
@@ -112,7 +116,15 @@ class Args:
     out: str = "results"
     """folder of the result files"""
     seed_set: str = arg("test", choices=SEED_SETS)
-    """test (reported numbers) or validation (training and tuning)"""
+    """test (reported numbers; every such run is logged in the ledger of test flights, lvgym ledger) or
+    validation (training and tuning)"""
+    first: int = arg(0, lo=0, hi=9_999, allowed="an integer in [0, 9999]")
+    """index of the first seed of the seed set flown (default 0: its first --episodes seeds)"""
+    block: str | None = arg(None, choices=lambda: sorted(SEED_BLOCKS))
+    """fly a named block of seeds in place of --seed-set, --first and --episodes (headline-200: the headline's
+    test seeds 12,000-12,199, flown once per selection: docs/benchmark.md; development-50: 10,000-10,049)"""
+    purpose: str | None = arg(None, metavar="TEXT")
+    """why the test seeds are flown, for the ledger of test flights (default: the command's name)"""
     reference: str | None = arg(None, metavar="POLICY")
     """policy label every policy is compared with (default: the best-ranked policy of each condition)"""
     vehicle: str | None = arg(None, check=check_vehicle, metavar="NAME|PATH")
@@ -170,6 +182,9 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
     if args.vehicle is not None and args.policies is None:
         fail(prog, f"--vehicle {args.vehicle}: give --policies too: the shipped designs are made for the shipped "
                    "vehicles (yours: module:factory or path/to/file.py:factory; zero and privileged fly any vehicle)")
+    if args.block is not None:
+        b = SEED_BLOCKS[args.block]
+        args.seed_set, args.first, args.episodes = b.seed_set, b.first, b.n
     if args.suites is None:
         args.suites = list(DEFAULT_SUITES) if args.policies is None else [DEFAULT_SUITE]
     try:
@@ -187,10 +202,15 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
     overrides = {k: v for k, v in (("mission_time_s", args.mission_time_s), ("vehicle", args.vehicle)) if v is not None}
     if overrides:
         suites = [s.with_options(**overrides) for s in suites]
+    try:
+        seeds = suites[0].seeds(args.seed_set, args.episodes, args.first)
+    except ValueError as exc:
+        fail(prog, exc)
+    announce(prog, seeds, "(reported numbers)")
     t0 = time.perf_counter()
     try:
         records = evaluate(per_suite, suites, args.episodes, args.seed_set, args.executor, args.workers,
-                           args.progress)
+                           args.progress, purpose=args.purpose, first=args.first)
     except TaskFailed as exc:                        # a bad value met in a worker: its message, in one line
         if isinstance(exc.__cause__, ConfigError):
             fail(prog, exc)
@@ -213,24 +233,25 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
         "protocol": ", ".join(sorted({s.version for s in suites})), "seed_set": args.seed_set,
         "episodes": args.episodes, "args": asdict(args),
         "suites": {s.name: {"version": s.version, "description": s.description, "overrides": dict(s.overrides),
-                            "first_seed": s.seeds(args.seed_set, args.episodes)[0],
-                            "last_seed": s.seeds(args.seed_set, args.episodes)[-1],
+                            "first_seed": seeds[0], "last_seed": seeds[-1],
                             "conditions": [c.to_dict() for c in s.conditions]} for s in suites},
         "policies": [{"name": p.name, "factory": p.factory, "kwargs": dict(p.kwargs)} for p in policies],
         "policies_per_suite": {s: [p.name for p in v] for s, v in per_suite.items()},
+        "reported_joined": {s.name: s.policies_joined() for s in suites if s.policies},
         "wall_time_s": round(wall, 3), "created_utc": dt.datetime.now(dt.timezone.utc).isoformat(timespec="seconds"),
     }
     family = family_rows(records)                   # a family suite: its vehicles gathered
     family_lines = family_table(family, family_room(records, kinds)) if family else []
-    table = markdown_table(summary, deg, meta, comparison, groups, rows, family_lines, beside)
+    faults = by_fault(records, {s.name: s.reference for s in suites if s.reference})
+    table = markdown_table(summary, deg, meta, comparison, groups, rows, family_lines, beside, faults)
     paths = write_results(args.out, records, summary, deg, meta, plots=args.plots, comparison=comparison,
-                          groups=groups, headline=rows, family=family_lines, others=beside)
+                          groups=groups, headline=rows, family=family_lines, others=beside, faults=faults)
     print(table)
     print(f"{len(records)} episodes in {wall:.1f} s ({args.executor}); results in {Path(args.out)}/: "
           f"{', '.join(sorted(paths))}", file=sys.stderr)
     return {"records": records, "summary": summary, "degradation": deg, "comparison": comparison,
             "run_groups": groups, "headline": rows, "headline_others": beside, "meta": meta, "table": table,
-            "family": family}
+            "family": family, "faults": faults}
 
 
 if __name__ == "__main__":

@@ -38,6 +38,18 @@ COMMANDS: tuple[Command, ...] = (
             "or on Ray), evaluation on the test seeds, comparison over the runs", "train", _TRAIN),
     Command("margins", "lvgym.cli.margins:main", "time-domain gain and delay margins of policies in the nonlinear "
             "simulation", "benchmark", _BENCHMARK),
+    Command("headline", None, "the headline that decides: its policies chosen on validation seeds, flown once on "
+            "the named test block, its results page", sub=(
+        Command("select", "lvgym.cli.headline:select_main", "fly every reported policy of the v2 suites on "
+                "validation seeds and write the frozen selection file", "benchmark", _BENCHMARK),
+        Command("fly", "lvgym.cli.headline:fly_main", "fly the selected policies on the named test block and the 50 "
+                "development seeds, and write the headline's record", "benchmark", _BENCHMARK),
+        Command("page", "lvgym.cli.results_page:page_main", "write docs/results.md from the headline's record"),
+    )),
+    Command("compare-headline", "lvgym.cli.results_page:compare_main", "compare your lvgym evaluate result files "
+            "with the headline, suite by suite, with the same statistics"),
+    Command("ledger", "lvgym.cli.ledger:main", "how often each policy has flown on test seeds, and on which "
+            "blocks (the ledger of test flights)"),
     Command("fingerprint", "lvgym.cli.fingerprint:main", "check (or write) a frozen protocol's fingerprint"),
     Command("verify", "lvgym.verify.__main__:main", "the verification table against the thesis (chapter 4)", sub=(
         Command("rocketpy", "lvgym.verify.rocketpy_case:main", "the rigid simulator against RocketPy (Stratos III)",

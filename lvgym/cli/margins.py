@@ -1,13 +1,14 @@
 """``lvgym margins``: time-domain margins of policies in the
 nonlinear simulation, gain up and down [dB] and delay [ms] (:mod:`lvgym.benchmark.margins`).
 
-    lvgym margins                                          # the default policies on smile-v1, 5 test seeds
+    lvgym margins                                          # the default policies on smile-v1, 5 validation seeds
     lvgym margins --policies zero pid gs-pid ppo --seeds 10 --models rigid
     lvgym margins --policies runs/ppo_smile --physics-dt-s 0.005   # 5 ms delay resolution
     lvgym margins --policies zero pid --vehicle my_rocket.yaml     # the suite's conditions, your vehicle
 
-Seeds: the ``test`` seeds by default: a margin is a measurement, not tuning (``--seed-set validation`` for
-design loops). Policies are registered names, SB3 ``.zip`` paths or ``train.py`` run folders, as
+Seeds: the ``validation`` seeds by default (margins are what designs are tuned by); ``--seed-set test``
+measures on the test seeds on purpose: it says so in one line, and the call is logged in the ledger of test
+flights (``lvgym ledger``; ``--purpose`` says why). Policies are registered names, SB3 ``.zip`` paths or ``train.py`` run folders, as
 ``lvgym evaluate`` takes them. docs/benchmark.md ("Time-domain margins") defines the bound and the search.
 """
 
@@ -28,6 +29,7 @@ from lvgym.errors import ConfigError
 from lvgym.parallel import TaskFailed, exit_on_sigterm
 
 from .flights import FlightArgs, check_vehicle, resolve_flights
+from .ledger import announce
 
 __all__ = ["Args", "main", "parse_args"]
 
@@ -48,8 +50,10 @@ class Args(FlightArgs):
     """only the suite's conditions of these flight models (default: all, e.g. rigid and nonrigid)"""
     seeds: int = arg(DEFAULT_SEEDS, lo=1, hi=10_000)
     """seeds per condition"""
-    seed_set: str = arg("test", choices=SEED_SETS)
-    """test (a measurement) or validation (design loops)"""
+    seed_set: str = arg("validation", choices=SEED_SETS)
+    """validation (design and tuning) or test (a deliberate measurement, logged in the ledger of test flights)"""
+    purpose: str | None = arg(None, metavar="TEXT")
+    """why test seeds are flown, for the ledger of test flights (default: the command's name)"""
     experiments: list[str] = arg(default_factory=lambda: list(EXPERIMENTS), choices=EXPERIMENTS)
     """what is injected: the gain raised, the gain lowered, a delay"""
     error_ratio: float = _D.error_ratio
@@ -111,11 +115,13 @@ def main(argv: list[str] | None = None) -> list[dict[str, Any]]:
             if abs(n - round(n)) > 1e-6:
                 fail(prog, f"--physics-dt-s = {args.physics_dt_s}: the control period {_control_dt_s(c)} s of "
                            f"{c.env_id} must be a whole multiple of it")
+    seeds = suite.seeds(args.seed_set, args.seeds)
+    announce(prog, seeds, "on purpose (--seed-set test): a measurement, not a design loop")
     t0 = time.perf_counter()
     try:
-        results = run_margins(policies, conds, suite.seeds(args.seed_set, args.seeds), seed_set=args.seed_set,
-                              options=args.options, experiments=args.experiments, executor=args.executor,
-                              workers=args.workers, progress=args.progress)
+        results = run_margins(policies, conds, seeds, seed_set=args.seed_set, options=args.options,
+                              experiments=args.experiments, executor=args.executor, workers=args.workers,
+                              progress=args.progress, purpose=args.purpose)
     except TaskFailed as exc:
         if isinstance(exc.__cause__, ConfigError):
             fail(prog, exc)
