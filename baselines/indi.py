@@ -125,21 +125,19 @@ class INDISchedule:
         rows = tuple(INDIRowParams(r.time_s, r.k_rate, r.k_attitude, k, r.filt) for r in self.rows)
         return INDISchedule(rows, self.power, self.sync, self.dt, self.source)
 
-    def tables(self, dt: float) -> tuple[INDITable, np.ndarray]:
-        """The kernel's table at the control period ``dt`` [s] and the sections (2,) of ``H`` and of ``H S``."""
-        coeffs, nh, na = [], set(), set()
+    def tables(self, dt: float) -> INDITable:
+        """The kernel's table at the control period ``dt`` [s]."""
+        coeffs, sections = [], []
         for r in self.rows:
             c, h, a = filter_coeffs(r.filt, self.sync, dt)
             coeffs.append(c)
-            nh.add(h)
-            na.add(a)
-        if len(nh) != 1 or len(na) != 1:
-            raise ConfigError(f"{self.source}: filter", sorted(nh), "the same notches in use in every row")
+            sections.append((h, a))
         gains = np.array([[r.k_rate for r in self.rows], [r.k_attitude for r in self.rows],
                           [r.k_accel for r in self.rows]])
         tb = INDITable(np.array([r.time_s for r in self.rows]), gains, np.ascontiguousarray(np.stack(coeffs, axis=1)),
-                       np.ascontiguousarray(self.power[:, 0]), np.ascontiguousarray(self.power[:, 1]))
-        return tb, np.array([nh.pop(), na.pop()], np.int64)
+                       np.ascontiguousarray(np.array(sections, np.int64).T), np.ascontiguousarray(self.power[:, 0]),
+                       np.ascontiguousarray(self.power[:, 1]))
+        return tb
 
 
 class INDILaw(BatchLaw):
@@ -172,8 +170,8 @@ class INDILaw(BatchLaw):
                           np.asarray([lay.index("gimbal_pitch"), lay.index("gimbal_yaw")], np.int64),
                           int(lay.index("controller_on")), int(lay.index("time_fraction")),
                           int(lay.index("pitch_rate_reference")))
-        self.tb, sections = sched.tables(self.dt)
-        self.su = INDISetup(self.dt, self.limit, float(task.task.mission_time_s), sections,
+        self.tb = sched.tables(self.dt)
+        self.su = INDISetup(self.dt, self.limit, float(task.task.mission_time_s),
                             np.asarray(ACCEL_SIGNS, float), bool(np.any(self.tb.gains[2] != 0.0)))
         self.allocate(n)
 

@@ -151,25 +151,24 @@ class _Sections:
 class INDITable(NamedTuple):
     """A schedule of ``m`` rows: ``t`` (m,) [s] their flight times (ascending), ``gains`` (3, m) the rate
     [1/s], attitude [1/s] and load-relief [rad/s per m/s^2] gains, ``coeffs`` (2, m, COEFFS.size) the discrete
-    ``H`` and ``H`` with the synchronisation sections; ``power_t`` (p,) [s] and ``power`` (p,) [1/s^2] the control
-    power over flight time (linear between, ends held)."""
+    ``H`` and ``H`` with the synchronisation sections, ``sections`` (2, m) how many sections of each are in use;
+    ``power_t`` (p,) [s] and ``power`` (p,) [1/s^2] the control power over flight time (linear between, ends held)."""
 
     t: np.ndarray
     gains: np.ndarray
     coeffs: np.ndarray
+    sections: np.ndarray
     power_t: np.ndarray
     power: np.ndarray
 
 
 class INDISetup(NamedTuple):
     """The constants: ``dt`` [s], ``limit`` [rad] the gimbal limit, ``mission`` [s] (the observation's time
-    fraction times it is the flight time), ``sections`` (2,) the sections of ``H`` and of the actuator's filter,
-    ``signs`` (2,) the load-relief signs per axis (:data:`.pid.ACCEL_SIGNS`), ``accel`` (the load relief on)."""
+    fraction times it is the flight time), ``signs`` (2,) the load-relief signs per axis (:data:`.pid.ACCEL_SIGNS`), ``accel`` (the load relief on)."""
 
     dt: float
     limit: float
     mission: float
-    sections: np.ndarray
     signs: np.ndarray
     accel: bool
 
@@ -229,7 +228,7 @@ def indi_row_k(tb, su, oc, r, f, obs):
         return
     G = interp_k(t, tb.power_t, tb.power)
     k_rate, k_att, k_acc = tb.gains[0, i], tb.gains[1, i], tb.gains[2, i]
-    nh, na = su.sections[0], su.sections[1]
+    nh, na = tb.sections[0, i], tb.sections[1, i]
     ref = float(obs[oc.ref]) if oc.ref >= 0 else 0.0
     start = r[R.running] == 0.0
     if start:                                             # switched on: every filter in the steady state of its input

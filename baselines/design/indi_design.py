@@ -118,14 +118,17 @@ def design_row(op_rigid: Any, op_nonrigid: Any, sync: SyncSections, rq: Requirem
 
 
 def control_power_table(vehicle: Any, step: float = 1.0) -> list[list[float]]:
-    """``[[t, G], ...]``: the rigid control power [1/s^2] every ``step`` seconds of the burning flight."""
+    """``[[t, G], ...]``: the rigid control power [1/s^2] every ``step`` seconds of the burning flight (where the
+    engine thrusts)."""
     fly = privileged_flyer()
     out = []
     with reused_flights():
         for a, b in burn_phases(vehicle, "v1"):
             for t in np.arange(a, b + 1e-9, step):
                 terms = rigid_terms(operating_point(vehicle, float(t), "rigid", "v1", policy=fly))
-                out.append([round(float(t), 3), round(terms["vectored_thrust"] * terms["arm"] / terms["inertia"], 5)])
+                power = terms["vectored_thrust"] * terms["arm"] / terms["inertia"]
+                if power > 0.0:                       # a phase's end may fall at the burn-out (no thrust)
+                    out.append([round(float(t), 3), round(power, 5)])
     return out
 
 

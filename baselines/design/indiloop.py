@@ -101,7 +101,8 @@ def open_loop(row: INDIRow, P_y: control.StateSpace, P_a: control.StateSpace) ->
 def equivalent_controller(row: INDIRow, P_a: control.StateSpace) -> control.StateSpace:
     """``C_eq = C_y / (1 - H S P_a)``: the fixed controller on the gyro that the law is on the plant ``P_y``."""
     C_y, H = _parts(row, float(P_a.dt))
-    return control.ss(control.series(C_y, control.feedback(control.ss(np.eye(1) * 1.0), control.series(P_a, H), +1)))
+    one = control.ss([], [], [], [[1.0]], P_a.dt)
+    return control.ss(control.series(control.feedback(one, control.series(P_a, H), +1), C_y))
 
 
 def noise_rate(row: INDIRow, op: Any, P_y: control.StateSpace, P_a: control.StateSpace, n: int = 20000) -> float:
