@@ -88,6 +88,16 @@ def test_off_outputs_zero_and_restarts():
     assert a == pytest.approx((0.002 - 3.0 * 0.01 / 15.0) / LIMIT, rel=1e-6)     # no acceleration at engagement
 
 
+def test_load_relief_by_hand():
+    """The first step with load relief: every filter at rest, ``u = k_q (k_a s g0 f) / G`` with the signs of
+    gs-pid-flex (pitch +accel_z, yaw -accel_y: the nose turned into the relative wind)."""
+    law = INDILaw(env=fake_env(), schedule=schedule(power=15.0, k_rate=3.0, k_att=2.0, k_accel=0.03))
+    law.reset(np.array([0]))
+    a = law.act(np.array([0]), obs(20.0, acc=(0.1, 0.1))[None], {})[0]
+    g0 = 9.80665
+    np.testing.assert_allclose(a, np.array([1.0, -1.0]) * 3.0 * 0.03 * g0 * 0.1 / 15.0 / LIMIT, rtol=1e-6)
+
+
 def loss_flight(loss_at=4.0, loss=0.5, d=0.4, m_alpha=1.0, steps=600, sub=10):
     """A rigid double integrator with an aerodynamic moment, ``theta_ddot = M_a theta + G_true(t) delta + d``, the
     actuator a first-order servo (40 rad/s), flown by the law with G = 15 1/s^2 from its tables while the true

@@ -14,7 +14,9 @@ as :mod:`.pdrelief` and ``lvgym design auto`` fly them):
   optionally, a notch on the slosh band (the geometric mean of its lowest and highest pendulum frequency);
   the synchronisation sections on the actuator position (:class:`..indikernel.SyncSections`: the IMU's
   anti-aliasing filter, design data of the env's IMU, and the two-sample mean);
-* the rate and attitude gains ``k_q``, ``k_theta``.
+* the rate and attitude gains ``k_q``, ``k_theta``;
+* the load-relief gain ``k_a`` (``--k-accel``, the same on every row): not on the linear loop, which leaves the
+  accelerometers out, but on validation flights of the v2 SMILE suites (docs/indi.md).
 
 The search: every candidate of :data:`GRID` is assessed on the row's rigid and non-rigid loop
 (:func:`.indiloop.row_margins` on a coarse grid of :data:`SEARCH_POINTS` frequencies); its shortfall against
@@ -50,6 +52,9 @@ SCHEDULES = Path(__file__).resolve().parents[1] / "schedules"
 GRID = {"k_rate": (2.0, 3.0, 4.0, 6.0), "k_attitude": (1.5, 2.5, 3.5), "lowpass_radps": (2.5,),
         "slosh_notch": (True,)}
 SEARCH_POINTS = 3000
+#: the load-relief gain [rad/s per m/s^2] of every row: chosen on validation seeds 0-99 of the v2 SMILE suites
+#: (docs/indi.md), not on the linear loop (which leaves the accelerometers out)
+DEFAULT_K_ACCEL = 0.03
 DEFAULT_TIMES = (3.0, 10.0, 15.0, 20.0, 24.4, 28.8, 32.4, 36.0, 42.5, 54.5, 62.0, 69.5)
 
 
@@ -93,8 +98,9 @@ def _filter(lowpass: float, modes: dict[str, list[float]], slosh_notch: bool, dt
 
 
 def design_row(op_rigid: Any, op_nonrigid: Any, sync: SyncSections, rq: Requirements = Requirements(),
-               grid: dict[str, tuple] | None = None) -> dict[str, Any]:
-    """The row at the operating points ``op_rigid``, ``op_nonrigid`` of one flight time (module docstring)."""
+               grid: dict[str, tuple] | None = None, k_accel: float = 0.0) -> dict[str, Any]:
+    """The row at the operating points ``op_rigid``, ``op_nonrigid`` of one flight time (module docstring);
+    ``k_accel`` [rad/s per m/s^2]: the load-relief gain the row carries (not in the linear loop)."""
     terms = rigid_terms(op_rigid)
     power = terms["vectored_thrust"] * terms["arm"] / terms["inertia"]
     modes = mode_frequencies(op_nonrigid)
@@ -113,7 +119,7 @@ def design_row(op_rigid: Any, op_nonrigid: Any, sync: SyncSections, rq: Requirem
     m = {"rigid": row_margins(row, op_rigid, noise=False, plants=pr),
          "nonrigid": row_margins(row, op_nonrigid, modes=modes, plants=pn)}
     return {"time_s": float(op_rigid.t), "control_power_per_s2": power, "k_rate": row.k_rate,
-            "k_attitude": row.k_attitude, "k_accel": 0.0, "filter": row.filt.as_dict(), "modes_radps": modes,
+            "k_attitude": row.k_attitude, "k_accel": k_accel, "filter": row.filt.as_dict(), "modes_radps": modes,
             "shortfall": shortfall(m, rq), "margins": m}
 
 
@@ -132,8 +138,9 @@ def control_power_table(vehicle: Any, step: float = 1.0) -> list[list[float]]:
     return out
 
 
-def design_schedule(vehicle: Any = "smile", times: tuple[float, ...] = DEFAULT_TIMES, log: Any = print) -> dict[str, Any]:
-    """The schedule document of ``vehicle`` (module docstring)."""
+def design_schedule(vehicle: Any = "smile", times: tuple[float, ...] = DEFAULT_TIMES, log: Any = print,
+                    k_accel: float = DEFAULT_K_ACCEL) -> dict[str, Any]:
+    """The schedule document of ``vehicle`` (module docstring); ``k_accel``: the load-relief gain of every row."""
     fly = privileged_flyer()
     rows = []
     t0 = time.time()
@@ -145,7 +152,7 @@ def design_schedule(vehicle: Any = "smile", times: tuple[float, ...] = DEFAULT_T
         imu = ops["rigid", times[0]].sim.imu
         sync = SyncSections(antialias_radps=2.0 * math.pi * float(imu.antialias_hz)) if imu is not None else SyncSections()
         for t in times:
-            r = design_row(ops["rigid", t], ops["nonrigid", t], sync)
+            r = design_row(ops["rigid", t], ops["nonrigid", t], sync, k_accel=k_accel)
             rows.append(r)
             log(f"t = {t:g} s: k_q {r['k_rate']:g}, k_theta {r['k_attitude']:g}, low-pass {r['filter']['lowpass_radps']:g}"
                 f" rad/s, slosh notch {r['filter']['slosh_radps'] is not None}, shortfall {r['shortfall']:.3f} "
@@ -201,9 +208,10 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--vehicle", default="smile")
     p.add_argument("--out", default=None, help="YAML file (default results/schedules/<vehicle>_indi.yaml)")
     p.add_argument("--overwrite", action="store_true", help="write the shipped baselines/schedules/<vehicle>_indi.yaml")
+    p.add_argument("--k-accel", type=float, default=DEFAULT_K_ACCEL, help="load-relief gain [rad/s per m/s^2]")
     a = p.parse_args(argv)
     out = Path(a.out) if a.out else (SCHEDULES if a.overwrite else Path("results/schedules")) / f"{a.vehicle}_indi.yaml"
-    doc = design_schedule(a.vehicle)
+    doc = design_schedule(a.vehicle, k_accel=a.k_accel)
     out.parent.mkdir(parents=True, exist_ok=True)
     head = (f"# indi schedule of {a.vehicle}, made by: python -m lvgym.baselines.design.indi_design --vehicle {a.vehicle}"
             f"{' --overwrite' if a.overwrite else ''}\n# Gains: k_rate, k_attitude [1/s]; control power [1/s^2]; "
