@@ -157,7 +157,8 @@ class INDILaw(BatchLaw):
         self.schedule = sched
         self.dt = float(task.task.control_dt_s)
         if abs(self.dt - sched.dt) > 1e-12:
-            raise ConfigError("env control_dt_s", self.dt, f"the schedule's control period {sched.dt} s ({sched.source})")
+            raise ConfigError("env control_dt_s", self.dt,
+                              f"the schedule's control period {sched.dt} s ({sched.source})")
         self.limit = float(task.gimbal_limit)
         lay = task.observation_layout
         for key in ("pitch_attitude_error", "accel_z", "gimbal_pitch", "time_fraction"):

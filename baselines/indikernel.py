@@ -135,7 +135,9 @@ class SyncSections:
 
     def tf(self, dt: float) -> Any:
         import control
-        return _sections_tf(self.discrete(dt), dt, "SyncSections.tf") if self.discrete(dt) else control.tf([1.0], [1.0], dt)
+        if not self.discrete(dt):
+            return control.tf([1.0], [1.0], dt)
+        return _sections_tf(self.discrete(dt), dt, "SyncSections.tf")
 
 
 class _Sections:
@@ -164,7 +166,8 @@ class INDITable(NamedTuple):
 
 class INDISetup(NamedTuple):
     """The constants: ``dt`` [s], ``limit`` [rad] the gimbal limit, ``mission`` [s] (the observation's time
-    fraction times it is the flight time), ``signs`` (2,) the load-relief signs per axis (:data:`.pid.ACCEL_SIGNS`), ``accel`` (the load relief on)."""
+    fraction times it is the flight time), ``signs`` (2,) the load-relief signs per axis (:data:`.pid.ACCEL_SIGNS`),
+    ``accel`` (the load relief on)."""
 
     dt: float
     limit: float
@@ -205,7 +208,8 @@ def filter_coeffs(filt: INDIFilter, sync: SyncSections, dt: float) -> tuple[np.n
 
 def new_state(n: int) -> INDIState:
     """The state of ``n`` rows as after a reset (no schedule row in use yet; coefficient sums 1)."""
-    return INDIState(INDI_ROW.pack({"sched": -1.0}, n), FILTER_ROW.pack({"bsum": 1.0, "asum": 1.0}, 4 * n).reshape(n, 4, -1))
+    filters = FILTER_ROW.pack({"bsum": 1.0, "asum": 1.0}, 4 * n).reshape(n, 4, -1)
+    return INDIState(INDI_ROW.pack({"sched": -1.0}, n), filters)
 
 
 @nb.njit(cache=True)

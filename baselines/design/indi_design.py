@@ -150,12 +150,13 @@ def design_schedule(vehicle: Any = "smile", times: tuple[float, ...] = DEFAULT_T
             for t in times:
                 ops[model, t] = operating_point(vehicle, t, model, "v1", policy=fly)
         imu = ops["rigid", times[0]].sim.imu
-        sync = SyncSections(antialias_radps=2.0 * math.pi * float(imu.antialias_hz)) if imu is not None else SyncSections()
+        sync = SyncSections() if imu is None else SyncSections(antialias_radps=2.0 * math.pi * float(imu.antialias_hz))
         for t in times:
             r = design_row(ops["rigid", t], ops["nonrigid", t], sync, k_accel=k_accel)
             rows.append(r)
-            log(f"t = {t:g} s: k_q {r['k_rate']:g}, k_theta {r['k_attitude']:g}, low-pass {r['filter']['lowpass_radps']:g}"
-                f" rad/s, slosh notch {r['filter']['slosh_radps'] is not None}, shortfall {r['shortfall']:.3f} "
+            log(f"t = {t:g} s: k_q {r['k_rate']:g}, k_theta {r['k_attitude']:g}, "
+                f"low-pass {r['filter']['lowpass_radps']:g} rad/s, slosh notch {r['filter']['slosh_radps'] is not None}, "
+                f"shortfall {r['shortfall']:.3f} "
                 f"({time.time() - t0:.0f} s)")
     dt = float(ops["rigid", times[0]].task.control_dt_s)
     return {"vehicle": str(vehicle), "protocol": "v1", "control_dt_s": dt,
@@ -193,7 +194,8 @@ def margin_table(doc: dict[str, Any]) -> str:
             return s + ("" if a["closed_loop_stable"] else " (unstable)")
         bend = m["nonrigid"].get("bending_db", [])
         lines.append(f"| {r['time_s']:g} | {r['control_power_per_s2']:.2f} | {r['k_rate']:g} | {r['k_attitude']:g} | "
-                     f"{f['lowpass_radps']:g} | {'-' if f['bending_radps'] is None else format(f['bending_radps'], '.1f')} | "
+                     f"{f['lowpass_radps']:g} | "
+                     f"{'-' if f['bending_radps'] is None else format(f['bending_radps'], '.1f')} | "
                      f"{'-' if f['slosh_radps'] is None else format(f['slosh_radps'], '.1f')} | {mm(m['rigid'])} | "
                      f"{mm(m['nonrigid'])} | {bend[0]:.1f} | {100 * m['nonrigid']['noise_rate_fraction']:.1f} | "
                      f"{'yes' if r['shortfall'] == 0 else 'no'} |" if bend else "")
@@ -213,11 +215,13 @@ def main(argv: list[str] | None = None) -> int:
     out = Path(a.out) if a.out else (SCHEDULES if a.overwrite else Path("results/schedules")) / f"{a.vehicle}_indi.yaml"
     doc = design_schedule(a.vehicle, k_accel=a.k_accel)
     out.parent.mkdir(parents=True, exist_ok=True)
-    head = (f"# indi schedule of {a.vehicle}, made by: python -m lvgym.baselines.design.indi_design --vehicle {a.vehicle}"
+    head = (f"# indi schedule of {a.vehicle}, made by: "
+            f"python -m lvgym.baselines.design.indi_design --vehicle {a.vehicle}"
             f"{' --overwrite' if a.overwrite else ''}\n# Gains: k_rate, k_attitude [1/s]; control power [1/s^2]; "
             "filter frequencies [rad/s].\n")
     out.write_text(head + yaml.safe_dump(doc, sort_keys=False, width=120))
-    out.with_name(out.stem + "_margins.md").write_text(f"# indi margins: {a.vehicle} (protocol v1)\n\n" + margin_table(doc))
+    table = f"# indi margins: {a.vehicle} (protocol v1)\n\n" + margin_table(doc)
+    out.with_name(out.stem + "_margins.md").write_text(table)
     print(f"wrote {out}")
     return 0
 

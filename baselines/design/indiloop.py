@@ -38,7 +38,8 @@ from .lqg_row import gain_at, loop_margins
 from .noise import gyro_noise, noise_rate_on_grid
 from .response import frequency_response
 
-__all__ = ["INDIRow", "actuator_plant", "open_loop", "equivalent_controller", "row_margins", "noise_rate", "loop_plants"]
+__all__ = ["INDIRow", "actuator_plant", "equivalent_controller", "loop_plants", "noise_rate", "open_loop",
+           "row_margins"]
 
 
 @dataclass(frozen=True)
