@@ -11,19 +11,21 @@ thesis's control study (docs/control-study.md).
 Importing this package registers its controllers with the benchmark by name
 (:func:`lvgym.benchmark.register_policy`): ``pid``, ``gs-pid``, ``gs-pid-flex``, ``aac``,
 ``gs-pid-flex-quiet``, ``aac-quiet``, ``pid-thesis``, ``gs-pid-thesis``, ``lqg``, ``lqg-front``, ``lqg-aw``,
-``mpc``, ``privileged`` (``evaluate.py --policies lqg``).
+``mpc``, ``indi``, ``privileged`` (``evaluate.py --policies lqg``).
 """
 
 from lvgym.benchmark.registry import register_policy
 
 from .aac import AACParams, AdaptiveAugmentingPolicy, flex_aac, smile_aac
 from .bangbang import BangBangRollPolicy
+from .indi import smile_indi
 from .lqg import smile_lqg
 from .pid import (GainSchedule, GainScheduledPIDPolicy, PIDLaw, PIDPolicy, flex_pid, smile_scheduled_pid,
                   smile_single_pid, smile_tuned_pid)
 
 # their kind in protocol v2's headline (lvgym.benchmark.headline): classical designs
-for _factory in (smile_tuned_pid, smile_scheduled_pid, smile_single_pid, flex_pid, flex_aac, smile_aac, smile_lqg):
+for _factory in (smile_tuned_pid, smile_scheduled_pid, smile_single_pid, flex_pid, flex_aac, smile_aac, smile_lqg,
+                 smile_indi):
     _factory.kind = "classical"  # type: ignore[attr-defined]
 
 # our tuning on the rigid linearisation (lvgym.baselines.design.tune): one gain set, and the schedule on mass
@@ -65,6 +67,10 @@ register_policy("fixed-lqg", "lvgym.baselines.designed:fixed_policy", name="fixe
 # constrained linear MPC on lqg's rows (its plants, filters and cost) under the gimbal's angle and rate limits,
 # OSQP per control period (lvgym.baselines.mpc, docs/mpc.md; needs the control extra)
 register_policy("mpc", "lvgym.baselines.mpc:smile_mpc", name="mpc")
+# incremental nonlinear dynamic inversion: the filtered angular acceleration and the measured actuator position
+# synchronised, the control power of the design tables, a rate and attitude outer loop (lvgym.baselines.indi,
+# lvgym.baselines.design.indi_design, docs/indi.md)
+register_policy("indi", smile_indi, name="indi")
 
 __all__ = ["AACParams", "AdaptiveAugmentingPolicy", "BangBangRollPolicy", "GainSchedule", "PIDLaw",
            "GainScheduledPIDPolicy", "PIDPolicy", "smile_aac", "smile_scheduled_pid", "smile_single_pid"]
