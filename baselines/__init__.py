@@ -11,7 +11,7 @@ thesis's control study (docs/control-study.md).
 Importing this package registers its controllers with the benchmark by name
 (:func:`lvgym.benchmark.register_policy`): ``pid``, ``gs-pid``, ``gs-pid-flex``, ``aac``,
 ``gs-pid-flex-quiet``, ``aac-quiet``, ``pid-thesis``, ``gs-pid-thesis``, ``lqg``, ``lqg-front``, ``lqg-aw``,
-``mpc``, ``privileged`` (``evaluate.py --policies lqg``).
+``mpc``, ``eso``, ``privileged`` (``evaluate.py --policies lqg``).
 """
 
 from lvgym.benchmark.registry import register_policy
@@ -65,6 +65,9 @@ register_policy("fixed-lqg", "lvgym.baselines.designed:fixed_policy", name="fixe
 # constrained linear MPC on lqg's rows (its plants, filters and cost) under the gimbal's angle and rate limits,
 # OSQP per control period (lvgym.baselines.mpc, docs/mpc.md; needs the control extra)
 register_policy("mpc", "lvgym.baselines.mpc:smile_mpc", name="mpc")
+# active disturbance rejection control: an extended-state observer of the total disturbance per plane and a PD on
+# its estimates (lvgym.baselines.eso, docs/eso.md); provisional: its linear rows do not all meet the rules
+register_policy("eso", "lvgym.baselines.eso:smile_eso", name="eso")
 
 __all__ = ["AACParams", "AdaptiveAugmentingPolicy", "BangBangRollPolicy", "GainSchedule", "PIDLaw",
            "GainScheduledPIDPolicy", "PIDPolicy", "smile_aac", "smile_scheduled_pid", "smile_single_pid"]
