@@ -6,12 +6,17 @@ Per plane and control period, the row on (the observation's ``controller_on``; t
 :mod:`.design.esodesign`, whose :func:`~.design.esodesign.compensator` is this law unclipped)::
 
     d_k     = Cs s                                   the gimbal the observer assumes (servo model, delayed)
-    x_bar   = Phi x_hat + Gam b0 (d_prev + d_k) / 2
-    x_hat   = x_bar + L (theta_k - x_bar[0])         theta_k: the attitude error [rad]
+    x_hat   = F x_hat + H (theta_k, omega_k) + G b0 (d_prev + d_k) / 2
     u       = clip(-(kp x_hat[0] + kd x_hat[1] + x_hat[2]) / b0, -limit, limit)
+
+``theta_k``, ``omega_k``: the attitude and rate errors [rad, rad/s]; ``F``, ``H``, ``G`` the row's observer
+(:func:`.eso.observer_matrices`: the attitude-fed full-order ESO or the rate-fed reduced-order one).
     s      <- As s + Bs c;  c <- u;  d_prev <- d_k   the servo model steps on the command of the last period
 
-At the first step of an engagement the estimate starts at ``(theta_k, rate error_k, 0)`` and the servo model at
+The attitude and rate errors pass first through the row's structural filter (one section, the same on both,
+so the attitude the observer reads is the integral of the rate it reads); its states are set at rest on the
+current sample at engagement and when the row in use changes to one of another filter. At the first step of an
+engagement the estimate starts at ``(theta_k, rate error_k, 0)`` and the servo model at
 rest at the gimbal's observed position (no observer step). Off: the command is zero and the state frozen.
 """
 
@@ -26,8 +31,10 @@ __all__ = ["ESOCols", "ESOState", "ESOTables", "eso_act_k", "new_state"]
 
 
 class ESOTables(NamedTuple):
-    """The schedule: ``t`` (m,) the design rows' flight times [s] (nearest row in use), ``kp`` (m,), ``kd`` (m,),
-    ``L`` (m, 3) the law's and the observer's gains; ``tb`` (q,) and ``b0`` (q,) the control power [1/s^2] over
+    """The schedule: ``t`` (m,) the design rows' flight times [s] (nearest row in use), ``kp`` (m,), ``kd`` (m,)
+    the law's gains, ``F`` (m, 3, 3), ``H`` (m, 3, 2), ``G`` (m, 3) the observer's matrices; ``fb``, ``fa``
+    (m, 3) the row's structural filter on both the attitude and the rate error (one Tustin section, ``fa[0] = 1``;
+    ``(1, 0, 0), (1, 0, 0)``: none); ``tb`` (q,) and ``b0`` (q,) the control power [1/s^2] over
     flight time (linear between, held beyond); ``As`` (2, 2), ``Bs`` (2,) the servo model over a control
     period (states position [rad], rate [rad/s]); ``dt`` [s], ``mission`` [s] (time = fraction x mission),
     ``limit`` [rad]."""
@@ -35,7 +42,11 @@ class ESOTables(NamedTuple):
     t: np.ndarray
     kp: np.ndarray
     kd: np.ndarray
-    L: np.ndarray
+    F: np.ndarray
+    H: np.ndarray
+    G: np.ndarray
+    fb: np.ndarray
+    fa: np.ndarray
     tb: np.ndarray
     b0: np.ndarray
     As: np.ndarray
@@ -58,11 +69,14 @@ class ESOCols(NamedTuple):
 
 class ESOState(NamedTuple):
     """``n`` rows: ``x`` (n, 2, 3) the estimates (attitude [rad], rate [rad/s], disturbance [rad/s^2]) per plane,
-    ``srv`` (n, 2, 2) the servo model, ``cmd`` (n, 2) the last command [rad], ``dprev`` (n, 2) the last assumed
+    ``srv`` (n, 2, 2) the servo model, ``flt`` (n, 2, 2, 2) the filter's states (plane, signal: attitude, rate),
+    ``row`` (n,) the design row in use, ``cmd`` (n, 2) the last command [rad], ``dprev`` (n, 2) the last assumed
     gimbal [rad], ``was_on`` (n,) whether the row acted at its last step, ``gimbal`` (n, 2) the last command."""
 
     x: np.ndarray
     srv: np.ndarray
+    flt: np.ndarray
+    row: np.ndarray
     cmd: np.ndarray
     dprev: np.ndarray
     was_on: np.ndarray
@@ -71,7 +85,8 @@ class ESOState(NamedTuple):
 
 def new_state(n: int) -> ESOState:
     """The state of ``n`` rows, as after a reset."""
-    return ESOState(np.zeros((n, 2, 3)), np.zeros((n, 2, 2)), np.zeros((n, 2)), np.zeros((n, 2)),
+    return ESOState(np.zeros((n, 2, 3)), np.zeros((n, 2, 2)), np.zeros((n, 2, 2, 2)), np.zeros(n, np.int64),
+                    np.zeros((n, 2)), np.zeros((n, 2)),
                     np.zeros(n, np.bool_), np.zeros((n, 2)))
 
 
@@ -100,11 +115,26 @@ def _nearest(t_rows, t):
 
 
 @nb.njit(cache=True)
+def _settle(fb, fa, z, x):
+    """Filter states ``z`` (2,) at rest for the constant input ``x`` (a section of unit gain at zero frequency)."""
+    z[1] = (fb[2] - fa[2]) * x
+    z[0] = (fb[1] - fa[1]) * x + z[1]
+
+
+@nb.njit(cache=True)
+def _section(fb, fa, z, x):
+    """One step of the section (direct form II transposed) on ``x``; its output."""
+    y = fb[0] * x + z[0]
+    z[0] = fb[1] * x - fa[1] * y + z[1]
+    z[1] = fb[2] * x - fa[2] * y
+    return y
+
+
+@nb.njit(cache=True)
 def eso_act_k(tb, oc, st, rows, obs, out):
     """The actions ``out`` (k, 2) float32 (command / limit) of the rows ``rows`` (k,) for their observations
     ``obs`` (k, n_obs) (module docstring)."""
     dt, lim = tb.dt, tb.limit
-    h2 = 0.5 * dt * dt
     for j in range(rows.size):
         b = rows[j]
         o = obs[j]
@@ -118,27 +148,39 @@ def eso_act_k(tb, oc, st, rows, obs, out):
         t = float(o[oc.time]) * tb.mission
         i = _nearest(tb.t, t)
         kp, kd = tb.kp[i], tb.kd[i]
-        l0, l1, l2 = tb.L[i, 0], tb.L[i, 1], tb.L[i, 2]
+        F, H, G = tb.F[i], tb.H[i], tb.G[i]
         b0 = _b0(tb.tb, tb.b0, t)
         first = not st.was_on[b]
+        fb, fa = tb.fb[i], tb.fa[i]
+        resettle = first
+        if not first and st.row[b] != i:
+            for q in range(3):
+                if fb[q] != tb.fb[st.row[b], q] or fa[q] != tb.fa[st.row[b], q]:
+                    resettle = True
+        st.row[b] = i
         for ax in range(2):
             theta = float(o[oc.att[ax]])
+            omega = float(o[oc.rate[ax]])
+            if resettle:
+                _settle(fb, fa, st.flt[b, ax, 0], theta)
+                _settle(fb, fa, st.flt[b, ax, 1], omega)
+            theta = _section(fb, fa, st.flt[b, ax, 0], theta)
+            omega = _section(fb, fa, st.flt[b, ax, 1], omega)
             x = st.x[b, ax]
             s = st.srv[b, ax]
             if first:
                 g = float(o[oc.gimbal[ax]]) * lim
-                x[0], x[1], x[2] = theta, float(o[oc.rate[ax]]), 0.0
+                x[0], x[1], x[2] = theta, omega, 0.0
                 s[0], s[1] = g, 0.0
                 st.cmd[b, ax] = g
                 st.dprev[b, ax] = g
             else:
                 d = s[0]
                 v = b0 * 0.5 * (st.dprev[b, ax] + d)
-                xb0 = x[0] + dt * x[1] + h2 * (x[2] + v)
-                xb1 = x[1] + dt * (x[2] + v)
-                xb2 = x[2]
-                e = theta - xb0
-                x[0], x[1], x[2] = xb0 + l0 * e, xb1 + l1 * e, xb2 + l2 * e
+                y0 = F[0, 0] * x[0] + F[0, 1] * x[1] + F[0, 2] * x[2] + H[0, 0] * theta + H[0, 1] * omega + G[0] * v
+                y1 = F[1, 0] * x[0] + F[1, 1] * x[1] + F[1, 2] * x[2] + H[1, 0] * theta + H[1, 1] * omega + G[1] * v
+                y2 = F[2, 0] * x[0] + F[2, 1] * x[1] + F[2, 2] * x[2] + H[2, 0] * theta + H[2, 1] * omega + G[2] * v
+                x[0], x[1], x[2] = y0, y1, y2
                 st.dprev[b, ax] = d
             u = -(kp * x[0] + kd * x[1] + x[2]) / b0
             u = max(-lim, min(lim, u))

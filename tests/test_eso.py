@@ -12,7 +12,7 @@ import pytest
 
 import lvgym
 import lvgym.baselines  # noqa: F401  (registers eso)
-from lvgym.baselines.eso import observer_gain, servo_model, smile_eso
+from lvgym.baselines.eso import observer_gain, row_gains, servo_model, smile_eso
 from lvgym.baselines.esokernel import ESOCols, ESOTables, eso_act_k, new_state
 
 DT = 0.02
@@ -58,10 +58,11 @@ def test_constant_disturbance_estimate_converges_at_the_triple_pole():
     assert f - xh[2] == pytest.approx(0.5 * 61 * math.exp(-10.0), rel=0.03)
 
 
-def _tables(wc=1.2, wo=6.0, b0=16.0, limit=0.1):
+def _tables(wc=1.2, wo=6.0, b0=16.0, limit=0.1, **row):
     As, Bs = servo_model(15.0, 0.7, DT)
-    return ESOTables(np.array([10.0]), np.array([wc * wc]), np.array([2 * wc]), observer_gain(wo, DT)[None, :],
-                     np.array([0.0, 100.0]), np.array([b0, b0]), As, Bs, DT, 100.0, limit)
+    kp, kd, F, H, G, fb, fa = row_gains([{"controller_bandwidth_radps": wc, "observer_bandwidth_radps": wo, **row}], DT)
+    return ESOTables(np.array([10.0]), kp, kd, F, H, G, fb, fa, np.array([0.0, 100.0]), np.array([b0, b0]), As, Bs, DT,
+                     100.0, limit)
 
 
 COLS = ESOCols(np.array([0, 1]), np.array([2, 3]), np.array([4, 5]), 6, 7)

@@ -40,11 +40,13 @@ import numpy as np
 
 from lvgym.errors import ConfigError
 
+from ..eso import eso_model, notch_section, observer_gain, observer_matrices
+
 from .flightloop import control_timing, delay_ss, gyro_chain, hold_and_sample, servo_discrete
 from .linearize import PLANES, OperatingPoint
 from .lqg_row import closed_loop_growth, frequency_grid, gain_at, margins_from_response, response
 
-__all__ = ["assess", "compensator", "eso_model", "law_gains", "observer_gain", "sampled_plant"]
+__all__ = ["RowFilter", "assess", "compensator", "eso_model", "law_gains", "observer_gain", "row_design", "sampled_plant"]
 
 
 def _positive(key: str, value: float) -> float:
@@ -53,46 +55,27 @@ def _positive(key: str, value: float) -> float:
     return float(value)
 
 
-def eso_model(dt: float) -> tuple[np.ndarray, np.ndarray]:
-    """``Phi`` (3, 3) and ``Gam`` (3,) of the observer's model (module docstring) at the period ``dt`` [s]."""
-    dt = _positive("dt", dt)
-    phi = np.array([[1.0, dt, 0.5 * dt * dt], [0.0, 1.0, dt], [0.0, 0.0, 1.0]])
-    return phi, np.array([0.5 * dt * dt, dt, 0.0])
-
-
-def observer_gain(wo: float, dt: float) -> np.ndarray:
-    """The observer's gain ``L`` (3,) of bandwidth ``wo`` [rad/s] at ``dt`` [s]: the eigenvalues of
-    ``(I - L C) Phi`` (``C = [1, 0, 0]``) all at ``exp(-wo dt)`` (Ackermann's formula on ``(Phi, C Phi)``)."""
-    wo = _positive("observer_bandwidth_radps", wo)
-    phi, _ = eso_model(dt)
-    beta = math.exp(-wo * dt)
-    c = np.array([[1.0, 0.0, 0.0]])
-    o = np.vstack([c @ phi, c @ phi @ phi, c @ phi @ phi @ phi])          # observability of (Phi, C Phi)
-    coeff = np.poly([beta, beta, beta])                                       # z^3 + a1 z^2 + a2 z + a3
-    p_phi = (np.linalg.matrix_power(phi, 3) + coeff[1] * phi @ phi + coeff[2] * phi + coeff[3] * np.eye(3))
-    return (p_phi @ np.linalg.solve(o, np.array([0.0, 0.0, 1.0])))
-
-
 def law_gains(wc: float) -> tuple[float, float]:
     """``(kp, kd)`` [1/s^2, 1/s] of the controller bandwidth ``wc`` [rad/s]: ``s^2 + kd s + kp = (s + wc)^2``."""
     wc = _positive("controller_bandwidth_radps", wc)
     return wc * wc, 2.0 * wc
 
 
-def core(b0: float, wc: float, wo: float, dt: float) -> control.StateSpace:
-    """The observer and the law as a discrete system from ``(theta_m, delta)`` [rad] to the command [rad]
-    (states: the last estimate ``x_hat`` and the last gimbal sample)."""
+def core(b0: float, wc: float, wo: float, dt: float, *, observer: str = "attitude", zeta: float = 1.0,
+         stiffness: float = 0.0, damping: float = 0.0) -> control.StateSpace:
+    """The observer (:func:`..eso.observer_matrices` of ``observer``, the model's known ``stiffness`` [1/s^2] and
+    ``damping`` [1/s]) and the law (``kp = wc^2 - stiffness``, ``kd = 2 zeta wc - damping``) as a discrete system
+    from ``(theta_k, omega_k, delta_k)`` [rad, rad/s, rad] to the command [rad] (states: the last estimate and
+    the last gimbal sample)."""
     b0 = _positive("control_power_per_s2", b0)
-    phi, gam = eso_model(dt)
-    lg = observer_gain(wo, dt)
-    kp, kd = law_gains(wc)
-    k = np.array([[kp, kd, 1.0]]) / b0
-    ilc = np.eye(3) - np.outer(lg, [1.0, 0.0, 0.0])
-    g2 = (ilc @ gam * 0.5 * b0).reshape(3, 1)
-    A = np.block([[ilc @ phi, g2], [np.zeros((1, 4))]])
-    B = np.block([[lg.reshape(3, 1), g2], [np.array([[0.0, 1.0]])]])
-    C = -k @ np.hstack([ilc @ phi, g2])
-    D = -k @ np.hstack([lg.reshape(3, 1), g2])
+    F, H, G = observer_matrices(observer, _positive("observer_bandwidth_radps", wo), dt, stiffness, damping)
+    wc = _positive("controller_bandwidth_radps", wc)
+    k = np.array([[wc * wc - stiffness, 2.0 * _positive("controller_damping", zeta) * wc - damping, 1.0]]) / b0
+    g2 = (G * 0.5 * b0).reshape(3, 1)
+    A = np.block([[F, g2], [np.zeros((1, 4))]])
+    B = np.block([[H, g2], [np.array([[0.0, 0.0, 1.0]])]])
+    C = -k @ np.hstack([F, g2])
+    D = -k @ np.hstack([H, g2])
     return control.ss(A, B, C, D, dt)
 
 
@@ -115,7 +98,7 @@ def close_input(c: control.StateSpace, m: control.StateSpace) -> control.StateSp
     a system from ``theta_m`` alone to the command."""
     A, B, C, D = (np.asarray(x, float) for x in (c.A, c.B, c.C, c.D))
     Am, Bm, Cm = (np.asarray(x, float) for x in (m.A, m.B, m.C))
-    b1, b2, d1, d2 = B[:, :1], B[:, 1:], D[:, :1], D[:, 1:]
+    b1, b2, d1, d2 = B[:, :-1], B[:, -1:], D[:, :-1], D[:, -1:]
     Ac = np.block([[A, b2 @ Cm], [Bm @ C, Am + Bm @ d2 @ Cm]])
     Bc = np.vstack([b1, Bm @ d1])
     Cc = np.hstack([C, d2 @ Cm])
@@ -123,19 +106,41 @@ def close_input(c: control.StateSpace, m: control.StateSpace) -> control.StateSp
 
 
 def compensator(b0: float, wc: float, wo: float, dt: float, filt: Any = None,
-                model: control.StateSpace | None = None) -> control.StateSpace:
-    """The whole law, unclipped: the strapdown attitude (trapezoidal integral of the gyro samples), the
-    structural filter ``filt`` (a :class:`..filters.StructuralFilter` or series; None: none) on it, then
-    :func:`core`. ``model`` None: the gimbal sample is the law's second input (from ``(gyro sample [rad/s],
-    gimbal sample [rad])`` to the command [rad]); else the gimbal angle is the law's own command through
-    ``model`` (:func:`input_model`; from the gyro sample alone)."""
-    integ = control.tf([0.5 * dt, 0.5 * dt], [1.0, -1.0], dt)
-    path = control.ss(integ if filt is None else control.series(integ, filt.tf(dt)))
-    c = core(b0, wc, wo, dt)
+                model: control.StateSpace | None = None, **row: Any) -> control.StateSpace:
+    """The whole law, unclipped: the structural filter ``filt`` (a :class:`..filters.StructuralFilter` or series;
+    None: none) on the gyro sample, the strapdown attitude (trapezoidal integral of the gyro samples), then
+    :func:`core` (``row``: its keywords) on (attitude, rate). ``model`` None: the gimbal sample is the law's second
+    input (from ``(gyro sample [rad/s], gimbal sample [rad])`` to the command [rad]); else the gimbal angle is the
+    law's own command through ``model`` (:func:`input_model`; from the gyro sample alone)."""
+    integ = control.ss(control.tf([0.5 * dt, 0.5 * dt], [1.0, -1.0], dt))
+    one = control.ss([], [], [], [[1.0]], dt)
+    split = control.ss(np.asarray(integ.A), np.asarray(integ.B), np.vstack([np.asarray(integ.C), np.zeros((1, 1))]),
+                       np.vstack([np.asarray(integ.D), [[1.0]]]), dt)               # g -> (theta, g)
+    path = split if filt is None else control.series(control.ss(filt.tf(dt)), split)
+    c = core(b0, wc, wo, dt, **row)
     if model is not None:
         return control.ss(control.series(path, close_input(c, model)))
-    pre = control.append(path, control.ss([], [], [], [[1.0]], dt))
+    pre = control.append(path, one)
     return control.ss(control.series(pre, c))
+
+
+class RowFilter:
+    """A schedule row's slosh notch (:func:`..eso.notch_section`) with the :meth:`tf` :func:`compensator` takes."""
+
+    def __init__(self, notch: Any, dt: float) -> None:
+        self.b, self.a = notch_section(notch, dt)
+        self.dt = dt
+
+    def tf(self, dt: float) -> control.TransferFunction:
+        if dt != self.dt:
+            raise ConfigError("dt", dt, f"the period the notch was made at, {self.dt} s")
+        return control.tf(self.b, self.a, dt)
+
+
+def row_design(row: dict[str, Any]) -> dict[str, Any]:
+    """A schedule row as :func:`compensator`'s keywords (``observer``, ``zeta``, ``stiffness``, ``damping``)."""
+    return {"observer": str(row.get("observer", "attitude")), "zeta": float(row.get("controller_damping", 1.0)),
+            "stiffness": float(row.get("stiffness_per_s2", 0.0)), "damping": float(row.get("damping_per_s", 0.0))}
 
 
 def sampled_plant(op: OperatingPoint, plane: str = "pitch") -> control.StateSpace:
@@ -213,5 +218,7 @@ def schedule_document(rows: list[dict[str, float]], power_source: str = "smile_p
     src = yaml.safe_load((SCHEDULES / f"{power_source}.yaml").read_text())
     power = {"time_s": [float(r["time_s"]) for r in src["rows"]],
              "per_s2": [float(r["control_power_per_s2"]) for r in src["rows"]], "source": f"{power_source}.yaml"}
-    return {"law": "u = -(wc^2 theta_hat + 2 wc omega_hat + f_hat) / b0; observer poles exp(-wo dt), triple",
+    return {"law": ("u = -((wc^2 - m) theta_hat + (2 zeta wc - c) omega_hat + f_hat) / b0; observer 'attitude': "
+                    "full order on the attitude, triple pole exp(-wo dt); 'rate': reduced order on the gyro rate, "
+                    "double pole; notch on attitude and rate"),
             "rows": rows, "control_power": power}
