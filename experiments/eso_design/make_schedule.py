@@ -10,15 +10,15 @@ from lvgym.baselines.design.esodesign import schedule_document
 
 NOTCH = {"frequency_radps": 9.0, "damping": 0.3, "depth": 0.3}
 #        t:   observer,  wc,   zeta, wo,   kappa, notch
-CHOICE = {3.0: ("attitude", 1.0, 0.7, 4.0, 1.0, None),
-          10.0: ("attitude", 2.52, 0.5, 6.0, 1.0, None),
-          20.0: ("attitude", 4.24, 0.3, 5.0, 0.75, None),
-          28.8: ("attitude", 2.52, 0.3, 5.0, 0.75, None),
-          36.0: ("attitude", 2.52, 0.3, 5.0, 0.75, None),
-          41.0: ("attitude", 2.52, 0.3, 5.0, 0.75, None),
-          56.0: ("rate", 0.4, 1.4, 30.0, 1.0, NOTCH),
-          62.0: ("rate", 0.4, 1.4, 30.0, 1.0, NOTCH),
-          68.0: ("rate", 0.4, 1.4, 30.0, 1.0, NOTCH)}
+CHOICE = {3.0: ("attitude", 1.5, 0.3, 11.0, 1.0, None),          # perf.py: the largest |L(1 rad/s)| of score >= 1.05
+          10.0: ("attitude", 3.07, 0.3, 8.0, 1.0, None),
+          20.0: ("attitude", 4.96, 0.3, 6.0, 1.0, None),
+          28.8: ("attitude", 3.07, 0.3, 6.0, 1.0, None),
+          36.0: ("attitude", 1.91, 0.3, 8.0, 0.5, None),
+          41.0: ("attitude", 1.91, 0.5, 16.0, 1.0, None),
+          56.0: ("rate", 0.4, 1.4, 30.0, 1.0, NOTCH),              # filt56.py: the rate-fed ESO with the slosh notch
+          62.0: ("rate", 0.4, 0.7, 22.0, 1.0, NOTCH),
+          68.0: ("rate", 0.4, 0.7, 11.0, 1.0, NOTCH)}
 
 
 def rows(choice):
