@@ -88,20 +88,30 @@ def test_law_at_a_frozen_state_against_hand_numbers():
     assert out[0, 0] == np.float32(st.gimbal[0, 0] / 0.1)
 
 
-def test_compiled_law_equals_the_design_compensator():
+ROWS = [{},                                                                    # Gao's plain ESO
+        {"observer": "attitude", "controller_damping": 0.3, "stiffness_per_s2": 27.04, "damping_per_s": 1.03},
+        {"observer": "rate", "controller_damping": 1.4, "stiffness_per_s2": -2.69, "damping_per_s": 0.02,
+         "notch": {"frequency_radps": 9.0, "damping": 0.3, "depth": 0.3}}]
+
+
+@pytest.mark.parametrize("row", ROWS, ids=["plain", "model-assisted", "rate-fed-notch"])
+def test_compiled_law_equals_the_design_compensator(row):
     """A random gyro sequence, its trapezoidal attitude fed to the kernel, the commands against
-    :func:`esodesign.compensator` (the servo model in the observer's input) on the same sequence, unclipped."""
+    :func:`esodesign.compensator` (the servo model in the observer's input, the row's notch on the gyro) on the
+    same sequence, unclipped: the plain ESO, the model-assisted one (max q's rigid pair) and the rate-fed one
+    with the slosh notch (the upper stage's)."""
     import control
 
     from lvgym.baselines.design import esodesign as ed
 
     wc, wo, b0 = 1.2, 6.0, 16.0
-    comp = ed.compensator(b0, wc, wo, DT, None, ed.input_model(DT, 1, (15.0, 0.7)))
+    filt = ed.RowFilter(row["notch"], DT) if "notch" in row else None
+    comp = ed.compensator(b0, wc, wo, DT, filt, ed.input_model(DT, 1, (15.0, 0.7)), **ed.row_design(row))
     rng = np.random.default_rng(1)
     y = np.concatenate([[0.0], 0.01 * rng.standard_normal(199)])
     theta = np.concatenate([[0.0], np.cumsum(0.5 * DT * (y[1:] + y[:-1]))])
     ref = control.forced_response(comp, np.arange(y.size) * DT, y).outputs.ravel()
-    tb, st = _tables(wc, wo, b0, limit=10.0), new_state(1)
+    tb, st = _tables(wc, wo, b0, limit=10.0, **row), new_state(1)
     got = []
     for k in range(y.size):
         obs = np.zeros((1, 8))
@@ -112,7 +122,25 @@ def test_compiled_law_equals_the_design_compensator():
         eso_act_k(tb, COLS, st, np.zeros(1, np.int64), obs, out)
         got.append(st.gimbal[0, 0])
     assert np.max(np.abs(ref)) > 1e-3
-    np.testing.assert_allclose(got, ref, rtol=1e-8, atol=1e-12)
+    np.testing.assert_allclose(got, ref, rtol=1e-7, atol=1e-12)
+
+
+def test_observer_matrices_hand_numbers():
+    """The rate-fed observer passes the attitude through (x[0] = theta_k, H[0] = (1, 0), F[0] = 0); its (rate,
+    disturbance) error map has the double pole exp(-wo dt); the model-assisted attitude ESO's error map the triple
+    one; with no stiffness the model is Gao's: Phi = [[1, dt, dt^2/2], [0, 1, dt], [0, 0, 1]], Gam = [dt^2/2, dt, 0]."""
+    from lvgym.baselines.eso import eso_model, observer_matrices
+
+    phi, gam = eso_model(DT)
+    assert np.allclose(phi, [[1, DT, DT * DT / 2], [0, 1, DT], [0, 0, 1]], atol=1e-15)
+    assert np.allclose(gam, [DT * DT / 2, DT, 0.0], atol=1e-15)
+    F, H, G = observer_matrices("rate", 20.0, DT, -2.69, 0.02)
+    assert np.allclose(F[0], 0.0) and np.allclose(H[0], [1.0, 0.0]) and G[0] == 0.0
+    assert np.allclose(np.linalg.eigvals(F[1:, 1:]), math.exp(-20.0 * DT), atol=1e-6)
+    F, H, G = observer_matrices("attitude", 5.0, DT, 27.04, 1.03)
+    assert np.allclose(np.linalg.eigvals(F), math.exp(-5.0 * DT), atol=2e-4)
+    with pytest.raises(lvgym.errors.ConfigError, match="observer"):
+        observer_matrices("accelerometer", 5.0, DT)
 
 
 class _NoInfo(Mapping):
