@@ -10,13 +10,13 @@ from lvgym.baselines.design.esodesign import schedule_document
 
 NOTCH = {"frequency_radps": 9.0, "damping": 0.3, "depth": 0.3}
 #        t:   observer,  wc,   zeta, wo,   kappa, notch
-CHOICE = {3.0: ("attitude", 1.5, 0.3, 11.0, 1.0, None),          # perf.py: the largest |L(1 rad/s)| of score >= 1.05
-          10.0: ("attitude", 3.07, 0.3, 8.0, 1.0, None),
-          20.0: ("attitude", 4.96, 0.3, 6.0, 1.0, None),
-          28.8: ("attitude", 3.07, 0.3, 6.0, 1.0, None),
-          36.0: ("attitude", 1.91, 0.3, 8.0, 0.5, None),
+CHOICE = {3.0: ("attitude", 1.5, 0.5, 8.0, 0.5, None),     # perf2.py: the largest |L(1 rad/s)| of score >= 1.05
+          10.0: ("attitude", 3.07, 0.3, 8.0, 1.0, None),   # whose rigid closed-loop poles (0.3-30 rad/s) are damped
+          20.0: ("attitude", 3.9, 0.5, 6.0, 1.0, None),    # at zeta >= 0.3 (10 s: zeta 0.3, its 0.5 has 5.4 dB non-rigid)
+          28.8: ("attitude", 3.07, 0.5, 6.0, 1.0, None),
+          36.0: ("attitude", 1.91, 0.7, 8.0, 1.0, None),
           41.0: ("attitude", 1.91, 0.5, 16.0, 1.0, None),
-          56.0: ("rate", 0.4, 1.4, 30.0, 1.0, NOTCH),              # filt56.py: the rate-fed ESO with the slosh notch
+          56.0: ("rate", 0.4, 1.4, 30.0, 1.0, NOTCH),        # filt56.py: the rate-fed ESO with the slosh notch
           62.0: ("rate", 0.4, 0.7, 22.0, 1.0, NOTCH),
           68.0: ("rate", 0.4, 0.7, 11.0, 1.0, NOTCH)}
 
