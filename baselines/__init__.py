@@ -11,7 +11,7 @@ thesis's control study (docs/control-study.md).
 Importing this package registers its controllers with the benchmark by name
 (:func:`lvgym.benchmark.register_policy`): ``pid``, ``gs-pid``, ``gs-pid-flex``, ``aac``,
 ``gs-pid-flex-quiet``, ``aac-quiet``, ``pid-thesis``, ``gs-pid-thesis``, ``lqg``, ``lqg-front``, ``lqg-aw``,
-``mpc``, ``indi``, ``privileged`` (``evaluate.py --policies lqg``).
+``mpc``, ``indi``, ``eso``, ``privileged`` (``evaluate.py --policies lqg``).
 """
 
 from lvgym.benchmark.registry import register_policy
@@ -71,6 +71,9 @@ register_policy("mpc", "lvgym.baselines.mpc:smile_mpc", name="mpc")
 # synchronised, the control power of the design tables, a rate and attitude outer loop (lvgym.baselines.indi,
 # lvgym.baselines.design.indi_design, docs/indi.md)
 register_policy("indi", smile_indi, name="indi")
+# active disturbance rejection control: an extended-state observer of the total disturbance per plane and a PD on
+# its estimates (lvgym.baselines.eso, docs/eso.md)
+register_policy("eso", "lvgym.baselines.eso:smile_eso", name="eso")
 
 __all__ = ["AACParams", "AdaptiveAugmentingPolicy", "BangBangRollPolicy", "GainSchedule", "PIDLaw",
            "GainScheduledPIDPolicy", "PIDPolicy", "smile_aac", "smile_scheduled_pid", "smile_single_pid"]

@@ -247,7 +247,7 @@ def test_every_registered_factory_lives_at_or_below_the_package_that_registers_i
     modules = {f.partition(":")[0] for f in factories}
     assert modules == {"lvgym.benchmark.runner", "lvgym.baselines.pid", "lvgym.baselines.aac", "lvgym.baselines.lqg",
                        "lvgym.baselines.mpc", "lvgym.baselines.privileged", "lvgym.baselines.designed",
-                       "lvgym.baselines.indi",
+                       "lvgym.baselines.indi", "lvgym.baselines.eso",
                        "lvgym.agents.policies.sb3", "lvgym.agents.policies.bc", "lvgym.agents.policies.inversion",
                        "lvgym.agents.policies.inversion_record"}
     for module in modules:                          # a worker imports it: the factory reaches no study
