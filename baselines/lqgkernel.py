@@ -15,7 +15,11 @@ where the integral's input ``s`` is the row's ``source`` (:data:`INTEGRAL_SOURCE
 strapdown attitude error, a pure integral ``a = 1``); its leak ``a`` is the row's too. One law, one code path.
 
 with the engagement restart, the schedule row chosen by flight time (the row whose interval holds it,
-else the nearest) and, at a switch, the states both rows name carried (``carry``) and the others zeroed.
+else the nearest) and, at a switch, the states both rows name carried (``carry``) and the others zeroed. The
+integral is carried too: the rate's as it is (``lqg``), the attitude's by its command ``K_i xi`` (``xi`` scaled by
+the old row's ``K_i`` over the new one's). The pure integral holds the trim a constant moment asks for, and the
+rows' ``K_i`` differ by up to five times: carried as it is, a switch would step the command by that much (a
+q-alpha failure at the 32.4 s switch on validation seed 0 of smile-v2-faults before this).
 
 Anti-windup (:class:`AntiWindup`, the ``lqg-aw`` policy; ``lqg`` flies :data:`NO_ANTI_WINDUP`, which leaves
 the law above unchanged): the command is also held to ``rate_step`` [rad] from the last one (the servo's rate
@@ -155,6 +159,8 @@ def lqg_step_k(tb, st, which, y, e, t, on, u_limit, aw, u):
             for k in range(N):
                 src = tb.carry[o, i, k] if o >= 0 else -1
                 st.x[b, k] = old[src] if src >= 0 else 0.0
+            if o >= 0 and tb.source[i] == 1 and tb.Ki[i] != 0.0:    # the attitude's integral: its command carried
+                st.xi[b] *= tb.Ki[o] / tb.Ki[i]
             st.row[b] = i
         m = tb.dim[i]
         cx = 0.0
