@@ -12,7 +12,11 @@ the last command sent [rad]).
 
 where the integral's input ``s`` is the row's ``source`` (:data:`INTEGRAL_SOURCES`): the gyro sample ``y``
 (``lqg``: the rate error, with a leak ``a < 1``) or the attitude error sample ``e`` [rad] (``lqi``: the
-strapdown attitude error, a pure integral ``a = 1``); its leak ``a`` is the row's too. One law, one code path.
+strapdown attitude error, a pure integral ``a = 1``); its leak ``a`` is the row's too. A row integrating the
+attitude also takes the measured attitude for the estimate's attitude state after the measurement update,
+``x_f[att] = e`` (the strapdown attitude is the better estimate: its error grows with the gyro's random walk,
+0.02 deg over the flight, where the rate-only filter's attitude drifts with every unmodelled moment, and the
+integral would hold the regulator's attitude gain times that drift). One law, one code path.
 
 with the engagement restart, the schedule row chosen by flight time (the row whose interval holds it,
 else the nearest) and, at a switch, the states both rows name carried (``carry``) and the others zeroed. The
@@ -45,7 +49,8 @@ class LQGTables(NamedTuple):
     """One plane's schedule, R rows padded to N states: ``A`` (R, N, N), ``B``, ``C``, ``Kx``, ``M`` (R, N),
     ``Ki``, ``a``, ``dt`` (R,), ``dim`` (R,) the row's own state count, ``lo``, ``hi`` (R,) its interval [s],
     ``carry`` (R, R, N): at a switch from row ``o`` to row ``i`` the new state ``k`` takes the old state
-    ``carry[o, i, k]`` (-1: zero); ``source`` (R,) the integral's input (:data:`INTEGRAL_SOURCES` index)."""
+    ``carry[o, i, k]`` (-1: zero); ``source`` (R,) the integral's input (:data:`INTEGRAL_SOURCES` index); ``att`` (R,)
+    the index of the attitude state (``theta_y``, ``theta_z``) of a row integrating the attitude (-1: none)."""
 
     A: np.ndarray
     B: np.ndarray
@@ -60,6 +65,7 @@ class LQGTables(NamedTuple):
     hi: np.ndarray
     carry: np.ndarray
     source: np.ndarray
+    att: np.ndarray
 
 
 class LQGState(NamedTuple):
@@ -112,7 +118,18 @@ def lqg_tables(rows: Any) -> LQGTables:
     return LQGTables(A, B, C, Kx, M, np.array([r.Ki for r in rows]), np.array([r.a for r in rows]),
                      np.array([r.dt for r in rows]), np.array([r.A.shape[0] for r in rows], dtype=np.int64),
                      np.array([r.interval_s[0] for r in rows]), np.array([r.interval_s[1] for r in rows]), carry,
-                     np.array([INTEGRAL_SOURCES.index(r.integral) for r in rows], dtype=np.int64))
+                     np.array([INTEGRAL_SOURCES.index(r.integral) for r in rows], dtype=np.int64),
+                     np.array([_attitude_state(r) for r in rows], dtype=np.int64))
+
+
+def _attitude_state(row: Any) -> int:
+    """The index of the attitude state of a row that integrates the attitude error, else -1."""
+    if row.integral != "attitude":
+        return -1
+    at = [k for k, name in enumerate(row.labels) if name in ("theta_y", "theta_z")]
+    if len(at) != 1:
+        raise ValueError(f"row {row.time_s:g} s integrates the attitude: one theta_y or theta_z state, found {len(at)}")
+    return at[0]
 
 
 @nb.njit(cache=True)
@@ -167,9 +184,12 @@ def lqg_step_k(tb, st, which, y, e, t, on, u_limit, aw, u):
         for k in range(m):
             cx += tb.C[i, k] * st.x[b, k]
         innov = y[j] - cx
-        kx = 0.0
         for k in range(m):
             xf[k] = st.x[b, k] + tb.M[i, k] * innov
+        if tb.source[i] == 1:                     # the attitude state: the measured attitude error
+            xf[tb.att[i]] = e[j]
+        kx = 0.0
+        for k in range(m):
             kx += tb.Kx[i, k] * xf[k]
         v = -kx - tb.Ki[i] * st.xi[b]
         uu = min(max(v, -u_limit), u_limit)

@@ -27,8 +27,10 @@ aerodynamic moment holds an attitude), so the pure integrator is controllable an
 stabilising solution; ``q_attitude`` weights ``e^2`` beside it (the place ``q_int`` takes in the rate design,
 whose integral of the rate is the attitude change), and ``q_int`` now weights the attitude's integral
 [1/(rad s)^2]. A constant disturbance moment then leaves no attitude offset: at rest ``xi`` is constant only
-where ``e = 0``. The compensator has two inputs, the gyro sample and the attitude error (:func:`compensator`),
-and its loop is assessed on the plant with both outputs (:func:`loop_plant`).
+where ``e = 0``. The compensator has two inputs, the gyro sample and the attitude error (:func:`compensator`):
+the attitude error also stands for the estimate's attitude state (the rate-only filter's attitude drifts with
+any moment it does not model, and the regulator's attitude gain would fly that drift); its loop is assessed on
+the plant with both outputs (:func:`loop_plant`).
 
 Estimator (:func:`kalman_gain`): the steady-state Kalman filter of the plant with process noise at the
 gimbal, after the delay (variance ``w_gimbal`` [rad^2] per control period: what stands in for the wind,
@@ -311,7 +313,8 @@ def design_row(op: OperatingPoint, plane: str, w: LQGWeights, integral: str = "r
 
 def compensator(d: RowDesign) -> control.StateSpace:
     """The linear compensator of a :class:`RowDesign` (module docstring), unclipped: ``y -> u``, or with the
-    attitude integral ``(y, e) -> u`` (the gyro sample [rad/s] and the attitude error [rad])."""
+    attitude integral ``(y, e) -> u`` (the gyro sample [rad/s] and the attitude error [rad]; the estimate's
+    attitude state is then the measured ``e`` after the measurement update, as :mod:`.lqgkernel` flies it)."""
     A, B, C, Kx, M = d.A, d.B, d.C, d.Kx, d.M
     n = A.shape[0]
     F = np.eye(n) - M @ C
@@ -322,8 +325,13 @@ def compensator(d: RowDesign) -> control.StateSpace:
         Bc = np.vstack([Acl @ M, [[-d.dt]]])
         Dc = -Kx @ M
         return control.ss(Ac, Bc, Cc, Dc, d.dt, inputs=["gyro"], outputs=["command"])
-    Bc = np.block([[Acl @ M, np.zeros((n, 1))], [np.array([[0.0, -d.dt]])]])
-    Dc = np.hstack([-Kx @ M, [[0.0]]])
+    # the estimate's attitude state replaced by the measured attitude error: x_f = S (F x_p + M y) + c e
+    c = attitude_output(d.state_labels).T
+    S = np.eye(n) - c @ c.T
+    Ac = np.block([[Acl @ S @ F, -B * d.Ki], [np.zeros((1, n)), np.array([[d.a]])]])
+    Bc = np.block([[Acl @ S @ M, Acl @ c], [np.array([[0.0, -d.dt]])]])
+    Cc = np.hstack([-Kx @ S @ F, [[-d.Ki]]])
+    Dc = np.hstack([-Kx @ S @ M, -Kx @ c])
     return control.ss(Ac, Bc, Cc, Dc, d.dt, inputs=["gyro", "attitude"], outputs=["command"])
 
 
