@@ -11,7 +11,7 @@ thesis's control study (docs/control-study.md).
 Importing this package registers its controllers with the benchmark by name
 (:func:`lvgym.benchmark.register_policy`): ``pid``, ``gs-pid``, ``gs-pid-flex``, ``aac``,
 ``gs-pid-flex-quiet``, ``aac-quiet``, ``pid-thesis``, ``gs-pid-thesis``, ``lqg``, ``lqg-front``, ``lqg-aw``,
-``mpc``, ``indi``, ``eso``, ``privileged`` (``evaluate.py --policies lqg``).
+``lqi``, ``mpc``, ``indi``, ``eso``, ``privileged`` (``evaluate.py --policies lqg``).
 """
 
 from lvgym.benchmark.registry import register_policy
@@ -56,6 +56,10 @@ register_policy("lqg-front", smile_lqg, name="lqg-front", schedule="smile_lqg_fr
 # lqg with anti-windup: the command held to the servo's rate limit as well, so that the filter carries what the
 # servo can follow, and the integral back-calculated (lvgym.baselines.lqgkernel.AntiWindup, docs/mpc.md)
 register_policy("lqg-aw", smile_lqg, name="lqg-aw", back_gain=0.1)
+# lqg-aw's law with the pure integral of the strapdown attitude error in place of the rate's leaky one, so that a
+# constant disturbance moment (a thrust-direction step) leaves no attitude offset; its flight time from the
+# observation (lvgym.baselines.design.lqg_design --integral attitude, docs/lqi.md)
+register_policy("lqi", smile_lqg, name="lqi", schedule="smile_lqi", back_gain=0.1, clock="observation")
 # the automatic designs of the env's vehicle file (lvgym.baselines.design.auto; the control extra): the rigid
 # design, the flexible design and the LQG, made the same way for any vehicle (a launcher family's baselines)
 register_policy("auto-gs-pid", "lvgym.baselines.designed:auto_policy", name="auto-gs-pid", kind="gs-pid")

@@ -14,6 +14,11 @@ sample ``y`` [rad/s] the observation's rate error, ``rate - reference``)::
     xi  <- a xi - dt y                     leaky integral of the rate error (held while the output is
                                            clipped and the integral would push it further)
 
+``lqi`` flies the same law on its own schedule (``baselines/schedules/smile_lqi.npz``, docs/lqi.md), whose rows
+integrate the observation's strapdown attitude error ``e`` [rad] instead, without a leak: ``xi <- xi - dt e``
+(the rows' ``integral``, :data:`.lqgkernel.INTEGRAL_SOURCES`), so that a constant disturbance moment leaves
+no attitude offset; it flies with ``lqg-aw``'s anti-windup.
+
 Without clipping this is exactly :func:`.lqg_design.compensator` (checked in the tests). ``lqg-aw`` flies the
 same law with anti-windup (``back_gain``: the command also held to the servo's rate limit, the integral
 back-calculated; :class:`.lqgkernel.AntiWindup`, docs/mpc.md); ``lqg`` without.
@@ -49,11 +54,14 @@ from lvgym.benchmark.batch import BatchLaw, RowFace
 from lvgym.errors import ConfigError, check_number
 
 from .filecache import read_once
-from .lqgkernel import NO_ANTI_WINDUP, AntiWindup, LQGState, LQGTables, lqg_act_k, lqg_step_k, lqg_tables, row_index
+from .lqgkernel import (INTEGRAL_SOURCES, NO_ANTI_WINDUP, AntiWindup, LQGState, LQGTables, lqg_act_k, lqg_step_k,
+                        lqg_tables, row_index)
 from .pidkernel import ObsColumns
 
 SCHEDULES = Path(__file__).resolve().parent / "schedules"
 PLANES = ("pitch", "yaw")
+#: where :class:`LQGLaw` reads the flight time: the step's ``info`` or the observation's time fraction
+CLOCKS = ("info", "observation")
 
 
 @dataclass(frozen=True)
@@ -73,6 +81,9 @@ class LQGRow:
     labels: tuple[str, ...]
     weights: tuple[float, ...] = ()
     """the design's :class:`.lqg_row.LQGWeights` in field order (empty if the file has none)"""
+    integral: str = "rate"
+    """what the integral integrates (:data:`.lqgkernel.INTEGRAL_SOURCES`): the rate error (leaky, ``lqg``) or the
+    attitude error (pure, ``lqi``)"""
 
     def __post_init__(self) -> None:
         n = self.A.shape[0]
@@ -83,6 +94,8 @@ class LQGRow:
             raise ConfigError(f"row {self.time_s:g} s.labels", len(self.labels), f"{n} state names")
         if not (self.dt > 0 and 0.0 < self.a <= 1.0):
             raise ConfigError(f"row {self.time_s:g} s.a", self.a, "an integrator factor in (0, 1] at dt > 0")
+        if self.integral not in INTEGRAL_SOURCES:
+            raise ConfigError(f"row {self.time_s:g} s.integral", self.integral, f"one of {INTEGRAL_SOURCES}")
 
 
 @dataclass(frozen=True)
@@ -144,7 +157,8 @@ class LQGSchedule:
                     float(t), (float(lo), float(hi)), *(_read_only(z[f"{plane}_{i}_{k}"]) for k in ("A", "B", "C", "Kx")),
                     float(z[f"{plane}_{i}_Ki"]), _read_only(z[f"{plane}_{i}_M"]), float(z[f"{plane}_{i}_a"]),
                     float(z[f"{plane}_{i}_dt"]), tuple(str(s) for s in z[f"{plane}_{i}_labels"]),
-                    tuple(float(v) for v in z[f"{plane}_{i}_weights"]) if f"{plane}_{i}_weights" in z else ())
+                    tuple(float(v) for v in z[f"{plane}_{i}_weights"]) if f"{plane}_{i}_weights" in z else (),
+                    str(z[f"{plane}_{i}_integral"]) if f"{plane}_{i}_integral" in z else "rate")
                     for i, (t, (lo, hi)) in enumerate(zip(times, intervals)))
         return cls(rows, str(p))
 
@@ -161,7 +175,8 @@ class LQGPlane:
     """One plane's law (module docstring) for ``n`` independent rows (episodes) of one schedule, its state in
     :attr:`state` (:class:`.lqgkernel.LQGState`): ``update(y, t, on, which) -> u`` [rad] steps the rows
     ``which`` with their gyro samples ``y`` [rad/s], flight times ``t`` [s] and switches ``on`` (the compiled
-    :func:`.lqgkernel.lqg_step_k`, the step :class:`LQGLaw` runs for each plane); ``aw``: its anti-windup
+    :func:`.lqgkernel.lqg_step_k`, the step :class:`LQGLaw` runs for each plane; ``e`` [rad]: the attitude
+    error samples a row integrating the attitude reads, zero if not given); ``aw``: its anti-windup
     (:class:`.lqgkernel.AntiWindup`; the default is ``lqg``'s plain law)."""
 
     def __init__(self, rows: tuple[LQGRow, ...], schedule: LQGSchedule, u_limit: float, n: int = 1,
@@ -188,15 +203,16 @@ class LQGPlane:
         st = self.state
         st.row[w], st.x[w], st.xi[w], st.was_on[w], st.saturated[w], st.u[w] = -1, 0.0, 0.0, False, False, 0.0
 
-    def update(self, y: Any, t: Any, on: Any, which: Any = None) -> np.ndarray:
-        """The commands [rad] of the rows ``which`` (None: all) for their gyro samples ``y`` [rad/s] at
-        flight times ``t`` [s], the law on where ``on``."""
+    def update(self, y: Any, t: Any, on: Any, which: Any = None, e: Any = None) -> np.ndarray:
+        """The commands [rad] of the rows ``which`` (None: all) for their gyro samples ``y`` [rad/s] and
+        attitude error samples ``e`` [rad] (None: zeros) at flight times ``t`` [s], the law on where ``on``."""
         which = self._all if which is None else np.asarray(which, dtype=np.int64).reshape(-1)
         y = np.asarray(y, dtype=float).reshape(-1)
+        e = np.zeros(y.size) if e is None else np.asarray(e, dtype=float).reshape(-1)
         t = np.asarray(t, dtype=float).reshape(-1)
         on = np.asarray(on, dtype=bool).reshape(-1)
         u = np.empty(which.size)
-        lqg_step_k(self.tables, self.state, which, y, t, on, self.u_limit, self.aw, u)
+        lqg_step_k(self.tables, self.state, which, y, e, t, on, self.u_limit, self.aw, u)
         return u
 
 
@@ -206,11 +222,13 @@ class LQGLaw(BatchLaw):
     against the schedule); ``schedule``: an :class:`LQGSchedule`, a path or a name in ``baselines/schedules``;
     ``back_gain``: None for ``lqg``'s plain law, else the anti-windup of ``lqg-aw`` with this back-calculation
     gain per period [-] in [0, 1] and the command held to the env's gimbal rate limit
-    (:class:`.lqgkernel.AntiWindup`). ``act`` reads ``info["time"]`` of every row. :attr:`gimbal` (n, 2)
+    (:class:`.lqgkernel.AntiWindup`); ``clock``: where the flight time comes from, ``info`` (``info["time"]`` of
+    every row, as ``lqg`` and ``lqg-aw`` have always flown) or ``observation`` (its ``time_fraction`` times the
+    env's mission time: the law then reads nothing but the observation, ``lqi``). :attr:`gimbal` (n, 2)
     [rad]: each row's last command."""
 
     def __init__(self, *, env: Any, schedule: LQGSchedule | str | Path = "smile_lqg", name: str = "lqg",
-                 back_gain: float | None = None, n: int = 1) -> None:
+                 back_gain: float | None = None, n: int = 1, clock: str = "info") -> None:
         task = env.unwrapped
         self.name = name
         self.schedule = schedule if isinstance(schedule, LQGSchedule) else LQGSchedule.load(schedule)
@@ -229,14 +247,25 @@ class LQGLaw(BatchLaw):
             rate = math.radians(float(task.task.gimbal_rate_limit_degps))        # rad/s
             self.aw = AntiWindup(True, rate * self.dt, gain)
         lay = task.observation_layout
+        if clock not in CLOCKS:
+            raise ConfigError("clock", clock, f"one of {CLOCKS}")
+        #: the observation's time_fraction column and the mission time [s] it is a fraction of (-1: info's time)
+        self.time_col = int(lay.index("time_fraction")) if clock == "observation" else -1
+        self.mission_s = float(task.task.mission_time_s)
         none = np.full(2, -1, np.int64)
+        att = np.asarray([lay.index(k) if k in lay.names else -1
+                          for k in ("pitch_attitude_error", "yaw_attitude_error")], np.int64)
+        if any(r.integral == "attitude" for p in PLANES for r in self.schedule.rows[p]) and np.any(att < 0):
+            raise ConfigError("env observation", getattr(lay, "title", ""), "one with pitch_attitude_error and "
+                              f"yaw_attitude_error (the schedule {self.schedule.source} integrates the attitude error)")
         self.oc = ObsColumns(np.asarray([lay.index("pitch_rate_error"), lay.index("yaw_rate_error")], np.int64),
-                             none, int(lay.index("controller_on")), -1, -1, none)
+                             none, int(lay.index("controller_on")), -1, -1, att)
         self.allocate(n)
 
     def _rows(self, n: int) -> None:
         self.planes = [LQGPlane(self.schedule.rows[p], self.schedule, self.limit, n, self.aw) for p in PLANES]
         self.gimbal = np.zeros((n, 2))
+        self.time = np.zeros(n)                      # the rows' flight times [s] of the observation clock
 
     def reset(self, rows: Any) -> None:
         """Rows ``rows`` start an episode."""
@@ -246,35 +275,43 @@ class LQGLaw(BatchLaw):
 
     def act(self, rows: Any, observations: np.ndarray, info: Mapping[str, Any]) -> np.ndarray:
         """Actions (len(rows), 2) float32 of the rows ``rows`` for their observations (len(rows), n_obs) and
-        the batched env's ``info`` (every row's ``time``): one call of :func:`.lqgkernel.lqg_act_k`."""
+        the batched env's ``info`` (every row's ``time``; not read with the observation's clock): one call of
+        :func:`.lqgkernel.lqg_act_k`."""
         rows = np.asarray(rows, dtype=np.int64).reshape(-1)
         obs = np.ascontiguousarray(observations).reshape(rows.size, -1)
         out = np.empty((rows.size, 2), np.float32)
         pitch, yaw = self.planes
-        lqg_act_k(pitch.tables, yaw.tables, pitch.state, yaw.state, self.oc, rows, obs,
-                  np.asarray(info["time"], dtype=np.float64), self.limit, self.aw, self.gimbal, out)
+        if self.time_col >= 0:
+            self.time[rows] = obs[:, self.time_col].astype(np.float64) * self.mission_s
+            t = self.time
+        else:
+            t = np.asarray(info["time"], dtype=np.float64)
+        lqg_act_k(pitch.tables, yaw.tables, pitch.state, yaw.state, self.oc, rows, obs, t, self.limit, self.aw,
+                  self.gimbal, out)
         return out
 
 
 class LQGPolicy(RowFace):
     """Pitch and yaw LQG as a benchmark :class:`~lvgym.benchmark.policy.Policy` of the TVC envs: one row of
-    :class:`LQGLaw` (its arguments). ``act`` needs ``info["time"]``; ``last_gimbal`` (2,) [rad]: the last
-    command."""
+    :class:`LQGLaw` (its arguments). ``act`` needs ``info["time"]`` unless ``clock="observation"``;
+    ``last_gimbal`` (2,) [rad]: the last command."""
 
     def __init__(self, *, env: Any, schedule: LQGSchedule | str | Path = "smile_lqg", name: str = "lqg",
-                 back_gain: float | None = None) -> None:
-        self.law = LQGLaw(env=env, schedule=schedule, name=name, back_gain=back_gain)
+                 back_gain: float | None = None, clock: str = "info") -> None:
+        self.law = LQGLaw(env=env, schedule=schedule, name=name, back_gain=back_gain, clock=clock)
 
     @property
     def last_gimbal(self) -> np.ndarray:
         return self.law.gimbal[0].copy()
 
 
-def smile_lqg(env: Any, name: str = "lqg", schedule: str = "smile_lqg", back_gain: float | None = None) -> LQGPolicy:
-    """The LQG schedule designed for SMILE v1 (``baselines/schedules/smile_lqg.npz``) on ``env``; the env
-    must fly the ``smile_v1`` vehicle. ``back_gain``: the anti-windup of ``lqg-aw`` (:class:`LQGPolicy`)."""
+def smile_lqg(env: Any, name: str = "lqg", schedule: str = "smile_lqg", back_gain: float | None = None,
+              clock: str = "info") -> LQGPolicy:
+    """The LQG schedule designed for SMILE v1 (``baselines/schedules/smile_lqg.npz``; ``smile_lqi``: ``lqi``'s) on
+    ``env``; the env must fly the ``smile_v1`` vehicle. ``back_gain``: the anti-windup of ``lqg-aw``, ``clock``:
+    where the flight time is read (:class:`LQGPolicy`)."""
     vehicle = getattr(env.unwrapped.task, "vehicle", None)
     if vehicle != "smile_v1":
         raise ConfigError("env vehicle", vehicle, "'smile_v1' (the LQG schedule is designed for SMILE v1, "
                           "lvgym/SmileAscent-v1)")
-    return LQGPolicy(env=env, schedule=schedule, name=name, back_gain=back_gain)
+    return LQGPolicy(env=env, schedule=schedule, name=name, back_gain=back_gain, clock=clock)

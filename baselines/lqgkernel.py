@@ -3,16 +3,27 @@ all the env rows of a residual policy's baselines in training. One code path for
 
 The schedule's rows are stacked, zero-padded to the largest state (:class:`LQGTables`, built once per
 schedule and plane by :func:`lqg_tables`); a law's state is :class:`LQGState` (``x``: the predicted
-state ``x_p`` per row in the first ``dim`` entries of the row in use; ``xi``: the rate error's leaky
-integral; ``row``: the schedule row in use, -1 since the last engagement; ``was_on``; ``saturated``; ``u``:
+state ``x_p`` per row in the first ``dim`` entries of the row in use; ``xi``: the integral; ``row``: the schedule row in use, -1 since the last engagement; ``was_on``; ``saturated``; ``u``:
 the last command sent [rad]).
 :func:`lqg_step_k` is the module docstring of :mod:`.lqg` row by row::
 
-    x_f = x_p + M (y - C x_p);  v = -K_x x_f - K_i xi;  u = clip(v);  xi <- a xi - dt y (held while clipped
+    x_f = x_p + M (y - C x_p);  v = -K_x x_f - K_i xi;  u = clip(v);  xi <- a xi - dt s (held while clipped
     and pushing further);  x_p <- A x_f + B u
 
+where the integral's input ``s`` is the row's ``source`` (:data:`INTEGRAL_SOURCES`): the gyro sample ``y``
+(``lqg``: the rate error, with a leak ``a < 1``) or the attitude error sample ``e`` [rad] (``lqi``: the
+strapdown attitude error, a pure integral ``a = 1``); its leak ``a`` is the row's too. A row integrating the
+attitude also takes the measured attitude for the estimate's attitude state after the measurement update,
+``x_f[att] = e`` (the strapdown attitude is the better estimate: its error grows with the gyro's random walk,
+0.02 deg over the flight, where the rate-only filter's attitude drifts with every unmodelled moment, and the
+integral would hold the regulator's attitude gain times that drift). One law, one code path.
+
 with the engagement restart, the schedule row chosen by flight time (the row whose interval holds it,
-else the nearest) and, at a switch, the states both rows name carried (``carry``) and the others zeroed.
+else the nearest) and, at a switch, the states both rows name carried (``carry``) and the others zeroed. The
+integral is carried too: the rate's as it is (``lqg``), the attitude's by its command ``K_i xi`` (``xi`` scaled by
+the old row's ``K_i`` over the new one's). The pure integral holds the trim a constant moment asks for, and the
+rows' ``K_i`` differ by up to five times: carried as it is, a switch would step the command by that much (a
+q-alpha failure at the 32.4 s switch on validation seed 0 of smile-v2-faults before this).
 
 Anti-windup (:class:`AntiWindup`, the ``lqg-aw`` policy; ``lqg`` flies :data:`NO_ANTI_WINDUP`, which leaves
 the law above unchanged): the command is also held to ``rate_step`` [rad] from the last one (the servo's rate
@@ -30,15 +41,16 @@ import numpy as np
 
 from .pidkernel import clip_k
 
-__all__ = ["NO_ANTI_WINDUP", "AntiWindup", "LQGState", "LQGTables", "lqg_act_k", "lqg_step_k", "lqg_tables",
-           "row_index"]
+__all__ = ["INTEGRAL_SOURCES", "NO_ANTI_WINDUP", "AntiWindup", "LQGState", "LQGTables", "lqg_act_k", "lqg_step_k",
+           "lqg_tables", "row_index"]
 
 
 class LQGTables(NamedTuple):
     """One plane's schedule, R rows padded to N states: ``A`` (R, N, N), ``B``, ``C``, ``Kx``, ``M`` (R, N),
     ``Ki``, ``a``, ``dt`` (R,), ``dim`` (R,) the row's own state count, ``lo``, ``hi`` (R,) its interval [s],
     ``carry`` (R, R, N): at a switch from row ``o`` to row ``i`` the new state ``k`` takes the old state
-    ``carry[o, i, k]`` (-1: zero)."""
+    ``carry[o, i, k]`` (-1: zero); ``source`` (R,) the integral's input (:data:`INTEGRAL_SOURCES` index); ``att`` (R,)
+    the index of the attitude state (``theta_y``, ``theta_z``) of a row integrating the attitude (-1: none)."""
 
     A: np.ndarray
     B: np.ndarray
@@ -52,6 +64,8 @@ class LQGTables(NamedTuple):
     lo: np.ndarray
     hi: np.ndarray
     carry: np.ndarray
+    source: np.ndarray
+    att: np.ndarray
 
 
 class LQGState(NamedTuple):
@@ -75,6 +89,10 @@ class AntiWindup(NamedTuple):
     back_gain: float
 
 
+#: what the integral of a row integrates (index in :data:`LQGTables`' ``source``): the rate error (the gyro
+#: sample ``y`` [rad/s]) or the attitude error (the observation's strapdown attitude error ``e`` [rad])
+INTEGRAL_SOURCES = ("rate", "attitude")
+
 #: the plain law (``lqg``): the command clipped to the gimbal limit only, the integral held while clipped
 NO_ANTI_WINDUP = AntiWindup(False, np.inf, 0.0)
 
@@ -82,7 +100,7 @@ NO_ANTI_WINDUP = AntiWindup(False, np.inf, 0.0)
 def lqg_tables(rows: Any) -> LQGTables:
     """The stacked tables of a plane's :class:`.lqg.LQGRow` sequence (carry maps from the state labels:
     identical labels carry every state; otherwise a state named once in the new row takes the old state
-    of that name)."""
+    of that name; ``source``: each row's ``integral``, :data:`INTEGRAL_SOURCES`)."""
     R, N = len(rows), max(r.A.shape[0] for r in rows)
     A, (B, C, Kx, M) = np.zeros((R, N, N)), (np.zeros((R, N)) for _ in range(4))
     carry = np.full((R, R, N), -1, dtype=np.int64)
@@ -99,7 +117,19 @@ def lqg_tables(rows: Any) -> LQGTables:
                     carry[o, i, k] = where[name]
     return LQGTables(A, B, C, Kx, M, np.array([r.Ki for r in rows]), np.array([r.a for r in rows]),
                      np.array([r.dt for r in rows]), np.array([r.A.shape[0] for r in rows], dtype=np.int64),
-                     np.array([r.interval_s[0] for r in rows]), np.array([r.interval_s[1] for r in rows]), carry)
+                     np.array([r.interval_s[0] for r in rows]), np.array([r.interval_s[1] for r in rows]), carry,
+                     np.array([INTEGRAL_SOURCES.index(r.integral) for r in rows], dtype=np.int64),
+                     np.array([_attitude_state(r) for r in rows], dtype=np.int64))
+
+
+def _attitude_state(row: Any) -> int:
+    """The index of the attitude state of a row that integrates the attitude error, else -1."""
+    if row.integral != "attitude":
+        return -1
+    at = [k for k, name in enumerate(row.labels) if name in ("theta_y", "theta_z")]
+    if len(at) != 1:
+        raise ValueError(f"row {row.time_s:g} s integrates the attitude: one theta_y or theta_z state, found {len(at)}")
+    return at[0]
 
 
 @nb.njit(cache=True)
@@ -117,9 +147,10 @@ def row_index(tb, t):
 
 
 @nb.njit(cache=True)
-def lqg_step_k(tb, st, which, y, t, on, u_limit, aw, u):
+def lqg_step_k(tb, st, which, y, e, t, on, u_limit, aw, u):
     """Step the rows ``which`` (k,) of the law ``st`` (:class:`LQGState`) with the gyro samples ``y`` (k,)
-    [rad/s] at flight times ``t`` (k,) [s], the law on where ``on`` (k,); their commands [rad] into ``u``
+    [rad/s] and the attitude error samples ``e`` (k,) [rad] (read by a row whose integral's ``source`` is the
+    attitude) at flight times ``t`` (k,) [s], the law on where ``on`` (k,); their commands [rad] into ``u``
     (k,). ``tb``: :class:`LQGTables`; ``u_limit``: the gimbal limit [rad]; ``aw``: :class:`AntiWindup`."""
     N = tb.A.shape[1]
     xf = np.empty(N)
@@ -145,22 +176,28 @@ def lqg_step_k(tb, st, which, y, t, on, u_limit, aw, u):
             for k in range(N):
                 src = tb.carry[o, i, k] if o >= 0 else -1
                 st.x[b, k] = old[src] if src >= 0 else 0.0
+            if o >= 0 and tb.source[i] == 1 and tb.Ki[i] != 0.0:    # the attitude's integral: its command carried
+                st.xi[b] *= tb.Ki[o] / tb.Ki[i]
             st.row[b] = i
         m = tb.dim[i]
         cx = 0.0
         for k in range(m):
             cx += tb.C[i, k] * st.x[b, k]
         innov = y[j] - cx
-        kx = 0.0
         for k in range(m):
             xf[k] = st.x[b, k] + tb.M[i, k] * innov
+        if tb.source[i] == 1:                     # the attitude state: the measured attitude error
+            xf[tb.att[i]] = e[j]
+        kx = 0.0
+        for k in range(m):
             kx += tb.Kx[i, k] * xf[k]
         v = -kx - tb.Ki[i] * st.xi[b]
         uu = min(max(v, -u_limit), u_limit)
         if aw.on:
             uu = min(max(uu, st.u[b] - aw.rate_step), st.u[b] + aw.rate_step)
         sat = uu != v
-        dxi = (tb.a[i] - 1.0) * st.xi[b] - tb.dt[i] * y[j]
+        s = y[j] if tb.source[i] == 0 else e[j]          # the integral's input (INTEGRAL_SOURCES)
+        dxi = (tb.a[i] - 1.0) * st.xi[b] - tb.dt[i] * s
         if aw.on:
             if aw.back_gain > 0.0 and tb.Ki[i] != 0.0:   # back-calculation: v towards the command sent
                 dxi += aw.back_gain * (v - uu) / tb.Ki[i]
@@ -182,21 +219,22 @@ def lqg_step_k(tb, st, which, y, t, on, u_limit, aw, u):
 @nb.njit(cache=True)
 def lqg_act_k(pitch, yaw, sp, sy, oc, rows, obs, t, u_limit, aw, gimbal, out):
     """Both planes' laws (``pitch``, ``yaw``: :class:`LQGTables`; ``sp``, ``sy``: :class:`LQGState`) for
-    the rows ``rows`` (k,) on their observations ``obs`` (k, n_obs) (``oc``: the columns of the rate errors
-    and the controller-on flag, :class:`.pidkernel.ObsColumns`) at the flight times ``t`` (n,) [s] of every
+    the rows ``rows`` (k,) on their observations ``obs`` (k, n_obs) (``oc``: the columns of the rate errors,
+    the attitude errors (-1: none, read as 0) and the controller-on flag, :class:`.pidkernel.ObsColumns`) at the flight times ``t`` (n,) [s] of every
     row: :func:`lqg_step_k` of each plane (anti-windup ``aw``); the commands [rad] into ``gimbal`` (n, 2),
     the actions ``out`` (k, 2) float32 (gimbal / limit, clipped to [-1, 1])."""
     k = rows.size
-    y, tk, u = np.empty(k), np.empty(k), np.empty(k)
+    y, e, tk, u = np.empty(k), np.empty(k), np.empty(k), np.empty(k)
     on = np.empty(k, np.bool_)
     for j in range(k):
         tk[j] = t[rows[j]]
         on[j] = float(obs[j, oc.on]) >= 0.5
     for ax in range(2):
-        col = oc.err[ax]
+        col, cat = oc.err[ax], oc.att[ax]
         for j in range(k):
             y[j] = float(obs[j, col])
-        lqg_step_k(pitch if ax == 0 else yaw, sp if ax == 0 else sy, rows, y, tk, on, u_limit, aw, u)
+            e[j] = float(obs[j, cat]) if cat >= 0 else 0.0
+        lqg_step_k(pitch if ax == 0 else yaw, sp if ax == 0 else sy, rows, y, e, tk, on, u_limit, aw, u)
         for j in range(k):
             gimbal[rows[j], ax] = u[j]
             out[j, ax] = np.float32(clip_k(u[j] / u_limit, -1.0, 1.0))

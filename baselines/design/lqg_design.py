@@ -1,7 +1,11 @@
 """LQG rate loops designed on the flight computer's non-rigid plant, per plane, at frozen flight times.
 
-``lvgym design lqg --vehicle smile [--out results/schedules] [--overwrite]``
+``lvgym design lqg --vehicle smile [--integral attitude] [--out results/schedules] [--overwrite]``
 (``python -m lvgym.baselines.design.lqg_design``)
+
+``--integral attitude`` designs ``lqi`` (docs/lqi.md): the pure integral of the attitude error in place of the
+rate's leaky one (:mod:`.lqg_row`), the search over :data:`LQI_GRID` with each row's estimator and mode weights
+those of the shipped ``lqg`` row, written as ``<vehicle>_lqi.npz``.
 
 Each row's law is :mod:`.lqg_row`'s (plant with the delay as a state, LQR on the rate error and its leaky
 integral, steady-state Kalman filter of the v1 gyro, the compensator and its margins with the loop broken
@@ -28,10 +32,11 @@ import scipy.linalg as sla
 from lvgym.commandline import arg
 from lvgym.errors import ConfigError, check_number
 
-from .flightloop import flight_plant, mode_frequencies
+from .flightloop import mode_frequencies
 from .linearize import OperatingPoint, operating_point, reused_flights
-from .lqg_row import (LQGWeights, RowDesign, closed_loop, closed_loop_growth, delayed_plant, design_row,
-                      frequency_grid, gain_at, margins_from_response, open_loop, plant_labels, response)
+from .lqg_row import (LQGWeights, RowDesign, check_integral, closed_loop, closed_loop_growth, delayed_plant, design_row,
+                      frequency_grid, gain_at, integral_input, loop_plant, loop_response, margins_from_response,
+                      open_loop, plant_labels, plant_responses)
 from .target import fly_option, vehicle_option
 
 SCHEDULES = Path(__file__).resolve().parents[1] / "schedules"
@@ -65,6 +70,10 @@ class MarginTargets:
 #: and mode-rate process noise
 SEARCH_GRID = {"q_int": (10.0, 100.0), "r_gimbal": (1.0, 3.0, 10.0, 30.0, 300.0), "w_gimbal": (1e-8, 1e-7),
                "q_modes": (1e-5, 1e-4, 1e-3), "w_modes": (1e-5, 1e-4, 1e-3, 1e-2)}
+#: the weights tried at every row of the attitude integral's design (``lqi``): the attitude weight takes the
+#: values of lqg's ``q_int`` (the rate's integral is the attitude change), its integral's [1/(rad s)^2] and the
+#: gimbal's lqg's; the estimator's and the modes' weights are the row's lqg weights (:func:`design_schedule`)
+LQI_GRID = {"q_attitude": (10.0, 100.0), "q_int": (1.0, 10.0, 100.0), "r_gimbal": (1.0, 3.0, 10.0, 30.0, 300.0)}
 _SEARCH_W = np.logspace(-5, math.log10(math.pi / 0.02 * 0.9999), 5000)
 
 
@@ -76,13 +85,12 @@ def assess(d: RowDesign, plants: dict[str, control.StateSpace], modes: dict[str,
     already computed (the loop's is the product with the compensator's)."""
     comp = d.compensator()
     w = frequency_grid(d.dt) if w is None else np.asarray(w, float)
-    kr = -response(comp, w)
     out: dict[str, Any] = {}
     for name, g in plants.items():
-        gr = plant_responses[name] if plant_responses is not None else response(g, w)
+        lr = loop_response(comp, g, w, None if plant_responses is None else plant_responses[name])
         L = open_loop(comp, g)
         growth = closed_loop_growth(L)
-        out[name] = {**margins_from_response(kr * gr, w), "closed_loop_stable": growth < 1e-4,
+        out[name] = {**margins_from_response(lr, w), "closed_loop_stable": growth < 1e-4,
                      "max_pole_real_per_s": growth}
         if name == "nonrigid":
             out["slosh_db"] = gain_at(L, modes["slosh"])
@@ -119,7 +127,8 @@ def gust_response(d: RowDesign, op: OperatingPoint, plane: str) -> float:
     labels = plant_labels(op, plane)
     Bd = np.zeros((A.shape[0], 1))
     Bd[labels.index(PLANE_VELOCITY[plane]), 0] = 1.0
-    Acl, _ = closed_loop(A, B, C, d.compensator())
+    Cl = C if d.integral == "rate" else np.vstack([C, integral_input(C, labels, d.integral)])
+    Acl, _ = closed_loop(A, B, Cl, d.compensator())
     nk = Acl.shape[0] - A.shape[0]
     Bcl = np.vstack([Bd, np.zeros((nk, 1))])
     Ccl = np.hstack([C, np.zeros((1, nk))])
@@ -154,23 +163,26 @@ DISPERSED_SLOSH = ((0.9, 0.5), (1.1, 0.5))
 
 def search_row(op_nonrigid: OperatingPoint, op_rigid: OperatingPoint, neighbours: dict[str, OperatingPoint],
                plane: str, tg: MarginTargets = MarginTargets(), grid: dict = SEARCH_GRID,
-               log=print) -> tuple[RowDesign, dict[str, Any], list[dict]]:
-    """Every combination of the weights of ``grid`` at one row: among the designs whose loops are
+               log=print, integral: str = "rate",
+               base: LQGWeights = LQGWeights()) -> tuple[RowDesign, dict[str, Any], list[dict]]:
+    """Every combination of the weights of ``grid`` (the others ``base``'s) at one row, with the integral
+    ``integral`` (:data:`.lqg_row.INTEGRALS`): among the designs whose loops are
     stable on the rigid, the non-rigid and the ``neighbours``' non-rigid plants (name -> operating
     point: the ends of the row's interval, the dispersed plants) and meet ``tg``, the one of the
     smallest rigid gust response (:func:`gust_response`); if none meets them, the one of smallest
     :func:`shortfall`. Returns the design, its assessment on the full frequency grid and the
     table of every candidate."""
+    check_integral(integral)
     modes = mode_frequencies(op_nonrigid, plane)
-    plants = {"rigid": flight_plant(op_rigid, plane), "nonrigid": flight_plant(op_nonrigid, plane)}
-    plants.update({name: flight_plant(op, plane) for name, op in neighbours.items()})
-    responses = {k: response(g, _SEARCH_W) for k, g in plants.items()}
+    plants = {"rigid": loop_plant(op_rigid, plane, integral), "nonrigid": loop_plant(op_nonrigid, plane, integral)}
+    plants.update({name: loop_plant(op, plane, integral) for name, op in neighbours.items()})
+    responses = {k: plant_responses(g, _SEARCH_W) for k, g in plants.items()}
     table, cands = [], []
     keys = list(grid)
     for vals in np.array(np.meshgrid(*[grid[k] for k in keys], indexing="ij")).reshape(len(keys), -1).T:
-        w = LQGWeights(**dict(zip(keys, (float(v) for v in vals))))
+        w = replace(base, **dict(zip(keys, (float(v) for v in vals))))
         try:
-            d = design_row(op_nonrigid, plane, w)
+            d = design_row(op_nonrigid, plane, w, integral)
         except (ValueError, np.linalg.LinAlgError) as exc:
             table.append({**asdict(w), "error": str(exc)})
             continue
@@ -191,7 +203,9 @@ def search_row(op_nonrigid: OperatingPoint, op_rigid: OperatingPoint, neighbours
     d = cands[0][3]
     final = assess(d, plants, modes)
     final["gust_h2"] = gust_response(d, op_rigid, plane)
-    log(f"  {plane} t = {d.t:5.1f} s: q_int {d.weights.q_int:g}, r {d.weights.r_gimbal:g}, w {d.weights.w_gimbal:g}, "
+    att = f"q_attitude {d.weights.q_attitude:g}, " if integral == "attitude" else ""
+    log(f"  {plane} t = {d.t:5.1f} s: {att}q_int {d.weights.q_int:g}, r {d.weights.r_gimbal:g}, "
+        f"w {d.weights.w_gimbal:g}, "
         f"q_modes {d.weights.q_modes:g}, w_modes {d.weights.w_modes:g}: shortfall {shortfall(final, tg):.3f}, "
         f"{sum(1 for c in cands if c[0] == 0)} of {len(table)} designs meet the targets")
     return d, final, table
@@ -246,6 +260,7 @@ def row_neighbours(vehicle: Any, t: float, interval: tuple[float, float], op_non
 def design_schedule(vehicle: Any = "smile", rows: tuple[float, ...] | None = None,
                     phases: tuple[tuple[float, float], ...] | None = None, tg: MarginTargets = MarginTargets(),
                     grid: dict = SEARCH_GRID, planes: tuple[str, ...] = PLANE_NAMES, log=print, fly: str = "auto",
+                    integral: str = "rate", base: tuple[LQGWeights, ...] | None = None,
                     **options: Any) -> dict[str, Any]:
     """Design every row and plane (:func:`search_row`); the neighbours of a row are the non-rigid plants
     at the ends of its interval (:func:`row_intervals`) and at the row with its slosh dispersed
@@ -257,7 +272,8 @@ def design_schedule(vehicle: Any = "smile", rows: tuple[float, ...] | None = Non
     ``gs-pid`` schedule, as the shipped design), ``pid`` (a rigid PID schedule designed first at the rows,
     :func:`.tune.schedule` with ``fly="rows"``), ``privileged`` (the privileged reference) or a schedule
     file; ``auto``: ``centred`` for a shipped vehicle, ``pid`` for a file. A document not flown as the shipped design records how in
-    ``operating_points``."""
+    ``operating_points``. ``integral``: the rate's leaky integral (``lqg``) or the attitude's pure one (``lqi``);
+    ``base``: per row, the weights the ``grid`` leaves as they are (default :class:`.lqg_row.LQGWeights`')."""
     from .target import burn_phases, check_fly, check_vehicle, describe, file_times, fly_mode, is_shipped
     from .target import flyer as fly_with
     from .target import schedule_flyer
@@ -273,6 +289,9 @@ def design_schedule(vehicle: Any = "smile", rows: tuple[float, ...] | None = Non
         raise ConfigError("phases" if rows is not None else "rows", None,
                           f"the rows and thrusting phases [s] of vehicle {vehicle!r} (SMILE v1's are the defaults)")
     rows = tuple(rows)
+    check_integral(integral)
+    if base is not None and len(base) != len(rows):
+        raise ConfigError("base", len(base), f"one LQGWeights per row ({len(rows)})")
     intervals = row_intervals(rows, tuple(phases))
     upper_after = phases[0][1] + 0.5
     fly = fly_mode(check_fly(fly), vehicle)
@@ -290,13 +309,15 @@ def design_schedule(vehicle: Any = "smile", rows: tuple[float, ...] | None = Non
     how = describe(fly) if fly != "centred" or vehicle != "smile" else \
         "gimbal centred up to the first stage's burnout, then the shipped rigid gs-pid schedule 'smile'"
     log(f"operating points: {how}")
-    out: dict[str, Any] = {"vehicle": vehicle, "rows": [], "targets": asdict(tg), "grid": {k: list(v) for k, v in grid.items()}}
+    out: dict[str, Any] = {"vehicle": vehicle, "rows": [], "targets": asdict(tg),
+                           "grid": {k: list(v) for k, v in grid.items()}, "integral": integral}
     if fly != "centred" or vehicle != "smile" or options:
         out["operating_points"] = {"flown_with": how, **({"env_options": dict(options)} if options else {}),
                                    **({"rigid_pid_rows": [{k: r[k] for k in ("time_s", "mass_kg", "kp", "ki", "kd", "n")}
                                                           for r in rigid_doc["rows"]]} if rigid_doc else {})}
-    for t, (lo, hi) in zip(rows, intervals):
+    for j, (t, (lo, hi)) in enumerate(zip(rows, intervals)):
         log(f"t = {t:g} s (used {lo:g}-{hi:g} s)")
+        row_base = LQGWeights() if base is None else base[j]
         op_n = _op(vehicle, t, "nonrigid", upper_after, flyer, **options)
         op_r = _op(vehicle, t, "rigid", upper_after, flyer, **options)
         near = row_neighbours(vehicle, t, (lo, hi), op_n, upper_after, flyer, **options)
@@ -305,12 +326,12 @@ def design_schedule(vehicle: Any = "smile", rows: tuple[float, ...] | None = Non
         for plane in planes:                 # the first plane's search; the others fly its weights (axisymmetric)
             g = grid if chosen is None else {k: (v,) for k, v in asdict(chosen).items()}
             try:
-                d, a, table = search_row(op_n, op_r, near, plane, tg, g, log)
+                d, a, table = search_row(op_n, op_r, near, plane, tg, g, log, integral, row_base)
             except RuntimeError:
                 if g is grid:
                     raise
                 log(f"  {plane}: the first plane's weights give no design here; the plane's own search")
-                d, a, table = search_row(op_n, op_r, near, plane, tg, grid, log)
+                d, a, table = search_row(op_n, op_r, near, plane, tg, grid, log, integral, row_base)
             chosen = chosen or d.weights
             entry[plane] = {"design": d, "assessment": a, "search": table,
                             "modes_radps": mode_frequencies(op_n, plane)}
@@ -334,6 +355,7 @@ def save_schedule(doc: dict[str, Any], path: Path) -> None:
             arrays[pre + "a"] = np.array(d.a)
             arrays[pre + "dt"] = np.array(d.dt)
             arrays[pre + "labels"] = np.array(d.state_labels)
+            arrays[pre + "integral"] = np.array(d.integral)
             arrays[pre + "weights"] = np.array([getattr(d.weights, f.name) for f in fields(LQGWeights)])
     path.parent.mkdir(parents=True, exist_ok=True)
     np.savez(path, **arrays)
@@ -351,8 +373,9 @@ def _slosh(gains_db: list[float]) -> str:
 
 
 def margin_table(doc: dict[str, Any]) -> str:
-    """The margins per row and plane as a Markdown table."""
-    lines = ["| t [s] | plane | q_int, r_gimbal, w_gimbal, q_modes, w_modes | rigid GM / GRM [dB] / PM [deg] at [rad/s] / CL | "
+    """The margins per row and plane as a Markdown table (the attitude integral's: ``q_attitude`` first)."""
+    att = doc.get("integral", "rate") == "attitude"
+    lines = [f"| t [s] | plane | {'q_attitude, ' if att else ''}q_int, r_gimbal, w_gimbal, q_modes, w_modes | rigid GM / GRM [dB] / PM [deg] at [rad/s] / CL | "
              "non-rigid GM / GRM / PM at / CL | slosh max dB | bending dB | gust H2 | robustness plants (non-rigid): interval ends, "
              "slosh dispersed |",
              "|---:|---|---|---|---|---:|---|---:|---|"]
@@ -364,7 +387,7 @@ def margin_table(doc: dict[str, Any]) -> str:
             ends = "; ".join(f"{k}: {_m(v)}" for k, v in a.items()
                              if isinstance(v, dict) and k not in ("rigid", "nonrigid"))
             wt = d.weights
-            lines.append(f"| {r['time_s']:g} | {plane} | {wt.q_int:g}, {wt.r_gimbal:g}, {wt.w_gimbal:g}, {wt.q_modes:g}, {wt.w_modes:g} "
+            lines.append(f"| {r['time_s']:g} | {plane} | {f'{wt.q_attitude:g}, ' if att else ''}{wt.q_int:g}, {wt.r_gimbal:g}, {wt.w_gimbal:g}, {wt.q_modes:g}, {wt.w_modes:g} "
                          f"| {_m(a['rigid'])} | {_m(a['nonrigid'])} | {_slosh(a['slosh_db'])} | "
                          f"{', '.join(f'{x:.1f}' for x in a['bending_db'])} | {a['gust_h2']:.4f} | {ends} |")
     return "\n".join(lines) + "\n"
@@ -387,6 +410,10 @@ class Args:
     parts of its burning flight)"""
     phases: list[float] | None = arg(None, lo=0.0, hi=3600.0, metavar="START END")
     """the thrusting phases with the controller on [s], pairs START END (default: SMILE v1's, 2 42.5 54.5 69.5)"""
+    integral: str = arg("rate", choices=("rate", "attitude"))
+    """what the integral integrates: rate (the rate error, leaky: lqg, <vehicle>_lqg.npz) or attitude (the
+    strapdown attitude error, pure: lqi, <vehicle>_lqi.npz; searched over LQI_GRID with each row's estimator
+    and mode weights those of the vehicle's lqg schedule, which must have the same rows)"""
     fly: str = arg("auto", check=fly_option, metavar="MODE|SCHEDULE")
     """how the operating points are reached: centred (SMILE: gimbal centred, its upper stage with gs-pid),
     pid (a rigid PID schedule designed first at the rows), privileged (the privileged reference, which needs
@@ -422,23 +449,51 @@ def main(argv: list[str] | None = None) -> int:
         fail(command_name(prog), exc)
     out = SCHEDULES if a.overwrite else Path(a.out)
     name = stem(a.vehicle)
+    lqi = a.integral == "attitude"
+    kind = "lqi" if lqi else "lqg"
+    try:
+        base, grid = (lqg_weights(out, name, rows), LQI_GRID) if lqi else (None, SEARCH_GRID)
+    except ConfigError as exc:
+        fail(command_name(prog), exc)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        doc = design_schedule(a.vehicle, rows, phases, fly=a.fly)
-    save_schedule(doc, out / f"{name}_lqg.npz")
+        doc = design_schedule(a.vehicle, rows, phases, grid=grid, fly=a.fly, integral=a.integral, base=base)
+    save_schedule(doc, out / f"{name}_{kind}.npz")
     again = (f"lvgym design lqg --vehicle {a.vehicle}" + ("" if not a.rows else " --rows " + " ".join(f"{t:g}" for t in rows))
              + ("" if not a.phases else " --phases " + " ".join(f"{t:g}" for p in phases for t in p))
-             + ("" if a.fly == "auto" else f" --fly {a.fly}"))
+             + ("" if a.fly == "auto" else f" --fly {a.fly}") + (" --integral attitude" if lqi else ""))
     flown = f"Operating points: {doc['operating_points']['flown_with']}. " if "operating_points" in doc else ""
-    head = (f"# LQG schedule of {name} v1: margins per row\n\nWritten by `{again}`. {flown}Loop broken at the plant "
+    what = ("LQI schedule (the pure integral of the attitude error; estimator and mode weights lqg's row's, "
+            "the search over q_attitude, q_int and r_gimbal)" if lqi else "LQG schedule")
+    head = (f"# {what} of {name} v1: margins per row\n\nWritten by `{again}`. {flown}Loop broken at the plant "
             "input; GM / GRM: gain and gain-reduction margin, "
             "PM: phase margin at the gain crossover of smallest |PM|, CL: closed-loop stability; slosh and "
             "bending: the non-rigid loop's |L| at each mode (bending modes above Nyquist folded). Targets: "
             f"{doc['targets']}.\n\n")
-    (out / f"{name}_lqg_margins.md").write_text(head + margin_table(doc))
+    (out / f"{name}_{kind}_margins.md").write_text(head + margin_table(doc))
     print(margin_table(doc))
-    print(f"wrote {out / (name + '_lqg.npz')} and {out / (name + '_lqg_margins.md')}")
+    print(f"wrote {out / f'{name}_{kind}.npz'} and {out / f'{name}_{kind}_margins.md'}")
     return 0
+
+
+def lqg_weights(folder: Path, name: str, rows: tuple[float, ...]) -> tuple[LQGWeights, ...]:
+    """The pitch weights of each row of the vehicle's lqg schedule (``<name>_lqg.npz`` in ``folder``, else the
+    shipped one): the attitude integral's design keeps their estimator and mode weights. Its rows must be
+    ``rows`` [s] (to 0.5 s: a row's time is where its flight reached it)."""
+    from ..lqg import LQGSchedule
+
+    path = folder / f"{name}_lqg.npz"
+    try:
+        sched = LQGSchedule.load(path if path.exists() else f"{name}_lqg")
+    except FileNotFoundError:
+        raise ConfigError("--integral", "attitude", f"a {name}_lqg.npz schedule first (lvgym design lqg --vehicle "
+                          "...): the attitude integral's design keeps its estimator and mode weights") from None
+    have = [r.time_s for r in sched.rows["pitch"]]
+    if len(have) != len(rows) or any(abs(x - t) > 0.5 for x, t in zip(have, rows)):
+        raise ConfigError("--rows", list(rows), f"the rows of {sched.source} ({[round(x, 2) for x in have]})")
+    if not all(r.weights for r in sched.rows["pitch"]):
+        raise ConfigError("--integral", "attitude", f"a lqg schedule with its weights ({sched.source} has none)")
+    return tuple(LQGWeights(*r.weights) for r in sched.rows["pitch"])
 
 
 if __name__ == "__main__":

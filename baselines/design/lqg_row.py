@@ -19,6 +19,19 @@ equation has no stabilising solution; the design therefore uses a leaky integrat
 system; the leak's time constant is far beyond the flight's dynamics, so it rejects a constant
 disturbance as an integrator would over the flight).
 
+The integral of the attitude error (``integral="attitude"``, the ``lqi`` design, docs/lqi.md) takes the
+place of the rate's: ``xi_{k+1} = xi_k - dt e_k`` with ``e = C_e x`` the attitude error (the vehicle's
+``theta_y`` or ``theta_z``: :func:`attitude_output`; in flight the observation's strapdown attitude error),
+without a leak. The attitude over the gimbal has no zero at ``z = 1`` (a held gimbal angle against the
+aerodynamic moment holds an attitude), so the pure integrator is controllable and ``dlqr`` has its
+stabilising solution; ``q_attitude`` weights ``e^2`` beside it (the place ``q_int`` takes in the rate design,
+whose integral of the rate is the attitude change), and ``q_int`` now weights the attitude's integral
+[1/(rad s)^2]. A constant disturbance moment then leaves no attitude offset: at rest ``xi`` is constant only
+where ``e = 0``. The compensator has two inputs, the gyro sample and the attitude error (:func:`compensator`):
+the attitude error also stands for the estimate's attitude state (the rate-only filter's attitude drifts with
+any moment it does not model, and the regulator's attitude gain would fly that drift); its loop is assessed on
+the plant with both outputs (:func:`loop_plant`).
+
 Estimator (:func:`kalman_gain`): the steady-state Kalman filter of the plant with process noise at the
 gimbal, after the delay (variance ``w_gimbal`` [rad^2] per control period: what stands in for the wind,
 the misalignment and the model's errors) and on the rates of the slosh pendulums and bending modes
@@ -69,7 +82,9 @@ class LQGWeights:
     """Weights of one row's design (module docstring). Units: ``q_rate`` [1/(rad/s)^2], ``q_int``
     [1/rad^2], ``r_gimbal`` [1/rad^2], ``q_modes`` [1/(1/s)^2 on each modal
     and pendulum rate], ``w_gimbal`` [rad^2 per control period], ``w_modes`` [(1/s)^2
-    per control period, on each modal and pendulum rate], ``integrator_leak_s`` [s]."""
+    per control period, on each modal and pendulum rate], ``integrator_leak_s`` [s] (the rate integral's),
+    ``q_attitude`` [1/rad^2] on the attitude error (the attitude integral's design; ``q_int`` is then in
+    [1/(rad s)^2])."""
 
     q_rate: float = 1.0
     q_int: float = 1.0
@@ -78,6 +93,7 @@ class LQGWeights:
     w_gimbal: float = 1e-6
     w_modes: float = 0.0
     integrator_leak_s: float = 100.0
+    q_attitude: float = 0.0
 
     def __post_init__(self) -> None:
         for f in fields(self):
@@ -106,10 +122,13 @@ class RowDesign:
     dt: float
     weights: LQGWeights
     state_labels: tuple[str, ...]
+    integral: str = "rate"
+    """what the integral integrates (:data:`INTEGRALS`): the rate error (leaky) or the attitude error (pure)"""
 
     def compensator(self) -> control.StateSpace:
-        """The compensator from the gyro sample ``y`` [rad/s] to the command ``u`` [rad] (states: the
-        predicted estimate ``x_p`` and the integral ``xi``), unclipped."""
+        """The compensator from the gyro sample ``y`` [rad/s] (and, integrating the attitude, the attitude
+        error ``e`` [rad]) to the command ``u`` [rad] (states: the predicted estimate ``x_p`` and the integral
+        ``xi``), unclipped."""
         return compensator(self)
 
 
@@ -189,35 +208,70 @@ def _delayed_plant(op: OperatingPoint, plane: str) -> tuple[np.ndarray, np.ndarr
     return A, B, C, Gw
 
 
+#: what a row's integral integrates (:data:`lvgym.baselines.lqgkernel.INTEGRAL_SOURCES`, in the same order)
+INTEGRALS = ("rate", "attitude")
+
+
+def check_integral(integral: str) -> str:
+    """``integral`` if it is one of :data:`INTEGRALS`, else a :class:`~lvgym.errors.ConfigError`."""
+    if integral not in INTEGRALS:
+        raise ConfigError("integral", integral, f"one of {INTEGRALS}")
+    return integral
+
+
+def attitude_output(labels: tuple[str, ...]) -> np.ndarray:
+    """``C_e`` (1, n): the attitude error of the plant of state names ``labels`` (its one ``theta_y`` or
+    ``theta_z``, the plane's attitude [rad]; the strapdown attitude error integrates the gyro's rate error,
+    whose rigid part is this state's rate)."""
+    at = [i for i, name in enumerate(labels) if name in ("theta_y", "theta_z")]
+    if len(at) != 1:
+        raise ValueError(f"one attitude state (theta_y or theta_z) among the plant's states, found {len(at)}")
+    out = np.zeros((1, len(labels)))
+    out[0, at[0]] = 1.0
+    return out
+
+
+def integral_input(C: np.ndarray, labels: tuple[str, ...], integral: str) -> np.ndarray:
+    """The output row the integral integrates (its input ``C_i x``): the gyro's ``C`` or the attitude's."""
+    return C if check_integral(integral) == "rate" else attitude_output(labels)
+
+
 def _mode_rates(labels: tuple[str, ...]) -> list[int]:
     """Indices of the bending (``eta_dot_*``) and pendulum (``omega_s_*``) rates among ``labels``."""
     return [i for i, name in enumerate(labels) if name.startswith(("eta_dot_", "omega_s_"))]
 
 
 def regulator_problem(A: np.ndarray, B: np.ndarray, C: np.ndarray, w: LQGWeights, dt: float,
-                      labels: tuple[str, ...] = ()) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, float]:
-    """The regulator's problem (module docstring): the plant augmented with the leaky integral of ``-y``,
-    ``Aa`` (n+1, n+1), ``Ba`` (n+1, 1), its state weight ``Q`` (n+1, n+1) (``q_modes`` on the mode rates of
-    ``labels``), the command weight ``R`` (1, 1) [1/rad^2] and the integrator factor ``a``. The MPC
-    (:mod:`lvgym.baselines.mpc`) minimises the same cost under the gimbal's limits."""
+                      labels: tuple[str, ...] = (), integral: str = "rate"
+                      ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, float]:
+    """The regulator's problem (module docstring): the plant augmented with the leaky integral of ``-y``
+    (``integral="attitude"``: the pure integral of ``-e``, the attitude of ``labels``), ``Aa`` (n+1, n+1),
+    ``Ba`` (n+1, 1), its state weight ``Q`` (n+1, n+1) (``q_modes`` on the mode rates of ``labels``,
+    ``q_attitude`` on the attitude), the command weight ``R`` (1, 1) [1/rad^2] and the integrator factor
+    ``a``. The MPC (:mod:`lvgym.baselines.mpc`) minimises the same cost under the gimbal's limits."""
     n = A.shape[0]
-    a = math.exp(-dt / w.integrator_leak_s)
-    Aa = np.block([[A, np.zeros((n, 1))], [-dt * C, np.array([[a]])]])
+    a = math.exp(-dt / w.integrator_leak_s) if check_integral(integral) == "rate" else 1.0
+    Ci = integral_input(C, labels, integral)
+    Aa = np.block([[A, np.zeros((n, 1))], [-dt * Ci, np.array([[a]])]])
     Ba = np.vstack([B, [[0.0]]])
     Q = np.zeros((n + 1, n + 1))
     Q[:n, :n] = w.q_rate * C.T @ C
     Q[n, n] = w.q_int
     for i in _mode_rates(labels):
         Q[i, i] += w.q_modes
+    if w.q_attitude > 0.0:
+        Ce = attitude_output(labels)
+        Q[:n, :n] += w.q_attitude * Ce.T @ Ce
     return Aa, Ba, Q, np.array([[w.r_gimbal]]), a
 
 
 def regulator(A: np.ndarray, B: np.ndarray, C: np.ndarray, w: LQGWeights, dt: float,
-              labels: tuple[str, ...] = ()) -> tuple[np.ndarray, float, float]:
-    """LQR gains ``(K_x, K_i, a)`` on the plant augmented with the leaky integral of ``-y``
-    (:func:`regulator_problem`); ``q_modes`` weights the mode rates of ``labels``."""
+              labels: tuple[str, ...] = (), integral: str = "rate") -> tuple[np.ndarray, float, float]:
+    """LQR gains ``(K_x, K_i, a)`` on the plant augmented with the leaky integral of ``-y`` (``integral``:
+    or the pure integral of the attitude error, :func:`regulator_problem`); ``q_modes`` weights the mode
+    rates of ``labels``."""
     n = A.shape[0]
-    Aa, Ba, Q, R, a = regulator_problem(A, B, C, w, dt, labels)
+    Aa, Ba, Q, R, a = regulator_problem(A, B, C, w, dt, labels, integral)
     K, _, _ = control.dlqr(Aa, Ba, Q, R)
     K = np.asarray(K, float)
     return K[:, :n], float(K[0, n]), a
@@ -243,30 +297,80 @@ def kalman_gain(A: np.ndarray, C: np.ndarray, Gw: np.ndarray, w: LQGWeights, dt:
     return P @ C.T / (C @ P @ C.T + V).item()
 
 
-def design_row(op: OperatingPoint, plane: str, w: LQGWeights) -> RowDesign:
-    """The LQG design of ``plane`` at the operating point ``op`` (use the non-rigid model's)."""
+def design_row(op: OperatingPoint, plane: str, w: LQGWeights, integral: str = "rate") -> RowDesign:
+    """The LQG design of ``plane`` at the operating point ``op`` (use the non-rigid model's); ``integral``:
+    the leaky integral of the rate error (``lqg``) or the pure integral of the attitude error (``lqi``)."""
     A, B, C, Gw = delayed_plant(op, plane)
     dt, _ = control_timing(op)
     labels = plant_labels(op, plane)
     if len(labels) != A.shape[0]:
         raise RuntimeError(f"{len(labels)} state names for {A.shape[0]} states")
-    Kx, Ki, a = regulator(A, B, C, w, dt, labels)
+    Kx, Ki, a = regulator(A, B, C, w, dt, labels, integral)
     arw = float(getattr(op.task, "gyro_arw_rad_per_sqrt_s", GYRO_ARW_RAD_PER_SQRT_S))
     M = kalman_gain(A, C, Gw, w, dt, labels, arw)
-    return RowDesign(float(op.t), plane, A, B, C, Kx, Ki, M, a, dt, w, labels)
+    return RowDesign(float(op.t), plane, A, B, C, Kx, Ki, M, a, dt, w, labels, integral)
 
 
 def compensator(d: RowDesign) -> control.StateSpace:
-    """The linear compensator ``y -> u`` of a :class:`RowDesign` (module docstring), unclipped."""
+    """The linear compensator of a :class:`RowDesign` (module docstring), unclipped: ``y -> u``, or with the
+    attitude integral ``(y, e) -> u`` (the gyro sample [rad/s] and the attitude error [rad]; the estimate's
+    attitude state is then the measured ``e`` after the measurement update, as :mod:`.lqgkernel` flies it)."""
     A, B, C, Kx, M = d.A, d.B, d.C, d.Kx, d.M
     n = A.shape[0]
     F = np.eye(n) - M @ C
     Acl = A - B @ Kx
     Ac = np.block([[Acl @ F, -B * d.Ki], [np.zeros((1, n)), np.array([[d.a]])]])
-    Bc = np.vstack([Acl @ M, [[-d.dt]]])
     Cc = np.hstack([-Kx @ F, [[-d.Ki]]])
-    Dc = -Kx @ M
-    return control.ss(Ac, Bc, Cc, Dc, d.dt, inputs=["gyro"], outputs=["command"])
+    if check_integral(d.integral) == "rate":
+        Bc = np.vstack([Acl @ M, [[-d.dt]]])
+        Dc = -Kx @ M
+        return control.ss(Ac, Bc, Cc, Dc, d.dt, inputs=["gyro"], outputs=["command"])
+    # the estimate's attitude state replaced by the measured attitude error: x_f = S (F x_p + M y) + c e
+    c = attitude_output(d.state_labels).T
+    S = np.eye(n) - c @ c.T
+    Ac = np.block([[Acl @ S @ F, -B * d.Ki], [np.zeros((1, n)), np.array([[d.a]])]])
+    Bc = np.block([[Acl @ S @ M, Acl @ c], [np.array([[0.0, -d.dt]])]])
+    Cc = np.hstack([-Kx @ S @ F, [[-d.Ki]]])
+    Dc = np.hstack([-Kx @ S @ M, -Kx @ c])
+    return control.ss(Ac, Bc, Cc, Dc, d.dt, inputs=["gyro", "attitude"], outputs=["command"])
+
+
+def loop_plant(op: OperatingPoint, plane: str = "pitch", integral: str = "rate") -> control.StateSpace:
+    """The plant a row's compensator is closed on: :func:`.flightloop.flight_plant` (gimbal command to gyro
+    sample), or for the attitude integral the same plant (:func:`delayed_plant`) with the attitude error
+    (:func:`attitude_output`) as its second output."""
+    if check_integral(integral) == "rate":
+        return flight_plant(op, plane)
+    A, B, C, _ = delayed_plant(op, plane)
+    Ce = attitude_output(plant_labels(op, plane))
+    return control.ss(A, B, np.vstack([C, Ce]), np.zeros((2, 1)), float(control_timing(op)[0]),
+                      inputs=["command"], outputs=["gyro", "attitude"])
+
+
+def loop_response(comp: control.StateSpace, plant: control.StateSpace, w: np.ndarray,
+                  plant_response: np.ndarray | None = None) -> np.ndarray:
+    """``L(e^{j w dt}) = -K G`` on ``w`` [rad/s]: the loop broken at the plant input, summed over the plant's
+    outputs (the compensator's inputs). ``plant_response``: the plant's response per output (p, len(w)), if
+    already computed (:func:`plant_responses`; a SISO plant's may be one row)."""
+    gr = plant_responses(plant, w) if plant_response is None else np.atleast_2d(plant_response)
+    p = gr.shape[0]
+    out = np.zeros(len(w), complex)
+    for i in range(p):
+        out = out + (-response(_siso(comp, 0, i), w)) * gr[i]
+    return out
+
+
+def plant_responses(plant: control.StateSpace, w: np.ndarray) -> np.ndarray:
+    """The response (p, len(w)) of each output of the single-input ``plant`` on ``w`` [rad/s]."""
+    return np.array([response(_siso(plant, i, 0), w) for i in range(plant.noutputs)])
+
+
+def _siso(sys_: control.StateSpace, out: int, inp: int) -> control.StateSpace:
+    """Output ``out`` over input ``inp`` of ``sys_`` (itself when it is SISO)."""
+    if sys_.ninputs == 1 and sys_.noutputs == 1:
+        return sys_
+    return control.ss(sys_.A, sys_.B[:, inp:inp + 1], sys_.C[out:out + 1, :], sys_.D[out:out + 1, inp:inp + 1],
+                      sys_.dt)
 
 
 def closed_loop(A: np.ndarray, B: np.ndarray, C: np.ndarray,
