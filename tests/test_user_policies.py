@@ -127,7 +127,7 @@ def test_a_failing_factory_is_one_line_naming_the_policy_and_the_cause(user_fold
     ("my_policy.py:nope", r"^evaluate\.py: policy 'my_policy\.py:nope': '.*my_policy\.py' has no 'nope'$"),
     ("missing.py:make", r"^evaluate\.py: policy 'missing\.py:make': no such file '.*missing\.py'$"),
     ("no_such_module:make", r"^evaluate\.py: policy 'no_such_module:make': cannot import 'no_such_module' "),
-    ("lqq", r"^evaluate\.py: policy 'lqq' \(did you mean 'lqg'\?\): not a registered name, module:factory, "
+    ("lqg-frnt", r"^evaluate\.py: policy 'lqg-frnt' \(did you mean 'lqg-front'\?\): not a registered name, module:factory, "
             r"path/to/file\.py:factory, a stable-baselines3 \.zip model or a train\.py run folder, a disturbance "
             r"observer's record \.json \(lvgym train --recipe teacher-student\), a cloned policy \.pt \(lvgym bc\); "
             r"the registered "
@@ -182,8 +182,8 @@ def test_the_built_in_names_are_the_registered_ones():
                                                        (("kind", "lqg"), ("name", "auto-lqg")))
     assert registry.POLICIES["fixed-gs-pid-flex"] == PolicySpec(
         "fixed-gs-pid-flex", "lvgym.baselines.designed:fixed_policy", (("kind", "gs-pid-flex"), ("name", "fixed-gs-pid-flex")))
-    assert sorted(registry.POLICIES) == ["aac", "aac-quiet", "auto-gs-pid", "auto-gs-pid-flex", "auto-lqg",
+    assert sorted(registry.POLICIES) == ["aac", "aac-quiet", "auto-gs-pid", "auto-gs-pid-flex", "auto-lqg", "eso",
                                          "fixed-gs-pid-flex", "fixed-lqg", "gs-pd-relief", "gs-pid", "gs-pid-flex",
-                                         "gs-pid-flex-quiet", "gs-pid-thesis", "inversion-id", "inversion-id-smile",
-                                         "inversion-id-stratos", "lqg", "lqg-aw", "lqg-front", "mpc", "pid", "pid-thesis",
-                                         "ppo", "ppo-res-lqg", "privileged", "zero"]
+                                         "gs-pid-flex-quiet", "gs-pid-thesis", "indi", "inversion-id",
+                                         "inversion-id-smile", "inversion-id-stratos", "lqg", "lqg-aw", "lqg-front",
+                                         "lqi", "mpc", "pid", "pid-thesis", "ppo", "ppo-res-lqg", "privileged", "zero"]

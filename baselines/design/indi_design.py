@@ -39,6 +39,8 @@ from typing import Any
 import numpy as np
 import yaml
 
+from lvgym.commandline import arg
+
 from ..indikernel import INDIFilter, SyncSections
 from .flightloop import mode_frequencies
 from .indiloop import INDIRow, loop_plants, row_margins
@@ -202,16 +204,25 @@ def margin_table(doc: dict[str, Any]) -> str:
     return "\n".join(lines) + "\n"
 
 
+@dataclass
+class Args:
+    """Command-line arguments (``python -m lvgym.baselines.design.indi_design --help``)."""
+
+    vehicle: str = "smile"
+    """the vehicle whose schedule is designed (smile)"""
+    out: str | None = None
+    """YAML file (default results/schedules/<vehicle>_indi.yaml)"""
+    overwrite: bool = False
+    """write the shipped baselines/schedules/<vehicle>_indi.yaml"""
+    k_accel: float = arg(DEFAULT_K_ACCEL, lo=0.0, hi=1.0)
+    """load-relief gain [rad/s per m/s^2]"""
+
+
 def main(argv: list[str] | None = None) -> int:
     """``python -m lvgym.baselines.design.indi_design [--vehicle smile] [--out PATH] [--overwrite]``."""
-    import argparse
+    from lvgym.commandline import parse
 
-    p = argparse.ArgumentParser(prog="python -m lvgym.baselines.design.indi_design", description=__doc__.split("\n")[0])
-    p.add_argument("--vehicle", default="smile")
-    p.add_argument("--out", default=None, help="YAML file (default results/schedules/<vehicle>_indi.yaml)")
-    p.add_argument("--overwrite", action="store_true", help="write the shipped baselines/schedules/<vehicle>_indi.yaml")
-    p.add_argument("--k-accel", type=float, default=DEFAULT_K_ACCEL, help="load-relief gain [rad/s per m/s^2]")
-    a = p.parse_args(argv)
+    a = parse(Args, argv, "python -m lvgym.baselines.design.indi_design", __doc__)
     out = Path(a.out) if a.out else (SCHEDULES if a.overwrite else Path("results/schedules")) / f"{a.vehicle}_indi.yaml"
     doc = design_schedule(a.vehicle, k_accel=a.k_accel)
     out.parent.mkdir(parents=True, exist_ok=True)
