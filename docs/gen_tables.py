@@ -1,4 +1,4 @@
-"""The tables of docs/rl.md and docs/benchmark.md, generated from the code: the layouts of
+"""The tables of docs/rl.md, docs/benchmark.md and docs/test-seeds.md, generated from the code: the layouts of
 ``lvgym/envs/layouts.py``, the option groups of ``lvgym/envs/options.py`` (their field docstrings and
 ranges), the protocol presets of ``lvgym/envs/presets.py`` and the dispersion table of
 ``lvgym/envs/dispersions.py``; and how often each policy of protocol v2 has flown on test seeds, from the
@@ -25,7 +25,8 @@ from typing import Any, Callable
 PAGE = Path(__file__).resolve().parent / "rl.md"
 #: the pages with generated blocks, and their blocks
 PAGES = {PAGE: ("options", "presets", "observation", "action", "reward", "termination", "info"),
-         PAGE.parent / "benchmark.md": ("dispersions", "faults", "test_flights")}
+         PAGE.parent / "benchmark.md": ("dispersions", "faults"),
+         PAGE.parent / "test-seeds.md": ("test_flights",)}
 
 #: the keys of a step's ``info`` (``AscentFuncEnv.transition_info``): unit and meaning. After a reset the
 #: ``info`` holds ``time``, ``cumulative_rate_error``, ``mass`` and ``controller_on`` only.
