@@ -27,7 +27,7 @@ bench: $(STAMP)
 	$(VENV)/bin/lvgym bench
 	$(PY) -m lvgym.bench_envs
 
-# the headline that decides (docs/benchmark.md, "The headline's test block"): every reported policy of the v2
+# the headline that decides (docs/test-seeds.md, "The headline's test block"): every reported policy of the v2
 # suites on 200 validation seeds chooses the best classical and learned policy per suite (the selection file,
 # docs/data/headline-selection.json: commit it), then the selected policies fly the named test block 12,000-12,199
 # once (and the 50 development seeds for continuity; both logged in docs/data/test-flights.jsonl), and the

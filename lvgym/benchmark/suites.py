@@ -102,7 +102,7 @@ class SeedBlock:
 DEVELOPMENT_BLOCK = SeedBlock("development-50", "test", 0, 50)
 #: the headline's test block: the 200 test seeds 12,000-12,199, never flown before it was named (2026-12-07; far
 #: from the development block and from the 150 seeds a re-flight study flew once beyond it, whose range is not
-#: recorded). ``lvgym headline fly`` flies the selected policies on it once per selection (docs/benchmark.md,
+#: recorded). ``lvgym headline fly`` flies the selected policies on it once per selection (docs/test-seeds.md,
 #: "The headline's test block"); the frozen suites' own seeds are unchanged
 HEADLINE_BLOCK = SeedBlock("headline-200", "test", 2_000, 200)
 #: the named blocks of seeds, by name

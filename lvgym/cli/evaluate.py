@@ -122,7 +122,7 @@ class Args:
     """index of the first seed of the seed set flown (default 0: its first --episodes seeds)"""
     block: str | None = arg(None, choices=lambda: sorted(SEED_BLOCKS))
     """fly a named block of seeds in place of --seed-set, --first and --episodes (headline-200: the headline's
-    test seeds 12,000-12,199, flown once per selection: docs/benchmark.md; development-50: 10,000-10,049)"""
+    test seeds 12,000-12,199, flown once per selection: docs/test-seeds.md; development-50: 10,000-10,049)"""
     purpose: str | None = arg(None, metavar="TEXT")
     """why the test seeds are flown, for the ledger of test flights (default: the command's name)"""
     reference: str | None = arg(None, metavar="POLICY")

@@ -1,4 +1,4 @@
-"""``lvgym headline``: the headline that decides (:mod:`lvgym.benchmark.selection`; docs/benchmark.md, "The
+"""``lvgym headline``: the headline that decides (:mod:`lvgym.benchmark.selection`; docs/test-seeds.md, "The
 headline's test block").
 
     lvgym headline select                 # every reported policy of the v2 suites on 200 validation seeds

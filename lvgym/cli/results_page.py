@@ -54,8 +54,8 @@ def page_text(record: dict[str, Any] | None) -> str:
         return "\n".join(out + [f"The headline on the named test block {HEADLINE_BLOCK.label()} has not been "
                                 "flown yet. `lvgym headline select` chooses its policies on validation seeds, "
                                 "`lvgym headline fly` flies them once on the block, and `lvgym headline page` "
-                                "writes this page from the record ([benchmark](benchmark.md), \"The headline's test "
-                                "block\")."]) + "\n"
+                                "writes this page from the record ([the test block](test-seeds.md#the-headlines-test-"
+                                "block))."]) + "\n"
     meta, sel = record["meta"], record["meta"]["selection"]
     names = list(dict.fromkeys(c[k] for c in sel["suites"].values() for k in ("classical", "learned", "privileged")
                                if c.get(k)))
