@@ -95,7 +95,7 @@ class INDISchedule:
             p = SCHEDULES / (str(path) if str(path).endswith(".yaml") else f"{path}.yaml")
         if not p.exists():
             raise FileNotFoundError(f"INDI schedule {str(path)!r}: no such file (nor {p}); write one with "
-                                    "`python -m lvgym.baselines.design.indi_design --vehicle smile`")
+                                    "`lvgym design indi --vehicle smile`")
         return read_once(p, cls._read, "INDISchedule")
 
     @classmethod
@@ -219,6 +219,6 @@ def smile_indi(env: Any, name: str = "indi", schedule: str | None = None, k_acce
         vehicle = getattr(env.unwrapped.task, "vehicle", None)
         if not isinstance(vehicle, Hashable) or vehicle not in SCHEDULES_BY_VEHICLE:
             raise ConfigError("env vehicle", vehicle, f"one of {list(SCHEDULES_BY_VEHICLE)} (an INDI schedule: "
-                              "python -m lvgym.baselines.design.indi_design)")
+                              "lvgym design indi)")
         schedule = SCHEDULES_BY_VEHICLE[vehicle]
     return INDIPolicy(env=env, schedule=schedule, name=name, k_accel=k_accel)

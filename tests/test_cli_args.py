@@ -178,7 +178,7 @@ def test_the_console_script_has_every_command_with_its_help(capsys):
     expected = ["evaluate", "train", "campaign", "margins", "headline select", "headline fly", "headline page",
                 "compare-headline", "ledger", "fingerprint", "verify", "verify rocketpy", "verify rocketpy-timing",
                 "bench", "bench-envs", "studies", "render", "export-policy", "dataset", "bc", "design pid", "design pid-flex",
-                "design lqg", "design pd-relief", "design charts", "design auto", "vehicle beam", "vehicle slender"]
+                "design lqg", "design indi", "design pd-relief", "design charts", "design auto", "vehicle beam", "vehicle slender"]
     assert listed == expected
     for name in expected:
         with pytest.raises(SystemExit) as exc:

@@ -274,8 +274,8 @@ class AgentConfig:
         """The learning rate and SB3's schedule of it as a resumed run loads them (``custom_objects``), rebuilt from
         this configuration rather than unpickled: a checkpoint pickles a schedule by reference to the module that
         defined it, and a run saved before :class:`LinearSchedule` moved here (from ``lvgym.agents.config``) names
-        a module that is gone. SB3 rebuilds its schedule from the learning rate on loading (``lr_schedule`` here is
-        a placeholder): the values are those the run trained with."""
+        a module that is gone. SB3 rebuilds its schedule from the learning rate on loading, so ``lr_schedule`` is
+        given as None: the values are those the run trained with."""
         return {"learning_rate": self.sb3_kwargs()["learning_rate"], "lr_schedule": None}
 
 

@@ -1,7 +1,7 @@
 """The ``indi`` schedule (:mod:`lvgym.baselines.indi`): control power over the flight and, per row, the gains and
 the structural filter chosen on the linear loop (:mod:`.indiloop`).
 
-``python -m lvgym.baselines.design.indi_design --vehicle smile`` writes ``results/schedules/smile_indi.yaml``
+``lvgym design indi --vehicle smile`` writes ``results/schedules/smile_indi.yaml``
 (``--overwrite``: the shipped ``baselines/schedules/smile_indi.yaml``) and its margin table ``*_margins.md``.
 
 What is designed, per row (a frozen flight time, its operating points flown with the privileged reference, no wind,
@@ -206,7 +206,7 @@ def margin_table(doc: dict[str, Any]) -> str:
 
 @dataclass
 class Args:
-    """Command-line arguments (``python -m lvgym.baselines.design.indi_design --help``)."""
+    """Command-line arguments (``lvgym design indi --help``)."""
 
     vehicle: str = "smile"
     """the vehicle whose schedule is designed (smile)"""
@@ -219,15 +219,15 @@ class Args:
 
 
 def main(argv: list[str] | None = None) -> int:
-    """``python -m lvgym.baselines.design.indi_design [--vehicle smile] [--out PATH] [--overwrite]``."""
+    """``lvgym design indi [--vehicle smile] [--out PATH] [--overwrite]``."""
     from lvgym.commandline import parse
 
-    a = parse(Args, argv, "python -m lvgym.baselines.design.indi_design", __doc__)
+    a = parse(Args, argv, "lvgym design indi", __doc__)
     out = Path(a.out) if a.out else (SCHEDULES if a.overwrite else Path("results/schedules")) / f"{a.vehicle}_indi.yaml"
     doc = design_schedule(a.vehicle, k_accel=a.k_accel)
     out.parent.mkdir(parents=True, exist_ok=True)
     head = (f"# indi schedule of {a.vehicle}, made by: "
-            f"python -m lvgym.baselines.design.indi_design --vehicle {a.vehicle}"
+            f"lvgym design indi --vehicle {a.vehicle}"
             f"{' --overwrite' if a.overwrite else ''}\n# Gains: k_rate, k_attitude [1/s]; control power [1/s^2]; "
             "filter frequencies [rad/s].\n")
     out.write_text(head + yaml.safe_dump(doc, sort_keys=False, width=120))

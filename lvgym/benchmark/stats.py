@@ -176,17 +176,10 @@ def relative_gain(a: Sequence[float], b: Sequence[float], level: float = LEVEL, 
     (per-seed scores, lower is better, ``a[i]`` and ``b[i]`` flown on seed i: 0.3 is a 30 % lower mean score)
     with the percentile interval at ``level`` of the same gain over ``reps`` resamplings of the seed indices,
     both policies' values of a seed drawn together (``numpy.random.default_rng(seed).integers(0, n, (reps,
-    n))``; a resample whose mean of ``b`` is not positive is dropped). NaNs when ``mean(b)`` is not positive."""
-    x, y = (np.asarray(v, dtype=float) for v in (a, b))
-    if not x.shape == y.shape or x.ndim != 1 or x.size == 0:
-        raise ValueError(f"paired values of shapes {x.shape} and {y.shape}: one value per common seed each")
-    if not y.mean() > 0.0:
-        return math.nan, math.nan, math.nan
-    idx = np.random.default_rng(seed).integers(0, x.size, (reps, x.size))
-    xs, ys = x[idx].mean(axis=1), y[idx].mean(axis=1)
-    ok = ys > 0.0
-    lo, hi = _percentile_interval(1.0 - xs[ok] / ys[ok], level) if ok.any() else (math.nan, math.nan)
-    return float(1.0 - x.mean() / y.mean()), lo, hi
+    n))``; a resample whose mean of ``b`` is not positive is dropped). NaNs when ``mean(b)`` is not positive:
+    :func:`ratio`'s value and interval, mirrored (the percentile interval of ``1 - r`` is ``1 -`` that of ``r``)."""
+    value, low, high = ratio(a, b, level, reps, seed)
+    return 1.0 - value, 1.0 - high, 1.0 - low
 
 
 def clopper_pearson(k: int, n: int, level: float = LEVEL) -> tuple[float, float, float]:

@@ -77,6 +77,8 @@ COMMANDS: tuple[Command, ...] = (
                 "for the flexible vehicle (gs-pid-flex)", "control", _CONTROL),
         Command("lqg", "lvgym.baselines.design.lqg_design:main", "design the LQG schedule on the non-rigid plant "
                 "(lqg)", "control", _CONTROL),
+        Command("indi", "lvgym.baselines.design.indi_design:main", "design the INDI schedule: control power, gains "
+                "and structural filters per row (indi)", "control", _CONTROL),
         Command("pd-relief", "lvgym.baselines.design.pdrelief:main", "place the soft attitude loop without integral "
                 "on the vehicle's control power (gs-pd-relief)", "control", _CONTROL),
         Command("charts", "lvgym.baselines.design.charts:main", "Bode and Nichols charts of a gain schedule's "
