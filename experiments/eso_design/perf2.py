@@ -1,8 +1,9 @@
 """Per row, among the attitude-fed model-assisted ESOs that meet the rules with a margin (score >= 1.05, closed
 loop stable), the one of the largest rigid loop gain at 1 rad/s (tracking of the pitch programme, rejection of
 the wind), with a damping floor (argument 2, default 0.3; 0: the margin rules alone): the rigid closed loop's
-poles between 0.3 and 30 rad/s damped at least ZMIN (the margin rules alone leave the weathercock mode near 5 rad/s at zeta ~0.1 when the crossover sits below it,
-and the wind rings it: twice lqg's rate error on validation seeds)."""
+poles between 0.3 and 30 rad/s damped at least ZMIN (the margin rules alone leave the weathercock mode near
+5 rad/s at zeta ~0.1 when the crossover sits below it, and the wind rings it: twice lqg's rate error on
+validation seeds)."""
 import sys, itertools, numpy as np, control, assisted as A
 ZMIN = float(sys.argv[2]) if len(sys.argv) > 2 else 0.3
 i1 = np.argmin(np.abs(A.W - 1.0))
