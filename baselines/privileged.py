@@ -39,6 +39,8 @@ from lvgym.benchmark.batch import BatchLaw, RowFace
 from lvgym.envs.privileged import PREVIEW_PERIODS
 from lvgym.errors import ConfigError
 
+from .privkernel import PrivilegedGains, PrivilegedInfo, privileged_act_k
+
 __all__ = ["PrivilegedLaw", "PrivilegedPolicy", "control_lever", "privileged", "relief_hold"]
 
 #: (bandwidth [rad/s], damping) of the attitude loop per flight model, with :data:`RELIEF`: the lowest mean
@@ -114,6 +116,9 @@ class PrivilegedLaw(BatchLaw):
         self.relief = (float(relief[0]), float(relief[1]))
         self.qalpha_limit = float(func.spec.qalpha_limit_pa_deg)
         self.limit = float(func.gimbal_limit)
+        self.gains = PrivilegedGains(self.w, self.z, self.relief[0], self.relief[1], self.limit,
+                                     1.0 if self.plant else 0.0)
+        self._neutral: tuple[np.ndarray, ...] | None = None
         names = list(func.observation_layout.names)
         self._i_ref = names.index("pitch_rate_reference") if "pitch_rate_reference" in names else None
         self.allocate(n)
@@ -126,39 +131,39 @@ class PrivilegedLaw(BatchLaw):
 
     def act(self, rows: Any, observations: np.ndarray, info: Mapping[str, Any]) -> np.ndarray:
         """The gimbal actions (len(rows), 2) in [-1, 1] of the rows ``rows`` from the step's privileged info
-        (zero before the first step, whose info holds none, and for a row without thrust)."""
+        (zero before the first step, whose info holds none, and for a row without thrust), computed by
+        :func:`.privkernel.privileged_act_k`."""
         rows = np.asarray(rows, dtype=np.int64).reshape(-1)
         out = np.zeros((rows.size, 2), dtype=np.float32)
         if "m_aero_b" not in info:                          # the reset's info
             return out
-        lever = control_lever(info, rows)
-        go = lever >= 1.0                                   # no thrust: no moment to command
-        if not go.any():
-            return out
-        k, lever = rows[go], lever[go]
-        w = np.asarray(info["omega_bi_b"], dtype=float)[k]
-        att = np.asarray(info["attitude_error"], dtype=float)[k]
-        m_aero = np.asarray(info["m_aero_b"] if self.preview == 0 else info["m_aero_ahead_b"][:, self.preview - 1],
-                            dtype=float)[k]
-        J = np.asarray(info["J_b_diag"], dtype=float)[k]
-        obs = np.asarray(observations)[go]
-        ref = obs[:, self._i_ref].astype(float) if self._i_ref is not None else np.zeros(k.size)
-        e_rate = np.stack([w[:, 1] - ref, w[:, 2]], axis=1)
-        # load relief: from ``onset`` to ``full`` of the q-alpha limit the law lets go of the attitude and of the
-        # aerodynamic moment (the statically stable vehicle turns into the relative wind); the rate damping stays
-        qalpha = np.asarray(info["qalpha_pa_deg"], dtype=float)[k] if "qalpha_pa_deg" in info else np.zeros(k.size)
-        limit = (np.asarray(info["qalpha_limit_pa_deg"], dtype=float)[k] if "qalpha_limit_pa_deg" in info
-                 else np.full(k.size, self.qalpha_limit))
-        hold = relief_hold(qalpha / limit, *self.relief)[:, None]
-        alpha = -2.0 * self.z * self.w * e_rate - hold * self.w * self.w * att
-        delta = (J[:, 1:] * alpha - hold * m_aero[:, 1:]) / lever[:, None]
-        if self.plant:                                      # the true thrust direction and actuator authority
-            mis = np.asarray(info["misalignment"], dtype=float)[k] if "misalignment" in info else 0.0
-            eff = (np.asarray(info["actuator_effectiveness"], dtype=float)[k] if "actuator_effectiveness" in info
-                   else 1.0)
-            delta = (delta - mis) / np.maximum(eff, 0.1)
-        out[go] = np.clip(delta / self.limit, -1.0, 1.0).astype(np.float32)
+        obs = np.asarray(observations)
+        ref = (obs[:, self._i_ref].astype(np.float64) if self._i_ref is not None
+               else np.zeros(rows.size))
+        privileged_act_k(rows, ref, self._info(info), self.gains, out)
         return out
+
+    def _info(self, info: Mapping[str, Any]) -> PrivilegedInfo:
+        """The kernel's view of a step's batched privileged info (the keys a step may lack at their neutral
+        values: all thrust vectored, no q-alpha, the env's limit, no misalignment, full effectiveness)."""
+        thrust = np.asarray(info["thrust"], dtype=np.float64)
+        n = thrust.shape[0]
+        if self._neutral is None or self._neutral[0].shape[0] != n:
+            self._neutral = (np.ones(n), np.zeros(n), np.full(n, self.qalpha_limit), np.zeros((n, 2)),
+                             np.ones((n, 2)))
+        ones, zeros, limit, mis, eff = self._neutral
+
+        def get(key: str, default: np.ndarray) -> np.ndarray:
+            return np.asarray(info[key], dtype=np.float64) if key in info else default
+
+        m_aero = info["m_aero_b"] if self.preview == 0 else info["m_aero_ahead_b"][:, self.preview - 1]
+        return PrivilegedInfo(thrust, get("vectored_share", ones), np.asarray(info["gimbal_arm"], dtype=np.float64),
+                              np.asarray(info["omega_bi_b"], dtype=np.float64),
+                              np.asarray(info["attitude_error"], dtype=np.float64),
+                              np.asarray(m_aero, dtype=np.float64), np.asarray(info["J_b_diag"], dtype=np.float64),
+                              get("qalpha_pa_deg", zeros), get("qalpha_limit_pa_deg", limit),
+                              get("misalignment", mis) if self.plant else mis,
+                              get("actuator_effectiveness", eff) if self.plant else eff)
 
 
 class PrivilegedPolicy(RowFace):
