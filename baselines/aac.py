@@ -50,6 +50,7 @@ from lvgym.benchmark.batch import BatchLaw, RowFace
 from lvgym.errors import ConfigError, check_bool, check_number
 
 from .aackernel import AAC_ROW, AACConsts, aac_act_k, aac_pid_act_k, dead_zone, first_order
+from .entry import Entry
 from .pid import PIDLaw, flex_pid, smile_scheduled_pid
 from .pidkernel import ObsColumns
 
@@ -193,14 +194,15 @@ class AACLaw(BatchLaw):
         """Actions (len(rows), 2) float32 of the rows ``rows``: the base acts, then the adaptive law scales
         its commands (:func:`.aackernel.aac_act_k`; around a :class:`.pid.PIDLaw`, both in one compiled call,
         :func:`.aackernel.aac_pid_act_k`)."""
-        rows = np.asarray(rows, dtype=np.int64).reshape(-1)
+        rows = np.ascontiguousarray(rows, dtype=np.int64).reshape(-1)
         obs = np.ascontiguousarray(observations).reshape(rows.size, -1)
         out = np.empty((rows.size, 2), np.float32)
         base = self.base
         if type(base) is PIDLaw:        # the shipped bases: both laws in one compiled call
-            value = base.values(info)
+            value = np.ascontiguousarray(base.values(info), dtype=np.float64)
             base.prepare(rows, obs, value)
-            aac_pid_act_k(base.tb, base.su, base.oc, base.st, self.law, self.oc, self.rows, rows, obs, value, out)
+            _AAC_PID((obs.dtype, obs.flags.writeable), base.tb, base.su, base.oc, base.st, self.law, self.oc,
+                     self.rows, rows, obs, value, out)
             return out
         base.act(rows, obs, info)
         u = np.ascontiguousarray(base.gimbal[rows], dtype=np.float64)
@@ -276,6 +278,9 @@ def smile_aac(env: Any, schedule: str = "smile", name: str = "aac", record: bool
 #: validation seeds 0-9): the defaults with a spectral-damper dead zone, so that the flex design's own
 #: high-frequency content (its lead, staging, gusts) does not lower k_T
 FLEX_AAC = {"damper_deadzone_rad2": 3e-3}
+#: the fused AAC and PID act, through its entry point (:class:`.entry.Entry`; key: the observations' dtype and
+#: writability, the rest of its arguments' types fixed by :meth:`AACLaw.act`)
+_AAC_PID = Entry(aac_pid_act_k)
 
 
 def flex_aac(env: Any, name: str = "aac", record: bool = False, schedule: str | None = None, quiet: bool = False,
