@@ -11,7 +11,7 @@ thesis's control study (docs/control-study.md).
 Importing this package registers its controllers with the benchmark by name
 (:func:`lvgym.benchmark.register_policy`): ``pid``, ``gs-pid``, ``gs-pid-flex``, ``aac``,
 ``gs-pid-flex-quiet``, ``aac-quiet``, ``pid-thesis``, ``gs-pid-thesis``, ``lqg``, ``lqg-front``, ``lqg-aw``,
-``lqi``, ``mpc``, ``indi``, ``eso``, ``privileged`` (``evaluate.py --policies lqg``).
+``lqi``, ``lqi-hold``, ``mpc``, ``indi``, ``eso``, ``privileged`` (``evaluate.py --policies lqg``).
 """
 
 from lvgym.benchmark.registry import register_policy
@@ -60,6 +60,10 @@ register_policy("lqg-aw", smile_lqg, name="lqg-aw", back_gain=0.1)
 # constant disturbance moment (a thrust-direction step) leaves no attitude offset; its flight time from the
 # observation (lvgym.baselines.design.lqg_design --integral attitude, docs/lqi.md)
 register_policy("lqi", smile_lqg, name="lqi", schedule="smile_lqi", back_gain=0.1, clock="observation")
+# lqi with the attitude at the engagement as its reference: the attitude the vehicle drifted to before the law
+# engages is held, as lqg's rate integral holds it, and only the offsets after it are integrated away (docs/lqi.md)
+register_policy("lqi-hold", smile_lqg, name="lqi-hold", schedule="smile_lqi", back_gain=0.1, clock="observation",
+                attitude_from="engagement")
 # the automatic designs of the env's vehicle file (lvgym.baselines.design.auto; the control extra): the rigid
 # design, the flexible design and the LQG, made the same way for any vehicle (a launcher family's baselines)
 register_policy("auto-gs-pid", "lvgym.baselines.designed:auto_policy", name="auto-gs-pid", kind="gs-pid")

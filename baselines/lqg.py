@@ -54,14 +54,17 @@ from lvgym.benchmark.batch import BatchLaw, RowFace
 from lvgym.errors import ConfigError, check_number
 
 from .filecache import read_once
-from .lqgkernel import (INTEGRAL_SOURCES, NO_ANTI_WINDUP, AntiWindup, LQGState, LQGTables, lqg_act_k, lqg_step_k,
-                        lqg_tables, row_index)
+from .lqgkernel import (INTEGRAL_SOURCES, NO_ANTI_WINDUP, AntiWindup, LQGState, LQGTables, from_engagement,
+                        lqg_act_k, lqg_step_k, lqg_tables, row_index)
 from .pidkernel import ObsColumns
 
 SCHEDULES = Path(__file__).resolve().parent / "schedules"
 PLANES = ("pitch", "yaw")
 #: where :class:`LQGLaw` reads the flight time: the step's ``info`` or the observation's time fraction
 CLOCKS = ("info", "observation")
+#: the reference of an attitude integral (:class:`LQGLaw`): the attitude error itself (``zero``) or the error less
+#: its value at the engagement (``engagement``: the attitude the vehicle holds when the law engages)
+ATTITUDE_FROM = ("zero", "engagement")
 
 
 @dataclass(frozen=True)
@@ -180,16 +183,18 @@ class LQGPlane:
     (:class:`.lqgkernel.AntiWindup`; the default is ``lqg``'s plain law)."""
 
     def __init__(self, rows: tuple[LQGRow, ...], schedule: LQGSchedule, u_limit: float, n: int = 1,
-                 aw: AntiWindup = NO_ANTI_WINDUP) -> None:
+                 aw: AntiWindup = NO_ANTI_WINDUP, attitude_from: str = "zero") -> None:
         if not u_limit > 0.0:
             raise ConfigError("u_limit", u_limit, "a gimbal limit > 0 rad")
         if int(n) < 1:
             raise ConfigError("n", n, "at least one row")
         self.rows, self.schedule, self.u_limit, self.n, self.aw = rows, schedule, float(u_limit), int(n), aw
         self.tables = schedule.tables(rows)
+        if attitude_from == "engagement":
+            self.tables = from_engagement(self.tables)
         N = self.tables.A.shape[1]
         self.state = LQGState(np.zeros((self.n, N)), np.zeros(self.n), np.full(self.n, -1, dtype=np.int64),
-                              np.zeros(self.n, bool), np.zeros(self.n, bool), np.zeros(self.n))
+                              np.zeros(self.n, bool), np.zeros(self.n, bool), np.zeros(self.n), np.zeros(self.n))
         self._all = np.arange(self.n, dtype=np.int64)
 
     @property
@@ -201,7 +206,7 @@ class LQGPlane:
         """Restart the rows ``which`` (None: all) as at the start of an episode."""
         w = slice(None) if which is None else np.asarray(which, dtype=np.int64)
         st = self.state
-        st.row[w], st.x[w], st.xi[w], st.was_on[w], st.saturated[w], st.u[w] = -1, 0.0, 0.0, False, False, 0.0
+        st.row[w], st.x[w], st.xi[w], st.was_on[w], st.saturated[w], st.u[w], st.e0[w] = -1, 0.0, 0.0, False, False, 0.0, 0.0
 
     def update(self, y: Any, t: Any, on: Any, which: Any = None, e: Any = None) -> np.ndarray:
         """The commands [rad] of the rows ``which`` (None: all) for their gyro samples ``y`` [rad/s] and
@@ -224,11 +229,13 @@ class LQGLaw(BatchLaw):
     gain per period [-] in [0, 1] and the command held to the env's gimbal rate limit
     (:class:`.lqgkernel.AntiWindup`); ``clock``: where the flight time comes from, ``info`` (``info["time"]`` of
     every row, as ``lqg`` and ``lqg-aw`` have always flown) or ``observation`` (its ``time_fraction`` times the
-    env's mission time: the law then reads nothing but the observation, ``lqi``). :attr:`gimbal` (n, 2)
-    [rad]: each row's last command."""
+    env's mission time: the law then reads nothing but the observation, ``lqi``); ``attitude_from``: the
+    reference of a schedule that integrates the attitude error, ``zero`` (``lqi``: the attitude error itself) or
+    ``engagement`` (``lqi-hold``: the error less its value when the law engages, :data:`ATTITUDE_FROM`).
+    :attr:`gimbal` (n, 2) [rad]: each row's last command."""
 
     def __init__(self, *, env: Any, schedule: LQGSchedule | str | Path = "smile_lqg", name: str = "lqg",
-                 back_gain: float | None = None, n: int = 1, clock: str = "info") -> None:
+                 back_gain: float | None = None, n: int = 1, clock: str = "info", attitude_from: str = "zero") -> None:
         task = env.unwrapped
         self.name = name
         self.schedule = schedule if isinstance(schedule, LQGSchedule) else LQGSchedule.load(schedule)
@@ -249,6 +256,9 @@ class LQGLaw(BatchLaw):
         lay = task.observation_layout
         if clock not in CLOCKS:
             raise ConfigError("clock", clock, f"one of {CLOCKS}")
+        if attitude_from not in ATTITUDE_FROM:
+            raise ConfigError("attitude_from", attitude_from, f"one of {ATTITUDE_FROM}")
+        self.attitude_from = attitude_from
         #: the observation's time_fraction column and the mission time [s] it is a fraction of (-1: info's time)
         self.time_col = int(lay.index("time_fraction")) if clock == "observation" else -1
         self.mission_s = float(task.task.mission_time_s)
@@ -263,7 +273,8 @@ class LQGLaw(BatchLaw):
         self.allocate(n)
 
     def _rows(self, n: int) -> None:
-        self.planes = [LQGPlane(self.schedule.rows[p], self.schedule, self.limit, n, self.aw) for p in PLANES]
+        self.planes = [LQGPlane(self.schedule.rows[p], self.schedule, self.limit, n, self.aw, self.attitude_from)
+                       for p in PLANES]
         self.gimbal = np.zeros((n, 2))
         self.time = np.zeros(n)                      # the rows' flight times [s] of the observation clock
 
@@ -297,8 +308,9 @@ class LQGPolicy(RowFace):
     ``last_gimbal`` (2,) [rad]: the last command."""
 
     def __init__(self, *, env: Any, schedule: LQGSchedule | str | Path = "smile_lqg", name: str = "lqg",
-                 back_gain: float | None = None, clock: str = "info") -> None:
-        self.law = LQGLaw(env=env, schedule=schedule, name=name, back_gain=back_gain, clock=clock)
+                 back_gain: float | None = None, clock: str = "info", attitude_from: str = "zero") -> None:
+        self.law = LQGLaw(env=env, schedule=schedule, name=name, back_gain=back_gain, clock=clock,
+                          attitude_from=attitude_from)
 
     @property
     def last_gimbal(self) -> np.ndarray:
@@ -306,12 +318,13 @@ class LQGPolicy(RowFace):
 
 
 def smile_lqg(env: Any, name: str = "lqg", schedule: str = "smile_lqg", back_gain: float | None = None,
-              clock: str = "info") -> LQGPolicy:
+              clock: str = "info", attitude_from: str = "zero") -> LQGPolicy:
     """The LQG schedule designed for SMILE v1 (``baselines/schedules/smile_lqg.npz``; ``smile_lqi``: ``lqi``'s) on
     ``env``; the env must fly the ``smile_v1`` vehicle. ``back_gain``: the anti-windup of ``lqg-aw``, ``clock``:
-    where the flight time is read (:class:`LQGPolicy`)."""
+    where the flight time is read, ``attitude_from``: the attitude integral's reference (:class:`LQGLaw`)."""
     vehicle = getattr(env.unwrapped.task, "vehicle", None)
     if vehicle != "smile_v1":
         raise ConfigError("env vehicle", vehicle, "'smile_v1' (the LQG schedule is designed for SMILE v1, "
                           "lvgym/SmileAscent-v1)")
-    return LQGPolicy(env=env, schedule=schedule, name=name, back_gain=back_gain, clock=clock)
+    return LQGPolicy(env=env, schedule=schedule, name=name, back_gain=back_gain, clock=clock,
+                     attitude_from=attitude_from)

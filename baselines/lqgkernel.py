@@ -3,8 +3,9 @@ all the env rows of a residual policy's baselines in training. One code path for
 
 The schedule's rows are stacked, zero-padded to the largest state (:class:`LQGTables`, built once per
 schedule and plane by :func:`lqg_tables`); a law's state is :class:`LQGState` (``x``: the predicted
-state ``x_p`` per row in the first ``dim`` entries of the row in use; ``xi``: the integral; ``row``: the schedule row in use, -1 since the last engagement; ``was_on``; ``saturated``; ``u``:
-the last command sent [rad]).
+state ``x_p`` per row in the first ``dim`` entries of the row in use; ``xi``: the integral; ``row``: the schedule
+row in use, -1 since the last engagement; ``was_on``; ``saturated``; ``u``: the last command sent [rad];
+``e0``: the attitude error sample at the last engagement [rad]).
 :func:`lqg_step_k` is the module docstring of :mod:`.lqg` row by row::
 
     x_f = x_p + M (y - C x_p);  v = -K_x x_f - K_i xi;  u = clip(v);  xi <- a xi - dt s (held while clipped
@@ -12,8 +13,10 @@ the last command sent [rad]).
 
 where the integral's input ``s`` is the row's ``source`` (:data:`INTEGRAL_SOURCES`): the gyro sample ``y``
 (``lqg``: the rate error, with a leak ``a < 1``) or the attitude error sample ``e`` [rad] (``lqi``: the
-strapdown attitude error, a pure integral ``a = 1``); its leak ``a`` is the row's too. A row integrating the
-attitude also takes the measured attitude for the estimate's attitude state after the measurement update,
+strapdown attitude error, a pure integral ``a = 1``) or that error less its value at the engagement,
+``e - e_0`` (``lqi-hold``: the attitude the vehicle holds when the law engages is its reference, as ``lqg``'s rate
+integral holds it); its leak ``a`` is the row's too. A row integrating the attitude also takes the measured
+attitude (less ``e_0`` for the third source) for the estimate's attitude state after the measurement update,
 ``x_f[att] = e`` (the strapdown attitude is the better estimate: its error grows with the gyro's random walk,
 0.02 deg over the flight, where the rate-only filter's attitude drifts with every unmodelled moment, and the
 integral would hold the regulator's attitude gain times that drift). One law, one code path.
@@ -41,8 +44,8 @@ import numpy as np
 
 from .pidkernel import clip_k
 
-__all__ = ["INTEGRAL_SOURCES", "NO_ANTI_WINDUP", "AntiWindup", "LQGState", "LQGTables", "lqg_act_k", "lqg_step_k",
-           "lqg_tables", "row_index"]
+__all__ = ["INTEGRAL_SOURCES", "NO_ANTI_WINDUP", "AntiWindup", "LQGState", "LQGTables", "from_engagement", "lqg_act_k",
+           "lqg_step_k", "lqg_tables", "row_index"]
 
 
 class LQGTables(NamedTuple):
@@ -77,6 +80,7 @@ class LQGState(NamedTuple):
     was_on: np.ndarray
     saturated: np.ndarray
     u: np.ndarray
+    e0: np.ndarray
 
 
 class AntiWindup(NamedTuple):
@@ -90,8 +94,10 @@ class AntiWindup(NamedTuple):
 
 
 #: what the integral of a row integrates (index in :data:`LQGTables`' ``source``): the rate error (the gyro
-#: sample ``y`` [rad/s]) or the attitude error (the observation's strapdown attitude error ``e`` [rad])
-INTEGRAL_SOURCES = ("rate", "attitude")
+#: sample ``y`` [rad/s]), the attitude error (the observation's strapdown attitude error ``e`` [rad]) or the
+#: attitude error from the engagement (``e - e_0``, ``e_0`` its sample at the engagement; a schedule's rows
+#: name the first two, a law flies a schedule of the second with the third: :func:`from_engagement`)
+INTEGRAL_SOURCES = ("rate", "attitude", "attitude-from-engagement")
 
 #: the plain law (``lqg``): the command clipped to the gimbal limit only, the integral held while clipped
 NO_ANTI_WINDUP = AntiWindup(False, np.inf, 0.0)
@@ -120,6 +126,14 @@ def lqg_tables(rows: Any) -> LQGTables:
                      np.array([r.interval_s[0] for r in rows]), np.array([r.interval_s[1] for r in rows]), carry,
                      np.array([INTEGRAL_SOURCES.index(r.integral) for r in rows], dtype=np.int64),
                      np.array([_attitude_state(r) for r in rows], dtype=np.int64))
+
+
+def from_engagement(tables: LQGTables) -> LQGTables:
+    """``tables`` with every row that integrates the attitude error integrating it from the engagement instead
+    (:data:`INTEGRAL_SOURCES`; the arrays shared, ``source`` new)."""
+    attitude = INTEGRAL_SOURCES.index("attitude")
+    source = np.where(tables.source == attitude, INTEGRAL_SOURCES.index("attitude-from-engagement"), tables.source)
+    return tables._replace(source=source.astype(np.int64))
 
 
 def _attitude_state(row: Any) -> int:
@@ -168,6 +182,7 @@ def lqg_step_k(tb, st, which, y, e, t, on, u_limit, aw, u):
             st.x[b, :] = 0.0
             st.xi[b] = 0.0
             st.u[b] = 0.0
+            st.e0[b] = e[j]
         st.was_on[b] = True
         i = row_index(tb, t[j])
         if i != st.row[b]:
@@ -176,7 +191,7 @@ def lqg_step_k(tb, st, which, y, e, t, on, u_limit, aw, u):
             for k in range(N):
                 src = tb.carry[o, i, k] if o >= 0 else -1
                 st.x[b, k] = old[src] if src >= 0 else 0.0
-            if o >= 0 and tb.source[i] == 1 and tb.Ki[i] != 0.0:    # the attitude's integral: its command carried
+            if o >= 0 and tb.source[i] >= 1 and tb.Ki[i] != 0.0:    # the attitude's integral: its command carried
                 st.xi[b] *= tb.Ki[o] / tb.Ki[i]
             st.row[b] = i
         m = tb.dim[i]
@@ -186,8 +201,9 @@ def lqg_step_k(tb, st, which, y, e, t, on, u_limit, aw, u):
         innov = y[j] - cx
         for k in range(m):
             xf[k] = st.x[b, k] + tb.M[i, k] * innov
-        if tb.source[i] == 1:                     # the attitude state: the measured attitude error
-            xf[tb.att[i]] = e[j]
+        ej = e[j] - st.e0[b] if tb.source[i] == 2 else e[j]     # the attitude error the row reads
+        if tb.source[i] >= 1:                     # the attitude state: the measured attitude error
+            xf[tb.att[i]] = ej
         kx = 0.0
         for k in range(m):
             kx += tb.Kx[i, k] * xf[k]
@@ -196,7 +212,7 @@ def lqg_step_k(tb, st, which, y, e, t, on, u_limit, aw, u):
         if aw.on:
             uu = min(max(uu, st.u[b] - aw.rate_step), st.u[b] + aw.rate_step)
         sat = uu != v
-        s = y[j] if tb.source[i] == 0 else e[j]          # the integral's input (INTEGRAL_SOURCES)
+        s = y[j] if tb.source[i] == 0 else ej            # the integral's input (INTEGRAL_SOURCES)
         dxi = (tb.a[i] - 1.0) * st.xi[b] - tb.dt[i] * s
         if aw.on:
             if aw.back_gain > 0.0 and tb.Ki[i] != 0.0:   # back-calculation: v towards the command sent

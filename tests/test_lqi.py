@@ -142,6 +142,39 @@ def test_law_equals_the_two_input_compensator(shipped):
         np.testing.assert_allclose(u_law, u_lin, rtol=1e-9, atol=1e-12 * np.abs(u_lin).max())
 
 
+def test_hold_integrates_the_attitude_from_the_engagement(shipped):
+    """lqi-hold (``attitude_from="engagement"``) on attitude samples e_k flies as lqi on e_k - e_0, e_0 the sample
+    at the engagement, to the bit, through an engagement, a switch-off and a re-engagement (a new e_0); and on
+    the toy plant under a constant moment, started 0.05 rad off, it ends at that attitude where lqi ends at 0."""
+    rng = np.random.default_rng(7)
+    r = shipped.rows["pitch"][3]
+    one = LQGSchedule({p: (r,) for p in ("pitch", "yaw")}, "one row")
+    hold = LQGPlane(one.rows["pitch"], one, u_limit=0.2, aw=AntiWindup(True, 0.005, 0.1), attitude_from="engagement")
+    plain = LQGPlane(one.rows["pitch"], one, u_limit=0.2, aw=AntiWindup(True, 0.005, 0.1))
+    y, e = 1e-3 * rng.standard_normal(300), 0.03 + 1e-2 * rng.standard_normal(300)
+    on = np.ones(300, bool)
+    on[150:160] = False
+    e0 = np.where(np.arange(300) < 150, e[0], e[160])
+    u_hold = np.array([hold.update(a, r.time_s, o, e=b)[0] for a, b, o in zip(y, e, on)])
+    u_plain = np.array([plain.update(a, r.time_s, o, e=b - c)[0] for a, b, c, o in zip(y, e, e0, on)])
+    np.testing.assert_array_equal(u_hold, u_plain)
+    assert np.abs(u_hold).max() > 1e-3 and not u_hold[150:160].any()
+    with pytest.raises(ConfigError, match="attitude_from"):
+        LQGLaw(env=lvgym.make_env("smile-v2", "rigid"), schedule="smile_lqi", attitude_from="start")
+    A, B, Bd, C = toy_plant()
+    row = toy_row("attitude")
+    toy = LQGSchedule({p: (row,) for p in ("pitch", "yaw")}, "toy")
+    ends = {}
+    for start in ("zero", "engagement"):
+        law = LQGPlane(toy.rows["pitch"], toy, u_limit=10.0, aw=AntiWindup(True, 10.0, 0.1), attitude_from=start)
+        x = np.array([0.05, 0.0])
+        for k in range(int(300.0 / DT)):
+            u = law.update(C @ x, k * DT, True, e=x[0])[0]
+            x = A @ x + B[:, 0] * u + Bd[:, 0] * D_MOMENT
+        ends[start] = x[0]
+    assert abs(ends["zero"]) < 1e-6 and abs(ends["engagement"] - 0.05) < 1e-6
+
+
 class NoInfo(dict):
     def __getitem__(self, key):
         raise AssertionError(f"lqi read info[{key!r}]")

@@ -186,4 +186,5 @@ def test_the_built_in_names_are_the_registered_ones():
                                          "fixed-gs-pid-flex", "fixed-lqg", "gs-pd-relief", "gs-pid", "gs-pid-flex",
                                          "gs-pid-flex-quiet", "gs-pid-thesis", "indi", "inversion-id",
                                          "inversion-id-smile", "inversion-id-stratos", "lqg", "lqg-aw", "lqg-front",
-                                         "lqi", "mpc", "pid", "pid-thesis", "ppo", "ppo-res-lqg", "privileged", "zero"]
+                                         "lqi", "lqi-hold", "mpc", "pid", "pid-thesis", "ppo", "ppo-res-lqg", "privileged",
+                                         "zero"]

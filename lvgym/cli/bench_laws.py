@@ -23,8 +23,8 @@ LAWS: tuple[tuple[str, str], ...] = (
     ("zero", "smile-v2"), ("pid", "smile-v2"), ("pid-thesis", "smile-v2"), ("gs-pid", "smile-v2"),
     ("gs-pid-thesis", "smile-v2"), ("gs-pid-flex", "smile-v2"), ("gs-pid-flex-quiet", "smile-v2"),
     ("gs-pd-relief", "smile-v2"), ("aac", "smile-v2"), ("aac-quiet", "smile-v2"), ("lqg", "smile-v2"),
-    ("lqg-front", "smile-v2"), ("lqg-aw", "smile-v2"), ("lqi", "smile-v2"), ("mpc", "smile-v2"),
-    ("indi", "smile-v2"), ("eso", "smile-v2"), ("privileged", "smile-v2"),
+    ("lqg-front", "smile-v2"), ("lqg-aw", "smile-v2"), ("lqi", "smile-v2"), ("lqi-hold", "smile-v2"),
+    ("mpc", "smile-v2"), ("indi", "smile-v2"), ("eso", "smile-v2"), ("privileged", "smile-v2"),
     ("ppo-res-lqg", "smile-v2"), ("ppo", "smile-windy"), ("inversion-id", "smile-v2-faults"),
     ("inversion-id-smile", "smile-v2"), ("inversion-id-stratos", "stratos-tvc-v2"),
 )
