@@ -145,18 +145,26 @@ def suite_option(option: str, value: str) -> str:
 
 
 def training_seed(seed: int, step: int, n_envs: int, prog: str = "train.py") -> int:
-    """Seed of env row 0 for a run segment starting at ``step`` (rows get ``+ i``): ``seed`` at the
-    start, a fresh draw on resume; always a validation seed (the test seeds stay unseen)."""
-    from lvgym.benchmark.suites import TEST_SEED0
+    """Seed of env row 0 for a run segment starting at ``step`` (rows get ``+ i``), always a training seed
+    (:data:`lvgym.benchmark.suites.TRAINING_SEEDS`: disjoint from every validation and test seed, so model
+    selection and reported numbers never fly an episode trained on): ``TRAINING_SEED0 + TRAINING_SEED_STRIDE *
+    seed`` at the start (runs of different ``seed`` share no row), a fresh draw among the training seeds on
+    resume."""
+    from lvgym.benchmark.suites import N_TRAINING_SEEDS, TRAINING_SEED0, TRAINING_SEED_STRIDE
 
+    most = N_TRAINING_SEEDS // TRAINING_SEED_STRIDE - 1
+    if not 0 <= seed <= most:
+        raise SystemExit(f"{prog}: --seed {seed}: an integer in [0, {most}] (rows start at training seed "
+                         f"{TRAINING_SEED0:,} + {TRAINING_SEED_STRIDE:,} seed)")
+    if n_envs > TRAINING_SEED_STRIDE:
+        raise SystemExit(f"{prog}: {n_envs} envs: at most {TRAINING_SEED_STRIDE:,} rows per run (a training seed's "
+                         "block of env seeds)")
     if step == 0:
-        if not 0 <= seed <= TEST_SEED0 - n_envs:
-            raise SystemExit(f"{prog}: --seed {seed} with {n_envs} envs: rows seed .. seed + n_envs - 1 must "
-                             f"be validation seeds (0 .. {TEST_SEED0 - 1}); the test seeds are for reported numbers")
-        return seed
+        return TRAINING_SEED0 + TRAINING_SEED_STRIDE * int(seed)
     import numpy as np
 
-    return int(np.random.SeedSequence([seed, step]).generate_state(1)[0]) % (TEST_SEED0 - n_envs)
+    draw = int(np.random.SeedSequence([seed, step]).generate_state(2, dtype=np.uint64)[0])
+    return TRAINING_SEED0 + draw % (N_TRAINING_SEEDS - n_envs + 1)
 
 
 def make_venv(env_id: str, n_envs: int, seed: int, env_kwargs: dict[str, Any], norm: Any, gamma: float,
