@@ -134,7 +134,7 @@ class Args:
     rad/s per unit of (rate / rate limit)^2 (lvgym.agents.wrappers.commandrate; 0: off)"""
     total_timesteps: int | None = arg(None, lo=1, hi=10**12)
     """env steps of the whole run, e.g. 2e6 (default: n_timesteps of the hyperparameter file)"""
-    seed: int = arg(0, lo=0, hi=99_998)
+    seed: int = arg(0, lo=0, hi=99_999)
     """seed of the networks and generators; env row i starts with training seed 100,000 + 10,000 seed + i
     (lvgym.benchmark.suites.TRAINING_SEEDS: disjoint from the validation and test seeds)"""
     n_envs: int | None = arg(None, lo=1, hi=4096)
