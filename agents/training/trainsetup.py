@@ -14,20 +14,40 @@ import yaml
 
 from lvgym.errors import ConfigError
 
-__all__ = ["DEFAULT_EVAL_SUITES", "RECIPES", "check_options", "env_kwargs_of", "eval_suite_option", "make_venv",
-           "is_family", "protocol_training", "suite_condition", "suite_option", "training_seed"]
+__all__ = ["DEFAULT_EVAL_SUITES", "RECIPES", "SB3_RECIPES", "check_options", "env_kwargs_of", "eval_suite_option",
+           "is_family", "make_venv", "protocol_training", "recipe_options", "suite_condition", "suite_option",
+           "training_seed"]
 
 DEFAULT_EVAL_SUITES = {"lvgym/SmileAscent-v0": "smile-windy", "lvgym/SlenderAscent-v0": "slender-ld30",
                        "lvgym/SmileAscent-v1": "smile-v1", "lvgym/SlenderAscent-v1": "slender-v1"}
 
-#: what a run on an env id flies when the option is not on the command line (an option given wins, so
-#: ``--residual none --history 0`` trains a plain PPO): the recipe of the policy shipped for the id
-#: (docs/training.md, "The policy shipped for protocol v1"): residual on ``lqg`` with 5 % of the gimbal,
-#: a 4-sample history, Dryden turbulence without the gust (trained with the gust it scored worse on the
-#: suite's gusts: IQM 0.629 against 0.612 rad non-rigid, three seeds each)
+#: what a run of ``--recipe residual`` (the default) on an env id flies where the option is not on the command line
+#: (an option given wins): the recipe of the policy shipped for the id (docs/training.md, "The policy shipped for
+#: protocol v1"): residual on ``lqg`` with 5 % of the gimbal, a 4-sample history, Dryden turbulence without the
+#: gust (trained with the gust it scored worse on the suite's gusts: IQM 0.629 against 0.612 rad non-rigid, three
+#: seeds each). An id without an entry trains plain
 RECIPES: dict[str, dict[str, Any]] = {
     "lvgym/SmileAscent-v1": {"residual": "lqg", "residual_scale": 0.05, "history": 4, "wind": "turbulence"},
 }
+#: the presets of ``lvgym train --recipe`` that train with stable-baselines3 (the third, ``teacher-student``, is
+#: :mod:`lvgym.agents.training.teacher_student`, with its own options): ``plain`` learns from scratch, with no
+#: residual baseline, no history and no teacher, in the protocol's (or the suite's) wind; ``residual`` flies the
+#: env id's :data:`RECIPES`
+SB3_RECIPES = ("plain", "residual")
+
+
+def recipe_options(args: Any, given: set[str]) -> dict[str, Any]:
+    """The options the run's ``--recipe`` sets (``args``: :class:`lvgym.agents.training.train.Args`), those given on
+    the command line (``given``) left as they are: nothing for ``plain`` (the options' own defaults: no residual,
+    no history, the protocol's wind), which refuses a ``--residual`` baseline; the env id's :data:`RECIPES` for
+    ``residual``, without its wind on a ``--suite`` (the suite's wind is the suite's). The recipe is one of
+    :data:`SB3_RECIPES` (:func:`check_options`)."""
+    if args.recipe == "plain":
+        if args.residual not in (None, "none"):
+            raise ConfigError("--residual", args.residual, "none with --recipe plain (it learns from scratch; "
+                                                           "--recipe residual flies a baseline)")
+        return {}
+    return {k: v for k, v in RECIPES.get(args.env_id, {}).items() if k not in given and not (args.suite and k == "wind")}
 
 
 def suite_condition(suite: str, model: str) -> Any:
@@ -111,9 +131,9 @@ def check_options(args: Any) -> None:
     from lvgym.envs.spec import RANDOMIZE
 
     check_fields(args)
-    if getattr(args, "recipe", "sb3") != "sb3":
-        raise ConfigError("--recipe", args.recipe, "sb3 for a stable-baselines3 run (lvgym train --recipe "
-                                                   "teacher-student takes its own options, not these)")
+    if getattr(args, "recipe", "residual") not in SB3_RECIPES:
+        raise ConfigError("--recipe", args.recipe, f"one of {list(SB3_RECIPES)} for a stable-baselines3 run (lvgym "
+                                                   "train --recipe teacher-student takes its own options, not these)")
     residual_options(args.residual, args.residual_scale)
     loop_dispersion_options(args.loop_gain_db, args.loop_delay_periods)
     load_margin_options(args.load_margin, args.load_margin_threshold)
