@@ -34,6 +34,10 @@ def foreign(tmp_path_factory):
     model = PPO("MlpPolicy", venv, n_steps=32, batch_size=32, n_epochs=1, policy_kwargs={"net_arch": [8]},
                 device="cpu", seed=0)
     model.learn(64)
+    import torch
+
+    with torch.no_grad():                           # actions of order one (a fresh PPO's are of order 0.01)
+        model.policy.action_net.weight.mul_(50.0)
     rng = np.random.default_rng(5)                  # statistics far from the identity
     n = venv.observation_space.shape[0]
     venv.obs_rms.mean = rng.normal(0.0, 0.5, n)
@@ -60,7 +64,7 @@ def _flown(policy, model, venv) -> int:
     while True:
         action = policy.act(obs, info)
         np.testing.assert_allclose(action, _by_hand(model, venv, obs), rtol=1e-5, atol=1e-6)
-        differs |= not np.allclose(action, model.predict(obs, deterministic=True)[0], atol=1e-3)
+        differs |= not np.allclose(action, model.predict(obs, deterministic=True)[0], atol=1e-2)
         obs, _, terminated, truncated, info = env.step(action)
         steps += 1
         if terminated or truncated:

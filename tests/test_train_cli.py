@@ -252,7 +252,7 @@ def test_a_spent_wall_time_budget_ends_the_run_validated_with_its_models(tmp_pat
     from lvgym.agents.policies.saved import describe_saved
 
     assert describe_saved(run) == f"{run / 'best_model.zip'}: its best model by validation (step {step:,})"
-    TRAIN.train(["--resume", str(run), "--total-timesteps", str(step + 128), "--no-progress"])
+    TRAIN.train(["--resume", str(run), "--total-timesteps", str(step + 128), "--max-wall-time", "600", "--no-progress"])
     assert json.loads((run / "final_model.json").read_text())["num_timesteps"] >= step + 128
 
 
