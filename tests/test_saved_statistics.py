@@ -94,7 +94,8 @@ def test_its_statistics_given_or_carried_fly_as_applied_by_hand(foreign, tmp_pat
     folder, model, venv = foreign
     given = SB3Policy(folder / "agent.zip", vecnormalize=folder / "vec_normalize.pkl")
     assert _flown(given, model, venv) > 10
-    export_main([str(folder / "agent.zip"), str(tmp_path / "mine"), "--vecnormalize", str(folder / "vec_normalize.pkl")])
+    export_main([str(folder / "agent.zip"), str(tmp_path / "mine"), "--vecnormalize",
+                 str(folder / "vec_normalize.pkl")])
     with zipfile.ZipFile(tmp_path / "mine.zip") as z:
         assert VECNORM_MEMBER in z.namelist()
     (tmp_path / "mine_vecnormalize.pkl").unlink()               # the .zip alone carries them

@@ -20,8 +20,8 @@ of the test seeds), ``comparison.md`` and ``comparison.json`` (:mod:`lvgym.agent
 Each run is one task: a ``train.py`` process started by a worker of the executor (``local``: ``workers``
 threads of this process, each waiting for its ``train.py``; ``ray``: a Ray task of one CPU). What the task
 does is decided when it starts: a run with ``final_model.json`` at its target step is finished and skipped, a
-run folder without it (or stopped short by its wall-time budget) continues with ``--resume`` (from its newest checkpoint), else the run starts. So the command
-can simply be run again after a kill, and a Ray task whose worker or node died is retried by Ray (its
+run folder without it (or stopped short by its wall-time budget) continues with ``--resume`` (from its newest
+checkpoint), else the run starts. So the command can simply be run again after a kill, and a Ray task whose worker or node died is retried by Ray (its
 default ``max_retries``, 3) on another node, where it resumes; the run's lock file (``logs/<run>.lock``)
 keeps a retry from starting while a ``train.py`` of the earlier attempt still writes. On a cluster the runs
 folder must be on a file system every node sees (and lvgym installed on every node). A run that fails, or

@@ -30,8 +30,8 @@ once). ``--max-wall-time`` is a budget for this process: once spent, the run sto
 ends as a finished run does, with a checkpoint, a validation (when the run validates), ``final_model.*``,
 ``best_model.*`` and ``evaluations.json``, says so and exits normally (status 0; ``--resume`` continues it).
 A line on stdout every ``--progress-interval-s`` seconds gives the step, the speed, the time spent and left
-and the latest validation score. Every option is checked before the run folder is made: a bad value is a one-line error
-and leaves nothing behind.
+and the latest validation score. Every option is checked before the run folder is made: a bad value is a
+one-line error and leaves nothing behind.
 
 ``--recipe`` chooses a preset: ``residual`` (the default) the env id's recipe (:data:`RECIPES`), ``plain`` learning
 from scratch (no residual, no history, no teacher); an option given on the command line wins over the preset's.

@@ -47,7 +47,8 @@ def recipe_options(args: Any, given: set[str]) -> dict[str, Any]:
             raise ConfigError("--residual", args.residual, "none with --recipe plain (it learns from scratch; "
                                                            "--recipe residual flies a baseline)")
         return {}
-    return {k: v for k, v in RECIPES.get(args.env_id, {}).items() if k not in given and not (args.suite and k == "wind")}
+    return {k: v for k, v in RECIPES.get(args.env_id, {}).items()
+            if k not in given and not (args.suite and k == "wind")}
 
 
 def suite_condition(suite: str, model: str) -> Any:
