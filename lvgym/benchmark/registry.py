@@ -110,9 +110,7 @@ def _describe(loader: PolicyLoader, path: Path, text: str, prog: str) -> None:
         return
     try:
         note = load_factory(loader.describe)(path=str(path.resolve()))
-    except ImportError as exc:
-        raise SystemExit(f"{prog}: policy {text!r}: {exc}")
-    except (ValueError, OSError) as exc:
+    except (ImportError, ValueError, OSError) as exc:
         raise SystemExit(f"{prog}: policy {text!r}: {exc}")
     if note:
         print(f"{prog}: policy {text!r} flies {note}", file=sys.stderr)
