@@ -1,7 +1,8 @@
 """The line a process prints before it compiles the flight model.
 
 numba compiles the simulator's kernels on their first use (the loads function when :mod:`.flight` is imported, the
-step :func:`.advance.advance_range` at the first step): about 30-60 s on 2 cores, with nothing to show for it. Each
+step :func:`.advance.advance_range` at the first step): 30 s on a quiet core, 121 s of CPU on a busy 2-core machine
+(224 s of wall time), with nothing to show for it. Each
 is ``cache=True``, so numba keeps the machine code on disk (``__pycache__`` beside the sources, or
 ``$NUMBA_CACHE_DIR``) and later processes load it in a second or two. :func:`announce_compile` says so in one line,
 :data:`MESSAGE`, on stderr, at most once per process, and only when numba's cache holds no entry for the function
@@ -15,7 +16,7 @@ from typing import Any, TextIO
 
 __all__ = ["MESSAGE", "announce_compile", "cache_is_cold"]
 
-MESSAGE = "lvgym: compiling the flight model (numba), about 30-60 s, once: later runs load it from numba's cache"
+MESSAGE = "lvgym: compiling the flight model (numba), 30 s to 2 min, once: later runs load it from numba's cache"
 _announced = False
 
 
