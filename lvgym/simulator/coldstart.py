@@ -1,12 +1,12 @@
 """The line a process prints before it compiles the flight model.
 
 numba compiles the simulator's kernels on their first use (the loads function when :mod:`.flight` is imported, the
-step :func:`.advance.advance_range` at the first step): 30 s on a quiet core, 121 s of CPU on a busy 2-core machine
-(224 s of wall time), with nothing to show for it. Each
-is ``cache=True``, so numba keeps the machine code on disk (``__pycache__`` beside the sources, or
-``$NUMBA_CACHE_DIR``) and later processes load it in a second or two. :func:`announce_compile` says so in one line,
-:data:`MESSAGE`, on stderr, at most once per process, and only when numba's cache holds no entry for the function
-about to compile (a fresh install, an edited source file, another numba version): :func:`cache_is_cold`.
+step :func:`.advance.advance_range` at the first step): 121 s of CPU (224 s of wall time) to the first step of a
+``smile-v2`` env on the busy 2-core development machine, with nothing to show for it. Each is ``cache=True``, so
+numba keeps the machine code on disk (``__pycache__`` beside the sources, or ``$NUMBA_CACHE_DIR``) and later
+processes load it (3.7 s to the first step). :func:`announce_compile` says so in one line, :data:`MESSAGE`, on
+stderr, at most once per process, and only when numba's cache holds no entry for the function about to compile (a
+fresh install, an edited source file, another numba version): :func:`cache_is_cold`.
 """
 
 from __future__ import annotations
@@ -16,7 +16,7 @@ from typing import Any, TextIO
 
 __all__ = ["MESSAGE", "announce_compile", "cache_is_cold"]
 
-MESSAGE = "lvgym: compiling the flight model (numba), 30 s to 2 min, once: later runs load it from numba's cache"
+MESSAGE = "lvgym: compiling the flight model (numba), a minute or two, once: later runs load it from numba's cache"
 _announced = False
 
 
