@@ -56,15 +56,15 @@ def policy_files(stem: str | Path) -> tuple[Path, Path, Path]:
     return s.with_name(s.name + ".zip"), s.with_name(s.name + VECNORM_SUFFIX), s.with_name(s.name + ".json")
 
 
-def _carry(zip_path: Path, vecnormalize: Any) -> None:
-    """Put ``vecnormalize``'s statistics into the ``.zip`` at ``zip_path`` as :data:`VECNORM_MEMBER` (replacing
-    any there), the other members as they are."""
+def _carry(zip_path: Path, statistics: bytes) -> None:
+    """Put ``statistics`` (a pickled VecNormalize, as ``VecNormalize.save`` writes it) into the ``.zip`` at
+    ``zip_path`` as :data:`VECNORM_MEMBER` (replacing any there), the other members as they are."""
     with zipfile.ZipFile(zip_path) as z:
         members = [(info, z.read(info.filename)) for info in z.infolist() if info.filename != VECNORM_MEMBER]
     with zipfile.ZipFile(zip_path, "w", zipfile.ZIP_DEFLATED) as z:
         for info, data in members:
             z.writestr(info, data)
-        z.writestr(VECNORM_MEMBER, pickle.dumps(vecnormalize, protocol=pickle.HIGHEST_PROTOCOL))
+        z.writestr(VECNORM_MEMBER, statistics)
 
 
 def save_model(model: Any, vecnormalize: Any, stem: str | Path) -> Path:
@@ -74,7 +74,7 @@ def save_model(model: Any, vecnormalize: Any, stem: str | Path) -> Path:
     with atomic_path(zip_path) as tmp:
         model.save(tmp)
         if vecnormalize is not None:
-            _carry(tmp, vecnormalize)
+            _carry(tmp, pickle.dumps(vecnormalize, protocol=pickle.HIGHEST_PROTOCOL))
     if vecnormalize is not None:
         with atomic_path(norm_path) as tmp:
             vecnormalize.save(tmp)
@@ -97,7 +97,10 @@ def copy_policy(src_stem: str | Path, dst_stem: str | Path, extra: dict[str, Any
     """Copy a saved policy's files to another stem (atomically, the JSON last); ``vecnormalize``: a file of
     VecNormalize statistics (``VecNormalize.save``'s) that the copy carries in place of the source's own."""
     src, dst = policy_files(src_stem), policy_files(dst_stem)
-    given = _read_statistics(Path(vecnormalize)) if vecnormalize is not None else None
+    given = None
+    if vecnormalize is not None:
+        _read_statistics(Path(vecnormalize))               # checked: VecNormalize statistics
+        given = Path(vecnormalize).read_bytes()
     for s, d in zip(src[:2], dst[:2]):
         if given is not None:
             with atomic_path(d) as tmp:
