@@ -180,10 +180,13 @@ class Condition:
                                             "gets s + i)")
         with warnings.catch_warnings():            # a frozen v0 suite flies its v0 env on purpose
             warnings.filterwarnings("ignore", message=".*is out of date", category=DeprecationWarning)
-            if api == "sb3":
-                from lvgym.envs import make_sb3_vec_env
+            if api == "sb3":                      # the id's class, as gymnasium.make finds it (registered)
+                from gymnasium.envs.registration import load_env_creator
 
-                return make_sb3_vec_env(self.env_id, int(num_envs), seed, **self.env_kwargs())
+                from lvgym.envs.sb3 import AscentSB3VecEnv
+
+                env_cls = load_env_creator(gymnasium.spec(self.env_id).entry_point)
+                return AscentSB3VecEnv(env_cls, int(num_envs), seed, **self.env_kwargs())
             return gymnasium.make_vec(self.env_id, num_envs=int(num_envs), vectorization_mode="vector_entry_point",
                                       **self.env_kwargs())
 
