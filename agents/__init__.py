@@ -50,10 +50,12 @@ register_policy("inversion-id-stratos", "lvgym.agents.policies.inversion:shipped
 # ... for smile-v2 (no faults): an observer trained on its flights, the moment carried 5 steps ahead
 register_policy("inversion-id-smile", "lvgym.agents.policies.inversion:shipped_inversion", file="inversion_id_smile_v2",
                 name="inversion-id-smile")
-# a saved stable-baselines3 model (an optional <stem>_vecnormalize.pkl next to it normalises the
-# observations) or a train.py run folder (its best model)
+# a saved stable-baselines3 model (flown with the VecNormalize statistics it carries or has beside it as
+# <stem>_vecnormalize.pkl; one trained under VecNormalize without them is refused) or a train.py run folder (its
+# best model, else its final model, else its newest checkpoint: the command names which)
 register_policy_loader("lvgym.agents.policies.sb3:load_policy", suffixes=(".zip",), folders=True,
-                       description="a stable-baselines3 .zip model or a train.py run folder")
+                       description="a stable-baselines3 .zip model or a train.py run folder",
+                       describe="lvgym.agents.policies.saved:describe_saved")
 # a learned disturbance observer's record (.json beside its .npz: lvgym train --recipe teacher-student writes one,
 # agents/trained holds the shipped ones): evaluate.py --policies results/teacher-student/smile-v2/inversion_id_smile_v2.json
 register_policy_loader("lvgym.agents.policies.inversion_record:from_record", suffixes=(".json",),

@@ -7,6 +7,7 @@ The benchmark's own envs, as a suite's condition flies them (wind, gust, dispers
 
     env = lvgym.make_env("smile-v1", model="nonrigid")                # gymnasium.Env
     venv = lvgym.make_vec_env("smile-v1", "rigid", num_envs=8)        # gymnasium VectorEnv, row i = seed + i
+    venv = lvgym.make_vec_env("smile-v1", "rigid", num_envs=8, api="sb3", seed=0)   # the same rows, an SB3 VecEnv
 """
 
 from __future__ import annotations
@@ -60,13 +61,18 @@ def make_env(suite: str, model: str = "nonrigid", **overrides: Any) -> Any:
     return condition(suite, model, **overrides).make_env()
 
 
-def make_vec_env(suite: str, model: str = "nonrigid", num_envs: int = 1, **overrides: Any) -> Any:
-    """:func:`make_env`'s env batched: a Gymnasium ``VectorEnv`` of ``num_envs`` rows
-    (:meth:`lvgym.benchmark.Condition.make_vec_env`); ``reset(seed=s)`` seeds row ``i`` with ``s + i``,
-    so row ``i`` flies the benchmark's episode of seed ``s + i``."""
+def make_vec_env(suite: str, model: str = "nonrigid", num_envs: int = 1, *, api: str = "gymnasium",
+                 seed: int | None = None, **overrides: Any) -> Any:
+    """:func:`make_env`'s env batched, ``num_envs`` rows over one simulator
+    (:meth:`lvgym.benchmark.Condition.make_vec_env`). ``api="gymnasium"`` (default): a Gymnasium ``VectorEnv``
+    whose ``reset(seed=s)`` seeds row ``i`` with ``s + i``, so row ``i`` flies the benchmark's episode of seed
+    ``s + i`` (a finished row restarts at the next step). ``api="sb3"``: the same rows as a stable-baselines3
+    ``VecEnv`` (:class:`lvgym.envs.sb3.AscentSB3VecEnv`, the ``train`` extra), for a pipeline of your own; its
+    ``reset()`` takes no seed, so ``seed`` (or ``venv.seed(s)`` before a reset) seeds row ``i`` with ``seed + i``,
+    and a finished row restarts within the step (its last observation in ``infos[i]["terminal_observation"]``)."""
     from lvgym.benchmark.suites import condition
 
-    return condition(suite, model, **overrides).make_vec_env(num_envs)
+    return condition(suite, model, **overrides).make_vec_env(num_envs, api=api, seed=seed)
 
 
 def register_envs() -> None:

@@ -69,7 +69,7 @@ def _file(tmp: Path, name: str = "tiny", **over) -> Path:
     ({"evaluation__suites": ["smile-v9"]}, r"evaluation\.suites\[0\] = 'smile-v9': a suite of the protocol"),
     ({"evaluation__baselines": ["zero"]}, r"evaluation\.baselines\[0\] = 'zero': a classical baseline"),
     ({"evaluation__episodes": 0}, r"evaluation\.episodes = 0: an integer in \[1, "),
-    ({"seeds": [0, 99999]}, r"seeds\[1\] = 99999: configuration 'a': --seed 99999 with 4 envs"),
+    ({"seeds": [0, 100000]}, r"seeds\[1\] = 100000: .*--seed = 100000: an integer in \[0, 99999\]"),
     ({"executor": "slurm"}, r"executor = 'slurm': one of \('local', 'ray'\)"),
     ({"epochs": 3}, r"epochs = 3: unknown key; one of \["),
 ])

@@ -1,7 +1,7 @@
 """The benchmark's envs from Python (``lvgym.make_env``, ``lvgym.make_vec_env``): the env of a suite's
 condition flies the protocol's episode of a seed (the stored v1 fingerprint, flown by the benchmark's own
-``Condition.make_env``), the batched env's row ``i`` flies seed ``s + i``, and a bad suite or model is
-refused in one line that names what is allowed."""
+``Condition.make_env``), the batched env's row ``i`` flies seed ``s + i`` (its Gymnasium face and its SB3
+face alike), and a bad suite or model is refused in one line that names what is allowed."""
 
 from __future__ import annotations
 
@@ -58,6 +58,42 @@ def test_vec_env_rows_are_the_benchmarks_seeds_and_overrides_apply():
             obs, reward, *_ = e.step(actions[i])
             np.testing.assert_array_equal(vobs[i], obs)
             assert vrew[i] == reward
+
+
+def test_the_sb3_face_is_make_env_row_by_row():
+    """``make_vec_env(..., api="sb3", seed=s)``: row ``i`` is ``make_env`` of the same condition reset with seed
+    ``s + i``, step for step with the same actions (observations, rewards, dones to the bit), through two
+    episodes per row: a finished row restarts within the step, its last observation in the info, and its next
+    episode is the single env's next reset (the same generator)."""
+    n, seed, overrides = 3, 4_000, {"mission_time_s": 0.6}
+    venv = lvgym.make_vec_env("smile-v2", "nonrigid", n, api="sb3", seed=seed, **overrides)
+    singles = [lvgym.make_env("smile-v2", "nonrigid", **overrides) for _ in range(n)]
+    assert venv.num_envs == n and venv.task == singles[0].unwrapped.task
+    assert venv.observation_space == singles[0].observation_space and venv.action_space == singles[0].action_space
+    np.testing.assert_array_equal(venv.reset(), np.stack([e.reset(seed=seed + i)[0] for i, e in enumerate(singles)]))
+    rng = np.random.default_rng(7)
+    episodes, steps = np.zeros(n, dtype=int), 0
+    while episodes.min() < 2:
+        actions = rng.uniform(-1, 1, (n, 2)).astype(np.float32)
+        obs, rewards, dones, infos = venv.step(actions)
+        steps += 1
+        for i, e in enumerate(singles):
+            o, r, terminated, truncated, _ = e.step(actions[i])
+            assert dones[i] == (terminated or truncated) and rewards[i] == np.float32(r)
+            if dones[i]:
+                np.testing.assert_array_equal(infos[i]["terminal_observation"], o)
+                assert infos[i]["TimeLimit.truncated"] == (truncated and not terminated)
+                o, _ = e.reset()
+                episodes[i] += 1
+            np.testing.assert_array_equal(obs[i], o)
+    assert steps > 20
+
+
+def test_make_vec_env_refuses_a_bad_api_or_a_seed_gymnasium_takes_at_reset():
+    with pytest.raises(ConfigError, match=r"^api = 'sb4': one of \['gymnasium', 'sb3'\] \(did you mean 'sb3'\?\)$"):
+        lvgym.make_vec_env("smile-v2", "rigid", 2, api="sb4")
+    with pytest.raises(ConfigError, match=r"^seed = 3: None with api='gymnasium'"):
+        lvgym.make_vec_env("smile-v2", "rigid", 2, seed=3)
 
 
 def test_a_bad_suite_or_model_is_one_line_naming_what_is_allowed():

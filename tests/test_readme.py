@@ -98,6 +98,11 @@ def test_fly_an_env():
     assert namespace["obs"].shape == namespace["env"].observation_space.shape
     assert set(namespace["info"]["reward_terms"]) == {"rate_roll", "rate_pitch", "rate_yaw", "effort", "effort_rate",
                                                       "failure"}
+    rows, _ = namespace["venv"].reset(seed=0)                                  # both faces: the same 8 rows
+    sb3_venv = namespace["sb3_venv"]
+    assert rows.shape == (8, *namespace["env"].observation_space.shape)
+    np.testing.assert_array_equal(sb3_venv.reset(), rows)
+    np.testing.assert_array_equal(rows[0], namespace["env"].reset(seed=0)[0])
 
 
 def test_train_then_evaluate(tmp_path):

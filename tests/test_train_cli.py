@@ -46,7 +46,8 @@ def _wait(cond, proc: subprocess.Popen, log: Path, what: str, timeout: float = 1
     (["--hp", "policy.net_arch=[8,"], r"--hp = 'policy\.net_arch=\[8,': KEY=VALUE with a YAML value"),
     (["--randomize", "winds"], r"--randomize = 'winds': names of \["),
     (["--eval-suite", "nope"], r"--eval-suite = 'nope': one of \["),
-    (["--seed", "99999"], r"--seed 99999 with 4 envs: rows seed \.\. seed \+ n_envs - 1 must be validation seeds"),
+    (["--seed", "100000"], r"--seed = 100000: an integer in \[0, 99999\]"),
+    (["--recipe", "plain", "--residual", "lqg"], r"--residual = 'lqg': none with --recipe plain"),
 ])
 def test_a_bad_option_is_one_line_and_leaves_no_run_folder(tmp_path, capsys, extra, message):
     with pytest.raises(SystemExit) as exit_:
@@ -178,19 +179,81 @@ def test_the_default_run_is_the_v1_recipe_and_given_options_win(tmp_path):
     assert not (tmp_path / "r").exists()
 
 
-def test_a_spent_wall_time_budget_stops_with_a_checkpoint_and_says_so(tmp_path, capsys):
-    """``--max-wall-time``: the run stops at the next env step once the budget (counted from the start of
-    the command) is spent, writes a checkpoint, says so and returns (no exit status); --resume finishes it."""
-    argv = _argv(tmp_path, "budget", steps=10**7, extra=("--eval-freq", "0", "--checkpoint-freq", "1000000000",
+def test_the_presets_plain_and_residual(tmp_path):
+    """``--recipe plain``: from scratch on the protocol's wind, no residual, no history (an option given still
+    wins); ``--recipe residual`` is the default, the env id's RECIPES; on an id without a recipe it trains plain.
+    A run folder of the days before the presets (recipe ``sb3``) resumes as ``residual``."""
+    base = ["--runs-dir", str(tmp_path), "--name", "r"]
+    args, config, _, _ = TRAIN.prepare(*TRAIN.parse_args(base + ["--recipe", "plain"]))
+    assert args.recipe == "plain" and args.residual is None and "residual" not in config
+    assert "history" not in config["env_kwargs"] and config["env_kwargs"]["wind"] == "turbulence_gust"
+    assert config["args"]["recipe"] == "plain"
+    args, config, _, _ = TRAIN.prepare(*TRAIN.parse_args(base + ["--recipe", "plain", "--history", "2"]))
+    assert config["env_kwargs"]["history"] == 2 and "residual" not in config
+    args, config, _, _ = TRAIN.prepare(*TRAIN.parse_args(base + ["--recipe", "plain", "--residual", "none"]))
+    assert args.residual in (None, "none") and "residual" not in config
+    given = TRAIN.prepare(*TRAIN.parse_args(base + ["--recipe", "residual"]))[1]
+    default = TRAIN.prepare(*TRAIN.parse_args(base))[1]
+    assert given["residual"] == default["residual"] == {"baseline": "lqg", "scale": 0.05}
+    assert given["env_kwargs"] == default["env_kwargs"] and default["args"]["recipe"] == "residual"
+    v0 = TRAIN.prepare(*TRAIN.parse_args(base + ["--recipe", "residual", "--env-id", "lvgym/SmileAscent-v0"]))[1]
+    plain = TRAIN.prepare(*TRAIN.parse_args(base + ["--recipe", "plain", "--env-id", "lvgym/SmileAscent-v0"]))[1]
+    assert v0["env_kwargs"] == plain["env_kwargs"] and "residual" not in v0
+    assert not (tmp_path / "r").exists()
+
+
+def test_the_help_shows_the_true_defaults(capsys):
+    """``--help`` gives each option's default as the default run flies it: the recipe's (RECIPES) for the default
+    env id, no longer "(default: not residual)" and "(default: 0)" where the recipe sets lqg and 4."""
+    with pytest.raises(SystemExit):
+        TRAIN.parse_args(["--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    recipe = TRAIN.RECIPES[TRAIN.Args().env_id]
+    assert TRAIN.Args().env_id == "lvgym/SmileAscent-v1" and TRAIN.Args().recipe == "residual"
+    assert "--recipe {plain,residual,teacher-student}" in text and "preset's (default: residual)" in text
+    assert "not residual" not in text
+    for option, value, otherwise in (("--residual", recipe["residual"], "none"),
+                                     ("--residual-scale", recipe["residual_scale"], "0.2"),
+                                     ("--history", recipe["history"], "0"),
+                                     ("--wind", recipe["wind"], "protocol")):
+        tail = "" if option != "--wind" else " without --suite"
+        shown = (f"(default: the --recipe's: {value:g}" if isinstance(value, float) else
+                 f"default: the --recipe's: {value}")
+        assert f"{shown} for residual on lvgym/SmileAscent-v1{tail}, else {otherwise})" in text, option
+    args, config, _, _ = TRAIN.prepare(*TRAIN.parse_args(["--name", "r"]))
+    assert (config["residual"]["baseline"], config["residual"]["scale"], config["env_kwargs"]["history"],
+            config["env_kwargs"]["wind"]) == (recipe["residual"], recipe["residual_scale"], recipe["history"],
+                                              recipe["wind"])
+
+
+def test_a_spent_wall_time_budget_ends_the_run_validated_with_its_models(tmp_path, capsys):
+    """``--max-wall-time``: the run stops at the next env step once the budget (counted from the start of the
+    command) is spent and ends as a finished run does: a checkpoint of that step, validated, ``final_model``,
+    ``best_model`` and ``evaluations.json``, which the curves tool reads; it says so and returns (no exit status);
+    --resume continues it to its target."""
+    from experiments.training_speed import curves
+
+    argv = _argv(tmp_path, "budget", steps=10**7, extra=("--checkpoint-freq", "1000000000", "--eval-freq", "1000000000",
                                                          "--checkpoint-interval-s", "0", "--max-wall-time", "2"))
     run = TRAIN.train(argv)
     err = capsys.readouterr().err
+    (step, stem), = list_checkpoints(run / "checkpoints")
+    assert 0 < step < 10**7
     assert "train.py: the wall-time budget of 2 s is spent: stopped at step" in err, err
+    assert f"checkpoint step_{step:012d}, validated, final_model, best_model written" in err, err
     assert f"continue with python train.py --resume {run}" in err
-    (step, _), = list_checkpoints(run / "checkpoints")
-    assert 0 < step < 10**7 and not (run / "final_model.json").exists()
-    TRAIN.train(["--resume", str(run), "--total-timesteps", str(step + 128), "--no-progress"])
-    assert (run / "final_model.json").is_file()
+    evaluations = json.loads((run / "evaluations.json").read_text())
+    assert [e["num_timesteps"] for e in evaluations] == [step] and evaluations[0]["seed_set"] == "validation"
+    for name in ("final_model", "best_model"):
+        assert json.loads((run / f"{name}.json").read_text())["num_timesteps"] == step
+        assert (run / f"{name}.zip").read_bytes() == stem.with_suffix(".zip").read_bytes()
+    rows = curves.load_curves(run)
+    assert {r["num_timesteps"] for r in rows} == {step} and {r["condition"] for r in rows} == {"rigid", "nonrigid"}
+    from lvgym.agents.policies.saved import describe_saved
+
+    assert describe_saved(run) == f"{run / 'best_model.zip'}: its best model by validation (step {step:,})"
+    TRAIN.train(["--resume", str(run), "--total-timesteps", str(step + 128), "--max-wall-time", "600", "--no-progress"])
+    assert json.loads((run / "final_model.json").read_text())["num_timesteps"] >= step + 128
 
 
 def test_the_progress_line_gives_steps_speed_time_and_the_validation_score(tmp_path, capsys):

@@ -2,16 +2,24 @@
 
 A saved policy is three files with one stem::
 
-    <stem>.zip                  the SB3 model (``model.save``)
-    <stem>_vecnormalize.pkl     the VecNormalize statistics (``VecNormalize.save``), if training normalised
+    <stem>.zip                  the SB3 model (``model.save``), carrying its VecNormalize statistics
+                                (the member ``lvgym_vecnormalize.pkl``, which SB3's loader passes over)
+    <stem>_vecnormalize.pkl     the same statistics (``VecNormalize.save``), if training normalised
     <stem>.json                 {"algo": "PPO", "env_id": ..., "env_kwargs": {...}, "num_timesteps": ...}
 
-:func:`save_policy` writes them (``lvgym train``), :func:`resolve_model_path` finds the ``.zip`` of a stem or of a
-run folder of ``train.py`` (``runs/<name>``: its best model by validation, else its final model, else its last
-checkpoint, :mod:`lvgym.agents.policies.checkpoints`), :func:`load_model` and :func:`load_vecnormalize` load it
-to fly (:class:`lvgym.agents.policies.sb3.SB3Policy`).
+:func:`save_model` and :func:`save_policy` write them (``lvgym train``), :func:`resolve_model_path` finds the
+``.zip`` of a stem or of a run folder of ``train.py`` (``runs/<name>``: its best model by validation, else its final
+model, else its last checkpoint, :mod:`lvgym.agents.policies.checkpoints`; :func:`describe_saved` says which),
+:func:`load_model` and :func:`statistics` load it to fly (:class:`lvgym.agents.policies.sb3.SB3Policy`).
+
+**Normalisation statistics.** A model trained under ``VecNormalize`` flies only with the statistics it was trained
+with. :func:`statistics` finds them: a file given, else ``<stem>_vecnormalize.pkl`` beside the ``.zip``, else the
+copy inside it. A ``.zip`` saved by another tool carries none; one trained under ``VecNormalize`` is known by its
+saved data (SB3 keeps the unnormalised observations, ``_last_original_obs``, only then), and without its statistics
+it is refused in one line that says what to pass (:func:`trained_normalised`), never flown on raw observations.
 
     lvgym export-policy runs/ppo-smile agents/trained/ppo_smile_ascent   # copy a run's policy
+    lvgym export-policy model.zip mine/model --vecnormalize vec_normalize.pkl   # a foreign model with its statistics
     python -m lvgym.agents.policies.saved export runs/ppo-smile agents/trained/ppo_smile_ascent   # the same
 """
 
@@ -30,10 +38,14 @@ from lvgym.commandline import arg
 
 from .algos import ALGOS, algo_class, algo_name
 
-__all__ = ["FLY_ONLY", "VECNORM_SUFFIX", "copy_policy", "guess_and_load", "load_model", "load_vecnormalize",
-           "policy_files", "read_meta", "resolve_model_path", "save_policy"]
+__all__ = ["FLY_ONLY", "VECNORM_MEMBER", "VECNORM_SUFFIX", "check_statistics", "copy_policy", "describe_saved",
+           "guess_and_load", "load_model", "load_vecnormalize", "policy_files", "read_meta", "resolve_model_path",
+           "save_model", "save_policy", "statistics", "trained_normalised"]
 
 VECNORM_SUFFIX = "_vecnormalize.pkl"
+#: the member of a saved ``.zip`` that carries its VecNormalize statistics (SB3's loader reads ``data`` and the
+#: ``.pth`` members only)
+VECNORM_MEMBER = "lvgym_vecnormalize.pkl"
 
 
 def policy_files(stem: str | Path) -> tuple[Path, Path, Path]:
@@ -44,26 +56,60 @@ def policy_files(stem: str | Path) -> tuple[Path, Path, Path]:
     return s.with_name(s.name + ".zip"), s.with_name(s.name + VECNORM_SUFFIX), s.with_name(s.name + ".json")
 
 
-def save_policy(model: Any, vecnormalize: Any, stem: str | Path, meta: dict[str, Any]) -> Path:
-    """Write the three files of ``stem``, each atomically, the JSON last (its presence means the others
-    are complete). ``meta`` must hold ``algo``; returns the ``.zip`` path."""
-    if "algo" not in meta:
-        raise ValueError("save_policy: meta needs 'algo' (e.g. 'PPO')")
-    zip_path, norm_path, json_path = policy_files(stem)
+def _carry(zip_path: Path, statistics: bytes) -> None:
+    """Put ``statistics`` (a pickled VecNormalize, as ``VecNormalize.save`` writes it) into the ``.zip`` at
+    ``zip_path`` as :data:`VECNORM_MEMBER` (replacing any there), the other members as they are."""
+    with zipfile.ZipFile(zip_path) as z:
+        members = [(info, z.read(info.filename)) for info in z.infolist() if info.filename != VECNORM_MEMBER]
+    with zipfile.ZipFile(zip_path, "w", zipfile.ZIP_DEFLATED) as z:
+        for info, data in members:
+            z.writestr(info, data)
+        z.writestr(VECNORM_MEMBER, statistics)
+
+
+def save_model(model: Any, vecnormalize: Any, stem: str | Path) -> Path:
+    """``<stem>.zip`` (``model.save``, carrying ``vecnormalize``'s statistics) and, with statistics,
+    ``<stem>_vecnormalize.pkl``, each written atomically; returns the ``.zip`` path."""
+    zip_path, norm_path, _ = policy_files(stem)
     with atomic_path(zip_path) as tmp:
         model.save(tmp)
+        if vecnormalize is not None:
+            _carry(tmp, pickle.dumps(vecnormalize, protocol=pickle.HIGHEST_PROTOCOL))
     if vecnormalize is not None:
         with atomic_path(norm_path) as tmp:
             vecnormalize.save(tmp)
-    atomic_write_text(json_path, json.dumps({**meta, "algo": algo_name(str(meta["algo"]))}, indent=1, sort_keys=True))
     return zip_path
 
 
-def copy_policy(src_stem: str | Path, dst_stem: str | Path, extra: dict[str, Any] | None = None) -> Path:
-    """Copy a saved policy's files to another stem (atomically, the JSON last)."""
+def save_policy(model: Any, vecnormalize: Any, stem: str | Path, meta: dict[str, Any]) -> Path:
+    """Write the three files of ``stem`` (:func:`save_model`), each atomically, the JSON last (its presence means
+    the others are complete). ``meta`` must hold ``algo``; returns the ``.zip`` path."""
+    if "algo" not in meta:
+        raise ValueError("save_policy: meta needs 'algo' (e.g. 'PPO')")
+    zip_path = save_model(model, vecnormalize, stem)
+    atomic_write_text(policy_files(stem)[2], json.dumps({**meta, "algo": algo_name(str(meta["algo"]))}, indent=1,
+                                                        sort_keys=True))
+    return zip_path
+
+
+def copy_policy(src_stem: str | Path, dst_stem: str | Path, extra: dict[str, Any] | None = None,
+                vecnormalize: str | Path | None = None) -> Path:
+    """Copy a saved policy's files to another stem (atomically, the JSON last); ``vecnormalize``: a file of
+    VecNormalize statistics (``VecNormalize.save``'s) that the copy carries in place of the source's own."""
     src, dst = policy_files(src_stem), policy_files(dst_stem)
+    given = None
+    if vecnormalize is not None:
+        _read_statistics(Path(vecnormalize))               # checked: VecNormalize statistics
+        given = Path(vecnormalize).read_bytes()
     for s, d in zip(src[:2], dst[:2]):
-        if s.is_file():
+        if given is not None:
+            with atomic_path(d) as tmp:
+                if d == dst[0]:
+                    shutil.copyfile(s, tmp)
+                    _carry(tmp, given)
+                else:
+                    shutil.copyfile(vecnormalize, tmp)
+        elif s.is_file():
             with atomic_path(d) as tmp:
                 shutil.copyfile(s, tmp)
         elif d.is_file():
@@ -170,16 +216,93 @@ def load_model(zip_path: str | Path, algo: str | None = None) -> Any:
     return cls.load(str(zip_path), device="cpu", custom_objects=FLY_ONLY)
 
 
-def load_vecnormalize(zip_path: str | Path) -> Any:
-    """The VecNormalize statistics saved next to ``zip_path`` (frozen: ``training = False``), or None."""
-    norm = policy_files(zip_path)[1]
-    if not norm.is_file():
-        return None
-    with open(norm, "rb") as f:
-        vn = pickle.load(f)
+def _read_statistics(path: Path) -> Any:
+    """The VecNormalize object pickled in the file ``path`` (``VecNormalize.save``'s), checked."""
+    if not path.is_file():
+        raise FileNotFoundError(f"{str(path)!r}: no such file of VecNormalize statistics")
+    with open(path, "rb") as f:
+        try:
+            vn = pickle.load(f)
+        except Exception as exc:  # noqa: BLE001  (not a pickle, or of a class not installed)
+            raise ValueError(f"{str(path)!r}: not a file of VecNormalize statistics ({type(exc).__name__})") from None
+    if not hasattr(vn, "normalize_obs") or not hasattr(vn, "obs_rms"):
+        raise ValueError(f"{str(path)!r}: holds a {type(vn).__name__}, not VecNormalize statistics "
+                         "(VecNormalize.save writes them)")
+    return vn
+
+
+def load_vecnormalize(zip_path: str | Path, stats: str | Path | None = None) -> Any:
+    """The VecNormalize statistics a saved model flies with, frozen (``training`` and ``norm_reward`` off), or None:
+    the file ``stats`` when given, else ``<stem>_vecnormalize.pkl`` beside ``zip_path``, else those the ``.zip``
+    carries (:data:`VECNORM_MEMBER`). :func:`statistics` also refuses a model that needs them and has none."""
+    beside = policy_files(zip_path)[1]
+    if stats is not None or beside.is_file():
+        vn = _read_statistics(Path(stats) if stats is not None else beside)
+    else:
+        try:
+            with zipfile.ZipFile(zip_path) as z:
+                vn = pickle.loads(z.read(VECNORM_MEMBER)) if VECNORM_MEMBER in z.namelist() else None
+        except zipfile.BadZipFile:
+            vn = None
+        if vn is None:
+            return None
     vn.training = False
     vn.norm_reward = False
     return vn
+
+
+def trained_normalised(zip_path: str | Path) -> bool:
+    """Whether the SB3 model at ``zip_path`` was trained under ``VecNormalize``: its saved data holds the last
+    unnormalised observations (``_last_original_obs``), which SB3 keeps only for a ``VecNormalize`` env."""
+    try:
+        with zipfile.ZipFile(zip_path) as z:
+            data = json.loads(z.read("data"))
+    except (KeyError, ValueError, OSError, zipfile.BadZipFile):
+        return False
+    return data.get("_last_original_obs") is not None
+
+
+def _carries_statistics(zip_path: Path) -> bool:
+    """Whether the saved model at ``zip_path`` has statistics beside it or inside it (nothing unpickled)."""
+    if policy_files(zip_path)[1].is_file():
+        return True
+    try:
+        with zipfile.ZipFile(zip_path) as z:
+            return VECNORM_MEMBER in z.namelist()
+    except (OSError, zipfile.BadZipFile):
+        return False
+
+
+def check_statistics(zip_path: str | Path) -> None:
+    """A one-line ``ValueError`` for a model trained under ``VecNormalize`` (:func:`trained_normalised`) that
+    carries no statistics and has none beside it: it would fly on raw observations. The message says what to pass."""
+    p = Path(zip_path)
+    if not _carries_statistics(p) and trained_normalised(p):
+        raise ValueError(f"{str(p)!r} was trained under VecNormalize and carries no statistics (none inside it, no "
+                         f"{p.stem}{VECNORM_SUFFIX} beside it): give it the file VecNormalize.save wrote, as "
+                         f"lvgym export-policy {p} STEM --vecnormalize FILE.pkl, and fly STEM.zip")
+
+
+def statistics(zip_path: str | Path, stats: str | Path | None = None) -> Any:
+    """:func:`load_vecnormalize`, after :func:`check_statistics` when no file ``stats`` is given."""
+    if stats is None:
+        check_statistics(zip_path)
+    return load_vecnormalize(zip_path, stats)
+
+
+def describe_saved(path: str | Path) -> str:
+    """One line naming what the saved policy at ``path`` flies: for a run folder its best model (by validation),
+    its final model or its newest checkpoint, with the step; ``""`` for a ``.zip`` given itself. Raises what
+    :func:`check_statistics` raises (the main process of ``evaluate.py`` calls it before any episode flies)."""
+    zip_path = resolve_model_path(path)
+    check_statistics(zip_path)
+    if not Path(path).is_dir():
+        return ""
+    step = read_meta(zip_path).get("num_timesteps")
+    at = f"step {int(step):,}" if step is not None else "step not recorded"
+    what = {"best_model": f"its best model by validation ({at})", "final_model": f"its final model ({at})"}
+    return f"{zip_path}: " + what.get(zip_path.stem, f"its newest checkpoint {zip_path.stem} ({at}; no best or final "
+                                                      "model)")
 
 
 @dataclasses.dataclass
@@ -190,6 +313,9 @@ class ExportArgs:
     """run folder (runs/<name>: its best, else final, else latest model) or a .zip"""
     stem: str = arg(positional=True, metavar="STEM")
     """destination without suffix, e.g. agents/trained/ppo_smile_ascent"""
+    vecnormalize: str | None = arg(None, metavar="FILE")
+    """VecNormalize statistics (the file VecNormalize.save wrote) for the copy to carry: a model trained under
+    VecNormalize by another tool flies only with them (default: the policy's own)"""
 
 
 def export_main(argv: list[str] | None = None) -> None:
@@ -201,9 +327,10 @@ def export_main(argv: list[str] | None = None) -> None:
     args = parse(ExportArgs, argv, prog, export_main.__doc__)
     try:
         src = resolve_model_path(args.run)
+        statistics(src, args.vecnormalize)           # the copy carries what it flies with, or nothing is written
     except (FileNotFoundError, ValueError) as exc:
         fail(command_name(prog), exc)
-    dst = copy_policy(src, args.stem, {"exported_from": str(src)})
+    dst = copy_policy(src, args.stem, {"exported_from": str(src)}, args.vecnormalize)
     print(f"{src} -> {dst}")
 
 

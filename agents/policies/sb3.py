@@ -20,7 +20,7 @@ from lvgym.benchmark.batch import BatchLaw, RowFace
 
 from .algos import algo_name
 from .mlp import MlpNet
-from .saved import load_model, load_vecnormalize, read_meta, resolve_model_path
+from .saved import load_model, read_meta, resolve_model_path, statistics
 
 
 def actor_net(model: Any) -> MlpNet | None:
@@ -144,12 +144,15 @@ class SB3Policy(RowFace):
     """A trained SB3 model behind the benchmark's Policy interface: one row of :class:`SB3Law`. It accepts a
     saved ``.zip``, its stem, or a run folder of ``train.py`` (``runs/<name>``: its best model by validation,
     else its final model, else its last checkpoint); ``name`` defaults to the file stem (the run name for a run
-    folder)."""
+    folder). It flies with the VecNormalize statistics the model was trained with (the file ``vecnormalize``, else
+    its own: :func:`lvgym.agents.policies.saved.statistics`, which refuses a model trained under VecNormalize
+    without them)."""
 
-    def __init__(self, path: str | Path, name: str | None = None, deterministic: bool = True) -> None:
+    def __init__(self, path: str | Path, name: str | None = None, deterministic: bool = True,
+                 vecnormalize: str | Path | None = None) -> None:
         zip_path = resolve_model_path(path)
         p = Path(path)
-        self.law = SB3Law(load_model(zip_path), load_vecnormalize(zip_path),
+        self.law = SB3Law(load_model(zip_path), statistics(zip_path, vecnormalize),
                           name or (p.resolve().name if p.is_dir() else zip_path.stem), deterministic,
                           read_meta(zip_path), str(zip_path))
 

@@ -3,7 +3,8 @@ and line: :mod:`lvgym.agents.training.progress`).
 
 A checkpoint ``checkpoints/step_<N>`` (N = env steps, 12 digits) is::
 
-    step_<N>.zip, step_<N>_vecnormalize.pkl     model (weights, optimiser) and normalisation statistics
+    step_<N>.zip, step_<N>_vecnormalize.pkl     model (weights, optimiser; carrying the normalisation
+                                                statistics) and the statistics
     step_<N>_rng.pkl                            torch, numpy and random generator states
     step_<N>_replay_buffer.pkl                  SAC / TD3 replay buffer (kept for the latest checkpoint only)
     step_<N>.json                               state: algo, steps, evaluation history, best so far
@@ -13,7 +14,9 @@ any moment resumes from a complete checkpoint (files of a half-written one are r
 Checkpoints are due every ``save_freq`` env steps and every ``interval_s`` seconds of wall time (so a
 kill loses at most about that much work), and on SIGTERM or SIGINT (:class:`SignalStop`): training then
 stops at the next env step, the checkpoint is written (without validation) and the run exits; a PPO
-rollout cut short is not trained on (SAC and TD3 keep its transitions in the replay buffer).
+rollout cut short is not trained on (SAC and TD3 keep its transitions in the replay buffer). A spent
+wall-time budget stops training the same way but ends the run as its last step does (a validated
+checkpoint, ``final_model.*``, ``best_model.*``, ``evaluations.json``).
 Checkpoints are taken at rollout boundaries (after a PPO update, before the next rollout), so the weights,
 the optimiser, the step counter and the statistics agree. Validation (when due) runs at a checkpoint, on
 the checkpointed model, with the protocol's validation seeds; its result is part of the checkpoint's JSON,
@@ -46,7 +49,7 @@ from lvgym.benchmark.runner import play_episode
 from lvgym.benchmark.suites import Suite, family_validation_suite, get_suite
 
 from ..policies.checkpoints import checkpoint_stem, list_checkpoints
-from ..policies.saved import copy_policy, policy_files
+from ..policies.saved import copy_policy, policy_files, save_model
 from ..policies.sb3 import SB3Policy, adapt
 
 #: what a validation's ``score`` is: compared lexicographically, lower is better (older runs' checkpoints
@@ -234,9 +237,10 @@ class CheckpointCallback(BaseCallback):
     (and at the end; ``eval_freq <= 0`` or no evaluator: never). Also checkpoints (without validation) at
     the first rollout boundary ``interval_s`` seconds of wall time after the last checkpoint (0: never),
     and when ``stop`` (a :class:`SignalStop`) has a signal: training then ends at the next env step with a
-    checkpoint and without ``final_model``; so too at the first env step past ``deadline`` (a
-    ``time.monotonic()`` value: the run's wall-time budget, :attr:`out_of_time`). Keeps the newest ``keep``
-    checkpoints and the best one.
+    checkpoint and without ``final_model``. At the first env step past ``deadline`` (a ``time.monotonic()``
+    value: the run's wall-time budget, :attr:`out_of_time`) training ends as at its last step: a checkpoint,
+    validated (with an evaluator), ``final_model`` and ``best_model``. Keeps the newest ``keep`` checkpoints
+    and the best one.
     ``meta``: written into every JSON (algo, env id and kwargs, ...). ``state``: the JSON of the
     checkpoint a resumed run starts from (restores the evaluation history, the best and the wall time
     spent, ``train_wall_s``)."""
@@ -325,13 +329,15 @@ class CheckpointCallback(BaseCallback):
     def _on_training_end(self) -> None:
         if self.out_of_time and self.num_timesteps >= int(getattr(self.model, "_total_timesteps", 0) or 0) > 0:
             self.out_of_time = False                 # the deadline came with the last step: the run is done
-        if self.stopping:                           # a signal or the deadline: checkpoint now, no validation,
-                                                    # no final model
-            if self.num_timesteps != self.last_save or not list_checkpoints(self.folder):
+        if self.stop is not None and self.stop.signum is not None:   # a signal: checkpoint now, no validation,
+            if self.num_timesteps != self.last_save or not list_checkpoints(self.folder):   # no final model
                 self.save(evaluate=False)
             return
-        if self.num_timesteps != self.last_save or not list_checkpoints(self.folder):
-            self.save(evaluate=self.evaluator is not None and self.eval_freq > 0)
+        # the end of the steps or of the wall-time budget: a validated checkpoint of the last step, the final model
+        validate = self.evaluator is not None and self.eval_freq > 0
+        if self.num_timesteps != self.last_save or not list_checkpoints(self.folder) or \
+                (validate and self.last_eval != self.num_timesteps):
+            self.save(evaluate=validate)
         last = list_checkpoints(self.folder)
         if last:
             copy_policy(last[-1][1], self.run_dir / "final_model")
@@ -340,12 +346,7 @@ class CheckpointCallback(BaseCallback):
         """Write a checkpoint of the model now (and validate it first if ``evaluate``)."""
         step = int(self.num_timesteps)
         stem = checkpoint_stem(self.folder, step)
-        zip_path, norm_path, json_path = policy_files(stem)
-        with atomic_path(zip_path) as tmp:
-            self.model.save(tmp)
-        if self.vecnormalize is not None:
-            with atomic_path(norm_path) as tmp:
-                self.vecnormalize.save(tmp)
+        zip_path, json_path = save_model(self.model, self.vecnormalize, stem), policy_files(stem)[2]
         save_rng(stem.with_name(stem.name + RNG_SUFFIX))
         if hasattr(self.model, "save_replay_buffer") and self.model.replay_buffer is not None:
             with atomic_path(stem.with_name(stem.name + BUFFER_SUFFIX)) as tmp:

@@ -19,9 +19,9 @@ of the test seeds), ``comparison.md`` and ``comparison.json`` (:mod:`lvgym.agent
 
 Each run is one task: a ``train.py`` process started by a worker of the executor (``local``: ``workers``
 threads of this process, each waiting for its ``train.py``; ``ray``: a Ray task of one CPU). What the task
-does is decided when it starts: a run with ``final_model.json`` is finished and skipped, a run folder
-without it continues with ``--resume`` (from its newest checkpoint), else the run starts. So the command
-can simply be run again after a kill, and a Ray task whose worker or node died is retried by Ray (its
+does is decided when it starts: a run with ``final_model.json`` at its target step is finished and skipped, a
+run folder without it (or stopped short by its wall-time budget) continues with ``--resume`` (from its newest
+checkpoint), else the run starts. So the command can simply be run again after a kill, and a Ray task whose worker or node died is retried by Ray (its
 default ``max_retries``, 3) on another node, where it resumes; the run's lock file (``logs/<run>.lock``)
 keeps a retry from starting while a ``train.py`` of the earlier attempt still writes. On a cluster the runs
 folder must be on a file system every node sees (and lvgym installed on every node). A run that fails, or
@@ -94,11 +94,26 @@ class RunTask:
 
 
 def run_state(folder: str | Path) -> str:
-    """``finished`` (``final_model.json``), ``resume`` (a run folder without it) or ``new``."""
+    """``finished`` (``final_model.json`` at the run's target step), ``resume`` (a run folder without it, or whose
+    final model is short of the target: a run stopped by its wall-time budget ends with one too) or ``new``."""
     folder = Path(folder)
-    if (folder / "final_model.json").is_file():
+    final = folder / "final_model.json"
+    if final.is_file() and _reached_target(folder, final):
         return "finished"
     return "resume" if (folder / "config.yaml").is_file() else "new"
+
+
+def _reached_target(folder: Path, final: Path) -> bool:
+    """Whether the final model's step is the run's target (``total_timesteps`` of its config.yaml) or beyond;
+    True where either is not recorded."""
+    import yaml
+
+    try:
+        step = json.loads(final.read_text(encoding="utf-8")).get("num_timesteps")
+        target = (yaml.safe_load((folder / "config.yaml").read_text(encoding="utf-8")) or {}).get("total_timesteps")
+    except (OSError, ValueError, AttributeError, yaml.YAMLError):
+        return True
+    return step is None or target is None or int(step) >= int(target)
 
 
 #: the train.py child: SIGTERM (it checkpoints and exits) once the worker thread that started it is gone

@@ -25,15 +25,18 @@ from typing import Any
 
 import numpy as np
 
+from lvgym.benchmark.suites import TRAINING_SEED0, TRAINING_SEED_STRIDE
+
 from ..policies.observer_net import Ensemble, Estimator, load, save
 from .observer_fit import Data, fit
 from .teacher import Pilot, fly
 
 __all__ = ["ROUND_STRIDE", "SEED_STRIDE", "TRAIN_SEED0", "check_training_seeds", "train_seed", "training_seeds"]
 
-#: the first env seed of the training flights, and the strides per training seed and per round
-TRAIN_SEED0 = 100_000
-SEED_STRIDE = 10_000
+#: the first env seed of the training flights, and the strides per training seed and per round (the training
+#: seeds of :mod:`lvgym.benchmark.suites`, as ``lvgym train`` draws them)
+TRAIN_SEED0 = TRAINING_SEED0
+SEED_STRIDE = TRAINING_SEED_STRIDE
 ROUND_STRIDE = 5_000
 #: rows of one batched flight
 BATCH = 100

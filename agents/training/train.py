@@ -1,12 +1,12 @@
 """Train a TVC policy with stable-baselines3 (PPO, SAC, TD3; sb3-contrib's RecurrentPPO) on the batched lvgym envs.
 
     lvgym train                         # PPO on SmileAscent-v1 with its recipe (RECIPES): residual on lqg, history 4
-    lvgym train --residual none --history 0 --wind protocol      # plain PPO on v1's flight observation
+    lvgym train --recipe plain          # PPO from scratch on v1's flight observation: no residual, no history
     lvgym train --env-id lvgym/SmileAscent-v0                    # v0: the ideal state, no recipe
     lvgym train --algo sac --model rigid --wind random --randomize all --total-timesteps 2e6 --name sac-rigid
     lvgym train --hp algo.n_steps=128 policy.net_arch=[32,32] --env-kwargs mission_time_s=20
     lvgym train --resume runs/sac-rigid                    # continue a stopped or killed run
-    lvgym train --max-wall-time 3600                       # stop after an hour with a checkpoint
+    lvgym train --max-wall-time 3600                       # stop after an hour: validated, best and final models
     lvgym train --algo recurrent-ppo --history 0           # an LSTM policy, residual on lqg
     lvgym train --residual gs-pid-flex --residual-scale 0.2
     lvgym train --suite smile-v2-faults --residual lqg-front   # a v2 suite's condition, validated on it
@@ -26,12 +26,15 @@ run's own configuration, the same target step count, the normalisation statistic
 Nothing is lost to a kill but the last minute: a checkpoint is written every ``--checkpoint-freq`` env
 steps and every ``--checkpoint-interval-s`` seconds of wall time (60 s), and on SIGTERM or SIGINT (Ctrl-C)
 the run writes one at the next env step and exits (status 128 + the signal; a second signal stops at
-once). ``--max-wall-time`` is a budget for this process: once spent, the run writes a checkpoint at the
-next env step, says so and exits normally (status 0; ``--resume`` continues it). A line on stdout every
-``--progress-interval-s`` seconds gives the step, the speed, the time spent and left and the latest
-validation score. Every option is checked before the run folder is made: a bad value is a one-line error
-and leaves nothing behind.
+once). ``--max-wall-time`` is a budget for this process: once spent, the run stops at the next env step and
+ends as a finished run does, with a checkpoint, a validation (when the run validates), ``final_model.*``,
+``best_model.*`` and ``evaluations.json``, says so and exits normally (status 0; ``--resume`` continues it).
+A line on stdout every ``--progress-interval-s`` seconds gives the step, the speed, the time spent and left
+and the latest validation score. Every option is checked before the run folder is made: a bad value is a
+one-line error and leaves nothing behind.
 
+``--recipe`` chooses a preset: ``residual`` (the default) the env id's recipe (:data:`RECIPES`), ``plain`` learning
+from scratch (no residual, no history, no teacher); an option given on the command line wins over the preset's.
 ``--recipe teacher-student`` hands the rest of the command line over to the recipe of the shipped
 ``inversion-id`` policies (:mod:`lvgym.agents.training.teacher_student`: a privileged teacher, DAgger rounds, a learned
 disturbance observer, its flight options chosen on validation seeds), which has its own options.
@@ -53,17 +56,20 @@ from lvgym.errors import ConfigError
 from lvgym.parallel import exit_on_sigterm
 
 from .runfolder import create_run, make_logger, provenance
-from .trainsetup import (DEFAULT_EVAL_SUITES, RECIPES, check_options, env_kwargs_of, eval_suite_option, is_family,
-                         make_venv, protocol_training, suite_condition, suite_option, training_seed)
+from .trainsetup import (DEFAULT_EVAL_SUITES, RECIPES, SB3_RECIPES, check_options, env_kwargs_of, eval_suite_option,
+                         is_family, make_venv, protocol_training, recipe_options, suite_condition, suite_option,
+                         training_seed)
 
 __all__ = ["Args", "DEFAULT_EVAL_SUITES", "RECIPES", "RESUME_OVERRIDABLE", "check_options", "create_run",
            "env_kwargs_of", "main", "make_venv", "parse_args", "prepare", "protocol_training", "train",
            "training_seed"]
 
 PROG = "train.py"
-#: the recipes ``--recipe`` chooses: stable-baselines3's runs (this module) or the teacher-student recipe
-#: (:mod:`lvgym.agents.training.teacher_student`, its own options)
-TRAINERS = ("sb3", "teacher-student")
+#: the recipes ``--recipe`` chooses: stable-baselines3's presets (this module; :data:`SB3_RECIPES`) or the
+#: teacher-student recipe (:mod:`lvgym.agents.training.teacher_student`, its own options)
+TRAINERS = (*SB3_RECIPES, "teacher-student")
+#: the recipe of a run folder made before the presets (``sb3``: the env id's recipe, today's ``residual``)
+LEGACY_RECIPES = {"sb3": "residual"}
 #: the options a resumed run takes from the command line (the rest from its config.yaml)
 RESUME_OVERRIDABLE = ("resume", "progress", "torch_threads", "verbose", "total_timesteps", "checkpoint_interval_s",
                       "max_wall_time_s", "progress_interval_s")
@@ -86,9 +92,12 @@ def _choices(name: str) -> Any:
 class Args:
     """Command-line arguments (``lvgym train --help``)."""
 
-    recipe: str = arg("sb3", choices=TRAINERS)
-    """sb3: a stable-baselines3 run (the options below); teacher-student: the recipe of the shipped inversion-id
-    policies, with its own options (lvgym train --recipe teacher-student --help)"""
+    recipe: str = arg("residual", choices=TRAINERS)
+    """residual: the env id's recipe (RECIPES; for lvgym/SmileAscent-v1 PPO residual on lqg at 5 % of the gimbal,
+    a 4-sample history, turbulence without the gust; an id without one trains plain); plain: from scratch, no
+    residual, no history, no teacher, the protocol's wind; teacher-student: the recipe of the shipped inversion-id
+    policies, with its own options (lvgym train --recipe teacher-student --help). An option given wins over the
+    preset's (default: residual)"""
     env_id: str = arg("lvgym/SmileAscent-v1", choices=_choices("env_id"))
     """registered lvgym env id (the options an id's recipe sets, RECIPES, default to it)"""
     suite: str | None = arg(None, check=suite_option)
@@ -101,7 +110,8 @@ class Args:
     """flight model: rigid, slosh, flex or nonrigid"""
     wind: str = arg("protocol", choices=_choices("wind"))
     """wind tier (lvgym.envs.WIND_TIERS), or protocol: the env's protocol (turbulence for v0 ids; the wind of
-    the id's v1 suite for v1 ids, turbulence_gust for SmileAscent-v1)"""
+    the id's v1 suite for v1 ids, turbulence_gust for SmileAscent-v1), with --suite the suite's (default: the
+    --recipe's: turbulence for residual on lvgym/SmileAscent-v1 without --suite, else protocol)"""
     randomize: list[str] = arg(default_factory=lambda: ["protocol"], nargs="*")
     """names drawn per episode (lvgym.envs.RANDOMIZE), 'all', 'none' or 'protocol': the env's protocol
     (wind thrust_misalignment for v0 ids; every dispersion of protocol v1, V1_DISPERSIONS, for v1 ids)"""
@@ -111,14 +121,16 @@ class Args:
     env_kwargs: list[str] = arg(default_factory=list, nargs="*", extend=True)
     """further env keywords KEY=VALUE (values in YAML), e.g. mission_time_s=20 (a repeated flag adds)"""
     history: int = arg(0, lo=0, hi=64)
-    """observation history: the last K samples and actions stacked (lvgym.envs.history; 0: off)"""
+    """observation history: the last K samples and actions stacked (lvgym.envs.history; 0: off; default: the
+    --recipe's: 4 for residual on lvgym/SmileAscent-v1, else 0)"""
     algo: str = arg("ppo", choices=_choices("algo"))
     """ppo, sac, td3 or recurrent-ppo (sb3-contrib's RecurrentPPO with MlpLstmPolicy)"""
     residual: str | None = None
-    """fly residual on this registered baseline, e.g. gs-pid-flex (lvgym.agents.wrappers.residual; default: not
-    residual)"""
+    """fly residual on this registered baseline, e.g. gs-pid-flex, or none (lvgym.agents.wrappers.residual;
+    default: the --recipe's: lqg for residual on lvgym/SmileAscent-v1, else none)"""
     residual_scale: float = 0.2
-    """with --residual: gimbal units per unit of learned action, in (0, 2]"""
+    """with --residual: gimbal units per unit of learned action, in (0, 2] (default: the --recipe's: 0.05 for
+    residual on lvgym/SmileAscent-v1, else 0.2)"""
     loop_gain_db: float = 0.0
     """train with the loop gain drawn per episode uniformly in +-this many dB (lvgym.agents.wrappers.loop_dispersion;
     0: off)"""
@@ -134,8 +146,9 @@ class Args:
     rad/s per unit of (rate / rate limit)^2 (lvgym.agents.wrappers.commandrate; 0: off)"""
     total_timesteps: int | None = arg(None, lo=1, hi=10**12)
     """env steps of the whole run, e.g. 2e6 (default: n_timesteps of the hyperparameter file)"""
-    seed: int = 0
-    """seed of the networks and generators; env row i starts with seed + i (validation seeds)"""
+    seed: int = arg(0, lo=0, hi=99_999)
+    """seed of the networks and generators; env row i starts with training seed 100,000 + 10,000 seed + i
+    (lvgym.benchmark.suites.TRAINING_SEEDS: disjoint from the validation and test seeds)"""
     n_envs: int | None = arg(None, lo=1, hi=4096)
     """rows of the batched VecEnv (default: the hyperparameter file's)"""
     hp: list[str] = arg(default_factory=list, nargs="*", extend=True)
@@ -217,6 +230,8 @@ def prepare(args: Args, given: set[str]) -> tuple[Args, dict[str, Any], Path, bo
         from lvgym.vehicle.yamlfile import read_yaml
 
         config = read_yaml(cfg_path)[0]
+        old = config["args"].get("recipe", "residual")
+        config["args"]["recipe"] = LEGACY_RECIPES.get(old, old)
         stored = Args(**{**config["args"], **{k: getattr(args, k) for k in given if k != "resume"}, "resume": None})
         if "total_timesteps" in given:
             config["total_timesteps"] = int(args.total_timesteps)
@@ -227,10 +242,7 @@ def prepare(args: Args, given: set[str]) -> tuple[Args, dict[str, Any], Path, bo
         if "env_id" in given and args.env_id != cond.env_id:
             raise ConfigError("--env-id", args.env_id, f"{cond.env_id!r} (suite {args.suite!r} flies it) or no --env-id")
         args = replace(args, env_id=cond.env_id)
-    # a suite's wind is the suite's: the id's recipe gives the rest (residual, history)
-    recipe = {k: v for k, v in RECIPES.get(args.env_id, {}).items()
-              if k not in given and not (args.suite and k == "wind")}
-    args = replace(args, **recipe)
+    args = replace(args, **recipe_options(args, given))          # the --recipe's options where none is given
     overrides = parse_overrides(args.hp)
     if args.n_envs is not None:
         overrides["n_envs"] = args.n_envs
@@ -394,8 +406,12 @@ def _train(args: Args, given: set[str], stop: Any, t0: float) -> Path:
     if stop.signum is not None or checkpoint.out_of_time:
         last = latest_checkpoint(ckpt_dir)
         where = f"checkpoint step_{int(last[1]['num_timesteps']):012d}" if last else "no checkpoint"
-        why = (f"stopped by {stop.name}" if stop.signum is not None else
-               f"the wall-time budget of {args.max_wall_time_s:g} s is spent: stopped")
+        if stop.signum is not None:
+            why = f"stopped by {stop.name}"
+        else:                                        # ended as a finished run: validated, final and best models
+            why = f"the wall-time budget of {args.max_wall_time_s:g} s is spent: stopped"
+            made = [n for n in ("final_model", "best_model") if (run_dir / f"{n}.json").is_file()]
+            where += (", validated" if evaluator is not None else "") + "".join(f", {n}" for n in made)
         print(f"{prog}: {why} at step {model.num_timesteps:,} of {target:,}; {where} written; continue with "
               f"{_again(run_dir)}", file=sys.stderr)
         if stop.signum is not None:
@@ -404,7 +420,7 @@ def _train(args: Args, given: set[str], stop: Any, t0: float) -> Path:
 
 
 def _recipe(argv: list[str]) -> tuple[str, list[str]]:
-    """The ``--recipe`` named on ``argv`` (``sb3`` when none) and ``argv`` without it."""
+    """The ``--recipe`` named on ``argv`` (``residual`` when none) and ``argv`` without it."""
     for i, word in enumerate(argv):
         if word == "--":
             break
@@ -412,7 +428,7 @@ def _recipe(argv: list[str]) -> tuple[str, list[str]]:
             return argv[i + 1], argv[:i] + argv[i + 2:]
         if word.startswith("--recipe="):
             return word.partition("=")[2], argv[:i] + argv[i + 1:]
-    return "sb3", argv
+    return "residual", argv
 
 
 def main(argv: list[str] | None = None) -> None:

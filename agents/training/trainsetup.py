@@ -14,20 +14,41 @@ import yaml
 
 from lvgym.errors import ConfigError
 
-__all__ = ["DEFAULT_EVAL_SUITES", "RECIPES", "check_options", "env_kwargs_of", "eval_suite_option", "make_venv",
-           "is_family", "protocol_training", "suite_condition", "suite_option", "training_seed"]
+__all__ = ["DEFAULT_EVAL_SUITES", "RECIPES", "SB3_RECIPES", "check_options", "env_kwargs_of", "eval_suite_option",
+           "is_family", "make_venv", "protocol_training", "recipe_options", "suite_condition", "suite_option",
+           "training_seed"]
 
 DEFAULT_EVAL_SUITES = {"lvgym/SmileAscent-v0": "smile-windy", "lvgym/SlenderAscent-v0": "slender-ld30",
                        "lvgym/SmileAscent-v1": "smile-v1", "lvgym/SlenderAscent-v1": "slender-v1"}
 
-#: what a run on an env id flies when the option is not on the command line (an option given wins, so
-#: ``--residual none --history 0`` trains a plain PPO): the recipe of the policy shipped for the id
-#: (docs/training.md, "The policy shipped for protocol v1"): residual on ``lqg`` with 5 % of the gimbal,
-#: a 4-sample history, Dryden turbulence without the gust (trained with the gust it scored worse on the
-#: suite's gusts: IQM 0.629 against 0.612 rad non-rigid, three seeds each)
+#: what a run of ``--recipe residual`` (the default) on an env id flies where the option is not on the command line
+#: (an option given wins): the recipe of the policy shipped for the id (docs/training.md, "The policy shipped for
+#: protocol v1"): residual on ``lqg`` with 5 % of the gimbal, a 4-sample history, Dryden turbulence without the
+#: gust (trained with the gust it scored worse on the suite's gusts: IQM 0.629 against 0.612 rad non-rigid, three
+#: seeds each). An id without an entry trains plain
 RECIPES: dict[str, dict[str, Any]] = {
     "lvgym/SmileAscent-v1": {"residual": "lqg", "residual_scale": 0.05, "history": 4, "wind": "turbulence"},
 }
+#: the presets of ``lvgym train --recipe`` that train with stable-baselines3 (the third, ``teacher-student``, is
+#: :mod:`lvgym.agents.training.teacher_student`, with its own options): ``plain`` learns from scratch, with no
+#: residual baseline, no history and no teacher, in the protocol's (or the suite's) wind; ``residual`` flies the
+#: env id's :data:`RECIPES`
+SB3_RECIPES = ("plain", "residual")
+
+
+def recipe_options(args: Any, given: set[str]) -> dict[str, Any]:
+    """The options the run's ``--recipe`` sets (``args``: :class:`lvgym.agents.training.train.Args`), those given on
+    the command line (``given``) left as they are: nothing for ``plain`` (the options' own defaults: no residual,
+    no history, the protocol's wind), which refuses a ``--residual`` baseline; the env id's :data:`RECIPES` for
+    ``residual``, without its wind on a ``--suite`` (the suite's wind is the suite's). The recipe is one of
+    :data:`SB3_RECIPES` (:func:`check_options`)."""
+    if args.recipe == "plain":
+        if args.residual not in (None, "none"):
+            raise ConfigError("--residual", args.residual, "none with --recipe plain (it learns from scratch; "
+                                                           "--recipe residual flies a baseline)")
+        return {}
+    return {k: v for k, v in RECIPES.get(args.env_id, {}).items()
+            if k not in given and not (args.suite and k == "wind")}
 
 
 def suite_condition(suite: str, model: str) -> Any:
@@ -111,9 +132,9 @@ def check_options(args: Any) -> None:
     from lvgym.envs.spec import RANDOMIZE
 
     check_fields(args)
-    if getattr(args, "recipe", "sb3") != "sb3":
-        raise ConfigError("--recipe", args.recipe, "sb3 for a stable-baselines3 run (lvgym train --recipe "
-                                                   "teacher-student takes its own options, not these)")
+    if getattr(args, "recipe", "residual") not in SB3_RECIPES:
+        raise ConfigError("--recipe", args.recipe, f"one of {list(SB3_RECIPES)} for a stable-baselines3 run (lvgym "
+                                                   "train --recipe teacher-student takes its own options, not these)")
     residual_options(args.residual, args.residual_scale)
     loop_dispersion_options(args.loop_gain_db, args.loop_delay_periods)
     load_margin_options(args.load_margin, args.load_margin_threshold)
@@ -145,18 +166,26 @@ def suite_option(option: str, value: str) -> str:
 
 
 def training_seed(seed: int, step: int, n_envs: int, prog: str = "train.py") -> int:
-    """Seed of env row 0 for a run segment starting at ``step`` (rows get ``+ i``): ``seed`` at the
-    start, a fresh draw on resume; always a validation seed (the test seeds stay unseen)."""
-    from lvgym.benchmark.suites import TEST_SEED0
+    """Seed of env row 0 for a run segment starting at ``step`` (rows get ``+ i``), always a training seed
+    (:data:`lvgym.benchmark.suites.TRAINING_SEEDS`: disjoint from every validation and test seed, so model
+    selection and reported numbers never fly an episode trained on): ``TRAINING_SEED0 + TRAINING_SEED_STRIDE *
+    seed`` at the start (runs of different ``seed`` share no row), a fresh draw among the training seeds on
+    resume."""
+    from lvgym.benchmark.suites import N_TRAINING_SEEDS, TRAINING_SEED0, TRAINING_SEED_STRIDE
 
+    most = N_TRAINING_SEEDS // TRAINING_SEED_STRIDE - 1
+    if not 0 <= seed <= most:
+        raise SystemExit(f"{prog}: --seed {seed}: an integer in [0, {most}] (rows start at training seed "
+                         f"{TRAINING_SEED0:,} + {TRAINING_SEED_STRIDE:,} seed)")
+    if n_envs > TRAINING_SEED_STRIDE:
+        raise SystemExit(f"{prog}: {n_envs} envs: at most {TRAINING_SEED_STRIDE:,} rows per run (a training seed's "
+                         "block of env seeds)")
     if step == 0:
-        if not 0 <= seed <= TEST_SEED0 - n_envs:
-            raise SystemExit(f"{prog}: --seed {seed} with {n_envs} envs: rows seed .. seed + n_envs - 1 must "
-                             f"be validation seeds (0 .. {TEST_SEED0 - 1}); the test seeds are for reported numbers")
-        return seed
+        return TRAINING_SEED0 + TRAINING_SEED_STRIDE * int(seed)
     import numpy as np
 
-    return int(np.random.SeedSequence([seed, step]).generate_state(1)[0]) % (TEST_SEED0 - n_envs)
+    draw = int(np.random.SeedSequence([seed, step]).generate_state(2, dtype=np.uint64)[0])
+    return TRAINING_SEED0 + draw % (N_TRAINING_SEEDS - n_envs + 1)
 
 
 def make_venv(env_id: str, n_envs: int, seed: int, env_kwargs: dict[str, Any], norm: Any, gamma: float,

@@ -22,6 +22,7 @@ from __future__ import annotations
 import inspect
 import os
 import re
+import sys
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from importlib.machinery import PathFinder
@@ -67,12 +68,16 @@ def register_policy(name: str, factory: str | Callable[..., Any], /, **kwargs: A
 @dataclass(frozen=True)
 class PolicyLoader:
     """How a saved policy on disk is flown: ``factory(path=<absolute path>)``; it takes files ending in
-    one of ``suffixes`` and, with ``folders``, folders. ``description`` says what in an error message."""
+    one of ``suffixes`` and, with ``folders``, folders. ``description`` says what in an error message.
+    ``describe`` (optional, ``"module:function"``): ``function(path=<absolute path>)`` is called in the main
+    process when a command resolves the path; it returns one line naming what flies (printed on stderr; ``""``:
+    nothing to say) or raises a ``ValueError`` or ``OSError`` whose message refuses the policy in one line."""
 
     factory: str
     suffixes: tuple[str, ...]
     folders: bool
     description: str
+    describe: str = ""
 
     def takes(self, path: Path) -> bool:
         """Whether this loader flies the existing file or folder ``path``."""
@@ -84,18 +89,31 @@ LOADERS: list[PolicyLoader] = []
 
 
 def register_policy_loader(factory: str | Callable[..., Any], suffixes: Sequence[str] = (), folders: bool = False,
-                           description: str = "") -> PolicyLoader:
+                           description: str = "", describe: str | Callable[..., Any] | None = None) -> PolicyLoader:
     """Fly a saved policy (a file ending in one of ``suffixes``, or with ``folders`` a folder) given by its
     path in ``--policies``: the spec calls ``factory(path=<absolute path>)`` and is labelled by the file's
-    stem or the folder's name. Idempotent for the same loader."""
+    stem or the folder's name; ``describe`` names what flies, or refuses it, when the path is resolved
+    (:class:`PolicyLoader`). Idempotent for the same loader."""
     loader = PolicyLoader(_reference(factory), tuple(suffixes), bool(folders),
-                          description or f"a file {'/'.join(suffixes)}")
+                          description or f"a file {'/'.join(suffixes)}", _reference(describe) if describe else "")
     if loader not in LOADERS:
         LOADERS.append(loader)
     return loader
 
 
 _LABEL = re.compile(r"^(?P<label>[\w.+-]+)=(?P<ref>.+)$")
+
+
+def _describe(loader: PolicyLoader, path: Path, text: str, prog: str) -> None:
+    """The loader's line on what ``path`` flies, on stderr; its refusal as a one-line exit."""
+    if not loader.describe:
+        return
+    try:
+        note = load_factory(loader.describe)(path=str(path.resolve()))
+    except (ImportError, ValueError, OSError) as exc:
+        raise SystemExit(f"{prog}: policy {text!r}: {exc}")
+    if note:
+        print(f"{prog}: policy {text!r} flies {note}", file=sys.stderr)
 
 
 def _forms() -> str:
@@ -180,6 +198,7 @@ def resolve_policy(name: str, prog: str = "evaluate.py") -> PolicySpec:
             raise SystemExit(f"{prog}: policy {text!r}: no such file")
         for loader in LOADERS:
             if loader.takes(path):
+                _describe(loader, path, text, prog)
                 return PolicySpec(label or (path.name if path.is_dir() else path.stem), loader.factory,
                                   (("path", str(path.resolve())),))
         raise SystemExit(f"{prog}: policy {text!r}: not a saved policy a loader takes; a policy is {_forms()}")

@@ -5,8 +5,10 @@ options); a *suite* is a list of conditions that share a seed set. Episode ``i``
 with the same seed under every condition and for every policy (common random numbers), so the rigid and
 the non-rigid episode of a seed fly the same wind and dispersions and the comparison is paired.
 
-Seeds: **validation** seeds ``0 .. 9_999`` are for training, tuning and model selection; **test**
-seeds ``10_000 ..`` are for reported numbers only, and every flight on them is logged (:mod:`.ledger`).
+Seeds: **training** seeds ``100_000 ..`` (:data:`TRAINING_SEEDS`) are what training runs fly; **validation**
+seeds ``0 .. 9_999`` are for tuning and model selection; **test** seeds ``10_000 .. 19_999`` are for reported
+numbers only, and every flight on them is logged (:mod:`.ledger`). The three ranges are disjoint: a policy is
+never selected or scored on an episode it was trained on.
 Episode ``i`` uses ``VALIDATION_SEED0 + i`` or ``TEST_SEED0 + i`` (from a named block's first seed on:
 :data:`DEVELOPMENT_BLOCK`, the 50 seeds flown throughout development, and :data:`HEADLINE_BLOCK`, the 200
 never-flown test seeds of the headline that decides).
@@ -74,6 +76,17 @@ N_VALIDATION_SEEDS = 10_000
 TEST_SEED0 = 10_000
 N_TEST_SEEDS = 10_000
 SEED_SETS = ("test", "validation")
+#: the faces of a condition's batched env (:meth:`Condition.make_vec_env`): Gymnasium's ``VectorEnv``, SB3's ``VecEnv``
+VEC_APIS = ("gymnasium", "sb3")
+#: first training seed; the training seeds are ``TRAINING_SEED0 + i`` for ``i < N_TRAINING_SEEDS``, above every
+#: validation and test seed. Training seed ``k`` of a run (``lvgym train --seed k``, the teacher-student recipe's
+#: ``--seeds``) starts its env rows at ``TRAINING_SEED0 + TRAINING_SEED_STRIDE * k``, so runs of different
+#: training seeds share no row
+TRAINING_SEED0 = 100_000
+N_TRAINING_SEEDS = 1_000_000_000
+TRAINING_SEED_STRIDE = 10_000
+#: the training seeds, as a range (``seed in TRAINING_SEEDS``)
+TRAINING_SEEDS = range(TRAINING_SEED0, TRAINING_SEED0 + N_TRAINING_SEEDS)
 
 
 @dataclass(frozen=True)
@@ -150,16 +163,30 @@ class Condition:
             warnings.filterwarnings("ignore", message=".*is out of date", category=DeprecationWarning)
             return gymnasium.make(self.env_id, **self.env_kwargs())
 
-    def make_vec_env(self, num_envs: int = 1) -> Any:
-        """A batched env of ``num_envs`` rows of this condition (the id's ``vector_entry_point``: one
-        simulator over all rows); ``reset(seed=s)`` seeds row ``i`` with ``s + i``, the single env's
-        episode of seed ``s + i``."""
+    def make_vec_env(self, num_envs: int = 1, api: str = "gymnasium", seed: int | None = None) -> Any:
+        """A batched env of ``num_envs`` rows of this condition, one simulator over all rows. ``api``
+        (:data:`VEC_APIS`): ``gymnasium``, the id's ``vector_entry_point``, whose ``reset(seed=s)`` seeds row
+        ``i`` with ``s + i``, the single env's episode of seed ``s + i``; ``sb3``, the same rows as a
+        stable-baselines3 ``VecEnv`` (:func:`lvgym.envs.make_sb3_vec_env`), row ``i`` seeded ``seed + i``
+        (``seed`` is for it alone: SB3's ``reset()`` takes none)."""
         import warnings
 
         import gymnasium
 
+        if api not in VEC_APIS:
+            raise ConfigError("api", api, f"one of {list(VEC_APIS)}{did_you_mean(api, VEC_APIS)}")
+        if api == "gymnasium" and seed is not None:
+            raise ConfigError("seed", seed, "None with api='gymnasium' (seed its rows with reset(seed=s): row i "
+                                            "gets s + i)")
         with warnings.catch_warnings():            # a frozen v0 suite flies its v0 env on purpose
             warnings.filterwarnings("ignore", message=".*is out of date", category=DeprecationWarning)
+            if api == "sb3":                      # the id's class, as gymnasium.make finds it (registered)
+                from gymnasium.envs.registration import load_env_creator
+
+                from lvgym.envs.sb3 import AscentSB3VecEnv
+
+                env_cls = load_env_creator(gymnasium.spec(self.env_id).entry_point)
+                return AscentSB3VecEnv(env_cls, int(num_envs), seed, **self.env_kwargs())
             return gymnasium.make_vec(self.env_id, num_envs=int(num_envs), vectorization_mode="vector_entry_point",
                                       **self.env_kwargs())
 

@@ -53,6 +53,7 @@ from lvgym.environment.gravity import gravity_at, harmonics_work
 from lvgym.environment.wind import wind_ned_at
 from lvgym.rotations import quat_to_dcm
 
+from .coldstart import announce_compile
 from .layouts import AE, AEL, AERO, CONDITIONS, CONTEXT, CTX, DISPERSION, DS, TG, TRIG, D
 from .strips import pack_strips, strip_loads_at, strip_modal_forces_k, strip_stage_k
 
@@ -180,6 +181,7 @@ def _flight_loads(t, x, p, ctx, u):
         strip_modal_forces_k(ctx, u)
 
 
+announce_compile(_flight_loads)                      # one line on stderr before a compile from a cold cache
 flight_loads = compile_loads(_flight_loads)
 
 

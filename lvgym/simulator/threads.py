@@ -10,6 +10,8 @@ from typing import Any
 
 from lvgym.parallel import default_workers
 
+from .coldstart import announce_compile
+
 __all__ = ["ROWS_PER_THREAD", "Kernel", "default_threads", "pool"]
 
 ROWS_PER_THREAD = 8          # smaller batches run on the calling thread
@@ -35,6 +37,7 @@ class Kernel:
 
     def __call__(self, *args: Any) -> None:
         if self.entry is None:
+            announce_compile(self.dispatcher)        # one line on stderr before a compile from a cold cache
             self.dispatcher(*args)
             if len(self.dispatcher.signatures) == 1:
                 self.entry = self.dispatcher.overloads[self.dispatcher.signatures[0]].entry_point
