@@ -10,6 +10,7 @@ import pytest
 from lvgym.benchmark import ZERO, evaluate, get_suite
 from lvgym.benchmark.ledger import (ENV_VAR, LEDGER_IN_REPO, blocks, checkout, ledger_path, log_flight, per_policy,
                                     read, table)
+from lvgym.benchmark.ledger import test_seeds as among_test_seeds
 from lvgym.benchmark.suites import DEVELOPMENT_BLOCK, HEADLINE_BLOCK, TEST_SEED0
 from lvgym.cli import ledger as ledger_cli
 
@@ -36,6 +37,8 @@ def test_blocks_are_ranges_of_consecutive_seeds():
 def test_a_line_per_call_and_nothing_for_validation_seeds(tmp_path):
     path = tmp_path / "ledger.jsonl"
     assert log_flight(range(0, 10), ["smile-v2"], ["rigid"], ["lqg"], path=path) is None
+    assert among_test_seeds([9_999, 10_000, 19_999, 20_000, 100_000]) == [10_000, 19_999]    # not the training seeds
+    assert log_flight([100_000, 100_001], ["smile-v2"], ["rigid"], ["lqg"], path=path) is None
     log_flight([10_000, 10_001, 12_000], ["smile-v2", "smile-v2"], ["rigid", "nonrigid"], ["lqg", "zero", "lqg"],
                purpose="a check", command="evaluate", path=path)
     (line,) = read(path)

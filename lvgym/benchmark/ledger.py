@@ -29,7 +29,7 @@ from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-from .suites import TEST_SEED0
+from .suites import N_TEST_SEEDS, TEST_SEED0
 
 __all__ = ["ENV_VAR", "LEDGER_IN_REPO", "blocks", "checkout", "ledger_path", "log_flight", "per_policy", "read",
            "source", "table", "test_seeds"]
@@ -93,8 +93,9 @@ def blocks(seeds: Iterable[int]) -> list[list[int]]:
 
 
 def test_seeds(seeds: Iterable[int]) -> list[int]:
-    """The test seeds among ``seeds`` (those from :data:`~.suites.TEST_SEED0` on)."""
-    return [int(s) for s in seeds if int(s) >= TEST_SEED0]
+    """The test seeds among ``seeds``: :data:`~.suites.TEST_SEED0` and the :data:`~.suites.N_TEST_SEEDS` after it
+    (not the training seeds beyond them, :data:`~.suites.TRAINING_SEEDS`)."""
+    return [int(s) for s in seeds if TEST_SEED0 <= int(s) < TEST_SEED0 + N_TEST_SEEDS]
 
 
 def _command() -> str:

@@ -48,7 +48,7 @@ from lvgym.parallel import check_workers, default_workers, run_map
 from .perturb import db_to_gain, summary, threshold_search
 from .results import atomic_write_text, csv_text, json_text
 from .runner import PolicySpec, episode_objects, fly_block
-from .suites import SEED_SETS, SUITES, TEST_SEED0, Condition, Suite
+from .suites import SEED_SETS, SUITES, Condition, Suite
 
 __all__ = ["EXPERIMENTS", "MarginOptions", "MarginTask", "RATE_ERROR_FLOOR_RADPS", "RATE_LIMIT_FLOOR_S", "bounds",
            "margin_rows", "margins_table", "run_margin_task",
@@ -263,14 +263,14 @@ def run_margins(policies: Sequence[PolicySpec], where: Suite | Condition | Seque
             raise ValueError(f"experiment = {e!r}: one of {EXPERIMENTS}")
     if seed_set not in SEED_SETS:
         raise ValueError(f"seed_set = {seed_set!r}: one of {SEED_SETS}")
+    from .ledger import log_flight, test_seeds
+
     conds, seed_list = _conditions(where), _seeds(where, seeds, seed_set)
     if not isinstance(seeds, int) and seed_list:                 # given seeds: the set they belong to
-        tested = [s >= TEST_SEED0 for s in seed_list]
+        tested = [bool(test_seeds([s])) for s in seed_list]
         seed_set = "test" if all(tested) else ("validation" if not any(tested) else "test and validation")
     if not conds or not seed_list:
         raise ValueError("margins need at least one condition and one seed")
-    from .ledger import log_flight
-
     log_flight(seed_list, sorted({c.group or c.name for c in conds}), [c.model for c in conds], names,
                purpose, command="margins")
     n_workers = 1 if executor == "serial" else (check_workers(workers) or default_workers())
