@@ -85,5 +85,5 @@ def compare_digests(fresh: list[dict[str, Any]], reference: list[dict[str, Any]]
             a, b = np.asarray(sums, float), np.asarray(old["blocks"][name], float)
             if not np.allclose(a, b, rtol=rtol, atol=0.0):
                 i = int(np.argmax(~np.isclose(a, b, rtol=rtol, atol=0.0)))
-                out.append(f"{key(r)} {name}: stretch {i} sums to {a[i]!r} against {b[i]!r}")
+                out.append(f"{key(r)} {name}: stretch {i} sums to {float(a[i])!r} against {float(b[i])!r}")
     return out
