@@ -48,7 +48,7 @@ def test_each_preset_is_the_dict_merge_it_replaced(env_id):
 
 def test_every_flat_keyword_is_its_groups_field():
     assert len(set(KEYWORDS)) == len(KEYWORDS)                        # unique: a keyword names one field
-    assert len(OPTION_GROUP) == 53 and not set(GROUPS) & set(OPTION_GROUP)
+    assert len(OPTION_GROUP) == 54 and not set(GROUPS) & set(OPTION_GROUP)
     base = TaskSpec("smile")
     for key, group in OPTION_GROUP.items():
         default = getattr(getattr(base, group), key)

@@ -103,7 +103,8 @@ class Args:
     suite: str | None = arg(None, check=suite_option)
     """train on this benchmark suite's condition of --model (its env id, wind, dispersions and options, e.g.
     smile-v2-faults' faults; rows reset with training seeds) and validate on the suite (default: --env-id's);
-    a family suite trains on the family's train vehicles and validates on its validation vehicles"""
+    a family suite trains on the family's train vehicles and validates on its validation vehicles; a v2 suite
+    trains on the score reward (reward_kind=score_v2; --env-kwargs reward_kind=weighted: the weighted terms)"""
     family_vehicles: int = arg(8, lo=1, hi=1000)
     """with a family --suite: the rows fly the family's first N train vehicles (lvgym.agents.training.familytrain)"""
     model: str = arg("nonrigid", choices=_choices("model"))

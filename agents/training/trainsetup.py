@@ -91,7 +91,8 @@ def env_kwargs_of(args: Any) -> dict[str, Any]:
     """The env keywords of a run (``args``: :class:`lvgym.agents.training.train.Args`): model, wind, randomisation,
     observation and the ``--env-kwargs``. With ``--suite``, ``--wind protocol`` and ``--randomize protocol``
     mean the suite condition's, whose further options (faults, a mission time, a vehicle) come first and
-    ``--env-kwargs`` after them."""
+    ``--env-kwargs`` after them; a suite that charges flyability (v2 on) trains on the score reward
+    (``reward_kind="score_v2"``, :mod:`lvgym.envs.scorereward`; ``--env-kwargs reward_kind=weighted`` turns it off)."""
     r: Any = list(args.randomize)
     wind, protocol_r = protocol_training(args.env_id)
     suite_options: dict[str, Any] = {}
@@ -99,6 +100,11 @@ def env_kwargs_of(args: Any) -> dict[str, Any]:
         cond = suite_condition(args.suite, args.model)
         wind, protocol_r = cond.wind, list(cond.randomize)
         suite_options = {k: v for k, v in cond.options}
+        from lvgym.benchmark.flyability import applies
+        from lvgym.benchmark.suites import get_suite
+
+        if applies(get_suite(args.suite).version):
+            suite_options["reward_kind"] = "score_v2"
     if r == ["protocol"]:
         r = protocol_r
     elif r in (["all"], ["true"], ["True"]):

@@ -16,7 +16,9 @@ v1 envs): a flight that spends exactly the rule's budget (``(r / R)^2`` averagin
 ``weight / 9`` per second, so ``weight`` 0.9 charges it the failure penalty's rate. The command is the
 action the env gets (a residual policy's mix, before the loop dispersion's gain and delay: what the flight
 computer commands). It is a training device, like :mod:`.loadmargin`: the env's reward, validation and
-evaluation are unchanged. The charge of each step is in the step's info, ``command_rate_charge``.
+evaluation are unchanged. The charge of each step is in the step's info, ``command_rate_charge``. The env's
+score reward (``reward_kind="score_v2"``, :mod:`lvgym.envs.scorereward`) charges the same running sum only
+where it breaks the rule (a failure's charge, and the episode ends); this charge warns before, at every step.
 """
 
 from __future__ import annotations

@@ -13,7 +13,8 @@ every control step, a charge for the load's ratio to its limit above a threshold
 v1 envs): ``weight`` 1 charges a flight held at the limit 0.2 rad/s above a threshold of 0.8, twice the
 failure penalty's rate. It is a training device, like the loop dispersion (:mod:`.loop_dispersion`): the
 env's reward, validation and evaluation are unchanged, and what the policy is judged on is the score.
-The charge of each step is in the step's info, ``load_margin_charge``.
+The charge of each step is in the step's info, ``load_margin_charge``. The env's score reward
+(``reward_kind="score_v2"``) charges the load only where it crosses the limit, as the default reward does.
 """
 
 from __future__ import annotations

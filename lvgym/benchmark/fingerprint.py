@@ -95,9 +95,11 @@ def _record(suite: Suite, condition: Any, seed: int, policy: str, first: np.ndar
     return out
 
 
-def _condition_records(suite: Suite, condition: Any, seeds: list[int]) -> list[dict[str, Any]]:
+def _condition_records(suite: Suite, condition: Any, seeds: list[int],
+                       rewards: list[dict[str, np.ndarray]] | None = None) -> list[dict[str, Any]]:
     """The fingerprint records of one condition: every seed with every policy, flown together as the rows of
-    its batched env (:func:`~.rows.fly_rows`: each row the single env's episode, to the bit)."""
+    its batched env (:func:`~.rows.fly_rows`: each row the single env's episode, to the bit); ``rewards``, if
+    given, receives each episode's per-step rewards and reward terms, in the records' order."""
     rows = [(seed, name) for seed in seeds for name in POLICIES]
     env = condition.make_env()
     groups = []
@@ -106,15 +108,16 @@ def _condition_records(suite: Suite, condition: Any, seeds: list[int]) -> list[d
         groups.append((as_batch(make(env), len(rows), lambda make=make: make(env)), mine))
     first: list[np.ndarray] = []
     records = fly_rows(condition.make_vec_env(len(rows)), [seed for seed, _ in rows], groups, first_observations=first,
-                       flyability=applies(suite.version))
+                       flyability=applies(suite.version), rewards=rewards)
     return [_record(suite, condition, seed, name, obs0, m) for (seed, name), obs0, m in zip(rows, first, records)]
 
 
-def fingerprint(version: str, seeds: int = 1) -> list[dict[str, Any]]:
+def fingerprint(version: str, seeds: int = 1, rewards: list[dict[str, np.ndarray]] | None = None) -> list[dict[str, Any]]:
     """The fingerprint records of protocol ``version``: every suite, condition and first ``seeds`` test seeds
-    (each condition's episodes flown together)."""
+    (each condition's episodes flown together); ``rewards``, if given, receives each episode's per-step rewards
+    and reward terms, in the records' order (what :mod:`.rewarddigest` digests)."""
     return [r for suite in _suites(version) for cond in suite.conditions
-            for r in _condition_records(suite, cond, suite.seeds("test", seeds))]
+            for r in _condition_records(suite, cond, suite.seeds("test", seeds), rewards)]
 
 
 def stored(version: str) -> list[dict[str, Any]]:

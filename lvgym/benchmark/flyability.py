@@ -23,7 +23,9 @@ score_v2                    rad     the v2 headline: ``score`` for a flyable fli
                                     ``failure_penalty_rad_per_s`` times the mission time left
 ==========================  ======  =================================================================
 
-The rule (docs/flyability.md has the reasons and the sources):
+The rule's per-step terms (the command, its rate and square, the budget, the burst window, the charge of the
+mission left) are :mod:`lvgym.envs.scoreterms`'s, which the env's score reward (``reward_kind="score_v2"``)
+charges step by step. The rule (docs/flyability.md has the reasons and the sources):
 
 - **budget**: ``cmd_rate_rms <= RMS_FRACTION`` (1/3): the rate limit is at least three standard deviations of
   the commanded rate (a Gaussian command exceeds it in 0.27 % of the steps). It breaks when the running sum
@@ -42,14 +44,12 @@ from typing import Any
 
 import numpy as np
 
+from lvgym.envs.scoreterms import (RMS_FRACTION, WINDOW_FRACTION, WINDOW_S, budget, burst_limit, command_rate,
+                                   mission_charge, rate_square, window_mean, window_quorum, window_steps)
+
 __all__ = ["RMS_FRACTION", "V2_METRICS", "WINDOW_FRACTION", "WINDOW_S", "applies", "command_metrics",
            "commanded_rate", "flyability_metrics", "v2_score"]
 
-#: the budget: the commanded rate's RMS over the controlled flight, as a fraction of the rate limit [-]
-RMS_FRACTION = 1.0 / 3.0
-#: the burst window [s] and the largest RMS of the commanded rate within it, as a fraction of the limit [-]
-WINDOW_S = 2.0
-WINDOW_FRACTION = 1.0
 #: the metrics a v2 record adds (summarised per suite beside v0's and v1's)
 V2_METRICS = ("score_v2", "cmd_rate_rms", "cmd_rate_peak", "cmd_reversal_hz")
 _VERSION = re.compile(r"^v(\d+)")
@@ -72,7 +72,7 @@ def commanded_rate(command_rad: np.ndarray, on: np.ndarray, dt: float) -> tuple[
         both[1:] &= on[:-1]
         both[0] = False
     r = np.zeros_like(u)
-    r[1:] = (u[1:] - u[:-1]) / dt
+    r[1:] = command_rate(u[1:], u[:-1], dt)
     return r, both
 
 
@@ -91,16 +91,16 @@ def command_metrics(command_rad: np.ndarray | None, on: np.ndarray, time_s: np.n
     if n == 0:
         return out
     lim = float(rate_limit_radps)
-    sq = np.where(both, np.mean(r ** 2, axis=1), 0.0)            # per step, the mean over the axes
+    sq = np.where(both, rate_square(r), 0.0)                     # per step, the mean over the axes
     cum = np.cumsum(sq)
     out["cmd_rate_rms"] = math.sqrt(cum[-1] / n) / lim
-    w = max(int(round(WINDOW_S / dt)), 1)
+    w = window_steps(dt)
     csum = np.concatenate([[0.0], cum])
     cnt = np.concatenate([[0], np.cumsum(both)])
     n_w = cnt[w:] - cnt[:-w] if len(sq) >= w else np.array([n])
     s_w = csum[w:] - csum[:-w] if len(sq) >= w else np.array([cum[-1]])
-    ok = n_w >= max(w // 2, 1)
-    ms = np.where(ok, s_w / np.maximum(n_w, 1), 0.0)
+    ok = n_w >= window_quorum(w)
+    ms = np.where(ok, window_mean(s_w, n_w), 0.0)
     out["cmd_rate_peak"] = math.sqrt(float(ms.max())) / lim if ms.size else 0.0
     inc = np.sign(r)
     rev = (inc[1:] * inc[:-1] < 0) & both[1:, None] & both[:-1, None]
@@ -108,10 +108,10 @@ def command_metrics(command_rad: np.ndarray | None, on: np.ndarray, time_s: np.n
     out["cmd_reversal_hz"] = float(rev.sum()) / (r.shape[1] * pairs * dt) if pairs else 0.0
     t = np.asarray(time_s, dtype=float)
     breaks = []
-    budget = (RMS_FRACTION * lim) ** 2 * n
-    if cum[-1] > budget:
-        breaks.append(float(t[int(np.argmax(cum > budget))]))
-    over = ms > (WINDOW_FRACTION * lim) ** 2
+    allowed = budget(lim, n)
+    if cum[-1] > allowed:
+        breaks.append(float(t[int(np.argmax(cum > allowed))]))
+    over = ms > burst_limit(lim)
     if over.any():                                             # window j ends at step j + w - 1
         end = int(np.argmax(over)) + (w - 1 if len(sq) >= w else len(sq) - 1)
         breaks.append(float(t[end]))
@@ -134,7 +134,7 @@ def v2_score(rate_error_radps: np.ndarray, time_s: np.ndarray, dt: float, score:
     e = np.abs(np.nan_to_num(np.reshape(rate_error_radps, (n, 3)), nan=0.0))
     keep = t <= unflyable_at_s
     integral = e[keep].sum(axis=0) * dt if keep.any() else np.zeros(3)
-    return float(integral[1] + integral[2]) + penalty_rad_per_s * max(mission_time_s - unflyable_at_s, 0.0)
+    return float(integral[1] + integral[2]) + mission_charge(penalty_rad_per_s, mission_time_s, unflyable_at_s)
 
 
 def flyability_metrics(facts: Any, columns: Any, record: dict[str, Any]) -> dict[str, Any]:

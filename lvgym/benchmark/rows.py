@@ -44,9 +44,10 @@ def neutral_action(space: Any) -> np.ndarray:
 
 class RowsLog:
     """The steps of every row of a batched env, kept whole (``add`` after each ``step``, ``end`` for the rows
-    that ended), and each row's record (:meth:`records`)."""
+    that ended), and each row's record (:meth:`records`); with ``terms`` also the reward's terms of every step
+    (:meth:`rewards`)."""
 
-    def __init__(self, env: Any) -> None:
+    def __init__(self, env: Any, terms: bool = False) -> None:
         u = env.unwrapped
         self.env, self.n = env, int(env.num_envs)
         self.facts = FlightFacts.for_env(env)              # the task's facts (control period, limits, gyro)
@@ -56,6 +57,10 @@ class RowsLog:
         self.events: list[list[tuple[float, str]]] = [[] for _ in range(self.n)]
         self.termination = [""] * self.n
         self.fault: list[str] | None = None               # the rows' faults, when the env draws them
+        self.terms: list[str] | None = None                # the reward terms' names, when they are kept
+        if terms:
+            self.steps["terms"] = []
+            self.terms = []
 
     def add(self, live: np.ndarray, observations: np.ndarray, reward: np.ndarray, info: dict[str, Any],
             actions: np.ndarray | None = None) -> None:
@@ -67,6 +72,10 @@ class RowsLog:
             steps["action"].append(np.array(actions, dtype=float))
         for key in STEP_KEYS:
             steps[key].append(np.asarray(info[key]))
+        if self.terms is not None:
+            self.terms = list(info["reward_terms"])
+            steps["terms"].append(np.stack([np.asarray(info["reward_terms"][k], dtype=float) for k in self.terms],
+                                           axis=1))
         if self.facts.gyro_index is not None:        # the gyro's view against the body rate
             u = self.env.unwrapped
             w = u.sim.state(u.state.sim, "omega_bi_b")
@@ -91,6 +100,19 @@ class RowsLog:
                 self.termination[b] = str(reason)
             if self.fault is not None:
                 self.fault[b] = str(info["fault"][b])
+
+    def rewards(self) -> list[dict[str, np.ndarray]]:
+        """Every row's per-step rewards (``reward``, (L,)) and, when kept, each reward term's (by its name)."""
+        reward = np.stack(self.steps["reward"]) if self.steps["reward"] else np.zeros((0, self.n))
+        terms = np.stack(self.steps["terms"]) if self.terms else None
+        out = []
+        for b in range(self.n):
+            L = int(self.length[b])
+            series = {"reward": reward[:L, b].copy()}
+            for i, name in enumerate(self.terms or ()):
+                series[name] = terms[:L, b, i].copy()
+            out.append(series)
+        return out
 
     def records(self, flyability: bool = False) -> list[dict[str, Any]]:
         """Every row's record: :func:`~.metrics.episode_metrics` and :func:`~.scoring.flight_metrics` of its
@@ -209,7 +231,8 @@ class OneRowEnv:
 
 def fly_rows(env: Any, seeds: Sequence[int], groups: Sequence[tuple[BatchPolicy, Sequence[int]]], *,
              gains: Sequence[float] | None = None, delay_steps: Sequence[int] | None = None,
-             first_observations: list[np.ndarray] | None = None, flyability: bool = False) -> list[dict[str, Any]]:
+             first_observations: list[np.ndarray] | None = None, flyability: bool = False,
+             rewards: list[dict[str, np.ndarray]] | None = None) -> list[dict[str, Any]]:
     """One episode per row of the batched lvgym env ``env`` (``env.num_envs == len(seeds)``), row ``i``
     reset with ``seeds[i]``; ``groups``: (batch policy, its rows) pairs that cover every row once (a
     policy's batch holds at least ``num_envs`` rows and is addressed by the env's row numbers). ``gains``
@@ -217,7 +240,8 @@ def fly_rows(env: Any, seeds: Sequence[int], groups: Sequence[tuple[BatchPolicy,
     them by whole physics steps (:class:`RowDelay`). Returns the rows' records in row order, each that of the
     single env's episode with that seed (and perturbation); ``first_observations``, if given, receives the
     reset's observation of every row; ``flyability``: add protocol v2's flyability fields
-    (:mod:`.flyability`) to every record."""
+    (:mod:`.flyability`) to every record; ``rewards``, if given, receives every row's per-step rewards and reward
+    terms (:meth:`RowsLog.rewards`)."""
     n = int(env.num_envs)
     if len(seeds) != n:
         raise ValueError(f"{len(seeds)} seeds for a batched env of {n} rows")
@@ -235,7 +259,7 @@ def fly_rows(env: Any, seeds: Sequence[int], groups: Sequence[tuple[BatchPolicy,
     if delay_steps is not None and np.any(np.asarray(delay_steps) != 0):
         delay = RowDelay(env, delay_steps)
     neutral = neutral_action(env.single_action_space)
-    log = RowsLog(env)
+    log = RowsLog(env, terms=rewards is not None)
     for policy, rows in groups:
         policy.reset(rows)
     done = np.zeros(n, dtype=bool)
@@ -259,4 +283,6 @@ def fly_rows(env: Any, seeds: Sequence[int], groups: Sequence[tuple[BatchPolicy,
         ended = live[(np.asarray(terminated) | np.asarray(truncated))[live]]
         log.end(ended, info)
         done[ended] = True
+    if rewards is not None:
+        rewards.extend(log.rewards())
     return log.records(flyability)

@@ -40,6 +40,8 @@ from typing import Any
 
 import numpy as np
 
+from lvgym.envs.scoreterms import gimbal_command, mission_charge
+
 __all__ = ["FlightColumns", "FlightFacts", "IDEAL_OBSERVATIONS", "MAX_Q_FRACTION", "PHASES", "QALPHA_COST_FRACTION",
            "flight_metrics", "gimbal_command"]
 
@@ -137,12 +139,6 @@ class FlightColumns:
     qalpha_limit_pa_deg: np.ndarray | None = None
 
 
-def gimbal_command(actions: np.ndarray, gimbal_limit_rad: float) -> np.ndarray:
-    """The gimbal command [rad] of TVC ``actions`` (N, 2) [-]: clipped to [-1, 1] (as the env clips them)
-    times the gimbal limit [rad]."""
-    return np.clip(np.asarray(actions, dtype=float), -1.0, 1.0) * float(gimbal_limit_rad)
-
-
 def flight_metrics(log: FlightFacts, c: FlightColumns) -> dict[str, Any]:
     """The v1 metrics of one episode (see the module docstring) of its steps ``c``, with the task's facts
     ``log``. ``rate_error_rad`` is summed as protocol v0's :func:`~.metrics.episode_metrics` sums it (per
@@ -160,7 +156,7 @@ def flight_metrics(log: FlightFacts, c: FlightColumns) -> dict[str, Any]:
     out: dict[str, Any] = {"rate_error_rad": float(integral[1] + integral[2])}
     failed = bool(c.termination)
     t_end = float(t[-1]) if t.size else 0.0
-    charge = log.failure_penalty_rad_per_s * max(log.mission_time_s - t_end, 0.0) if failed else 0.0
+    charge = mission_charge(log.failure_penalty_rad_per_s, log.mission_time_s, t_end) if failed else 0.0
     out["score"] = out["rate_error_rad"] + charge
     masks = _phase_masks(t, qbar, c.events) if t.size else {p: np.zeros(0, bool) for p in PHASES}
     pitch_yaw = e[:, 1] + e[:, 2]

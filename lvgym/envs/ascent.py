@@ -30,7 +30,9 @@ episode's sum is minus the weighted cumulative rate error in rad) ``- effort_wei
 ``- failure_penalty_rad_per_s * remaining time`` (``failure``). ``info["reward_terms"]`` holds each term;
 they add up to the reward. ``info["rate_error"]`` holds the step's ``|rate - reference|`` [rad/s] (roll,
 pitch, yaw), ``info["cumulative_rate_error"]`` its integral [rad], ``info["effort_rad_s"]`` the step's integral
-of ``|gimbal pitch| + |gimbal yaw|`` (the reward's ``effort``), ``info["mass"]`` the stack's mass [kg].
+of ``|gimbal pitch| + |gimbal yaw|`` (the reward's ``effort``), ``info["mass"]`` the stack's mass [kg]. With
+``reward_kind="score_v2"`` the reward is minus each step's increment of protocol v2's score instead
+(:mod:`.scorereward`).
 
 Actions: a ``Box`` action outside [-1, 1] is clipped (Gymnasium's convention); an action of another shape,
 a non-finite one, or an RCS action outside {0, 1, 2} raises a ``ValueError`` naming the action and the space.

@@ -56,6 +56,7 @@ from .layouts import (ACTIONS, FLIGHT_DRAWS, NAV, OBSERVATIONS, REASONS, REWARD,
                       FAULT_INFO, VEHICLE_INFO, informed_layout)
 from .limits import qalpha_task_entries, resolve_qalpha_limit
 from .privileged import privileged_info
+from .scorereward import ScoreReward
 from .signals import TaskData, qalpha_limit_rows, reset_signals, step_signals_range
 from .spec import IMU_STATION_INTERVALS, IMU_STATION_SIGMA, TaskSpec, wind_spec
 
@@ -188,6 +189,9 @@ class AscentFuncEnv(FuncEnv):
         self._i_J = lay.params["J_b"]
         self.qalpha_limit = resolve_qalpha_limit(s, vehicle)
         super().__init__()
+        #: the score reward (``reward_kind="score_v2"``, :mod:`.scorereward`) or None (the weighted terms)
+        self.score_reward = (ScoreReward(s, self.gimbal_limit, self.n_steps, self.default_params.task, self.sim.tables)
+                             if s.reward_kind == "score_v2" else None)
 
     # ------------------------------------------------------------------------------ parameters
     def get_default_params(self, **kwargs: Any) -> AscentParams:
@@ -227,7 +231,8 @@ class AscentFuncEnv(FuncEnv):
                                         self._neutral),
                         nav=NAV.zeros(B), draws=FLIGHT_DRAWS.zeros(B),
                         history=self.history.zeros(B) if self.history else np.zeros((B, 0), np.float32),
-                        fault=FAULT.zeros(B))
+                        fault=FAULT.zeros(B),
+                        score=np.zeros((B, self.score_reward.columns if self.score_reward else 0)))
         return AscentState(sim=self.sim.new_data(B), task=task, events=[()] * B)
 
     @staticmethod
@@ -296,6 +301,8 @@ class AscentFuncEnv(FuncEnv):
         ts.truncated[rows] = False
         ts.qalpha[rows] = 0.0
         ts.pending[rows] = self._neutral
+        if self.score_reward:
+            self.score_reward.reset(ts, rows)
         self._draw_flight(sim, ts, rows, rngs, self._draw_sigma_reset)
         reset_signals(rows, params.task, params.setup, sim, ts, params.tables)
         self._add_noise(sim, ts, rows, rngs)
@@ -343,6 +350,8 @@ class AscentFuncEnv(FuncEnv):
         ts.steps[:] += 1
         self._draw_flight(sim, ts, range(B), rng, self._draw_sigma)
         self.sim.run_rows(_SIGNALS, B, params.task, params.setup, sim, ts, params.tables)
+        if self.score_reward:
+            self.score_reward.step(ts, sim.t, sampled)
         if self._noisy:
             self._add_noise(sim, ts, range(B), rng)
         self._add_info(sim, ts, slice(None))
@@ -406,7 +415,8 @@ class AscentFuncEnv(FuncEnv):
         return next_state.task.reward.copy()
 
     def terminal(self, state: AscentState, rng: Any = None, params: AscentParams | None = None) -> np.ndarray:
-        """Whether each row ended (B,): a non-finite state, q-alpha or attitude error beyond the limit."""
+        """Whether each row ended (B,): a non-finite state, q-alpha or attitude error beyond the limit (with the
+        score reward also a gimbal command that breaks the flyability rule)."""
         return state.task.reason != 0
 
     def truncation(self, state: AscentState, params: AscentParams | None = None) -> np.ndarray:

@@ -196,7 +196,9 @@ REWARD = Packed("reward terms", [
 ], interface=True)
 REWARD_TERMS = REWARD.names
 #: termination codes (the order is the precedence: a later one overrides an earlier one)
-REASONS = ("", "attitude error beyond the limit", "q-alpha beyond the structural limit", "non-finite state")
+#: (``gimbal command unflyable``: only with the score reward, ``reward_kind="score_v2"``, :mod:`.scorereward`)
+REASONS = ("", "attitude error beyond the limit", "q-alpha beyond the structural limit", "non-finite state",
+           "gimbal command unflyable")
 
 T, O, OS, OF, RW, FD, NV = (TASK.at, OBS_STATE.at, OBS_SENSORS.at, OBS_FLIGHT.at, REWARD.at, FLIGHT_DRAWS.at,
                              NAV.at)

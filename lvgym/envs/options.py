@@ -22,10 +22,13 @@ from lvgym.simulator.spec import LaunchSite
 from .dispersions import RANDOMIZE, RANDOMIZE_V0
 from .faults import FAULT_NAMES
 
+#: the rewards an env gives (``reward_kind``; :mod:`.scorereward`)
+REWARD_KINDS = ("weighted", "score_v2")
+
 __all__ = ["ActuatorOptions", "AtmosphereOptions", "CoastOptions", "DispersionOptions", "FaultOptions",
            "GuidanceOptions", "LaunchOptions", "LimitOptions", "Options", "PhysicsOptions", "RewardOptions", "Rule",
            "SensorOptions", "TimingOptions", "option", "rule_of", "CONTROLS", "OBSERVATIONS", "REFERENCES", "REFERENCE_VELOCITIES",
-           "WIND_TIERS"]
+           "REWARD_KINDS", "WIND_TIERS"]
 
 #: protocol v0's wind tiers, then v1's, then ``random_gust`` (v1's gust alone, for the error budget)
 WIND_TIERS = ("none", "profile", "gust", "turbulence", "random", "turbulence_gust", "maxq_gust", "random_gust")
@@ -316,6 +319,10 @@ class RewardOptions(Options):
     """the weight per rad/s of gimbal rate per second"""
     failure_penalty_rad_per_s: float = option(0.1, lo=0.0, hi=1e6)
     """on termination, the penalty per second of mission time left [rad/s]"""
+    reward_kind: str = option("weighted", choices=REWARD_KINDS)
+    """``weighted``: the weighted terms above; ``score_v2``: minus each step's increment of protocol v2's score
+    (:mod:`.scorereward`: the pitch and yaw rate errors, the failure penalty, and a break of the flyability rule
+    charged as a failure that ends the episode; the weights are not used)"""
 
     def check(self) -> None:
         try:

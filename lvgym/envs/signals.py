@@ -42,10 +42,12 @@ from .layouts import G0, NV, RW, OF, OS, O, T
 #: attitude and the last gyro sample (layout NAV), ``draws`` (B, n_draws) the step's sensor draws (layout
 #: FLIGHT_DRAWS); ``history`` (B, n_hist) float32 the stacked observation of ``history=k`` (:mod:`.history`;
 #: no columns when it is off; the compiled signals do not touch it); ``fault`` (B, n_fault) the episode's
-#: in-flight fault (layout :data:`.faults.FAULT`; zeros: none; the compiled signals do not touch it)
+#: in-flight fault (layout :data:`.faults.FAULT`; zeros: none; the compiled signals do not touch it); ``score``
+#: (B, n_score) the score reward's running sums (:mod:`.scorereward`; no columns without ``reward_kind="score_v2"``;
+#: the compiled signals do not touch it)
 TaskData = namedtuple("TaskData", ["steps", "on", "on_step", "axis_ref_i", "cum_error", "rate_error", "gyro_bias",
                                    "obs", "att", "terms", "reward", "reason", "truncated", "qalpha", "mass",
-                                   "stage", "pending", "nav", "draws", "history", "fault"])
+                                   "stage", "pending", "nav", "draws", "history", "fault", "score"])
 XF = STATE.fixed
 
 
