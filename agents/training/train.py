@@ -113,7 +113,8 @@ class Args:
     history: int = arg(0, lo=0, hi=64)
     """observation history: the last K samples and actions stacked (lvgym.envs.history; 0: off)"""
     algo: str = arg("ppo", choices=_choices("algo"))
-    """ppo, sac, td3 or recurrent-ppo (sb3-contrib's RecurrentPPO with MlpLstmPolicy)"""
+    """ppo, sac, td3, recurrent-ppo (sb3-contrib's RecurrentPPO with MlpLstmPolicy) or ppo-fast (PPO on the native
+    VectorEnv at the env's speed, lvgym.agents.training.ppo: a plain run, never residual)"""
     residual: str | None = None
     """fly residual on this registered baseline, e.g. gs-pid-flex (lvgym.agents.wrappers.residual; default: not
     residual)"""
@@ -229,7 +230,8 @@ def prepare(args: Args, given: set[str]) -> tuple[Args, dict[str, Any], Path, bo
         args = replace(args, env_id=cond.env_id)
     # a suite's wind is the suite's: the id's recipe gives the rest (residual, history)
     recipe = {k: v for k, v in RECIPES.get(args.env_id, {}).items()
-              if k not in given and not (args.suite and k == "wind")}
+              if k not in given and not (args.suite and k == "wind")
+              and not (args.algo == "ppo-fast" and k in ("residual", "residual_scale"))}   # ppo-fast: plain
     args = replace(args, **recipe)
     overrides = parse_overrides(args.hp)
     if args.n_envs is not None:
@@ -312,6 +314,10 @@ def _train(args: Args, given: set[str], stop: Any, t0: float) -> Path:
         seed = training_seed(int(config["seed"]), start, cfg.n_envs, prog)
     except ConfigError as exc:
         fail(prog, exc)
+    if config["algo"] == "ppo-fast":                 # the fast PPO on the native VectorEnv: its own loop
+        from .fastrun import train_fast
+
+        return train_fast(args, given, config, cfg, run_dir, resumed, stem, state, seed, stop, t0, prog)
     try:                                             # the env's keywords (--model, --wind, --env-kwargs, ...)
         vehicles = None
         if config.get("family_vehicles"):            # a family run: its train vehicles' files
