@@ -8,9 +8,10 @@
 It prints, as a Markdown table:
 
 - the env's raw batched rate: env steps per second of the native ``VectorEnv`` of the suite's condition
-  (``lvgym.make_vec_env``) stepped with fixed random actions and nothing else;
-- ppo-fast's end-to-end rate (:mod:`lvgym.agents.training.ppo`: rollouts and updates, after one warm-up
-  rollout and update) and its ratio to the raw rate;
+  (``lvgym.make_vec_env``) stepped with fixed random actions (drawn as the untrained policy draws them) and
+  nothing else;
+- ppo-fast's end-to-end rate (:mod:`lvgym.agents.training.ppo`: rollouts and their updates) and its ratio to
+  the raw rate;
 - where ppo-fast's time goes, in microseconds per sample (one env step of one row): the env's ``step``, the
   inference (forward passes, sampling, normalisation, buffers and episode accounting) and the update
   (advantages and the epochs), with the epochs and the minibatch;
@@ -23,6 +24,7 @@ On two cores the env (its simulator threads) and the learner take turns, so the 
 
 from __future__ import annotations
 
+import math
 import os
 import time
 from dataclasses import dataclass
@@ -48,7 +50,7 @@ class Args:
     steps: int = arg(32, lo=2, hi=100_000)
     """rollout steps per row (n_steps)"""
     rollouts: int = arg(4, lo=1, hi=10_000)
-    """timed rollouts, each followed by its update (after one warm-up)"""
+    """timed rollouts, each followed by its update (after the warm-up: WARM_STEPS steps of every row)"""
     epochs: int = arg(4, lo=1, hi=1000)
     """epochs of an update"""
     minibatch: int = arg(8192, lo=2, hi=10_000_000)
@@ -78,11 +80,18 @@ def _config(args: Args, env_id: str) -> Any:
                                             "algo.n_epochs": args.epochs, "policy.net_arch": list(args.net)})
 
 
-def raw_rate(venv: Any, steps: int) -> float:
-    """Env steps per second (rows x steps over the wall time) of ``steps`` steps with fixed random actions."""
+#: env steps of every row before a rate is timed: the flight off the pad with the controller on (as
+#: ``lvgym bench-envs``), and the trainers' first compiles and allocations done
+WARM_STEPS = 256
+
+
+def raw_rate(venv: Any, steps: int, std: float) -> float:
+    """Env steps per second (rows x steps over the wall time) of ``steps`` steps with fixed random actions drawn
+    as the untrained policy draws them (a Gaussian of standard deviation ``std`` around 0, clipped)."""
     rng = np.random.default_rng(0)
     space = venv.single_action_space
-    actions = rng.uniform(space.low, space.high, (8, venv.num_envs, space.shape[0])).astype(np.float32) * 0.2
+    actions = np.clip(rng.normal(0.0, std, (8, venv.num_envs, space.shape[0])), space.low, space.high)
+    actions = actions.astype(np.float32)
     t0 = time.perf_counter()
     for i in range(steps):
         venv.step(actions[i % 8])
@@ -90,7 +99,9 @@ def raw_rate(venv: Any, steps: int) -> float:
 
 
 def measure(args: Args) -> dict[str, Any]:
-    """The numbers of the table (the module docstring)."""
+    """The numbers of the table (the module docstring). Each rate is timed from the same start: every row reset
+    with seeds from 0, :data:`WARM_STEPS` steps flown (ppo-fast: whole rollouts and their updates), then the
+    timed steps."""
     import torch
 
     from lvgym.agents.training.ppo import FastPPO, Timers, make_shell, make_stats
@@ -99,15 +110,18 @@ def measure(args: Args) -> dict[str, Any]:
     torch.set_num_threads(args.torch_threads)
     cond = condition(args.suite, args.model)
     cfg = _config(args, cond.env_id)
+    warm = -(-WARM_STEPS // args.steps)                            # whole rollouts
     venv = cond.make_vec_env(args.rows)
+    std = math.exp(cfg.policy.log_std_init)
     venv.reset(seed=0)
-    raw_rate(venv, max(2, args.steps // 2))                       # the first steps compile and warm up
-    raw = raw_rate(venv, args.steps * args.rollouts)
+    raw_rate(venv, warm * args.steps, std)
+    raw = raw_rate(venv, args.steps * args.rollouts, std)
     model = make_shell(venv.single_observation_space, venv.single_action_space, cfg, 0)
     stats = make_stats(venv.single_observation_space, venv.single_action_space, cfg.normalize, cfg.hyper.gamma)
-    ppo = FastPPO(venv, cfg, model, stats, seed=0)
-    ppo.collect()                                                 # warm-up
-    ppo.update(1.0)
+    ppo = FastPPO(venv, cfg, model, stats, seed=0)                 # resets every row with seeds from 0
+    for _ in range(warm):
+        ppo.collect()
+        ppo.update(1.0)
     ppo.timers = Timers()
     t0 = time.perf_counter()
     for _ in range(args.rollouts):
@@ -119,14 +133,14 @@ def measure(args: Args) -> dict[str, Any]:
            "fast": fast, "ratio": fast / raw, "us": ppo.timers.per_sample_us(), "epochs": cfg.hyper.n_epochs,
            "minibatch": cfg.hyper.batch_size, "net": list(cfg.policy.net_arch), "threads": args.torch_threads}
     if args.sb3:
-        out["sb3"] = sb3_rate(args, cond, cfg)
+        out["sb3"] = sb3_rate(args, cond, cfg, warm)
         out["sb3_ratio"] = out["sb3"] / raw
     return out
 
 
-def sb3_rate(args: Args, cond: Any, cfg: Any) -> float:
+def sb3_rate(args: Args, cond: Any, cfg: Any, warm: int) -> float:
     """Env steps per second of stable-baselines3's PPO (``learn``) with ``cfg``'s settings on the SB3 ``VecEnv``
-    of ``cond``, after one warm-up rollout and update."""
+    of ``cond`` (with ``VecNormalize``), after ``warm`` rollouts and their updates."""
     from stable_baselines3 import PPO
     from stable_baselines3.common.vec_env import VecNormalize
 
@@ -136,7 +150,7 @@ def sb3_rate(args: Args, cond: Any, cfg: Any) -> float:
                         gamma=cfg.hyper.gamma)
     kw = cfg.sb3_kwargs()
     model = PPO("MlpPolicy", venv, seed=0, device="cpu", verbose=0, **kw)
-    model.learn(args.rows * args.steps)                           # warm-up
+    model.learn(args.rows * args.steps * warm)                    # warm-up
     t0 = time.perf_counter()
     model.learn(args.rows * args.steps * args.rollouts, reset_num_timesteps=False)
     rate = args.rows * args.steps * args.rollouts / (time.perf_counter() - t0)
