@@ -54,6 +54,7 @@ def fast_run(tmp_path_factory):
     return train(TRAIN + ["--runs-dir", str(tmp_path_factory.mktemp("runs"))])
 
 
+@pytest.mark.slow
 def test_a_short_run_lowers_the_validation_score(fast_run):
     evals = json.loads((fast_run / "evaluations.json").read_text())
     first, last = (e["conditions"]["smile-v2/rigid"]["score_v2_mean"] for e in (evals[0], evals[-1]))
@@ -68,6 +69,7 @@ def test_a_short_run_lowers_the_validation_score(fast_run):
         assert key in head, key
 
 
+@pytest.mark.slow
 def test_the_run_folder_flies_through_the_benchmark_to_its_validation_numbers(fast_run, tmp_path):
     from lvgym.cli.evaluate import main as evaluate
 
@@ -84,6 +86,7 @@ def test_the_run_folder_flies_through_the_benchmark_to_its_validation_numbers(fa
         assert sum(mine) / 4 == pytest.approx(chosen["conditions"][f"smile-v2/{cond}"]["score_v2_mean"], rel=1e-9)
 
 
+@pytest.mark.slow
 def test_the_curves_of_the_run(fast_run, tmp_path, capsys):
     from lvgym.agents.training.curves import load_rollouts, main
 
