@@ -41,7 +41,7 @@ def test_advantages_cut_at_an_episode_end_and_bootstrap_a_truncation_only():
 MISSION_S = 10.0
 TRAIN = ["--algo", "ppo-fast", "--suite", "smile-v2", "--model", "rigid", "--env-kwargs", f"mission_time_s={MISSION_S}",
          "--n-envs", "64", "--hp", "algo.n_steps=64", "algo.batch_size=2048", "algo.n_epochs=4",
-         "algo.learning_rate=1e-3", "--total-timesteps", "300000", "--eval-freq", "100000", "--checkpoint-freq",
+         "algo.learning_rate=0.001", "--total-timesteps", "300000", "--eval-freq", "100000", "--checkpoint-freq",
          "100000", "--eval-episodes", "4", "--eval-mission-time-s", f"{MISSION_S}", "--no-progress",
          "--progress-interval-s", "0", "--name", "fast-s0"]
 
