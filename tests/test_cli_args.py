@@ -175,9 +175,9 @@ def test_the_console_script_has_every_command_with_its_help(capsys):
     assert tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]["scripts"] == {"lvgym": "lvgym.cli.main:main"}
     assert main(["--help"]) == 0
     listed = [line.split("  ")[1] for line in capsys.readouterr().out.splitlines() if line.startswith("  ")]
-    expected = ["evaluate", "train", "campaign", "margins", "headline select", "headline fly", "headline page",
+    expected = ["evaluate", "train", "curves", "campaign", "margins", "headline select", "headline fly", "headline page",
                 "compare-headline", "ledger", "fingerprint", "verify", "verify rocketpy", "verify rocketpy-timing",
-                "bench", "bench-envs", "studies", "render", "export-policy", "dataset", "bc", "design pid", "design pid-flex",
+                "bench", "bench-envs", "bench-train", "studies", "render", "export-policy", "dataset", "bc", "design pid", "design pid-flex",
                 "design lqg", "design indi", "design pd-relief", "design charts", "design auto", "vehicle beam", "vehicle slender"]
     assert listed == expected
     for name in expected:

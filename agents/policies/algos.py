@@ -8,8 +8,9 @@ from __future__ import annotations
 
 __all__ = ["ALGOS", "CONTRIB", "algo_class", "algo_name"]
 
-#: the algorithms train.py trains: name -> stable-baselines3 class (the one list of them)
-ALGOS = {"ppo": "PPO", "sac": "SAC", "td3": "TD3", "recurrent-ppo": "RecurrentPPO"}
+#: the algorithms train.py trains: name -> stable-baselines3 class (the one list of them); ``ppo-fast``
+#: (:mod:`lvgym.agents.training.ppo`) trains its own loop on SB3's PPO networks and saves an SB3 PPO
+ALGOS = {"ppo": "PPO", "sac": "SAC", "td3": "TD3", "recurrent-ppo": "RecurrentPPO", "ppo-fast": "PPO"}
 #: the algorithms of sb3-contrib (the others are stable-baselines3's)
 CONTRIB = ("RecurrentPPO",)
 

@@ -4,6 +4,9 @@
   :mod:`.trainsetup` (recipes, env keywords, seeds, the vectorised env), :mod:`.config` (per-env
   hyperparameters, ``hyperparams/<algo>.yaml`` beside it, as validated dataclasses), :mod:`.runfolder` (the run's
   folder and provenance), :mod:`.familytrain` (a vehicle family's rows);
+- :mod:`.ppo`: PPO at the batched env's speed on the native VectorEnv (``lvgym train --algo ppo-fast``), with
+  :mod:`.fastrun` (its run folder: the same checkpoints, validations and models as an SB3 run);
+  :mod:`.curves`: the learning curves of run folders (``lvgym curves``);
 - :mod:`.callbacks`: crash-safe checkpoints (named and listed by :mod:`lvgym.agents.policies.checkpoints`),
   validation on the protocol's validation seeds; :mod:`.progress`: the progress bar and line; :mod:`.timing`:
   where a run's wall time goes;

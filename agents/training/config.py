@@ -33,7 +33,7 @@ from ..policies.algos import ALGOS
 
 HYPERPARAMS_DIR = Path(__file__).resolve().parent / "hyperparams"
 #: the on-policy algorithms (their ``algo:`` keys are :class:`PPOConfig`'s)
-ON_POLICY = ("ppo", "recurrent-ppo")
+ON_POLICY = ("ppo", "recurrent-ppo", "ppo-fast")
 ACTIVATIONS = ("tanh", "relu", "elu", "leaky_relu")
 LR_SCHEDULES = ("constant", "linear")
 ACTION_NOISES = ("none", "normal", "ornstein_uhlenbeck")

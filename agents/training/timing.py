@@ -7,8 +7,8 @@ passes during the rollout, the gradient updates, the validations and the checkpo
 :class:`lvgym.agents.training.callbacks.CheckpointCallback` logs ``time/env_share`` (env seconds over wall seconds since
 the run started, resumed segments included, both counted from the start of learning: the first reset
 and its kernel loading come before) after every rollout and records ``train_wall_s`` and
-``env_wall_s`` in every checkpoint and validation, which is what :mod:`experiments.training_speed.curves` plots the learning
-curve against.
+``env_wall_s`` in every checkpoint and validation, which is what ``lvgym curves``
+(:mod:`lvgym.agents.training.curves`) plots the learning curve against.
 """
 
 from __future__ import annotations

@@ -125,7 +125,8 @@ class Args:
     """observation history: the last K samples and actions stacked (lvgym.envs.history; 0: off; default: the
     --recipe's: 4 for residual on lvgym/SmileAscent-v1, else 0)"""
     algo: str = arg("ppo", choices=_choices("algo"))
-    """ppo, sac, td3 or recurrent-ppo (sb3-contrib's RecurrentPPO with MlpLstmPolicy)"""
+    """ppo, sac, td3, recurrent-ppo (sb3-contrib's RecurrentPPO with MlpLstmPolicy) or ppo-fast (PPO on the native
+    VectorEnv at the env's speed, lvgym.agents.training.ppo: a plain run, never residual)"""
     residual: str | None = None
     """fly residual on this registered baseline, e.g. gs-pid-flex, or none (lvgym.agents.wrappers.residual;
     default: the --recipe's: lqg for residual on lvgym/SmileAscent-v1, else none)"""
@@ -325,6 +326,10 @@ def _train(args: Args, given: set[str], stop: Any, t0: float) -> Path:
         seed = training_seed(int(config["seed"]), start, cfg.n_envs, prog)
     except ConfigError as exc:
         fail(prog, exc)
+    if config["algo"] == "ppo-fast":                 # the fast PPO on the native VectorEnv: its own loop
+        from .fastrun import train_fast
+
+        return train_fast(args, given, config, cfg, run_dir, resumed, stem, state, seed, stop, t0, prog)
     try:                                             # the env's keywords (--model, --wind, --env-kwargs, ...)
         vehicles = None
         if config.get("family_vehicles"):            # a family run: its train vehicles' files

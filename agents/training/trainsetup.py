@@ -40,7 +40,8 @@ def recipe_options(args: Any, given: set[str]) -> dict[str, Any]:
     """The options the run's ``--recipe`` sets (``args``: :class:`lvgym.agents.training.train.Args`), those given on
     the command line (``given``) left as they are: nothing for ``plain`` (the options' own defaults: no residual,
     no history, the protocol's wind), which refuses a ``--residual`` baseline; the env id's :data:`RECIPES` for
-    ``residual``, without its wind on a ``--suite`` (the suite's wind is the suite's). The recipe is one of
+    ``residual``, without its wind on a ``--suite`` (the suite's wind is the suite's) and without its residual
+    for ``--algo ppo-fast`` (which wraps no baseline). The recipe is one of
     :data:`SB3_RECIPES` (:func:`check_options`)."""
     if args.recipe == "plain":
         if args.residual not in (None, "none"):
@@ -48,7 +49,8 @@ def recipe_options(args: Any, given: set[str]) -> dict[str, Any]:
                                                            "--recipe residual flies a baseline)")
         return {}
     return {k: v for k, v in RECIPES.get(args.env_id, {}).items()
-            if k not in given and not (args.suite and k == "wind")}
+            if k not in given and not (args.suite and k == "wind")
+            and not (args.algo == "ppo-fast" and k in ("residual", "residual_scale"))}   # ppo-fast flies no residual
 
 
 def suite_condition(suite: str, model: str) -> Any:

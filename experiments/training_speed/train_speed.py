@@ -12,7 +12,7 @@ the first compilation left out), and the env's share of the wall time (``time/en
 :class:`lvgym.agents.training.timing.EnvClock`: the env and a residual's baselines; the rest is the learner: the
 policy's forward passes, the PPO epochs). Printed as a Markdown table: the median over the repeats and each repeat.
 Throughput only: whether a faster setting learns as well per env step is a training experiment (several seeds, learning
-curves against wall time; :mod:`experiments.training_speed.curves`).
+curves against wall time; ``lvgym curves``, :mod:`lvgym.agents.training.curves`).
 """
 
 from __future__ import annotations

@@ -34,6 +34,9 @@ COMMANDS: tuple[Command, ...] = (
             "benchmark", _BENCHMARK),
     Command("train", "lvgym.agents.training.train:main", "train a policy with stable-baselines3 (train.py)", "train",
             _TRAIN),
+    Command("curves", "lvgym.agents.training.curves:main", "learning curves of training runs: score_v2 of the "
+            "validations and the rollouts' cost against env steps and wall time, the IQM over seeds", "benchmark",
+            _BENCHMARK),
     Command("campaign", "lvgym.agents.training.campaign:main", "a training campaign: configurations x seeds (locally "
             "or on Ray), evaluation on the test seeds, comparison over the runs", "train", _TRAIN),
     Command("margins", "lvgym.cli.margins:main", "time-domain gain and delay margins of policies in the nonlinear "
@@ -60,6 +63,8 @@ COMMANDS: tuple[Command, ...] = (
     Command("bench", "lvgym.cli.bench:main", "speed of the dynamics core (RK4 steps per second) and of the shipped "
             "control laws (microseconds per row-step at 1 and 1,024 rows)", "benchmark", _BENCHMARK),
     Command("bench-envs", "lvgym.bench_envs:main", "speed of the ascent envs (env steps per second, construction)"),
+    Command("bench-train", "lvgym.cli.bench_train:main", "speed of training against the env's: raw batched env steps/s, "
+            "ppo-fast end to end, microseconds per sample in the env, inference and update", "train", _TRAIN),
     Command("studies", "lvgym.studies.__main__:main", "the thesis's studies: doe, ld-sweep, tw-sweep", "studies",
             ("pandas", "statsmodels", "matplotlib")),
     Command("render", "lvgym.envs.render:main", "draw the renderer's example frame to a PNG", "benchmark",
