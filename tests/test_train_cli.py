@@ -231,7 +231,7 @@ def test_a_spent_wall_time_budget_ends_the_run_validated_with_its_models(tmp_pat
     command) is spent and ends as a finished run does: a checkpoint of that step, validated, ``final_model``,
     ``best_model`` and ``evaluations.json``, which the curves tool reads; it says so and returns (no exit status);
     --resume continues it to its target."""
-    from experiments.training_speed import curves
+    from lvgym.agents.training import curves
 
     argv = _argv(tmp_path, "budget", steps=10**7, extra=("--checkpoint-freq", "1000000000", "--eval-freq", "1000000000",
                                                          "--checkpoint-interval-s", "0", "--max-wall-time", "2"))
