@@ -206,7 +206,8 @@ class LQGPlane:
         """Restart the rows ``which`` (None: all) as at the start of an episode."""
         w = slice(None) if which is None else np.asarray(which, dtype=np.int64)
         st = self.state
-        st.row[w], st.x[w], st.xi[w], st.was_on[w], st.saturated[w], st.u[w], st.e0[w] = -1, 0.0, 0.0, False, False, 0.0, 0.0
+        st.row[w], st.x[w], st.xi[w], st.was_on[w], st.saturated[w] = -1, 0.0, 0.0, False, False
+        st.u[w], st.e0[w] = 0.0, 0.0
 
     def update(self, y: Any, t: Any, on: Any, which: Any = None, e: Any = None) -> np.ndarray:
         """The commands [rad] of the rows ``which`` (None: all) for their gyro samples ``y`` [rad/s] and
