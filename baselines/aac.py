@@ -48,9 +48,9 @@ import numpy as np
 
 from lvgym.benchmark.batch import BatchLaw, RowFace
 from lvgym.errors import ConfigError, check_bool, check_number
+from lvgym.simulator.threads import Kernel
 
 from .aackernel import AAC_ROW, AACConsts, aac_act_k, aac_pid_act_k, dead_zone, first_order
-from .entry import Entry
 from .pid import PIDLaw, flex_pid, smile_scheduled_pid
 from .pidkernel import ObsColumns
 
@@ -201,7 +201,7 @@ class AACLaw(BatchLaw):
         if type(base) is PIDLaw:        # the shipped bases: both laws in one compiled call
             value = np.ascontiguousarray(base.values(info), dtype=np.float64)
             base.prepare(rows, obs, value)
-            _AAC_PID((obs.dtype, obs.flags.writeable), base.tb, base.su, base.oc, base.st, self.law, self.oc,
+            _AAC_PID.keyed((obs.dtype, obs.flags.writeable), base.tb, base.su, base.oc, base.st, self.law, self.oc,
                      self.rows, rows, obs, value, out)
             return out
         base.act(rows, obs, info)
@@ -278,9 +278,9 @@ def smile_aac(env: Any, schedule: str = "smile", name: str = "aac", record: bool
 #: validation seeds 0-9): the defaults with a spectral-damper dead zone, so that the flex design's own
 #: high-frequency content (its lead, staging, gusts) does not lower k_T
 FLEX_AAC = {"damper_deadzone_rad2": 3e-3}
-#: the fused AAC and PID act, through its entry point (:class:`.entry.Entry`; key: the observations' dtype and
-#: writability, the rest of its arguments' types fixed by :meth:`AACLaw.act`)
-_AAC_PID = Entry(aac_pid_act_k)
+#: the fused AAC and PID act, through its entry point (:meth:`lvgym.simulator.threads.Kernel.keyed`; key: the
+#: observations' dtype and writability, the rest of its arguments' types fixed by :meth:`AACLaw.act`)
+_AAC_PID = Kernel(aac_pid_act_k)
 
 
 def flex_aac(env: Any, name: str = "aac", record: bool = False, schedule: str | None = None, quiet: bool = False,

@@ -27,6 +27,8 @@ from typing import NamedTuple
 import numba as nb
 import numpy as np
 
+from .pidkernel import nearest_k
+
 __all__ = ["ESOCols", "ESOState", "ESOTables", "eso_act_k", "new_state"]
 
 
@@ -105,16 +107,6 @@ def _b0(tb, b0, t):
 
 
 @nb.njit(cache=True)
-def _nearest(t_rows, t):
-    best, dist = 0, abs(t_rows[0] - t)
-    for i in range(1, t_rows.size):
-        d = abs(t_rows[i] - t)
-        if d < dist:
-            best, dist = i, d
-    return best
-
-
-@nb.njit(cache=True)
 def _settle(fb, fa, z, x):
     """Filter states ``z`` (2,) at rest for the constant input ``x`` (a section of unit gain at zero frequency)."""
     z[1] = (fb[2] - fa[2]) * x
@@ -146,7 +138,7 @@ def eso_act_k(tb, oc, st, rows, obs, out):
             out[j, 1] = np.float32(0.0)
             continue
         t = float(o[oc.time]) * tb.mission
-        i = _nearest(tb.t, t)
+        i = nearest_k(tb.t, t)
         kp, kd = tb.kp[i], tb.kd[i]
         F, H, G = tb.F[i], tb.H[i], tb.G[i]
         b0 = _b0(tb.tb, tb.b0, t)

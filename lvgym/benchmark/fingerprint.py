@@ -31,7 +31,7 @@ from .rows import fly_rows
 from .runner import zero_policy
 from .suites import SUITES, Suite
 
-__all__ = ["FINGERPRINTS", "POLICIES", "RTOL", "ProbePolicy", "compare", "fingerprint", "stored"]
+__all__ = ["FINGERPRINTS", "POLICIES", "RTOL", "ProbePolicy", "compare", "episode_key", "fingerprint", "paired", "stored"]
 
 #: where the stored fingerprints live, per protocol version
 FINGERPRINTS = Path(__file__).resolve().parent / "data"
@@ -125,16 +125,33 @@ def stored(version: str) -> list[dict[str, Any]]:
     return json.loads((FINGERPRINTS / f"{version}.json").read_text(encoding="utf-8"))["episodes"]
 
 
+def episode_key(r: dict[str, Any]) -> tuple[Any, ...]:
+    """A fingerprint episode's key: its suite, condition, seed and policy."""
+    return r["suite"], r["condition"], r["seed"], r["policy"]
+
+
+def paired(fresh: list[dict[str, Any]], reference: list[dict[str, Any]],
+           stored: str) -> tuple[list[str], list[tuple[dict[str, Any], dict[str, Any]]]]:
+    """The episodes of a fresh run and of a stored file (``stored`` names it in the lines) matched by
+    :func:`episode_key`: a line for each episode on one side only, and the pairs (fresh, stored)."""
+    ref = {episode_key(r): r for r in reference}
+    keys = {episode_key(r) for r in fresh}
+    out = [f"{k}: not in the fresh run" for k in ref if k not in keys]
+    pairs = []
+    for r in fresh:
+        old = ref.get(episode_key(r))
+        if old is None:
+            out.append(f"{episode_key(r)}: not in the stored {stored}")
+        else:
+            pairs.append((r, old))
+    return out, pairs
+
+
 def compare(fresh: list[dict[str, Any]], reference: list[dict[str, Any]], rtol: float = RTOL) -> list[str]:
     """The differences between two fingerprints, one line each (empty: the same)."""
-    key = lambda r: (r["suite"], r["condition"], r["seed"], r["policy"])           # noqa: E731
-    ref = {key(r): r for r in reference}
-    out = [f"{k}: not in the fresh run" for k in ref if k not in {key(r) for r in fresh}]
-    for r in fresh:
-        old = ref.get(key(r))
-        if old is None:
-            out.append(f"{key(r)}: not in the stored fingerprint")
-            continue
+    key = episode_key
+    out, pairs = paired(fresh, reference, "fingerprint")
+    for r, old in pairs:
         exact = EXACT + tuple(f for f in V2_EXACT if f in old)
         numbers = NUMBERS + tuple(f for f in V2_NUMBERS if f in old)
         out += [f"{key(r)} {f}: {r.get(f)!r} against {old[f]!r}" for f in exact if r.get(f) != old[f]]

@@ -22,7 +22,7 @@ from typing import Any
 
 import numpy as np
 
-from .fingerprint import FINGERPRINTS, RTOL, fingerprint
+from .fingerprint import FINGERPRINTS, RTOL, episode_key, fingerprint, paired
 
 __all__ = ["BLOCKS", "compare_digests", "digest", "digests", "path", "stored_digests", "write_digests"]
 
@@ -67,14 +67,9 @@ def write_digests(version: str, episodes: list[dict[str, Any]], seeds: int = 1) 
 
 def compare_digests(fresh: list[dict[str, Any]], reference: list[dict[str, Any]], rtol: float = RTOL) -> list[str]:
     """The differences between two digests, one line each (empty: the same)."""
-    key = lambda r: tuple(r[k] for k in _KEY)           # noqa: E731
-    ref = {key(r): r for r in reference}
-    out = [f"{k}: not in the fresh run" for k in ref if k not in {key(r) for r in fresh}]
-    for r in fresh:
-        old = ref.get(key(r))
-        if old is None:
-            out.append(f"{key(r)}: not in the stored digest")
-            continue
+    key = episode_key
+    out, pairs = paired(fresh, reference, "digest")
+    for r, old in pairs:
         if r["steps"] != old["steps"]:
             out.append(f"{key(r)} steps: {r['steps']} against {old['steps']}")
             continue
